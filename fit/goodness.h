@@ -29,8 +29,10 @@ typedef struct phc_goodness {
 
 /* y: observations, yhat: model values, sigma: per-point standard deviations
  * (NULL = unweighted), n >= 1.  PHC_ERR_INVALID for n = 0 or a sigma <= 0 or
- * non-finite input.  Quantities that are undefined (r2 when all y are equal)
- * are NAN. */
+ * non-finite input (then every field but n and k is NAN).  Quantities that
+ * are undefined are NAN: r2 and nse when all y are equal, reduced_chi2 when
+ * n <= k, aicc when n <= k + 2, and log_likelihood, aic, aicc, bic for a
+ * perfect fit (wrss = 0: the ML scale is 0 and the likelihood unbounded). */
 int phc_goodness_compute(const double *y, const double *yhat,
                          const double *sigma, size_t n, size_t k,
                          phc_goodness *out);

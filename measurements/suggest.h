@@ -4,7 +4,9 @@
 
 #include <stddef.h>
 
-/* Levenshtein edit distance between two strings, byte-wise, case-sensitive. */
+/* Levenshtein edit distance between two strings, byte-wise, case-sensitive.
+ * NULL counts as "".  Returns SIZE_MAX if memory for a long string (over 63
+ * bytes) cannot be had, so that phc_suggest then offers nothing. */
 size_t phc_edit_distance(const char *a, const char *b);
 
 /* The candidate nearest to `word` by edit distance (ties: the first), or NULL

@@ -11,7 +11,13 @@
  * double quotes (RFC 4180, "" inside quotes is a quote).  Lines whose first
  * non-blank character is '#' and blank lines are skipped.  Leading and
  * trailing blanks of unquoted fields are trimmed.  A UTF-8 byte-order mark is
- * ignored.  CRLF line ends are accepted. */
+ * ignored.  CRLF line ends are accepted (and lone CR).
+ *
+ * Details the rules above leave open: a quoted field may span lines (its
+ * line breaks are stored as '\n'; the row's line is where it starts); a '"'
+ * inside an unquoted field is kept literally (3" long); text after a closing
+ * quote other than blanks and the delimiter is an error; a delimiter at the
+ * end of a line starts one more (empty) field; a NUL byte is an error. */
 #ifndef PHC_TABLE_H
 #define PHC_TABLE_H
 

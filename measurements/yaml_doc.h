@@ -3,8 +3,9 @@
  *
  * Built on libyaml.  Only the YAML subset a configuration needs: block and
  * flow mappings and sequences, plain and quoted scalars, comments.  Anchors
- * and aliases are accepted (an alias node is a copy of its anchor).  Tags are
- * ignored.  Duplicate keys in one mapping are an error. */
+ * and aliases are accepted (an alias node is a copy of its anchor, keeping the
+ * anchor's positions; expansion is capped at 10^6 nodes and nesting at 256
+ * levels).  Tags are ignored.  Duplicate keys in one mapping are an error. */
 #ifndef PHC_YAML_DOC_H
 #define PHC_YAML_DOC_H
 
@@ -33,7 +34,8 @@ struct phc_yaml_node {
 
 typedef struct phc_yaml_doc {
     char *path;                 /* as given to phc_yaml_load */
-    phc_yaml_node *root;        /* NULL for an empty document */
+    phc_yaml_node *root;        /* NULL for an empty document (including "---"
+                                   with nothing after it) */
 } phc_yaml_doc;
 
 /* Loads the first document of a file.  Syntax errors are PHC_ERR_INPUT:
@@ -63,7 +65,11 @@ int phc_yaml_check_keys(const phc_yaml_doc *doc, const phc_yaml_node *map,
  * the _required variant is used.  Type errors are PHC_ERR_INPUT:
  *   "FILE:LINE:COL: key 'lower': expected a number, found 'abc'".
  * Numbers: finite doubles in C or YAML syntax (.inf/.nan are rejected).
- * Integers: whole numbers within long range.  Booleans: true/false/yes/no/on/off. */
+ * Integers: whole numbers within long range (1e3 and 100.0 count).
+ * Booleans: true/false/yes/no/on/off, any case.
+ * The scalar's text is read whether or not it was quoted ("2.5" is 2.5).  A
+ * YAML null (an empty value, ~, null) is a type error for every accessor,
+ * strings included: it is a value the user left empty, not an absent key. */
 int phc_yaml_number(const phc_yaml_doc *doc, const phc_yaml_node *node,
                     const char *key, double *out, phc_error *err);
 int phc_yaml_integer(const phc_yaml_doc *doc, const phc_yaml_node *node,
@@ -75,7 +81,9 @@ int phc_yaml_string(const phc_yaml_doc *doc, const phc_yaml_node *node,
                     const char *key, const char **out, phc_error *err);
 
 /* The same, for `key` looked up in `map`; if the key is missing and
- * `required` is non-zero: PHC_ERR_INPUT "FILE:LINE: <context>: missing key 'KEY'". */
+ * `required` is non-zero: PHC_ERR_INPUT "FILE:LINE: <context>: missing key 'KEY'"
+ * (LINE is the mapping's; "FILE: <context>: ..." when map is NULL).  A map
+ * that is not a mapping is PHC_ERR_INPUT even for an optional key. */
 int phc_yaml_map_number(const phc_yaml_doc *doc, const phc_yaml_node *map,
                         const char *key, int required, const char *context,
                         double *out, phc_error *err);

@@ -11,6 +11,10 @@
 
 #include <stddef.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* X-macro list: name, short description.  Order fixes the numeric codes. */
 #define PHC_STATUS_LIST(X)                                                  \
     X(PHC_OK, "success")                                                    \
@@ -53,5 +57,9 @@ int phc_error_set(phc_error *err, int status, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* PHC_STATUS_H */

@@ -1,0 +1,596 @@
+// The only file of phytocal that touches Ceres Solver: see ceres_bridge.h.
+//
+// Every extern "C" function catches all exceptions and returns an error
+// code, and every size and index is validated before Ceres sees it (Ceres
+// CHECK failures abort the process).
+
+#include "fit/ceres_bridge.h"
+
+#include <ceres/ceres.h>
+#include <ceres/dynamic_numeric_diff_cost_function.h>
+#include <glog/logging.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Parameter {
+    double lower = -INFINITY;
+    double upper = INFINITY;
+    double scale = 1.0;
+    bool fixed = false;
+};
+
+struct Block {
+    size_t m = 0;
+    std::vector<size_t> index;  // global parameter indices
+    phc_residual_fn fn = nullptr;
+    phc_derivatives derivs = PHC_DERIV_ANALYTIC;
+    phc_loss_kind loss = PHC_LOSS_NONE;
+    double loss_scale = 1.0;
+    void *user_data = nullptr;
+};
+
+// Shared by all cost functions of one solve: a fatal callback error stops it.
+struct SolveState {
+    std::atomic<bool> fatal{false};
+    std::atomic<int> fatal_code{0};
+};
+
+// Maps the block's scaled parameters u to physical x = u * scale.
+static void unscale(const Block &b, const std::vector<Parameter> &params,
+                    double const *const *u, double *x)
+{
+    for (size_t j = 0; j < b.index.size(); ++j)
+        x[j] = u[j][0] * params[b.index[j]].scale;
+}
+
+static bool all_finite(const double *v, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!std::isfinite(v[i]))
+            return false;
+    return true;
+}
+
+// Calls the user's callback; false (step rejected) for a domain failure or
+// non-finite output, and records fatal errors in the solve state.
+static bool call_block(const Block &b, const double *x, double *r, double *jac,
+                       SolveState *state)
+{
+    if (state && state->fatal.load())
+        return false;
+    const int rc = b.fn(x, r, jac, b.user_data);
+    if (rc < 0) {
+        if (state) {
+            state->fatal_code.store(rc);
+            state->fatal.store(true);
+        }
+        return false;
+    }
+    if (rc > 0)
+        return false;
+    if (!all_finite(r, b.m))
+        return false;
+    if (jac && !all_finite(jac, b.m * b.index.size()))
+        return false;
+    return true;
+}
+
+// A block with analytic derivatives, in scaled coordinates.
+class AnalyticCost final : public ceres::CostFunction {
+  public:
+    AnalyticCost(const Block &b, const std::vector<Parameter> &params, SolveState *state)
+        : b_(b), params_(params), state_(state)
+    {
+        set_num_residuals(static_cast<int>(b.m));
+        for (size_t j = 0; j < b.index.size(); ++j)
+            mutable_parameter_block_sizes()->push_back(1);
+    }
+
+    bool Evaluate(double const *const *u, double *residuals, double **jacobians) const override
+    {
+        const size_t k = b_.index.size();
+        std::vector<double> x(k);
+        unscale(b_, params_, u, x.data());
+        std::vector<double> jac;
+        if (jacobians)
+            jac.assign(b_.m * k, 0.0);
+        if (!call_block(b_, x.data(), residuals, jacobians ? jac.data() : nullptr, state_))
+            return false;
+        if (jacobians) {
+            // d r / d u_j = d r / d x_j * scale_j; Ceres wants per-block m x 1.
+            for (size_t j = 0; j < k; ++j) {
+                if (!jacobians[j])
+                    continue;
+                const double s = params_[b_.index[j]].scale;
+                for (size_t i = 0; i < b_.m; ++i)
+                    jacobians[j][i] = jac[i * k + j] * s;
+            }
+        }
+        return true;
+    }
+
+  private:
+    const Block &b_;
+    const std::vector<Parameter> &params_;
+    SolveState *state_;
+};
+
+// Residuals only, for Ceres's numerical differentiation.
+class ResidualFunctor {
+  public:
+    ResidualFunctor(const Block &b, const std::vector<Parameter> &params, SolveState *state)
+        : b_(b), params_(params), state_(state) {}
+
+    bool operator()(double const *const *u, double *residuals) const
+    {
+        std::vector<double> x(b_.index.size());
+        unscale(b_, params_, u, x.data());
+        return call_block(b_, x.data(), residuals, nullptr, state_);
+    }
+
+  private:
+    const Block &b_;
+    const std::vector<Parameter> &params_;
+    SolveState *state_;
+};
+
+static std::unique_ptr<ceres::CostFunction>
+make_block_cost(const Block &b, const std::vector<Parameter> &params, SolveState *state)
+{
+    if (b.derivs == PHC_DERIV_ANALYTIC)
+        return std::make_unique<AnalyticCost>(b, params, state);
+    ceres::NumericDiffOptions nd;
+    std::unique_ptr<ceres::DynamicCostFunction> cost;
+    if (b.derivs == PHC_DERIV_RIDDERS) {
+        cost = std::make_unique<ceres::DynamicNumericDiffCostFunction<ResidualFunctor, ceres::RIDDERS>>(
+            new ResidualFunctor(b, params, state), ceres::TAKE_OWNERSHIP, nd);
+    } else {
+        // Optimal central step for double precision is about eps^(1/3) ~ 6e-6
+        // relative; the scaled parameters are O(1).
+        nd.relative_step_size = 6e-6;
+        cost = std::make_unique<ceres::DynamicNumericDiffCostFunction<ResidualFunctor, ceres::CENTRAL>>(
+            new ResidualFunctor(b, params, state), ceres::TAKE_OWNERSHIP, nd);
+    }
+    for (size_t j = 0; j < b.index.size(); ++j)
+        cost->AddParameterBlock(1);
+    cost->SetNumResiduals(static_cast<int>(b.m));
+    return cost;
+}
+
+// Robust losses act on each residual, but Ceres applies a loss to a residual
+// block's squared norm.  So a data set with a loss becomes m one-residual
+// blocks that share one evaluation of the data set through this cache (the
+// model is evaluated once per parameter vector, not m times).
+class SharedEvaluation {
+  public:
+    SharedEvaluation(ceres::CostFunction *inner, size_t m, size_t k)
+        : inner_(inner), m_(m), k_(k), key_(k), r_(m), jac_(m * k) {}
+
+    bool Get(double const *const *u, size_t row, double *residual, double **jacobians)
+    {
+        std::lock_guard<std::mutex> lock(mutex_);
+        bool same = has_r_;
+        for (size_t j = 0; same && j < k_; ++j)
+            same = (key_[j] == u[j][0]);
+        const bool need_jac = jacobians != nullptr;
+        if (!same || (need_jac && !has_j_)) {
+            has_r_ = has_j_ = false;
+            std::vector<double *> cols;
+            if (need_jac) {
+                cols.resize(k_);
+                for (size_t j = 0; j < k_; ++j)
+                    cols[j] = jac_.data() + j * m_;  // block j: m x 1
+            }
+            if (!inner_->Evaluate(u, r_.data(), need_jac ? cols.data() : nullptr))
+                return false;
+            for (size_t j = 0; j < k_; ++j)
+                key_[j] = u[j][0];
+            has_r_ = true;
+            has_j_ = need_jac;
+        }
+        *residual = r_[row];
+        if (need_jac)
+            for (size_t j = 0; j < k_; ++j)
+                if (jacobians[j])
+                    jacobians[j][0] = jac_[j * m_ + row];
+        return true;
+    }
+
+  private:
+    ceres::CostFunction *inner_;
+    size_t m_, k_;
+    std::mutex mutex_;
+    std::vector<double> key_, r_, jac_;
+    bool has_r_ = false, has_j_ = false;
+};
+
+class PointView final : public ceres::CostFunction {
+  public:
+    PointView(SharedEvaluation *shared, size_t row, size_t k) : shared_(shared), row_(row)
+    {
+        set_num_residuals(1);
+        for (size_t j = 0; j < k; ++j)
+            mutable_parameter_block_sizes()->push_back(1);
+    }
+    bool Evaluate(double const *const *u, double *residuals, double **jacobians) const override
+    {
+        return shared_->Get(u, row_, residuals, jacobians);
+    }
+
+  private:
+    SharedEvaluation *shared_;
+    size_t row_;
+};
+
+static std::unique_ptr<ceres::LossFunction> make_loss(phc_loss_kind kind, double a)
+{
+    switch (kind) {
+    case PHC_LOSS_HUBER: return std::make_unique<ceres::HuberLoss>(a);
+    case PHC_LOSS_CAUCHY: return std::make_unique<ceres::CauchyLoss>(a);
+    case PHC_LOSS_SOFT_L1: return std::make_unique<ceres::SoftLOneLoss>(a);
+    // Ceres's ArctanLoss(b) is b atan(s / b) with b in units of s = r^2.
+    case PHC_LOSS_ARCTAN: return std::make_unique<ceres::ArctanLoss>(a * a);
+    case PHC_LOSS_NONE: break;
+    }
+    return nullptr;
+}
+
+class AbortOnFatal final : public ceres::IterationCallback {
+  public:
+    explicit AbortOnFatal(const SolveState *state) : state_(state) {}
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary &) override
+    {
+        return state_->fatal.load() ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+    }
+
+  private:
+    const SolveState *state_;
+};
+
+// Everything a ceres::Problem built for one solve points into.
+struct Assembly {
+    std::vector<std::unique_ptr<ceres::CostFunction>> costs;
+    std::vector<std::unique_ptr<ceres::LossFunction>> losses;
+    std::vector<std::unique_ptr<SharedEvaluation>> shared;
+};
+
+static void quiet_glog()
+{
+    // Ceres logs through glog; the library must not print.  Only FATAL
+    // messages (which precede an abort we prevent by validation) remain.
+    static std::once_flag once;
+    std::call_once(once, [] { FLAGS_minloglevel = google::GLOG_FATAL; });
+}
+
+}  // namespace
+
+struct phc_nls {
+    std::vector<Parameter> params;
+    std::vector<Block> blocks;
+    size_t total_residuals = 0;
+};
+
+static int internal_error(phc_error *err, const char *what)
+{
+    return phc_error_set(err, PHC_ERR_INTERNAL, "Ceres bridge: %s", what);
+}
+
+extern "C" phc_nls_options phc_nls_options_default(void)
+{
+    phc_nls_options o;
+    o.max_iterations = 1000;
+    o.function_tolerance = 1e-15;
+    o.gradient_tolerance = 1e-15;
+    o.parameter_tolerance = 1e-15;
+    o.method = PHC_LEVENBERG_MARQUARDT;
+    o.num_threads = 1;
+    return o;
+}
+
+extern "C" phc_nls *phc_nls_new(size_t n_params)
+{
+    try {
+        phc_nls *nls = new phc_nls;
+        nls->params.resize(n_params);
+        return nls;
+    } catch (...) {
+        return nullptr;
+    }
+}
+
+extern "C" void phc_nls_free(phc_nls *nls)
+{
+    delete nls;
+}
+
+extern "C" int phc_nls_set_parameter(phc_nls *nls, size_t index, double lower, double upper,
+                                     int fixed, double scale, phc_error *err)
+{
+    if (!nls)
+        return phc_error_set(err, PHC_ERR_INVALID, "phc_nls_set_parameter: NULL problem");
+    if (index >= nls->params.size())
+        return phc_error_set(err, PHC_ERR_INVALID, "parameter index %zu out of range (%zu parameters)",
+                             index, nls->params.size());
+    if (std::isnan(lower) || std::isnan(upper) || lower > upper || (!fixed && lower == upper))
+        return phc_error_set(err, PHC_ERR_INVALID, "parameter %zu: bounds [%g, %g] are not an interval",
+                             index, lower, upper);
+    if (!(scale > 0) || !std::isfinite(scale))
+        return phc_error_set(err, PHC_ERR_INVALID, "parameter %zu: scale %g must be positive and finite",
+                             index, scale);
+    Parameter &p = nls->params[index];
+    p.lower = lower;
+    p.upper = upper;
+    p.fixed = fixed != 0;
+    p.scale = scale;
+    return PHC_OK;
+}
+
+extern "C" int phc_nls_add_block(phc_nls *nls, size_t m, const size_t *param_index, size_t k,
+                                 phc_residual_fn fn, phc_derivatives derivs, phc_loss_kind loss,
+                                 double loss_scale, void *user_data, phc_error *err)
+{
+    try {
+        if (!nls || !fn || (k > 0 && !param_index))
+            return phc_error_set(err, PHC_ERR_INVALID, "phc_nls_add_block: NULL argument");
+        if (m == 0 || k == 0)
+            return phc_error_set(err, PHC_ERR_INVALID,
+                                 "a residual block needs at least one residual and one parameter (m=%zu, k=%zu)", m, k);
+        if (m > static_cast<size_t>(INT32_MAX) / 2)
+            return phc_error_set(err, PHC_ERR_INVALID, "too many residuals in one block (%zu)", m);
+        for (size_t j = 0; j < k; ++j) {
+            if (param_index[j] >= nls->params.size())
+                return phc_error_set(err, PHC_ERR_INVALID, "block parameter %zu out of range (%zu parameters)",
+                                     param_index[j], nls->params.size());
+            for (size_t i = 0; i < j; ++i)
+                if (param_index[i] == param_index[j])
+                    return phc_error_set(err, PHC_ERR_INVALID, "parameter %zu appears twice in one block",
+                                         param_index[j]);
+        }
+        if (derivs != PHC_DERIV_ANALYTIC && derivs != PHC_DERIV_CENTRAL && derivs != PHC_DERIV_RIDDERS)
+            return phc_error_set(err, PHC_ERR_INVALID, "unknown derivative method %d", (int)derivs);
+        if (loss < PHC_LOSS_NONE || loss > PHC_LOSS_ARCTAN)
+            return phc_error_set(err, PHC_ERR_INVALID, "unknown loss %d", (int)loss);
+        if (loss != PHC_LOSS_NONE && (!(loss_scale > 0) || !std::isfinite(loss_scale)))
+            return phc_error_set(err, PHC_ERR_INVALID, "loss scale %g must be positive and finite", loss_scale);
+        Block b;
+        b.m = m;
+        b.index.assign(param_index, param_index + k);
+        b.fn = fn;
+        b.derivs = derivs;
+        b.loss = loss;
+        b.loss_scale = loss_scale;
+        b.user_data = user_data;
+        nls->blocks.push_back(std::move(b));
+        nls->total_residuals += m;
+        return PHC_OK;
+    } catch (const std::bad_alloc &) {
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory adding a residual block");
+    } catch (...) {
+        return internal_error(err, "exception in phc_nls_add_block");
+    }
+}
+
+extern "C" size_t phc_nls_residual_count(const phc_nls *nls)
+{
+    return nls ? nls->total_residuals : 0;
+}
+
+static int check_point(const phc_nls *nls, const double *x, phc_error *err)
+{
+    for (size_t i = 0; i < nls->params.size(); ++i) {
+        const Parameter &p = nls->params[i];
+        if (!std::isfinite(x[i]))
+            return phc_error_set(err, PHC_ERR_INVALID, "parameter %zu: value %g is not finite", i, x[i]);
+        if (!p.fixed && (x[i] < p.lower || x[i] > p.upper))
+            return phc_error_set(err, PHC_ERR_INVALID, "parameter %zu: value %.17g outside its bounds [%g, %g]",
+                                 i, x[i], p.lower, p.upper);
+    }
+    return PHC_OK;
+}
+
+extern "C" int phc_nls_solve(phc_nls *nls, const phc_nls_options *options, double *x,
+                             phc_nls_summary *summary, phc_error *err)
+{
+    try {
+        if (!nls || !options || !x || !summary)
+            return phc_error_set(err, PHC_ERR_INVALID, "phc_nls_solve: NULL argument");
+        if (nls->blocks.empty())
+            return phc_error_set(err, PHC_ERR_INVALID, "the problem has no residual blocks");
+        if (options->max_iterations < 1 || options->num_threads < 1)
+            return phc_error_set(err, PHC_ERR_INVALID, "max_iterations and num_threads must be at least 1");
+        int rc = check_point(nls, x, err);
+        if (rc)
+            return rc;
+        quiet_glog();
+
+        const size_t n = nls->params.size();
+        std::vector<bool> used(n, false);
+        for (const Block &b : nls->blocks)
+            for (size_t i : b.index)
+                used[i] = true;
+
+        std::vector<double> u(n);
+        for (size_t i = 0; i < n; ++i)
+            u[i] = x[i] / nls->params[i].scale;
+
+        SolveState state;
+        Assembly assembly;
+        ceres::Problem::Options popts;
+        popts.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+        popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+        ceres::Problem problem(popts);
+        for (size_t i = 0; i < n; ++i) {
+            if (!used[i])
+                continue;
+            const Parameter &p = nls->params[i];
+            problem.AddParameterBlock(&u[i], 1);
+            if (p.fixed) {
+                problem.SetParameterBlockConstant(&u[i]);
+                continue;
+            }
+            if (std::isfinite(p.lower))
+                problem.SetParameterLowerBound(&u[i], 0, p.lower / p.scale);
+            if (std::isfinite(p.upper))
+                problem.SetParameterUpperBound(&u[i], 0, p.upper / p.scale);
+        }
+        for (const Block &b : nls->blocks) {
+            std::vector<double *> blocks;
+            for (size_t i : b.index)
+                blocks.push_back(&u[i]);
+            assembly.costs.push_back(make_block_cost(b, nls->params, &state));
+            ceres::CostFunction *whole = assembly.costs.back().get();
+            if (b.loss == PHC_LOSS_NONE) {
+                problem.AddResidualBlock(whole, nullptr, blocks);
+                continue;
+            }
+            assembly.losses.push_back(make_loss(b.loss, b.loss_scale));
+            ceres::LossFunction *loss = assembly.losses.back().get();
+            assembly.shared.push_back(std::make_unique<SharedEvaluation>(whole, b.m, b.index.size()));
+            SharedEvaluation *shared = assembly.shared.back().get();
+            for (size_t row = 0; row < b.m; ++row) {
+                assembly.costs.push_back(std::make_unique<PointView>(shared, row, b.index.size()));
+                problem.AddResidualBlock(assembly.costs.back().get(), loss, blocks);
+            }
+        }
+
+        ceres::Solver::Options o;
+        o.minimizer_type = ceres::TRUST_REGION;
+        o.trust_region_strategy_type =
+            options->method == PHC_DOGLEG ? ceres::DOGLEG : ceres::LEVENBERG_MARQUARDT;
+        o.linear_solver_type = ceres::DENSE_QR;
+        o.max_num_iterations = options->max_iterations;
+        o.function_tolerance = options->function_tolerance;
+        o.gradient_tolerance = options->gradient_tolerance;
+        o.parameter_tolerance = options->parameter_tolerance;
+        o.num_threads = options->num_threads;
+        o.logging_type = ceres::SILENT;
+        o.minimizer_progress_to_stdout = false;
+        AbortOnFatal abort_cb(&state);
+        o.callbacks.push_back(&abort_cb);
+
+        ceres::Solver::Summary s;
+        ceres::Solve(o, &problem, &s);
+
+        std::memset(summary, 0, sizeof *summary);
+        std::snprintf(summary->termination, sizeof summary->termination, "%s", s.message.c_str());
+        summary->iterations = s.num_successful_steps + s.num_unsuccessful_steps;
+        summary->initial_cost = s.initial_cost;
+        summary->final_cost = s.final_cost;
+        summary->residual_evaluations = s.num_residual_evaluations;
+        summary->jacobian_evaluations = s.num_jacobian_evaluations;
+        summary->wall_time = s.total_time_in_seconds;
+        switch (s.termination_type) {
+        case ceres::CONVERGENCE:
+        case ceres::USER_SUCCESS: summary->outcome = PHC_NLS_CONVERGED; break;
+        case ceres::NO_CONVERGENCE: summary->outcome = PHC_NLS_NOT_CONVERGED; break;
+        default: summary->outcome = PHC_NLS_FAILED; break;
+        }
+        if (state.fatal.load())
+            return phc_error_set(err, PHC_ERR_NUMERIC,
+                                 "a residual callback failed fatally (code %d); the solve was stopped",
+                                 state.fatal_code.load());
+        if (!s.IsSolutionUsable()) {
+            summary->outcome = PHC_NLS_FAILED;
+            return PHC_OK;  // x keeps the start
+        }
+        for (size_t i = 0; i < n; ++i)
+            if (used[i] && !nls->params[i].fixed)
+                x[i] = u[i] * nls->params[i].scale;
+        return PHC_OK;
+    } catch (const std::bad_alloc &) {
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory in the solver");
+    } catch (const std::exception &e) {
+        return internal_error(err, e.what());
+    } catch (...) {
+        return internal_error(err, "unknown exception in phc_nls_solve");
+    }
+}
+
+extern "C" int phc_nls_evaluate(phc_nls *nls, const double *x, double *residuals, double *jacobian,
+                                double *cost, phc_error *err)
+{
+    try {
+        if (!nls || !x)
+            return phc_error_set(err, PHC_ERR_INVALID, "phc_nls_evaluate: NULL argument");
+        for (size_t i = 0; i < nls->params.size(); ++i)
+            if (!std::isfinite(x[i]))
+                return phc_error_set(err, PHC_ERR_INVALID, "parameter %zu: value %g is not finite", i, x[i]);
+        const size_t n = nls->params.size();
+        if (jacobian)
+            std::fill(jacobian, jacobian + nls->total_residuals * n, 0.0);
+        double total_cost = 0.0;
+        size_t row0 = 0;
+        for (const Block &b : nls->blocks) {
+            const size_t k = b.index.size();
+            std::vector<double> xb(k), r(b.m), jac(jacobian ? b.m * k : 0);
+            for (size_t j = 0; j < k; ++j)
+                xb[j] = x[b.index[j]];
+            if (!call_block(b, xb.data(), r.data(), nullptr, nullptr))
+                return phc_error_set(err, PHC_ERR_DOMAIN,
+                                     "residual block %zu cannot be evaluated at these parameters",
+                                     static_cast<size_t>(&b - nls->blocks.data()));
+            if (jacobian) {
+                if (b.derivs == PHC_DERIV_ANALYTIC) {
+                    std::vector<double> r2(b.m);
+                    if (!call_block(b, xb.data(), r2.data(), jac.data(), nullptr))
+                        return phc_error_set(err, PHC_ERR_DOMAIN, "Jacobian of block %zu cannot be evaluated",
+                                             static_cast<size_t>(&b - nls->blocks.data()));
+                } else {
+                    std::unique_ptr<ceres::CostFunction> c = make_block_cost(b, nls->params, nullptr);
+                    std::vector<double> u(k), r2(b.m), cols(b.m * k);
+                    std::vector<const double *> up(k);
+                    std::vector<double *> jp(k);
+                    for (size_t j = 0; j < k; ++j) {
+                        u[j] = xb[j] / nls->params[b.index[j]].scale;
+                        up[j] = &u[j];
+                        jp[j] = cols.data() + j * b.m;
+                    }
+                    if (!c->Evaluate(up.data(), r2.data(), jp.data()))
+                        return phc_error_set(err, PHC_ERR_DOMAIN,
+                                             "numerical Jacobian of block %zu cannot be evaluated",
+                                             static_cast<size_t>(&b - nls->blocks.data()));
+                    for (size_t j = 0; j < k; ++j)
+                        for (size_t i = 0; i < b.m; ++i)
+                            jac[i * k + j] = cols[j * b.m + i] / nls->params[b.index[j]].scale;
+                }
+                for (size_t i = 0; i < b.m; ++i)
+                    for (size_t j = 0; j < k; ++j)
+                        jacobian[(row0 + i) * n + b.index[j]] = jac[i * k + j];
+            }
+            std::unique_ptr<ceres::LossFunction> loss = make_loss(b.loss, b.loss_scale);
+            for (size_t i = 0; i < b.m; ++i) {
+                const double s = r[i] * r[i];
+                double rho[3] = {s, 1.0, 0.0};
+                if (loss)
+                    loss->Evaluate(s, rho);
+                total_cost += 0.5 * rho[0];
+                if (residuals)
+                    residuals[row0 + i] = r[i];
+            }
+            row0 += b.m;
+        }
+        if (cost)
+            *cost = total_cost;
+        return PHC_OK;
+    } catch (const std::bad_alloc &) {
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory evaluating the problem");
+    } catch (const std::exception &e) {
+        return internal_error(err, e.what());
+    } catch (...) {
+        return internal_error(err, "unknown exception in phc_nls_evaluate");
+    }
+}
+
+extern "C" const char *phc_nls_version(void)
+{
+    return CERES_VERSION_STRING;
+}

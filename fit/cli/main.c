@@ -1,0 +1,341 @@
+/* The phytocal command (DESIGN.md §4).  The only place that prints.
+ *
+ *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal simulate CONFIG.yaml [-o DIR] [--force]
+ *   phytocal report DIR/result.json [--strict] [--level L]
+ *   phytocal version
+ *
+ * Exit codes: 0 success; 1 usage; 2 bad input; 3 the fit did not converge or
+ * (with --strict) a report check failed; 4 internal error. */
+#include <errno.h>
+#include <gsl/gsl_errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "fit/ceres_bridge.h"
+#include "fit/config.h"
+#include "fit/fit.h"
+#include "fit/plots.h"
+#include "fit/report.h"
+#include "fit/result_json.h"
+#include "fit/run_dir.h"
+
+#ifndef PHC_VERSION
+#define PHC_VERSION "dev"
+#endif
+
+enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2, EXIT_FIT = 3, EXIT_INTERNAL = 4 };
+
+static void usage(FILE *out)
+{
+    fprintf(out, "usage:\n"
+                 "  phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]\n"
+                 "  phytocal simulate CONFIG.yaml [-o DIR] [--force]\n"
+                 "  phytocal report DIR/result.json [--strict] [--level L]\n"
+                 "  phytocal version\n");
+}
+
+static int exit_code_for(int status)
+{
+    switch (status) {
+    case PHC_OK: return EXIT_OK;
+    case PHC_ERR_INPUT:
+    case PHC_ERR_IO:
+    case PHC_ERR_EXISTS:
+    case PHC_ERR_DOMAIN:
+    case PHC_ERR_INVALID: return EXIT_INPUT;
+    case PHC_ERR_NOT_CONVERGED: return EXIT_FIT;
+    default: return EXIT_INTERNAL;
+    }
+}
+
+static int fail(const phc_error *err)
+{
+    fprintf(stderr, "phytocal: %s\n", err->message[0] ? err->message : phc_strerror(err->status));
+    return exit_code_for(err->status);
+}
+
+typedef struct cli_options {
+    const char *input;
+    const char *out_dir;
+    int force, quiet, strict;
+    double level;
+} cli_options;
+
+/* Parses the arguments after the command; returns -1 on a usage error. */
+static int parse_args(int argc, char **argv, cli_options *o, const char *allowed)
+{
+    memset(o, 0, sizeof *o);
+    o->level = -1;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if ((strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) && strchr(allowed, 'o')) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "phytocal: %s needs a directory\n", a);
+                return -1;
+            }
+            o->out_dir = argv[++i];
+        } else if (strcmp(a, "--force") == 0 && strchr(allowed, 'f')) {
+            o->force = 1;
+        } else if (strcmp(a, "--quiet") == 0 && strchr(allowed, 'q')) {
+            o->quiet = 1;
+        } else if (strcmp(a, "--strict") == 0 && strchr(allowed, 's')) {
+            o->strict = 1;
+        } else if (strcmp(a, "--level") == 0 && strchr(allowed, 'l')) {
+            char *end = NULL;
+            if (i + 1 >= argc || (o->level = strtod(argv[++i], &end), *end != '\0') || !(o->level > 0 && o->level < 1)) {
+                fprintf(stderr, "phytocal: --level needs a number between 0 and 1\n");
+                return -1;
+            }
+        } else if (a[0] == '-' && a[1] != '\0') {
+            fprintf(stderr, "phytocal: unknown option '%s'\n", a);
+            return -1;
+        } else if (!o->input) {
+            o->input = a;
+        } else {
+            fprintf(stderr, "phytocal: unexpected argument '%s'\n", a);
+            return -1;
+        }
+    }
+    if (!o->input) {
+        fprintf(stderr, "phytocal: missing input file\n");
+        return -1;
+    }
+    return 0;
+}
+
+/* Progress: a bar on a terminal, plain lines otherwise. */
+static int progress_cb(const char *stage, double fraction, void *user_data)
+{
+    const int tty = *(const int *)user_data;
+    if (tty) {
+        const int width = 30, done = (int)(fraction * width + 0.5);
+        fprintf(stderr, "\r%-12s [", stage);
+        for (int i = 0; i < width; ++i)
+            fputc(i < done ? '#' : ' ', stderr);
+        fprintf(stderr, "] %3d%%", (int)(fraction * 100 + 0.5));
+        if (fraction >= 1.0)
+            fputc('\n', stderr);
+    } else {
+        fprintf(stderr, "%s: %3d%%\n", stage, (int)(fraction * 100 + 0.5));
+    }
+    fflush(stderr);
+    return 0;
+}
+
+static void default_dir(const phc_problem *pb, char *buf, size_t size)
+{
+    snprintf(buf, size, "runs/%s", pb->name);
+}
+
+static int cmd_fit(int argc, char **argv)
+{
+    cli_options o;
+    if (parse_args(argc, argv, &o, "ofq") != 0) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    phc_error err;
+    phc_error_clear(&err);
+    phc_problem *pb = NULL;
+    if (phc_config_load(o.input, &pb, &err))
+        return fail(&err);
+    char dir[4096];
+    if (o.out_dir)
+        snprintf(dir, sizeof dir, "%s", o.out_dir);
+    else
+        default_dir(pb, dir, sizeof dir);
+    if (phc_run_dir_check(dir, o.force, &err)) {
+        phc_problem_free(pb);
+        return fail(&err);
+    }
+    int tty = isatty(STDERR_FILENO);
+    phc_fit_result *res = NULL;
+    int rc = phc_fit_run(pb, o.quiet ? NULL : progress_cb, &tty, &res, &err);
+    phc_problem_free(pb);
+    if (rc)
+        return fail(&err);
+    if ((rc = phc_run_dir_write(res, dir, o.force, &err))) {
+        phc_fit_result_free(res);
+        return fail(&err);
+    }
+    if (!o.quiet) {
+        phc_report_print_summary(res, stdout);
+        printf("results: %s/ (result.json, report.md, plots)\n", dir);
+    }
+    const int converged = res->summary.outcome == PHC_NLS_CONVERGED;
+    phc_fit_result_free(res);
+    if (!converged) {
+        fprintf(stderr, "phytocal: the fit did not converge; results written to %s for inspection\n", dir);
+        return EXIT_FIT;
+    }
+    return EXIT_OK;
+}
+
+/* simulate: each data set's model at the configured parameter values, as a
+ * CSV (x, observed, model) and a plot, in a run directory. */
+static int cmd_simulate(int argc, char **argv)
+{
+    cli_options o;
+    if (parse_args(argc, argv, &o, "of") != 0) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    phc_error err;
+    phc_error_clear(&err);
+    phc_problem *pb = NULL;
+    if (phc_config_load(o.input, &pb, &err))
+        return fail(&err);
+    char dir[4096], tmpdir[4096 + 16], path[8192];
+    if (o.out_dir)
+        snprintf(dir, sizeof dir, "%s", o.out_dir);
+    else
+        snprintf(dir, sizeof dir, "runs/%s-simulation", pb->name);
+    int rc = EXIT_OK;
+    if (phc_run_dir_check(dir, o.force, &err)) {
+        phc_problem_free(pb);
+        return fail(&err);
+    }
+    snprintf(tmpdir, sizeof tmpdir, "%s.tmp-XXXXXX", dir);
+    if (!mkdtemp(tmpdir)) {
+        fprintf(stderr, "phytocal: %s: cannot create directory: %s\n", tmpdir, strerror(errno));
+        phc_problem_free(pb);
+        return EXIT_INPUT;
+    }
+    for (size_t d = 0; d < pb->n_datasets && rc == EXIT_OK; ++d) {
+        phc_dataset *ds = pb->datasets[d];
+        double *p = calloc(ds->k, sizeof *p), *yhat = calloc(ds->n, sizeof *yhat);
+        if (!p || !yhat) {
+            rc = EXIT_INTERNAL;
+        } else {
+            for (size_t j = 0; j < ds->k; ++j)
+                p[j] = pb->params[ds->param_index[j]].value;
+            if (ds->ops->predict(ds, p, yhat, NULL) != 0) {
+                fprintf(stderr, "phytocal: data set '%s': the model cannot be evaluated at the start values\n",
+                        ds->name);
+                rc = EXIT_INPUT;
+            } else {
+                snprintf(path, sizeof path, "%s/%s_simulated.csv", tmpdir, ds->name);
+                FILE *f = fopen(path, "w");
+                if (!f) {
+                    fprintf(stderr, "phytocal: %s: cannot write\n", path);
+                    rc = EXIT_INPUT;
+                } else {
+                    fprintf(f, "x,observed,model\n");
+                    for (size_t i = 0; i < ds->n; ++i)
+                        fprintf(f, "%.17g,%.17g,%.17g\n", ds->x[i], ds->y[i], yhat[i]);
+                    if (fclose(f) != 0)
+                        rc = EXIT_INPUT;
+                }
+                char title[256];
+                snprintf(title, sizeof title, "%s: model at the start values", ds->name);
+                phc_plot_labels lab = {title, ds->x_label, ds->y_label};
+                snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, ds->name);
+                if (rc == EXIT_OK && phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, ds->x, yhat, ds->n, &err))
+                    rc = fail(&err);
+            }
+        }
+        free(p);
+        free(yhat);
+    }
+    if (rc == EXIT_OK) {
+        struct stat st;
+        if (stat(dir, &st) == 0) {
+            char cmd_old[8192];
+            snprintf(cmd_old, sizeof cmd_old, "%s.old", dir);
+            if (rename(dir, cmd_old) == 0) {
+                if (rename(tmpdir, dir) != 0) {
+                    rename(cmd_old, dir);
+                    rc = EXIT_INPUT;
+                } else {
+                    /* remove the replaced run's files */
+                    char sub[8192 + 256];
+                    for (size_t d = 0; d < pb->n_datasets; ++d) {
+                        snprintf(sub, sizeof sub, "%s/%s_simulated.csv", cmd_old, pb->datasets[d]->name);
+                        unlink(sub);
+                        snprintf(sub, sizeof sub, "%s/%s_simulated.png", cmd_old, pb->datasets[d]->name);
+                        unlink(sub);
+                    }
+                    rmdir(cmd_old);
+                }
+            } else {
+                rc = EXIT_INPUT;
+            }
+        } else if (rename(tmpdir, dir) != 0) {
+            rc = EXIT_INPUT;
+        }
+        if (rc == EXIT_OK)
+            printf("simulated %zu data set%s: %s/\n", pb->n_datasets, pb->n_datasets == 1 ? "" : "s", dir);
+        else
+            fprintf(stderr, "phytocal: %s: cannot move the simulation into place\n", dir);
+    }
+    if (rc != EXIT_OK) {
+        for (size_t d = 0; d < pb->n_datasets; ++d) {
+            snprintf(path, sizeof path, "%s/%s_simulated.csv", tmpdir, pb->datasets[d]->name);
+            unlink(path);
+            snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, pb->datasets[d]->name);
+            unlink(path);
+        }
+        rmdir(tmpdir);
+    }
+    phc_problem_free(pb);
+    return rc;
+}
+
+static int cmd_report(int argc, char **argv)
+{
+    cli_options o;
+    if (parse_args(argc, argv, &o, "sl") != 0) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    phc_error err;
+    phc_error_clear(&err);
+    phc_fit_result *res = NULL;
+    if (phc_result_read_json(o.input, &res, &err))
+        return fail(&err);
+    if (o.level > 0 && phc_fit_recheck(res, o.level, &err)) {
+        phc_fit_result_free(res);
+        return fail(&err);
+    }
+    phc_report_print_summary(res, stdout);
+    int rc = EXIT_OK;
+    if (o.strict && !phc_report_all_passed(res)) {
+        fprintf(stderr, "phytocal: --strict: %zu check%s failed\n", res->n_warnings, res->n_warnings == 1 ? "" : "s");
+        rc = EXIT_FIT;
+    }
+    phc_fit_result_free(res);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    /* GSL's default error handler aborts; the library checks its inputs and
+     * reports errors itself. */
+    gsl_set_error_handler_off();
+    if (argc < 2) {
+        usage(stderr);
+        return EXIT_USAGE;
+    }
+    const char *cmd = argv[1];
+    if (strcmp(cmd, "fit") == 0)
+        return cmd_fit(argc - 2, argv + 2);
+    if (strcmp(cmd, "simulate") == 0)
+        return cmd_simulate(argc - 2, argv + 2);
+    if (strcmp(cmd, "report") == 0)
+        return cmd_report(argc - 2, argv + 2);
+    if (strcmp(cmd, "version") == 0) {
+        printf("phytocal %s (Ceres Solver %s)\n", PHC_VERSION, phc_nls_version());
+        return EXIT_OK;
+    }
+    if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0 || strcmp(cmd, "help") == 0) {
+        usage(stdout);
+        return EXIT_OK;
+    }
+    fprintf(stderr, "phytocal: unknown command '%s'\n", cmd);
+    usage(stderr);
+    return EXIT_USAGE;
+}

@@ -1,0 +1,431 @@
+/* YAML configuration -> calibration problem: see config.h. */
+#include "fit/config.h"
+
+#include <libgen.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/costs/curve.h"
+#include "measurements/suggest.h"
+#include "measurements/yaml_doc.h"
+
+/* The data-set kinds this build knows. */
+typedef int (*kind_loader)(const phc_yaml_doc *doc, const phc_yaml_node *node,
+                           const char *base_dir, phc_is_parameter_fn is_parameter,
+                           void *user_data, phc_dataset **out, phc_error *err);
+typedef struct kind_entry {
+    const char *kind;
+    const char *const *keys;
+    kind_loader load;
+} kind_entry;
+
+static const kind_entry kinds[] = {
+    {"curve", phc_curve_keys, phc_curve_load},
+};
+#define N_KINDS (sizeof kinds / sizeof kinds[0])
+
+static const char *const common_dataset_keys[] = {"kind", "name", "parameters", "loss",
+                                                  "loss_scale", "derivatives", NULL};
+static const char *const top_keys[] = {"name", "parameters", "datasets", "solver", "report", NULL};
+static const char *const parameter_keys[] = {"value", "lower", "upper", "fixed", "unit",
+                                             "scale", "range", NULL};
+static const char *const solver_keys[] = {"method", "max_iterations", "function_tolerance",
+                                          "gradient_tolerance", "parameter_tolerance",
+                                          "threads", "starts", NULL};
+static const char *const report_keys[] = {"level", "absolute_sigma", "collinearity_threshold",
+                                          "correlation_threshold", NULL};
+
+static int expect_kind(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_yaml_kind kind,
+                       const char *what, phc_error *err)
+{
+    static const char *names[] = {"a scalar", "a sequence", "a mapping"};
+    if (node && node->kind == kind)
+        return PHC_OK;
+    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu:%zu: %s: expected %s, found %s", doc->path,
+                         node ? node->line : 1, node ? node->column : 1, what, names[kind],
+                         node ? names[node->kind] : "nothing");
+}
+
+static int parse_parameter(const phc_yaml_doc *doc, phc_problem *pb, const char *name,
+                           const phc_yaml_node *spec, size_t key_line, phc_error *err)
+{
+    char ctx[160];
+    snprintf(ctx, sizeof ctx, "parameter '%s'", name);
+    double value = NAN;
+    int rc;
+    if (spec->kind == PHC_YAML_SCALAR) {
+        if ((rc = phc_yaml_number(doc, spec, name, &value, err)))
+            return rc;
+    } else {
+        if ((rc = expect_kind(doc, spec, PHC_YAML_MAPPING, ctx, err)) ||
+            (rc = phc_yaml_check_keys(doc, spec, parameter_keys, ctx, err)) ||
+            (rc = phc_yaml_map_number(doc, spec, "value", 1, ctx, &value, err)))
+            return rc;
+    }
+    size_t index;
+    if ((rc = phc_problem_add_parameter(pb, name, value, &index, err))) {
+        if (rc == PHC_ERR_INPUT) /* duplicate: give the place */
+            return phc_error_set(err, rc, "%s:%zu: parameter '%s' is defined twice", doc->path, key_line, name);
+        return rc;
+    }
+    phc_parameter *p = &pb->params[index];
+    if (spec->kind == PHC_YAML_SCALAR)
+        return PHC_OK;
+    const char *unit = NULL;
+    if ((rc = phc_yaml_map_number(doc, spec, "lower", 0, ctx, &p->lower, err)) ||
+        (rc = phc_yaml_map_number(doc, spec, "upper", 0, ctx, &p->upper, err)) ||
+        (rc = phc_yaml_map_boolean(doc, spec, "fixed", 0, ctx, &p->fixed, err)) ||
+        (rc = phc_yaml_map_number(doc, spec, "scale", 0, ctx, &p->scale, err)) ||
+        (rc = phc_yaml_map_string(doc, spec, "unit", 0, ctx, &unit, err)))
+        return rc;
+    if (unit && !(p->unit = strdup(unit)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (p->lower > p->upper)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: lower bound %g is above upper bound %g",
+                             doc->path, spec->line, ctx, p->lower, p->upper);
+    if (p->value < p->lower || p->value > p->upper)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: start value %g is outside its bounds [%g, %g]",
+                             doc->path, spec->line, ctx, p->value, p->lower, p->upper);
+    const phc_yaml_node *scale = phc_yaml_get(spec, "scale");
+    if (scale && !(p->scale > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: scale must be positive, found %g",
+                             doc->path, scale->line, ctx, p->scale);
+    const phc_yaml_node *range = phc_yaml_get(spec, "range");
+    if (range) {
+        if (range->kind != PHC_YAML_SEQUENCE || range->count != 2)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: range: expected [low, high]",
+                                 doc->path, range->line, ctx);
+        if ((rc = phc_yaml_number(doc, range->items[0], "range", &p->range_lo, err)) ||
+            (rc = phc_yaml_number(doc, range->items[1], "range", &p->range_hi, err)))
+            return rc;
+        if (!(p->range_lo < p->range_hi))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: range [%g, %g] is empty",
+                                 doc->path, range->line, ctx, p->range_lo, p->range_hi);
+    }
+    return PHC_OK;
+}
+
+static int parse_solver(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_fit_options *o,
+                        phc_error *err)
+{
+    const char *ctx = "solver";
+    int rc;
+    if ((rc = expect_kind(doc, node, PHC_YAML_MAPPING, ctx, err)) ||
+        (rc = phc_yaml_check_keys(doc, node, solver_keys, ctx, err)))
+        return rc;
+    const char *method = NULL;
+    long max_it = o->nls.max_iterations, threads = o->nls.num_threads, starts = (long)o->starts;
+    if ((rc = phc_yaml_map_string(doc, node, "method", 0, ctx, &method, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "max_iterations", 0, ctx, &max_it, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "threads", 0, ctx, &threads, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "starts", 0, ctx, &starts, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "function_tolerance", 0, ctx, &o->nls.function_tolerance, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "gradient_tolerance", 0, ctx, &o->nls.gradient_tolerance, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "parameter_tolerance", 0, ctx, &o->nls.parameter_tolerance, err)))
+        return rc;
+    if (method) {
+        if (strcmp(method, "levenberg_marquardt") == 0)
+            o->nls.method = PHC_LEVENBERG_MARQUARDT;
+        else if (strcmp(method, "dogleg") == 0)
+            o->nls.method = PHC_DOGLEG;
+        else
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: solver.method: expected levenberg_marquardt or dogleg, found '%s'",
+                                 doc->path, phc_yaml_get(node, "method")->line, method);
+    }
+    if (max_it < 1 || max_it > 1000000 || threads < 1 || threads > 256 || starts < 1 || starts > 100000)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s:%zu: solver: max_iterations (1..1e6), threads (1..256) and starts (1..1e5) "
+                             "must be positive whole numbers in range", doc->path, node->line);
+    if (!(o->nls.function_tolerance >= 0) || !(o->nls.gradient_tolerance >= 0) ||
+        !(o->nls.parameter_tolerance >= 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: solver: tolerances must not be negative",
+                             doc->path, node->line);
+    o->nls.max_iterations = (int)max_it;
+    o->nls.num_threads = (int)threads;
+    o->starts = (size_t)starts;
+    return PHC_OK;
+}
+
+static int parse_report(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_fit_options *o,
+                        phc_error *err)
+{
+    const char *ctx = "report";
+    int rc;
+    if ((rc = expect_kind(doc, node, PHC_YAML_MAPPING, ctx, err)) ||
+        (rc = phc_yaml_check_keys(doc, node, report_keys, ctx, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "level", 0, ctx, &o->level, err)) ||
+        (rc = phc_yaml_map_boolean(doc, node, "absolute_sigma", 0, ctx, &o->absolute_sigma, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "collinearity_threshold", 0, ctx, &o->collinearity_threshold, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "correlation_threshold", 0, ctx, &o->correlation_threshold, err)))
+        return rc;
+    if (!(o->level > 0 && o->level < 1))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: report.level must be in (0, 1), found %g",
+                             doc->path, node->line, o->level);
+    if (!(o->collinearity_threshold > 1) || !(o->correlation_threshold > 0 && o->correlation_threshold <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s:%zu: report: collinearity_threshold must exceed 1 and correlation_threshold be in (0, 1]",
+                             doc->path, node->line);
+    return PHC_OK;
+}
+
+/* Context for deciding which expression names are parameters. */
+typedef struct binding_ctx {
+    const phc_problem *pb;
+    const phc_yaml_node *binding; /* the data set's `parameters:` mapping or NULL */
+} binding_ctx;
+
+static int is_parameter(const char *name, void *user_data)
+{
+    const binding_ctx *b = user_data;
+    if (b->binding && phc_yaml_get(b->binding, name))
+        return 1;
+    return phc_problem_find_parameter(b->pb, name) >= 0;
+}
+
+static int bind_slots(const phc_yaml_doc *doc, const phc_yaml_node *binding, phc_problem *pb,
+                      phc_dataset *ds, size_t line, phc_error *err)
+{
+    int rc;
+    for (size_t j = 0; j < ds->k; ++j) {
+        const char *global = ds->slot_names[j];
+        const phc_yaml_node *b = binding ? phc_yaml_get(binding, global) : NULL;
+        size_t where = line;
+        if (b) {
+            if ((rc = phc_yaml_string(doc, b, global, &global, err)))
+                return rc;
+            where = b->line;
+        }
+        long idx = phc_problem_find_parameter(pb, global);
+        if (idx < 0) {
+            const char **names = malloc((pb->n_params + 1) * sizeof *names);
+            if (!names)
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            for (size_t i = 0; i < pb->n_params; ++i)
+                names[i] = pb->params[i].name;
+            const char *near = phc_suggest(global, names, pb->n_params);
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: data set '%s': slot '%s' is bound to '%s', which is not under parameters:%s%s%s",
+                               doc->path, where, ds->name, ds->slot_names[j], global,
+                               near ? " did you mean '" : "", near ? near : "", near ? "'?" : "");
+            free(names);
+            return rc;
+        }
+        for (size_t i = 0; i < j; ++i)
+            if (ds->param_index[i] == (size_t)idx)
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s:%zu: data set '%s': slots '%s' and '%s' are bound to the same parameter '%s'",
+                                     doc->path, where, ds->name, ds->slot_names[i], ds->slot_names[j], global);
+        ds->param_index[j] = (size_t)idx;
+    }
+    /* Binding keys that name no slot are mistakes (typos) too. */
+    for (size_t i = 0; binding && i < binding->count; ++i) {
+        int found = 0;
+        for (size_t j = 0; j < ds->k && !found; ++j)
+            found = strcmp(binding->keys[i], ds->slot_names[j]) == 0;
+        if (!found)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: data set '%s': binding '%s' names no parameter slot of this data set%s%s%s",
+                                 doc->path, binding->key_lines[i], ds->name, binding->keys[i],
+                                 ds->k ? " (slots: " : "", ds->k ? ds->slot_names[0] : "", ds->k ? ", ...)" : "");
+    }
+    return PHC_OK;
+}
+
+static int parse_loss(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_dataset *ds,
+                      const char *ctx, phc_error *err)
+{
+    static const char *names[] = {"none", "huber", "cauchy", "soft_l1", "arctan"};
+    const char *loss = NULL;
+    int rc;
+    if ((rc = phc_yaml_map_string(doc, node, "loss", 0, ctx, &loss, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "loss_scale", 0, ctx, &ds->loss_scale, err)))
+        return rc;
+    if (loss) {
+        size_t i;
+        for (i = 0; i < 5; ++i)
+            if (strcmp(loss, names[i]) == 0)
+                break;
+        if (i == 5) {
+            const char *near = phc_suggest(loss, names, 5);
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: %s: loss '%s' is not one of none, huber, cauchy, soft_l1, arctan%s%s%s",
+                                 doc->path, phc_yaml_get(node, "loss")->line, ctx, loss,
+                                 near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "");
+        }
+        ds->loss = (phc_loss_kind)i;
+    }
+    if (!(ds->loss_scale > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: loss_scale must be positive, found %g",
+                             doc->path, node->line, ctx, ds->loss_scale);
+    const char *derivs = NULL;
+    if ((rc = phc_yaml_map_string(doc, node, "derivatives", 0, ctx, &derivs, err)))
+        return rc;
+    if (derivs) {
+        if (strcmp(derivs, "central") == 0)
+            ds->derivatives = PHC_DERIV_CENTRAL;
+        else if (strcmp(derivs, "ridders") == 0)
+            ds->derivatives = PHC_DERIV_RIDDERS;
+        else if (strcmp(derivs, "analytic") == 0 && ds->derivatives == PHC_DERIV_ANALYTIC)
+            ; /* the kind provides them */
+        else
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: %s: derivatives '%s': expected central or ridders%s",
+                                 doc->path, phc_yaml_get(node, "derivatives")->line, ctx, derivs,
+                                 ds->derivatives == PHC_DERIV_ANALYTIC ? " or analytic" : "");
+    }
+    return PHC_OK;
+}
+
+static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, size_t index,
+                         const char *base_dir, phc_problem *pb, phc_error *err)
+{
+    char ctx[96];
+    snprintf(ctx, sizeof ctx, "data set %zu", index + 1);
+    int rc;
+    if ((rc = expect_kind(doc, node, PHC_YAML_MAPPING, ctx, err)))
+        return rc;
+    const char *kind = NULL, *name = NULL;
+    if ((rc = phc_yaml_map_string(doc, node, "kind", 1, ctx, &kind, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "name", 0, ctx, &name, err)))
+        return rc;
+    const kind_entry *entry = NULL;
+    const char *kind_names[N_KINDS];
+    for (size_t i = 0; i < N_KINDS; ++i) {
+        kind_names[i] = kinds[i].kind;
+        if (strcmp(kinds[i].kind, kind) == 0)
+            entry = &kinds[i];
+    }
+    if (!entry) {
+        const char *near = phc_suggest(kind, kind_names, N_KINDS);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: unknown kind '%s'%s%s%s (known: curve)",
+                             doc->path, phc_yaml_get(node, "kind")->line, ctx, kind,
+                             near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "");
+    }
+    /* Allowed keys: the common ones and the kind's own. */
+    const char *allowed[64];
+    size_t na = 0;
+    for (size_t i = 0; common_dataset_keys[i] && na < 63; ++i)
+        allowed[na++] = common_dataset_keys[i];
+    for (size_t i = 0; entry->keys[i] && na < 63; ++i)
+        allowed[na++] = entry->keys[i];
+    allowed[na] = NULL;
+    if ((rc = phc_yaml_check_keys(doc, node, allowed, ctx, err)))
+        return rc;
+    const phc_yaml_node *binding = phc_yaml_get(node, "parameters");
+    if (binding && (rc = expect_kind(doc, binding, PHC_YAML_MAPPING, "parameters of a data set", err)))
+        return rc;
+
+    binding_ctx bctx = {pb, binding};
+    phc_dataset *ds = NULL;
+    if ((rc = entry->load(doc, node, base_dir, is_parameter, &bctx, &ds, err)))
+        return rc;
+    char fallback[64];
+    snprintf(fallback, sizeof fallback, "%s-%zu", kind, index + 1);
+    ds->name = strdup(name ? name : fallback);
+    if (!ds->name) {
+        phc_dataset_free(ds);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    for (size_t d = 0; d < pb->n_datasets; ++d)
+        if (strcmp(pb->datasets[d]->name, ds->name) == 0) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: data set name '%s' is used twice",
+                               doc->path, node->line, ds->name);
+            phc_dataset_free(ds);
+            return rc;
+        }
+    if ((rc = bind_slots(doc, binding, pb, ds, node->line, err)) ||
+        (rc = parse_loss(doc, node, ds, ctx, err))) {
+        phc_dataset_free(ds);
+        return rc;
+    }
+    return phc_problem_add_dataset(pb, ds, err);
+}
+
+static char *stem_of(const char *path)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    char *s = strdup(base);
+    if (!s)
+        return NULL;
+    char *dot = strrchr(s, '.');
+    if (dot && dot != s)
+        *dot = '\0';
+    return s;
+}
+
+int phc_config_load(const char *path, phc_problem **out, phc_error *err)
+{
+    phc_yaml_doc *doc = NULL;
+    phc_problem *pb = NULL;
+    char *dir_copy = NULL, *stem = NULL;
+    int rc;
+    *out = NULL;
+    if ((rc = phc_yaml_load(path, &doc, err)))
+        return rc;
+    const phc_yaml_node *root = doc->root;
+    if (!root) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: the configuration is empty", path);
+        goto fail;
+    }
+    if ((rc = expect_kind(doc, root, PHC_YAML_MAPPING, "configuration", err)) ||
+        (rc = phc_yaml_check_keys(doc, root, top_keys, "the configuration", err)))
+        goto fail;
+    const char *name = NULL;
+    if ((rc = phc_yaml_map_string(doc, root, "name", 0, "configuration", &name, err)))
+        goto fail;
+    stem = stem_of(path);
+    pb = phc_problem_new(name ? name : stem);
+    dir_copy = strdup(path);
+    if (!pb || !stem || !dir_copy || !(pb->source = strdup(path))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    const char *base_dir = dirname(dir_copy);
+
+    const phc_yaml_node *params = phc_yaml_get(root, "parameters");
+    if (!params) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: missing key 'parameters'", path, root->line);
+        goto fail;
+    }
+    if ((rc = expect_kind(doc, params, PHC_YAML_MAPPING, "parameters", err)))
+        goto fail;
+    for (size_t i = 0; i < params->count; ++i)
+        if ((rc = parse_parameter(doc, pb, params->keys[i], params->values[i], params->key_lines[i], err)))
+            goto fail;
+
+    const phc_yaml_node *solver = phc_yaml_get(root, "solver");
+    if (solver && (rc = parse_solver(doc, solver, &pb->options, err)))
+        goto fail;
+    const phc_yaml_node *report = phc_yaml_get(root, "report");
+    if (report && (rc = parse_report(doc, report, &pb->options, err)))
+        goto fail;
+
+    const phc_yaml_node *datasets = phc_yaml_get(root, "datasets");
+    if (!datasets) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: missing key 'datasets'", path, root->line);
+        goto fail;
+    }
+    if ((rc = expect_kind(doc, datasets, PHC_YAML_SEQUENCE, "datasets", err)))
+        goto fail;
+    if (datasets->count == 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: datasets: the list is empty", path, datasets->line);
+        goto fail;
+    }
+    for (size_t i = 0; i < datasets->count; ++i)
+        if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, err)))
+            goto fail;
+    if ((rc = phc_problem_validate(pb, err)))
+        goto fail;
+    *out = pb;
+    pb = NULL;
+fail:
+    phc_problem_free(pb);
+    phc_yaml_free(doc);
+    free(dir_copy);
+    free(stem);
+    return rc;
+}

@@ -1,0 +1,333 @@
+/* `curve` data sets through muparser's C API: see curve.h.
+ *
+ * muparser's bulk mode offsets every variable by the row index, including
+ * scalar parameters (checked with muparser 2.3.3), so rows are evaluated one
+ * at a time with scalar variables; the expression's byte code is compiled
+ * once and reused. */
+#include "fit/costs/curve.h"
+
+#include <math.h>
+#include <muParserDLL.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "measurements/suggest.h"
+#include "measurements/table.h"
+
+const char *const phc_curve_keys[] = {"file", "x", "y", "expression", "sigma",
+                                      "x_label", "y_label", NULL};
+
+typedef struct curve_impl {
+    muParserHandle_t parser;
+    size_t n_cols;        /* columns used by the expression */
+    double **cols;        /* n_cols arrays of n values */
+    double *row;          /* n_cols current values (muparser variables) */
+    double *slots;        /* k current parameter values (muparser variables) */
+    long x_col;           /* index into cols of the x column, -1 if unused */
+    int other_cols;       /* expression uses columns other than x */
+} curve_impl;
+
+static void curve_free(void *p)
+{
+    curve_impl *c = p;
+    if (!c)
+        return;
+    if (c->parser)
+        mupRelease(c->parser);
+    for (size_t j = 0; j < c->n_cols; ++j)
+        free(c->cols[j]);
+    free(c->cols);
+    free(c->row);
+    free(c->slots);
+    free(c);
+}
+
+static int curve_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    curve_impl *c = ds->impl;
+    (void)jac; /* numerical derivatives only */
+    memcpy(c->slots, p, ds->k * sizeof *p);
+    for (size_t i = 0; i < ds->n; ++i) {
+        for (size_t j = 0; j < c->n_cols; ++j)
+            c->row[j] = c->cols[j][i];
+        yhat[i] = mupEval(c->parser);
+        if (mupError(c->parser)) {
+            mupErrorReset(c->parser);
+            return -1;
+        }
+        if (!isfinite(yhat[i]))
+            return 1; /* outside the expression's domain: reject the step */
+    }
+    return 0;
+}
+
+static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
+                            size_t m, double *y)
+{
+    curve_impl *c = ds->impl;
+    if (c->other_cols)
+        return 1; /* depends on more than x: no single curve */
+    memcpy(c->slots, p, ds->k * sizeof *p);
+    for (size_t i = 0; i < m; ++i) {
+        if (c->x_col >= 0)
+            c->row[c->x_col] = x[i];
+        y[i] = mupEval(c->parser);
+        if (mupError(c->parser)) {
+            mupErrorReset(c->parser);
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free};
+
+static char *join_path(const char *dir, const char *file)
+{
+    if (file[0] == '/' || !dir || !dir[0])
+        return strdup(file);
+    size_t len = strlen(dir) + strlen(file) + 2;
+    char *s = malloc(len);
+    if (s)
+        snprintf(s, len, "%s/%s", dir, file);
+    return s;
+}
+
+/* A column name that is not in the table: name the columns that are. */
+static int unknown_column(const phc_yaml_doc *doc, size_t line, const char *what,
+                          const char *name, const phc_table *t, phc_error *err)
+{
+    size_t nc = phc_table_columns(t);
+    const char *names[64];
+    size_t shown = nc < 64 ? nc : 64;
+    char list[512] = "";
+    for (size_t j = 0; j < shown; ++j) {
+        names[j] = phc_table_column_name(t, j);
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s'%s'", j ? ", " : "", names[j]);
+    }
+    const char *near = phc_suggest(name, names, shown);
+    if (near)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s '%s' is not a column of %s; did you mean '%s'?",
+                             doc->path, line, what, name, phc_table_source(t), near);
+    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s '%s' is not a column of %s (columns: %s)",
+                         doc->path, line, what, name, phc_table_source(t), list);
+}
+
+static size_t key_line(const phc_yaml_node *map, const char *key)
+{
+    for (size_t i = 0; i < map->count; ++i)
+        if (strcmp(map->keys[i], key) == 0)
+            return map->key_lines[i];
+    return map->line;
+}
+
+static char *label_or(const char *given, const char *fallback)
+{
+    return strdup(given ? given : fallback);
+}
+
+int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
+                   const char *base_dir, phc_is_parameter_fn is_parameter,
+                   void *user_data, phc_dataset **out, phc_error *err)
+{
+    const char *file = NULL, *xname = NULL, *yname = NULL, *expr = NULL;
+    const char *x_label = NULL, *y_label = NULL;
+    const char *ctx = "curve data set";
+    phc_table *table = NULL;
+    phc_dataset *ds = NULL;
+    curve_impl *c = NULL;
+    char *path = NULL;
+    char **slot_names = NULL;
+    size_t n_slots = 0;
+    int rc;
+
+    *out = NULL;
+    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "x", 1, ctx, &xname, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "y", 1, ctx, &yname, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "expression", 1, ctx, &expr, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
+        return rc;
+
+    path = join_path(base_dir, file);
+    if (!path)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if ((rc = phc_table_read(path, &table, err)))
+        goto fail;
+    if (phc_table_rows(table) == 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
+        goto fail;
+    }
+
+    c = calloc(1, sizeof *c);
+    if (!c) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    c->x_col = -1;
+    c->parser = mupCreate(muBASETYPE_FLOAT);
+    if (!c->parser) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "cannot create an expression parser");
+        goto fail;
+    }
+    mupDefineConst(c->parser, "pi", 3.14159265358979323846);
+    mupSetExpr(c->parser, expr);
+    int n_vars = mupGetExprVarNum(c->parser);
+    if (mupError(c->parser)) {
+        const size_t line = key_line(node, "expression");
+        const int pos = (int)mupGetErrorPos(c->parser);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)",
+                           doc->path, line, expr, mupGetErrorMsg(c->parser), pos + 1);
+        goto fail;
+    }
+    if (n_vars <= 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
+                           doc->path, key_line(node, "expression"), expr);
+        goto fail;
+    }
+
+    /* Split the expression's names into parameter slots and columns. */
+    slot_names = calloc((size_t)n_vars, sizeof *slot_names);
+    c->cols = calloc((size_t)n_vars, sizeof *c->cols);
+    c->row = calloc((size_t)n_vars, sizeof *c->row);
+    c->slots = calloc((size_t)n_vars, sizeof *c->slots);
+    if (!slot_names || !c->cols || !c->row || !c->slots) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    char **var_names = calloc((size_t)n_vars, sizeof *var_names);
+    if (!var_names) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (int v = 0; v < n_vars; ++v) {
+        const char *name = NULL;
+        double *ptr = NULL;
+        mupGetExprVar(c->parser, (unsigned)v, &name, &ptr);
+        var_names[v] = strdup(name ? name : "");
+    }
+    rc = PHC_OK;
+    for (int v = 0; v < n_vars && !rc; ++v) {
+        const char *name = var_names[v];
+        const int is_param = is_parameter(name, user_data);
+        const long col = phc_table_find(table, name);
+        const size_t line = key_line(node, "expression");
+        if (is_param && col >= 0) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: expression name '%s' is both a parameter and a column of %s; rename one",
+                               doc->path, line, name, path);
+        } else if (is_param) {
+            slot_names[n_slots] = strdup(name);
+            if (!slot_names[n_slots])
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            else
+                mupDefineVar(c->parser, name, &c->slots[n_slots++]);
+        } else if (col >= 0) {
+            rc = phc_table_column_numbers(table, name, &c->cols[c->n_cols], err);
+            if (!rc) {
+                if (strcmp(name, xname) == 0)
+                    c->x_col = (long)c->n_cols;
+                else
+                    c->other_cols = 1;
+                mupDefineVar(c->parser, name, &c->row[c->n_cols++]);
+            }
+        } else {
+            rc = unknown_column(doc, line, "expression name", name, table, err);
+            if (rc == PHC_ERR_INPUT)
+                strncat(err->message, " (not a parameter either)",
+                        sizeof err->message - strlen(err->message) - 1);
+        }
+    }
+    for (int v = 0; v < n_vars; ++v)
+        free(var_names[v]);
+    free(var_names);
+    if (rc)
+        goto fail;
+    if (n_slots == 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
+                           doc->path, key_line(node, "expression"), expr);
+        goto fail;
+    }
+
+    ds = phc_dataset_new(&curve_ops, n_slots);
+    if (!ds) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t j = 0; j < n_slots; ++j) {
+        ds->slot_names[j] = slot_names[j];
+        slot_names[j] = NULL;
+    }
+    ds->n = phc_table_rows(table);
+    if (phc_table_find(table, xname) < 0) {
+        rc = unknown_column(doc, key_line(node, "x"), "x", xname, table, err);
+        goto fail;
+    }
+    if (phc_table_find(table, yname) < 0) {
+        rc = unknown_column(doc, key_line(node, "y"), "y", yname, table, err);
+        goto fail;
+    }
+    if ((rc = phc_table_column_numbers(table, xname, &ds->x, err)) ||
+        (rc = phc_table_column_numbers(table, yname, &ds->y, err)))
+        goto fail;
+
+    const phc_yaml_node *sig = phc_yaml_get(node, "sigma");
+    if (sig) {
+        double s = 0;
+        if (sig->kind == PHC_YAML_SCALAR && phc_table_find(table, sig->scalar) >= 0) {
+            if ((rc = phc_table_column_numbers(table, sig->scalar, &ds->sigma, err)))
+                goto fail;
+            for (size_t i = 0; i < ds->n; ++i)
+                if (!(ds->sigma[i] > 0)) {
+                    rc = phc_error_set(err, PHC_ERR_INPUT,
+                                       "%s:%zu: column '%s': sigma must be positive, found %g",
+                                       path, phc_table_row_line(table, i), sig->scalar, ds->sigma[i]);
+                    goto fail;
+                }
+        } else {
+            if ((rc = phc_yaml_number(doc, sig, "sigma", &s, err))) {
+                snprintf(err->message, sizeof err->message,
+                         "%s:%zu: key 'sigma': expected a positive number or a column of %s, found '%s'",
+                         doc->path, sig->line, path, sig->kind == PHC_YAML_SCALAR ? sig->scalar : "(not a scalar)");
+                goto fail;
+            }
+            if (!(s > 0)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': must be positive, found %g",
+                                   doc->path, sig->line, s);
+                goto fail;
+            }
+            ds->sigma = malloc(ds->n * sizeof *ds->sigma);
+            if (!ds->sigma) {
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                goto fail;
+            }
+            for (size_t i = 0; i < ds->n; ++i)
+                ds->sigma[i] = s;
+        }
+    }
+    ds->x_label = label_or(x_label, xname);
+    ds->y_label = label_or(y_label, yname);
+    if (!ds->x_label || !ds->y_label) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    ds->impl = c;
+    c = NULL;
+    ds->config_line = node->line;
+    *out = ds;
+    ds = NULL;
+    rc = PHC_OK;
+fail:
+    if (slot_names)
+        for (size_t j = 0; j < n_slots; ++j)
+            free(slot_names[j]);
+    free(slot_names);
+    phc_dataset_free(ds);
+    curve_free(c);
+    phc_table_free(table);
+    free(path);
+    return rc;
+}

@@ -1,0 +1,56 @@
+/* A data set: observations, the model that predicts them, and how its
+ * parameter slots are bound to the problem's global parameters.
+ *
+ * Every kind (curve, weight_curve, ...) implements phc_dataset_ops.  The fit
+ * engine sees only weighted residuals r_i = (y_i - yhat_i) / sigma_i and
+ * their Jacobian; the report sees observations, predictions and x. */
+#ifndef PHC_DATASET_H
+#define PHC_DATASET_H
+
+#include <stddef.h>
+
+#include "fit/ceres_bridge.h"
+#include "model/status.h"
+
+typedef struct phc_dataset phc_dataset;
+
+typedef struct phc_dataset_ops {
+    const char *kind; /* "curve", ... */
+    /* Model values yhat[0..n-1] at the slot values p[0..k-1]; jac (n x k
+     * row-major d yhat / d p) when non-NULL and the kind has analytic
+     * derivatives.  Same return convention as phc_residual_fn (0 / >0 / <0). */
+    int (*predict)(phc_dataset *ds, const double *p, double *yhat, double *jac);
+    /* Model values at arbitrary x (for the fitted-curve plot); NULL when the
+     * kind has no single x axis.  Returns 0 on success. */
+    int (*predict_at)(phc_dataset *ds, const double *p, const double *x,
+                      size_t m, double *y);
+    void (*free_impl)(void *impl);
+} phc_dataset_ops;
+
+struct phc_dataset {
+    const phc_dataset_ops *ops;
+    void *impl;                  /* owned by the kind */
+    char *name;                  /* unique within a problem */
+    size_t n;                    /* observations = residuals */
+    size_t k;                    /* parameter slots */
+    char **slot_names;           /* k names as the model calls them */
+    size_t *param_index;         /* k global parameter indices */
+    double *x;                   /* n abscissae for plots and ordering (time, x) */
+    double *y;                   /* n observations */
+    double *sigma;               /* n standard deviations (all > 0); NULL = 1 */
+    char *x_label, *y_label;     /* with units, for plots and tables */
+    phc_derivatives derivatives; /* how the Jacobian is obtained */
+    phc_loss_kind loss;
+    double loss_scale;           /* in units of the weighted residual */
+    size_t config_line;          /* where the data set starts in the config */
+};
+
+/* Allocates an empty data set with k slots (names and indices zeroed). */
+phc_dataset *phc_dataset_new(const phc_dataset_ops *ops, size_t k);
+void phc_dataset_free(phc_dataset *ds); /* accepts NULL; frees impl via ops */
+
+/* The phc_residual_fn that the fit hands to the bridge, with the data set as
+ * user_data: r = (y - yhat)/sigma, d r / d p = -(d yhat / d p)/sigma. */
+int phc_dataset_residuals(const double *p, double *r, double *jac, void *ds);
+
+#endif /* PHC_DATASET_H */

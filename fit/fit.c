@@ -1,0 +1,597 @@
+/* Running a calibration: see fit.h. */
+#include "fit/fit.h"
+
+#include <gsl/gsl_cdf.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/multistart.h"
+#include "fit/residual_checks.h"
+#include "fit/uncertainty.h"
+
+#define CURVE_POINTS 400
+#define MAX_COLLIN_SETS 200000
+
+const char *phc_fit_status_name(phc_nls_outcome outcome)
+{
+    switch (outcome) {
+    case PHC_NLS_CONVERGED: return "converged";
+    case PHC_NLS_NOT_CONVERGED: return "not_converged";
+    default: return "failed";
+    }
+}
+
+static void dataset_result_clear(phc_dataset_result *d)
+{
+    free(d->name);
+    free(d->kind);
+    free(d->x_label);
+    free(d->y_label);
+    free(d->x);
+    free(d->y);
+    free(d->yhat);
+    free(d->residual);
+    free(d->std_residual);
+    free(d->sigma);
+    free(d->curve_x);
+    free(d->curve_y);
+}
+
+void phc_fit_result_free(phc_fit_result *res)
+{
+    if (!res)
+        return;
+    for (size_t i = 0; i < res->n_params; ++i) {
+        free(res->params[i].name);
+        free(res->params[i].unit);
+    }
+    free(res->params);
+    free(res->free_index);
+    free(res->correlation);
+    for (size_t i = 0; i < res->n_undetermined; ++i)
+        free(res->undetermined[i]);
+    free(res->undetermined);
+    phc_sensitivity_clear(&res->sensitivity);
+    for (size_t i = 0; i < res->n_datasets; ++i)
+        dataset_result_clear(&res->datasets[i]);
+    free(res->datasets);
+    for (size_t i = 0; i < res->n_warnings; ++i)
+        free(res->warnings[i]);
+    free(res->warnings);
+    free(res->name);
+    free(res);
+}
+
+static int add_warning(phc_fit_result *res, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static int add_warning(phc_fit_result *res, const char *fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, sizeof buf, fmt, ap);
+    va_end(ap);
+    char **grown = realloc(res->warnings, (res->n_warnings + 1) * sizeof *grown);
+    if (!grown)
+        return PHC_ERR_NOMEM;
+    res->warnings = grown;
+    if (!(res->warnings[res->n_warnings] = strdup(buf)))
+        return PHC_ERR_NOMEM;
+    res->n_warnings++;
+    return PHC_OK;
+}
+
+static double *dup_array(const double *src, size_t n)
+{
+    if (!src || n == 0)
+        return NULL;
+    double *d = malloc(n * sizeof *d);
+    if (d)
+        memcpy(d, src, n * sizeof *d);
+    return d;
+}
+
+/* Stable order by x (residual checks look for structure along x). */
+typedef struct keyed {
+    double x;
+    size_t i;
+} keyed;
+static int by_key(const void *a, const void *b)
+{
+    const keyed *ka = a, *kb = b;
+    if (ka->x < kb->x)
+        return -1;
+    if (ka->x > kb->x)
+        return 1;
+    return (ka->i > kb->i) - (ka->i < kb->i);
+}
+
+static void set_check(phc_check_result *c, const char *name, const char *what, int rc,
+                      double stat, double p, double level)
+{
+    snprintf(c->name, sizeof c->name, "%s", name);
+    snprintf(c->what, sizeof c->what, "%s", what);
+    c->applicable = rc == PHC_OK && isfinite(p);
+    c->statistic = c->applicable ? stat : NAN;
+    c->p_value = c->applicable ? p : NAN;
+    c->pass = !c->applicable || p >= level;
+}
+
+/* Residual checks of one data set.  X: n x kx rows of the weighted Jacobian
+ * in data order (for Durbin–Watson's exact moments), or NULL to keep the
+ * stored Durbin–Watson p-value (recheck from a saved result). */
+static int compute_checks(phc_dataset_result *d, const double *X, size_t kx, double level)
+{
+    const size_t n = d->n;
+    keyed *order = malloc(n * sizeof *order);
+    double *r = malloc(n * sizeof *r);
+    double *Xs = X && kx ? malloc(n * kx * sizeof *Xs) : NULL;
+    double *fitted = malloc(n * sizeof *fitted);
+    if (!order || !r || !fitted || (X && kx && !Xs)) {
+        free(order);
+        free(r);
+        free(Xs);
+        free(fitted);
+        return PHC_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        order[i].x = d->x[i];
+        order[i].i = i;
+    }
+    qsort(order, n, sizeof *order, by_key);
+    for (size_t i = 0; i < n; ++i) {
+        const size_t o = order[i].i;
+        r[i] = d->std_residual[o];
+        fitted[i] = d->yhat[o];
+        if (Xs)
+            memcpy(Xs + i * kx, X + o * kx, kx * sizeof *X);
+    }
+    double stat, p;
+    size_t runs;
+    int rc = phc_check_runs(r, n, &stat, &p, &runs);
+    set_check(&d->checks[PHC_CHECK_RUNS], "runs", "runs of residual signs along x", rc, stat, p, level);
+    if (X || !d->checks[PHC_CHECK_DURBIN_WATSON].applicable) {
+        rc = phc_check_durbin_watson(r, n, Xs, Xs ? kx : 0, &stat, &p);
+    } else {
+        /* keep the stored p-value, recompute the statistic */
+        double num = 0, den = 0;
+        for (size_t i = 0; i < n; ++i) {
+            den += r[i] * r[i];
+            if (i)
+                num += (r[i] - r[i - 1]) * (r[i] - r[i - 1]);
+        }
+        stat = den > 0 ? num / den : NAN;
+        p = d->checks[PHC_CHECK_DURBIN_WATSON].p_value;
+        rc = PHC_OK;
+    }
+    set_check(&d->checks[PHC_CHECK_DURBIN_WATSON], "durbin_watson", "lag-1 serial correlation", rc, stat, p, level);
+    rc = phc_check_ljung_box(r, n, 0, 0, &stat, &p);
+    set_check(&d->checks[PHC_CHECK_LJUNG_BOX], "ljung_box", "serial correlation up to lag 10", rc, stat, p, level);
+    if (n <= 5000) {
+        rc = phc_check_shapiro_wilk(r, n, &stat, &p);
+        set_check(&d->checks[PHC_CHECK_NORMALITY], "shapiro_wilk", "normality of residuals", rc, stat, p, level);
+    } else {
+        rc = phc_check_anderson_darling(r, n, &stat, &p);
+        set_check(&d->checks[PHC_CHECK_NORMALITY], "anderson_darling", "normality of residuals", rc, stat, p, level);
+    }
+    rc = phc_check_breusch_pagan(r, fitted, n, 1, &stat, &p);
+    set_check(&d->checks[PHC_CHECK_BREUSCH_PAGAN], "breusch_pagan", "variance changing with the fitted value",
+              rc, stat, p, level);
+    size_t lags = n > 2 ? (n - 1 < PHC_ACF_MAX_LAG ? n - 1 : PHC_ACF_MAX_LAG) : 0;
+    if (lags > n / 2)
+        lags = n / 2;
+    d->acf_lags = (lags > 0 && phc_check_acf(r, n, lags, d->acf) == PHC_OK) ? lags : 0;
+    free(order);
+    free(r);
+    free(Xs);
+    free(fitted);
+    return PHC_OK;
+}
+
+/* Warnings that make up the verdict. */
+static int build_verdict(phc_fit_result *res)
+{
+    int rc = PHC_OK;
+    for (size_t i = 0; i < res->n_warnings; ++i)
+        free(res->warnings[i]);
+    free(res->warnings);
+    res->warnings = NULL;
+    res->n_warnings = 0;
+    if (res->summary.outcome != PHC_NLS_CONVERGED)
+        rc |= add_warning(res, "the solver did not converge: %s", res->summary.termination);
+    for (size_t i = 0; i < res->n_params; ++i) {
+        const phc_param_result *p = &res->params[i];
+        if (p->at_bound)
+            rc |= add_warning(res, "parameter '%s' ended at its %s bound (%g): its interval is not reliable",
+                              p->name, p->at_bound < 0 ? "lower" : "upper", p->value);
+    }
+    for (size_t i = 0; i < res->n_undetermined; ++i)
+        rc |= add_warning(res, "the data cannot determine the combination %s", res->undetermined[i]);
+    const size_t nf = res->n_free;
+    for (size_t a = 0; a < nf; ++a)
+        for (size_t b = a + 1; b < nf; ++b) {
+            const double c = res->correlation[a * nf + b];
+            if (fabs(c) > res->correlation_threshold)
+                rc |= add_warning(res, "parameters '%s' and '%s' are strongly correlated (r = %.4f)",
+                                  res->params[res->free_index[a]].name, res->params[res->free_index[b]].name, c);
+        }
+    const phc_sensitivity *s = &res->sensitivity;
+    size_t shown = 0;
+    for (size_t i = 0; i < s->n_sets && shown < 3; ++i) {
+        if (!(s->sets[i].gamma > res->collinearity_threshold))
+            break;
+        char names[256] = "";
+        for (size_t a = 0; a < s->sets[i].size; ++a) {
+            size_t used = strlen(names);
+            snprintf(names + used, sizeof names - used, "%s%s", a ? ", " : "",
+                     res->params[res->free_index[s->sets[i].index[a]]].name);
+        }
+        rc |= add_warning(res, "parameters {%s} are collinear (collinearity index %.3g > %g)", names,
+                          s->sets[i].gamma, res->collinearity_threshold);
+        ++shown;
+    }
+    for (size_t d = 0; d < res->n_datasets; ++d)
+        for (size_t c = 0; c < PHC_CHECK_COUNT; ++c) {
+            const phc_check_result *ck = &res->datasets[d].checks[c];
+            if (ck->applicable && !ck->pass)
+                rc |= add_warning(res, "data set '%s': %s check failed (%s, p = %.3g < %g)",
+                                  res->datasets[d].name, ck->name, ck->what, ck->p_value, res->level);
+        }
+    if (res->dof <= 0)
+        rc |= add_warning(res, "no degrees of freedom left (%ld): standard errors are not available", res->dof);
+    return rc ? PHC_ERR_NOMEM : PHC_OK;
+}
+
+int phc_fit_recheck(phc_fit_result *res, double level, phc_error *err)
+{
+    if (!(level > 0 && level < 1))
+        return phc_error_set(err, PHC_ERR_INVALID, "level must be in (0, 1), found %g", level);
+    res->level = level;
+    for (size_t d = 0; d < res->n_datasets; ++d)
+        if (compute_checks(&res->datasets[d], NULL, 0, level))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (build_verdict(res))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
+/* Slot values of a data set from the global parameter vector. */
+static void slot_values(const phc_dataset *ds, const double *x, double *p)
+{
+    for (size_t j = 0; j < ds->k; ++j)
+        p[j] = x[ds->param_index[j]];
+}
+
+static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r_w,
+                               const double *J, size_t n_all, const size_t *free_index,
+                               size_t n_free, double s, double level, phc_dataset_result *d,
+                               phc_error *err)
+{
+    const size_t n = ds->n;
+    double *p = calloc(ds->k, sizeof *p);
+    double *X = NULL;
+    size_t *cols = calloc(n_free ? n_free : 1, sizeof *cols);
+    size_t kx = 0;
+    int rc = PHC_OK;
+    d->name = strdup(ds->name);
+    d->kind = strdup(ds->ops->kind);
+    d->x_label = strdup(ds->x_label ? ds->x_label : "x");
+    d->y_label = strdup(ds->y_label ? ds->y_label : "y");
+    d->n = n;
+    d->x = dup_array(ds->x, n);
+    d->y = dup_array(ds->y, n);
+    d->sigma = dup_array(ds->sigma, n);
+    d->yhat = calloc(n, sizeof *d->yhat);
+    d->residual = calloc(n, sizeof *d->residual);
+    d->std_residual = calloc(n, sizeof *d->std_residual);
+    if (!p || !cols || !d->name || !d->kind || !d->x_label || !d->y_label || !d->x || !d->y ||
+        (ds->sigma && !d->sigma) || !d->yhat || !d->residual || !d->std_residual) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    slot_values(ds, x, p);
+    if (ds->ops->predict(ds, p, d->yhat, NULL) != 0) {
+        rc = phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the model cannot be evaluated at the optimum",
+                           ds->name);
+        goto fail;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        d->residual[i] = d->y[i] - d->yhat[i];
+        d->std_residual[i] = r_w[i] / (s > 0 ? s : 1.0);
+    }
+    /* free parameters this data set depends on: columns of J */
+    for (size_t f = 0; f < n_free; ++f)
+        for (size_t j = 0; j < ds->k; ++j)
+            if (ds->param_index[j] == free_index[f]) {
+                cols[kx++] = free_index[f];
+                break;
+            }
+    d->k = kx;
+    if (phc_goodness_compute(d->y, d->yhat, ds->sigma, n, kx, &d->goodness) != PHC_OK)
+        memset(&d->goodness, 0, sizeof d->goodness);
+    if (kx) {
+        X = malloc(n * kx * sizeof *X);
+        if (!X) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < n; ++i)
+            for (size_t c = 0; c < kx; ++c)
+                X[i * kx + c] = J[i * n_all + cols[c]];
+    }
+    for (size_t c = 0; c < PHC_CHECK_COUNT; ++c)
+        d->checks[c].applicable = 0;
+    if (compute_checks(d, X, kx, level)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (ds->ops->predict_at) {
+        double lo = INFINITY, hi = -INFINITY;
+        for (size_t i = 0; i < n; ++i) {
+            lo = fmin(lo, d->x[i]);
+            hi = fmax(hi, d->x[i]);
+        }
+        d->curve_x = malloc(CURVE_POINTS * sizeof *d->curve_x);
+        d->curve_y = malloc(CURVE_POINTS * sizeof *d->curve_y);
+        if (!d->curve_x || !d->curve_y) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < CURVE_POINTS; ++i)
+            d->curve_x[i] = lo + (hi - lo) * (double)i / (CURVE_POINTS - 1);
+        if (hi > lo && ds->ops->predict_at(ds, p, d->curve_x, CURVE_POINTS, d->curve_y) == 0) {
+            d->curve_n = CURVE_POINTS;
+        } else {
+            free(d->curve_x);
+            free(d->curve_y);
+            d->curve_x = d->curve_y = NULL;
+        }
+    }
+fail:
+    free(p);
+    free(X);
+    free(cols);
+    return rc;
+}
+
+int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
+                phc_fit_result **out, phc_error *err)
+{
+    phc_nls *nls = NULL;
+    phc_fit_result *res = NULL;
+    phc_multistart *ms = NULL;
+    double *x = NULL, *best = NULL, *r = NULL, *J = NULL, *Jf = NULL, *S = NULL;
+    phc_covariance cov = {0};
+    int rc;
+    *out = NULL;
+    if ((rc = phc_problem_validate(pb, err)))
+        return rc;
+    const size_t np = pb->n_params;
+    const phc_fit_options *opt = &pb->options;
+
+    nls = phc_nls_new(np);
+    res = calloc(1, sizeof *res);
+    x = calloc(np, sizeof *x);
+    best = calloc(np, sizeof *best);
+    if (!nls || !res || !x || !best) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < np; ++i) {
+        const phc_parameter *p = &pb->params[i];
+        if ((rc = phc_nls_set_parameter(nls, i, p->lower, p->upper, p->fixed, phc_problem_scale(pb, i), err)))
+            goto fail;
+        x[i] = p->value;
+    }
+    for (size_t d = 0; d < pb->n_datasets; ++d) {
+        phc_dataset *ds = pb->datasets[d];
+        if ((rc = phc_nls_add_block(nls, ds->n, ds->param_index, ds->k, phc_dataset_residuals,
+                                    ds->derivatives, ds->loss, ds->loss_scale, ds, err)))
+            goto fail;
+    }
+
+    /* Start 0 is the configured start; the others come from the Sobol box. */
+    double best_cost = INFINITY;
+    double costs_buf[1];
+    double *costs = opt->starts > 1 ? calloc(opt->starts, sizeof *costs) : costs_buf;
+    if (!costs) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (opt->starts > 1 && !(ms = phc_multistart_new(pb))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_costs;
+    }
+    for (size_t s = 0; s < opt->starts; ++s) {
+        if (progress && progress("fitting", (double)s / (double)opt->starts, user_data)) {
+            rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+            goto fail_costs;
+        }
+        if (s > 0 && (rc = phc_multistart_next(ms, x))) {
+            phc_error_set(err, rc, "cannot draw start %zu", s + 1);
+            goto fail_costs;
+        }
+        phc_nls_summary sum;
+        if ((rc = phc_nls_solve(nls, &opt->nls, x, &sum, err)))
+            goto fail_costs;
+        res->total_time += sum.wall_time;
+        costs[s] = sum.outcome == PHC_NLS_FAILED ? INFINITY : sum.final_cost;
+        const int better = costs[s] < best_cost ||
+                           (s == 0 && !isfinite(best_cost)) ||
+                           (costs[s] == best_cost && res->summary.outcome != PHC_NLS_CONVERGED &&
+                            sum.outcome == PHC_NLS_CONVERGED);
+        if (better) {
+            best_cost = costs[s];
+            memcpy(best, x, np * sizeof *x);
+            res->summary = sum;
+        }
+    }
+    res->starts = opt->starts;
+    for (size_t s = 0; s < opt->starts; ++s)
+        if (isfinite(costs[s]) && costs[s] <= best_cost + 1e-8 * fabs(best_cost) + 1e-300)
+            res->starts_at_best++;
+    if (costs != costs_buf)
+        free(costs);
+    costs = NULL;
+    if (progress)
+        progress("uncertainty", 1.0, user_data);
+
+    /* Everything else is judged at the best point. */
+    const size_t m = phc_nls_residual_count(nls);
+    r = calloc(m, sizeof *r);
+    J = calloc(m * np, sizeof *J);
+    if (!r || !J) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((rc = phc_nls_evaluate(nls, best, r, J, &res->cost, err)))
+        goto fail;
+    res->name = strdup(pb->name);
+    res->n_params = np;
+    res->params = calloc(np, sizeof *res->params);
+    res->free_index = calloc(np, sizeof *res->free_index);
+    res->n_datasets = pb->n_datasets;
+    res->datasets = calloc(pb->n_datasets, sizeof *res->datasets);
+    if (!res->name || !res->params || !res->free_index || !res->datasets) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    res->n_obs = m;
+    for (size_t i = 0; i < np; ++i)
+        if (!pb->params[i].fixed)
+            res->free_index[res->n_free++] = i;
+    const size_t nf = res->n_free;
+    res->dof = (long)m - (long)nf;
+    res->absolute_sigma = opt->absolute_sigma;
+    res->level = opt->level;
+    res->collinearity_threshold = opt->collinearity_threshold;
+    res->correlation_threshold = opt->correlation_threshold;
+    for (size_t i = 0; i < m; ++i)
+        res->wrss += r[i] * r[i];
+    res->s2 = opt->absolute_sigma ? 1.0 : (res->dof > 0 ? res->wrss / (double)res->dof : NAN);
+
+    /* Covariance over the free parameters. */
+    Jf = malloc(m * nf * sizeof *Jf);
+    if (!Jf) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < m; ++i)
+        for (size_t f = 0; f < nf; ++f)
+            Jf[i * nf + f] = J[i * np + res->free_index[f]];
+    const double s2 = isfinite(res->s2) ? res->s2 : 1.0;
+    if ((rc = phc_covariance_compute(Jf, m, nf, s2, 1e-10, &cov, err)))
+        goto fail;
+    res->rank = cov.rank;
+    res->condition = cov.condition;
+    res->correlation = dup_array(cov.correlation, nf * nf);
+    if (!res->correlation) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if (cov.n_null) {
+        const char **names = malloc(nf * sizeof *names);
+        res->undetermined = calloc(cov.n_null, sizeof *res->undetermined);
+        if (!names || !res->undetermined) {
+            free(names);
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (size_t f = 0; f < nf; ++f)
+            names[f] = pb->params[res->free_index[f]].name;
+        for (size_t k = 0; k < cov.n_null; ++k) {
+            char buf[512];
+            phc_covariance_describe_null(&cov, k, names, buf, sizeof buf);
+            res->undetermined[res->n_undetermined++] = strdup(buf);
+        }
+        free(names);
+    }
+    const double t = res->dof > 0 ? gsl_cdf_tdist_Pinv(0.975, (double)res->dof) : NAN;
+    for (size_t i = 0, f = 0; i < np; ++i) {
+        const phc_parameter *p = &pb->params[i];
+        phc_param_result *pr = &res->params[i];
+        pr->name = strdup(p->name);
+        pr->unit = p->unit ? strdup(p->unit) : NULL;
+        if (!pr->name || (p->unit && !pr->unit)) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        pr->start = p->value;
+        pr->value = best[i];
+        pr->fixed = p->fixed;
+        pr->stderr_ = pr->ci_lo = pr->ci_hi = pr->sens_l1 = pr->sens_l2 = NAN;
+        if (p->fixed)
+            continue;
+        pr->stderr_ = res->dof > 0 ? cov.stderr_[f] : NAN;
+        pr->ci_lo = pr->value - t * pr->stderr_;
+        pr->ci_hi = pr->value + t * pr->stderr_;
+        const double tol = 1e-10 * phc_problem_scale(pb, i);
+        if (isfinite(p->lower) && pr->value - p->lower <= tol)
+            pr->at_bound = -1;
+        else if (isfinite(p->upper) && p->upper - pr->value <= tol)
+            pr->at_bound = 1;
+        ++f;
+    }
+
+    /* Normalised sensitivities S_ij = d yhat_i / d p_j * p_j / sigma_i. */
+    S = malloc(m * (nf ? nf : 1) * sizeof *S);
+    if (!S) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    const double s_noise = isfinite(res->s2) && res->s2 > 0 ? sqrt(res->s2) : 1.0;
+    for (size_t d = 0, row = 0; d < pb->n_datasets; ++d) {
+        const phc_dataset *ds = pb->datasets[d];
+        /* residuals are already divided by sigma when sigmas are given */
+        const double extra = ds->sigma && opt->absolute_sigma ? 1.0 : s_noise;
+        for (size_t i = 0; i < ds->n; ++i, ++row)
+            for (size_t f = 0; f < nf; ++f) {
+                const size_t gi = res->free_index[f];
+                const double pj = best[gi] != 0 ? best[gi] : phc_problem_scale(pb, gi);
+                S[row * nf + f] = -Jf[row * nf + f] * pj / extra;
+            }
+    }
+    if (nf && (rc = phc_sensitivity_compute(S, m, nf, MAX_COLLIN_SETS, &res->sensitivity, err)))
+        goto fail;
+    for (size_t f = 0; f < nf; ++f) {
+        res->params[res->free_index[f]].sens_l1 = res->sensitivity.l1[f];
+        res->params[res->free_index[f]].sens_l2 = res->sensitivity.l2[f];
+    }
+
+    /* Per data set: goodness, checks, curves. */
+    for (size_t d = 0, row = 0; d < pb->n_datasets; ++d) {
+        phc_dataset *ds = pb->datasets[d];
+        if ((rc = fill_dataset_result(ds, best, r + row, J + row * np, np, res->free_index, nf,
+                                      opt->absolute_sigma ? 1.0 : s_noise, opt->level, &res->datasets[d], err)))
+            goto fail;
+        for (size_t i = 0; i < ds->n; ++i)
+            res->rss += res->datasets[d].residual[i] * res->datasets[d].residual[i];
+        row += ds->n;
+    }
+    if (build_verdict(res)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    *out = res;
+    res = NULL;
+    rc = PHC_OK;
+    goto fail;
+fail_costs:
+    if (costs != costs_buf)
+        free(costs);
+fail:
+    phc_covariance_clear(&cov);
+    phc_multistart_free(ms);
+    phc_nls_free(nls);
+    phc_fit_result_free(res);
+    free(x);
+    free(best);
+    free(r);
+    free(J);
+    free(Jf);
+    free(S);
+    return rc;
+}

@@ -1,0 +1,64 @@
+/* A calibration problem: named global parameters, data sets bound to them,
+ * and the options of the solve and of the report.  Built from a YAML config
+ * by phc_config_load (config.h) or by hand through this API. */
+#ifndef PHC_PROBLEM_H
+#define PHC_PROBLEM_H
+
+#include <stddef.h>
+
+#include "fit/ceres_bridge.h"
+#include "fit/dataset.h"
+#include "model/status.h"
+
+typedef struct phc_parameter {
+    char *name;
+    double value;        /* start value (physical units) */
+    double lower, upper; /* bounds; -INFINITY / INFINITY when open */
+    int fixed;
+    char *unit;          /* free text for reports, e.g. "g s-1 cm-1"; may be NULL */
+    double scale;        /* typical magnitude; 0 = automatic (|value| or 1) */
+    double range_lo, range_hi; /* multi-start box; NAN = automatic */
+} phc_parameter;
+
+typedef struct phc_fit_options {
+    phc_nls_options nls;   /* solver settings for every start */
+    size_t starts;         /* >= 1; extra starts are Sobol points in the box */
+    int absolute_sigma;    /* 1: sigmas are true standard deviations (s^2 = 1) */
+    double level;          /* significance level of residual checks (0.05) */
+    double collinearity_threshold; /* FME's rule of thumb: 20 */
+    double correlation_threshold;  /* |r| above this is reported (0.95) */
+} phc_fit_options;
+
+phc_fit_options phc_fit_options_default(void);
+
+typedef struct phc_problem {
+    char *name;
+    char *source;                 /* config path, for messages */
+    phc_parameter *params;
+    size_t n_params;
+    phc_dataset **datasets;
+    size_t n_datasets;
+    phc_fit_options options;
+} phc_problem;
+
+phc_problem *phc_problem_new(const char *name);
+void phc_problem_free(phc_problem *pb); /* accepts NULL */
+
+/* Adds a parameter (name copied; unique); returns its index in *index. */
+int phc_problem_add_parameter(phc_problem *pb, const char *name, double value,
+                              size_t *index, phc_error *err);
+/* Index of a parameter by name, or -1. */
+long phc_problem_find_parameter(const phc_problem *pb, const char *name);
+/* Takes ownership of ds (also on failure). */
+int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err);
+
+/* Checks the whole problem before a fit: bounds are intervals, starts inside
+ * them, every parameter used by some data set, at least as many
+ * observations as free parameters, positive sigmas. Messages name the
+ * parameter or data set. */
+int phc_problem_validate(const phc_problem *pb, phc_error *err);
+
+/* The scale used for parameter i (explicit, or |value|, or 1). */
+double phc_problem_scale(const phc_problem *pb, size_t i);
+
+#endif /* PHC_PROBLEM_H */

@@ -1,0 +1,238 @@
+/* The residual report: see report.h. */
+#include "fit/report.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+int phc_report_all_passed(const phc_fit_result *res)
+{
+    return res->n_warnings == 0;
+}
+
+/* %g that prints "—" for NAN and "inf" plainly. */
+static const char *fmt_num(char *buf, size_t size, double v)
+{
+    if (isnan(v))
+        snprintf(buf, size, "—");
+    else
+        snprintf(buf, size, "%.6g", v);
+    return buf;
+}
+
+static const char *fmt_p(char *buf, size_t size, double p)
+{
+    if (isnan(p))
+        snprintf(buf, size, "—");
+    else if (p < 1e-4)
+        snprintf(buf, size, "%.1e", p);
+    else
+        snprintf(buf, size, "%.4f", p);
+    return buf;
+}
+
+static void print_parameters_md(const phc_fit_result *res, FILE *f)
+{
+    char a[32], b[32], c[32], d[32], e[32], g[32];
+    fprintf(f, "| parameter | value | std. error | 95%% interval | unit | note | sensitivity L1 | L2 |\n");
+    fprintf(f, "|---|---:|---:|---|---|---|---:|---:|\n");
+    for (size_t i = 0; i < res->n_params; ++i) {
+        const phc_param_result *p = &res->params[i];
+        const char *note = p->fixed ? "fixed" : p->at_bound < 0 ? "at lower bound" : p->at_bound > 0 ? "at upper bound"
+                                            : isnan(p->stderr_)  ? "not determined"
+                                                                 : "";
+        fprintf(f, "| %s | %s | %s | [%s, %s] | %s | %s | %s | %s |\n", p->name, fmt_num(a, sizeof a, p->value),
+                fmt_num(b, sizeof b, p->stderr_), fmt_num(c, sizeof c, p->ci_lo), fmt_num(d, sizeof d, p->ci_hi),
+                p->unit ? p->unit : "", note, fmt_num(e, sizeof e, p->sens_l1), fmt_num(g, sizeof g, p->sens_l2));
+    }
+}
+
+static void print_checks_md(const phc_dataset_result *d, double level, FILE *f)
+{
+    char a[32], b[32];
+    fprintf(f, "| check | tests for | statistic | p-value | result (level %g) |\n", level);
+    fprintf(f, "|---|---|---:|---:|---|\n");
+    for (size_t c = 0; c < PHC_CHECK_COUNT; ++c) {
+        const phc_check_result *ck = &d->checks[c];
+        fprintf(f, "| %s | %s | %s | %s | %s |\n", ck->name, ck->what, fmt_num(a, sizeof a, ck->statistic),
+                fmt_p(b, sizeof b, ck->p_value), !ck->applicable ? "n/a (too few points)" : ck->pass ? "pass" : "**FAIL**");
+    }
+}
+
+static void print_goodness_md(const phc_dataset_result *d, FILE *f)
+{
+    const phc_goodness *g = &d->goodness;
+    char v[12][32];
+    fprintf(f, "| n | k | RSS | RMSE | MAE | bias | R² | NSE | reduced χ² | AIC | AICc | BIC |\n");
+    fprintf(f, "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    fprintf(f, "| %zu | %zu | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", d->n, d->k,
+            fmt_num(v[0], 32, g->rss), fmt_num(v[1], 32, g->rmse), fmt_num(v[2], 32, g->mae),
+            fmt_num(v[3], 32, g->bias), fmt_num(v[4], 32, g->r2), fmt_num(v[5], 32, g->nse),
+            fmt_num(v[6], 32, g->reduced_chi2), fmt_num(v[7], 32, g->aic), fmt_num(v[8], 32, g->aicc),
+            fmt_num(v[9], 32, g->bic));
+}
+
+int phc_report_write_markdown(const phc_fit_result *res, const char *path, const char *const *plots,
+                              phc_error *err)
+{
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write", tmp);
+    char a[32], b[32];
+    fprintf(f, "# Fit report: %s\n\n", res->name);
+    fprintf(f, "## Verdict\n\n");
+    if (res->n_warnings == 0) {
+        fprintf(f, "**No problems found**: the solver converged, every parameter is determined, no parameter is at "
+                   "a bound, no strong correlation or collinearity, and every residual check passes at level %g.\n\n",
+                res->level);
+    } else {
+        fprintf(f, "**%zu warning%s** — read these before trusting the parameters:\n\n", res->n_warnings,
+                res->n_warnings == 1 ? "" : "s");
+        for (size_t i = 0; i < res->n_warnings; ++i)
+            fprintf(f, "- %s\n", res->warnings[i]);
+        fprintf(f, "\n");
+    }
+    fprintf(f, "## Solver\n\n");
+    fprintf(f, "- status: **%s** (%s)\n", phc_fit_status_name(res->summary.outcome), res->summary.termination);
+    fprintf(f, "- iterations: %d; residual evaluations: %d; Jacobian evaluations: %d\n", res->summary.iterations,
+            res->summary.residual_evaluations, res->summary.jacobian_evaluations);
+    fprintf(f, "- cost: initial %s, final %s (½ Σ ρ(r²) of weighted residuals)\n",
+            fmt_num(a, sizeof a, res->summary.initial_cost), fmt_num(b, sizeof b, res->cost));
+    if (res->starts > 1)
+        fprintf(f, "- starts: %zu (Sobol points in the search box); %zu reached the best cost\n", res->starts,
+                res->starts_at_best);
+    fprintf(f, "- observations: %zu; free parameters: %zu; degrees of freedom: %ld\n", res->n_obs, res->n_free,
+            res->dof);
+    fprintf(f, "- variance factor s² = %s (%s)\n", fmt_num(a, sizeof a, res->s2),
+            res->absolute_sigma ? "sigmas are absolute: s² = 1" : "weighted RSS / dof");
+    fprintf(f, "- wall time: %.3g s\n\n", res->total_time);
+
+    fprintf(f, "## Parameters\n\n");
+    print_parameters_md(res, f);
+    fprintf(f, "\nIntervals are value ± t(0.975, dof) · std. error. Sensitivity L1/L2: mean absolute and "
+               "root-mean-square of ∂ŷ/∂p · p/σ over all observations (FME's sensFun summaries; σ is the "
+               "observation's sigma, or the residual standard deviation when none is given).\n\n");
+
+    fprintf(f, "## Identifiability\n\n");
+    fprintf(f, "- rank of the Jacobian: %zu of %zu", res->rank, res->n_free);
+    if (isfinite(res->condition))
+        fprintf(f, "; condition number (column-scaled): %.3g", res->condition);
+    fprintf(f, "\n");
+    for (size_t i = 0; i < res->n_undetermined; ++i)
+        fprintf(f, "- not determined by the data: %s\n", res->undetermined[i]);
+    int any = 0;
+    for (size_t x = 0; x < res->n_free; ++x)
+        for (size_t y = x + 1; y < res->n_free; ++y) {
+            const double c = res->correlation[x * res->n_free + y];
+            if (fabs(c) > res->correlation_threshold) {
+                fprintf(f, "- strong correlation: %s and %s, r = %.4f\n", res->params[res->free_index[x]].name,
+                        res->params[res->free_index[y]].name, c);
+                any = 1;
+            }
+        }
+    if (!any)
+        fprintf(f, "- no correlation above |r| = %g\n", res->correlation_threshold);
+    const phc_sensitivity *s = &res->sensitivity;
+    if (s->n_sets) {
+        fprintf(f, "\nCollinearity index of parameter subsets (Brun et al. 2001; above %g the subset is poorly "
+                   "identifiable). Largest:\n\n| parameters | index |\n|---|---:|\n",
+                res->collinearity_threshold);
+        for (size_t i = 0; i < s->n_sets && i < 10; ++i) {
+            fprintf(f, "| ");
+            for (size_t k = 0; k < s->sets[i].size; ++k)
+                fprintf(f, "%s%s", k ? ", " : "", res->params[res->free_index[s->sets[i].index[k]]].name);
+            fprintf(f, " | %s%s |\n", fmt_num(a, sizeof a, s->sets[i].gamma),
+                    s->sets[i].gamma > res->collinearity_threshold ? " **high**" : "");
+        }
+    }
+    if (res->n_free > 1) {
+        fprintf(f, "\nCorrelation matrix:\n\n|   |");
+        for (size_t y = 0; y < res->n_free; ++y)
+            fprintf(f, " %s |", res->params[res->free_index[y]].name);
+        fprintf(f, "\n|---|");
+        for (size_t y = 0; y < res->n_free; ++y)
+            fprintf(f, "---:|");
+        fprintf(f, "\n");
+        for (size_t x = 0; x < res->n_free; ++x) {
+            fprintf(f, "| %s |", res->params[res->free_index[x]].name);
+            for (size_t y = 0; y < res->n_free; ++y) {
+                const double c = res->correlation[x * res->n_free + y];
+                if (isnan(c))
+                    fprintf(f, " — |");
+                else
+                    fprintf(f, " %.3f |", c);
+            }
+            fprintf(f, "\n");
+        }
+    }
+    fprintf(f, "\n## Data sets\n");
+    for (size_t d = 0; d < res->n_datasets; ++d) {
+        const phc_dataset_result *ds = &res->datasets[d];
+        fprintf(f, "\n### %s (%s)\n\n", ds->name, ds->kind);
+        print_goodness_md(ds, f);
+        fprintf(f, "\nResidual checks (residuals ordered by %s):\n\n", ds->x_label);
+        print_checks_md(ds, res->level, f);
+        fprintf(f, "\n");
+        for (size_t i = 0; plots && plots[i]; ++i) {
+            size_t len = strlen(ds->name);
+            if (strncmp(plots[i], ds->name, len) == 0 && plots[i][len] == '_')
+                fprintf(f, "![%s](%s)\n", plots[i], plots[i]);
+        }
+    }
+    fprintf(f, "\n## How to read the checks\n\n"
+               "- **runs** (Wald–Wolfowitz): too few sign changes along x means the model misses a trend.\n"
+               "- **durbin_watson**: d near 2 is fine; d well below 2 means neighbouring residuals move together.\n"
+               "- **ljung_box**: autocorrelation over the first lags together.\n"
+               "- **shapiro_wilk** / **anderson_darling**: residuals far from normal make the intervals unreliable.\n"
+               "- **breusch_pagan**: residual variance that grows or shrinks with the fitted value; "
+               "consider per-point sigmas.\n");
+    int bad = ferror(f);
+    if (fclose(f) != 0 || bad) {
+        unlink(tmp);
+        return phc_error_set(err, PHC_ERR_IO, "%s: write failed", tmp);
+    }
+    if (rename(tmp, path) != 0) {
+        unlink(tmp);
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot rename into place", path);
+    }
+    return PHC_OK;
+}
+
+void phc_report_print_summary(const phc_fit_result *res, FILE *out)
+{
+    char a[32], b[32], c[32], d[32];
+    fprintf(out, "%s: %s after %d iterations (%s)\n", res->name, phc_fit_status_name(res->summary.outcome),
+            res->summary.iterations, res->summary.termination);
+    if (res->starts > 1)
+        fprintf(out, "starts: %zu, %zu reached the best cost\n", res->starts, res->starts_at_best);
+    fprintf(out, "%-16s %15s %13s %29s  %s\n", "parameter", "value", "std. error", "95% interval", "unit");
+    for (size_t i = 0; i < res->n_params; ++i) {
+        const phc_param_result *p = &res->params[i];
+        char interval[80];
+        snprintf(interval, sizeof interval, "[%s, %s]", fmt_num(c, sizeof c, p->ci_lo), fmt_num(d, sizeof d, p->ci_hi));
+        fprintf(out, "%-16s %15s %13s %29s  %s%s\n", p->name, fmt_num(a, sizeof a, p->value),
+                fmt_num(b, sizeof b, p->stderr_), interval, p->unit ? p->unit : "",
+                p->fixed ? " (fixed)" : p->at_bound ? " (at bound)" : "");
+    }
+    for (size_t k = 0; k < res->n_datasets; ++k) {
+        const phc_dataset_result *ds = &res->datasets[k];
+        fprintf(out, "data set %s: n=%zu RMSE=%s R²=%s AICc=%s", ds->name, ds->n,
+                fmt_num(a, sizeof a, ds->goodness.rmse), fmt_num(b, sizeof b, ds->goodness.r2),
+                fmt_num(c, sizeof c, ds->goodness.aicc));
+        int failed = 0;
+        for (size_t i = 0; i < PHC_CHECK_COUNT; ++i)
+            if (ds->checks[i].applicable && !ds->checks[i].pass)
+                fprintf(out, "%s%s", failed++ ? ", " : "; failed: ", ds->checks[i].name);
+        fprintf(out, "%s\n", failed ? "" : "; all residual checks pass");
+    }
+    if (res->n_warnings == 0)
+        fprintf(out, "verdict: no problems found\n");
+    else {
+        fprintf(out, "verdict: %zu warning%s\n", res->n_warnings, res->n_warnings == 1 ? "" : "s");
+        for (size_t i = 0; i < res->n_warnings; ++i)
+            fprintf(out, "  - %s\n", res->warnings[i]);
+    }
+}

@@ -1,0 +1,472 @@
+/* result.json writer and reader (jansson): see result_json.h. */
+#include "fit/result_json.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static json_t *num(double v)
+{
+    return isfinite(v) ? json_real(v) : json_null();
+}
+
+static json_t *num_array(const double *v, size_t n)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; a && v && i < n; ++i)
+        json_array_append_new(a, num(v[i]));
+    return a;
+}
+
+static json_t *goodness_json(const phc_goodness *g)
+{
+    return json_pack("{s:I, s:I, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}",
+                     "n", (json_int_t)g->n, "k", (json_int_t)g->k, "rss", num(g->rss), "wrss", num(g->wrss),
+                     "rmse", num(g->rmse), "mae", num(g->mae), "bias", num(g->bias), "r2", num(g->r2),
+                     "nse", num(g->nse), "reduced_chi2", num(g->reduced_chi2), "log_likelihood",
+                     num(g->log_likelihood), "aic", num(g->aic), "aicc", num(g->aicc), "bic", num(g->bic));
+}
+
+static json_t *dataset_json(const phc_dataset_result *d)
+{
+    json_t *checks = json_object();
+    for (size_t c = 0; c < PHC_CHECK_COUNT; ++c) {
+        const phc_check_result *ck = &d->checks[c];
+        json_object_set_new(checks, ck->name,
+                            json_pack("{s:o, s:o, s:b, s:b, s:s}", "value", num(ck->statistic), "p_value",
+                                      num(ck->p_value), "pass", ck->pass, "applicable", ck->applicable,
+                                      "tests", ck->what));
+    }
+    json_t *o = json_pack("{s:s, s:s, s:I, s:o, s:o, s:o, s:o, s:o, s:s, s:s}", "name", d->name, "kind", d->kind,
+                          "n", (json_int_t)d->n, "rss", num(d->goodness.rss), "rmse", num(d->goodness.rmse),
+                          "r2", num(d->goodness.r2), "checks", checks, "goodness", goodness_json(&d->goodness),
+                          "x_label", d->x_label, "y_label", d->y_label);
+    json_object_set_new(o, "x", num_array(d->x, d->n));
+    json_object_set_new(o, "y", num_array(d->y, d->n));
+    json_object_set_new(o, "fitted", num_array(d->yhat, d->n));
+    json_object_set_new(o, "residuals", num_array(d->residual, d->n));
+    json_object_set_new(o, "standardised_residuals", num_array(d->std_residual, d->n));
+    json_object_set_new(o, "sigma", d->sigma ? num_array(d->sigma, d->n) : json_null());
+    json_object_set_new(o, "acf", num_array(d->acf, d->acf_lags ? d->acf_lags + 1 : 0));
+    return o;
+}
+
+static json_t *result_json(const phc_fit_result *res)
+{
+    json_t *root = json_object();
+    json_object_set_new(root, "name", json_string(res->name));
+    json_object_set_new(root, "status", json_string(phc_fit_status_name(res->summary.outcome)));
+    json_object_set_new(root, "termination", json_string(res->summary.termination));
+    json_object_set_new(root, "iterations", json_integer(res->summary.iterations));
+    json_object_set_new(root, "initial_cost", num(res->summary.initial_cost));
+    json_object_set_new(root, "cost", num(res->cost));
+    json_object_set_new(root, "rss", num(res->rss));
+    json_object_set_new(root, "weighted_rss", num(res->wrss));
+    json_object_set_new(root, "dof", json_integer(res->dof));
+    json_object_set_new(root, "n_observations", json_integer((json_int_t)res->n_obs));
+    json_object_set_new(root, "variance_factor", num(res->s2));
+    json_object_set_new(root, "absolute_sigma", json_boolean(res->absolute_sigma));
+    json_object_set_new(root, "level", num(res->level));
+    json_object_set_new(root, "collinearity_threshold", num(res->collinearity_threshold));
+    json_object_set_new(root, "correlation_threshold", num(res->correlation_threshold));
+    json_object_set_new(root, "solver",
+                        json_pack("{s:I, s:I, s:I, s:o, s:o, s:I, s:I}", "residual_evaluations",
+                                  (json_int_t)res->summary.residual_evaluations, "jacobian_evaluations",
+                                  (json_int_t)res->summary.jacobian_evaluations, "iterations",
+                                  (json_int_t)res->summary.iterations, "wall_time_best_start",
+                                  num(res->summary.wall_time), "wall_time_total", num(res->total_time),
+                                  "starts", (json_int_t)res->starts, "starts_at_best",
+                                  (json_int_t)res->starts_at_best));
+    json_t *params = json_object();
+    for (size_t i = 0; i < res->n_params; ++i) {
+        const phc_param_result *p = &res->params[i];
+        json_t *ci = json_pack("[o, o]", num(p->ci_lo), num(p->ci_hi));
+        json_object_set_new(params, p->name,
+                            json_pack("{s:o, s:o, s:o, s:b, s:b, s:i, s:o, s:o, s:o, s:o}", "value", num(p->value),
+                                      "stderr", num(p->stderr_), "ci95", ci, "fixed", p->fixed, "at_bound",
+                                      p->at_bound != 0, "bound_side", p->at_bound, "unit",
+                                      p->unit ? json_string(p->unit) : json_null(), "start", num(p->start),
+                                      "sensitivity_l1", num(p->sens_l1), "sensitivity_l2", num(p->sens_l2)));
+    }
+    json_object_set_new(root, "parameters", params);
+    json_t *names = json_array(), *matrix = json_array();
+    for (size_t a = 0; a < res->n_free; ++a) {
+        json_array_append_new(names, json_string(res->params[res->free_index[a]].name));
+        json_array_append_new(matrix, num_array(res->correlation + a * res->n_free, res->n_free));
+    }
+    json_object_set_new(root, "correlation", json_pack("{s:o, s:o}", "names", names, "matrix", matrix));
+    json_t *und = json_array();
+    for (size_t i = 0; i < res->n_undetermined; ++i)
+        json_array_append_new(und, json_string(res->undetermined[i]));
+    json_object_set_new(root, "identifiability",
+                        json_pack("{s:I, s:o, s:o}", "rank", (json_int_t)res->rank, "condition_number",
+                                  num(res->condition), "undetermined", und));
+    json_t *sets = json_array();
+    const phc_sensitivity *s = &res->sensitivity;
+    for (size_t i = 0; i < s->n_sets && i < 200; ++i) {
+        json_t *members = json_array();
+        for (size_t a = 0; a < s->sets[i].size; ++a)
+            json_array_append_new(members, json_string(res->params[res->free_index[s->sets[i].index[a]]].name));
+        json_array_append_new(sets, json_pack("{s:o, s:o}", "parameters", members, "index", num(s->sets[i].gamma)));
+    }
+    json_t *maxg = json_object();
+    for (size_t k = 2; k <= s->max_size; ++k) {
+        char key[8];
+        snprintf(key, sizeof key, "%zu", k);
+        json_object_set_new(maxg, key, num(s->max_gamma[k]));
+    }
+    json_object_set_new(root, "collinearity",
+                        json_pack("{s:I, s:o, s:o}", "subsets_evaluated", (json_int_t)s->n_sets, "max_by_size", maxg,
+                                  "largest", sets));
+    json_t *ds = json_array();
+    for (size_t d = 0; d < res->n_datasets; ++d)
+        json_array_append_new(ds, dataset_json(&res->datasets[d]));
+    json_object_set_new(root, "datasets", ds);
+    json_t *warn = json_array();
+    for (size_t i = 0; i < res->n_warnings; ++i)
+        json_array_append_new(warn, json_string(res->warnings[i]));
+    json_object_set_new(root, "verdict",
+                        json_pack("{s:s, s:o}", "summary", res->n_warnings ? "check the warnings" : "no problems found",
+                                  "warnings", warn));
+    return root;
+}
+
+int phc_result_write_json(const phc_fit_result *res, const char *path, phc_error *err)
+{
+    json_t *root = result_json(res);
+    if (!root)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory building result.json");
+    char tmp[4096];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    int rc = PHC_OK;
+    if (json_dump_file(root, tmp, JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0)
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", tmp);
+    else if (rename(tmp, path) != 0)
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename into place", path);
+    if (rc)
+        unlink(tmp);
+    json_decref(root);
+    return rc;
+}
+
+/* ---- reading --------------------------------------------------------------- */
+
+typedef struct reader {
+    const char *path;
+    phc_error *err;
+} reader;
+
+static int fail_field(reader *rd, const char *field, const char *expected)
+{
+    return phc_error_set(rd->err, PHC_ERR_INPUT, "%s: %s: expected %s", rd->path, field, expected);
+}
+
+static int get_number(reader *rd, json_t *obj, const char *key, const char *where, double *out)
+{
+    json_t *v = json_object_get(obj, key);
+    char field[128];
+    snprintf(field, sizeof field, "%s%s", where, key);
+    if (v && json_is_null(v)) {
+        *out = NAN;
+        return PHC_OK;
+    }
+    if (!v || !json_is_number(v))
+        return fail_field(rd, field, "a number");
+    *out = json_number_value(v);
+    return PHC_OK;
+}
+
+static int get_array(reader *rd, json_t *obj, const char *key, const char *where, size_t n, double **out)
+{
+    json_t *a = json_object_get(obj, key);
+    char field[128], expected[64];
+    snprintf(field, sizeof field, "%s%s", where, key);
+    snprintf(expected, sizeof expected, "an array of %zu numbers", n);
+    if (!a || !json_is_array(a) || json_array_size(a) != n)
+        return fail_field(rd, field, expected);
+    *out = calloc(n ? n : 1, sizeof **out);
+    if (!*out)
+        return phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n; ++i) {
+        json_t *v = json_array_get(a, i);
+        if (json_is_null(v))
+            (*out)[i] = NAN;
+        else if (json_is_number(v))
+            (*out)[i] = json_number_value(v);
+        else
+            return fail_field(rd, field, expected);
+    }
+    return PHC_OK;
+}
+
+static int get_string(reader *rd, json_t *obj, const char *key, const char *where, char **out)
+{
+    json_t *v = json_object_get(obj, key);
+    char field[128];
+    snprintf(field, sizeof field, "%s%s", where, key);
+    if (!v || !json_is_string(v))
+        return fail_field(rd, field, "a string");
+    *out = strdup(json_string_value(v));
+    return *out ? PHC_OK : phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
+}
+
+static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result *d)
+{
+    char where[64];
+    snprintf(where, sizeof where, "datasets[%zu].", index);
+    int rc;
+    json_t *n = json_object_get(o, "n");
+    if (!json_is_integer(n) || json_integer_value(n) < 1)
+        return fail_field(rd, "datasets[].n", "a positive integer");
+    d->n = (size_t)json_integer_value(n);
+    if ((rc = get_string(rd, o, "name", where, &d->name)) || (rc = get_string(rd, o, "kind", where, &d->kind)) ||
+        (rc = get_string(rd, o, "x_label", where, &d->x_label)) ||
+        (rc = get_string(rd, o, "y_label", where, &d->y_label)) ||
+        (rc = get_array(rd, o, "x", where, d->n, &d->x)) || (rc = get_array(rd, o, "y", where, d->n, &d->y)) ||
+        (rc = get_array(rd, o, "fitted", where, d->n, &d->yhat)) ||
+        (rc = get_array(rd, o, "residuals", where, d->n, &d->residual)) ||
+        (rc = get_array(rd, o, "standardised_residuals", where, d->n, &d->std_residual)))
+        return rc;
+    json_t *sig = json_object_get(o, "sigma");
+    if (sig && !json_is_null(sig) && (rc = get_array(rd, o, "sigma", where, d->n, &d->sigma)))
+        return rc;
+    json_t *g = json_object_get(o, "goodness");
+    if (!json_is_object(g))
+        return fail_field(rd, "datasets[].goodness", "an object");
+    struct {
+        const char *key;
+        double *dst;
+    } fields[] = {{"rss", &d->goodness.rss},   {"wrss", &d->goodness.wrss},
+                  {"rmse", &d->goodness.rmse}, {"mae", &d->goodness.mae},
+                  {"bias", &d->goodness.bias}, {"r2", &d->goodness.r2},
+                  {"nse", &d->goodness.nse},   {"reduced_chi2", &d->goodness.reduced_chi2},
+                  {"aic", &d->goodness.aic},   {"aicc", &d->goodness.aicc},
+                  {"bic", &d->goodness.bic},   {"log_likelihood", &d->goodness.log_likelihood}};
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i)
+        if ((rc = get_number(rd, g, fields[i].key, "datasets[].goodness.", fields[i].dst)))
+            return rc;
+    d->goodness.n = d->n;
+    json_t *k = json_object_get(g, "k");
+    d->k = d->goodness.k = json_is_integer(k) ? (size_t)json_integer_value(k) : 0;
+    /* The stored Durbin–Watson p-value is kept (its exact moments need the
+     * Jacobian); everything else is recomputed by phc_fit_recheck. */
+    json_t *checks = json_object_get(o, "checks");
+    json_t *dw = json_object_get(checks, "durbin_watson");
+    d->checks[PHC_CHECK_DURBIN_WATSON].applicable = 0;
+    if (json_is_object(dw)) {
+        double p = NAN;
+        if ((rc = get_number(rd, dw, "p_value", "datasets[].checks.durbin_watson.", &p)))
+            return rc;
+        d->checks[PHC_CHECK_DURBIN_WATSON].p_value = p;
+        d->checks[PHC_CHECK_DURBIN_WATSON].applicable = isfinite(p);
+    }
+    return PHC_OK;
+}
+
+int phc_result_read_json(const char *path, phc_fit_result **out, phc_error *err)
+{
+    json_error_t jerr;
+    *out = NULL;
+    json_t *root = json_load_file(path, 0, &jerr);
+    if (!root) {
+        if (jerr.line < 0)
+            return phc_error_set(err, PHC_ERR_IO, "%s: %s", path, jerr.text);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%d:%d: invalid JSON: %s", path, jerr.line, jerr.column,
+                             jerr.text);
+    }
+    reader rd = {path, err};
+    int rc = PHC_OK;
+    phc_fit_result *res = calloc(1, sizeof *res);
+    if (!res) {
+        json_decref(root);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    if (!json_is_object(root)) {
+        rc = fail_field(&rd, "(top level)", "an object");
+        goto fail;
+    }
+    char *status = NULL, *termination = NULL;
+    if ((rc = get_string(&rd, root, "name", "", &res->name)) ||
+        (rc = get_string(&rd, root, "status", "", &status)) ||
+        (rc = get_string(&rd, root, "termination", "", &termination)))
+        goto fail_strings;
+    res->summary.outcome = strcmp(status, "converged") == 0       ? PHC_NLS_CONVERGED
+                           : strcmp(status, "not_converged") == 0 ? PHC_NLS_NOT_CONVERGED
+                                                                  : PHC_NLS_FAILED;
+    snprintf(res->summary.termination, sizeof res->summary.termination, "%s", termination);
+    double level = 0.05, dof = 0;
+    if ((rc = get_number(&rd, root, "cost", "", &res->cost)) || (rc = get_number(&rd, root, "rss", "", &res->rss)) ||
+        (rc = get_number(&rd, root, "weighted_rss", "", &res->wrss)) ||
+        (rc = get_number(&rd, root, "variance_factor", "", &res->s2)) ||
+        (rc = get_number(&rd, root, "level", "", &level)) || (rc = get_number(&rd, root, "dof", "", &dof)) ||
+        (rc = get_number(&rd, root, "collinearity_threshold", "", &res->collinearity_threshold)) ||
+        (rc = get_number(&rd, root, "correlation_threshold", "", &res->correlation_threshold)))
+        goto fail_strings;
+    res->dof = (long)dof;
+    res->level = level;
+    json_t *it = json_object_get(root, "iterations");
+    res->summary.iterations = json_is_integer(it) ? (int)json_integer_value(it) : 0;
+
+    json_t *params = json_object_get(root, "parameters");
+    if (!json_is_object(params) || json_object_size(params) == 0) {
+        rc = fail_field(&rd, "parameters", "a non-empty object");
+        goto fail_strings;
+    }
+    res->n_params = json_object_size(params);
+    res->params = calloc(res->n_params, sizeof *res->params);
+    res->free_index = calloc(res->n_params, sizeof *res->free_index);
+    if (!res->params || !res->free_index) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_strings;
+    }
+    const char *key;
+    json_t *pv;
+    size_t i = 0;
+    json_object_foreach(params, key, pv)
+    {
+        phc_param_result *p = &res->params[i++];
+        char where[160];
+        snprintf(where, sizeof where, "parameters.%s.", key);
+        if (!(p->name = strdup(key))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_strings;
+        }
+        json_t *ci = json_object_get(pv, "ci95");
+        if (!json_is_object(pv) || !json_is_array(ci) || json_array_size(ci) != 2) {
+            rc = fail_field(&rd, where, "an object with value, stderr, ci95 [lo, hi]");
+            goto fail_strings;
+        }
+        if ((rc = get_number(&rd, pv, "value", where, &p->value)) ||
+            (rc = get_number(&rd, pv, "stderr", where, &p->stderr_)) ||
+            (rc = get_number(&rd, pv, "start", where, &p->start)) ||
+            (rc = get_number(&rd, pv, "sensitivity_l1", where, &p->sens_l1)) ||
+            (rc = get_number(&rd, pv, "sensitivity_l2", where, &p->sens_l2)))
+            goto fail_strings;
+        json_t *lo = json_array_get(ci, 0), *hi = json_array_get(ci, 1);
+        p->ci_lo = json_is_number(lo) ? json_number_value(lo) : NAN;
+        p->ci_hi = json_is_number(hi) ? json_number_value(hi) : NAN;
+        p->fixed = json_is_true(json_object_get(pv, "fixed"));
+        json_t *side = json_object_get(pv, "bound_side");
+        p->at_bound = json_is_integer(side) ? (int)json_integer_value(side) : 0;
+        json_t *unit = json_object_get(pv, "unit");
+        if (json_is_string(unit) && !(p->unit = strdup(json_string_value(unit)))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_strings;
+        }
+    }
+    /* correlation over the free parameters, in the stored name order */
+    json_t *corr = json_object_get(root, "correlation");
+    json_t *names = json_object_get(corr, "names"), *matrix = json_object_get(corr, "matrix");
+    if (!json_is_array(names) || !json_is_array(matrix) || json_array_size(names) != json_array_size(matrix)) {
+        rc = fail_field(&rd, "correlation", "{names: [...], matrix: [[...]]} of equal sizes");
+        goto fail_strings;
+    }
+    res->n_free = json_array_size(names);
+    if (res->n_free > res->n_params) {
+        rc = fail_field(&rd, "correlation.names", "at most as many names as parameters");
+        goto fail_strings;
+    }
+    res->correlation = calloc(res->n_free * res->n_free + 1, sizeof *res->correlation);
+    if (!res->correlation) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_strings;
+    }
+    for (size_t a = 0; a < res->n_free; ++a) {
+        const char *nm = json_string_value(json_array_get(names, a));
+        size_t found = res->n_params;
+        for (size_t j = 0; nm && j < res->n_params; ++j)
+            if (strcmp(res->params[j].name, nm) == 0)
+                found = j;
+        json_t *row = json_array_get(matrix, a);
+        if (found == res->n_params || !json_is_array(row) || json_array_size(row) != res->n_free) {
+            rc = fail_field(&rd, "correlation", "names of parameters and a square matrix");
+            goto fail_strings;
+        }
+        res->free_index[a] = found;
+        for (size_t b = 0; b < res->n_free; ++b) {
+            json_t *v = json_array_get(row, b);
+            res->correlation[a * res->n_free + b] = json_is_number(v) ? json_number_value(v) : NAN;
+        }
+    }
+    json_t *ident = json_object_get(root, "identifiability");
+    json_t *und = json_object_get(ident, "undetermined");
+    if (json_is_array(und) && json_array_size(und)) {
+        res->undetermined = calloc(json_array_size(und), sizeof *res->undetermined);
+        if (!res->undetermined) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_strings;
+        }
+        for (size_t u = 0; u < json_array_size(und); ++u) {
+            const char *s = json_string_value(json_array_get(und, u));
+            res->undetermined[res->n_undetermined++] = strdup(s ? s : "?");
+        }
+    }
+    json_t *rank = json_object_get(ident, "rank");
+    res->rank = json_is_integer(rank) ? (size_t)json_integer_value(rank) : res->n_free;
+    /* largest collinear subsets, as stored */
+    json_t *largest = json_object_get(json_object_get(root, "collinearity"), "largest");
+    if (json_is_array(largest) && json_array_size(largest)) {
+        phc_sensitivity *s = &res->sensitivity;
+        s->sets = calloc(json_array_size(largest), sizeof *s->sets);
+        if (!s->sets) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_strings;
+        }
+        for (size_t k = 0; k < json_array_size(largest); ++k) {
+            json_t *e = json_array_get(largest, k);
+            json_t *members = json_object_get(e, "parameters");
+            json_t *g = json_object_get(e, "index");
+            phc_collinear_set *set = &s->sets[s->n_sets];
+            if (!json_is_array(members) || json_array_size(members) > PHC_COLLIN_MAX_SIZE)
+                continue;
+            set->size = json_array_size(members);
+            set->gamma = json_is_number(g) ? json_number_value(g) : INFINITY;
+            int ok = 1;
+            for (size_t a = 0; a < set->size && ok; ++a) {
+                const char *nm = json_string_value(json_array_get(members, a));
+                ok = 0;
+                for (size_t f = 0; nm && f < res->n_free; ++f)
+                    if (strcmp(res->params[res->free_index[f]].name, nm) == 0) {
+                        set->index[a] = f;
+                        ok = 1;
+                    }
+            }
+            if (ok)
+                s->n_sets++;
+        }
+    }
+    json_t *ds = json_object_get(root, "datasets");
+    if (!json_is_array(ds) || json_array_size(ds) == 0) {
+        rc = fail_field(&rd, "datasets", "a non-empty array");
+        goto fail_strings;
+    }
+    res->n_datasets = json_array_size(ds);
+    res->datasets = calloc(res->n_datasets, sizeof *res->datasets);
+    if (!res->datasets) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_strings;
+    }
+    for (size_t d = 0; d < res->n_datasets; ++d) {
+        if (!json_is_object(json_array_get(ds, d))) {
+            rc = fail_field(&rd, "datasets[]", "objects");
+            goto fail_strings;
+        }
+        if ((rc = read_dataset(&rd, json_array_get(ds, d), d, &res->datasets[d])))
+            goto fail_strings;
+        res->n_obs += res->datasets[d].n;
+    }
+    if ((rc = phc_fit_recheck(res, level, err)))
+        goto fail_strings;
+    *out = res;
+    res = NULL;
+fail_strings:
+    free(status);
+    free(termination);
+fail:
+    phc_fit_result_free(res);
+    json_decref(root);
+    return rc;
+}

@@ -1,0 +1,214 @@
+/* Run directories: see run_dir.h. */
+#define _XOPEN_SOURCE 700 /* nftw */
+#include "fit/run_dir.h"
+
+#include <errno.h>
+#include <ftw.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "fit/plots.h"
+#include "fit/report.h"
+#include "fit/result_json.h"
+
+#define MAX_PLOTS 512
+
+static int remove_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
+{
+    (void)sb;
+    (void)flag;
+    (void)ftw;
+    return remove(path);
+}
+
+static void remove_tree(const char *path)
+{
+    nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+int phc_run_dir_check(const char *dir, int force, phc_error *err)
+{
+    struct stat st;
+    if (stat(dir, &st) == 0) {
+        if (!S_ISDIR(st.st_mode))
+            return phc_error_set(err, PHC_ERR_EXISTS, "%s: exists and is not a directory", dir);
+        if (!force)
+            return phc_error_set(err, PHC_ERR_EXISTS,
+                                 "%s: output directory exists; use --force to replace it or -o to choose another", dir);
+    }
+    return PHC_OK;
+}
+
+/* mkdir -p for the parent of dir. */
+static int make_parents(const char *dir, phc_error *err)
+{
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (char *p = buf + 1; *p; ++p) {
+        if (*p != '/')
+            continue;
+        *p = '\0';
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+            return phc_error_set(err, PHC_ERR_IO, "%s: cannot create directory: %s", buf, strerror(errno));
+        *p = '/';
+    }
+    return PHC_OK;
+}
+
+static int add_plot(char **names, size_t *n, const char *name)
+{
+    if (*n + 1 >= MAX_PLOTS)
+        return PHC_OK;
+    names[*n] = strdup(name);
+    if (!names[*n])
+        return PHC_ERR_NOMEM;
+    (*n)++;
+    return PHC_OK;
+}
+
+/* File-name-safe copy of a data set name. */
+static void safe_name(const char *in, char *out, size_t size)
+{
+    size_t j = 0;
+    for (size_t i = 0; in[i] && j + 1 < size; ++i) {
+        const char c = in[i];
+        out[j++] = ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                    c == '_' || c == '.')
+                       ? c
+                       : '_';
+    }
+    out[j] = '\0';
+}
+
+static int write_plots(const phc_fit_result *res, const char *tmpdir, char **names, size_t *n_names,
+                       phc_error *err)
+{
+    char path[8192], file[512], title[512], label[512];
+    int rc;
+    for (size_t d = 0; d < res->n_datasets; ++d) {
+        const phc_dataset_result *ds = &res->datasets[d];
+        char base[256];
+        safe_name(ds->name, base, sizeof base);
+        /* the report links plots by data-set name; keep names consistent */
+        snprintf(title, sizeof title, "%s: data and fit", ds->name);
+        phc_plot_labels lab = {title, ds->x_label, ds->y_label};
+        snprintf(file, sizeof file, "%s_fit.png", base);
+        snprintf(path, sizeof path, "%s/%s", tmpdir, file);
+        const double *cx = ds->curve_x, *cy = ds->curve_y;
+        size_t cn = ds->curve_n;
+        double *sx = NULL, *sy = NULL;
+        if (!cx) {
+            /* no dense curve: connect the predictions in x order */
+            sx = malloc(ds->n * sizeof *sx);
+            sy = malloc(ds->n * sizeof *sy);
+            if (!sx || !sy) {
+                free(sx);
+                free(sy);
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            }
+            for (size_t i = 0; i < ds->n; ++i) {
+                sx[i] = ds->x[i];
+                sy[i] = ds->yhat[i];
+            }
+            for (size_t i = 1; i < ds->n; ++i) /* insertion sort: plots are small */
+                for (size_t j = i; j > 0 && sx[j - 1] > sx[j]; --j) {
+                    double t = sx[j];
+                    sx[j] = sx[j - 1];
+                    sx[j - 1] = t;
+                    t = sy[j];
+                    sy[j] = sy[j - 1];
+                    sy[j - 1] = t;
+                }
+            cx = sx;
+            cy = sy;
+            cn = ds->n;
+        }
+        rc = phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, cx, cy, cn, err);
+        free(sx);
+        free(sy);
+        if (rc || (rc = add_plot(names, n_names, file)))
+            return rc;
+
+        double s = 0;
+        for (size_t i = 0; i < ds->n; ++i)
+            s += ds->residual[i] * ds->residual[i];
+        s = ds->n > ds->k ? sqrt(s / (double)(ds->n - ds->k)) : NAN;
+        snprintf(title, sizeof title, "%s: residuals", ds->name);
+        snprintf(label, sizeof label, "residual: %s", ds->y_label);
+        phc_plot_labels rl = {title, ds->x_label, label};
+        snprintf(file, sizeof file, "%s_residuals.png", base);
+        snprintf(path, sizeof path, "%s/%s", tmpdir, file);
+        if ((rc = phc_plot_residuals(path, &rl, ds->x, ds->residual, ds->n, s, err)) ||
+            (rc = add_plot(names, n_names, file)))
+            return rc;
+
+        snprintf(title, sizeof title, "%s: normal QQ plot of residuals", ds->name);
+        phc_plot_labels ql = {title, NULL, NULL};
+        snprintf(file, sizeof file, "%s_qq.png", base);
+        snprintf(path, sizeof path, "%s/%s", tmpdir, file);
+        if ((rc = phc_plot_qq(path, &ql, ds->std_residual, ds->n, err)) || (rc = add_plot(names, n_names, file)))
+            return rc;
+
+        if (ds->acf_lags > 0) {
+            snprintf(title, sizeof title, "%s: residual autocorrelation (ordered by x)", ds->name);
+            phc_plot_labels al = {title, "lag (observations)", "autocorrelation"};
+            snprintf(file, sizeof file, "%s_acf.png", base);
+            snprintf(path, sizeof path, "%s/%s", tmpdir, file);
+            if ((rc = phc_plot_acf(path, &al, ds->acf, ds->acf_lags, ds->n, err)) ||
+                (rc = add_plot(names, n_names, file)))
+                return rc;
+        }
+    }
+    return PHC_OK;
+}
+
+int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc_error *err)
+{
+    int rc;
+    if ((rc = phc_run_dir_check(dir, force, err)) || (rc = make_parents(dir, err)))
+        return rc;
+    char tmpdir[4096], path[8192], old[4096];
+    snprintf(tmpdir, sizeof tmpdir, "%s.tmp-XXXXXX", dir);
+    if (!mkdtemp(tmpdir))
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot create a temporary directory: %s", tmpdir, strerror(errno));
+    char *names[MAX_PLOTS] = {0};
+    size_t n_names = 0;
+    if ((rc = write_plots(res, tmpdir, names, &n_names, err)))
+        goto fail;
+    snprintf(path, sizeof path, "%s/result.json", tmpdir);
+    if ((rc = phc_result_write_json(res, path, err)))
+        goto fail;
+    snprintf(path, sizeof path, "%s/report.md", tmpdir);
+    if ((rc = phc_report_write_markdown(res, path, (const char *const *)names, err)))
+        goto fail;
+    /* Swap into place: the old run (with --force) is removed only now. */
+    struct stat st;
+    old[0] = '\0';
+    if (stat(dir, &st) == 0) {
+        snprintf(old, sizeof old, "%s.old-XXXXXX", dir);
+        if (!mkdtemp(old) || rmdir(old) != 0 || rename(dir, old) != 0) {
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot move the earlier run aside: %s", dir, strerror(errno));
+            goto fail;
+        }
+    }
+    if (rename(tmpdir, dir) != 0) {
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename the new run into place: %s", dir, strerror(errno));
+        if (old[0])
+            rename(old, dir); /* put the earlier run back */
+        goto fail;
+    }
+    if (old[0])
+        remove_tree(old);
+    for (size_t i = 0; i < n_names; ++i)
+        free(names[i]);
+    return PHC_OK;
+fail:
+    remove_tree(tmpdir);
+    for (size_t i = 0; i < n_names; ++i)
+        free(names[i]);
+    return rc;
+}

@@ -1,0 +1,133 @@
+/* Sensitivities and collinearity indices: see sensitivity.h. */
+#include "fit/sensitivity.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void phc_sensitivity_clear(phc_sensitivity *s)
+{
+    if (!s)
+        return;
+    free(s->l1);
+    free(s->l2);
+    free(s->sets);
+    memset(s, 0, sizeof *s);
+}
+
+static double binomial(size_t n, size_t k)
+{
+    double r = 1;
+    for (size_t i = 1; i <= k; ++i)
+        r = r * (double)(n - k + i) / (double)i;
+    return r;
+}
+
+static int by_gamma_desc(const void *a, const void *b)
+{
+    const double ga = ((const phc_collinear_set *)a)->gamma, gb = ((const phc_collinear_set *)b)->gamma;
+    return (ga < gb) - (ga > gb);
+}
+
+/* gamma of one subset from the Gram matrix G = Sn'Sn of all columns. */
+static double subset_gamma(const double *G, size_t n, const size_t *idx, size_t k)
+{
+    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], w[PHC_COLLIN_MAX_SIZE];
+    for (size_t a = 0; a < k; ++a)
+        for (size_t b = 0; b < k; ++b)
+            A[a * k + b] = G[idx[a] * n + idx[b]];
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', (lapack_int)k, A, (lapack_int)k, w) != 0)
+        return NAN;
+    const double lmin = w[0];
+    return lmin > 0 ? 1.0 / sqrt(lmin) : INFINITY;
+}
+
+int phc_sensitivity_compute(const double *S, size_t m, size_t n, size_t max_sets,
+                            phc_sensitivity *out, phc_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!S || m == 0 || n == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "sensitivity: empty matrix");
+    out->n = n;
+    out->l1 = calloc(n, sizeof *out->l1);
+    out->l2 = calloc(n, sizeof *out->l2);
+    double *norm = calloc(n, sizeof *norm);
+    double *G = calloc(n * n, sizeof *G);
+    int rc = PHC_OK;
+    if (!out->l1 || !out->l2 || !norm || !G) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "sensitivity: out of memory");
+        goto fail;
+    }
+    for (size_t j = 0; j < n; ++j) {
+        double s1 = 0, s2 = 0;
+        for (size_t i = 0; i < m; ++i) {
+            s1 += fabs(S[i * n + j]);
+            s2 += S[i * n + j] * S[i * n + j];
+        }
+        out->l1[j] = s1 / (double)m;
+        out->l2[j] = sqrt(s2 / (double)m);
+        norm[j] = sqrt(s2);
+    }
+    for (size_t a = 0; a < n; ++a)
+        for (size_t b = a; b < n; ++b) {
+            double g = 0;
+            for (size_t i = 0; i < m; ++i)
+                g += S[i * n + a] * S[i * n + b];
+            const double d = norm[a] * norm[b];
+            G[a * n + b] = G[b * n + a] = d > 0 ? g / d : (a == b ? 0.0 : 0.0);
+        }
+    /* How many subset sizes fit in the budget. */
+    size_t kmax = n < PHC_COLLIN_MAX_SIZE ? n : PHC_COLLIN_MAX_SIZE;
+    double total = 0;
+    size_t usable = 1;
+    for (size_t k = 2; k <= kmax; ++k) {
+        total += binomial(n, k);
+        if (total > (double)max_sets)
+            break;
+        usable = k;
+    }
+    out->max_size = usable;
+    if (usable < 2)
+        goto fail; /* nothing to evaluate: n = 1 or no budget */
+    size_t count = 0;
+    for (size_t k = 2; k <= usable; ++k)
+        count += (size_t)binomial(n, k);
+    out->sets = calloc(count, sizeof *out->sets);
+    if (!out->sets) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "sensitivity: out of memory");
+        goto fail;
+    }
+    for (size_t k = 2; k <= usable; ++k) {
+        size_t idx[PHC_COLLIN_MAX_SIZE];
+        for (size_t a = 0; a < k; ++a)
+            idx[a] = a;
+        for (;;) {
+            phc_collinear_set *set = &out->sets[out->n_sets++];
+            set->size = k;
+            memcpy(set->index, idx, k * sizeof *idx);
+            int zero = 0;
+            for (size_t a = 0; a < k; ++a)
+                zero |= norm[idx[a]] == 0;
+            set->gamma = zero ? INFINITY : subset_gamma(G, n, idx, k);
+            if (!(set->gamma <= out->max_gamma[k]))
+                out->max_gamma[k] = set->gamma;
+            /* next combination in lexicographic order */
+            size_t a = k;
+            while (a > 0 && idx[a - 1] == n - k + a - 1)
+                --a;
+            if (a == 0)
+                break;
+            ++idx[a - 1];
+            for (size_t b = a; b < k; ++b)
+                idx[b] = idx[b - 1] + 1;
+        }
+    }
+    qsort(out->sets, out->n_sets, sizeof *out->sets, by_gamma_desc);
+fail:
+    free(norm);
+    free(G);
+    if (rc)
+        phc_sensitivity_clear(out);
+    return rc;
+}
