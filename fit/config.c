@@ -33,7 +33,7 @@ static const char *const parameter_keys[] = {"value", "lower", "upper", "fixed",
                                              "scale", "range", NULL};
 static const char *const solver_keys[] = {"method", "max_iterations", "function_tolerance",
                                           "gradient_tolerance", "parameter_tolerance",
-                                          "threads", "starts", NULL};
+                                          "threads", "starts", "rescue_starts", NULL};
 static const char *const report_keys[] = {"level", "absolute_sigma", "collinearity_threshold",
                                           "correlation_threshold", NULL};
 
@@ -117,10 +117,12 @@ static int parse_solver(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
         return rc;
     const char *method = NULL;
     long max_it = o->nls.max_iterations, threads = o->nls.num_threads, starts = (long)o->starts;
+    long rescue = (long)o->rescue_starts;
     if ((rc = phc_yaml_map_string(doc, node, "method", 0, ctx, &method, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "max_iterations", 0, ctx, &max_it, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "threads", 0, ctx, &threads, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "starts", 0, ctx, &starts, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "rescue_starts", 0, ctx, &rescue, err)) ||
         (rc = phc_yaml_map_number(doc, node, "function_tolerance", 0, ctx, &o->nls.function_tolerance, err)) ||
         (rc = phc_yaml_map_number(doc, node, "gradient_tolerance", 0, ctx, &o->nls.gradient_tolerance, err)) ||
         (rc = phc_yaml_map_number(doc, node, "parameter_tolerance", 0, ctx, &o->nls.parameter_tolerance, err)))
@@ -135,9 +137,10 @@ static int parse_solver(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
                                  "%s:%zu: solver.method: expected levenberg_marquardt or dogleg, found '%s'",
                                  doc->path, phc_yaml_get(node, "method")->line, method);
     }
-    if (max_it < 1 || max_it > 1000000 || threads < 1 || threads > 256 || starts < 1 || starts > 100000)
+    if (max_it < 1 || max_it > 1000000 || threads < 1 || threads > 256 || starts < 1 || starts > 100000 ||
+        rescue < 0 || rescue > 100000)
         return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: solver: max_iterations (1..1e6), threads (1..256) and starts (1..1e5) "
+                             "%s:%zu: solver: max_iterations (1..1e6), threads (1..256), starts (1..1e5) and rescue_starts (0..1e5) "
                              "must be positive whole numbers in range", doc->path, node->line);
     if (!(o->nls.function_tolerance >= 0) || !(o->nls.gradient_tolerance >= 0) ||
         !(o->nls.parameter_tolerance >= 0))
@@ -146,6 +149,7 @@ static int parse_solver(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
     o->nls.max_iterations = (int)max_it;
     o->nls.num_threads = (int)threads;
     o->starts = (size_t)starts;
+    o->rescue_starts = (size_t)rescue;
     return PHC_OK;
 }
 

@@ -2,6 +2,7 @@
 #include "fit/fit.h"
 
 #include <gsl/gsl_cdf.h>
+#include <lapacke.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -357,6 +358,121 @@ fail:
     return rc;
 }
 
+/* 1 when some free parameter has (relatively) no effect on the residuals at
+ * x: |d r / d p_j| |p_j| <= 1e-10 max_i |d r / d p_i| |p_i|. */
+static int stalled_on_plateau(phc_nls *nls, const phc_problem *pb, const double *x)
+{
+    const size_t m = phc_nls_residual_count(nls), np = pb->n_params;
+    double *J = malloc(m * np * sizeof *J), *effect = malloc(np * sizeof *effect);
+    int stalled = 0;
+    if (J && effect && phc_nls_evaluate(nls, x, NULL, J, NULL, NULL) == PHC_OK) {
+        double top = 0;
+        for (size_t j = 0; j < np; ++j) {
+            double ss = 0;
+            for (size_t i = 0; i < m; ++i)
+                ss += J[i * np + j] * J[i * np + j];
+            effect[j] = sqrt(ss) * (x[j] != 0 ? fabs(x[j]) : phc_problem_scale(pb, j));
+            if (!pb->params[j].fixed)
+                top = fmax(top, effect[j]);
+        }
+        for (size_t j = 0; j < np; ++j)
+            if (!pb->params[j].fixed && effect[j] <= 1e-10 * top)
+                stalled = 1;
+    }
+    free(J);
+    free(effect);
+    return stalled;
+}
+
+/* Gauss–Newton polish of a converged least-squares optimum.
+ *
+ * The trust-region solver accepts a step only when the cost decreases, and
+ * near the optimum a parameter error e changes the cost by O(e^2): below
+ * the round-off of the cost once e ~ 1e-8 relative.  So the solver stops
+ * with ~8 correct digits however tight its tolerances.  Gauss–Newton steps
+ * (min |J d + r| by SVD, column-scaled) converge on the step size instead,
+ * which the cost's round-off does not limit.  A step is kept while the cost
+ * does not rise beyond its round-off (residuals y - yhat lose digits to
+ * cancellation: Misra1b's cost is only good to ~1e-13, so the allowance is
+ * 1e-10 relative) and the steps keep shrinking. */
+static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_error *err)
+{
+    const size_t np = pb->n_params;
+    size_t nf = 0;
+    for (size_t i = 0; i < np; ++i)
+        nf += !pb->params[i].fixed;
+    for (size_t d = 0; d < pb->n_datasets; ++d)
+        if (pb->datasets[d]->loss != PHC_LOSS_NONE)
+            return PHC_OK; /* robust losses: Gauss–Newton on plain residuals would ignore them */
+    if (nf == 0 || m < nf)
+        return PHC_OK;
+    double *r = malloc(m * sizeof *r), *J = malloc(m * np * sizeof *J), *A = malloc(m * nf * sizeof *A);
+    double *b = malloc(m * sizeof *b), *sv = malloc(nf * sizeof *sv), *trial = malloc(np * sizeof *trial);
+    double *colscale = malloc(nf * sizeof *colscale);
+    size_t *fi = malloc(nf * sizeof *fi);
+    int rc = PHC_OK;
+    if (!r || !J || !A || !b || !sv || !trial || !colscale || !fi) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0, f = 0; i < np; ++i)
+        if (!pb->params[i].fixed)
+            fi[f++] = i;
+    double cost;
+    if (phc_nls_evaluate(nls, x, r, J, &cost, NULL) != PHC_OK)
+        goto done;
+    double last_step = INFINITY;
+    for (int it = 0; it < 10; ++it) {
+        for (size_t f = 0; f < nf; ++f) {
+            double ss = 0;
+            for (size_t i = 0; i < m; ++i)
+                ss += J[i * np + fi[f]] * J[i * np + fi[f]];
+            colscale[f] = ss > 0 ? sqrt(ss) : 1.0;
+            for (size_t i = 0; i < m; ++i)
+                A[i * nf + f] = J[i * np + fi[f]] / colscale[f];
+        }
+        for (size_t i = 0; i < m; ++i)
+            b[i] = -r[i];
+        lapack_int rank = 0;
+        if (LAPACKE_dgelsd(LAPACK_ROW_MAJOR, (lapack_int)m, (lapack_int)nf, 1, A, (lapack_int)nf, b, 1, sv,
+                           1e-13, &rank) != 0 || (size_t)rank < nf)
+            break; /* rank-deficient: leave it to the covariance analysis */
+        double step = 0;
+        memcpy(trial, x, np * sizeof *x);
+        int inside = 1;
+        for (size_t f = 0; f < nf; ++f) {
+            const size_t i = fi[f];
+            const double d = b[f] / colscale[f];
+            trial[i] = x[i] + d;
+            step = fmax(step, fabs(d) / (fabs(x[i]) + phc_problem_scale(pb, i) * 1e-300 + 1e-300));
+            inside &= trial[i] >= pb->params[i].lower && trial[i] <= pb->params[i].upper;
+        }
+        if (!inside || !(step < 1e-4) || step >= last_step)
+            break; /* not in the Gauss–Newton basin, or no longer contracting */
+        double trial_cost;
+        if (phc_nls_evaluate(nls, trial, r, J, &trial_cost, NULL) != PHC_OK ||
+            !(trial_cost <= cost * (1 + 1e-10) + 1e-300)) {
+            phc_nls_evaluate(nls, x, r, J, &cost, NULL);
+            break;
+        }
+        memcpy(x, trial, np * sizeof *x);
+        cost = trial_cost;
+        last_step = step;
+        if (step < 1e-15)
+            break;
+    }
+done:
+    free(r);
+    free(J);
+    free(A);
+    free(b);
+    free(sv);
+    free(trial);
+    free(colscale);
+    free(fi);
+    return rc;
+}
+
 int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
                 phc_fit_result **out, phc_error *err)
 {
@@ -393,21 +509,24 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             goto fail;
     }
 
-    /* Start 0 is the configured start; the others come from the Sobol box. */
+    /* Start 0 is the configured start; the others come from the Sobol box.
+     * With a single configured start, a result that did not converge or that
+     * sits where the model no longer depends on a parameter (a stall on a
+     * plateau, e.g. NIST BoxBOD from Start 1) triggers rescue starts. */
     double best_cost = INFINITY;
-    double costs_buf[1];
-    double *costs = opt->starts > 1 ? calloc(opt->starts, sizeof *costs) : costs_buf;
+    size_t planned = opt->starts;
+    double *costs = calloc(opt->starts + opt->rescue_starts, sizeof *costs);
     if (!costs) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if (opt->starts > 1 && !(ms = phc_multistart_new(pb))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail_costs;
-    }
-    for (size_t s = 0; s < opt->starts; ++s) {
-        if (progress && progress("fitting", (double)s / (double)opt->starts, user_data)) {
+    for (size_t s = 0; s < planned; ++s) {
+        if (progress && progress("fitting", (double)s / (double)planned, user_data)) {
             rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+            goto fail_costs;
+        }
+        if (s > 0 && !ms && !(ms = phc_multistart_new(pb))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             goto fail_costs;
         }
         if (s > 0 && (rc = phc_multistart_next(ms, x))) {
@@ -428,19 +547,25 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             memcpy(best, x, np * sizeof *x);
             res->summary = sum;
         }
+        if (s == 0 && planned == 1 && opt->rescue_starts > 0 &&
+            (res->summary.outcome != PHC_NLS_CONVERGED || stalled_on_plateau(nls, pb, best))) {
+            planned += opt->rescue_starts;
+            res->rescue_starts = opt->rescue_starts;
+        }
     }
-    res->starts = opt->starts;
-    for (size_t s = 0; s < opt->starts; ++s)
+    res->starts = planned;
+    for (size_t s = 0; s < planned; ++s)
         if (isfinite(costs[s]) && costs[s] <= best_cost + 1e-8 * fabs(best_cost) + 1e-300)
             res->starts_at_best++;
-    if (costs != costs_buf)
-        free(costs);
+    free(costs);
     costs = NULL;
     if (progress)
         progress("uncertainty", 1.0, user_data);
 
     /* Everything else is judged at the best point. */
     const size_t m = phc_nls_residual_count(nls);
+    if (res->summary.outcome == PHC_NLS_CONVERGED && (rc = polish(nls, pb, best, m, err)))
+        goto fail;
     r = calloc(m, sizeof *r);
     J = calloc(m * np, sizeof *J);
     if (!r || !J) {
@@ -483,7 +608,18 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         for (size_t f = 0; f < nf; ++f)
             Jf[i * nf + f] = J[i * np + res->free_index[f]];
     const double s2 = isfinite(res->s2) ? res->s2 : 1.0;
-    if ((rc = phc_covariance_compute(Jf, m, nf, s2, 1e-10, &cov, err)))
+    double *scales = malloc((nf ? nf : 1) * sizeof *scales);
+    if (!scales) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t f = 0; f < nf; ++f) {
+        const size_t gi = res->free_index[f];
+        scales[f] = best[gi] != 0 ? fabs(best[gi]) : phc_problem_scale(pb, gi);
+    }
+    rc = phc_covariance_compute(Jf, m, nf, s2, 1e-10, scales, &cov, err);
+    free(scales);
+    if (rc)
         goto fail;
     res->rank = cov.rank;
     res->condition = cov.condition;
@@ -580,8 +716,7 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     rc = PHC_OK;
     goto fail;
 fail_costs:
-    if (costs != costs_buf)
-        free(costs);
+    free(costs);
 fail:
     phc_covariance_clear(&cov);
     phc_multistart_free(ms);

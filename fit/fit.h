@@ -65,6 +65,7 @@ typedef struct phc_fit_result {
     phc_nls_summary summary;     /* of the best start */
     double total_time;           /* all starts, seconds */
     size_t starts;               /* starts run */
+    size_t rescue_starts;        /* of which added because start 0 stalled or failed */
     size_t starts_at_best;       /* starts whose cost is within 1e-8 (relative) of the best */
     size_t n_obs, n_free;
     long dof;                    /* n_obs - n_free */

@@ -10,6 +10,7 @@ phc_fit_options phc_fit_options_default(void)
     phc_fit_options o;
     o.nls = phc_nls_options_default();
     o.starts = 1;
+    o.rescue_starts = 16;
     o.absolute_sigma = 0;
     o.level = 0.05;
     o.collinearity_threshold = 20.0;

@@ -23,6 +23,9 @@ typedef struct phc_parameter {
 typedef struct phc_fit_options {
     phc_nls_options nls;   /* solver settings for every start */
     size_t starts;         /* >= 1; extra starts are Sobol points in the box */
+    size_t rescue_starts;  /* with starts = 1: Sobol starts added when the first
+                              solve fails to converge or stalls on a plateau
+                              (a parameter with no effect); 0 disables (16) */
     int absolute_sigma;    /* 1: sigmas are true standard deviations (s^2 = 1) */
     double level;          /* significance level of residual checks (0.05) */
     double collinearity_threshold; /* FME's rule of thumb: 20 */

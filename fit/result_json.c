@@ -73,13 +73,13 @@ static json_t *result_json(const phc_fit_result *res)
     json_object_set_new(root, "collinearity_threshold", num(res->collinearity_threshold));
     json_object_set_new(root, "correlation_threshold", num(res->correlation_threshold));
     json_object_set_new(root, "solver",
-                        json_pack("{s:I, s:I, s:I, s:o, s:o, s:I, s:I}", "residual_evaluations",
+                        json_pack("{s:I, s:I, s:I, s:o, s:o, s:I, s:I, s:I}", "residual_evaluations",
                                   (json_int_t)res->summary.residual_evaluations, "jacobian_evaluations",
                                   (json_int_t)res->summary.jacobian_evaluations, "iterations",
                                   (json_int_t)res->summary.iterations, "wall_time_best_start",
                                   num(res->summary.wall_time), "wall_time_total", num(res->total_time),
                                   "starts", (json_int_t)res->starts, "starts_at_best",
-                                  (json_int_t)res->starts_at_best));
+                                  (json_int_t)res->starts_at_best, "rescue_starts", (json_int_t)res->rescue_starts));
     json_t *params = json_object();
     for (size_t i = 0; i < res->n_params; ++i) {
         const phc_param_result *p = &res->params[i];

@@ -19,7 +19,7 @@ void phc_covariance_clear(phc_covariance *c)
 }
 
 int phc_covariance_compute(const double *J, size_t m, size_t n, double s2, double rcond,
-                           phc_covariance *out, phc_error *err)
+                           const double *scale, phc_covariance *out, phc_error *err)
 {
     memset(out, 0, sizeof *out);
     if (!J || n == 0 || m == 0)
@@ -47,6 +47,12 @@ int phc_covariance_compute(const double *J, size_t m, size_t n, double s2, doubl
             ss += J[i * n + j] * J[i * n + j];
         D[j] = sqrt(ss);
     }
+    double effect_max = 0;
+    for (size_t j = 0; j < n; ++j)
+        effect_max = fmax(effect_max, D[j] * (scale ? scale[j] : 1.0));
+    for (size_t j = 0; j < n; ++j)
+        if (D[j] * (scale ? scale[j] : 1.0) <= rcond * effect_max)
+            D[j] = 0; /* negligible effect: treated as a zero column */
     for (size_t i = 0; i < m; ++i)
         for (size_t j = 0; j < n; ++j)
             A[i * n + j] = D[j] > 0 ? J[i * n + j] / D[j] : 0.0;

@@ -31,9 +31,13 @@ typedef struct phc_covariance {
 /* J: m x n row-major (weighted residual Jacobian over the free parameters);
  * s2: the variance factor (RSS/dof, or 1 for absolute sigmas); rcond:
  * relative singular value cut-off (1e-10 is a good default; it is applied
- * to the column-scaled J).  Zero columns are always undetermined. */
+ * to the column-scaled J).  scale: n typical parameter magnitudes (NULL =
+ * ones); a column whose effect |J_j| * scale_j is below rcond times the
+ * largest is undetermined too (a parameter driven where the model no longer
+ * depends on it, e.g. a rate so fast that exp(-b x) is 0 at every x). */
 int phc_covariance_compute(const double *J, size_t m, size_t n, double s2,
-                           double rcond, phc_covariance *out, phc_error *err);
+                           double rcond, const double *scale,
+                           phc_covariance *out, phc_error *err);
 void phc_covariance_clear(phc_covariance *c);
 
 /* Describes null vector `which` as text, e.g. "0.707 b1 - 0.707 b2",

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/costs/expression.h"
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 
@@ -20,8 +21,10 @@ const char *const phc_curve_keys[] = {"file", "x", "y", "expression", "sigma",
 
 typedef struct curve_impl {
     muParserHandle_t parser;
+    phc_expr *tape;       /* exact derivatives; NULL = muparser + numerical */
     size_t n_cols;        /* columns used by the expression */
     double **cols;        /* n_cols arrays of n values */
+    char **col_names;     /* n_cols names */
     double *row;          /* n_cols current values (muparser variables) */
     double *slots;        /* k current parameter values (muparser variables) */
     long x_col;           /* index into cols of the x column, -1 if unused */
@@ -35,9 +38,13 @@ static void curve_free(void *p)
         return;
     if (c->parser)
         mupRelease(c->parser);
-    for (size_t j = 0; j < c->n_cols; ++j)
+    phc_expr_free(c->tape);
+    for (size_t j = 0; j < c->n_cols; ++j) {
         free(c->cols[j]);
+        free(c->col_names[j]);
+    }
     free(c->cols);
+    free(c->col_names);
     free(c->row);
     free(c->slots);
     free(c);
@@ -46,7 +53,16 @@ static void curve_free(void *p)
 static int curve_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
 {
     curve_impl *c = ds->impl;
-    (void)jac; /* numerical derivatives only */
+    if (c->tape) {
+        for (size_t i = 0; i < ds->n; ++i) {
+            for (size_t j = 0; j < c->n_cols; ++j)
+                c->row[j] = c->cols[j][i];
+            yhat[i] = phc_expr_eval(c->tape, p, c->row, jac ? jac + i * ds->k : NULL);
+            if (!isfinite(yhat[i]))
+                return 1; /* outside the expression's domain: reject the step */
+        }
+        return 0;
+    }
     memcpy(c->slots, p, ds->k * sizeof *p);
     for (size_t i = 0; i < ds->n; ++i) {
         for (size_t j = 0; j < c->n_cols; ++j)
@@ -72,6 +88,10 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     for (size_t i = 0; i < m; ++i) {
         if (c->x_col >= 0)
             c->row[c->x_col] = x[i];
+        if (c->tape) {
+            y[i] = phc_expr_eval(c->tape, p, c->row, NULL);
+            continue;
+        }
         y[i] = mupEval(c->parser);
         if (mupError(c->parser)) {
             mupErrorReset(c->parser);
@@ -121,6 +141,41 @@ static size_t key_line(const phc_yaml_node *map, const char *key)
         if (strcmp(map->keys[i], key) == 0)
             return map->key_lines[i];
     return map->line;
+}
+
+/* Compiles the derivative tape and binds its names to the slots and to the
+ * columns muparser registered (same names, same order as c->cols). */
+static int bind_tape(curve_impl *c, const char *expr, const char *const *slot_names, size_t n_slots,
+                     phc_error *err)
+{
+    phc_error tape_err;
+    size_t pos = 0;
+    phc_error_clear(&tape_err);
+    if (phc_expr_compile(expr, &c->tape, &pos, &tape_err) != PHC_OK) {
+        c->tape = NULL; /* unsupported construct: numerical derivatives */
+        return tape_err.status == PHC_ERR_NOMEM ? phc_error_set(err, PHC_ERR_NOMEM, "out of memory") : PHC_OK;
+    }
+    for (size_t i = 0; i < phc_expr_name_count(c->tape); ++i) {
+        const char *name = phc_expr_name(c->tape, i);
+        int bound = 0;
+        for (size_t j = 0; j < n_slots && !bound; ++j)
+            if (strcmp(slot_names[j], name) == 0)
+                bound = phc_expr_bind(c->tape, i, 1, j) == PHC_OK;
+        for (size_t j = 0; j < c->n_cols && !bound; ++j)
+            if (strcmp(c->col_names[j], name) == 0)
+                bound = phc_expr_bind(c->tape, i, 0, j) == PHC_OK;
+        if (!bound) { /* the two parsers disagree: trust muparser */
+            phc_expr_free(c->tape);
+            c->tape = NULL;
+            return PHC_OK;
+        }
+    }
+    if (phc_expr_prepare(c->tape, n_slots, err) != PHC_OK) {
+        phc_expr_free(c->tape);
+        c->tape = NULL;
+        return err->status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_OK;
+    }
+    return PHC_OK;
 }
 
 static char *label_or(const char *given, const char *fallback)
@@ -192,9 +247,10 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     /* Split the expression's names into parameter slots and columns. */
     slot_names = calloc((size_t)n_vars, sizeof *slot_names);
     c->cols = calloc((size_t)n_vars, sizeof *c->cols);
+    c->col_names = calloc((size_t)n_vars, sizeof *c->col_names);
     c->row = calloc((size_t)n_vars, sizeof *c->row);
     c->slots = calloc((size_t)n_vars, sizeof *c->slots);
-    if (!slot_names || !c->cols || !c->row || !c->slots) {
+    if (!slot_names || !c->cols || !c->col_names || !c->row || !c->slots) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -227,6 +283,11 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                 mupDefineVar(c->parser, name, &c->slots[n_slots++]);
         } else if (col >= 0) {
             rc = phc_table_column_numbers(table, name, &c->cols[c->n_cols], err);
+            if (!rc && !(c->col_names[c->n_cols] = strdup(name))) {
+                free(c->cols[c->n_cols]);
+                c->cols[c->n_cols] = NULL;
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            }
             if (!rc) {
                 if (strcmp(name, xname) == 0)
                     c->x_col = (long)c->n_cols;
@@ -252,11 +313,16 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     }
 
+    /* Exact derivatives when the expression stays within DESIGN.md's
+     * grammar; otherwise muparser with numerical derivatives. */
+    if ((rc = bind_tape(c, expr, (const char *const *)slot_names, n_slots, err)))
+        goto fail;
     ds = phc_dataset_new(&curve_ops, n_slots);
     if (!ds) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    ds->derivatives = c->tape ? PHC_DERIV_ANALYTIC : PHC_DERIV_CENTRAL;
     for (size_t j = 0; j < n_slots; ++j) {
         ds->slot_names[j] = slot_names[j];
         slot_names[j] = NULL;

@@ -1,0 +1,444 @@
+/* Forward-mode differentiation of curve expressions: see expression.h.
+ *
+ * The expression becomes a list of nodes in evaluation order (children
+ * before parents).  Evaluation carries each node's value and its gradient
+ * with respect to the parameter slots; nodes that depend on no slot (data
+ * columns, constants) skip the gradient work. */
+#include "fit/costs/expression.h"
+
+#include <ctype.h>
+#include <locale.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef enum op {
+    OP_CONST, OP_NAME, OP_NEG, OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW,
+    OP_EXP, OP_LOG, OP_SQRT, OP_SIN, OP_COS, OP_TAN, OP_ATAN, OP_ABS
+} op;
+
+typedef struct node {
+    op op;
+    size_t a, b;      /* children (node indices) */
+    double value;     /* OP_CONST */
+    size_t name;      /* OP_NAME: index into names */
+    int active;       /* depends on a slot */
+} node;
+
+struct phc_expr {
+    node *nodes;
+    size_t n_nodes, cap;
+    char **names;
+    size_t n_names;
+    int *is_slot;     /* per name */
+    size_t *index;    /* per name: slot or column */
+    int *bound;
+    size_t n_slots;
+    double *val;      /* n_nodes values */
+    double *grad;     /* n_nodes x n_slots */
+};
+
+typedef struct parser {
+    const char *s;
+    size_t pos;
+    phc_expr *e;
+    phc_error *err;
+    size_t err_pos;
+    int failed;
+} parser;
+
+static const struct {
+    const char *name;
+    op op;
+} functions[] = {{"exp", OP_EXP}, {"log", OP_LOG}, {"ln", OP_LOG}, {"sqrt", OP_SQRT}, {"sin", OP_SIN},
+                 {"cos", OP_COS}, {"tan", OP_TAN}, {"atan", OP_ATAN}, {"abs", OP_ABS}};
+
+static int fail_at(parser *p, size_t pos, const char *what)
+{
+    if (!p->failed) {
+        p->failed = 1;
+        p->err_pos = pos;
+        phc_error_set(p->err, PHC_ERR_INPUT, "%s at character %zu", what, pos + 1);
+    }
+    return -1;
+}
+
+static long add_node(parser *p, node n)
+{
+    phc_expr *e = p->e;
+    if (e->n_nodes == e->cap) {
+        size_t cap = e->cap ? 2 * e->cap : 32;
+        node *grown = realloc(e->nodes, cap * sizeof *grown);
+        if (!grown) {
+            p->failed = 1;
+            phc_error_set(p->err, PHC_ERR_NOMEM, "out of memory");
+            return -1;
+        }
+        e->nodes = grown;
+        e->cap = cap;
+    }
+    e->nodes[e->n_nodes] = n;
+    return (long)e->n_nodes++;
+}
+
+static void skip_space(parser *p)
+{
+    while (isspace((unsigned char)p->s[p->pos]))
+        p->pos++;
+}
+
+static long parse_expr(parser *p);
+static long parse_unary(parser *p);
+
+static long binary(parser *p, op o, long a, long b)
+{
+    if (a < 0 || b < 0)
+        return -1;
+    node n = {o, (size_t)a, (size_t)b, 0, 0, 0};
+    return add_node(p, n);
+}
+
+static long unary_node(parser *p, op o, long a)
+{
+    if (a < 0)
+        return -1;
+    node n = {o, (size_t)a, 0, 0, 0, 0};
+    return add_node(p, n);
+}
+
+static long name_node(parser *p, const char *name, size_t len)
+{
+    phc_expr *e = p->e;
+    size_t i;
+    for (i = 0; i < e->n_names; ++i)
+        if (strlen(e->names[i]) == len && strncmp(e->names[i], name, len) == 0)
+            break;
+    if (i == e->n_names) {
+        char **grown = realloc(e->names, (e->n_names + 1) * sizeof *grown);
+        if (!grown)
+            return fail_at(p, p->pos, "out of memory");
+        e->names = grown;
+        e->names[e->n_names] = strndup(name, len);
+        if (!e->names[e->n_names])
+            return fail_at(p, p->pos, "out of memory");
+        e->n_names++;
+    }
+    node n = {OP_NAME, 0, 0, 0, i, 0};
+    return add_node(p, n);
+}
+
+static long parse_primary(parser *p)
+{
+    skip_space(p);
+    const char *s = p->s;
+    const size_t start = p->pos;
+    const char c = s[start];
+    if (c == '(') {
+        p->pos++;
+        long inner = parse_expr(p);
+        skip_space(p);
+        if (inner < 0)
+            return -1;
+        if (s[p->pos] != ')')
+            return fail_at(p, p->pos, "expected ')'");
+        p->pos++;
+        return inner;
+    }
+    if (isdigit((unsigned char)c) || (c == '.' && isdigit((unsigned char)s[start + 1]))) {
+        /* strtod honours the locale's decimal point; configs use '.' */
+        size_t end = start;
+        while (isdigit((unsigned char)s[end]) || s[end] == '.')
+            end++;
+        if ((s[end] == 'e' || s[end] == 'E') &&
+            (isdigit((unsigned char)s[end + 1]) ||
+             ((s[end + 1] == '+' || s[end + 1] == '-') && isdigit((unsigned char)s[end + 2])))) {
+            end += 2;
+            while (isdigit((unsigned char)s[end]))
+                end++;
+        }
+        char buf[64];
+        if (end - start >= sizeof buf)
+            return fail_at(p, start, "number too long");
+        memcpy(buf, s + start, end - start);
+        buf[end - start] = '\0';
+        char *stop = NULL;
+        double v = strtod(buf, &stop);
+        if (*stop != '\0') {
+            /* a locale with a decimal comma: parse by hand */
+            double ip = 0, frac = 0, scale = 1;
+            size_t i = 0;
+            for (; isdigit((unsigned char)buf[i]); ++i)
+                ip = ip * 10 + (buf[i] - '0');
+            if (buf[i] == '.')
+                for (++i; isdigit((unsigned char)buf[i]); ++i)
+                    frac += (buf[i] - '0') * (scale /= 10);
+            v = ip + frac;
+            if (buf[i] == 'e' || buf[i] == 'E')
+                v *= pow(10.0, atof(buf + i + 1));
+        }
+        p->pos = end;
+        node n = {OP_CONST, 0, 0, v, 0, 0};
+        return add_node(p, n);
+    }
+    if (isalpha((unsigned char)c) || c == '_') {
+        size_t end = start;
+        while (isalnum((unsigned char)s[end]) || s[end] == '_')
+            end++;
+        const size_t len = end - start;
+        p->pos = end;
+        skip_space(p);
+        if (s[p->pos] == '(') {
+            for (size_t f = 0; f < sizeof functions / sizeof functions[0]; ++f)
+                if (strlen(functions[f].name) == len && strncmp(functions[f].name, s + start, len) == 0) {
+                    p->pos++;
+                    long arg = parse_expr(p);
+                    skip_space(p);
+                    if (arg < 0)
+                        return -1;
+                    if (s[p->pos] != ')')
+                        return fail_at(p, p->pos, "expected ')' after the function argument");
+                    p->pos++;
+                    return unary_node(p, functions[f].op, arg);
+                }
+            return fail_at(p, start, "function not supported for exact derivatives");
+        }
+        if ((len == 2 && strncmp(s + start, "pi", 2) == 0) || (len == 3 && strncmp(s + start, "_pi", 3) == 0)) {
+            node n = {OP_CONST, 0, 0, 3.14159265358979323846, 0, 0};
+            return add_node(p, n);
+        }
+        if (len == 2 && strncmp(s + start, "_e", 2) == 0) {
+            node n = {OP_CONST, 0, 0, 2.71828182845904523536, 0, 0};
+            return add_node(p, n);
+        }
+        return name_node(p, s + start, len);
+    }
+    return fail_at(p, start, c ? "unexpected character" : "unexpected end of expression");
+}
+
+/* power := primary ('^' unary)?  -- right-associative, binds tighter than unary minus */
+static long parse_power(parser *p)
+{
+    long base = parse_primary(p);
+    if (base < 0)
+        return -1;
+    skip_space(p);
+    if (p->s[p->pos] == '^') {
+        p->pos++;
+        long expo = parse_unary(p);
+        return binary(p, OP_POW, base, expo);
+    }
+    return base;
+}
+
+static long parse_unary(parser *p)
+{
+    skip_space(p);
+    const char c = p->s[p->pos];
+    if (c == '-') {
+        p->pos++;
+        return unary_node(p, OP_NEG, parse_unary(p));
+    }
+    if (c == '+') {
+        p->pos++;
+        return parse_unary(p);
+    }
+    return parse_power(p);
+}
+
+static long parse_term(parser *p)
+{
+    long left = parse_unary(p);
+    for (;;) {
+        if (left < 0)
+            return -1;
+        skip_space(p);
+        const char c = p->s[p->pos];
+        if (c != '*' && c != '/')
+            return left;
+        p->pos++;
+        left = binary(p, c == '*' ? OP_MUL : OP_DIV, left, parse_unary(p));
+    }
+}
+
+static long parse_expr(parser *p)
+{
+    long left = parse_term(p);
+    for (;;) {
+        if (left < 0)
+            return -1;
+        skip_space(p);
+        const char c = p->s[p->pos];
+        if (c != '+' && c != '-')
+            return left;
+        p->pos++;
+        left = binary(p, c == '+' ? OP_ADD : OP_SUB, left, parse_term(p));
+    }
+}
+
+void phc_expr_free(phc_expr *e)
+{
+    if (!e)
+        return;
+    for (size_t i = 0; i < e->n_names; ++i)
+        free(e->names[i]);
+    free(e->names);
+    free(e->nodes);
+    free(e->is_slot);
+    free(e->index);
+    free(e->bound);
+    free(e->val);
+    free(e->grad);
+    free(e);
+}
+
+int phc_expr_compile(const char *text, phc_expr **out, size_t *pos, phc_error *err)
+{
+    *out = NULL;
+    phc_expr *e = calloc(1, sizeof *e);
+    if (!e)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    parser p = {text, 0, e, err, 0, 0};
+    long root = parse_expr(&p);
+    skip_space(&p);
+    if (root >= 0 && text[p.pos] != '\0')
+        fail_at(&p, p.pos, "unexpected text after the expression");
+    if (p.failed || root < 0 || (size_t)root != e->n_nodes - 1) {
+        if (pos)
+            *pos = p.err_pos;
+        if (!p.failed)
+            phc_error_set(err, PHC_ERR_INPUT, "cannot compile the expression");
+        int status = err ? err->status : PHC_ERR_INPUT;
+        phc_expr_free(e);
+        return status ? status : PHC_ERR_INPUT;
+    }
+    e->is_slot = calloc(e->n_names + 1, sizeof *e->is_slot);
+    e->index = calloc(e->n_names + 1, sizeof *e->index);
+    e->bound = calloc(e->n_names + 1, sizeof *e->bound);
+    if (!e->is_slot || !e->index || !e->bound) {
+        phc_expr_free(e);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    *out = e;
+    return PHC_OK;
+}
+
+size_t phc_expr_name_count(const phc_expr *e)
+{
+    return e->n_names;
+}
+
+const char *phc_expr_name(const phc_expr *e, size_t i)
+{
+    return i < e->n_names ? e->names[i] : NULL;
+}
+
+int phc_expr_bind(phc_expr *e, size_t i, int is_slot, size_t index)
+{
+    if (i >= e->n_names)
+        return PHC_ERR_INVALID;
+    e->is_slot[i] = is_slot;
+    e->index[i] = index;
+    e->bound[i] = 1;
+    return PHC_OK;
+}
+
+int phc_expr_prepare(phc_expr *e, size_t n_slots, phc_error *err)
+{
+    for (size_t i = 0; i < e->n_names; ++i) {
+        if (!e->bound[i])
+            return phc_error_set(err, PHC_ERR_INVALID, "expression name '%s' is not bound", e->names[i]);
+        if (e->is_slot[i] && e->index[i] >= n_slots)
+            return phc_error_set(err, PHC_ERR_INVALID, "slot %zu out of range", e->index[i]);
+    }
+    e->n_slots = n_slots;
+    free(e->val);
+    free(e->grad);
+    e->val = calloc(e->n_nodes, sizeof *e->val);
+    e->grad = calloc(e->n_nodes * (n_slots ? n_slots : 1), sizeof *e->grad);
+    if (!e->val || !e->grad)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < e->n_nodes; ++i) {
+        node *n = &e->nodes[i];
+        switch (n->op) {
+        case OP_CONST: n->active = 0; break;
+        case OP_NAME: n->active = e->is_slot[n->name]; break;
+        case OP_ADD:
+        case OP_SUB:
+        case OP_MUL:
+        case OP_DIV:
+        case OP_POW: n->active = e->nodes[n->a].active || e->nodes[n->b].active; break;
+        default: n->active = e->nodes[n->a].active; break;
+        }
+    }
+    return PHC_OK;
+}
+
+double phc_expr_eval(phc_expr *e, const double *slots, const double *row, double *grad)
+{
+    const size_t k = e->n_slots;
+    double *v = e->val;
+    double *g = e->grad;
+    const int want = grad != NULL;
+    for (size_t i = 0; i < e->n_nodes; ++i) {
+        const node *n = &e->nodes[i];
+        double *gi = g + i * k;
+        const double a = v[n->a], b = v[n->b];
+        const double *ga = g + n->a * k, *gb = g + n->b * k;
+        const int aa = e->nodes[n->a].active, ab = e->nodes[n->b].active;
+        const int grad_here = want && n->active;
+        double r = 0, da = 0, db = 0; /* value and local partials d r/d a, d r/d b */
+        switch (n->op) {
+        case OP_CONST: r = n->value; break;
+        case OP_NAME:
+            if (e->is_slot[n->name]) {
+                r = slots[e->index[n->name]];
+                if (grad_here) {
+                    memset(gi, 0, k * sizeof *gi);
+                    gi[e->index[n->name]] = 1.0;
+                }
+                v[i] = r;
+                continue;
+            }
+            r = row[e->index[n->name]];
+            break;
+        case OP_NEG: r = -a; da = -1; break;
+        case OP_ADD: r = a + b; da = 1; db = 1; break;
+        case OP_SUB: r = a - b; da = 1; db = -1; break;
+        case OP_MUL: r = a * b; da = b; db = a; break;
+        case OP_DIV: r = a / b; da = 1 / b; db = -r / b; break;
+        case OP_POW:
+            r = pow(a, b);
+            /* d/da a^b = b a^(b-1); d/db a^b = a^b log a (only needed when b varies) */
+            da = b == 0 ? 0 : b * pow(a, b - 1);
+            db = ab ? r * log(a) : 0;
+            break;
+        case OP_EXP: r = exp(a); da = r; break;
+        case OP_LOG: r = log(a); da = 1 / a; break;
+        case OP_SQRT: r = sqrt(a); da = 0.5 / r; break;
+        case OP_SIN: r = sin(a); da = cos(a); break;
+        case OP_COS: r = cos(a); da = -sin(a); break;
+        case OP_TAN: r = tan(a); da = 1 + r * r; break;
+        case OP_ATAN: r = atan(a); da = 1 / (1 + a * a); break;
+        case OP_ABS: r = fabs(a); da = a > 0 ? 1 : (a < 0 ? -1 : 0); break;
+        }
+        v[i] = r;
+        if (!grad_here)
+            continue;
+        const int binary_op = n->op >= OP_ADD && n->op <= OP_POW;
+        for (size_t j = 0; j < k; ++j) {
+            double s = aa ? da * ga[j] : 0;
+            if (binary_op && ab)
+                s += db * gb[j];
+            gi[j] = s;
+        }
+    }
+    const size_t root = e->n_nodes - 1;
+    if (grad) {
+        if (e->nodes[root].active)
+            memcpy(grad, g + root * k, k * sizeof *grad);
+        else
+            memset(grad, 0, k * sizeof *grad);
+    }
+    return v[root];
+}

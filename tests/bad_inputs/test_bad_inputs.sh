@@ -1,0 +1,625 @@
+#!/usr/bin/env bash
+# Bad-input tests of the phytocal command line (DESIGN.md §3-4, tests/bad_inputs).
+#
+#   bash test_bad_inputs.sh PATH/TO/phytocal [SHARED_DATA_DIR]
+#
+# Every malformed input must give: exit code 2; exactly one line on stderr,
+# starting with "phytocal: ", that names the file and the line (or key) of the
+# problem; no crash (no signal, no sanitizer report); no output directory and
+# no temporary directory left behind.  Usage errors exit 1.  A positive
+# control (the bundled enzyme example) checks that the harness itself is sound.
+#
+# PHC_TEST_VERBOSE=1 also prints each case's exit code and stderr.
+# Prints "ok - <case>" / "not ok - <case>: <why>" per case, then
+# "N passed, M failed"; exits 1 if any case failed.
+
+set -u
+
+PHC=${1:-}
+if [ -z "$PHC" ]; then
+    echo "usage: bash test_bad_inputs.sh PATH/TO/phytocal [SHARED_DATA_DIR]" >&2
+    exit 2
+fi
+case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
+if [ ! -x "$PHC" ]; then
+    echo "not ok - setup: $PHC is not an executable" >&2
+    echo "0 passed, 1 failed"
+    exit 1
+fi
+# The shared data folder is not needed: every input is written here.
+
+SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+EXAMPLE_DIR="$SCRIPT_DIR/../../measurements/examples/enzyme_kinetics"
+
+T=$(mktemp -d "${TMPDIR:-/tmp}/phc_bad_inputs.XXXXXX") || exit 1
+trap 'chmod -R u+rwx "$T" 2>/dev/null; rm -rf "$T"' EXIT
+cd "$T" || exit 1
+mkdir -p cases
+C="$T/cases"
+
+# A generous limit: a hang is a failure, not a stuck CI job.
+TIMEOUT=120
+if command -v timeout >/dev/null 2>&1; then
+    RUN=(timeout "$TIMEOUT")
+else
+    RUN=()
+fi
+
+PASSED=0
+FAILED=0
+FAIL_LIST=()
+
+pass() { PASSED=$((PASSED + 1)); echo "ok - $1"; }
+failc() {
+    FAILED=$((FAILED + 1))
+    FAIL_LIST+=("$1")
+    echo "not ok - $1: $2"
+}
+
+# Runs phytocal with the given arguments; sets RC and ERR (stderr); stdout is in $T/stdout.
+run_phc() {
+    "${RUN[@]}" "$PHC" "$@" >"$T/stdout" 2>"$T/stderr"
+    RC=$?
+    ERR=$(cat "$T/stderr")
+}
+
+# Appends to WHY the problems common to every error case.
+# $1 expected exit code; remaining: substrings stderr must contain.
+WHY=""
+add_why() { WHY="${WHY:+$WHY; }$1"; }
+
+check_error_output() {
+    local want_rc=$1
+    shift
+    if [ "$RC" -ge 128 ] || [ "$RC" -eq 124 ]; then
+        add_why "crashed or hung (exit code $RC)"
+    elif [ "$RC" -ne "$want_rc" ]; then
+        add_why "exit code $RC, expected $want_rc"
+    fi
+    if grep -q -e 'AddressSanitizer' -e 'runtime error' -e 'LeakSanitizer' "$T/stderr"; then
+        add_why "sanitizer report on stderr"
+    fi
+    local nlines
+    nlines=$(awk 'END { print NR }' "$T/stderr")
+    if [ "$nlines" -ne 1 ]; then
+        add_why "stderr has $nlines lines, expected exactly 1"
+    fi
+    case "$ERR" in
+    "phytocal: "*) ;;
+    *) add_why "stderr does not start with 'phytocal: '" ;;
+    esac
+    local s
+    for s in "$@"; do
+        case "$ERR" in
+        *"$s"*) ;;
+        *) add_why "stderr lacks '$s'" ;;
+        esac
+    done
+}
+
+# No output directory, no temporary or set-aside directory next to it.
+check_no_output() {
+    local out=$1
+    if [ -e "$out" ]; then
+        add_why "output directory $(basename "$out") was created"
+    fi
+    local left
+    left=$(cd "$(dirname "$out")" && ls -d "$(basename "$out")".tmp-* "$(basename "$out")".old* 2>/dev/null | head -3 | tr '\n' ' ')
+    if [ -n "$left" ]; then
+        add_why "left behind: $left"
+    fi
+    if [ -e "$T/runs" ]; then
+        add_why "a default runs/ directory was created"
+        rm -rf "$T/runs"
+    fi
+}
+
+report_case() {
+    local name=$1
+    if [ -n "${PHC_TEST_VERBOSE:-}" ]; then
+        echo "# rc=$RC stderr: $(head -c 400 "$T/stderr" | tr '\n' '|')"
+    fi
+    if [ -z "$WHY" ]; then
+        pass "$name"
+    else
+        failc "$name" "$WHY [rc=$RC stderr: $(head -c 400 "$T/stderr" | tr '\n' '|')]"
+    fi
+    WHY=""
+}
+
+# fit_case NAME CONFIG SUBSTRING...: `phytocal fit CONFIG -o OUT` must fail
+# with exit code 2, one line naming the file and line/key, and no output.
+# FIT_OPTS holds extra options (--quiet where the error comes after the fit
+# has started, so progress lines do not count as error lines).
+FIT_OPTS=()
+fit_case() {
+    local name=$1 config=$2
+    shift 2
+    local out="$T/out_${name//[^A-Za-z0-9_]/_}"
+    WHY=""
+    run_phc fit "$config" -o "$out" ${FIT_OPTS[@]+"${FIT_OPTS[@]}"}
+    check_error_output 2 "$@"
+    check_no_output "$out"
+    report_case "$name"
+}
+
+# ----------------------------------------------------------------------------
+# Shared valid pieces.
+cat >"$C/data.csv" <<'EOF'
+x,y
+1,2.1
+2,3.9
+3,6.2
+4,8.0
+5,9.9
+6,12.1
+EOF
+
+# write_config FILE [PARAMETERS_BLOCK] [DATASET_BLOCK] [EXTRA]: a config with
+# the given parameter and data-set blocks (defaults: a valid straight line).
+PARAMS_OK='parameters:
+  a: {value: 1, lower: 0, upper: 10}
+  b: {value: 0.5}'
+dataset_block() { # $1 csv file, $2 expression, $3 extra data-set lines
+    printf '  - kind: curve\n    file: %s\n    x: x\n    y: y\n    expression: "%s"\n%s' "$1" "$2" "${3:-}"
+}
+write_config() {
+    local file=$1 params=${2:-$PARAMS_OK} ds=${3:-}
+    [ -n "$ds" ] || ds=$(dataset_block data.csv "a*x + b")
+    printf 'name: t\n%s\ndatasets:\n%s\n' "$params" "$ds" >"$file"
+}
+
+# Sanity: the valid base config fits (otherwise every case below is moot).
+write_config "$C/base.yaml"
+WHY=""
+run_phc fit "$C/base.yaml" -o "$T/out_base" --quiet
+if [ "$RC" -ne 0 ]; then
+    add_why "exit code $RC, expected 0"
+fi
+[ -f "$T/out_base/result.json" ] || add_why "no result.json"
+report_case "control: valid base config fits"
+rm -rf "$T/out_base"
+
+# ---- malformed YAML ----------------------------------------------------------
+cat >"$C/indent.yaml" <<'EOF'
+name: t
+parameters:
+  a: {value: 1}
+   b: {value: 2}
+datasets:
+  - kind: curve
+    file: data.csv
+    x: x
+    y: y
+    expression: "a*x + b"
+EOF
+fit_case "yaml: bad indentation" "$C/indent.yaml" "indent.yaml:4"
+
+cat >"$C/bracket.yaml" <<'EOF'
+name: t
+parameters:
+  a: {value: 1, lower: 0
+  b: {value: 2}
+datasets:
+  - kind: curve
+    file: data.csv
+    x: x
+    y: y
+    expression: "a*x + b"
+EOF
+fit_case "yaml: unclosed bracket" "$C/bracket.yaml" "bracket.yaml:"
+
+cat >"$C/bracket2.yaml" <<'EOF'
+name: t
+parameters:
+  a: {value: 1}
+  b: {value: 2}
+datasets: [
+EOF
+fit_case "yaml: unclosed flow sequence at end of file" "$C/bracket2.yaml" "bracket2.yaml:"
+
+printf 'name: t\nparameters:\n\ta: {value: 1}\n' >"$C/tab.yaml"
+fit_case "yaml: tab indentation" "$C/tab.yaml" "tab.yaml:3"
+
+printf 'just a scalar\n' >"$C/scalar.yaml"
+fit_case "yaml: config is a bare scalar" "$C/scalar.yaml" "scalar.yaml:1"
+
+: >"$C/empty.yaml"
+fit_case "yaml: empty config file" "$C/empty.yaml" "empty.yaml"
+
+printf -- '- a\n- b\n' >"$C/seq.yaml"
+fit_case "yaml: config is a sequence" "$C/seq.yaml" "seq.yaml:1"
+
+cat >"$C/dupkey.yaml" <<'EOF'
+name: t
+parameters:
+  a: {value: 1, value: 2}
+  b: {value: 2}
+datasets:
+  - kind: curve
+    file: data.csv
+    x: x
+    y: y
+    expression: "a*x + b"
+EOF
+fit_case "yaml: duplicate key" "$C/dupkey.yaml" "dupkey.yaml:3" "value"
+
+# ---- unknown keys, with suggestions -----------------------------------------
+{
+    printf 'name: t\nparamters:\n  a: {value: 1}\n  b: {value: 2}\ndatasets:\n'
+    dataset_block data.csv "a*x + b"
+} >"$C/topkey.yaml"
+fit_case "unknown top-level key 'paramters'" "$C/topkey.yaml" "topkey.yaml:2" "paramters" "did you mean 'parameters'"
+
+write_config "$C/lowr.yaml" 'parameters:
+  a: {value: 1, lowr: 0}
+  b: {value: 0.5}'
+fit_case "unknown parameter key 'lowr'" "$C/lowr.yaml" "lowr.yaml:3" "lowr" "did you mean 'lower'"
+
+write_config "$C/dskey.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    sigmaa: 1
+')"
+fit_case "unknown data-set key 'sigmaa'" "$C/dskey.yaml" "dskey.yaml:11" "sigmaa" "did you mean 'sigma'"
+
+write_config "$C/dskey2.yaml" "$PARAMS_OK" '  - kind: curve
+    file: data.csv
+    x: x
+    y: y
+    expresion: "a*x + b"'
+fit_case "unknown data-set key 'expresion'" "$C/dskey2.yaml" "dskey2.yaml:10" "did you mean 'expression'"
+
+write_config "$C/kind.yaml" "$PARAMS_OK" '  - kind: curv
+    file: data.csv
+    x: x
+    y: y
+    expression: "a*x + b"'
+fit_case "unknown data-set kind 'curv'" "$C/kind.yaml" "kind.yaml:6" "curv" "did you mean 'curve'"
+
+write_config "$C/solverkey.yaml"
+printf 'solver:\n  max_iteration: 10\n' >>"$C/solverkey.yaml"
+fit_case "unknown solver key 'max_iteration'" "$C/solverkey.yaml" "solverkey.yaml:" "did you mean 'max_iterations'"
+
+write_config "$C/nokind.yaml" "$PARAMS_OK" '  - file: data.csv
+    x: x
+    y: y
+    expression: "a*x + b"'
+fit_case "data set without 'kind'" "$C/nokind.yaml" "nokind.yaml:6" "kind"
+
+write_config "$C/noexpr.yaml" "$PARAMS_OK" '  - kind: curve
+    file: data.csv
+    x: x
+    y: y'
+fit_case "curve data set without 'expression'" "$C/noexpr.yaml" "noexpr.yaml:6" "expression"
+
+write_config "$C/nocol.yaml" "$PARAMS_OK" '  - kind: curve
+    file: data.csv
+    x: x
+    y: yy
+    expression: "a*x + b"'
+fit_case "y column not in the CSV" "$C/nocol.yaml" "nocol.yaml:9" "yy"
+
+write_config "$C/valnum.yaml" 'parameters:
+  a: {value: abc}
+  b: {value: 0.5}'
+fit_case "parameter value not a number" "$C/valnum.yaml" "valnum.yaml:3" "abc"
+
+# ---- missing and unreadable files -------------------------------------------
+write_config "$C/missing.yaml" "$PARAMS_OK" "$(dataset_block nope.csv "a*x + b")"
+fit_case "missing CSV file" "$C/missing.yaml" "nope.csv"
+
+mkdir -p "$C/adir.csv"
+write_config "$C/dirfile.yaml" "$PARAMS_OK" "$(dataset_block adir.csv "a*x + b")"
+fit_case "directory given as the CSV file" "$C/dirfile.yaml" "adir.csv"
+
+fit_case "missing config file" "$C/no_such_config.yaml" "no_such_config.yaml"
+
+mkdir -p "$C/dirconfig.yaml"
+fit_case "directory given as the config file" "$C/dirconfig.yaml" "dirconfig.yaml"
+
+if [ "$(id -u)" -ne 0 ]; then
+    cp "$C/data.csv" "$C/noread.csv"
+    chmod 000 "$C/noread.csv"
+    write_config "$C/noread.yaml" "$PARAMS_OK" "$(dataset_block noread.csv "a*x + b")"
+    fit_case "CSV file without read permission" "$C/noread.yaml" "noread.csv"
+fi
+
+# ---- CSV contents -------------------------------------------------------------
+# csv_case NAME ROW3 EXPECT...: data.csv with its 3rd data row (file line 4)
+# replaced by ROW3.
+csv_case() {
+    local name=$1 file=$2 row=$3
+    shift 3
+    printf 'x,y\n1,2.1\n2,3.9\n%s\n4,8.0\n5,9.9\n6,12.1\n' "$row" >"$C/$file.csv"
+    write_config "$C/$file.yaml" "$PARAMS_OK" "$(dataset_block "$file.csv" "a*x + b")"
+    fit_case "$name" "$C/$file.yaml" "$file.csv:4:" "$@"
+}
+csv_case "CSV: empty cell" cell_empty "3,"
+csv_case "CSV: empty cell in the first column" cell_empty1 ",6.2"
+csv_case "CSV: non-numeric cell 'n/a'" cell_na "3,n/a" "n/a"
+csv_case "CSV: 'nan'" cell_nan "3,nan" "nan"
+csv_case "CSV: 'NaN'" cell_nan2 "3,NaN" "NaN"
+csv_case "CSV: 'inf'" cell_inf "3,inf" "inf"
+csv_case "CSV: '-Infinity'" cell_ninf "3,-Infinity" "Infinity"
+csv_case "CSV: overflowing number 1e999" cell_huge "3,1e999" "1e999"
+csv_case "CSV: trailing garbage '6.2abc'" cell_garbage "3,6.2abc" "6.2abc"
+csv_case "CSV: ragged row (too many cells)" ragged_long "3,6.2,7"
+csv_case "CSV: ragged row (too few cells)" ragged_short "3"
+
+printf 'x,y\n' >"$C/header_only.csv"
+write_config "$C/header_only.yaml" "$PARAMS_OK" "$(dataset_block header_only.csv "a*x + b")"
+fit_case "CSV: header only, no rows" "$C/header_only.yaml" "header_only.csv"
+
+: >"$C/empty_csv.csv"
+write_config "$C/empty_csv.yaml" "$PARAMS_OK" "$(dataset_block empty_csv.csv "a*x + b")"
+fit_case "CSV: empty file" "$C/empty_csv.yaml" "empty_csv.csv"
+
+# ---- expressions ----------------------------------------------------------------
+write_config "$C/expr_syntax.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + * b")"
+# the second '*' is character 7 of the expression
+fit_case "expression: syntax error (position)" "$C/expr_syntax.yaml" "expr_syntax.yaml:10" "character 7"
+
+write_config "$C/expr_paren.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*(x + b")"
+fit_case "expression: unbalanced parenthesis" "$C/expr_paren.yaml" "expr_paren.yaml:10" "character "
+
+write_config "$C/expr_name.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b + zeta")"
+fit_case "expression: unknown name" "$C/expr_name.yaml" "expr_name.yaml:10" "zeta"
+
+write_config "$C/expr_ambig.yaml" 'parameters:
+  a: {value: 1}
+  x: {value: 0.5}' "$(dataset_block data.csv "a*x")"
+fit_case "expression: name is both a parameter and a column" "$C/expr_ambig.yaml" "expr_ambig.yaml:10" "'x'"
+
+# The model cannot be evaluated at the start values: b/(x-3) divides by zero
+# on the row x = 3 (nonfinite.csv line 4).  The message must still say where:
+# the config or the CSV file, not only an internal residual-block number.
+cp "$C/data.csv" "$C/nonfinite.csv"
+write_config "$C/nonfinite.yaml" "$PARAMS_OK" "$(dataset_block nonfinite.csv "a*x + b/(x - 3)")"
+FIT_OPTS=(--quiet)
+fit_case "model not finite at the start values" "$C/nonfinite.yaml" "nonfinite."
+FIT_OPTS=()
+
+write_config "$C/expr_empty.yaml" "$PARAMS_OK" "$(dataset_block data.csv "")"
+fit_case "expression: empty" "$C/expr_empty.yaml" "expr_empty.yaml:" "expression"
+
+# ---- parameters and bounds ------------------------------------------------------
+write_config "$C/bounds.yaml" 'parameters:
+  a: {value: 1, lower: 5, upper: 2}
+  b: {value: 0.5}'
+fit_case "lower > upper" "$C/bounds.yaml" "bounds.yaml:3" "lower"
+
+write_config "$C/start.yaml" 'parameters:
+  a: {value: 20, lower: 0, upper: 10}
+  b: {value: 0.5}'
+fit_case "start outside its bounds" "$C/start.yaml" "start.yaml:3" "20"
+
+write_config "$C/start2.yaml" 'parameters:
+  a: {value: -1, lower: 0}
+  b: {value: 0.5}'
+fit_case "start below its lower bound" "$C/start2.yaml" "start2.yaml:3"
+
+write_config "$C/unused.yaml" 'parameters:
+  a: {value: 1, lower: 0, upper: 10}
+  b: {value: 0.5}
+  c: {value: 3}'
+fit_case "parameter not used by any data set" "$C/unused.yaml" "unused.yaml" "'c'"
+
+printf 'name: t\n%s\ndatasets: []\n' "$PARAMS_OK" >"$C/nodatasets.yaml"
+fit_case "empty datasets list" "$C/nodatasets.yaml" "nodatasets.yaml:5" "datasets"
+
+printf 'name: t\n%s\n' "$PARAMS_OK" >"$C/nodatasetkey.yaml"
+fit_case "no datasets key" "$C/nodatasetkey.yaml" "nodatasetkey.yaml" "datasets"
+
+write_config "$C/bind.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    parameters: {a: zz}
+')"
+fit_case "data set binds a slot to an unknown parameter" "$C/bind.yaml" "bind.yaml:11" "'zz'"
+
+write_config "$C/allfixed.yaml" 'parameters:
+  a: {value: 1, fixed: true}
+  b: {value: 0.5, fixed: true}'
+fit_case "every parameter fixed" "$C/allfixed.yaml" "allfixed.yaml" "fixed"
+
+write_config "$C/dupname.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    name: same
+')
+$(dataset_block data.csv "a*x + b" '    name: same
+')"
+fit_case "two data sets with the same name" "$C/dupname.yaml" "dupname.yaml:" "'same'"
+
+# ---- sigma -----------------------------------------------------------------------
+write_config "$C/sigma0.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    sigma: 0
+')"
+fit_case "sigma 0" "$C/sigma0.yaml" "sigma0.yaml:11" "sigma"
+
+write_config "$C/sigmaneg.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    sigma: -0.5
+')"
+fit_case "sigma negative" "$C/sigmaneg.yaml" "sigmaneg.yaml:11" "sigma"
+
+printf 'x,y,s\n1,2.1,0.1\n2,3.9,0.1\n3,6.2,0\n4,8.0,0.1\n5,9.9,0.1\n6,12.1,0.1\n' >"$C/sigcol.csv"
+write_config "$C/sigcol.yaml" "$PARAMS_OK" "$(dataset_block sigcol.csv "a*x + b" '    sigma: s
+')"
+fit_case "sigma column with a zero" "$C/sigcol.yaml" "sigcol.csv:4:" "'s'"
+
+printf 'x,y,s\n1,2.1,0.1\n2,3.9,0.1\n3,6.2,0.1\n4,8.0,-0.1\n5,9.9,0.1\n6,12.1,0.1\n' >"$C/sigcolneg.csv"
+write_config "$C/sigcolneg.yaml" "$PARAMS_OK" "$(dataset_block sigcolneg.csv "a*x + b" '    sigma: s
+')"
+fit_case "sigma column with a negative value" "$C/sigcolneg.yaml" "sigcolneg.csv:5:" "'s'"
+
+# ---- too few points --------------------------------------------------------------
+printf 'x,y\n1,2.1\n' >"$C/few.csv"
+write_config "$C/few.yaml" "$PARAMS_OK" "$(dataset_block few.csv "a*x + b")"
+fit_case "fewer points than free parameters" "$C/few.yaml" "few.yaml"
+
+# ---- loss and solver values --------------------------------------------------------
+write_config "$C/loss.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    loss: hubber
+')"
+fit_case "unknown loss 'hubber'" "$C/loss.yaml" "loss.yaml:11" "did you mean 'huber'"
+
+write_config "$C/starts.yaml"
+printf 'solver:\n  starts: -3\n' >>"$C/starts.yaml"
+fit_case "solver starts negative" "$C/starts.yaml" "starts.yaml:12" "starts"
+
+write_config "$C/level.yaml"
+printf 'report:\n  level: 2\n' >>"$C/level.yaml"
+fit_case "report level outside (0, 1)" "$C/level.yaml" "level.yaml:12" "level"
+
+write_config "$C/lscale.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    loss: huber
+    loss_scale: -1
+')"
+fit_case "negative loss_scale" "$C/lscale.yaml" "lscale.yaml:" "loss_scale"
+
+write_config "$C/sigmacol.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    sigma: nosuchcol
+')"
+fit_case "sigma names a column that does not exist" "$C/sigmacol.yaml" "sigmacol.yaml:11" "nosuchcol"
+
+# ---- existing output directory ------------------------------------------------------
+write_config "$C/exists.yaml"
+EXIST="$T/out_exists"
+mkdir -p "$EXIST"
+echo "earlier run" >"$EXIST/marker.txt"
+WHY=""
+run_phc fit "$C/exists.yaml" -o "$EXIST"
+check_error_output 2 "out_exists" "--force"
+if [ "$(cat "$EXIST/marker.txt" 2>/dev/null)" != "earlier run" ]; then
+    add_why "the existing directory's marker file did not survive"
+fi
+if [ "$(ls -A "$EXIST" | wc -l)" -ne 1 ]; then
+    add_why "the existing directory was modified: $(ls -A "$EXIST" | tr '\n' ' ')"
+fi
+left=$(ls -d "$EXIST".tmp-* "$EXIST".old* 2>/dev/null | head -3)
+[ -z "$left" ] || add_why "left behind: $left"
+report_case "existing output directory without --force"
+
+echo "a file" >"$T/out_isfile"
+WHY=""
+run_phc fit "$C/exists.yaml" -o "$T/out_isfile" --force
+check_error_output 2 "out_isfile"
+[ "$(cat "$T/out_isfile")" = "a file" ] || add_why "the existing file was modified"
+left=$(ls -d "$T"/out_isfile.tmp-* "$T"/out_isfile.old* 2>/dev/null | head -3)
+[ -z "$left" ] || add_why "left behind: $left"
+report_case "output path is an existing file (with --force)"
+
+# The output's parent is a file: fails when the run directory is created, after
+# the fit (hence --quiet); nothing may be left behind.
+echo "a file" >"$T/parent_file"
+WHY=""
+run_phc fit "$C/exists.yaml" -o "$T/parent_file/out" --quiet
+check_error_output 2 "parent_file"
+[ "$(cat "$T/parent_file")" = "a file" ] || add_why "the file was modified"
+left=$(ls -d "$T"/parent_file.tmp-* "$T"/parent_file/out* 2>/dev/null | head -3)
+[ -z "$left" ] || add_why "left behind: $left"
+report_case "output directory under an existing file"
+
+# ---- report on bad files -------------------------------------------------------------
+report_case_run() { # NAME FILE SUBSTRING...
+    local name=$1 file=$2
+    shift 2
+    WHY=""
+    run_phc report "$file"
+    check_error_output 2 "$@"
+    report_case "$name"
+}
+report_case_run "report: missing file" "$T/nowhere/result.json" "nowhere/result.json"
+
+printf '{\n  "status": "converged",\n  "iterations": 3,,\n  "cost": 1\n}\n' >"$C/malformed.json"
+report_case_run "report: malformed JSON (line:col)" "$C/malformed.json" "malformed.json:3:"
+
+printf '{\n  "status": "converged",\n  "iterations": 3\n' >"$C/truncated.json"
+report_case_run "report: truncated JSON" "$C/truncated.json" "truncated.json:"
+
+printf '{\n  "status": "converged",\n  "iterations": 3,\n  "cost": 1.5\n}\n' >"$C/fields.json"
+# result.json without "parameters", "datasets", ... : the missing field is named
+report_case_run "report: JSON missing fields" "$C/fields.json" "fields.json:" "expected"
+
+printf '[1, 2, 3]\n' >"$C/array.json"
+report_case_run "report: JSON that is not an object" "$C/array.json" "array.json"
+
+: >"$C/empty.json"
+report_case_run "report: empty file" "$C/empty.json" "empty.json"
+
+mkdir -p "$C/dir.json"
+# Not "invalid JSON near end of file": say that it is a directory.
+report_case_run "report: a directory" "$C/dir.json" "dir.json" "directory"
+
+# ---- usage errors: exit 1 ---------------------------------------------------------
+usage_case() { # NAME ARGS...
+    local name=$1
+    shift
+    WHY=""
+    run_phc "$@"
+    if [ "$RC" -ge 128 ] || [ "$RC" -eq 124 ]; then
+        add_why "crashed or hung (exit code $RC)"
+    elif [ "$RC" -ne 1 ]; then
+        add_why "exit code $RC, expected 1"
+    fi
+    if grep -q -e 'AddressSanitizer' -e 'runtime error' "$T/stderr"; then
+        add_why "sanitizer report on stderr"
+    fi
+    [ -n "$ERR" ] || add_why "nothing on stderr"
+    case "$ERR" in *usage*) ;; *) add_why "stderr shows no usage" ;; esac
+    [ ! -e "$T/runs" ] || { add_why "a runs/ directory was created"; rm -rf "$T/runs"; }
+    report_case "$name"
+}
+usage_case "usage: no arguments"
+usage_case "usage: unknown command" frobnicate
+usage_case "usage: unknown option" fit "$C/base.yaml" --bogus
+usage_case "usage: fit without a config" fit
+usage_case "usage: -o without a directory" fit "$C/base.yaml" -o
+usage_case "usage: report with an unknown option" report "$C/fields.json" --force
+usage_case "usage: two config files" fit "$C/base.yaml" "$C/base.yaml"
+
+# ---- positive control: the bundled enzyme example -------------------------------------
+GOOD="$T/out_enzyme"
+WHY=""
+if [ ! -f "$EXAMPLE_DIR/enzyme.yaml" ]; then
+    add_why "example $EXAMPLE_DIR/enzyme.yaml not found"
+    RC=0
+    : >"$T/stderr"
+else
+    run_phc fit "$EXAMPLE_DIR/enzyme.yaml" -o "$GOOD"
+    [ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+    [ -s "$GOOD/result.json" ] || add_why "no result.json"
+    [ -s "$GOOD/report.md" ] || add_why "no report.md"
+    npng=$(ls "$GOOD"/*.png 2>/dev/null | wc -l)
+    [ "$npng" -eq 4 ] || add_why "$npng PNG files, expected 4"
+    left=$(ls -d "$GOOD".tmp-* "$GOOD".old* 2>/dev/null | head -3)
+    [ -z "$left" ] || add_why "left behind: $left"
+fi
+report_case "control: enzyme example fits, writes result.json, report.md, 4 PNGs"
+
+WHY=""
+if [ -d "$GOOD" ]; then
+    echo "stale" >"$GOOD/stale_marker.txt"
+    run_phc fit "$EXAMPLE_DIR/enzyme.yaml" -o "$GOOD" --force --quiet
+    [ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+    [ ! -e "$GOOD/stale_marker.txt" ] || add_why "the earlier run was not replaced (marker still there)"
+    [ -s "$GOOD/result.json" ] || add_why "no result.json after --force"
+    npng=$(ls "$GOOD"/*.png 2>/dev/null | wc -l)
+    [ "$npng" -eq 4 ] || add_why "$npng PNG files after --force, expected 4"
+    left=$(ls -d "$GOOD".tmp-* "$GOOD".old* 2>/dev/null | head -3)
+    [ -z "$left" ] || add_why "left behind: $left"
+else
+    add_why "no earlier run to replace"
+fi
+report_case "control: --force replaces the earlier run"
+
+WHY=""
+run_phc report "$GOOD/result.json"
+[ "$RC" -eq 0 ] || add_why "report exit code $RC, expected 0"
+verdict=$(grep -i '^verdict:' "$T/stdout" | head -1)
+[ -n "$verdict" ] || add_why "no 'verdict:' line in the report output"
+run_phc report "$GOOD/result.json" --strict
+strict_rc=$RC
+case "$verdict" in
+*"no problems"*)
+    [ "$strict_rc" -eq 0 ] || add_why "verdict '$verdict' but --strict exits $strict_rc (expected 0)" ;;
+"")
+    ;;
+*)
+    [ "$strict_rc" -eq 3 ] || add_why "verdict '$verdict' but --strict exits $strict_rc (expected 3)" ;;
+esac
+if [ "$strict_rc" -ne 0 ] && [ "$strict_rc" -ne 3 ]; then
+    add_why "--strict exit code $strict_rc, expected 0 or 3"
+fi
+report_case "control: report exits 0 and --strict agrees with the verdict"
+
+# ----------------------------------------------------------------------------
+echo "$PASSED passed, $FAILED failed"
+[ "$FAILED" -eq 0 ]
