@@ -1,6 +1,7 @@
 /* Data sets: see dataset.h. */
 #include "fit/dataset.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 phc_dataset *phc_dataset_new(const phc_dataset_ops *ops, size_t k)
@@ -39,6 +40,8 @@ void phc_dataset_free(phc_dataset *ds)
     free(ds->x);
     free(ds->y);
     free(ds->sigma);
+    free(ds->data_file);
+    free(ds->data_lines);
     free(ds->x_label);
     free(ds->y_label);
     free(ds);
@@ -59,4 +62,35 @@ int phc_dataset_residuals(const double *p, double *r, double *jac, void *user_da
                 jac[i * ds->k + j] *= -w;
     }
     return 0;
+}
+
+int phc_dataset_check_start(phc_dataset *ds, const double *x, phc_error *err)
+{
+    double *p = calloc(ds->k ? ds->k : 1, sizeof *p), *yhat = calloc(ds->n ? ds->n : 1, sizeof *yhat);
+    if (!p || !yhat) {
+        free(p);
+        free(yhat);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    for (size_t j = 0; j < ds->k; ++j)
+        p[j] = x[ds->param_index[j]];
+    const int rc = ds->ops->predict(ds, p, yhat, NULL);
+    int status = PHC_OK;
+    size_t bad = ds->n;
+    for (size_t i = 0; i < ds->n && bad == ds->n; ++i)
+        if (!isfinite(yhat[i]))
+            bad = i;
+    if (rc != 0 || bad < ds->n) {
+        if (bad == ds->n) /* the model failed without saying where */
+            bad = 0;
+        const char *file = ds->data_file ? ds->data_file : "(data)";
+        const size_t line = ds->data_lines ? ds->data_lines[bad] : bad + 1;
+        status = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: data set '%s': the model is not finite at the start values "
+                               "(%s = %g); change the start values or the data",
+                               file, line, ds->name, ds->x_label ? ds->x_label : "x", ds->x ? ds->x[bad] : NAN);
+    }
+    free(p);
+    free(yhat);
+    return status;
 }

@@ -43,6 +43,8 @@ struct phc_dataset {
     phc_loss_kind loss;
     double loss_scale;           /* in units of the weighted residual */
     size_t config_line;          /* where the data set starts in the config */
+    char *data_file;             /* the file the observations came from (or NULL) */
+    size_t *data_lines;          /* n 1-based line numbers in data_file (or NULL) */
 };
 
 /* Allocates an empty data set with k slots (names and indices zeroed). */
@@ -52,5 +54,11 @@ void phc_dataset_free(phc_dataset *ds); /* accepts NULL; frees impl via ops */
 /* The phc_residual_fn that the fit hands to the bridge, with the data set as
  * user_data: r = (y - yhat)/sigma, d r / d p = -(d yhat / d p)/sigma. */
 int phc_dataset_residuals(const double *p, double *r, double *jac, void *ds);
+
+/* Evaluates the model at the slot values of x (global parameters) and checks
+ * that every prediction is finite; otherwise PHC_ERR_INPUT naming the data
+ * file and line of the first bad observation ("data.csv:4: data set 'd': the
+ * model is not finite here at the start values (x = 3)"). */
+int phc_dataset_check_start(phc_dataset *ds, const double *x, phc_error *err);
 
 #endif /* PHC_DATASET_H */

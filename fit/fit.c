@@ -504,6 +504,8 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     }
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         phc_dataset *ds = pb->datasets[d];
+        if ((rc = phc_dataset_check_start(ds, x, err)))
+            goto fail;
         if ((rc = phc_nls_add_block(nls, ds->n, ds->param_index, ds->k, phc_dataset_residuals,
                                     ds->derivatives, ds->loss, ds->loss_scale, ds, err)))
             goto fail;

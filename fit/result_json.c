@@ -6,6 +6,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 static json_t *num(double v)
@@ -269,7 +271,12 @@ static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result 
 int phc_result_read_json(const char *path, phc_fit_result **out, phc_error *err)
 {
     json_error_t jerr;
+    struct stat st;
     *out = NULL;
+    if (stat(path, &st) != 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return phc_error_set(err, PHC_ERR_IO, "%s: is a directory; give the result.json inside it", path);
     json_t *root = json_load_file(path, 0, &jerr);
     if (!root) {
         if (jerr.line < 0)

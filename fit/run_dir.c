@@ -40,7 +40,31 @@ int phc_run_dir_check(const char *dir, int force, phc_error *err)
             return phc_error_set(err, PHC_ERR_EXISTS,
                                  "%s: output directory exists; use --force to replace it or -o to choose another", dir);
     }
-    return PHC_OK;
+    /* The nearest existing ancestor must be a writable directory, so that a
+     * long fit is not wasted on an output path that cannot be created. */
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", dir);
+    for (;;) {
+        char *slash = strrchr(buf, '/');
+        if (!slash) {
+            snprintf(buf, sizeof buf, ".");
+        } else if (slash == buf) {
+            buf[1] = '\0';
+        } else {
+            *slash = '\0';
+        }
+        if (stat(buf, &st) == 0) {
+            if (!S_ISDIR(st.st_mode))
+                return phc_error_set(err, PHC_ERR_IO, "%s: cannot create the output directory: '%s' is not a directory",
+                                     dir, buf);
+            if (access(buf, W_OK | X_OK) != 0)
+                return phc_error_set(err, PHC_ERR_IO, "%s: cannot create the output directory: '%s' is not writable",
+                                     dir, buf);
+            return PHC_OK;
+        }
+        if (strcmp(buf, ".") == 0 || strcmp(buf, "/") == 0)
+            return PHC_OK;
+    }
 }
 
 /* mkdir -p for the parent of dir. */
@@ -203,6 +227,7 @@ int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc
     }
     if (old[0])
         remove_tree(old);
+    chmod(dir, 0755); /* mkdtemp made it private; results are for sharing */
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return PHC_OK;

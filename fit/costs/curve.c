@@ -233,7 +233,9 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     int n_vars = mupGetExprVarNum(c->parser);
     if (mupError(c->parser)) {
         const size_t line = key_line(node, "expression");
-        const int pos = (int)mupGetErrorPos(c->parser);
+        int pos = (int)mupGetErrorPos(c->parser);
+        if (pos > (int)strlen(expr))
+            pos = (int)strlen(expr); /* muparser may point past the end */
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)",
                            doc->path, line, expr, mupGetErrorMsg(c->parser), pos + 1);
         goto fail;
@@ -374,6 +376,14 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                 ds->sigma[i] = s;
         }
     }
+    ds->data_file = strdup(path);
+    ds->data_lines = malloc(ds->n * sizeof *ds->data_lines);
+    if (!ds->data_file || !ds->data_lines) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < ds->n; ++i)
+        ds->data_lines[i] = phc_table_row_line(table, i);
     ds->x_label = label_or(x_label, xname);
     ds->y_label = label_or(y_label, yname);
     if (!ds->x_label || !ds->y_label) {

@@ -298,7 +298,6 @@ int main(int argc, char **argv)
     printf("timed_phytocal: phc_fit_run in-process (Ceres solve + covariance, sensitivities, "
            "collinearity, goodness and residual checks; config load excluded), min of %d runs per fit\n",
            repeat);
-    printf("timed_peers: the least_squares / lmfit.minimize call only, min of %d runs per fit\n", repeat);
     printf("phytocal_solved: %zu of %zu (min parameter LRE >= 4)\n", solved, n_fits);
     printf("phytocal_average_lre: %.2f digits\n", sum_lre / (double)n_fits);
     printf("phytocal_total_time: %.4f s\n", total_time);
@@ -323,6 +322,7 @@ int main(int argc, char **argv)
         printf("lmfit: not available (install python3-lmfit)\n");
         peers[1].available = 0;
     }
+    printf("timed_peers: the least_squares / lmfit.minimize call only, min of %d runs per fit\n", repeat);
     if (run_peers(data_dir, repeat, table, peers, 2) != 0)
         return 1;
 
