@@ -1,9 +1,10 @@
-/* Forward-mode differentiation of curve expressions: see expression.h.
+/* Automatic differentiation of curve expressions: see expression.h.
  *
  * The expression becomes a list of nodes in evaluation order (children
- * before parents).  Evaluation carries each node's value and its gradient
- * with respect to the parameter slots; nodes that depend on no slot (data
- * columns, constants) skip the gradient work. */
+ * before parents).  A forward sweep computes each node's value and its
+ * local partial derivatives; a reverse sweep accumulates adjoints from the
+ * root to the parameter slots (reverse-mode AD), skipping nodes that depend
+ * on no slot (data columns, constants). */
 #include "fit/costs/expression.h"
 
 #include <ctype.h>
@@ -36,7 +37,7 @@ struct phc_expr {
     int *bound;
     size_t n_slots;
     double *val;      /* n_nodes values */
-    double *grad;     /* n_nodes x n_slots */
+    double *grad;     /* 3 x n_nodes: partials to child a, to child b, adjoints */
 };
 
 typedef struct parser {
@@ -355,7 +356,7 @@ int phc_expr_prepare(phc_expr *e, size_t n_slots, phc_error *err)
     free(e->val);
     free(e->grad);
     e->val = calloc(e->n_nodes, sizeof *e->val);
-    e->grad = calloc(e->n_nodes * (n_slots ? n_slots : 1), sizeof *e->grad);
+    e->grad = calloc(3 * e->n_nodes, sizeof *e->grad); /* partials a, b; adjoints */
     if (!e->val || !e->grad)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < e->n_nodes; ++i) {
@@ -376,42 +377,38 @@ int phc_expr_prepare(phc_expr *e, size_t n_slots, phc_error *err)
 
 double phc_expr_eval(phc_expr *e, const double *slots, const double *row, double *grad)
 {
-    const size_t k = e->n_slots;
     double *v = e->val;
-    double *g = e->grad;
-    const int want = grad != NULL;
+    double *pa = e->grad;              /* local partial d node / d child a */
+    double *pb = e->grad + e->n_nodes; /* ... and d node / d child b */
+    double *adj = pb + e->n_nodes;     /* adjoints for the reverse sweep */
+    /* Forward sweep: values and local partials. */
     for (size_t i = 0; i < e->n_nodes; ++i) {
         const node *n = &e->nodes[i];
-        double *gi = g + i * k;
         const double a = v[n->a], b = v[n->b];
-        const double *ga = g + n->a * k, *gb = g + n->b * k;
-        const int aa = e->nodes[n->a].active, ab = e->nodes[n->b].active;
-        const int grad_here = want && n->active;
-        double r = 0, da = 0, db = 0; /* value and local partials d r/d a, d r/d b */
+        double r = 0, da = 0, db = 0;
         switch (n->op) {
         case OP_CONST: r = n->value; break;
-        case OP_NAME:
-            if (e->is_slot[n->name]) {
-                r = slots[e->index[n->name]];
-                if (grad_here) {
-                    memset(gi, 0, k * sizeof *gi);
-                    gi[e->index[n->name]] = 1.0;
-                }
-                v[i] = r;
-                continue;
-            }
-            r = row[e->index[n->name]];
-            break;
+        case OP_NAME: r = e->is_slot[n->name] ? slots[e->index[n->name]] : row[e->index[n->name]]; break;
         case OP_NEG: r = -a; da = -1; break;
         case OP_ADD: r = a + b; da = 1; db = 1; break;
         case OP_SUB: r = a - b; da = 1; db = -1; break;
         case OP_MUL: r = a * b; da = b; db = a; break;
         case OP_DIV: r = a / b; da = 1 / b; db = -r / b; break;
         case OP_POW:
+            if (!e->nodes[n->b].active && b == 2) { /* x^2 is common in models: no pow() */
+                r = a * a;
+                da = 2 * a;
+                break;
+            }
+            if (!e->nodes[n->b].active && b == 3) {
+                r = a * a * a;
+                da = 3 * a * a;
+                break;
+            }
             r = pow(a, b);
             /* d/da a^b = b a^(b-1); d/db a^b = a^b log a (only needed when b varies) */
-            da = b == 0 ? 0 : b * pow(a, b - 1);
-            db = ab ? r * log(a) : 0;
+            da = b == 0 ? 0 : (a != 0 ? b * r / a : b * pow(a, b - 1));
+            db = e->nodes[n->b].active ? r * log(a) : 0;
             break;
         case OP_EXP: r = exp(a); da = r; break;
         case OP_LOG: r = log(a); da = 1 / a; break;
@@ -423,22 +420,35 @@ double phc_expr_eval(phc_expr *e, const double *slots, const double *row, double
         case OP_ABS: r = fabs(a); da = a > 0 ? 1 : (a < 0 ? -1 : 0); break;
         }
         v[i] = r;
-        if (!grad_here)
-            continue;
-        const int binary_op = n->op >= OP_ADD && n->op <= OP_POW;
-        for (size_t j = 0; j < k; ++j) {
-            double s = aa ? da * ga[j] : 0;
-            if (binary_op && ab)
-                s += db * gb[j];
-            gi[j] = s;
-        }
+        pa[i] = da;
+        pb[i] = db;
     }
     const size_t root = e->n_nodes - 1;
-    if (grad) {
-        if (e->nodes[root].active)
-            memcpy(grad, g + root * k, k * sizeof *grad);
-        else
-            memset(grad, 0, k * sizeof *grad);
+    if (!grad)
+        return v[root];
+    /* Reverse sweep (reverse-mode AD): one pass gives all k derivatives, so
+     * a Jacobian row costs about twice a value whatever k is. */
+    memset(grad, 0, e->n_slots * sizeof *grad);
+    memset(adj, 0, e->n_nodes * sizeof *adj);
+    adj[root] = 1.0;
+    for (size_t i = root + 1; i-- > 0;) {
+        const node *n = &e->nodes[i];
+        const double w = adj[i];
+        if (!n->active || w == 0)
+            continue;
+        switch (n->op) {
+        case OP_CONST: break;
+        case OP_NAME: grad[e->index[n->name]] += w; break;
+        case OP_ADD:
+        case OP_SUB:
+        case OP_MUL:
+        case OP_DIV:
+        case OP_POW:
+            adj[n->a] += pa[i] * w;
+            adj[n->b] += pb[i] * w;
+            break;
+        default: adj[n->a] += pa[i] * w; break;
+        }
     }
     return v[root];
 }

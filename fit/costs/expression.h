@@ -1,5 +1,6 @@
-/* Exact derivatives of `curve` expressions by forward-mode automatic
- * differentiation.
+/* Exact derivatives of `curve` expressions by automatic differentiation
+ * (reverse mode: one backward sweep per row gives every parameter's
+ * derivative).
  *
  * Why this exists beside muparser: muparser parses, validates and evaluates
  * the user's expression (it gives the error messages with positions), but it
@@ -9,7 +10,7 @@
  * 2.9; measured with this project's test).  This compiles the same grammar
  * (DESIGN.md §4: numbers, names, + - * / ^, parentheses, unary minus,
  * exp log sqrt sin cos tan atan abs, pi) into a tape that yields the value
- * and all parameter derivatives in one pass.  Expressions using anything
+ * and all parameter derivatives in two sweeps.  Expressions using anything
  * else muparser knows (sinh, min, ...) are refused here, and the data set
  * falls back to muparser with numerical derivatives.
  *
