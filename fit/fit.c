@@ -415,9 +415,17 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    for (size_t i = 0, f = 0; i < np; ++i)
-        if (!pb->params[i].fixed)
-            fi[f++] = i;
+    /* Parameters on a bound stay there: Gauss–Newton refines the others. */
+    size_t f_count = 0;
+    for (size_t i = 0; i < np; ++i) {
+        const phc_parameter *p = &pb->params[i];
+        const double tol = 1e-12 * phc_problem_scale(pb, i);
+        if (!p->fixed && !(x[i] - p->lower <= tol) && !(p->upper - x[i] <= tol))
+            fi[f_count++] = i;
+    }
+    nf = f_count;
+    if (nf == 0)
+        goto done;
     double cost;
     if (phc_nls_evaluate(nls, x, r, J, &cost, NULL) != PHC_OK)
         goto done;

@@ -1,6 +1,7 @@
 /* Sensitivities and collinearity indices: see sensitivity.h. */
 #include "fit/sensitivity.h"
 
+#include <float.h>
 #include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
@@ -39,8 +40,12 @@ static double subset_gamma(const double *G, size_t n, const size_t *idx, size_t 
             A[a * k + b] = G[idx[a] * n + idx[b]];
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', (lapack_int)k, A, (lapack_int)k, w) != 0)
         return NAN;
+    /* Singular to working precision counts as singular: dsyev's eigenvalues
+     * carry an absolute error of a few k eps lambda_max, so two proportional
+     * columns (y = a b x) give lambda_min ~ +-1e-16 and gamma ~ 1e8 rather
+     * than inf, depending on rounding. */
     const double lmin = w[0];
-    return lmin > 0 ? 1.0 / sqrt(lmin) : INFINITY;
+    return lmin > 4.0 * (double)k * DBL_EPSILON * w[k - 1] ? 1.0 / sqrt(lmin) : INFINITY;
 }
 
 int phc_sensitivity_compute(const double *S, size_t m, size_t n, size_t max_sets,

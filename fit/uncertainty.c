@@ -116,19 +116,19 @@ void phc_covariance_describe_null(const phc_covariance *c, size_t which,
     if (!c || which >= c->n_null)
         return;
     const double *v = c->null_vectors + which * c->n;
-    /* components sorted by |v|, largest first (n is small: selection sort) */
+    /* components sorted by |v|, largest first; magnitudes equal to 1e-9
+     * (e.g. +-0.70710678118654746 and 0.70710678118654757 for y = (a+b) x)
+     * keep parameter order, so the text does not depend on the last bits
+     * of the SVD (stable insertion sort; n is small) */
     size_t order[64];
     size_t cnt = 0;
     for (size_t j = 0; j < c->n && cnt < 64; ++j)
-        if (fabs(v[j]) >= 0.05)
-            order[cnt++] = j;
-    for (size_t a = 0; a < cnt; ++a)
-        for (size_t b = a + 1; b < cnt; ++b)
-            if (fabs(v[order[b]]) > fabs(v[order[a]])) {
-                size_t t = order[a];
-                order[a] = order[b];
-                order[b] = t;
-            }
+        if (fabs(v[j]) >= 0.05) {
+            size_t a = cnt++;
+            for (; a > 0 && fabs(v[j]) > fabs(v[order[a - 1]]) * (1 + 1e-9); --a)
+                order[a] = order[a - 1];
+            order[a] = j;
+        }
     /* sign convention: first component positive */
     const double sign = cnt && v[order[0]] < 0 ? -1.0 : 1.0;
     size_t used = 0;

@@ -148,9 +148,13 @@ static long parse_primary(parser *p)
     }
     if (isdigit((unsigned char)c) || (c == '.' && isdigit((unsigned char)s[start + 1]))) {
         /* strtod honours the locale's decimal point; configs use '.' */
+        /* digits, at most one '.', digits: "1.2.3" must not read as 1.2 */
         size_t end = start;
-        while (isdigit((unsigned char)s[end]) || s[end] == '.')
+        while (isdigit((unsigned char)s[end]))
             end++;
+        if (s[end] == '.')
+            for (end++; isdigit((unsigned char)s[end]); end++)
+                ;
         if ((s[end] == 'e' || s[end] == 'E') &&
             (isdigit((unsigned char)s[end + 1]) ||
              ((s[end + 1] == '+' || s[end + 1] == '-') && isdigit((unsigned char)s[end + 2])))) {
@@ -408,7 +412,9 @@ double phc_expr_eval(phc_expr *e, const double *slots, const double *row, double
             r = pow(a, b);
             /* d/da a^b = b a^(b-1); d/db a^b = a^b log a (only needed when b varies) */
             da = b == 0 ? 0 : (a != 0 ? b * r / a : b * pow(a, b - 1));
-            db = e->nodes[n->b].active ? r * log(a) : 0;
+            /* 0^b = 0 for every b > 0, so d/db is 0 there (r log a would be 0 * -inf = NaN,
+             * e.g. b1*x^b2 on a data row with x = 0) */
+            db = e->nodes[n->b].active ? (a == 0 && b > 0 ? 0 : r * log(a)) : 0;
             break;
         case OP_EXP: r = exp(a); da = r; break;
         case OP_LOG: r = log(a); da = 1 / a; break;
