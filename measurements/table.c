@@ -3,6 +3,7 @@
  * A small reader of our own rather than libcsv: libcsv does not detect the
  * delimiter, knows nothing of comment lines or whitespace-separated columns,
  * and reports no line numbers, which every message here must carry. */
+#include "measurements/text_file.h"
 #include "measurements/table.h"
 
 #include <ctype.h>
@@ -430,47 +431,6 @@ fail:
     return rc;
 }
 
-/* Reads a whole file; works for pipes too (no ftell). */
-static int read_file(const char *path, char **text, size_t *length, phc_error *err)
-{
-    FILE *f = NULL;
-    char *buf = NULL;
-    size_t len = 0, cap = 0;
-    int rc;
-
-    f = fopen(path, "rb");
-    if (!f) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-        goto fail;
-    }
-    for (;;) {
-        size_t got;
-        char *q = grow(buf, &cap, len + 65536, 1);
-        if (!q) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-            goto fail;
-        }
-        buf = q;
-        got = fread(buf + len, 1, cap - len, f);
-        len += got;
-        if (got == 0)
-            break;
-    }
-    if (ferror(f)) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
-        goto fail;
-    }
-    fclose(f);
-    *text = buf;
-    *length = len;
-    return 0;
-
-fail:
-    if (f)
-        fclose(f);
-    free(buf);
-    return rc;
-}
 
 int phc_table_read(const char *path, phc_table **out, phc_error *err)
 {
@@ -482,7 +442,7 @@ int phc_table_read(const char *path, phc_table **out, phc_error *err)
         *out = NULL;
     if (!path || !out)
         return phc_error_set(err, PHC_ERR_INVALID, "phc_table_read: invalid argument");
-    if ((rc = read_file(path, &text, &length, err)))
+    if ((rc = phc_read_text_file(path, &text, &length, err)))
         return rc;
     rc = phc_table_parse(text, length, path, out, err);
     free(text);
