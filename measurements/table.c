@@ -3,7 +3,6 @@
  * A small reader of our own rather than libcsv: libcsv does not detect the
  * delimiter, knows nothing of comment lines or whitespace-separated columns,
  * and reports no line numbers, which every message here must carry. */
-#include "measurements/text_file.h"
 #include "measurements/table.h"
 
 #include <ctype.h>
@@ -15,7 +14,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "measurements/c_number.h"
 #include "measurements/suggest.h"
+#include "measurements/text_file.h"
 
 /* Cells quoted in messages are cut to this many bytes so that one long cell
  * cannot push the file and line out of the fixed-size message. */
@@ -537,9 +538,7 @@ int phc_table_column_numbers(const phc_table *t, const char *name,
     long column;
     size_t r;
     int rc;
-    /* strtod follows LC_NUMERIC; a program that set a German locale would
-     * read "1.5" as 1.  Numbers in data files are always C syntax. */
-    locale_t c_locale = (locale_t)0, old_locale = (locale_t)0;
+    phc_c_numeric c_numeric = {(locale_t)0, (locale_t)0}; /* data files use C syntax */
     char shown_name[TABLE_SHOW_MAX + 8];
 
     if (values)
@@ -561,10 +560,8 @@ int phc_table_column_numbers(const phc_table *t, const char *name,
     v = malloc(t->nrows * sizeof *v);
     if (!v)
         goto fail;
-    c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-    if (!c_locale)
+    if (phc_c_numeric_begin(&c_numeric) != 0)
         goto fail;
-    old_locale = uselocale(c_locale);
     for (r = 0; r < t->nrows; ++r) {
         const char *cell = t->cells[r * t->ncols + (size_t)column];
         char shown[TABLE_SHOW_MAX + 8];
@@ -590,8 +587,7 @@ int phc_table_column_numbers(const phc_table *t, const char *name,
         }
         v[r] = x;
     }
-    uselocale(old_locale);
-    freelocale(c_locale);
+    phc_c_numeric_end(&c_numeric);
     *values = v;
     phc_error_clear(err);
     return 0;
@@ -599,10 +595,7 @@ int phc_table_column_numbers(const phc_table *t, const char *name,
 fail:
     if (rc == PHC_ERR_NOMEM)
         phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", t->source);
-    if (old_locale)
-        uselocale(old_locale);
-    if (c_locale)
-        freelocale(c_locale);
+    phc_c_numeric_end(&c_numeric);
     free(v);
     return rc;
 }

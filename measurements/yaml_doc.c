@@ -5,7 +5,6 @@
  * contains an alias to itself is an error, not an endless copy), bound the
  * nesting depth and the number of nodes that aliases may expand to (the
  * "billion laughs" document), and catch duplicate keys as they arrive. */
-#include "measurements/text_file.h"
 #include "measurements/yaml_doc.h"
 
 #include <ctype.h>
@@ -20,7 +19,9 @@
 
 #include <yaml.h>
 
+#include "measurements/c_number.h"
 #include "measurements/suggest.h"
+#include "measurements/text_file.h"
 
 /* A configuration is a few levels deep; the limits only stop hostile or
  * broken input from exhausting the stack (node_free and node_copy recurse)
@@ -656,24 +657,6 @@ static int type_error(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
                          value);
 }
 
-/* strtod in the C locale, whatever LC_NUMERIC the program chose: numbers in a
- * configuration file are written the same everywhere. */
-static double c_strtod(const char *s, char **end)
-{
-    locale_t c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
-    locale_t old = (locale_t)0;
-    double x;
-    if (c_locale)
-        old = uselocale(c_locale);
-    x = strtod(s, end);
-    if (c_locale) {
-        if (old)
-            uselocale(old);
-        freelocale(c_locale);
-    }
-    return x;
-}
-
 /* 0: a finite number; 1: not a number; 2: a number but not finite. */
 static int parse_number(const char *s, double *out)
 {
@@ -685,7 +668,7 @@ static int parse_number(const char *s, double *out)
     if (!*s || isspace((unsigned char)*s))
         return 1;
     errno = 0;
-    x = c_strtod(s, &end);
+    x = phc_strtod_c(s, &end);
     if (end != s && !*end) {
         if (!isfinite(x))
             return 2;

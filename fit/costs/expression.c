@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "measurements/c_number.h"
+
 typedef enum op {
     OP_CONST, OP_NAME, OP_NEG, OP_ADD, OP_SUB, OP_MUL, OP_DIV, OP_POW,
     OP_EXP, OP_LOG, OP_SQRT, OP_SIN, OP_COS, OP_TAN, OP_ATAN, OP_ABS
@@ -147,14 +149,14 @@ static long parse_primary(parser *p)
         return inner;
     }
     if (isdigit((unsigned char)c) || (c == '.' && isdigit((unsigned char)s[start + 1]))) {
-        /* strtod honours the locale's decimal point; configs use '.' */
-        /* digits, at most one '.', digits: "1.2.3" must not read as 1.2 */
         size_t end = start;
         while (isdigit((unsigned char)s[end]))
             end++;
-        if (s[end] == '.')
-            for (end++; isdigit((unsigned char)s[end]); end++)
-                ;
+        if (s[end] == '.') { /* one decimal point: "1.2.3" is an error below */
+            end++;
+            while (isdigit((unsigned char)s[end]))
+                end++;
+        }
         if ((s[end] == 'e' || s[end] == 'E') &&
             (isdigit((unsigned char)s[end + 1]) ||
              ((s[end + 1] == '+' || s[end + 1] == '-') && isdigit((unsigned char)s[end + 2])))) {
@@ -167,21 +169,7 @@ static long parse_primary(parser *p)
             return fail_at(p, start, "number too long");
         memcpy(buf, s + start, end - start);
         buf[end - start] = '\0';
-        char *stop = NULL;
-        double v = strtod(buf, &stop);
-        if (*stop != '\0') {
-            /* a locale with a decimal comma: parse by hand */
-            double ip = 0, frac = 0, scale = 1;
-            size_t i = 0;
-            for (; isdigit((unsigned char)buf[i]); ++i)
-                ip = ip * 10 + (buf[i] - '0');
-            if (buf[i] == '.')
-                for (++i; isdigit((unsigned char)buf[i]); ++i)
-                    frac += (buf[i] - '0') * (scale /= 10);
-            v = ip + frac;
-            if (buf[i] == 'e' || buf[i] == 'E')
-                v *= pow(10.0, atof(buf + i + 1));
-        }
+        const double v = phc_strtod_c(buf, NULL);
         p->pos = end;
         node n = {OP_CONST, 0, 0, v, 0, 0};
         return add_node(p, n);
