@@ -94,8 +94,7 @@ static int add_plot(char **names, size_t *n, const char *name)
     return PHC_OK;
 }
 
-/* File-name-safe copy of a data set name. */
-static void safe_name(const char *in, char *out, size_t size)
+void phc_run_dir_safe_name(const char *in, char *out, size_t size)
 {
     size_t j = 0;
     for (size_t i = 0; in[i] && j + 1 < size; ++i) {
@@ -116,7 +115,7 @@ static int write_plots(const phc_fit_result *res, const char *tmpdir, char **nam
     for (size_t d = 0; d < res->n_datasets; ++d) {
         const phc_dataset_result *ds = &res->datasets[d];
         char base[256];
-        safe_name(ds->name, base, sizeof base);
+        phc_run_dir_safe_name(ds->name, base, sizeof base);
         /* the report links plots by data-set name; keep names consistent */
         snprintf(title, sizeof title, "%s: data and fit", ds->name);
         phc_plot_labels lab = {title, ds->x_label, ds->y_label};
@@ -190,15 +189,58 @@ static int write_plots(const phc_fit_result *res, const char *tmpdir, char **nam
     return PHC_OK;
 }
 
-int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc_error *err)
+int phc_run_dir_begin(const char *dir, int force, char *tmpdir, size_t size, phc_error *err)
 {
     int rc;
     if ((rc = phc_run_dir_check(dir, force, err)) || (rc = make_parents(dir, err)))
         return rc;
-    char tmpdir[4096], path[8192], old[4096];
-    snprintf(tmpdir, sizeof tmpdir, "%s.tmp-XXXXXX", dir);
+    if ((size_t)snprintf(tmpdir, size, "%s.tmp-XXXXXX", dir) >= size)
+        return phc_error_set(err, PHC_ERR_IO, "%s: output path too long", dir);
     if (!mkdtemp(tmpdir))
         return phc_error_set(err, PHC_ERR_IO, "%s: cannot create a temporary directory: %s", tmpdir, strerror(errno));
+    return PHC_OK;
+}
+
+void phc_run_dir_discard(const char *tmpdir)
+{
+    remove_tree(tmpdir);
+}
+
+int phc_run_dir_commit(const char *tmpdir, const char *dir, phc_error *err)
+{
+    /* Swap into place: the old run (with --force) is removed only now. */
+    char old[4096];
+    struct stat st;
+    old[0] = '\0';
+    if (stat(dir, &st) == 0) {
+        snprintf(old, sizeof old, "%s.old-XXXXXX", dir);
+        if (!mkdtemp(old) || rmdir(old) != 0 || rename(dir, old) != 0) {
+            const int rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot move the earlier run aside: %s", dir,
+                                         strerror(errno));
+            remove_tree(tmpdir);
+            return rc;
+        }
+    }
+    if (rename(tmpdir, dir) != 0) {
+        const int rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename the new run into place: %s", dir,
+                                     strerror(errno));
+        if (old[0])
+            rename(old, dir); /* put the earlier run back */
+        remove_tree(tmpdir);
+        return rc;
+    }
+    if (old[0])
+        remove_tree(old);
+    chmod(dir, 0755); /* mkdtemp made it private; results are for sharing */
+    return PHC_OK;
+}
+
+int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc_error *err)
+{
+    char tmpdir[4096], path[8192];
+    int rc;
+    if ((rc = phc_run_dir_begin(dir, force, tmpdir, sizeof tmpdir, err)))
+        return rc;
     char *names[MAX_PLOTS] = {0};
     size_t n_names = 0;
     if ((rc = write_plots(res, tmpdir, names, &n_names, err)))
@@ -209,30 +251,12 @@ int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc
     snprintf(path, sizeof path, "%s/report.md", tmpdir);
     if ((rc = phc_report_write_markdown(res, path, (const char *const *)names, err)))
         goto fail;
-    /* Swap into place: the old run (with --force) is removed only now. */
-    struct stat st;
-    old[0] = '\0';
-    if (stat(dir, &st) == 0) {
-        snprintf(old, sizeof old, "%s.old-XXXXXX", dir);
-        if (!mkdtemp(old) || rmdir(old) != 0 || rename(dir, old) != 0) {
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot move the earlier run aside: %s", dir, strerror(errno));
-            goto fail;
-        }
-    }
-    if (rename(tmpdir, dir) != 0) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename the new run into place: %s", dir, strerror(errno));
-        if (old[0])
-            rename(old, dir); /* put the earlier run back */
-        goto fail;
-    }
-    if (old[0])
-        remove_tree(old);
-    chmod(dir, 0755); /* mkdtemp made it private; results are for sharing */
+    rc = phc_run_dir_commit(tmpdir, dir, err);
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
-    return PHC_OK;
+    return rc;
 fail:
-    remove_tree(tmpdir);
+    phc_run_dir_discard(tmpdir);
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return rc;

@@ -14,7 +14,24 @@
  * is not wasted on a directory that will be refused. */
 int phc_run_dir_check(const char *dir, int force, phc_error *err);
 
+/* Writes a fit's run directory (result.json, report.md, plots) by the three
+ * steps below. */
 int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force,
                       phc_error *err);
+
+/* The steps, for any command that writes a run directory:
+ * begin checks DIR (as phc_run_dir_check), creates its parents and a
+ * temporary sibling, whose path goes to tmpdir (size bytes);
+ * commit renames the temporary directory to DIR (replacing an earlier run
+ * only now) or, on failure, removes it and keeps the earlier run;
+ * discard removes the temporary directory after a failure. */
+int phc_run_dir_begin(const char *dir, int force, char *tmpdir, size_t size,
+                      phc_error *err);
+int phc_run_dir_commit(const char *tmpdir, const char *dir, phc_error *err);
+void phc_run_dir_discard(const char *tmpdir);
+
+/* A file-name-safe copy of a data-set name: characters other than letters,
+ * digits, '-', '_' and '.' become '_'. */
+void phc_run_dir_safe_name(const char *name, char *out, size_t size);
 
 #endif /* PHC_RUN_DIR_H */

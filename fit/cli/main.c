@@ -7,21 +7,19 @@
  *
  * Exit codes: 0 success; 1 usage; 2 bad input; 3 the fit did not converge or
  * (with --strict) a report check failed; 4 internal error. */
-#include <errno.h>
 #include <gsl/gsl_errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include "fit/ceres_bridge.h"
 #include "fit/config.h"
 #include "fit/fit.h"
-#include "fit/plots.h"
 #include "fit/report.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
+#include "fit/simulate.h"
 
 #ifndef PHC_VERSION
 #define PHC_VERSION "dev"
@@ -175,8 +173,7 @@ static int cmd_fit(int argc, char **argv)
     return EXIT_OK;
 }
 
-/* simulate: each data set's model at the configured parameter values, as a
- * CSV (x, observed, model) and a plot, in a run directory. */
+/* simulate: each data set's model at the start values (simulate.h). */
 static int cmd_simulate(int argc, char **argv)
 {
     cli_options o;
@@ -189,100 +186,16 @@ static int cmd_simulate(int argc, char **argv)
     phc_problem *pb = NULL;
     if (phc_config_load(o.input, &pb, &err))
         return fail(&err);
-    char dir[4096], tmpdir[4096 + 16], path[8192];
+    char dir[4096];
     if (o.out_dir)
         snprintf(dir, sizeof dir, "%s", o.out_dir);
     else
         snprintf(dir, sizeof dir, "runs/%s-simulation", pb->name);
-    int rc = EXIT_OK;
-    if (phc_run_dir_check(dir, o.force, &err)) {
-        phc_problem_free(pb);
-        return fail(&err);
-    }
-    snprintf(tmpdir, sizeof tmpdir, "%s.tmp-XXXXXX", dir);
-    if (!mkdtemp(tmpdir)) {
-        fprintf(stderr, "phytocal: %s: cannot create directory: %s\n", tmpdir, strerror(errno));
-        phc_problem_free(pb);
-        return EXIT_INPUT;
-    }
-    for (size_t d = 0; d < pb->n_datasets && rc == EXIT_OK; ++d) {
-        phc_dataset *ds = pb->datasets[d];
-        double *p = calloc(ds->k, sizeof *p), *yhat = calloc(ds->n, sizeof *yhat);
-        if (!p || !yhat) {
-            rc = EXIT_INTERNAL;
-        } else {
-            for (size_t j = 0; j < ds->k; ++j)
-                p[j] = pb->params[ds->param_index[j]].value;
-            if (ds->ops->predict(ds, p, yhat, NULL) != 0) {
-                fprintf(stderr, "phytocal: data set '%s': the model cannot be evaluated at the start values\n",
-                        ds->name);
-                rc = EXIT_INPUT;
-            } else {
-                snprintf(path, sizeof path, "%s/%s_simulated.csv", tmpdir, ds->name);
-                FILE *f = fopen(path, "w");
-                if (!f) {
-                    fprintf(stderr, "phytocal: %s: cannot write\n", path);
-                    rc = EXIT_INPUT;
-                } else {
-                    fprintf(f, "x,observed,model\n");
-                    for (size_t i = 0; i < ds->n; ++i)
-                        fprintf(f, "%.17g,%.17g,%.17g\n", ds->x[i], ds->y[i], yhat[i]);
-                    if (fclose(f) != 0)
-                        rc = EXIT_INPUT;
-                }
-                char title[256];
-                snprintf(title, sizeof title, "%s: model at the start values", ds->name);
-                phc_plot_labels lab = {title, ds->x_label, ds->y_label};
-                snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, ds->name);
-                if (rc == EXIT_OK && phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, ds->x, yhat, ds->n, &err))
-                    rc = fail(&err);
-            }
-        }
-        free(p);
-        free(yhat);
-    }
-    if (rc == EXIT_OK) {
-        struct stat st;
-        if (stat(dir, &st) == 0) {
-            char cmd_old[8192];
-            snprintf(cmd_old, sizeof cmd_old, "%s.old", dir);
-            if (rename(dir, cmd_old) == 0) {
-                if (rename(tmpdir, dir) != 0) {
-                    rename(cmd_old, dir);
-                    rc = EXIT_INPUT;
-                } else {
-                    /* remove the replaced run's files */
-                    char sub[8192 + 256];
-                    for (size_t d = 0; d < pb->n_datasets; ++d) {
-                        snprintf(sub, sizeof sub, "%s/%s_simulated.csv", cmd_old, pb->datasets[d]->name);
-                        unlink(sub);
-                        snprintf(sub, sizeof sub, "%s/%s_simulated.png", cmd_old, pb->datasets[d]->name);
-                        unlink(sub);
-                    }
-                    rmdir(cmd_old);
-                }
-            } else {
-                rc = EXIT_INPUT;
-            }
-        } else if (rename(tmpdir, dir) != 0) {
-            rc = EXIT_INPUT;
-        }
-        if (rc == EXIT_OK)
-            printf("simulated %zu data set%s: %s/\n", pb->n_datasets, pb->n_datasets == 1 ? "" : "s", dir);
-        else
-            fprintf(stderr, "phytocal: %s: cannot move the simulation into place\n", dir);
-    }
-    if (rc != EXIT_OK) {
-        for (size_t d = 0; d < pb->n_datasets; ++d) {
-            snprintf(path, sizeof path, "%s/%s_simulated.csv", tmpdir, pb->datasets[d]->name);
-            unlink(path);
-            snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, pb->datasets[d]->name);
-            unlink(path);
-        }
-        rmdir(tmpdir);
-    }
+    const int rc = phc_simulate_write(pb, dir, o.force, &err);
+    if (rc == PHC_OK)
+        printf("simulated %zu data set%s: %s/\n", pb->n_datasets, pb->n_datasets == 1 ? "" : "s", dir);
     phc_problem_free(pb);
-    return rc;
+    return rc ? fail(&err) : EXIT_OK;
 }
 
 static int cmd_report(int argc, char **argv)

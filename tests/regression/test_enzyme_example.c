@@ -14,6 +14,7 @@
 #include "fit/fit.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
+#include "fit/simulate.h"
 
 static const phc_param_result *param(const phc_fit_result *r, const char *name)
 {
@@ -34,6 +35,24 @@ int main(void)
         fprintf(stderr, "%s\n", err.message);
         return 1;
     }
+    /* simulate: the model at the start values, written whole */
+    char sim_root[] = "/tmp/phc-simulate-XXXXXX";
+    CHECK(mkdtemp(sim_root) != NULL);
+    char sim[300], sim_file[400];
+    snprintf(sim, sizeof sim, "%s/sim", sim_root);
+    CHECK(phc_simulate_write(pb, sim, 0, &err) == PHC_OK);
+    struct stat sst;
+    snprintf(sim_file, sizeof sim_file, "%s/assay_simulated.csv", sim);
+    CHECK(stat(sim_file, &sst) == 0 && sst.st_size > 0);
+    snprintf(sim_file, sizeof sim_file, "%s/assay_simulated.png", sim);
+    CHECK(stat(sim_file, &sst) == 0 && sst.st_size > 0);
+    CHECK(phc_simulate_write(pb, sim, 0, &err) == PHC_ERR_EXISTS);
+    CHECK(phc_simulate_write(pb, sim, 1, &err) == PHC_OK);
+    char sim_cmd[400];
+    snprintf(sim_cmd, sizeof sim_cmd, "rm -rf %s", sim_root);
+    if (system(sim_cmd) != 0)
+        fprintf(stderr, "warning: could not remove %s\n", sim_root);
+
     phc_fit_result *res = NULL;
     CHECK(phc_fit_run(pb, NULL, NULL, &res, &err) == PHC_OK);
     phc_problem_free(pb);
