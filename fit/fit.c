@@ -358,29 +358,36 @@ fail:
     return rc;
 }
 
+/* Relative effect below which a parameter counts as having none (the
+ * covariance's singular-value cut-off too). */
+#define NEGLIGIBLE_EFFECT 1e-10
+
+/* The magnitude a relative change of parameter i is measured against: its
+ * value, or its scale when the value is 0. */
+static double effect_scale(const phc_problem *pb, const double *x, size_t i)
+{
+    return x[i] != 0 ? fabs(x[i]) : phc_problem_scale(pb, i);
+}
+
 /* 1 when some free parameter has (relatively) no effect on the residuals at
- * x: |d r / d p_j| |p_j| <= 1e-10 max_i |d r / d p_i| |p_i|. */
+ * x (phc_negligible_columns): a stall on a plateau. */
 static int stalled_on_plateau(phc_nls *nls, const phc_problem *pb, const double *x)
 {
     const size_t m = phc_nls_residual_count(nls), np = pb->n_params;
-    double *J = malloc(m * np * sizeof *J), *effect = malloc(np * sizeof *effect);
+    double *J = malloc(m * np * sizeof *J), *scale = malloc(np * sizeof *scale);
+    int *fixed = malloc(np * sizeof *fixed), *negligible = malloc(np * sizeof *negligible);
     int stalled = 0;
-    if (J && effect && phc_nls_evaluate(nls, x, NULL, J, NULL, NULL) == PHC_OK) {
-        double top = 0;
+    if (J && scale && fixed && negligible && phc_nls_evaluate(nls, x, NULL, J, NULL, NULL) == PHC_OK) {
         for (size_t j = 0; j < np; ++j) {
-            double ss = 0;
-            for (size_t i = 0; i < m; ++i)
-                ss += J[i * np + j] * J[i * np + j];
-            effect[j] = sqrt(ss) * (x[j] != 0 ? fabs(x[j]) : phc_problem_scale(pb, j));
-            if (!pb->params[j].fixed)
-                top = fmax(top, effect[j]);
+            scale[j] = effect_scale(pb, x, j);
+            fixed[j] = pb->params[j].fixed;
         }
-        for (size_t j = 0; j < np; ++j)
-            if (!pb->params[j].fixed && effect[j] <= 1e-10 * top)
-                stalled = 1;
+        stalled = phc_negligible_columns(J, m, np, np, scale, fixed, NEGLIGIBLE_EFFECT, negligible) > 0;
     }
     free(J);
-    free(effect);
+    free(scale);
+    free(fixed);
+    free(negligible);
     return stalled;
 }
 
@@ -625,9 +632,9 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     }
     for (size_t f = 0; f < nf; ++f) {
         const size_t gi = res->free_index[f];
-        scales[f] = best[gi] != 0 ? fabs(best[gi]) : phc_problem_scale(pb, gi);
+        scales[f] = effect_scale(pb, best, gi);
     }
-    rc = phc_covariance_compute(Jf, m, nf, s2, 1e-10, scales, &cov, err);
+    rc = phc_covariance_compute(Jf, m, nf, s2, NEGLIGIBLE_EFFECT, scales, &cov, err);
     free(scales);
     if (rc)
         goto fail;
@@ -696,7 +703,7 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         for (size_t i = 0; i < ds->n; ++i, ++row)
             for (size_t f = 0; f < nf; ++f) {
                 const size_t gi = res->free_index[f];
-                const double pj = best[gi] != 0 ? best[gi] : phc_problem_scale(pb, gi);
+                const double pj = best[gi] != 0 ? best[gi] : phc_problem_scale(pb, gi); /* signed */
                 S[row * nf + f] = -Jf[row * nf + f] * pj / extra;
             }
     }

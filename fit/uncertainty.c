@@ -7,6 +7,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* |J_j| * scale_j: how much the residuals move for a relative change of p_j. */
+static double column_effect(const double *J, size_t m, size_t ld, size_t j, const double *scale)
+{
+    double ss = 0;
+    for (size_t i = 0; i < m; ++i)
+        ss += J[i * ld + j] * J[i * ld + j];
+    return sqrt(ss) * (scale ? scale[j] : 1.0);
+}
+
 void phc_covariance_clear(phc_covariance *c)
 {
     if (!c)
@@ -47,12 +56,16 @@ int phc_covariance_compute(const double *J, size_t m, size_t n, double s2, doubl
             ss += J[i * n + j] * J[i * n + j];
         D[j] = sqrt(ss);
     }
-    double effect_max = 0;
+    int *negligible = calloc(n, sizeof *negligible);
+    if (!negligible) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "covariance: out of memory");
+        goto fail;
+    }
+    phc_negligible_columns(J, m, n, n, scale, NULL, rcond, negligible);
     for (size_t j = 0; j < n; ++j)
-        effect_max = fmax(effect_max, D[j] * (scale ? scale[j] : 1.0));
-    for (size_t j = 0; j < n; ++j)
-        if (D[j] * (scale ? scale[j] : 1.0) <= rcond * effect_max)
-            D[j] = 0; /* negligible effect: treated as a zero column */
+        if (negligible[j])
+            D[j] = 0; /* treated as a zero column */
+    free(negligible);
     for (size_t i = 0; i < m; ++i)
         for (size_t j = 0; j < n; ++j)
             A[i * n + j] = D[j] > 0 ? J[i * n + j] / D[j] : 0.0;
@@ -105,6 +118,26 @@ fail:
     if (rc)
         phc_covariance_clear(out);
     return rc;
+}
+
+size_t phc_negligible_columns(const double *J, size_t m, size_t n, size_t ld, const double *scale,
+                              const int *skip, double rcond, int *negligible)
+{
+    /* First pass: the largest effect, kept column by column in negligible[]
+     * as 0 (skipped) or 1 (measured); second pass: compare. */
+    double top = 0;
+    for (size_t j = 0; j < n; ++j) {
+        negligible[j] = !(skip && skip[j]);
+        if (negligible[j])
+            top = fmax(top, column_effect(J, m, ld, j, scale));
+    }
+    size_t count = 0;
+    for (size_t j = 0; j < n; ++j) {
+        if (negligible[j])
+            negligible[j] = column_effect(J, m, ld, j, scale) <= rcond * top;
+        count += (size_t)negligible[j];
+    }
+    return count;
 }
 
 void phc_covariance_describe_null(const phc_covariance *c, size_t which,

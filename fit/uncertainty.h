@@ -40,6 +40,17 @@ int phc_covariance_compute(const double *J, size_t m, size_t n, double s2,
                            phc_covariance *out, phc_error *err);
 void phc_covariance_clear(phc_covariance *c);
 
+/* The rule for "the model does not depend on this parameter here": marks
+ * (negligible[j] = 1) the columns of J (m x n, row stride ld) whose effect
+ * |J_j| * scale_j is at most rcond times the largest effect among the
+ * columns not skipped.  scale may be NULL (ones); skip may be NULL, else
+ * columns with skip[j] != 0 (fixed parameters) are neither measured nor
+ * marked.  Returns the number marked.  Used by the covariance and by the
+ * fit's plateau test for rescue starts. */
+size_t phc_negligible_columns(const double *J, size_t m, size_t n, size_t ld,
+                              const double *scale, const int *skip,
+                              double rcond, int *negligible);
+
 /* Describes null vector `which` as text, e.g. "0.707 b1 - 0.707 b2",
  * listing components with |v| >= 0.05, largest first. */
 void phc_covariance_describe_null(const phc_covariance *c, size_t which,
