@@ -68,8 +68,11 @@ static size_t nist_list(const char *dir, char ***paths_out)
     return n;
 }
 
-/* Fits one problem from one start; work_dir receives the config and CSV. */
-static void nist_run_case(const nist_problem *p, int start, const char *work_dir, nist_outcome *o)
+/* Fits one problem from one start; work_dir receives the config and CSV.
+ * derivatives: NULL for the default, or a value of the data set's
+ * `derivatives:` key ("central", "ridders") appended to the config. */
+static void nist_run_case(const nist_problem *p, int start, const char *work_dir, const char *derivatives,
+                          nist_outcome *o)
 {
     memset(o, 0, sizeof *o);
     snprintf(o->name, sizeof o->name, "%s", p->name);
@@ -78,6 +81,13 @@ static void nist_run_case(const nist_problem *p, int start, const char *work_dir
     if (nist_write_case(p, start, work_dir, config, sizeof config, msg, sizeof msg) != 0) {
         snprintf(o->message, sizeof o->message, "cannot write case: %s", msg);
         return;
+    }
+    if (derivatives) { /* the data set is the config's last mapping */
+        FILE *f = fopen(config, "a");
+        if (!f || fprintf(f, "    derivatives: %s\n", derivatives) < 0 || fclose(f) != 0) {
+            snprintf(o->message, sizeof o->message, "cannot append to the config of %s", p->name);
+            return;
+        }
     }
     phc_error err;
     phc_error_clear(&err);

@@ -51,9 +51,10 @@
 
 static void usage(FILE *f)
 {
-    fprintf(f, "usage: bench_nist_peers [DATA_DIR] [--repeat R] [--no-peers] [--table]\n"
+    fprintf(f, "usage: bench_nist_peers [DATA_DIR] [--repeat R] [--derivatives D] [--no-peers] [--table]\n"
                "  DATA_DIR    NIST StRD *.dat files (default %s)\n"
                "  --repeat R  runs per fit, the minimum time is kept (default %d)\n"
+               "  --derivatives D  central or ridders instead of the exact Jacobian\n"
                "  --no-peers  do not run the SciPy / lmfit peers\n"
                "  --table     print a per-fit table (peers' table goes to stderr)\n",
             PHC_SHARED_DATA "/nist", DEFAULT_REPEAT);
@@ -189,6 +190,7 @@ int main(int argc, char **argv)
 {
     const char *data_dir = PHC_SHARED_DATA "/nist";
     int repeat = DEFAULT_REPEAT, peers_wanted = 1, table = 0, have_dir = 0;
+    const char *derivatives = NULL;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--repeat") == 0 && i + 1 < argc) {
             char *end;
@@ -199,6 +201,8 @@ int main(int argc, char **argv)
                 return 2;
             }
             repeat = (int)r;
+        } else if (strcmp(argv[i], "--derivatives") == 0 && i + 1 < argc) {
+            derivatives = argv[++i]; /* central | ridders: instead of the exact (AD) Jacobian */
         } else if (strcmp(argv[i], "--no-peers") == 0) {
             peers_wanted = 0;
         } else if (strcmp(argv[i], "--table") == 0) {
@@ -254,7 +258,7 @@ int main(int argc, char **argv)
             nist_outcome *b = &best[n_fits++];
             for (int r = 0; r < repeat; ++r) {
                 nist_outcome o;
-                nist_run_case(&p, start, work, &o);
+                nist_run_case(&p, start, work, derivatives, &o);
                 /* nist_run_case leaves 99 when no fitted parameter matched a
                  * b<j>: score that as nothing matched */
                 if (o.ok && o.lre_param > 11)
@@ -302,6 +306,7 @@ int main(int argc, char **argv)
     printf("timed_phytocal: phc_fit_run in-process (Ceres solve + covariance, sensitivities, "
            "collinearity, goodness and residual checks; config load excluded), min of %d runs per fit\n",
            repeat);
+    printf("phytocal_derivatives: %s\n", derivatives ? derivatives : "exact (reverse-mode AD of the expression)");
     printf("phytocal_solved: %zu of %zu (min parameter LRE >= 4)\n", solved, n_fits);
     printf("phytocal_average_lre: %.2f digits\n", sum_lre / (double)n_fits);
     printf("phytocal_total_time: %.4f s\n", total_time);

@@ -33,7 +33,7 @@ int main(void)
         CHECK(nist_load(paths[i], &p, msg, sizeof msg) == 0);
         for (int start = 1; start <= 2; ++start) {
             nist_outcome o;
-            nist_run_case(&p, start, work, &o);
+            nist_run_case(&p, start, work, NULL, &o);
             const int lanczos1 = strcmp(p.name, "Lanczos1") == 0;
             printf("%-10s %5d %-13s %9.2f %9.2f %9s %9.3f %s\n", p.name, start, o.ok ? o.status : "error",
                    o.lre_param, o.lre_sd, lanczos1 ? "(n/a)" : "", o.seconds * 1e3, o.message);
