@@ -124,28 +124,41 @@ static int progress_cb(const char *stage, double fraction, void *user_data)
     return 0;
 }
 
-static void default_dir(const phc_problem *pb, char *buf, size_t size)
+/* The start of `fit` and `simulate`: options, the config, the run
+ * directory (-o, or runs/<name><suffix>).  Returns -1 when *exit_code is
+ * set (usage or bad input), 0 with *pb loaded otherwise. */
+static int load_for_run(int argc, char **argv, const char *allowed, const char *suffix, cli_options *o,
+                        phc_problem **pb, char *dir, size_t size, int *exit_code)
 {
-    snprintf(buf, size, "runs/%s", pb->name);
+    phc_error err;
+    phc_error_clear(&err);
+    *pb = NULL;
+    if (parse_args(argc, argv, o, allowed) != 0) {
+        usage(stderr);
+        *exit_code = EXIT_USAGE;
+        return -1;
+    }
+    if (phc_config_load(o->input, pb, &err)) {
+        *exit_code = fail(&err);
+        return -1;
+    }
+    if (o->out_dir)
+        snprintf(dir, size, "%s", o->out_dir);
+    else
+        snprintf(dir, size, "runs/%s%s", (*pb)->name, suffix);
+    return 0;
 }
 
 static int cmd_fit(int argc, char **argv)
 {
     cli_options o;
-    if (parse_args(argc, argv, &o, "ofq") != 0) {
-        usage(stderr);
-        return EXIT_USAGE;
-    }
+    phc_problem *pb = NULL;
+    char dir[4096];
+    int code;
+    if (load_for_run(argc, argv, "ofq", "", &o, &pb, dir, sizeof dir, &code))
+        return code;
     phc_error err;
     phc_error_clear(&err);
-    phc_problem *pb = NULL;
-    if (phc_config_load(o.input, &pb, &err))
-        return fail(&err);
-    char dir[4096];
-    if (o.out_dir)
-        snprintf(dir, sizeof dir, "%s", o.out_dir);
-    else
-        default_dir(pb, dir, sizeof dir);
     if (phc_run_dir_check(dir, o.force, &err)) {
         phc_problem_free(pb);
         return fail(&err);
@@ -177,20 +190,13 @@ static int cmd_fit(int argc, char **argv)
 static int cmd_simulate(int argc, char **argv)
 {
     cli_options o;
-    if (parse_args(argc, argv, &o, "of") != 0) {
-        usage(stderr);
-        return EXIT_USAGE;
-    }
+    phc_problem *pb = NULL;
+    char dir[4096];
+    int code;
+    if (load_for_run(argc, argv, "of", "-simulation", &o, &pb, dir, sizeof dir, &code))
+        return code;
     phc_error err;
     phc_error_clear(&err);
-    phc_problem *pb = NULL;
-    if (phc_config_load(o.input, &pb, &err))
-        return fail(&err);
-    char dir[4096];
-    if (o.out_dir)
-        snprintf(dir, sizeof dir, "%s", o.out_dir);
-    else
-        snprintf(dir, sizeof dir, "runs/%s-simulation", pb->name);
     const int rc = phc_simulate_write(pb, dir, o.force, &err);
     if (rc == PHC_OK)
         printf("simulated %zu data set%s: %s/\n", pb->n_datasets, pb->n_datasets == 1 ? "" : "s", dir);
