@@ -534,7 +534,14 @@ static int unknown_column(const phc_table *t, const char *name, phc_error *err)
 int phc_table_column_numbers(const phc_table *t, const char *name,
                              double **values, phc_error *err)
 {
+    return phc_table_column_numbers_rows(t, name, NULL, t ? t->nrows : 0, values, err);
+}
+
+int phc_table_column_numbers_rows(const phc_table *t, const char *name, const size_t *rows,
+                                  size_t n_rows, double **values, phc_error *err)
+{
     double *v = NULL;
+    size_t i;
     long column;
     size_t r;
     int rc;
@@ -549,20 +556,25 @@ int phc_table_column_numbers(const phc_table *t, const char *name,
     column = phc_table_find(t, name);
     if (column < 0)
         return unknown_column(t, name, err);
-    if (t->nrows == 0) {
+    for (i = 0; rows && i < n_rows; ++i)
+        if (rows[i] >= t->nrows)
+            return phc_error_set(err, PHC_ERR_INVALID,
+                                 "phc_table_column_numbers_rows: row %zu out of range", rows[i]);
+    if (n_rows == 0) {
         phc_error_clear(err);
         return 0;
     }
     shorten(name, shown_name, sizeof shown_name);
     rc = PHC_ERR_NOMEM;
-    if (t->nrows > SIZE_MAX / sizeof *v)
+    if (n_rows > SIZE_MAX / sizeof *v)
         goto fail;
-    v = malloc(t->nrows * sizeof *v);
+    v = malloc(n_rows * sizeof *v);
     if (!v)
         goto fail;
     if (phc_c_numeric_begin(&c_numeric) != 0)
         goto fail;
-    for (r = 0; r < t->nrows; ++r) {
+    for (i = 0; i < n_rows; ++i) {
+        r = rows ? rows[i] : i;
         const char *cell = t->cells[r * t->ncols + (size_t)column];
         char shown[TABLE_SHOW_MAX + 8];
         char *end;
@@ -585,7 +597,7 @@ int phc_table_column_numbers(const phc_table *t, const char *name,
                                shorten(cell, shown, sizeof shown));
             goto fail;
         }
-        v[r] = x;
+        v[i] = x;
     }
     phc_c_numeric_end(&c_numeric);
     *values = v;

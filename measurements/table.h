@@ -60,5 +60,9 @@ size_t phc_table_row_line(const phc_table *t, size_t row);
  * PHC_ERR_INPUT naming the columns that exist and the nearest match. */
 int phc_table_column_numbers(const phc_table *t, const char *name,
                              double **values, phc_error *err);
+/* The same for the rows rows[0..n_rows-1] only (0-based row indices, in the
+ * order given); *values has n_rows entries. */
+int phc_table_column_numbers_rows(const phc_table *t, const char *name, const size_t *rows,
+                                  size_t n_rows, double **values, phc_error *err);
 
 #endif /* PHC_TABLE_H */

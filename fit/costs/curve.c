@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "fit/costs/expression.h"
-#include "measurements/suggest.h"
+#include "fit/costs/source_file.h"
 #include "measurements/table.h"
 
 const char *const phc_curve_keys[] = {"file", "x", "y", "expression", "sigma",
@@ -103,38 +103,6 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
 
 static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free};
 
-static char *join_path(const char *dir, const char *file)
-{
-    if (file[0] == '/' || !dir || !dir[0])
-        return strdup(file);
-    size_t len = strlen(dir) + strlen(file) + 2;
-    char *s = malloc(len);
-    if (s)
-        snprintf(s, len, "%s/%s", dir, file);
-    return s;
-}
-
-/* A column name that is not in the table: name the columns that are. */
-static int unknown_column(const phc_yaml_doc *doc, size_t line, const char *what,
-                          const char *name, const phc_table *t, phc_error *err)
-{
-    size_t nc = phc_table_columns(t);
-    const char *names[64];
-    size_t shown = nc < 64 ? nc : 64;
-    char list[512] = "";
-    for (size_t j = 0; j < shown; ++j) {
-        names[j] = phc_table_column_name(t, j);
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof list - used, "%s'%s'", j ? ", " : "", names[j]);
-    }
-    const char *near = phc_suggest(name, names, shown);
-    if (near)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s '%s' is not a column of %s; did you mean '%s'?",
-                             doc->path, line, what, name, phc_table_source(t), near);
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s '%s' is not a column of %s (columns: %s)",
-                         doc->path, line, what, name, phc_table_source(t), list);
-}
-
 static size_t key_line(const phc_yaml_node *map, const char *key)
 {
     for (size_t i = 0; i < map->count; ++i)
@@ -207,7 +175,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
         return rc;
 
-    path = join_path(base_dir, file);
+    path = phc_join_path(base_dir, file);
     if (!path)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if ((rc = phc_table_read(path, &table, err)))
@@ -298,7 +266,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                 mupDefineVar(c->parser, name, &c->row[c->n_cols++]);
             }
         } else {
-            rc = unknown_column(doc, line, "expression name", name, table, err);
+            rc = phc_unknown_column(doc, line, "expression name", name, table, err);
             if (rc == PHC_ERR_INPUT)
                 strncat(err->message, " (not a parameter either)",
                         sizeof err->message - strlen(err->message) - 1);
@@ -331,11 +299,11 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     ds->n = phc_table_rows(table);
     if (phc_table_find(table, xname) < 0) {
-        rc = unknown_column(doc, key_line(node, "x"), "x", xname, table, err);
+        rc = phc_unknown_column(doc, key_line(node, "x"), "x", xname, table, err);
         goto fail;
     }
     if (phc_table_find(table, yname) < 0) {
-        rc = unknown_column(doc, key_line(node, "y"), "y", yname, table, err);
+        rc = phc_unknown_column(doc, key_line(node, "y"), "y", yname, table, err);
         goto fail;
     }
     if ((rc = phc_table_column_numbers(table, xname, &ds->x, err)) ||

@@ -1,0 +1,22 @@
+/* Shared by the data-set kinds: finding a data file named in a config, and
+ * saying which columns exist when a config names one that does not. */
+#ifndef PHC_COSTS_SOURCE_FILE_H
+#define PHC_COSTS_SOURCE_FILE_H
+
+#include <stddef.h>
+
+#include "measurements/table.h"
+#include "measurements/yaml_doc.h"
+#include "model/status.h"
+
+/* `file` relative to `dir` (the config file's directory) unless absolute;
+ * malloc'd, NULL when out of memory. */
+char *phc_join_path(const char *dir, const char *file);
+
+/* PHC_ERR_INPUT for a column name that is not in the table, at config line
+ * `line`: "cfg.yaml:7: mass column 'mas' is not a column of data.csv; did you
+ * mean 'mass'?" (or the list of columns when nothing is close). */
+int phc_unknown_column(const phc_yaml_doc *doc, size_t line, const char *what, const char *name,
+                       const phc_table *t, phc_error *err);
+
+#endif /* PHC_COSTS_SOURCE_FILE_H */
