@@ -8,6 +8,8 @@
 #include <string.h>
 
 #include "fit/costs/curve.h"
+#include "fit/costs/elasticity_curve.h"
+#include "fit/costs/pv_curve.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
@@ -23,6 +25,8 @@ typedef struct kind_entry {
 
 static const kind_entry kinds[] = {
     {"curve", phc_curve_keys, phc_curve_load},
+    {"elasticity_curve", phc_elasticity_curve_keys, phc_elasticity_curve_load},
+    {"pv_curve", phc_pv_curve_keys, phc_pv_curve_load},
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])
 
@@ -304,9 +308,14 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     }
     if (!entry) {
         const char *near = phc_suggest(kind, kind_names, N_KINDS);
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: unknown kind '%s'%s%s%s (known: curve)",
+        char known[256] = "";
+        for (size_t i = 0; i < N_KINDS; ++i) {
+            size_t used = strlen(known);
+            snprintf(known + used, sizeof known - used, "%s%s", i ? ", " : "", kind_names[i]);
+        }
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: unknown kind '%s'%s%s%s (known: %s)",
                              doc->path, phc_yaml_get(node, "kind")->line, ctx, kind,
-                             near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "");
+                             near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "", known);
     }
     /* Allowed keys: the common ones and the kind's own. */
     const char *allowed[64];

@@ -22,7 +22,8 @@
  *                             optional first line `# unit: m` (or cm, mm, um).
  *   PHC_PLANT_FORMAT_AUTO     by extension: .swc SWC, .csv native, a file whose
  *                             first line starts with `verts` paper, otherwise
- *                             TreeQSM when it has 16 tab-separated columns.
+ *                             TreeQSM when it has 15 or 16 tab-separated
+ *                             columns (aRchi's TreeQSM export has 15).
  *
  * Every error names the file and line:
  *     "plant.txt:12: edge 4,4: a segment cannot be its own neighbour"

@@ -620,6 +620,66 @@ if [ "$strict_rc" -ne 0 ] && [ "$strict_rc" -ne 3 ]; then
 fi
 report_case "control: report exits 0 and --strict agrees with the verdict"
 
+# ---- pv_curve ---------------------------------------------------------------
+# Pressure-volume data sets (fit/costs/pv_curve.h): each case exits 2 with one
+# stderr line naming the file and line (or the config key).
+PV_PARAMS='parameters:
+  kappa: {value: 20, lower: 0}
+  chi0:  {value: 0.85}
+  e_min: {value: 0, fixed: true}
+  e_max: {value: 5, lower: 0}'
+pv_csv() { # FILE [ROW3]: two leaves of 6 points; ROW3 replaces leaf A's 3rd point (line 4)
+    local row3=${2:-A,-0.95,1.5305,0.352,1.604}
+    printf 'leaf,psi,fresh,dry,sat\nA,-0.40,1.6025,0.352,1.604\nA,-0.67,1.5681,0.352,1.604\n%s\nA,-1.28,1.4725,0.352,1.604\nA,-1.46,1.4102,0.352,1.604\nA,-1.64,1.3514,0.352,1.604\nB,-0.45,1.3692,0.291,1.377\nB,-0.71,1.3420,0.291,1.377\nB,-0.91,1.3172,0.291,1.377\nB,-1.29,1.2591,0.291,1.377\nB,-1.48,1.2091,0.291,1.377\nB,-1.64,1.1547,0.291,1.377\n' "$row3" >"$C/$1"
+}
+pv_config() { # FILE CSV EXTRA_LINES (dry/saturated/leaf keys)
+    printf 'name: t\n%s\ndatasets:\n  - kind: pv_curve\n    file: %s\n    psi: psi\n    fresh_mass: fresh\n    group: leaf\n%s' \
+        "$PV_PARAMS" "$2" "$3" >"$C/$1"
+}
+pv_csv pv_ok.csv
+pv_config pv_nodry.yaml pv_ok.csv '    saturated_mass: sat
+    leaf: A
+'
+fit_case "pv_curve: missing dry mass" "$C/pv_nodry.yaml" "pv_nodry.yaml:8" "dry_mass"
+pv_config pv_nosat.yaml pv_ok.csv '    dry_mass: dry
+    leaf: A
+'
+fit_case "pv_curve: missing saturated mass" "$C/pv_nosat.yaml" "pv_nosat.yaml:8" "saturated_mass"
+pv_csv pv_pos.csv A,0.95,1.5305,0.352,1.604
+pv_config pv_pos.yaml pv_pos.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+'
+fit_case "pv_curve: positive water potential" "$C/pv_pos.yaml" "pv_pos.csv:4:" "negative"
+pv_csv pv_text.csv A,-0.95,n/a,0.352,1.604
+pv_config pv_text.yaml pv_text.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+'
+fit_case "pv_curve: non-numeric mass" "$C/pv_text.yaml" "pv_text.csv:4:" "n/a"
+pv_config pv_group.yaml pv_ok.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: L9
+'
+fit_case "pv_curve: unknown leaf id" "$C/pv_group.yaml" "pv_group.yaml:15" "'L9'"
+printf 'leaf,psi,fresh,dry,sat\nA,-0.40,1.6025,0.352,1.604\n' >"$C/pv_one.csv"
+pv_config pv_one.yaml pv_one.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+'
+fit_case "pv_curve: a single point" "$C/pv_one.yaml" "pv_one.csv:2:" "1 point"
+pv_config pv_each.yaml pv_ok.csv '    dry_mass: dry
+    saturated_mass: sat
+'
+fit_case "pv_curve: several leaves, none chosen" "$C/pv_each.yaml" "pv_each.yaml:" "leaf"
+pv_config pv_unit.yaml pv_ok.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+    psi_unit: psi
+'
+fit_case "pv_curve: unknown potential unit" "$C/pv_unit.yaml" "pv_unit.yaml:16" "psi_unit"
+# ---- end pv_curve -------------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
