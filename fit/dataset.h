@@ -25,6 +25,11 @@ typedef struct phc_dataset_ops {
     int (*predict_at)(phc_dataset *ds, const double *p, const double *x,
                       size_t m, double *y);
     void (*free_impl)(void *impl);
+    /* Optional (NULL = none): a markdown section the kind adds to the report
+     * after the data set's checks (for example the classic pressure–volume
+     * parameters of every leaf, or the model set-up), at the fitted slot
+     * values p.  *markdown is malloc'd; return PHC_OK or an error. */
+    int (*report_section)(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {

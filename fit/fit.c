@@ -39,6 +39,7 @@ static void dataset_result_clear(phc_dataset_result *d)
     free(d->sigma);
     free(d->curve_x);
     free(d->curve_y);
+    free(d->extra_markdown);
 }
 
 void phc_fit_result_free(phc_fit_result *res)
@@ -299,6 +300,8 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
                            ds->name);
         goto fail;
     }
+    if (ds->ops->report_section && (rc = ds->ops->report_section(ds, p, &d->extra_markdown, err)))
+        goto fail;
     for (size_t i = 0; i < n; ++i) {
         d->residual[i] = d->y[i] - d->yhat[i];
         d->std_residual[i] = r_w[i] / (s > 0 ? s : 1.0);

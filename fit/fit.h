@@ -48,6 +48,7 @@ typedef struct phc_dataset_result {
     size_t curve_n;
     double acf[PHC_ACF_MAX_LAG + 1];
     size_t acf_lags;             /* lags computed (0 when n too small) */
+    char *extra_markdown;        /* the kind's own report section, or NULL */
 } phc_dataset_result;
 
 typedef struct phc_param_result {

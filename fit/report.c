@@ -179,6 +179,8 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
         fprintf(f, "\nResidual checks (residuals ordered by %s):\n\n", ds->x_label);
         print_checks_md(ds, res->level, f);
         fprintf(f, "\n");
+        if (ds->extra_markdown)
+            fprintf(f, "%s\n", ds->extra_markdown);
         for (size_t i = 0; plots && plots[i]; ++i) {
             size_t len = strlen(ds->name);
             if (strncmp(plots[i], ds->name, len) == 0 && plots[i][len] == '_')

@@ -53,6 +53,8 @@ static json_t *dataset_json(const phc_dataset_result *d)
     json_object_set_new(o, "standardised_residuals", num_array(d->std_residual, d->n));
     json_object_set_new(o, "sigma", d->sigma ? num_array(d->sigma, d->n) : json_null());
     json_object_set_new(o, "acf", num_array(d->acf, d->acf_lags ? d->acf_lags + 1 : 0));
+    if (d->extra_markdown)
+        json_object_set_new(o, "extra_markdown", json_string(d->extra_markdown));
     return o;
 }
 
@@ -234,6 +236,9 @@ static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result 
         return rc;
     json_t *sig = json_object_get(o, "sigma");
     if (sig && !json_is_null(sig) && (rc = get_array(rd, o, "sigma", where, d->n, &d->sigma)))
+        return rc;
+    json_t *extra = json_object_get(o, "extra_markdown");
+    if (extra && (rc = get_string(rd, o, "extra_markdown", where, &d->extra_markdown)))
         return rc;
     json_t *g = json_object_get(o, "goodness");
     if (!json_is_object(g))

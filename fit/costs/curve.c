@@ -101,7 +101,7 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     return 0;
 }
 
-static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free};
+static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free, NULL};
 
 static size_t key_line(const phc_yaml_node *map, const char *key)
 {

@@ -92,7 +92,7 @@ nomem:
 }
 
 static const phc_dataset_ops elasticity_ops = {"elasticity_curve", phc_elasticity_predict,
-                                               phc_elasticity_predict_at, phc_elasticity_impl_free};
+                                               phc_elasticity_predict_at, phc_elasticity_impl_free, NULL};
 
 static char *join_path(const char *dir, const char *file)
 {

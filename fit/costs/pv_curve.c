@@ -41,8 +41,10 @@ static void pv_extra_free(void *p)
     free(x);
 }
 
+static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
+
 static const phc_dataset_ops pv_ops = {"pv_curve", phc_elasticity_predict, phc_elasticity_predict_at,
-                                       phc_elasticity_impl_free};
+                                       phc_elasticity_impl_free, pv_report_section};
 
 static pv_extra *extra_of(const phc_dataset *ds)
 {
@@ -537,4 +539,12 @@ fail:
     free(lrwc);
     free(lwater);
     return rc;
+}
+
+/* The report hook: the classic PV parameters do not depend on the fitted
+ * logistic, so p is not needed. */
+static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
+{
+    (void)p;
+    return phc_pv_curve_markdown(ds, markdown, err);
 }
