@@ -10,6 +10,7 @@
 #include "fit/costs/curve.h"
 #include "fit/costs/elasticity_curve.h"
 #include "fit/costs/pv_curve.h"
+#include "fit/costs/weight_curve.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
@@ -27,6 +28,7 @@ static const kind_entry kinds[] = {
     {"curve", phc_curve_keys, phc_curve_load},
     {"elasticity_curve", phc_elasticity_curve_keys, phc_elasticity_curve_load},
     {"pv_curve", phc_pv_curve_keys, phc_pv_curve_load},
+    {"weight_curve", phc_weight_curve_keys, phc_weight_curve_load},
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])
 

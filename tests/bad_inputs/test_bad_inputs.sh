@@ -680,6 +680,67 @@ pv_config pv_unit.yaml pv_ok.csv '    dry_mass: dry
 fit_case "pv_curve: unknown potential unit" "$C/pv_unit.yaml" "pv_unit.yaml:16" "psi_unit"
 # ---- end pv_curve -------------------------------------------------------------
 
+# ---- weight_curve and plant graphs -----------------------------------------
+# Balance curves (fit/costs/weight_curve.h) and every malformed plant-graph
+# file of tests/bad_inputs/plant_graphs/ (read through `plant:`): each case
+# exits 2 with one stderr line naming the file and line (or the key).
+GRAPH_DIR="$SCRIPT_DIR/plant_graphs"
+WC_PARAMS='parameters:
+  delta: {value: 1.0e-3, lower: 0}
+  initial_water: {value: 3, lower: 0}
+  dry_mass: {value: 1, lower: 0}'
+printf 't,m\n0,4.0\n1,3.9\n2,3.8\n3,3.7\n' >"$C/wc_ok.csv"
+wc_config() { # FILE CSV EXTRA_LINES (must include plant: or leaf_area:)
+    printf 'name: t\n%s\ndatasets:\n  - kind: weight_curve\n    file: %s\n    time: {column: t, unit: h}\n    mass: {column: m, unit: g}\n%s' \
+        "$WC_PARAMS" "$2" "$3" >"$C/$1"
+}
+if [ -d "$GRAPH_DIR" ]; then
+    while IFS='|' read -r gfile gwant; do
+        case "$gfile" in '#'* | '') continue ;; esac
+        wc_config "wcg_${gfile}.yaml" wc_ok.csv "    plant: $GRAPH_DIR/$gfile
+"
+        fit_case "plant graph: $gfile" "$C/wcg_${gfile}.yaml" "$gwant"
+    done <"$GRAPH_DIR/expected.txt"
+fi
+printf 't,m\n0,4.0\n1,3.9\n1,3.8\n3,3.7\n' >"$C/wc_time.csv"
+wc_config wc_time.yaml wc_time.csv '    leaf_area: 100
+'
+fit_case "weight_curve: time not increasing" "$C/wc_time.yaml" "wc_time.csv:4:" "not after"
+printf 't,m\n0,4.0\n' >"$C/wc_one.csv"
+wc_config wc_one.yaml wc_one.csv '    leaf_area: 100
+'
+fit_case "weight_curve: a single weighing" "$C/wc_one.yaml" "wc_one.csv" "at least 2"
+wc_config wc_dry.yaml wc_ok.csv '    leaf_area: 100
+    dry_mass: 3.8
+'
+fit_case "weight_curve: mass below the dry mass" "$C/wc_dry.yaml" "wc_ok.csv:5:" "below the measured dry mass"
+printf 't,m\n0,4.0\n1,3.9\n2,5.8\n3,5.7\n' >"$C/wc_jump.csv"
+wc_config wc_jump.yaml wc_jump.csv '    leaf_area: 100
+'
+fit_case "weight_curve: irrigation jump" "$C/wc_jump.yaml" "wc_jump.csv:4:" "jumps: split"
+wc_config wc_unit.yaml wc_ok.csv '    leaf_area: 100
+' && sed -i 's/unit: h}/unit: hourz}/' "$C/wc_unit.yaml"
+fit_case "weight_curve: unknown time unit" "$C/wc_unit.yaml" "wc_unit.yaml:" "hourz"
+wc_config wc_munit.yaml wc_ok.csv '    leaf_area: 100
+' && sed -i 's/unit: g}/unit: s}/' "$C/wc_munit.yaml"
+fit_case "weight_curve: mass in a time unit" "$C/wc_munit.yaml" "wc_munit.yaml:" "cannot be converted to 'g'"
+wc_config wc_both.yaml wc_ok.csv '    leaf_area: 100
+    plant: x.csv
+'
+fit_case "weight_curve: plant and leaf_area" "$C/wc_both.yaml" "wc_both.yaml:" "either 'plant'"
+wc_config wc_col.yaml wc_ok.csv '    leaf_area: 100
+' && sed -i 's/column: m,/column: mass,/' "$C/wc_col.yaml"
+fit_case "weight_curve: unknown mass column" "$C/wc_col.yaml" "wc_col.yaml:" "'mass'"
+printf 't,m\n0,4.0\n1,n/a\n2,3.8\n' >"$C/wc_text.csv"
+wc_config wc_text.yaml wc_text.csv '    leaf_area: 100
+'
+fit_case "weight_curve: non-numeric mass" "$C/wc_text.yaml" "wc_text.csv:3:" "n/a"
+wc_config wc_sel.yaml wc_ok.csv '    leaf_area: 100
+    select: {plant: 3}
+'
+fit_case "weight_curve: select names no column" "$C/wc_sel.yaml" "wc_sel.yaml:" "'plant'"
+# ---- end weight_curve ------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

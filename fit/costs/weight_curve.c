@@ -1,0 +1,767 @@
+/* `weight_curve` data sets: see weight_curve.h. */
+#include "fit/costs/weight_curve.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/costs/source_file.h"
+#include "measurements/c_number.h"
+#include "measurements/plant_io.h"
+#include "measurements/table.h"
+#include "measurements/units.h"
+#include "model/plant_graph.h"
+#include "model/water.h"
+
+const char *const phc_weight_curve_keys[] = {
+    "file", "time", "mass", "select", "plant", "plant_format", "plant_unit", "leaf_area",
+    "chain_segments", "vein_radius", "dry_mass", "sigma", "exclude", "jumps", "jump_threshold",
+    "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
+
+/* A stretch of the curve between irrigations.  Piece 0 starts from the
+ * `initial_water` slot; later pieces start from their first measured mass. */
+typedef struct piece {
+    size_t first, count;  /* residuals first .. first+count-1 */
+    double start_x;       /* time of the piece's start, user time unit from the first row */
+    double start_mass;    /* g; the measured start of pieces > 0 */
+} piece;
+
+enum { SLOT_DELTA, SLOT_W0, SLOT_DRY, SLOT_MU, N_SLOT_KINDS };
+
+typedef struct wc_impl {
+    phc_plant_graph *graph;
+    phc_water_params params;   /* weights (conductance), edge options */
+    phc_water_method method;
+    double step;               /* BDF6 step, s (0 = the model's choice) */
+    phc_water_system *sys;     /* built for sys_mu; rebuilt when μ changes */
+    double sys_mu;
+    double viscosity;          /* mPa·s when not a slot */
+    double dry_measured;       /* g, or NAN */
+    int slot[N_SLOT_KINDS];    /* slot index of each quantity, -1 when fixed */
+    double *t_model;           /* n: s since the start of the residual's piece */
+    size_t n_pieces;
+    piece *pieces;
+    double seconds_per_x;      /* the user's time unit in s */
+    double *u, *du;            /* workspace: unit response and its derivatives */
+} wc_impl;
+
+static void wc_free(void *p)
+{
+    wc_impl *w = p;
+    if (!w)
+        return;
+    phc_plant_graph_free(w->graph);
+    phc_water_system_free(w->sys);
+    free(w->t_model);
+    free(w->pieces);
+    free(w->u);
+    free(w->du);
+    free(w);
+}
+
+static double slot_value(const wc_impl *w, const double *p, int kind, double fallback)
+{
+    return w->slot[kind] >= 0 ? p[w->slot[kind]] : fallback;
+}
+
+/* The unit response u(t) = W(t)/W(0) of the water model at m sorted times
+ * (s) and, when du is given, du (m x 3: d/dδ, d/dW0, d/dμ).  The system is
+ * built once and rebuilt only when μ changes (δ is set in place, O(n)). */
+static int unit_response(wc_impl *w, double delta, double mu, const double *t, size_t m,
+                         double *u, double *du)
+{
+    phc_error err;
+    phc_error_clear(&err);
+    if (!w->sys || w->sys_mu != mu) {
+        phc_water_system_free(w->sys);
+        w->sys = NULL;
+        phc_water_params p = w->params;
+        p.viscosity = mu;
+        p.loss_rate = delta;
+        p.initial_water = 1.0;
+        int rc = phc_water_system_new(w->graph, &p, &w->sys, &err);
+        if (rc)
+            return rc == PHC_ERR_NOMEM ? -1 : 1;
+        w->sys_mu = mu;
+    }
+    if (phc_water_system_set_loss_rate(w->sys, delta, &err))
+        return 1; /* a trial point outside the model's domain: reject the step */
+    int rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err);
+    if (rc == PHC_ERR_NOMEM || rc == PHC_ERR_INTERNAL || rc == PHC_ERR_INVALID)
+        return -1;
+    return rc ? 1 : 0;
+}
+
+static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    wc_impl *w = ds->impl;
+    const double delta = slot_value(w, p, SLOT_DELTA, 0);
+    const double w0 = slot_value(w, p, SLOT_W0, 0);
+    const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
+    const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
+    if (!(delta >= 0) || !(mu > 0) || !isfinite(w0) || !isfinite(dry))
+        return 1;
+    for (size_t k = 0; k < w->n_pieces; ++k) {
+        const piece *pc = &w->pieces[k];
+        int rc = unit_response(w, delta, mu, w->t_model + pc->first, pc->count, w->u,
+                               jac ? w->du : NULL);
+        if (rc)
+            return rc;
+        /* Later pieces restart from the water measured at their start. */
+        const double start = k == 0 ? w0 : pc->start_mass - dry;
+        for (size_t i = 0; i < pc->count; ++i) {
+            const size_t r = pc->first + i;
+            yhat[r] = dry + start * w->u[i];
+            if (!jac)
+                continue;
+            double *row = jac + r * ds->k;
+            for (size_t j = 0; j < ds->k; ++j)
+                row[j] = 0;
+            if (w->slot[SLOT_DELTA] >= 0)
+                row[w->slot[SLOT_DELTA]] = start * w->du[3 * i];
+            if (w->slot[SLOT_MU] >= 0)
+                row[w->slot[SLOT_MU]] = start * w->du[3 * i + 2];
+            if (w->slot[SLOT_W0] >= 0 && k == 0)
+                row[w->slot[SLOT_W0]] = w->u[i];
+            if (w->slot[SLOT_DRY] >= 0)
+                row[w->slot[SLOT_DRY]] = k == 0 ? 1.0 : 1.0 - w->u[i];
+        }
+    }
+    return 0;
+}
+
+/* The fitted curve at arbitrary x (user time unit since the first row),
+ * piece by piece; x must be sorted (the plot's grid is). */
+static int wc_predict_at(phc_dataset *ds, const double *p, const double *x, size_t m, double *y)
+{
+    wc_impl *w = ds->impl;
+    const double delta = slot_value(w, p, SLOT_DELTA, 0);
+    const double w0 = slot_value(w, p, SLOT_W0, 0);
+    const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
+    const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
+    double *t = malloc((m ? m : 1) * sizeof *t), *u = malloc((m ? m : 1) * sizeof *u);
+    int rc = 0;
+    if (!t || !u) {
+        rc = -1;
+        goto done;
+    }
+    for (size_t i = 0; i < m && !rc;) {
+        size_t k = 0;
+        while (k + 1 < w->n_pieces && w->pieces[k + 1].start_x <= x[i])
+            ++k;
+        const double end = k + 1 < w->n_pieces ? w->pieces[k + 1].start_x : INFINITY;
+        size_t j = i;
+        while (j < m && x[j] < end) {
+            const double dt = (x[j] - w->pieces[k].start_x) * w->seconds_per_x;
+            t[j - i] = dt > 0 ? dt : 0;
+            ++j;
+        }
+        if (j == i) { /* before the first piece */
+            y[i++] = NAN;
+            continue;
+        }
+        rc = unit_response(w, delta, mu, t, j - i, u, NULL);
+        const double start = k == 0 ? w0 : w->pieces[k].start_mass - dry;
+        for (size_t q = i; q < j && !rc; ++q)
+            y[q] = dry + start * u[q - i];
+        i = j;
+    }
+done:
+    free(t);
+    free(u);
+    return rc;
+}
+
+static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
+
+static const phc_dataset_ops weight_curve_ops = {"weight_curve", wc_predict, wc_predict_at,
+                                                 wc_free, wc_report_section};
+
+/* ---- loading ------------------------------------------------------------- */
+
+/* A `{column: NAME, unit: UNIT}` mapping (or a bare column name). */
+static int column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                       const char *default_unit, const char **column, const char **unit,
+                       phc_error *err)
+{
+    const phc_yaml_node *v = phc_yaml_get(node, key);
+    static const char *const spec_keys[] = {"column", "unit", NULL};
+    char ctx[64];
+    int rc;
+    snprintf(ctx, sizeof ctx, "key '%s'", key);
+    *unit = default_unit;
+    if (!v)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: weight_curve data set: missing key '%s' ({column: NAME, unit: UNIT})",
+                             doc->path, node->line, key);
+    if (v->kind == PHC_YAML_SCALAR)
+        return phc_yaml_string(doc, v, key, column, err);
+    if ((rc = phc_yaml_check_keys(doc, v, spec_keys, ctx, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "column", 1, ctx, column, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, unit, err)))
+        return rc;
+    return PHC_OK;
+}
+
+/* A quantity given as a number, or {value: X | column: NAME, unit: UNIT};
+ * a column is read at the first selected row.  Converted to `model_unit`. */
+static int quantity(const phc_yaml_doc *doc, const phc_yaml_node *v, const char *key,
+                    const char *default_unit, const char *model_unit, phc_units *units,
+                    const phc_table *t, size_t row, double *out, phc_error *err)
+{
+    static const char *const q_keys[] = {"value", "column", "unit", NULL};
+    char ctx[64];
+    const char *unit = default_unit, *column = NULL;
+    double value = NAN;
+    int rc;
+    snprintf(ctx, sizeof ctx, "key '%s'", key);
+    if (v->kind == PHC_YAML_SCALAR) {
+        if ((rc = phc_yaml_number(doc, v, key, &value, err)))
+            return rc;
+    } else {
+        if ((rc = phc_yaml_check_keys(doc, v, q_keys, ctx, err)) ||
+            (rc = phc_yaml_map_number(doc, v, "value", 0, ctx, &value, err)) ||
+            (rc = phc_yaml_map_string(doc, v, "column", 0, ctx, &column, err)) ||
+            (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, &unit, err)))
+            return rc;
+        if ((column != NULL) == !isnan(value))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': give either value or column",
+                                 doc->path, v->line, key);
+        if (column) {
+            long c = phc_table_find(t, column);
+            if (c < 0)
+                return phc_unknown_column(doc, v->line, key, column, t, err);
+            const char *cell = phc_table_cell(t, row, (size_t)c);
+            char *end = NULL;
+            value = phc_strtod_c(cell, &end);
+            if (!end || end == cell || *end || !isfinite(value))
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': expected a number, found '%s'",
+                                     phc_table_source(t), phc_table_row_line(t, row), column, cell);
+        }
+    }
+    char where[160];
+    snprintf(where, sizeof where, "%s:%zu: %s unit", doc->path, v->line, key);
+    phc_unit_conversion conv;
+    if ((rc = phc_units_conversion(units, unit, model_unit, where, &conv, err)))
+        return rc;
+    *out = phc_unit_apply(conv, value);
+    if (!(*out > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': must be positive, found %g",
+                             doc->path, v->line, key, value);
+    return PHC_OK;
+}
+
+/* Does row r match every `select` pair?  Text equality, or numeric equality
+ * when both sides are numbers ("1" matches "1.0"). */
+static int row_selected(const phc_table *t, size_t r, const phc_yaml_node *sel, const long *cols)
+{
+    for (size_t i = 0; sel && i < sel->count; ++i) {
+        const char *cell = phc_table_cell(t, r, (size_t)cols[i]);
+        const char *want = sel->values[i]->scalar;
+        if (strcmp(cell, want) == 0)
+            continue;
+        char *e1 = NULL, *e2 = NULL;
+        double a = phc_strtod_c(cell, &e1), b = phc_strtod_c(want, &e2);
+        if (e1 && e2 && e1 != cell && e2 != want && !*e1 && !*e2 && a == b)
+            continue;
+        return 0;
+    }
+    return 1;
+}
+
+static int parse_choice(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                        const char *const *names, int *out, phc_error *err)
+{
+    const char *s = NULL;
+    int rc;
+    if ((rc = phc_yaml_map_string(doc, node, key, 0, "weight_curve data set", &s, err)) || !s)
+        return rc;
+    char list[160] = "";
+    for (int i = 0; names[i]; ++i) {
+        if (strcmp(names[i], s) == 0) {
+            *out = i;
+            return PHC_OK;
+        }
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", names[i]);
+    }
+    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not one of %s", doc->path,
+                         phc_yaml_get(node, key)->line, key, s, list);
+}
+
+enum { JUMPS_ERROR, JUMPS_SPLIT, JUMPS_KEEP };
+
+int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
+                          const char *base_dir, phc_is_parameter_fn is_parameter,
+                          void *user_data, phc_dataset **out, phc_error *err)
+{
+    const char *ctx = "weight_curve data set";
+    const char *file = NULL, *tcol = NULL, *tunit = NULL, *mcol = NULL, *munit = NULL;
+    const char *x_label = NULL, *y_label = NULL;
+    phc_units *units = NULL;
+    phc_table *table = NULL;
+    phc_dataset *ds = NULL;
+    wc_impl *w = NULL;
+    char *path = NULL;
+    double *tv = NULL, *mv = NULL, *sv = NULL;
+    size_t *keep = NULL;
+    long *sel_cols = NULL;
+    int rc;
+
+    *out = NULL;
+    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
+        (rc = column_spec(doc, node, "time", "s", &tcol, &tunit, err)) ||
+        (rc = column_spec(doc, node, "mass", "g", &mcol, &munit, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
+        return rc;
+    if (!(units = phc_units_new(err)))
+        return err->status;
+    w = calloc(1, sizeof *w);
+    if (!w) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    w->params = phc_water_params_default();
+    w->method = PHC_WATER_AUTO;
+    w->viscosity = 0.89; /* mPa·s, water at 25 °C (model/water.h) */
+    w->dry_measured = NAN;
+
+    /* Units: time to s, mass to g. */
+    phc_unit_conversion tconv, mconv;
+    char where[160];
+    snprintf(where, sizeof where, "%s:%zu: time unit", doc->path, phc_yaml_get(node, "time")->line);
+    if ((rc = phc_units_conversion(units, tunit, "s", where, &tconv, err)))
+        goto fail;
+    snprintf(where, sizeof where, "%s:%zu: mass unit", doc->path, phc_yaml_get(node, "mass")->line);
+    if ((rc = phc_units_conversion(units, munit, "g", where, &mconv, err)))
+        goto fail;
+    w->seconds_per_x = tconv.scale;
+
+    if (!(path = phc_join_path(base_dir, file))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((rc = phc_table_read(path, &table, err)))
+        goto fail;
+    const size_t rows = phc_table_rows(table);
+    if (phc_table_find(table, tcol) < 0) {
+        rc = phc_unknown_column(doc, phc_yaml_get(node, "time")->line, "time column", tcol, table, err);
+        goto fail;
+    }
+    if (phc_table_find(table, mcol) < 0) {
+        rc = phc_unknown_column(doc, phc_yaml_get(node, "mass")->line, "mass column", mcol, table, err);
+        goto fail;
+    }
+
+    /* Rows of this plant. */
+    const phc_yaml_node *sel = phc_yaml_get(node, "select");
+    if (sel) {
+        if (sel->kind != PHC_YAML_MAPPING) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'select': expected a mapping {COLUMN: VALUE}",
+                               doc->path, sel->line);
+            goto fail;
+        }
+        sel_cols = malloc((sel->count ? sel->count : 1) * sizeof *sel_cols);
+        if (!sel_cols) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < sel->count; ++i) {
+            sel_cols[i] = phc_table_find(table, sel->keys[i]);
+            if (sel_cols[i] < 0) {
+                rc = phc_unknown_column(doc, sel->key_lines[i], "select column", sel->keys[i], table, err);
+                goto fail;
+            }
+            if (sel->values[i]->kind != PHC_YAML_SCALAR) {
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: select '%s': expected a value",
+                                   doc->path, sel->key_lines[i], sel->keys[i]);
+                goto fail;
+            }
+        }
+    }
+    keep = malloc((rows ? rows : 1) * sizeof *keep);
+    if (!keep) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    size_t n_sel = 0;
+    for (size_t r = 0; r < rows; ++r)
+        if (row_selected(table, r, sel, sel_cols))
+            keep[n_sel++] = r;
+    if (n_sel == 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows%s", path,
+                           sel ? " match the data set's `select`" : "");
+        goto fail;
+    }
+    if ((rc = phc_table_column_numbers_rows(table, tcol, keep, n_sel, &tv, err)) ||
+        (rc = phc_table_column_numbers_rows(table, mcol, keep, n_sel, &mv, err)))
+        goto fail;
+    for (size_t i = 0; i < n_sel; ++i) {
+        if (i > 0 && !(tv[i] > tv[i - 1])) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: column '%s': time %g is not after the previous weighing's %g (line %zu); weighings must be in time order",
+                               path, phc_table_row_line(table, keep[i]), tcol, tv[i], tv[i - 1],
+                               phc_table_row_line(table, keep[i - 1]));
+            goto fail;
+        }
+        if (!(mv[i] > 0)) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': a mass must be positive, found %g",
+                               path, phc_table_row_line(table, keep[i]), mcol, mv[i]);
+            goto fail;
+        }
+    }
+
+    /* Per-point sigma (mass unit -> g). */
+    const phc_yaml_node *sig = phc_yaml_get(node, "sigma");
+    double sigma_scalar = NAN;
+    if (sig) {
+        if (sig->kind == PHC_YAML_SCALAR && phc_table_find(table, sig->scalar) >= 0) {
+            if ((rc = phc_table_column_numbers_rows(table, sig->scalar, keep, n_sel, &sv, err)))
+                goto fail;
+            for (size_t i = 0; i < n_sel; ++i)
+                if (!(sv[i] > 0)) {
+                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
+                                       path, phc_table_row_line(table, keep[i]), sig->scalar, sv[i]);
+                    goto fail;
+                }
+        } else {
+            if ((rc = phc_yaml_number(doc, sig, "sigma", &sigma_scalar, err)))
+                goto fail;
+            if (!(sigma_scalar > 0)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': must be positive, found %g",
+                                   doc->path, sig->line, sigma_scalar);
+                goto fail;
+            }
+        }
+    }
+
+    /* Measured dry mass: fixes the slot and bounds the masses. */
+    const phc_yaml_node *dry = phc_yaml_get(node, "dry_mass");
+    if (dry) {
+        if ((rc = quantity(doc, dry, "dry_mass", munit, "g", units, table, keep[0], &w->dry_measured, err)))
+            goto fail;
+        for (size_t i = 0; i < n_sel; ++i)
+            if (phc_unit_apply(mconv, mv[i]) < w->dry_measured) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: column '%s': mass %g is below the measured dry mass %g %s",
+                                   path, phc_table_row_line(table, keep[i]), mcol, mv[i],
+                                   (w->dry_measured - mconv.offset) / mconv.scale, munit);
+                goto fail;
+            }
+    }
+
+    /* The plant: a graph file or a leaf's venation chain. */
+    const phc_yaml_node *plant = phc_yaml_get(node, "plant");
+    const phc_yaml_node *area = phc_yaml_get(node, "leaf_area");
+    if ((plant != NULL) == (area != NULL)) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu: weight_curve data set: give either 'plant' (a plant-graph file) or 'leaf_area' (a detached leaf)",
+                           doc->path, node->line);
+        goto fail;
+    }
+    if (plant) {
+        const char *pfile = NULL, *fmt_name = "auto", *punit = NULL;
+        if ((rc = phc_yaml_string(doc, plant, "plant", &pfile, err)) ||
+            (rc = phc_yaml_map_string(doc, node, "plant_format", 0, ctx, &fmt_name, err)) ||
+            (rc = phc_yaml_map_string(doc, node, "plant_unit", 0, ctx, &punit, err)))
+            goto fail;
+        int fmt = phc_plant_format_from_name(fmt_name);
+        if (fmt < 0) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: key 'plant_format': '%s' is not one of auto, paper, treeqsm, swc, native",
+                               doc->path, phc_yaml_get(node, "plant_format")->line, fmt_name);
+            goto fail;
+        }
+        double to_m = 0;
+        if (punit) {
+            phc_unit_conversion lc;
+            snprintf(where, sizeof where, "%s:%zu: plant_unit", doc->path, phc_yaml_get(node, "plant_unit")->line);
+            if ((rc = phc_units_conversion(units, punit, "m", where, &lc, err)))
+                goto fail;
+            to_m = lc.scale;
+        }
+        char *gpath = phc_join_path(base_dir, pfile);
+        if (!gpath) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        rc = phc_plant_io_read(gpath, (phc_plant_format)fmt, to_m, &w->graph, err);
+        free(gpath);
+        if (rc)
+            goto fail;
+        if (phc_plant_graph_leaf_count(w->graph) == 0) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: plant '%s' has no leaf segments, so it cannot lose water",
+                               doc->path, plant->line, pfile);
+            goto fail;
+        }
+    } else {
+        double area_m2 = 0, radius_m = 0.5e-3;
+        long segments = 20;
+        if ((rc = quantity(doc, area, "leaf_area", "cm2", "m2", units, table, keep[0], &area_m2, err)) ||
+            (rc = phc_yaml_map_integer(doc, node, "chain_segments", 0, ctx, &segments, err)))
+            goto fail;
+        const phc_yaml_node *vr = phc_yaml_get(node, "vein_radius");
+        if (vr && (rc = quantity(doc, vr, "vein_radius", "mm", "m", units, table, keep[0], &radius_m, err)))
+            goto fail;
+        if (segments < 2 || segments > 100000) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'chain_segments': expected 2 to 100000, found %ld",
+                               doc->path, phc_yaml_get(node, "chain_segments")->line, segments);
+            goto fail;
+        }
+        w->graph = phc_plant_graph_leaf_chain(area_m2, (size_t)segments, radius_m);
+        if (!w->graph) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: cannot build a leaf of area %g m2 and vein radius %g m",
+                               doc->path, area->line, area_m2, radius_m);
+            goto fail;
+        }
+    }
+
+    /* Model options. */
+    static const char *const cond_names[] = {"poiseuille", "mean", "paper", "reference",
+                                             "reference_2024", NULL};
+    static const char *const method_names[] = {"auto", "exact", "bdf6", NULL};
+    static const char *const jump_names[] = {"error", "split", "keep", NULL};
+    int cond = 0, method = 0, jumps = JUMPS_ERROR;
+    double step = 0, jump_threshold = NAN;
+    if ((rc = parse_choice(doc, node, "conductance", cond_names, &cond, err)) ||
+        (rc = parse_choice(doc, node, "method", method_names, &method, err)) ||
+        (rc = parse_choice(doc, node, "jumps", jump_names, &jumps, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "step", 0, ctx, &step, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "jump_threshold", 0, ctx, &jump_threshold, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "viscosity", 0, ctx, &w->viscosity, err)))
+        goto fail;
+    static const phc_water_weights cond_values[] = {PHC_WATER_POISEUILLE, PHC_WATER_MEAN_CONDUCTANCE,
+                                                    PHC_WATER_PAPER, PHC_WATER_REFERENCE,
+                                                    PHC_WATER_REFERENCE_2024};
+    static const phc_water_method method_values[] = {PHC_WATER_AUTO, PHC_WATER_EXACT, PHC_WATER_BDF6};
+    w->params.weights = cond_values[cond];
+    w->method = method_values[method];
+    if (!phc_yaml_get(node, "viscosity") && cond >= 3)
+        w->viscosity = 0.9; /* the authors' code */
+    if (step < 0 || !(w->viscosity > 0) || (!isnan(jump_threshold) && !(jump_threshold > 0))) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: weight_curve data set: step must be >= 0, viscosity and jump_threshold positive",
+                           doc->path, node->line);
+        goto fail;
+    }
+    w->step = step * tconv.scale;
+
+    /* Exclusion windows, then irrigation jumps, over the selected rows. */
+    const phc_yaml_node *excl = phc_yaml_get(node, "exclude");
+    if (excl && excl->kind != PHC_YAML_SEQUENCE) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'exclude': expected a list of [from, to] windows",
+                           doc->path, excl->line);
+        goto fail;
+    }
+    size_t n_kept = 0;
+    for (size_t i = 0; i < n_sel; ++i) {
+        const double rel = tv[i] - tv[0];
+        int drop = 0;
+        for (size_t e = 0; excl && e < excl->count && !drop; ++e) {
+            const phc_yaml_node *win = excl->items[e];
+            double lo, hi;
+            if (win->kind != PHC_YAML_SEQUENCE || win->count != 2 ||
+                phc_yaml_number(doc, win->items[0], "exclude", &lo, err) ||
+                phc_yaml_number(doc, win->items[1], "exclude", &hi, err) || !(lo < hi)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: key 'exclude': each window is [from, to] with from < to (time unit, from the first row)",
+                                   doc->path, win->line);
+                goto fail;
+            }
+            drop = rel >= lo && rel <= hi;
+        }
+        if (drop)
+            continue;
+        tv[n_kept] = tv[i];
+        mv[n_kept] = phc_unit_apply(mconv, mv[i]);
+        if (sv)
+            sv[n_kept] = sv[i] * mconv.scale;
+        keep[n_kept++] = keep[i];
+    }
+    if (n_kept < 2) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s: %zu weighing%s left after select and exclude; a weight curve needs at least 2",
+                           path, n_kept, n_kept == 1 ? "" : "s");
+        goto fail;
+    }
+    if (isnan(jump_threshold)) {
+        double mmax = 0;
+        for (size_t i = 0; i < n_kept; ++i)
+            mmax = fmax(mmax, mv[i]);
+        jump_threshold = fmax(isnan(sigma_scalar) ? 0 : 5 * sigma_scalar * mconv.scale, 0.005 * mmax);
+    } else {
+        jump_threshold *= mconv.scale;
+    }
+
+    /* Slots: delta and initial_water always; dry_mass unless measured;
+     * viscosity when the user made it a parameter. */
+    const char *slot_names[N_SLOT_KINDS];
+    size_t k_slots = 0;
+    for (int s = 0; s < N_SLOT_KINDS; ++s)
+        w->slot[s] = -1;
+    w->slot[SLOT_DELTA] = (int)k_slots;
+    slot_names[k_slots++] = "delta";
+    w->slot[SLOT_W0] = (int)k_slots;
+    slot_names[k_slots++] = "initial_water";
+    if (isnan(w->dry_measured)) {
+        w->slot[SLOT_DRY] = (int)k_slots;
+        slot_names[k_slots++] = "dry_mass";
+    }
+    if (is_parameter("viscosity", user_data)) {
+        w->slot[SLOT_MU] = (int)k_slots;
+        slot_names[k_slots++] = "viscosity";
+    }
+    ds = phc_dataset_new(&weight_curve_ops, k_slots);
+    if (!ds) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t j = 0; j < k_slots; ++j)
+        if (!(ds->slot_names[j] = strdup(slot_names[j]))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+    /* Pieces.  Count first, then fill. */
+    size_t n_pieces = 1;
+    for (size_t i = 1; i < n_kept; ++i)
+        if (mv[i] - mv[i - 1] > jump_threshold) {
+            if (jumps == JUMPS_ERROR) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: the mass rises by %g g since line %zu (an irrigation?); set `jumps: split` or `exclude` the window",
+                                   path, phc_table_row_line(table, keep[i]), mv[i] - mv[i - 1],
+                                   phc_table_row_line(table, keep[i - 1]));
+                goto fail;
+            }
+            if (jumps == JUMPS_SPLIT)
+                ++n_pieces;
+        }
+    w->pieces = calloc(n_pieces, sizeof *w->pieces);
+    const size_t n = n_kept - (n_pieces - 1);
+    w->t_model = malloc(n * sizeof *w->t_model);
+    if (!w->pieces || !w->t_model) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    ds->n = n;
+    ds->x = malloc(n * sizeof *ds->x);
+    ds->y = malloc(n * sizeof *ds->y);
+    ds->sigma = (sv || !isnan(sigma_scalar)) ? malloc(n * sizeof *ds->sigma) : NULL;
+    ds->data_lines = malloc(n * sizeof *ds->data_lines);
+    ds->data_file = strdup(path);
+    if (!ds->x || !ds->y || !ds->data_lines || !ds->data_file ||
+        ((sv || !isnan(sigma_scalar)) && !ds->sigma)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    size_t r = 0, k = 0;
+    double piece_t0 = tv[0];
+    w->pieces[0].start_x = 0;
+    for (size_t i = 0; i < n_kept; ++i) {
+        if (i > 0 && jumps == JUMPS_SPLIT && mv[i] - mv[i - 1] > jump_threshold) {
+            w->pieces[k].count = r - w->pieces[k].first;
+            ++k;
+            w->pieces[k].first = r;
+            w->pieces[k].start_x = tv[i] - tv[0];
+            w->pieces[k].start_mass = mv[i];
+            piece_t0 = tv[i];
+            continue; /* the measured start of the piece is not a residual */
+        }
+        ds->x[r] = tv[i] - tv[0];
+        ds->y[r] = mv[i];
+        w->t_model[r] = (tv[i] - piece_t0) * tconv.scale;
+        if (ds->sigma)
+            ds->sigma[r] = sv ? sv[i] : sigma_scalar * mconv.scale;
+        ds->data_lines[r] = phc_table_row_line(table, keep[i]);
+        ++r;
+    }
+    w->pieces[k].count = r - w->pieces[k].first;
+    w->n_pieces = n_pieces;
+    for (size_t p = 0; p < n_pieces; ++p)
+        if (w->pieces[p].count == 0) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s: a piece of the curve between irrigations has no weighing after its start; exclude it",
+                               path);
+            goto fail;
+        }
+    w->u = malloc(n * sizeof *w->u);
+    w->du = malloc(3 * n * sizeof *w->du);
+    if (!w->u || !w->du) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+
+    ds->derivatives = PHC_DERIV_ANALYTIC;
+    char label[160];
+    snprintf(label, sizeof label, "time since the first weighing (%s)", tunit);
+    ds->x_label = strdup(x_label ? x_label : label);
+    ds->y_label = strdup(y_label ? y_label : "mass (g)");
+    if (!ds->x_label || !ds->y_label) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    ds->config_line = node->line;
+    ds->impl = w;
+    w = NULL;
+    *out = ds;
+    ds = NULL;
+    rc = PHC_OK;
+fail:
+    phc_dataset_free(ds);
+    wc_free(w);
+    phc_table_free(table);
+    phc_units_free(units);
+    free(path);
+    free(tv);
+    free(mv);
+    free(sv);
+    free(keep);
+    free(sel_cols);
+    return rc;
+}
+
+/* The report hook: what the model was (graph, weights, evaluator) and what
+ * the fitted curve means in plain numbers. */
+static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
+{
+    wc_impl *w = ds->impl;
+    static const char *const weight_names[] = {"poiseuille (physical default)", "mean conductance",
+                                               "paper", "reference (authors' code)",
+                                               "reference_2024"};
+    static const char *const method_names[] = {"auto", "exact", "bdf6"};
+    const double delta = slot_value(w, p, SLOT_DELTA, 0);
+    const double w0 = slot_value(w, p, SLOT_W0, 0);
+    const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
+    const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
+    const piece *last = &w->pieces[w->n_pieces - 1];
+    const double t_end = w->t_model[last->first + last->count - 1];
+    double u_end = NAN;
+    if (unit_response(w, delta, mu, &t_end, 1, &u_end, NULL) != 0)
+        u_end = NAN;
+    const double start = w->n_pieces == 1 ? w0 : last->start_mass - dry;
+    /* Initial loss rate: dW/dt(0) = -Σ ℓ_i θ_i(0) = -δ Σ A_i V_i / Σ V_i · W0. */
+    size_t n = w->graph->n, leaves = phc_plant_graph_leaf_count(w->graph);
+    double vol = phc_plant_graph_volume(w->graph) * 1e6; /* cm³ */
+    char *buf = malloc(2048);
+    if (!buf)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    snprintf(buf, 2048,
+             "#### Water model (%s)\n\n"
+             "| | |\n|---|---|\n"
+             "| plant graph | %zu segments, %zu leaf, volume %.4g cm³ |\n"
+             "| edge weights | %s |\n"
+             "| evaluator | %s%s, stiffness %.3g s⁻¹ |\n"
+             "| viscosity μ | %g mPa·s%s |\n"
+             "| dry mass | %.6g g (%s) |\n"
+             "| curve pieces | %zu%s |\n"
+             "| water at the first weighing | %.6g g |\n"
+             "| water left at the last weighing | %.6g g (%.1f%% of its piece's start) |\n",
+             ds->name, n, leaves, vol, weight_names[w->params.weights], method_names[w->method],
+             w->step > 0 ? " (fixed step)" : "", w->sys ? phc_water_system_stiffness(w->sys) : NAN, mu,
+             w->slot[SLOT_MU] >= 0 ? " (fitted)" : " (fixed)", dry,
+             w->slot[SLOT_DRY] >= 0 ? "fitted" : "measured", w->n_pieces,
+             w->n_pieces > 1 ? " (split at irrigations; later pieces start from their measured mass)" : "",
+             w0, start * u_end, 100 * u_end);
+    *markdown = buf;
+    return PHC_OK;
+}

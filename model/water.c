@@ -1,0 +1,935 @@
+/* Water in a plant graph (wilting paper §3-4): see water.h.
+ * Pure C: no I/O, no printing, no globals.
+ *
+ * Internally segments are renumbered breadth-first (g->order), so that the
+ * parent of position k is at a position < k: the tree elimination of BDF6
+ * then runs over contiguous arrays, leaves first (k = n-1 .. 1) and back
+ * (k = 1 .. n-1), without fill-in. */
+#include "model/water.h"
+
+#include <cblas.h>
+#include <float.h>
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+struct phc_water_system {
+    size_t n;
+    size_t *perm;        /* n: graph index of position k */
+    size_t *par;         /* n: parent position (par[0] unused) */
+    double *w;           /* n: weight of edge (k, par[k]), w[0] = 0 */
+    double *wsum;        /* n: sum of the weights at k */
+    double *d;           /* n: capacity, theta / pressure (cm^3 per pressure unit) */
+    double *vol;         /* n: V, cm^3 */
+    double *area;        /* n: A (masked: 0 on stem and no-loss segments), cm^2 */
+    double *ell;         /* n: delta * area, 1/s */
+    double *theta0;      /* n: g */
+    double delta, w0, mu, mu_power; /* R is proportional to mu^mu_power */
+    phc_water_weights weights;
+};
+
+phc_water_params phc_water_params_default(void)
+{
+    phc_water_params p;
+    memset(&p, 0, sizeof p);
+    p.weights = PHC_WATER_POISEUILLE;
+    p.loss_rate = 0.0;
+    p.initial_water = 1.0;
+    p.viscosity = 0.0;
+    return p;
+}
+
+void phc_water_system_free(phc_water_system *s)
+{
+    if (!s)
+        return;
+    free(s->perm);
+    free(s->par);
+    free(s->w);
+    free(s->wsum);
+    free(s->d);
+    free(s->vol);
+    free(s->area);
+    free(s->ell);
+    free(s->theta0);
+    free(s);
+}
+
+static void system_refresh(phc_water_system *s)
+{
+    double vsum = 0.0;
+    for (size_t k = 0; k < s->n; ++k) {
+        s->ell[k] = s->delta * s->area[k];
+        vsum += s->vol[k];
+    }
+    for (size_t k = 0; k < s->n; ++k)
+        s->theta0[k] = s->w0 * s->vol[k] / vsum;
+}
+
+int phc_water_system_new(const phc_plant_graph *g, const phc_water_params *p,
+                         phc_water_system **out, phc_error *err)
+{
+    phc_water_system *s = NULL;
+    double *gi = NULL;
+    size_t *pos = NULL;
+    if (out)
+        *out = NULL;
+    if (!g || !p || !out)
+        return phc_error_set(err, PHC_ERR_INVALID, "water model: NULL argument");
+    if (g->n == 0 || !g->order || !g->parent)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "water model: the plant graph is empty or not finished");
+    if ((int)p->weights < PHC_WATER_POISEUILLE || p->weights > PHC_WATER_REFERENCE_2024)
+        return phc_error_set(err, PHC_ERR_INVALID, "water model: unknown weights mode %d",
+                             (int)p->weights);
+    if (!(p->loss_rate >= 0.0) || !isfinite(p->loss_rate))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water model: loss rate delta must be >= 0 and finite, found %g",
+                             p->loss_rate);
+    if (!(p->initial_water > 0.0) || !isfinite(p->initial_water))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water model: initial water must be > 0 g and finite, found %g",
+                             p->initial_water);
+    if (p->viscosity != 0.0 && (!(p->viscosity > 0.0) || !isfinite(p->viscosity)))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water model: viscosity must be > 0 mPa s, found %g", p->viscosity);
+    int reference = p->weights == PHC_WATER_REFERENCE || p->weights == PHC_WATER_REFERENCE_2024;
+    size_t n = g->n;
+    if (p->edge_factor) {
+        for (size_t i = 0; i < n; ++i) {
+            if (g->parent[i] == PHC_PLANT_NO_PARENT)
+                continue;
+            double f = p->edge_factor[i];
+            if (!(f >= 0.0 && f <= 1.0))
+                return phc_error_set(err, PHC_ERR_DOMAIN,
+                                     "water model: segment %ld: edge conductance factor must be "
+                                     "in [0, 1] (0 = cut), found %g",
+                                     g->source_id ? g->source_id[i] : (long)i, f);
+        }
+    }
+    s = calloc(1, sizeof *s);
+    if (!s)
+        goto nomem;
+    s->n = n;
+    s->perm = malloc(n * sizeof *s->perm);
+    s->par = calloc(n, sizeof *s->par);
+    s->w = calloc(n, sizeof *s->w);
+    s->wsum = calloc(n, sizeof *s->wsum);
+    s->d = malloc(n * sizeof *s->d);
+    s->vol = malloc(n * sizeof *s->vol);
+    s->area = malloc(n * sizeof *s->area);
+    s->ell = malloc(n * sizeof *s->ell);
+    s->theta0 = malloc(n * sizeof *s->theta0);
+    gi = malloc(n * sizeof *gi);
+    pos = malloc(n * sizeof *pos);
+    if (!s->perm || !s->par || !s->w || !s->wsum || !s->d || !s->vol || !s->area || !s->ell ||
+        !s->theta0 || !gi || !pos)
+        goto nomem;
+
+    s->weights = p->weights;
+    s->mu = p->viscosity != 0.0 ? p->viscosity : (reference ? 0.9 : 0.89);
+    s->delta = p->loss_rate;
+    s->w0 = p->initial_water;
+    /* The weights are homogeneous in g of degree +1 (conductance forms) or
+     * -1 (the resistance forms of the paper and the 2023 code); g ~ 1/mu. */
+    s->mu_power = (p->weights == PHC_WATER_PAPER || p->weights == PHC_WATER_REFERENCE) ? 1.0 : -1.0;
+
+    /* K: pressure per (g/cm^3).  Physical: R T / M_w in Ba cm^3/g
+     * (J/g * 1e7 erg/J).  Reference: the authors' 11.538 (T in Celsius). */
+    double K = reference ? 1.0 / PHC_WATER_REFERENCE_PRESS_CONST
+                         : PHC_WATER_GAS_CONSTANT * PHC_WATER_TEMPERATURE / PHC_WATER_MOLAR_MASS * 1e7;
+    /* mu: physical modes in poise (1 mPa s = 1e-2 P) so that g is in
+     * cm^3/(s Ba); reference: their 1e6 * pi r^4 / (8 * 0.9 * L). */
+    double mu_unit = reference ? s->mu : s->mu * 1e-2;
+    double g_scale = reference ? 1e6 : 1.0;
+
+    for (size_t k = 0; k < n; ++k) {
+        size_t i = g->order[k];
+        s->perm[k] = i;
+        pos[i] = k;
+        double r = 100.0 * g->radius[i], h = 100.0 * g->length[i]; /* m -> cm */
+        s->vol[k] = M_PI * r * r * h;
+        int loses = g->leaf && g->leaf[i] && !(p->no_loss && p->no_loss[i]);
+        s->area[k] = loses ? r * h : 0.0;
+        /* reference: S = Adj diag(PC V)^-1 so d = PC V; physical d = V / K */
+        s->d[k] = reference ? s->vol[k] / K : s->vol[k] / K;
+        gi[k] = g_scale * M_PI * r * r * r * r / (8.0 * mu_unit * h);
+    }
+    if (g->parent[s->perm[0]] != PHC_PLANT_NO_PARENT) {
+        phc_error_set(err, PHC_ERR_INVALID, "water model: graph order does not start at the root");
+        goto fail;
+    }
+    for (size_t k = 1; k < n; ++k) {
+        size_t i = s->perm[k];
+        size_t pk = pos[g->parent[i]];
+        if (pk >= k) {
+            phc_error_set(err, PHC_ERR_INVALID,
+                          "water model: graph order is not parents-before-children");
+            goto fail;
+        }
+        s->par[k] = pk;
+        double a = gi[k], b = gi[pk], w;
+        switch (p->weights) {
+        case PHC_WATER_POISEUILLE: w = 2.0 * a * b / (a + b); break;     /* half pipes in series */
+        case PHC_WATER_MEAN_CONDUCTANCE:
+        case PHC_WATER_REFERENCE_2024: w = 0.5 * (a + b); break;
+        default: w = 1.0 / (0.5 * (a + b)); break;                        /* paper, 2023 code */
+        }
+        if (p->edge_factor)
+            w *= p->edge_factor[i];
+        s->w[k] = w;
+        s->wsum[k] += w;
+        s->wsum[pk] += w;
+    }
+    system_refresh(s);
+    free(gi);
+    free(pos);
+    *out = s;
+    return PHC_OK;
+nomem:
+    phc_error_set(err, PHC_ERR_NOMEM, "water model: out of memory for %zu segments", g->n);
+fail:
+    free(gi);
+    free(pos);
+    phc_water_system_free(s);
+    return err ? err->status : PHC_ERR_NOMEM;
+}
+
+int phc_water_system_set_loss_rate(phc_water_system *s, double delta, phc_error *err)
+{
+    if (!s)
+        return phc_error_set(err, PHC_ERR_INVALID, "water model: NULL system");
+    if (!(delta >= 0.0) || !isfinite(delta))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water model: loss rate delta must be >= 0 and finite, found %g", delta);
+    s->delta = delta;
+    system_refresh(s);
+    return PHC_OK;
+}
+
+int phc_water_system_set_initial_water(phc_water_system *s, double w0, phc_error *err)
+{
+    if (!s)
+        return phc_error_set(err, PHC_ERR_INVALID, "water model: NULL system");
+    if (!(w0 > 0.0) || !isfinite(w0))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water model: initial water must be > 0 g and finite, found %g", w0);
+    s->w0 = w0;
+    system_refresh(s);
+    return PHC_OK;
+}
+
+size_t phc_water_system_size(const phc_water_system *s) { return s ? s->n : 0; }
+double phc_water_system_loss_rate(const phc_water_system *s) { return s->delta; }
+double phc_water_system_initial_water(const phc_water_system *s) { return s->w0; }
+double phc_water_system_viscosity(const phc_water_system *s) { return s->mu; }
+
+void phc_water_system_volume(const phc_water_system *s, double *v)
+{
+    for (size_t k = 0; k < s->n; ++k)
+        v[s->perm[k]] = s->vol[k];
+}
+
+void phc_water_system_theta0(const phc_water_system *s, double *theta0)
+{
+    for (size_t k = 0; k < s->n; ++k)
+        theta0[s->perm[k]] = s->theta0[k];
+}
+
+/* Gershgorin bound on the spectral radius of A (= that of S). */
+double phc_water_system_stiffness(const phc_water_system *s)
+{
+    size_t n = s->n;
+    double *row = calloc(n, sizeof *row), rho = 0.0;
+    if (!row)
+        return INFINITY;
+    for (size_t k = 1; k < n; ++k) {
+        double o = s->w[k] / sqrt(s->d[k] * s->d[s->par[k]]);
+        row[k] += o;
+        row[s->par[k]] += o;
+    }
+    for (size_t k = 0; k < n; ++k) {
+        double r = s->wsum[k] / s->d[k] + s->ell[k] + row[k];
+        if (r > rho)
+            rho = r;
+    }
+    free(row);
+    return rho;
+}
+
+/* out = R D^-1 x (the diffusion part of S x), O(n). */
+static void diffusion_apply(const phc_water_system *s, const double *x, double *out)
+{
+    size_t n = s->n;
+    for (size_t k = 0; k < n; ++k)
+        out[k] = 0.0;
+    for (size_t k = 1; k < n; ++k) {
+        size_t pk = s->par[k];
+        double f = s->w[k] * (x[pk] / s->d[pk] - x[k] / s->d[k]);
+        out[k] += f;
+        out[pk] -= f;
+    }
+}
+
+/* Dense symmetric A = D^-1/2 R D^-1/2 - D_l, column major, both triangles. */
+static double *dense_symmetric(const phc_water_system *s)
+{
+    size_t n = s->n;
+    double *A = calloc(n * n, sizeof *A);
+    if (!A)
+        return NULL;
+    for (size_t k = 0; k < n; ++k)
+        A[k * n + k] = -s->wsum[k] / s->d[k] - s->ell[k];
+    for (size_t k = 1; k < n; ++k) {
+        size_t pk = s->par[k];
+        double o = s->w[k] / sqrt(s->d[k] * s->d[pk]);
+        A[pk * n + k] = o;
+        A[k * n + pk] = o;
+    }
+    return A;
+}
+
+/* ------------------------------------------------------------------------ */
+/* Exact evaluator                                                           */
+
+struct phc_water_exact {
+    size_t n;
+    phc_water_exact_kind kind;
+    double *lambda;  /* n, ascending */
+    double *ab;      /* n: a_i b_i (g) */
+    double *a, *b;   /* n (full kinds) */
+    double *Q;       /* n x n column major (full kinds) */
+    double *M;       /* n x n: Q^T D_a Q (sensitivity kind) */
+    double *sqd;     /* n: sqrt(d) */
+    size_t *perm;
+    double delta, w0, mu, mu_power;
+};
+
+void phc_water_exact_free(phc_water_exact *e)
+{
+    if (!e)
+        return;
+    free(e->lambda);
+    free(e->ab);
+    free(e->a);
+    free(e->b);
+    free(e->Q);
+    free(e->M);
+    free(e->sqd);
+    free(e->perm);
+    free(e);
+}
+
+int phc_water_exact_new(const phc_water_system *s, phc_water_exact_kind kind,
+                        phc_water_exact **out, phc_error *err)
+{
+    phc_water_exact *e = NULL;
+    double *A = NULL, *tau = NULL, *off = NULL, *Z = NULL;
+    if (out)
+        *out = NULL;
+    if (!s || !out)
+        return phc_error_set(err, PHC_ERR_INVALID, "water exact: NULL argument");
+    size_t n = s->n;
+    lapack_int ln = (lapack_int)n;
+    e = calloc(1, sizeof *e);
+    if (!e)
+        goto nomem;
+    e->n = n;
+    e->kind = kind;
+    e->delta = s->delta;
+    e->w0 = s->w0;
+    e->mu = s->mu;
+    e->mu_power = s->mu_power;
+    e->lambda = malloc(n * sizeof *e->lambda);
+    e->ab = malloc(n * sizeof *e->ab);
+    e->sqd = malloc(n * sizeof *e->sqd);
+    e->perm = malloc(n * sizeof *e->perm);
+    A = dense_symmetric(s);
+    if (!e->lambda || !e->ab || !e->sqd || !e->perm || !A)
+        goto nomem;
+    memcpy(e->perm, s->perm, n * sizeof *e->perm);
+    double sumd = 0.0;
+    for (size_t k = 0; k < n; ++k) {
+        e->sqd[k] = sqrt(s->d[k]);
+        sumd += s->d[k];
+    }
+
+    if (kind == PHC_WATER_EXACT_TOTAL_ONLY) {
+        /* theta0 is proportional to d, so W(t) = W0 vh^T exp(A t) vh with
+         * vh = sqrt(d)/|sqrt(d)|.  Reflect vh onto e1 (H = I - 2uu^T), reduce
+         * H A H to tridiagonal T with dsytrd('L'), whose Q = H(1)..H(n-1)
+         * leaves e1 fixed: W(t) = W0 sum_i Z(1,i)^2 exp(lambda_i t). */
+        double nrm = sqrt(sumd);
+        double *u = malloc(n * sizeof *u), *q = malloc(n * sizeof *q);
+        if (!u || !q) {
+            free(u);
+            free(q);
+            goto nomem;
+        }
+        double sgn = e->sqd[0] >= 0 ? 1.0 : -1.0, un = 0.0;
+        for (size_t k = 0; k < n; ++k)
+            u[k] = e->sqd[k] / nrm;
+        u[0] += sgn; /* u = vh + sign e1: maps vh to -sign e1 (stable) */
+        for (size_t k = 0; k < n; ++k)
+            un += u[k] * u[k];
+        un = sqrt(un);
+        for (size_t k = 0; k < n; ++k)
+            u[k] /= un;
+        cblas_dsymv(CblasColMajor, CblasLower, (int)n, 1.0, A, (int)n, u, 1, 0.0, q, 1);
+        double Kq = cblas_ddot((int)n, u, 1, q, 1);
+        cblas_daxpy((int)n, -Kq, u, 1, q, 1);
+        cblas_dsyr2(CblasColMajor, CblasLower, (int)n, -2.0, u, 1, q, 1, A, (int)n);
+        free(u);
+        free(q);
+        off = malloc((n > 1 ? n - 1 : 1) * sizeof *off);
+        tau = malloc((n > 1 ? n - 1 : 1) * sizeof *tau);
+        Z = malloc(n * n * sizeof *Z);
+        if (!off || !tau || !Z)
+            goto nomem;
+        if (n > 1 && LAPACKE_dsytrd(LAPACK_COL_MAJOR, 'L', ln, A, ln, e->lambda, off, tau) != 0) {
+            phc_error_set(err, PHC_ERR_NUMERIC, "water exact: dsytrd failed");
+            goto fail;
+        }
+        if (n == 1)
+            e->lambda[0] = A[0];
+        if (LAPACKE_dstedc(LAPACK_COL_MAJOR, 'I', ln, e->lambda, off, Z, ln) != 0) {
+            phc_error_set(err, PHC_ERR_NUMERIC, "water exact: dstedc did not converge");
+            goto fail;
+        }
+        for (size_t i = 0; i < n; ++i)
+            e->ab[i] = e->w0 * Z[i * n] * Z[i * n];
+        free(A);
+        free(off);
+        free(tau);
+        free(Z);
+        *out = e;
+        return PHC_OK;
+    }
+
+    e->a = malloc(n * sizeof *e->a);
+    e->b = malloc(n * sizeof *e->b);
+    if (!e->a || !e->b)
+        goto nomem;
+    if (LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'L', ln, A, ln, e->lambda) != 0) {
+        phc_error_set(err, PHC_ERR_NUMERIC, "water exact: dsyevd did not converge");
+        goto fail;
+    }
+    e->Q = A;
+    A = NULL;
+    {
+        double *x = malloc(n * sizeof *x);
+        if (!x)
+            goto nomem;
+        for (size_t k = 0; k < n; ++k)
+            x[k] = s->theta0[k] / e->sqd[k];
+        cblas_dgemv(CblasColMajor, CblasTrans, (int)n, (int)n, 1.0, e->Q, (int)n, e->sqd, 1, 0.0,
+                    e->a, 1);
+        cblas_dgemv(CblasColMajor, CblasTrans, (int)n, (int)n, 1.0, e->Q, (int)n, x, 1, 0.0, e->b, 1);
+        free(x);
+    }
+    for (size_t i = 0; i < n; ++i)
+        e->ab[i] = e->a[i] * e->b[i];
+    if (kind == PHC_WATER_EXACT_SENSITIVITY) {
+        double *T = malloc(n * n * sizeof *T);
+        e->M = malloc(n * n * sizeof *e->M);
+        if (!T || !e->M) {
+            free(T);
+            goto nomem;
+        }
+        for (size_t j = 0; j < n; ++j)
+            for (size_t k = 0; k < n; ++k)
+                T[j * n + k] = s->area[k] * e->Q[j * n + k];
+        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)n, (int)n, 1.0, e->Q,
+                    (int)n, T, (int)n, 0.0, e->M, (int)n);
+        free(T);
+    }
+    *out = e;
+    return PHC_OK;
+nomem:
+    phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory for %zu segments", s->n);
+fail:
+    free(A);
+    free(off);
+    free(tau);
+    free(Z);
+    phc_water_exact_free(e);
+    return err ? err->status : PHC_ERR_NOMEM;
+}
+
+double phc_water_exact_total(const phc_water_exact *e, double t)
+{
+    double W = 0.0;
+    for (size_t i = 0; i < e->n; ++i)
+        W += e->ab[i] * exp(e->lambda[i] * t);
+    return W;
+}
+
+int phc_water_exact_state(const phc_water_exact *e, double t, double *theta, phc_error *err)
+{
+    if (!e || !theta)
+        return phc_error_set(err, PHC_ERR_INVALID, "water exact: NULL argument");
+    if (!e->Q)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "water exact: state needs a FULL or SENSITIVITY evaluator");
+    size_t n = e->n;
+    double *c = malloc(2 * n * sizeof *c);
+    if (!c)
+        return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory");
+    for (size_t i = 0; i < n; ++i)
+        c[i] = e->b[i] * exp(e->lambda[i] * t);
+    cblas_dgemv(CblasColMajor, CblasNoTrans, (int)n, (int)n, 1.0, e->Q, (int)n, c, 1, 0.0, c + n, 1);
+    for (size_t k = 0; k < n; ++k)
+        theta[e->perm[k]] = e->sqd[k] * c[n + k];
+    free(c);
+    return PHC_OK;
+}
+
+/* Divided difference of exp(. t) at lambda_i, lambda_j (Frechet derivative
+ * of the matrix exponential in the eigenbasis): (E_i - E_j)/(l_i - l_j),
+ * t E on the diagonal; written with expm1 around the larger eigenvalue. */
+static double phi(double li, double lj, double Ei, double Ej, double t)
+{
+    if (li > lj) {
+        double tmp = li;
+        li = lj;
+        lj = tmp;
+        tmp = Ei;
+        Ei = Ej;
+        Ej = tmp;
+    }
+    double dl = li - lj; /* <= 0 */
+    if (dl == 0.0)
+        return t * Ej;
+    double x = dl * t;
+    if (fabs(x) < 1e-300)
+        return t * Ej;
+    return Ej * expm1(x) / dl;
+}
+
+int phc_water_exact_sensitivity(const phc_water_exact *e, double t, double *dW,
+                                double *dtheta_ddelta, phc_error *err)
+{
+    if (!e || !dW)
+        return phc_error_set(err, PHC_ERR_INVALID, "water exact: NULL argument");
+    if (!e->M)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "water exact: sensitivities need a SENSITIVITY evaluator");
+    size_t n = e->n;
+    double *E = malloc(2 * n * sizeof *E);
+    if (!E)
+        return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory");
+    double *y = E + n;
+    for (size_t i = 0; i < n; ++i)
+        E[i] = exp(e->lambda[i] * t);
+    /* y_i = sum_j Phi_ij M_ij b_j; dW/d delta = -a^T y (dA/d delta = -D_a) */
+    double dWd = 0.0, lamterm = 0.0, W = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        double acc = 0.0;
+        const double *Mi = e->M + i * n; /* column i = row i (symmetric) */
+        for (size_t j = 0; j < n; ++j)
+            acc += phi(e->lambda[i], e->lambda[j], E[i], E[j], t) * Mi[j] * e->b[j];
+        y[i] = acc;
+        dWd -= e->a[i] * acc;
+        lamterm += e->ab[i] * t * e->lambda[i] * E[i];
+        W += e->ab[i] * E[i];
+    }
+    dW[0] = dWd;
+    dW[1] = W / e->w0;
+    /* dA/d mu = (p/mu) (A + D_l); Q^T (A + D_l) Q = Lambda + delta M */
+    dW[2] = e->mu_power / e->mu * (lamterm - e->delta * dWd);
+    if (dtheta_ddelta) {
+        double *z = malloc(n * sizeof *z);
+        if (!z) {
+            free(E);
+            return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory");
+        }
+        cblas_dgemv(CblasColMajor, CblasNoTrans, (int)n, (int)n, -1.0, e->Q, (int)n, y, 1, 0.0, z, 1);
+        for (size_t k = 0; k < n; ++k)
+            dtheta_ddelta[e->perm[k]] = e->sqd[k] * z[k];
+        free(z);
+    }
+    free(E);
+    return PHC_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+/* BDF6                                                                      */
+
+struct phc_water_bdf6 {
+    const phc_water_system *s;
+    size_t n;
+    double h;
+    int sens;
+    /* factorisation of I - c S over the tree */
+    double c;
+    double *l, *u, *ipiv;
+    /* ring of the last 6 states (theta, and s_delta, s_mu with sensitivities) */
+    double *ring;       /* 6 * nv * n */
+    size_t nv;          /* 1 or 3 */
+    double *rhs, *tmp;  /* nv * n, n */
+    size_t steps;       /* current state is at t = steps * h */
+    double *Wh;         /* (steps+1) * nv: sums of the components */
+    size_t Wcap;
+};
+
+/* Factorises M = I - c S (S = R D^-1 - D_l) by elimination leaves first:
+ * row k (after its children) holds only M_kk and M_k,par, so there is no
+ * fill-in.  M is column diagonally dominant (column sums 1 + c l_k), so no
+ * pivoting is needed; the pivots are computed GTH-style (Grassmann, Taksar
+ * & Heyman 1985) from the running column sums sigma of the Schur complement,
+ * pivot_k = sigma_k + |M_par,k|, which involves no cancellation: stiff
+ * systems (c w / d ~ 1e15 in the physical mode) stay exactly conservative. */
+static void tree_factor(phc_water_bdf6 *b, double c)
+{
+    const phc_water_system *s = b->s;
+    size_t n = b->n;
+    double *sig = b->ipiv;
+    for (size_t k = 0; k < n; ++k)
+        sig[k] = 1.0 + c * s->ell[k];
+    for (size_t k = n - 1; k >= 1; --k) {
+        size_t pk = s->par[k];
+        double akp = c * s->w[k] / s->d[pk]; /* -M(k, par) */
+        double apk = c * s->w[k] / s->d[k];  /* -M(par, k) */
+        double piv = sig[k] + apk;
+        b->l[k] = -apk / piv;
+        b->u[k] = -akp;
+        sig[pk] += akp * sig[k] / piv;
+        sig[k] = 1.0 / piv;
+    }
+    sig[0] = 1.0 / sig[0];
+    b->c = c;
+}
+
+/* y <- M^-1 y. */
+static void tree_solve(const phc_water_bdf6 *b, double *restrict y)
+{
+    const size_t *restrict par = b->s->par;
+    const double *restrict l = b->l, *restrict u = b->u, *restrict ip = b->ipiv;
+    size_t n = b->n;
+    for (size_t k = n - 1; k >= 1; --k)
+        y[par[k]] -= l[k] * y[k];
+    y[0] *= ip[0];
+    for (size_t k = 1; k < n; ++k)
+        y[k] = (y[k] - u[k] * y[par[k]]) * ip[k];
+}
+
+/* Implicit step for the augmented system: x[0] = theta (rhs given), then
+ * the sensitivities (rhs_s + c dS/dp theta_new).  x holds rhs on entry. */
+static void augmented_solve(phc_water_bdf6 *b, double *x)
+{
+    size_t n = b->n;
+    tree_solve(b, x);
+    if (b->sens) {
+        const phc_water_system *s = b->s;
+        double c = b->c;
+        double *sd = x + n, *sm = x + 2 * n;
+        for (size_t k = 0; k < n; ++k)
+            sd[k] -= c * s->area[k] * x[k];        /* dS/d delta = -D_a */
+        diffusion_apply(s, x, b->tmp);             /* dS/d mu = (p/mu) R D^-1 */
+        double f = c * s->mu_power / s->mu;
+        for (size_t k = 0; k < n; ++k)
+            sm[k] += f * b->tmp[k];
+        tree_solve(b, sd);
+        tree_solve(b, sm);
+    }
+}
+
+static int record_total(phc_water_bdf6 *b, const double *x)
+{
+    size_t idx = b->steps;
+    if ((idx + 1) * b->nv > b->Wcap) {
+        size_t cap = b->Wcap ? 2 * b->Wcap : 64 * b->nv;
+        while (cap < (idx + 1) * b->nv)
+            cap *= 2;
+        double *p = realloc(b->Wh, cap * sizeof *p);
+        if (!p)
+            return PHC_ERR_NOMEM;
+        b->Wh = p;
+        b->Wcap = cap;
+    }
+    for (size_t v = 0; v < b->nv; ++v) {
+        double sum = 0.0;
+        const double *xv = x + v * b->n;
+        for (size_t k = 0; k < b->n; ++k)
+            sum += xv[k];
+        b->Wh[idx * b->nv + v] = sum;
+    }
+    return PHC_OK;
+}
+
+void phc_water_bdf6_free(phc_water_bdf6 *b)
+{
+    if (!b)
+        return;
+    free(b->l);
+    free(b->u);
+    free(b->ipiv);
+    free(b->ring);
+    free(b->rhs);
+    free(b->tmp);
+    free(b->Wh);
+    free(b);
+}
+
+#define START_ORDERS 8   /* implicit Euler with 1..8 sub-steps, extrapolated */
+#define START_SUBINTERVALS 2
+
+/* One interval of length H from x (nv*n) by extrapolated implicit Euler
+ * (harmonic sequence n_j = j, Aitken-Neville in h; Deuflhard 1985). */
+static void extrapolated_euler(phc_water_bdf6 *b, double H, double *x, double *T, double *y)
+{
+    size_t len = b->nv * b->n;
+    for (int j = 0; j < START_ORDERS; ++j) {
+        int nj = j + 1;
+        tree_factor(b, H / nj);
+        memcpy(y, x, len * sizeof *y);
+        for (int r = 0; r < nj; ++r)
+            augmented_solve(b, y);
+        for (int k = 1; k <= j; ++k) {
+            double f = (double)nj / (double)(nj - k) - 1.0;
+            double *Tk = T + (size_t)(k - 1) * len;
+            for (size_t q = 0; q < len; ++q) {
+                double cur = y[q];
+                y[q] = cur + (cur - Tk[q]) / f;
+                Tk[q] = cur;
+            }
+        }
+        memcpy(T + (size_t)j * len, y, len * sizeof *y);
+    }
+    memcpy(x, T + (size_t)(START_ORDERS - 1) * len, len * sizeof *x);
+}
+
+static const double bdf6_beta[6] = {-10.0 / 147, 72.0 / 147, -225.0 / 147,
+                                    400.0 / 147, -450.0 / 147, 360.0 / 147};
+#define BDF6_ALPHA (60.0 / 147.0)
+
+int phc_water_bdf6_new(const phc_water_system *s, double h, int sensitivities,
+                       phc_water_bdf6 **out, phc_error *err)
+{
+    phc_water_bdf6 *b = NULL;
+    double *T = NULL, *y = NULL;
+    if (out)
+        *out = NULL;
+    if (!s || !out)
+        return phc_error_set(err, PHC_ERR_INVALID, "water BDF6: NULL argument");
+    if (!(h > 0.0) || !isfinite(h))
+        return phc_error_set(err, PHC_ERR_DOMAIN, "water BDF6: step must be > 0 s, found %g", h);
+    size_t n = s->n;
+    b = calloc(1, sizeof *b);
+    if (!b)
+        goto nomem;
+    b->s = s;
+    b->n = n;
+    b->h = h;
+    b->sens = sensitivities ? 1 : 0;
+    b->nv = b->sens ? 3 : 1;
+    size_t len = b->nv * n;
+    b->l = calloc(n, sizeof *b->l);
+    b->u = calloc(n, sizeof *b->u);
+    b->ipiv = calloc(n, sizeof *b->ipiv);
+    b->ring = calloc(6 * len, sizeof *b->ring);
+    b->rhs = calloc(len, sizeof *b->rhs);
+    b->tmp = calloc(n, sizeof *b->tmp);
+    T = malloc((size_t)START_ORDERS * len * sizeof *T);
+    y = malloc(len * sizeof *y);
+    if (!b->l || !b->u || !b->ipiv || !b->ring || !b->rhs || !b->tmp || !T || !y)
+        goto nomem;
+    /* state 0: theta0, sensitivities 0 (theta0 does not depend on delta, mu) */
+    memcpy(b->ring, s->theta0, n * sizeof(double));
+    if (record_total(b, b->ring))
+        goto nomem;
+    double *x = b->rhs;
+    memcpy(x, b->ring, len * sizeof *x);
+    for (int q = 1; q <= 5; ++q) {
+        for (int r = 0; r < START_SUBINTERVALS; ++r)
+            extrapolated_euler(b, h / START_SUBINTERVALS, x, T, y);
+        memcpy(b->ring + (size_t)q * len, x, len * sizeof *x);
+        b->steps = (size_t)q;
+        if (record_total(b, x))
+            goto nomem;
+    }
+    tree_factor(b, BDF6_ALPHA * h);
+    free(T);
+    free(y);
+    *out = b;
+    return PHC_OK;
+nomem:
+    free(T);
+    free(y);
+    phc_water_bdf6_free(b);
+    return phc_error_set(err, PHC_ERR_NOMEM, "water BDF6: out of memory for %zu segments", n);
+}
+
+/* One BDF6 step (eq. 8): (I - alpha h S) x_{n+1} = sum_j beta_j x_{n-5+j}. */
+static int bdf6_step(phc_water_bdf6 *b)
+{
+    size_t len = b->nv * b->n;
+    size_t cur = b->steps; /* ring slot of x_m is m % 6 */
+    const double *h0 = b->ring + ((cur + 1) % 6) * len; /* x_{n-5} */
+    const double *h1 = b->ring + ((cur + 2) % 6) * len;
+    const double *h2 = b->ring + ((cur + 3) % 6) * len;
+    const double *h3 = b->ring + ((cur + 4) % 6) * len;
+    const double *h4 = b->ring + ((cur + 5) % 6) * len;
+    const double *h5 = b->ring + (cur % 6) * len;         /* x_n */
+    double *out = b->ring + ((cur + 1) % 6) * len; /* overwrites x_{n-5} */
+    const double b0 = bdf6_beta[0], b1 = bdf6_beta[1], b2 = bdf6_beta[2], b3 = bdf6_beta[3],
+                 b4 = bdf6_beta[4], b5 = bdf6_beta[5];
+    for (size_t q = 0; q < len; ++q)
+        out[q] = b0 * h0[q] + b1 * h1[q] + b2 * h2[q] + b3 * h3[q] + b4 * h4[q] + b5 * h5[q];
+    augmented_solve(b, out);
+    b->steps = cur + 1;
+    return record_total(b, out);
+}
+
+int phc_water_bdf6_advance(phc_water_bdf6 *b, double t_end, phc_error *err)
+{
+    if (!b)
+        return phc_error_set(err, PHC_ERR_INVALID, "water BDF6: NULL integrator");
+    if (!isfinite(t_end))
+        return phc_error_set(err, PHC_ERR_DOMAIN, "water BDF6: end time must be finite");
+    if (b->c != BDF6_ALPHA * b->h)
+        tree_factor(b, BDF6_ALPHA * b->h);
+    while (b->steps < 6 || (double)b->steps * b->h < t_end) {
+        if (bdf6_step(b))
+            return phc_error_set(err, PHC_ERR_NOMEM, "water BDF6: out of memory for the history");
+    }
+    return PHC_OK;
+}
+
+size_t phc_water_bdf6_steps(const phc_water_bdf6 *b) { return b->steps; }
+double phc_water_bdf6_time(const phc_water_bdf6 *b) { return (double)b->steps * b->h; }
+
+void phc_water_bdf6_state(const phc_water_bdf6 *b, double *theta, double *dtheta_ddelta)
+{
+    size_t len = b->nv * b->n;
+    const double *x = b->ring + (b->steps % 6) * len;
+    for (size_t k = 0; k < b->n; ++k) {
+        if (theta)
+            theta[b->s->perm[k]] = x[k];
+        if (dtheta_ddelta && b->sens)
+            dtheta_ddelta[b->s->perm[k]] = x[b->n + k];
+    }
+}
+
+int phc_water_bdf6_total(const phc_water_bdf6 *b, double t, double *W, double *dW, phc_error *err)
+{
+    if (!b || !W)
+        return phc_error_set(err, PHC_ERR_INVALID, "water BDF6: NULL argument");
+    double tend = (double)b->steps * b->h;
+    if (!(t >= 0.0) || t > tend * (1.0 + 1e-12))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water BDF6: time %g s outside the integrated range [0, %g] s", t,
+                             tend);
+    if (dW && !b->sens)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "water BDF6: derivatives need an integrator with sensitivities");
+    /* 7-point Lagrange interpolation (degree 6) on the nodes around t */
+    double xs = t / b->h;
+    long k0 = (long)floor(xs) - 3;
+    if (k0 < 0)
+        k0 = 0;
+    if (k0 > (long)b->steps - 6)
+        k0 = (long)b->steps - 6;
+    double acc[3] = {0, 0, 0};
+    for (int i = 0; i < 7; ++i) {
+        double L = 1.0;
+        for (int j = 0; j < 7; ++j)
+            if (j != i)
+                L *= (xs - (double)(k0 + j)) / (double)(i - j);
+        for (size_t v = 0; v < b->nv; ++v)
+            acc[v] += L * b->Wh[(size_t)(k0 + i) * b->nv + v];
+    }
+    *W = acc[0];
+    if (dW) {
+        dW[0] = acc[1];
+        dW[1] = acc[0] / b->s->w0;
+        dW[2] = acc[2];
+    }
+    return PHC_OK;
+}
+
+/* ------------------------------------------------------------------------ */
+
+int phc_water_system_total_curve(const phc_water_system *s, phc_water_method method,
+                                 double step_or_0, const double *t, size_t m, double *W,
+                                 double *dW, phc_error *err)
+{
+    if (!s || !t || !W)
+        return phc_error_set(err, PHC_ERR_INVALID, "water curve: NULL argument");
+    if (m == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "water curve: empty time list");
+    for (size_t i = 0; i < m; ++i) {
+        if (!(t[i] >= 0.0) || !isfinite(t[i]))
+            return phc_error_set(err, PHC_ERR_DOMAIN,
+                                 "water curve: time %zu must be finite and >= 0 s, found %g", i, t[i]);
+        if (i > 0 && t[i] < t[i - 1])
+            return phc_error_set(err, PHC_ERR_INVALID,
+                                 "water curve: times must be sorted ascending: t[%zu] = %g < t[%zu] = %g",
+                                 i, t[i], i - 1, t[i - 1]);
+    }
+    if (!(step_or_0 >= 0.0) || !isfinite(step_or_0))
+        return phc_error_set(err, PHC_ERR_DOMAIN, "water curve: step must be >= 0 s, found %g",
+                             step_or_0);
+    double tmax = t[m - 1];
+    if (tmax == 0.0) {
+        for (size_t i = 0; i < m; ++i) {
+            W[i] = s->w0;
+            if (dW) {
+                dW[3 * i] = 0.0;
+                dW[3 * i + 1] = 1.0;
+                dW[3 * i + 2] = 0.0;
+            }
+        }
+        return PHC_OK;
+    }
+    if (method == PHC_WATER_AUTO)
+        method = (s->n <= PHC_WATER_AUTO_EXACT_MAX &&
+                  phc_water_system_stiffness(s) * tmax <= 1e7)
+                     ? PHC_WATER_EXACT
+                     : PHC_WATER_BDF6;
+    int rc;
+    if (method == PHC_WATER_EXACT) {
+        phc_water_exact *e = NULL;
+        rc = phc_water_exact_new(s, dW ? PHC_WATER_EXACT_SENSITIVITY : PHC_WATER_EXACT_TOTAL_ONLY,
+                                 &e, err);
+        if (rc)
+            return rc;
+        for (size_t i = 0; i < m && !rc; ++i) {
+            W[i] = phc_water_exact_total(e, t[i]);
+            if (dW)
+                rc = phc_water_exact_sensitivity(e, t[i], dW + 3 * i, NULL, err);
+        }
+        phc_water_exact_free(e);
+        return rc;
+    }
+    if (method != PHC_WATER_BDF6)
+        return phc_error_set(err, PHC_ERR_INVALID, "water curve: unknown method %d", (int)method);
+    double h = step_or_0 > 0.0 ? step_or_0 : tmax / 1000.0;
+    phc_water_bdf6 *b = NULL;
+    rc = phc_water_bdf6_new(s, h, dW != NULL, &b, err);
+    if (rc)
+        return rc;
+    rc = phc_water_bdf6_advance(b, tmax, err);
+    for (size_t i = 0; i < m && !rc; ++i)
+        rc = phc_water_bdf6_total(b, t[i], W + i, dW ? dW + 3 * i : NULL, err);
+    phc_water_bdf6_free(b);
+    return rc;
+}
+
+int phc_water_total_curve(const phc_plant_graph *g, const phc_water_params *p,
+                          phc_water_method method, double step_or_0, const double *t, size_t m,
+                          double *W, double *dW, phc_error *err)
+{
+    phc_water_system *s = NULL;
+    int rc = phc_water_system_new(g, p, &s, err);
+    if (rc)
+        return rc;
+    rc = phc_water_system_total_curve(s, method, step_or_0, t, m, W, dW, err);
+    phc_water_system_free(s);
+    return rc;
+}
