@@ -20,14 +20,14 @@ const char *const phc_weight_curve_keys[] = {
     "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
 
 /* A stretch of the curve between irrigations.  Piece 0 starts from the
- * `initial_water` slot; later pieces start from their first measured mass. */
+ * `initial_water` slot, piece k > 0 from its own slot `initial_water_<k+1>`. */
 typedef struct piece {
     size_t first, count;  /* residuals first .. first+count-1 */
     double start_x;       /* time of the piece's start, user time unit from the first row */
-    double start_mass;    /* g; the measured start of pieces > 0 */
+    int slot;             /* slot of the piece's initial water */
 } piece;
 
-enum { SLOT_DELTA, SLOT_W0, SLOT_DRY, SLOT_MU, N_SLOT_KINDS };
+enum { SLOT_DELTA, SLOT_DRY, SLOT_MU, N_SLOT_KINDS }; /* initial waters: per piece */
 
 typedef struct wc_impl {
     phc_plant_graph *graph;
@@ -97,10 +97,9 @@ static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
 {
     wc_impl *w = ds->impl;
     const double delta = slot_value(w, p, SLOT_DELTA, 0);
-    const double w0 = slot_value(w, p, SLOT_W0, 0);
     const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
     const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
-    if (!(delta >= 0) || !(mu > 0) || !isfinite(w0) || !isfinite(dry))
+    if (!(delta >= 0) || !(mu > 0) || !isfinite(dry))
         return 1;
     for (size_t k = 0; k < w->n_pieces; ++k) {
         const piece *pc = &w->pieces[k];
@@ -108,8 +107,7 @@ static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
                                jac ? w->du : NULL);
         if (rc)
             return rc;
-        /* Later pieces restart from the water measured at their start. */
-        const double start = k == 0 ? w0 : pc->start_mass - dry;
+        const double start = p[pc->slot];
         for (size_t i = 0; i < pc->count; ++i) {
             const size_t r = pc->first + i;
             yhat[r] = dry + start * w->u[i];
@@ -122,10 +120,9 @@ static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
                 row[w->slot[SLOT_DELTA]] = start * w->du[3 * i];
             if (w->slot[SLOT_MU] >= 0)
                 row[w->slot[SLOT_MU]] = start * w->du[3 * i + 2];
-            if (w->slot[SLOT_W0] >= 0 && k == 0)
-                row[w->slot[SLOT_W0]] = w->u[i];
+            row[pc->slot] = w->u[i];
             if (w->slot[SLOT_DRY] >= 0)
-                row[w->slot[SLOT_DRY]] = k == 0 ? 1.0 : 1.0 - w->u[i];
+                row[w->slot[SLOT_DRY]] = 1.0;
         }
     }
     return 0;
@@ -137,7 +134,6 @@ static int wc_predict_at(phc_dataset *ds, const double *p, const double *x, size
 {
     wc_impl *w = ds->impl;
     const double delta = slot_value(w, p, SLOT_DELTA, 0);
-    const double w0 = slot_value(w, p, SLOT_W0, 0);
     const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
     const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
     double *t = malloc((m ? m : 1) * sizeof *t), *u = malloc((m ? m : 1) * sizeof *u);
@@ -162,7 +158,7 @@ static int wc_predict_at(phc_dataset *ds, const double *p, const double *x, size
             continue;
         }
         rc = unit_response(w, delta, mu, t, j - i, u, NULL);
-        const double start = k == 0 ? w0 : w->pieces[k].start_mass - dry;
+        const double start = p[w->pieces[k].slot];
         for (size_t q = i; q < j && !rc; ++q)
             y[q] = dry + start * u[q - i];
         i = j;
@@ -594,35 +590,7 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         jump_threshold *= mconv.scale;
     }
 
-    /* Slots: delta and initial_water always; dry_mass unless measured;
-     * viscosity when the user made it a parameter. */
-    const char *slot_names[N_SLOT_KINDS];
-    size_t k_slots = 0;
-    for (int s = 0; s < N_SLOT_KINDS; ++s)
-        w->slot[s] = -1;
-    w->slot[SLOT_DELTA] = (int)k_slots;
-    slot_names[k_slots++] = "delta";
-    w->slot[SLOT_W0] = (int)k_slots;
-    slot_names[k_slots++] = "initial_water";
-    if (isnan(w->dry_measured)) {
-        w->slot[SLOT_DRY] = (int)k_slots;
-        slot_names[k_slots++] = "dry_mass";
-    }
-    if (is_parameter("viscosity", user_data)) {
-        w->slot[SLOT_MU] = (int)k_slots;
-        slot_names[k_slots++] = "viscosity";
-    }
-    ds = phc_dataset_new(&weight_curve_ops, k_slots);
-    if (!ds) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t j = 0; j < k_slots; ++j)
-        if (!(ds->slot_names[j] = strdup(slot_names[j]))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-    /* Pieces.  Count first, then fill. */
+    /* Pieces: an irrigation (a rise above the threshold) starts a new one. */
     size_t n_pieces = 1;
     for (size_t i = 1; i < n_kept; ++i)
         if (mv[i] - mv[i - 1] > jump_threshold) {
@@ -636,54 +604,78 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
             if (jumps == JUMPS_SPLIT)
                 ++n_pieces;
         }
+
+    /* Slots: delta, one initial water per piece (initial_water, then
+     * initial_water_2, ...), dry_mass unless measured, viscosity when the
+     * user made it a parameter. */
+    const size_t k_slots = 1 + n_pieces + isnan(w->dry_measured) + is_parameter("viscosity", user_data);
+    for (int q = 0; q < N_SLOT_KINDS; ++q)
+        w->slot[q] = -1;
     w->pieces = calloc(n_pieces, sizeof *w->pieces);
-    const size_t n = n_kept - (n_pieces - 1);
-    w->t_model = malloc(n * sizeof *w->t_model);
-    if (!w->pieces || !w->t_model) {
+    ds = phc_dataset_new(&weight_curve_ops, k_slots);
+    if (!w->pieces || !ds) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    size_t js = 0;
+    char slot_name[48];
+    w->slot[SLOT_DELTA] = (int)js;
+    ds->slot_names[js++] = strdup("delta");
+    for (size_t q = 0; q < n_pieces; ++q) {
+        if (q == 0)
+            snprintf(slot_name, sizeof slot_name, "initial_water");
+        else
+            snprintf(slot_name, sizeof slot_name, "initial_water_%zu", q + 1);
+        w->pieces[q].slot = (int)js;
+        ds->slot_names[js++] = strdup(slot_name);
+    }
+    if (isnan(w->dry_measured)) {
+        w->slot[SLOT_DRY] = (int)js;
+        ds->slot_names[js++] = strdup("dry_mass");
+    }
+    if (js < k_slots) {
+        w->slot[SLOT_MU] = (int)js;
+        ds->slot_names[js++] = strdup("viscosity");
+    }
+    for (size_t j = 0; j < k_slots; ++j)
+        if (!ds->slot_names[j]) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+
+    const size_t n = n_kept;
+    w->t_model = malloc(n * sizeof *w->t_model);
     ds->n = n;
     ds->x = malloc(n * sizeof *ds->x);
     ds->y = malloc(n * sizeof *ds->y);
     ds->sigma = (sv || !isnan(sigma_scalar)) ? malloc(n * sizeof *ds->sigma) : NULL;
     ds->data_lines = malloc(n * sizeof *ds->data_lines);
     ds->data_file = strdup(path);
-    if (!ds->x || !ds->y || !ds->data_lines || !ds->data_file ||
+    if (!w->t_model || !ds->x || !ds->y || !ds->data_lines || !ds->data_file ||
         ((sv || !isnan(sigma_scalar)) && !ds->sigma)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    size_t r = 0, k = 0;
+    size_t k = 0;
     double piece_t0 = tv[0];
     w->pieces[0].start_x = 0;
     for (size_t i = 0; i < n_kept; ++i) {
         if (i > 0 && jumps == JUMPS_SPLIT && mv[i] - mv[i - 1] > jump_threshold) {
-            w->pieces[k].count = r - w->pieces[k].first;
+            w->pieces[k].count = i - w->pieces[k].first;
             ++k;
-            w->pieces[k].first = r;
+            w->pieces[k].first = i;
             w->pieces[k].start_x = tv[i] - tv[0];
-            w->pieces[k].start_mass = mv[i];
             piece_t0 = tv[i];
-            continue; /* the measured start of the piece is not a residual */
         }
-        ds->x[r] = tv[i] - tv[0];
-        ds->y[r] = mv[i];
-        w->t_model[r] = (tv[i] - piece_t0) * tconv.scale;
+        ds->x[i] = tv[i] - tv[0];
+        ds->y[i] = mv[i];
+        w->t_model[i] = (tv[i] - piece_t0) * tconv.scale;
         if (ds->sigma)
-            ds->sigma[r] = sv ? sv[i] : sigma_scalar * mconv.scale;
-        ds->data_lines[r] = phc_table_row_line(table, keep[i]);
-        ++r;
+            ds->sigma[i] = sv ? sv[i] : sigma_scalar * mconv.scale;
+        ds->data_lines[i] = phc_table_row_line(table, keep[i]);
     }
-    w->pieces[k].count = r - w->pieces[k].first;
+    w->pieces[k].count = n_kept - w->pieces[k].first;
     w->n_pieces = n_pieces;
-    for (size_t p = 0; p < n_pieces; ++p)
-        if (w->pieces[p].count == 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s: a piece of the curve between irrigations has no weighing after its start; exclude it",
-                               path);
-            goto fail;
-        }
     w->u = malloc(n * sizeof *w->u);
     w->du = malloc(3 * n * sizeof *w->du);
     if (!w->u || !w->du) {
@@ -730,7 +722,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
                                                "reference_2024"};
     static const char *const method_names[] = {"auto", "exact", "bdf6"};
     const double delta = slot_value(w, p, SLOT_DELTA, 0);
-    const double w0 = slot_value(w, p, SLOT_W0, 0);
+    const double w0 = p[w->pieces[0].slot];
     const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
     const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
     const piece *last = &w->pieces[w->n_pieces - 1];
@@ -738,7 +730,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
     double u_end = NAN;
     if (unit_response(w, delta, mu, &t_end, 1, &u_end, NULL) != 0)
         u_end = NAN;
-    const double start = w->n_pieces == 1 ? w0 : last->start_mass - dry;
+    const double start = p[last->slot];
     /* Initial loss rate: dW/dt(0) = -Σ ℓ_i θ_i(0) = -δ Σ A_i V_i / Σ V_i · W0. */
     size_t n = w->graph->n, leaves = phc_plant_graph_leaf_count(w->graph);
     double vol = phc_plant_graph_volume(w->graph) * 1e6; /* cm³ */
@@ -760,7 +752,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
              w->step > 0 ? " (fixed step)" : "", w->sys ? phc_water_system_stiffness(w->sys) : NAN, mu,
              w->slot[SLOT_MU] >= 0 ? " (fitted)" : " (fixed)", dry,
              w->slot[SLOT_DRY] >= 0 ? "fitted" : "measured", w->n_pieces,
-             w->n_pieces > 1 ? " (split at irrigations; later pieces start from their measured mass)" : "",
+             w->n_pieces > 1 ? " (split at irrigations; each piece has its own initial water, initial_water_2, ...)" : "",
              w0, start * u_end, 100 * u_end);
     *markdown = buf;
     return PHC_OK;

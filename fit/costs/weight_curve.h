@@ -10,6 +10,8 @@
  *   delta          δ, leaf water-loss rate per unit of segment area proxy
  *                  A = r·h: s⁻¹·cm⁻² (the model's units; ℓ = δ·A in s⁻¹)
  *   initial_water  water in the plant at the first weighing, g
+ *   initial_water_2, _3, ...  with `jumps: split`, the water at the start of
+ *                  each later piece of the curve, g
  *   dry_mass       g; absent as a slot when the data set gives a measured
  *                  `dry_mass:` (then fixed at the measurement)
  *   viscosity      μ of the sap, mPa·s; a slot only when the problem has a
@@ -37,9 +39,9 @@
  *   jumps:           what a rise of the mass by more than `jump_threshold`
  *                    between weighings (an irrigation) does: `error`
  *                    (default: stop and name the line), `split` (the curve
- *                    restarts there: each later piece starts from its first
- *                    measured mass, whose water is mass − dry_mass, and that
- *                    first weighing is not a residual) or `keep`
+ *                    restarts there: piece k = 2, 3, ... gets its own slot
+ *                    `initial_water_<k>`, the water right after watering,
+ *                    while delta and the dry mass are shared) or `keep`
  *   jump_threshold:  in the mass unit (default max(5σ, 0.5% of the largest mass))
  *   conductance:     poiseuille (default) | mean | paper | reference |
  *                    reference_2024 (model/water.h)

@@ -1,0 +1,526 @@
+/* Wilting paper (Maggioli et al., SIGGRAPH Asia 2023), Fig. 6 in spirit:
+ * simulated against measured weight.  The paper compares its simulated
+ * water loss with plants weighed while they wilt; we use real balance data
+ * that phytocal can read: twelve detached kohlrabi leaves drying on a
+ * balance (R package pvldcurve 1.2.6, `leaf_drying_data`, two treatments;
+ * ../shared/data/leaf_drying).
+ *
+ * One joint fit through the same YAML path a user takes (fit/config.h):
+ * one loss rate delta shared by the twelve leaves, an initial water per leaf,
+ * the measured dry weight as the dry mass; each leaf is a venation chain
+ * built from its measured area (weight_curve `leaf_area`).  Plotted: the
+ * measurements and the fitted curves for six leaves (three per treatment),
+ * and the residuals.
+ *
+ * Checks (exit 1 when one fails): the fit converges, delta is positive and
+ * determined, every fitted initial water lies between 0 and the first
+ * weighing, every fitted curve decreases.
+ *
+ * Usage: notebook_wilting_fig6_leaf_drying OUTPUT_DIR */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <plplot.h>
+
+#include "fit/config.h"
+#include "fit/fit.h"
+
+/* ---- a small multi-panel line plot with PLplot (pngcairo), in the style of
+ * fit/plots.c: white background, black frame, light grid, labelled axes with
+ * units, a legend, readable fonts.  Local to this notebook (fit/plots.h draws
+ * one data set per figure; these figures need several curves per panel). */
+enum {
+    NB_BG, NB_FG, NB_GRID, NB_BLUE, NB_RED, NB_GREEN, NB_ORANGE, NB_PURPLE,
+    NB_BROWN, NB_PINK, NB_GREY, NB_OLIVE, NB_CYAN, NB_BLACK, NB_NCOL
+};
+#define NB_MAX_SERIES 16
+#define NB_CHR 0.85 /* character height scale */
+
+typedef struct nb_series {
+    const double *x, *y;  /* n points; non-finite (or <= 0 on a log axis) skipped */
+    size_t n;
+    const char *label;    /* legend text; NULL = not in the legend (n = 0: legend only) */
+    int color;            /* NB_BLUE ... */
+    int dashed;           /* 0 solid, 1 dashed, 2 dotted */
+    int markers;          /* 1: markers instead of a line */
+    double width;         /* line width (0 = 2.5) */
+} nb_series;
+
+typedef struct nb_panel {
+    const char *title, *xlab, *ylab;
+    int logy;             /* 1: log10 y axis */
+    double ymin, ymax;    /* both 0: automatic */
+    int legend;           /* 0 none, 1 top right, 2 top left, 3 bottom right, 4 bottom left,
+                             5 right middle, 6 left middle */
+    const nb_series *s;
+    size_t ns;
+} nb_panel;
+
+static void nb_colours(void)
+{
+    static const int rgb[NB_NCOL][3] = {
+        {255, 255, 255}, {0, 0, 0}, {221, 221, 221}, {31, 100, 190}, {214, 39, 40},
+        {44, 160, 44}, {230, 120, 0}, {148, 103, 189}, {140, 86, 75}, {227, 119, 194},
+        {110, 110, 110}, {150, 150, 30}, {23, 170, 190}, {0, 0, 0}};
+    plscmap0n(16);
+    for (int i = 0; i < NB_NCOL; ++i)
+        plscol0(i, rgb[i][0], rgb[i][1], rgb[i][2]);
+}
+
+/* Log-axis tick labels as 10 with a superscript exponent (custom labels,
+ * so the decade step can be chosen). */
+static void nb_log_label(PLINT axis, PLFLT value, char *label, PLINT length, PLPointer data)
+{
+    (void)data;
+    if (axis == PL_Y_AXIS)
+        snprintf(label, (size_t)length, "10#u%d#d", (int)lround(value));
+    else
+        snprintf(label, (size_t)length, "%g", value);
+}
+
+static int nb_ok(double v, int logy) { return isfinite(v) && (!logy || v > 0.0); }
+
+static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0, double vy1)
+{
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    for (size_t k = 0; k < p->ns; ++k)
+        for (size_t i = 0; i < p->s[k].n; ++i) {
+            double x = p->s[k].x[i], y = p->s[k].y[i];
+            if (!isfinite(x) || !nb_ok(y, p->logy))
+                continue;
+            y = p->logy ? log10(y) : y;
+            xmin = fmin(xmin, x), xmax = fmax(xmax, x);
+            ymin = fmin(ymin, y), ymax = fmax(ymax, y);
+        }
+    if (!(xmin < xmax))
+        xmin -= 1.0, xmax += 1.0;
+    if (p->ymin != 0.0 || p->ymax != 0.0) {
+        ymin = p->logy ? log10(p->ymin) : p->ymin;
+        ymax = p->logy ? log10(p->ymax) : p->ymax;
+    } else if (p->logy) {
+        ymin = floor(ymin), ymax = ceil(ymax);
+        if (ymin == ymax)
+            ymin -= 1.0;
+    } else {
+        if (!(ymin < ymax))
+            ymin -= 1.0, ymax += 1.0;
+        double pad = 0.05 * (ymax - ymin);
+        ymin -= pad, ymax += pad;
+    }
+    plvpor(vx0, vx1, vy0, vy1);
+    plwind(xmin, xmax, ymin, ymax);
+    plcol0(NB_GRID);
+    plwidth(1.0);
+    pllsty(1);
+    double ystep = p->logy ? (ymax - ymin > 8.0 ? 2.0 : 1.0) : 0.0;
+    plbox("g", 0.0, 0, "g", ystep, 0);
+    const char *lab[NB_MAX_SERIES];
+    PLINT opt[NB_MAX_SERIES], col[NB_MAX_SERIES], sty[NB_MAX_SERIES], tcol[NB_MAX_SERIES];
+    PLINT snum[NB_MAX_SERIES];
+    PLFLT wid[NB_MAX_SERIES], ssc[NB_MAX_SERIES];
+    const char *sym[NB_MAX_SERIES];
+    int nl = 0;
+    for (size_t k = 0; k < p->ns; ++k) {
+        const nb_series *s = &p->s[k];
+        PLINT style = s->dashed == 1 ? 3 : s->dashed == 2 ? 2 : 1;
+        double w = s->width > 0.0 ? s->width : 2.5;
+        plcol0(s->color);
+        pllsty(style);
+        plwidth(w);
+        PLFLT *px = malloc((s->n + 1) * sizeof *px), *py = malloc((s->n + 1) * sizeof *py);
+        if (!px || !py) {
+            free(px), free(py);
+            continue;
+        }
+        size_t m = 0;
+        for (size_t i = 0; i <= s->n; ++i) {
+            int good = i < s->n && isfinite(s->x[i]) && nb_ok(s->y[i], p->logy);
+            if (good) {
+                px[m] = s->x[i];
+                py[m] = p->logy ? log10(s->y[i]) : s->y[i];
+                ++m;
+            }
+            if ((!good || i == s->n) && m > 0) {
+                if (s->markers) {
+                    plschr(0.0, 0.7 * NB_CHR);
+                    plstring((PLINT)m, px, py, "\xe2\x97\x8f");
+                    plschr(0.0, NB_CHR);
+                } else if (m > 1) {
+                    plline((PLINT)m, px, py);
+                }
+                m = 0;
+            }
+        }
+        free(px), free(py);
+        if (s->label && nl < NB_MAX_SERIES) {
+            lab[nl] = s->label;
+            opt[nl] = s->markers ? PL_LEGEND_SYMBOL : PL_LEGEND_LINE;
+            col[nl] = s->color;
+            tcol[nl] = NB_FG;
+            sty[nl] = style;
+            wid[nl] = w;
+            ssc[nl] = 0.75;
+            snum[nl] = 1;
+            sym[nl] = "\xe2\x97\x8f";
+            ++nl;
+        }
+    }
+    pllsty(1);
+    plwidth(1.2);
+    plcol0(NB_FG);
+    if (p->logy)
+        plslabelfunc(nb_log_label, NULL);
+    plbox("bcnst", 0.0, 0, p->logy ? "bcnstvo" : "bcnstv", ystep, p->logy ? (int)ystep : 0);
+    plslabelfunc(NULL, NULL);
+    plmtex("b", 3.0, 0.5, 0.5, p->xlab);
+    plmtex("l", p->logy ? 4.6 : 4.2, 0.5, 0.5, p->ylab);
+    if (p->title) {
+        plschr(0.0, 1.1 * NB_CHR);
+        plmtex("t", 1.5, 0.5, 0.5, p->title);
+        plschr(0.0, NB_CHR);
+    }
+    if (p->legend && nl > 0) {
+        static const PLINT where[7] = {0, PL_POSITION_TOP | PL_POSITION_RIGHT,
+                                       PL_POSITION_TOP | PL_POSITION_LEFT,
+                                       PL_POSITION_BOTTOM | PL_POSITION_RIGHT,
+                                       PL_POSITION_BOTTOM | PL_POSITION_LEFT,
+                                       PL_POSITION_RIGHT, PL_POSITION_LEFT};
+        PLFLT lw, lh;
+        PLINT zero[NB_MAX_SERIES] = {0};
+        PLFLT one[NB_MAX_SERIES];
+        for (int i = 0; i < nl; ++i)
+            one[i] = 1.0;
+        pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+                 where[p->legend] | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.03, 0.06,
+                 NB_BG, NB_FG, 1, 0, 0, nl, opt, 0.7, 0.8, 1.5, 0.0, tcol, lab, col, zero, one,
+                 one, col, sty, wid, col, ssc, snum, sym);
+    }
+}
+
+/* Draws np panels on a cols x rows grid into a width x height PNG at path
+ * (written to path.tmp, then renamed).  Returns 0 or -1. */
+static int nb_plot(const char *path, int width, int height, int cols, int rows,
+                   const nb_panel *panels, size_t np)
+{
+    char tmp[1040];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    PLINT old;
+    plgstrm(&old);
+    PLINT strm;
+    plmkstrm(&strm);
+    if (strm < 0)
+        return -1;
+    plsdev("pngcairo");
+    plsfnam(tmp);
+    plspage(0.0, 0.0, width, height, 0, 0);
+    nb_colours();
+    plinit();
+    pladv(0);
+    plschr(0.0, NB_CHR);
+    for (size_t k = 0; k < np; ++k) {
+        int c = (int)(k % (size_t)cols), r = (int)(k / (size_t)cols);
+        double cw = 1.0 / cols, chh = 1.0 / rows;
+        double x0 = c * cw, y1 = 1.0 - r * chh;
+        /* margins in pixels: room for tick labels, axis labels, a title */
+        double vx0 = x0 + 120.0 / width, vx1 = x0 + cw - 35.0 / width;
+        double vy0 = y1 - chh + 80.0 / height, vy1 = y1 - 60.0 / height;
+        nb_draw_panel(&panels[k], vx0, vx1, vy0, vy1);
+    }
+    plend1();
+    plsstrm(old);
+    if (rename(tmp, path) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+/* ---- end of the plot helper ---------------------------------------------- */
+/* mkdir -p; 0 or -1. */
+static int nb_mkdirs(const char *dir)
+{
+    char buf[1024];
+    size_t len = strlen(dir);
+    if (len == 0 || len >= sizeof buf)
+        return -1;
+    memcpy(buf, dir, len + 1);
+    for (size_t i = 1; i <= len; ++i) {
+        if (buf[i] == '/' || buf[i] == '\0') {
+            char c = buf[i];
+            buf[i] = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+            buf[i] = c;
+        }
+    }
+    return 0;
+}
+
+/* Opens dir/name for writing through a temporary name; nb_close_md renames it. */
+static FILE *nb_open_md(const char *dir, const char *name, char *final, char *tmp, size_t cap)
+{
+    snprintf(final, cap, "%s/%s", dir, name);
+    snprintf(tmp, cap, "%s/%s.tmp", dir, name);
+    return fopen(tmp, "w");
+}
+
+static int nb_close_md(FILE *f, const char *final, const char *tmp)
+{
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, final) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+#define N_LEAVES 12
+#define N_SHOW 6
+
+static const phc_param_result *param(const phc_fit_result *r, const char *name)
+{
+    for (size_t i = 0; i < r->n_params; ++i)
+        if (strcmp(r->params[i].name, name) == 0)
+            return &r->params[i];
+    return NULL;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
+        return 2;
+    }
+    const char *out = argv[1];
+    const char *csv = PHC_SHARED_DATA "/leaf_drying/pvldcurve_leaf_drying.csv";
+    struct stat st;
+    if (stat(csv, &st) != 0) {
+        printf("skipped: %s is absent (the real-data folder ../shared/data is not here)\n", csv);
+        return 77;
+    }
+    if (nb_mkdirs(out) != 0) {
+        fprintf(stderr, "%s: cannot create the output directory: %s\n", out, strerror(errno));
+        return 1;
+    }
+    /* The configuration, kept next to the figure so the fit can be re-run
+     * with `phytocal fit`. */
+    char yaml[1024];
+    snprintf(yaml, sizeof yaml, "%s/wilting_fig6_leaf_drying.yaml", out);
+    FILE *f = fopen(yaml, "w");
+    if (!f) {
+        fprintf(stderr, "%s: cannot write: %s\n", yaml, strerror(errno));
+        return 1;
+    }
+    fprintf(f, "# written by notebook_wilting_fig6_leaf_drying: one delta, twelve initial waters\n"
+               "name: wilting-fig6-leaf-drying\nparameters:\n"
+               "  delta: {value: 1.0e-3, lower: 0, unit: \"s-1 cm-2\"}\n");
+    for (int l = 1; l <= N_LEAVES; ++l)
+        fprintf(f, "  w%d: {value: 4, lower: 0, unit: g}\n", l);
+    fprintf(f, "datasets:\n");
+    for (int l = 1; l <= N_LEAVES; ++l)
+        fprintf(f,
+                "  - kind: weight_curve\n"
+                "    name: leaf%d\n"
+                "    file: %s\n"
+                "    select: {sample: %d}\n"
+                "    time: {column: date.and.time, unit: s}\n"
+                "    mass: {column: fresh.weight, unit: g}\n"
+                "    leaf_area: {column: leaf.area, unit: cm2}\n"
+                "    dry_mass: {column: dry.weight, unit: g}\n"
+                "    parameters: {initial_water: w%d}\n",
+                l, csv, l, l);
+    if (fclose(f) != 0) {
+        fprintf(stderr, "%s: cannot write\n", yaml);
+        return 1;
+    }
+
+    phc_error err;
+    phc_error_clear(&err);
+    phc_problem *pb = NULL;
+    phc_fit_result *r = NULL;
+    if (phc_config_load(yaml, &pb, &err) != PHC_OK || phc_fit_run(pb, NULL, NULL, &r, &err) != PHC_OK) {
+        fprintf(stderr, "%s\n", err.message);
+        phc_problem_free(pb);
+        return 1;
+    }
+    phc_problem_free(pb);
+    if (r->n_datasets != N_LEAVES) {
+        fprintf(stderr, "expected %d data sets, found %zu\n", N_LEAVES, r->n_datasets);
+        return 1;
+    }
+
+    /* Per leaf: first and last weighing, the fitted initial water, the
+     * plateau a single exponential would need, residual runs. */
+    const phc_param_result *delta = param(r, "delta");
+    int ok_conv = r->summary.outcome == PHC_NLS_CONVERGED;
+    int ok_delta = delta && delta->value > 0 && isfinite(delta->stderr_) && delta->stderr_ < delta->value;
+    int ok_w = 1, ok_dec = 1;
+    double rmse_all = sqrt(r->rss / (double)r->n_obs);
+    double w0[N_LEAVES], first[N_LEAVES], last[N_LEAVES], dry[N_LEAVES], fit_last[N_LEAVES];
+    double rmse[N_LEAVES], early[N_LEAVES], late[N_LEAVES], mid[N_LEAVES], mid_t[N_LEAVES];
+    int checks_fail[N_LEAVES], leaves_with_structure = 0;
+    for (int l = 0; l < N_LEAVES; ++l) {
+        const phc_dataset_result *d = &r->datasets[l];
+        char wn[8];
+        snprintf(wn, sizeof wn, "w%d", l + 1);
+        const phc_param_result *w = param(r, wn);
+        w0[l] = w ? w->value : NAN;
+        first[l] = d->y[0];
+        last[l] = d->y[d->n - 1];
+        fit_last[l] = d->yhat[d->n - 1];
+        dry[l] = d->yhat[0] - w0[l]; /* yhat(0) = dry + W0 */
+        rmse[l] = d->goodness.rmse;
+        ok_w &= w0[l] > 0 && w0[l] < first[l];
+        for (size_t j = 1; j < d->curve_n; ++j)
+            ok_dec &= d->curve_y[j] <= d->curve_y[j - 1];
+        /* the residual at the first weighing, the most negative one, and
+         * the residual at the last weighing: the U shape of a convex curve
+         * fitted by a nearly straight one */
+        early[l] = d->residual[0];
+        late[l] = d->residual[d->n - 1];
+        mid[l] = INFINITY;
+        for (size_t i = 0; i < d->n; ++i)
+            if (d->residual[i] < mid[l])
+                mid[l] = d->residual[i], mid_t[l] = d->x[i] / 3600.0;
+        checks_fail[l] = 0;
+        for (int c = 0; c < PHC_CHECK_COUNT; ++c)
+            checks_fail[l] += d->checks[c].applicable && !d->checks[c].pass;
+        leaves_with_structure += checks_fail[l] > 0;
+    }
+
+    printf("joint fit of %d leaves (%zu weighings): %s after %d iterations\n", N_LEAVES, r->n_obs,
+           phc_fit_status_name(r->summary.outcome), (int)r->summary.iterations);
+    printf("delta = %.4e +- %.2e s-1 cm-2 (95%% [%.4e, %.4e]); RMSE over all weighings %.4f g\n",
+           delta ? delta->value : NAN, delta ? delta->stderr_ : NAN, delta ? delta->ci_lo : NAN,
+           delta ? delta->ci_hi : NAN, rmse_all);
+    printf("leaf treatment  first (g)  last (g)  fit last (g)  dry (g)  W0 fit (g)  RMSE (g)  "
+           "residual first / min (at h) / last (g)  checks failed\n");
+    for (int l = 0; l < N_LEAVES; ++l)
+        printf("%4d %9s %10.4f %9.4f %13.4f %8.4f %11.4f %9.4f   %+.3f / %+.3f (%.1f) / %+.3f %8d\n",
+               l + 1, (l % 2 == 0) ? "10%" : "40%", first[l], last[l], fit_last[l], dry[l], w0[l], rmse[l],
+               early[l], mid[l], mid_t[l], late[l], checks_fail[l]);
+    double end10 = 0.0, end40 = 0.0;
+    for (int l = 0; l < N_LEAVES; ++l)
+        *(l % 2 == 0 ? &end10 : &end40) += late[l] / (N_LEAVES / 2);
+    printf("mean residual at the last weighing: 10%% leaves %+.3f g, 40%% leaves %+.3f g\n", end10, end40);
+    printf("leaves whose residual checks find structure: %d of %d\n", leaves_with_structure, N_LEAVES);
+
+    /* Plot: six leaves (samples 1, 3, 5: 10%; 2, 4, 6: 40%), hours. */
+    static const int show[N_SHOW] = {0, 2, 4, 1, 3, 5};
+    static const int col[N_SHOW] = {NB_BLUE, NB_GREEN, NB_CYAN, NB_RED, NB_ORANGE, NB_PURPLE};
+    static double hx[N_SHOW][64], cx[N_SHOW][512], res[N_SHOW][64];
+    static char lab[N_SHOW][48];
+    nb_series sa[2 * N_SHOW + 2], sb[2 * N_SHOW];
+    size_t ma = 0, mb = 0;
+    for (int k = 0; k < N_SHOW; ++k) {
+        const phc_dataset_result *d = &r->datasets[show[k]];
+        size_t n = d->n < 64 ? d->n : 64, cn = d->curve_n < 512 ? d->curve_n : 512;
+        for (size_t i = 0; i < n; ++i) {
+            hx[k][i] = d->x[i] / 3600.0;
+            res[k][i] = d->residual[i];
+        }
+        for (size_t j = 0; j < cn; ++j)
+            cx[k][j] = d->curve_x[j] / 3600.0;
+        snprintf(lab[k], sizeof lab[k], "leaf %d (%s)", show[k] + 1, show[k] % 2 == 0 ? "10%" : "40%");
+        sa[ma++] = (nb_series){hx[k], d->y, n, lab[k], col[k], 0, 1, 0};
+        sa[ma++] = (nb_series){cx[k], d->curve_y, cn, NULL, col[k], 0, 0, 2.0};
+        sb[mb++] = (nb_series){hx[k], res[k], n, lab[k], col[k], 0, 1, 0};
+        sb[mb++] = (nb_series){hx[k], res[k], n, NULL, col[k], 2, 0, 1.0};
+    }
+    sa[ma++] = (nb_series){NULL, NULL, 0, "measured", NB_BLACK, 0, 1, 0};
+    sa[ma++] = (nb_series){NULL, NULL, 0, "fitted (shared \xce\xb4)", NB_BLACK, 0, 0, 2.0};
+    double ylo = INFINITY, yhi = -INFINITY, rlo = 0.0, rhi = 0.0;
+    for (int k = 0; k < N_SHOW; ++k) {
+        const phc_dataset_result *d = &r->datasets[show[k]];
+        for (size_t i = 0; i < d->n; ++i) {
+            ylo = fmin(ylo, fmin(d->y[i], d->yhat[i])), yhi = fmax(yhi, fmax(d->y[i], d->yhat[i]));
+            rlo = fmin(rlo, d->residual[i]), rhi = fmax(rhi, d->residual[i]);
+        }
+    }
+    /* room for the legends above (masses) and below (residuals) the data */
+    double ytop = yhi + 0.75 * (yhi - ylo), rbot = rlo - 1.1 * (rhi - rlo);
+    double zx[2] = {0.0, 12.0}, zy[2] = {0.0, 0.0};
+    nb_series sb0[2 * N_SHOW + 1];
+    memcpy(sb0, sb, mb * sizeof *sb);
+    sb0[mb] = (nb_series){zx, zy, 2, NULL, NB_GREY, 0, 0, 1.2};
+    nb_panel pan[2] = {
+        {"detached kohlrabi leaves: measured and fitted mass", "time since the first weighing (h)",
+         "fresh mass (g)", 0, ylo - 0.05 * (yhi - ylo), ytop, 1, sa, ma},
+        {"residuals (measured \xe2\x88\x92 fitted)", "time since the first weighing (h)", "residual (g)",
+         0, rbot, rhi + 0.05 * (rhi - rlo), 3, sb0, mb + 1}};
+    char png[1024];
+    snprintf(png, sizeof png, "%s/wilting_fig6_leaf_drying.png", out);
+    if (nb_plot(png, 1500, 650, 2, 1, pan, 2) != 0) {
+        fprintf(stderr, "%s: cannot write the plot\n", png);
+        return 1;
+    }
+
+    char md[1024], mdtmp[1024];
+    FILE *m = nb_open_md(out, "wilting_fig6_leaf_drying.md", md, mdtmp, sizeof md);
+    if (!m) {
+        fprintf(stderr, "%s: cannot write the page\n", out);
+        return 1;
+    }
+    fprintf(m,
+            "# Wilting paper, Fig. 6 in spirit: simulated against measured weight\n\n"
+            "**The paper's figure** (Maggioli et al., SIGGRAPH Asia 2023, Fig. 6) compares the water loss\n"
+            "the model simulates with the weight of real plants measured while they wilt, and argues that\n"
+            "modelling the internal water flow follows the measurements better than ignoring it.\n\n"
+            "**What we computed.** The authors' measurements are not in phytocal's shared data; we use real balance data\n"
+            "phytocal ships a reader for: twelve detached kohlrabi leaves drying on a balance for about\n"
+            "11 h (R package pvldcurve 1.2.6, `leaf_drying_data`, two treatments, 10%% and 40%%). Each leaf is\n"
+            "a venation chain of 20 segments built from its measured area; its measured dry weight is the\n"
+            "dry mass. One joint fit (`%s`, the same configuration path a user takes): **one loss rate δ\n"
+            "for all twelve leaves, one initial water per leaf**.\n\n"
+            "- δ = %.4e ± %.2e s⁻¹ cm⁻² (95%% interval [%.4e, %.4e]); %s after %d iterations;\n"
+            "- %zu weighings, RMSE %.4f g over all of them.\n\n"
+            "![measured and fitted mass](wilting_fig6_leaf_drying.png)\n\n"
+            "| leaf | treatment | first weighing (g) | last (g) | fitted last (g) | dry (g) | fitted W0 (g) | RMSE (g) | residual at first weighing / most negative (at h) / at last weighing (g) | residual checks failed |\n"
+            "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+            "wilting_fig6_leaf_drying.yaml", delta ? delta->value : NAN, delta ? delta->stderr_ : NAN,
+            delta ? delta->ci_lo : NAN, delta ? delta->ci_hi : NAN, phc_fit_status_name(r->summary.outcome),
+            (int)r->summary.iterations, r->n_obs, rmse_all);
+    for (int l = 0; l < N_LEAVES; ++l)
+        fprintf(m, "| %d | %s | %.4f | %.4f | %.4f | %.4f | %.4f | %.4f | %+.3f / %+.3f (%.1f h) / %+.3f | %d of %d |\n",
+                l + 1, l % 2 == 0 ? "10%" : "40%", first[l], last[l], fit_last[l], dry[l], w0[l], rmse[l],
+                early[l], mid[l], mid_t[l], late[l], checks_fail[l], PHC_CHECK_COUNT);
+    fprintf(m,
+            "\n**What the residuals show.** %d of %d leaves fail at least one residual check (runs,\n"
+            "Durbin–Watson, Ljung–Box, normality, Breusch–Pagan): the residuals are not noise but one\n"
+            "systematic U: positive at the first weighing (the fit starts below it), negative from about\n"
+            "1.5 to 6 h, positive again at the end (table). The measured curves are convex: a detached leaf\n"
+            "loses water fast while its stomata are open (the 40%% leaves drop by ~0.9 g in the first\n"
+            "2 h), then closes them and slows down to the much smaller cuticular loss. The model's loss is\n"
+            "first order in the water present (ℓ = δ·A, one rate for the whole run) and the fitted δ\n"
+            "drains the leaf towards its *measured dry mass*, about a tenth of the fresh weight and far\n"
+            "below the level where the measured curves flatten (the last weighings are still ~80%% of the\n"
+            "first). An exponential towards a floor that far away is nearly a straight line over 11 h: it\n"
+            "cannot bend from fast to slow, so the fit cuts through the curve. One shared δ adds a second\n"
+            "misfit: the 40%% leaves drop faster early and flatten more (mean residual at the last\n"
+            "weighing %+.3f g against %+.3f g for the 10%% leaves).\n\n"
+            "**How ours differs.** Different data (detached leaves rather than whole potted plants) and a\n"
+            "fit rather than a hand-set loss rate. What carries over from the paper: the linear model with\n"
+            "a constant loss rate reproduces the early, nearly linear part of a drying curve; it does not\n"
+            "reproduce stomatal closure. A model that should follow these curves needs a loss rate that\n"
+            "falls with the water content (e.g. through the logistic elasticity of wilting eq. 9) or a\n"
+            "residual mass that is fitted rather than measured (`test_leaf_drying` fits that \"apparent\"\n"
+            "dry mass for comparison).\n\n"
+            "**Checks** (the notebook fails when one does not hold): converged %s; δ positive and\n"
+            "determined (standard error below the value) %s; every fitted initial water between 0 and the\n"
+            "first weighing %s; every fitted curve decreasing %s.\n",
+            leaves_with_structure, N_LEAVES, end40, end10, ok_conv ? "(pass)" : "(**FAIL**)", ok_delta ? "(pass)" : "(**FAIL**)",
+            ok_w ? "(pass)" : "(**FAIL**)", ok_dec ? "(pass)" : "(**FAIL**)");
+    if (nb_close_md(m, md, mdtmp) != 0) {
+        fprintf(stderr, "%s: cannot write the page\n", md);
+        return 1;
+    }
+    phc_fit_result_free(r);
+    int fail = !(ok_conv && ok_delta && ok_w && ok_dec);
+    printf("%s: %s\n", fail ? "FAIL" : "ok", out);
+    return fail;
+}
