@@ -433,6 +433,21 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
     for (size_t i = 0; i < datasets->count; ++i)
         if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, err)))
             goto fail;
+    /* A model computed to a relative accuracy tol (an ODE solver) cannot
+     * resolve cost changes below it: stopping tolerances the user did not
+     * set are raised to it instead of iterating on round-off. */
+    double model_tol = 0;
+    for (size_t d = 0; d < pb->n_datasets; ++d)
+        model_tol = fmax(model_tol, pb->datasets[d]->model_tolerance);
+    if (model_tol > 0) {
+        static const char *const tol_keys[] = {"function_tolerance", "gradient_tolerance",
+                                               "parameter_tolerance"};
+        double *tols[] = {&pb->options.nls.function_tolerance, &pb->options.nls.gradient_tolerance,
+                          &pb->options.nls.parameter_tolerance};
+        for (size_t t = 0; t < 3; ++t)
+            if (!solver || !phc_yaml_get(solver, tol_keys[t]))
+                *tols[t] = fmax(*tols[t], model_tol);
+    }
     if ((rc = phc_problem_validate(pb, err)))
         goto fail;
     *out = pb;

@@ -48,6 +48,9 @@ struct phc_dataset {
     phc_loss_kind loss;
     double loss_scale;           /* in units of the weighted residual */
     size_t config_line;          /* where the data set starts in the config */
+    double model_tolerance;      /* relative accuracy of the model's numbers (0 = exact to
+                                    round-off); solver tolerances the user leaves unset are
+                                    raised to it, since the cost cannot be resolved further */
     char *data_file;             /* the file the observations came from (or NULL) */
     size_t *data_lines;          /* n 1-based line numbers in data_file (or NULL) */
 };

@@ -514,7 +514,7 @@ int phc_water_exact_state(const phc_water_exact *e, double t, double *theta, phc
         return phc_error_set(err, PHC_ERR_INVALID,
                              "water exact: state needs a FULL or SENSITIVITY evaluator");
     size_t n = e->n;
-    double *c = malloc(2 * n * sizeof *c);
+    double *c = calloc(2 * n, sizeof *c); /* zeroed: cblas reads c + n with beta = 0 */
     if (!c)
         return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory");
     for (size_t i = 0; i < n; ++i)
