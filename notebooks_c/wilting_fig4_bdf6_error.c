@@ -184,7 +184,7 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
     plmtex("l", p->logy ? 4.6 : 4.2, 0.5, 0.5, p->ylab);
     if (p->title) {
         plschr(0.0, 1.1 * NB_CHR);
-        plmtex("t", 1.5, 0.5, 0.5, p->title);
+        plmtex("t", 2.0, 0.5, 0.5, p->title);
         plschr(0.0, NB_CHR);
     }
     if (p->legend && nl > 0) {
@@ -200,7 +200,7 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
             one[i] = 1.0;
         pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
                  where[p->legend] | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.03, 0.06,
-                 NB_BG, NB_FG, 1, 0, 0, nl, opt, 0.7, 0.8, 1.5, 0.0, tcol, lab, col, zero, one,
+                 NB_BG, NB_FG, 1, 0, 0, nl, opt, 0.7, 0.7, 1.5, 0.0, tcol, lab, col, zero, one,
                  one, col, sty, wid, col, ssc, snum, sym);
     }
 }
@@ -589,8 +589,8 @@ int main(int argc, char **argv)
                     lo = fmin(lo, err_acc[q][p][k]);
                 hi = fmax(hi, err_crude[q][p][k]);
             }
-    lo = fmax(1e-14, pow(10.0, floor(log10(lo))));
-    hi = pow(10.0, ceil(log10(hi)));
+    lo = fmax(1e-16, pow(10.0, floor(log10(lo)) - 2.0)); /* room for the legend */
+    hi = pow(10.0, ceil(log10(hi)) + 1.0);
     for (int p = 0; p < NPLANT; ++p)
         snprintf(lab_p[p], sizeof lab_p[p], "%s, %zu segments", names[p], nseg[p]);
     static const char *sup[NH] = {"10\xc2\xb3", "10\xe2\x81\xb4", "10\xe2\x81\xb5"};
@@ -608,7 +608,7 @@ int main(int argc, char **argv)
         }
         snprintf(titles[q], sizeof titles[q], "h = %.0f s, 1000 steps (t \xe2\x89\xa4 %s s)", hs[q],
                  sup[q]);
-        pan[q] = (nb_panel){titles[q], "step", "relative error of W (1)", 1, lo, hi, q == 0 ? 6 : 0,
+        pan[q] = (nb_panel){titles[q], "step", "relative error of W (1)", 1, lo, hi, q == 0 ? 5 : 0,
                             ser[q], m};
     }
     char png[1024];
