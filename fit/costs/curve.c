@@ -103,14 +103,6 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
 
 static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free, NULL};
 
-static size_t key_line(const phc_yaml_node *map, const char *key)
-{
-    for (size_t i = 0; i < map->count; ++i)
-        if (strcmp(map->keys[i], key) == 0)
-            return map->key_lines[i];
-    return map->line;
-}
-
 /* Compiles the derivative tape and binds its names to the slots and to the
  * columns muparser registered (same names, same order as c->cols). */
 static int bind_tape(curve_impl *c, const char *expr, const char *const *slot_names, size_t n_slots,
@@ -200,7 +192,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     mupSetExpr(c->parser, expr);
     int n_vars = mupGetExprVarNum(c->parser);
     if (mupError(c->parser)) {
-        const size_t line = key_line(node, "expression");
+        const size_t line = phc_key_line(node, "expression");
         int pos = (int)mupGetErrorPos(c->parser);
         if (pos > (int)strlen(expr))
             pos = (int)strlen(expr); /* muparser may point past the end */
@@ -210,7 +202,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     if (n_vars <= 0) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
-                           doc->path, key_line(node, "expression"), expr);
+                           doc->path, phc_key_line(node, "expression"), expr);
         goto fail;
     }
 
@@ -240,7 +232,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         const char *name = var_names[v];
         const int is_param = is_parameter(name, user_data);
         const long col = phc_table_find(table, name);
-        const size_t line = key_line(node, "expression");
+        const size_t line = phc_key_line(node, "expression");
         if (is_param && col >= 0) {
             rc = phc_error_set(err, PHC_ERR_INPUT,
                                "%s:%zu: expression name '%s' is both a parameter and a column of %s; rename one",
@@ -279,7 +271,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     if (n_slots == 0) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
-                           doc->path, key_line(node, "expression"), expr);
+                           doc->path, phc_key_line(node, "expression"), expr);
         goto fail;
     }
 
@@ -299,11 +291,11 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     ds->n = phc_table_rows(table);
     if (phc_table_find(table, xname) < 0) {
-        rc = phc_unknown_column(doc, key_line(node, "x"), "x", xname, table, err);
+        rc = phc_unknown_column(doc, phc_key_line(node, "x"), "x", xname, table, err);
         goto fail;
     }
     if (phc_table_find(table, yname) < 0) {
-        rc = phc_unknown_column(doc, key_line(node, "y"), "y", yname, table, err);
+        rc = phc_unknown_column(doc, phc_key_line(node, "y"), "y", yname, table, err);
         goto fail;
     }
     if ((rc = phc_table_column_numbers(table, xname, &ds->x, err)) ||

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/costs/source_file.h"
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"
@@ -94,39 +95,6 @@ nomem:
 static const phc_dataset_ops elasticity_ops = {"elasticity_curve", phc_elasticity_predict,
                                                phc_elasticity_predict_at, phc_elasticity_impl_free, NULL};
 
-static char *join_path(const char *dir, const char *file)
-{
-    if (file[0] == '/' || !dir || !dir[0])
-        return strdup(file);
-    size_t len = strlen(dir) + strlen(file) + 2;
-    char *s = malloc(len);
-    if (s)
-        snprintf(s, len, "%s/%s", dir, file);
-    return s;
-}
-
-static size_t key_line(const phc_yaml_node *map, const char *key)
-{
-    for (size_t i = 0; i < map->count; ++i)
-        if (strcmp(map->keys[i], key) == 0)
-            return map->key_lines[i];
-    return map->line;
-}
-
-static int need_column(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
-                       const char *name, const phc_table *t, phc_error *err)
-{
-    if (phc_table_find(t, name) >= 0)
-        return PHC_OK;
-    size_t nc = phc_table_columns(t), shown = nc < 64 ? nc : 64;
-    const char *names[64];
-    for (size_t j = 0; j < shown; ++j)
-        names[j] = phc_table_column_name(t, j);
-    const char *near = phc_suggest(name, names, shown);
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not a column of %s%s%s%s", doc->path,
-                         key_line(node, key), key, name, phc_table_source(t), near ? "; did you mean '" : "",
-                         near ? near : "", near ? "'?" : "");
-}
 
 int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                               const char *base_dir, phc_is_parameter_fn is_parameter,
@@ -157,8 +125,8 @@ int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node
         is_rwc = 0;
     else
         return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'water_content': expected rwc or absolute, found '%s'",
-                             doc->path, key_line(node, "water_content"), content);
-    if (!(path = join_path(base_dir, file)))
+                             doc->path, phc_key_line(node, "water_content"), content);
+    if (!(path = phc_join_path(base_dir, file)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if ((rc = phc_table_read(path, &table, err)))
         goto fail;
@@ -167,8 +135,8 @@ int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
         goto fail;
     }
-    if ((rc = need_column(doc, node, "water", water, table, err)) ||
-        (rc = need_column(doc, node, "modulus", modulus, table, err)) ||
+    if ((rc = phc_need_column(doc, node, "water", water, table, err)) ||
+        (rc = phc_need_column(doc, node, "modulus", modulus, table, err)) ||
         (rc = phc_table_column_numbers(table, water, &wx, err)) ||
         (rc = phc_table_column_numbers(table, modulus, &my, err)))
         goto fail;

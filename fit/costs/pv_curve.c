@@ -1,6 +1,8 @@
 /* `pv_curve` data sets: see pv_curve.h. */
 #include "fit/costs/pv_curve.h"
 
+#include "fit/costs/source_file.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -162,45 +164,6 @@ int phc_pv_curve_markdown(const phc_dataset *ds, char **out, phc_error *err)
 
 /* ---- loading ------------------------------------------------------------- */
 
-static char *join_path(const char *dir, const char *file)
-{
-    if (file[0] == '/' || !dir || !dir[0])
-        return strdup(file);
-    size_t len = strlen(dir) + strlen(file) + 2;
-    char *s = malloc(len);
-    if (s)
-        snprintf(s, len, "%s/%s", dir, file);
-    return s;
-}
-
-static size_t key_line(const phc_yaml_node *map, const char *key)
-{
-    for (size_t i = 0; i < map->count; ++i)
-        if (strcmp(map->keys[i], key) == 0)
-            return map->key_lines[i];
-    return map->line;
-}
-
-static int need_column(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *name,
-                       const phc_table *t, phc_error *err)
-{
-    if (phc_table_find(t, name) >= 0)
-        return PHC_OK;
-    size_t nc = phc_table_columns(t), shown = nc < 64 ? nc : 64;
-    const char *names[64];
-    char list[512] = "";
-    for (size_t j = 0; j < shown; ++j) {
-        names[j] = phc_table_column_name(t, j);
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof list - used, "%s'%s'", j ? ", " : "", names[j]);
-    }
-    const char *near = phc_suggest(name, names, shown);
-    if (near)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not a column of %s; did you mean '%s'?",
-                             doc->path, key_line(node, key), key, name, phc_table_source(t), near);
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not a column of %s (columns: %s)", doc->path,
-                         key_line(node, key), key, name, phc_table_source(t), list);
-}
 
 /* A mass given as a column name or a number (g): n values in *values.
  * *extrapolate is set instead when allowed and the value is `extrapolate`. */
@@ -231,7 +194,7 @@ static int mass_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const c
     double x;
     phc_error_clear(&tmp);
     if (phc_yaml_number(doc, v, key, &x, &tmp) != PHC_OK) {
-        int rc = need_column(doc, node, key, v->scalar, t, err);
+        int rc = phc_need_column(doc, node, key, v->scalar, t, err);
         if (rc == PHC_ERR_INPUT)
             strncat(err->message, " (nor a number)", sizeof err->message - strlen(err->message) - 1);
         return rc;
@@ -281,7 +244,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         to_mpa = 1e-3;
     else
         return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'psi_unit': expected MPa, bar or kPa, found '%s'",
-                             doc->path, key_line(node, "psi_unit"), unit);
+                             doc->path, phc_key_line(node, "psi_unit"), unit);
     phc_pv_options opt = phc_pv_options_default();
     if (bp) {
         char *end = NULL;
@@ -296,13 +259,13 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         } else
             return phc_error_set(err, PHC_ERR_INPUT,
                                  "%s:%zu: key 'breakpoint': expected min_rss, max_r2 or a whole number of points >= 3, "
-                                 "found '%s'", doc->path, key_line(node, "breakpoint"), bp);
+                                 "found '%s'", doc->path, phc_key_line(node, "breakpoint"), bp);
     }
     if (leaf && !group_col)
         return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'leaf' needs key 'group' (the column of leaf ids)",
-                             doc->path, key_line(node, "leaf"));
+                             doc->path, phc_key_line(node, "leaf"));
 
-    if (!(path = join_path(base_dir, file)))
+    if (!(path = phc_join_path(base_dir, file)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if ((rc = phc_table_read(path, &t, err)))
         goto fail;
@@ -311,9 +274,9 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
         goto fail;
     }
-    if ((rc = need_column(doc, node, "psi", psi_col, t, err)) ||
-        (rc = need_column(doc, node, "fresh_mass", fresh_col, t, err)) ||
-        (group_col && (rc = need_column(doc, node, "group", group_col, t, err))) ||
+    if ((rc = phc_need_column(doc, node, "psi", psi_col, t, err)) ||
+        (rc = phc_need_column(doc, node, "fresh_mass", fresh_col, t, err)) ||
+        (group_col && (rc = phc_need_column(doc, node, "group", group_col, t, err))) ||
         (rc = phc_table_column_numbers(t, psi_col, &psi, err)) ||
         (rc = phc_table_column_numbers(t, fresh_col, &fresh, err)) ||
         (rc = mass_spec(doc, node, "bag_mass", 0, t, NULL, &bag, err)) ||
@@ -376,7 +339,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
             rc = phc_error_set(err, PHC_ERR_INPUT,
                                "%s:%zu: column '%s' of %s holds %zu leaves ('%s', '%s', ...); choose one with "
                                "'leaf: <id>', or 'leaf: each' or 'leaf: pooled'",
-                               doc->path, key_line(node, "group"), group_col, path, n_groups, gname[0], gname[1]);
+                               doc->path, phc_key_line(node, "group"), group_col, path, n_groups, gname[0], gname[1]);
             goto fail;
         }
         if (leaf && strcmp(leaf, "each") == 0)
@@ -394,7 +357,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
                 const char *near = phc_suggest(leaf, gname, n_groups);
                 rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'leaf': '%s' is not a value of column '%s' in %s "
                                    "(values: %s%s)%s%s%s",
-                                   doc->path, key_line(node, "leaf"), leaf, group_col, path, list,
+                                   doc->path, phc_key_line(node, "leaf"), leaf, group_col, path, list,
                                    n_groups > 20 ? ", ..." : "", near ? "; did you mean '" : "", near ? near : "",
                                    near ? "'?" : "");
                 goto fail;
@@ -433,7 +396,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         if (opt.rule == PHC_PV_BREAK_FIXED && (opt.n_osmotic > m - opt.min_points)) {
             rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'breakpoint': %zu linear points leave fewer than %zu "
                                "above the turgor loss point in leaf '%s' (%zu points)",
-                               doc->path, key_line(node, "breakpoint"), opt.n_osmotic, opt.min_points, gname[g], m);
+                               doc->path, phc_key_line(node, "breakpoint"), opt.n_osmotic, opt.min_points, gname[g], m);
             goto fail;
         }
         for (size_t j = 0; j < m; ++j) {

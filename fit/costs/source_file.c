@@ -38,3 +38,21 @@ int phc_unknown_column(const phc_yaml_doc *doc, size_t line, const char *what,
     return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s '%s' is not a column of %s (columns: %s)",
                          doc->path, line, what, name, phc_table_source(t), list);
 }
+
+size_t phc_key_line(const phc_yaml_node *map, const char *key)
+{
+    for (size_t i = 0; i < map->count; ++i)
+        if (strcmp(map->keys[i], key) == 0)
+            return map->key_lines[i];
+    return map->line;
+}
+
+int phc_need_column(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                    const char *name, const phc_table *t, phc_error *err)
+{
+    if (phc_table_find(t, name) >= 0)
+        return PHC_OK;
+    char what[64];
+    snprintf(what, sizeof what, "key '%s':", key);
+    return phc_unknown_column(doc, phc_key_line(node, key), what, name, t, err);
+}

@@ -19,4 +19,12 @@ char *phc_join_path(const char *dir, const char *file);
 int phc_unknown_column(const phc_yaml_doc *doc, size_t line, const char *what, const char *name,
                        const phc_table *t, phc_error *err);
 
+/* PHC_OK when column `name` (named by config key `key` of `node`) is in the
+ * table, else phc_unknown_column's message at that key's line. */
+int phc_need_column(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                    const char *name, const phc_table *t, phc_error *err);
+
+/* The line of `key` in a YAML mapping (the mapping's own line when absent). */
+size_t phc_key_line(const phc_yaml_node *map, const char *key);
+
 #endif /* PHC_COSTS_SOURCE_FILE_H */

@@ -1,0 +1,267 @@
+/* Shared by the notebooks_c programs (one figure each): a small multi-panel
+ * line plot with PLplot's pngcairo driver in the style of fit/plots.c (white
+ * background, grid, labelled axes with units, legends), and writing the
+ * figure's markdown page through a temporary name.  Header-only (static
+ * functions) because ctest builds each notebook as its own program. */
+#ifndef PHC_NOTEBOOK_PLOT_H
+#define PHC_NOTEBOOK_PLOT_H
+
+#include <errno.h>
+#include <math.h>
+#include <plplot.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* ---- a small multi-panel line plot with PLplot (pngcairo), in the style of
+ * fit/plots.c: white background, black frame, light grid, labelled axes with
+ * units, a legend, readable fonts.  Local to this notebook (fit/plots.h draws
+ * one data set per figure; these figures need several curves per panel). */
+enum {
+    NB_BG, NB_FG, NB_GRID, NB_BLUE, NB_RED, NB_GREEN, NB_ORANGE, NB_PURPLE,
+    NB_BROWN, NB_PINK, NB_GREY, NB_OLIVE, NB_CYAN, NB_BLACK, NB_NCOL
+};
+#define NB_MAX_SERIES 16
+#define NB_CHR 0.85 /* character height scale */
+
+typedef struct nb_series {
+    const double *x, *y;  /* n points; non-finite (or <= 0 on a log axis) skipped */
+    size_t n;
+    const char *label;    /* legend text; NULL = not in the legend (n = 0: legend only) */
+    int color;            /* NB_BLUE ... */
+    int dashed;           /* 0 solid, 1 dashed, 2 dotted */
+    int markers;          /* 1: markers instead of a line */
+    double width;         /* line width (0 = 2.5) */
+} nb_series;
+
+typedef struct nb_panel {
+    const char *title, *xlab, *ylab;
+    int logy;             /* 1: log10 y axis */
+    double ymin, ymax;    /* both 0: automatic */
+    int legend;           /* 0 none, 1 top right, 2 top left, 3 bottom right, 4 bottom left,
+                             5 right middle, 6 left middle */
+    const nb_series *s;
+    size_t ns;
+} nb_panel;
+
+static void nb_colours(void)
+{
+    static const int rgb[NB_NCOL][3] = {
+        {255, 255, 255}, {0, 0, 0}, {221, 221, 221}, {31, 100, 190}, {214, 39, 40},
+        {44, 160, 44}, {230, 120, 0}, {148, 103, 189}, {140, 86, 75}, {227, 119, 194},
+        {110, 110, 110}, {150, 150, 30}, {23, 170, 190}, {0, 0, 0}};
+    plscmap0n(16);
+    for (int i = 0; i < NB_NCOL; ++i)
+        plscol0(i, rgb[i][0], rgb[i][1], rgb[i][2]);
+}
+
+/* Log-axis tick labels as 10 with a superscript exponent (custom labels,
+ * so the decade step can be chosen). */
+static void nb_log_label(PLINT axis, PLFLT value, char *label, PLINT length, PLPointer data)
+{
+    (void)data;
+    if (axis == PL_Y_AXIS)
+        snprintf(label, (size_t)length, "10#u%d#d", (int)lround(value));
+    else
+        snprintf(label, (size_t)length, "%g", value);
+}
+
+static int nb_ok(double v, int logy) { return isfinite(v) && (!logy || v > 0.0); }
+
+static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0, double vy1)
+{
+    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+    for (size_t k = 0; k < p->ns; ++k)
+        for (size_t i = 0; i < p->s[k].n; ++i) {
+            double x = p->s[k].x[i], y = p->s[k].y[i];
+            if (!isfinite(x) || !nb_ok(y, p->logy))
+                continue;
+            y = p->logy ? log10(y) : y;
+            xmin = fmin(xmin, x), xmax = fmax(xmax, x);
+            ymin = fmin(ymin, y), ymax = fmax(ymax, y);
+        }
+    if (!(xmin < xmax))
+        xmin -= 1.0, xmax += 1.0;
+    if (p->ymin != 0.0 || p->ymax != 0.0) {
+        ymin = p->logy ? log10(p->ymin) : p->ymin;
+        ymax = p->logy ? log10(p->ymax) : p->ymax;
+    } else if (p->logy) {
+        ymin = floor(ymin), ymax = ceil(ymax);
+        if (ymin == ymax)
+            ymin -= 1.0;
+    } else {
+        if (!(ymin < ymax))
+            ymin -= 1.0, ymax += 1.0;
+        double pad = 0.05 * (ymax - ymin);
+        ymin -= pad, ymax += pad;
+    }
+    plvpor(vx0, vx1, vy0, vy1);
+    plwind(xmin, xmax, ymin, ymax);
+    plcol0(NB_GRID);
+    plwidth(1.0);
+    pllsty(1);
+    double ystep = p->logy ? (ymax - ymin > 8.0 ? 2.0 : 1.0) : 0.0;
+    plbox("g", 0.0, 0, "g", ystep, 0);
+    const char *lab[NB_MAX_SERIES];
+    PLINT opt[NB_MAX_SERIES], col[NB_MAX_SERIES], sty[NB_MAX_SERIES], tcol[NB_MAX_SERIES];
+    PLINT snum[NB_MAX_SERIES];
+    PLFLT wid[NB_MAX_SERIES], ssc[NB_MAX_SERIES];
+    const char *sym[NB_MAX_SERIES];
+    int nl = 0;
+    for (size_t k = 0; k < p->ns; ++k) {
+        const nb_series *s = &p->s[k];
+        PLINT style = s->dashed == 1 ? 3 : s->dashed == 2 ? 2 : 1;
+        double w = s->width > 0.0 ? s->width : 2.5;
+        plcol0(s->color);
+        pllsty(style);
+        plwidth(w);
+        PLFLT *px = malloc((s->n + 1) * sizeof *px), *py = malloc((s->n + 1) * sizeof *py);
+        if (!px || !py) {
+            free(px), free(py);
+            continue;
+        }
+        size_t m = 0;
+        for (size_t i = 0; i <= s->n; ++i) {
+            int good = i < s->n && isfinite(s->x[i]) && nb_ok(s->y[i], p->logy);
+            if (good) {
+                px[m] = s->x[i];
+                py[m] = p->logy ? log10(s->y[i]) : s->y[i];
+                ++m;
+            }
+            if ((!good || i == s->n) && m > 0) {
+                if (s->markers) {
+                    plschr(0.0, 0.7 * NB_CHR);
+                    plstring((PLINT)m, px, py, "\xe2\x97\x8f");
+                    plschr(0.0, NB_CHR);
+                } else if (m > 1) {
+                    plline((PLINT)m, px, py);
+                }
+                m = 0;
+            }
+        }
+        free(px), free(py);
+        if (s->label && nl < NB_MAX_SERIES) {
+            lab[nl] = s->label;
+            opt[nl] = s->markers ? PL_LEGEND_SYMBOL : PL_LEGEND_LINE;
+            col[nl] = s->color;
+            tcol[nl] = NB_FG;
+            sty[nl] = style;
+            wid[nl] = w;
+            ssc[nl] = 0.75;
+            snum[nl] = 1;
+            sym[nl] = "\xe2\x97\x8f";
+            ++nl;
+        }
+    }
+    pllsty(1);
+    plwidth(1.2);
+    plcol0(NB_FG);
+    if (p->logy)
+        plslabelfunc(nb_log_label, NULL);
+    plbox("bcnst", 0.0, 0, p->logy ? "bcnstvo" : "bcnstv", ystep, p->logy ? (int)ystep : 0);
+    plslabelfunc(NULL, NULL);
+    plmtex("b", 3.0, 0.5, 0.5, p->xlab);
+    plmtex("l", p->logy ? 4.6 : 4.2, 0.5, 0.5, p->ylab);
+    if (p->title) {
+        plschr(0.0, 1.1 * NB_CHR);
+        plmtex("t", 2.0, 0.5, 0.5, p->title);
+        plschr(0.0, NB_CHR);
+    }
+    if (p->legend && nl > 0) {
+        static const PLINT where[7] = {0, PL_POSITION_TOP | PL_POSITION_RIGHT,
+                                       PL_POSITION_TOP | PL_POSITION_LEFT,
+                                       PL_POSITION_BOTTOM | PL_POSITION_RIGHT,
+                                       PL_POSITION_BOTTOM | PL_POSITION_LEFT,
+                                       PL_POSITION_RIGHT, PL_POSITION_LEFT};
+        PLFLT lw, lh;
+        PLINT zero[NB_MAX_SERIES] = {0};
+        PLFLT one[NB_MAX_SERIES];
+        for (int i = 0; i < nl; ++i)
+            one[i] = 1.0;
+        pllegend(&lw, &lh, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+                 where[p->legend] | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.03, 0.06,
+                 NB_BG, NB_FG, 1, 0, 0, nl, opt, 0.7, 0.7, 1.5, 0.0, tcol, lab, col, zero, one,
+                 one, col, sty, wid, col, ssc, snum, sym);
+    }
+}
+
+/* Draws np panels on a cols x rows grid into a width x height PNG at path
+ * (written to path.tmp, then renamed).  Returns 0 or -1. */
+static int nb_plot(const char *path, int width, int height, int cols, int rows,
+                   const nb_panel *panels, size_t np)
+{
+    char tmp[1040];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    PLINT old;
+    plgstrm(&old);
+    PLINT strm;
+    plmkstrm(&strm);
+    if (strm < 0)
+        return -1;
+    plsdev("pngcairo");
+    plsfnam(tmp);
+    plspage(0.0, 0.0, width, height, 0, 0);
+    nb_colours();
+    plinit();
+    pladv(0);
+    plschr(0.0, NB_CHR);
+    for (size_t k = 0; k < np; ++k) {
+        int c = (int)(k % (size_t)cols), r = (int)(k / (size_t)cols);
+        double cw = 1.0 / cols, chh = 1.0 / rows;
+        double x0 = c * cw, y1 = 1.0 - r * chh;
+        /* margins in pixels: room for tick labels, axis labels, a title */
+        double vx0 = x0 + 120.0 / width, vx1 = x0 + cw - 35.0 / width;
+        double vy0 = y1 - chh + 80.0 / height, vy1 = y1 - 60.0 / height;
+        nb_draw_panel(&panels[k], vx0, vx1, vy0, vy1);
+    }
+    plend1();
+    plsstrm(old);
+    if (rename(tmp, path) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+/* ---- end of the plot helper ---------------------------------------------- */
+/* mkdir -p; 0 or -1. */
+static int nb_mkdirs(const char *dir)
+{
+    char buf[1024];
+    size_t len = strlen(dir);
+    if (len == 0 || len >= sizeof buf)
+        return -1;
+    memcpy(buf, dir, len + 1);
+    for (size_t i = 1; i <= len; ++i) {
+        if (buf[i] == '/' || buf[i] == '\0') {
+            char c = buf[i];
+            buf[i] = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return -1;
+            buf[i] = c;
+        }
+    }
+    return 0;
+}
+
+/* Opens dir/name for writing through a temporary name; nb_close_md renames it. */
+static FILE *nb_open_md(const char *dir, const char *name, char *final, char *tmp, size_t cap)
+{
+    snprintf(final, cap, "%s/%s", dir, name);
+    snprintf(tmp, cap, "%s/%s.tmp", dir, name);
+    return fopen(tmp, "w");
+}
+
+static int nb_close_md(FILE *f, const char *final, const char *tmp)
+{
+    int bad = ferror(f);
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, final) != 0) {
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+#endif /* PHC_NOTEBOOK_PLOT_H */
