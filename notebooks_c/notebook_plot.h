@@ -264,4 +264,26 @@ static int nb_close_md(FILE *f, const char *final, const char *tmp)
     return 0;
 }
 
+/* The notebooks' common start: the usage check, the skip (exit 77) when a
+ * real-data file is absent, and the output directory argv[1] (created).
+ * Returns 0 to go on with *out set, otherwise the exit code to return. */
+static int nb_begin(int argc, char **argv, const char *data_file, const char **out)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
+        return 2;
+    }
+    *out = argv[1];
+    struct stat st;
+    if (data_file && stat(data_file, &st) != 0) {
+        printf("skipped: %s is absent (the real-data folder ../shared/data is not here)\n", data_file);
+        return 77;
+    }
+    if (nb_mkdirs(*out) != 0) {
+        fprintf(stderr, "%s: cannot create the output directory: %s\n", *out, strerror(errno));
+        return 1;
+    }
+    return 0;
+}
+
 #endif /* PHC_NOTEBOOK_PLOT_H */

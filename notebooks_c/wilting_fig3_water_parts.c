@@ -34,21 +34,11 @@
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
-        return 2;
-    }
-    const char *out = argv[1];
     const char *plant = PHC_SHARED_DATA "/plants/plant002.txt";
-    struct stat st;
-    if (stat(plant, &st) != 0) {
-        printf("skipped: %s is absent (the real-data folder ../shared/data is not here)\n", plant);
-        return 77;
-    }
-    if (nb_mkdirs(out) != 0) {
-        fprintf(stderr, "%s: cannot create the output directory: %s\n", out, strerror(errno));
-        return 1;
-    }
+    const char *out = NULL;
+    int started = nb_begin(argc, argv, plant, &out);
+    if (started)
+        return started;
     phc_error err;
     phc_error_clear(&err);
     phc_plant_graph *g = NULL;

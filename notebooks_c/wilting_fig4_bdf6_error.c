@@ -180,26 +180,16 @@ static void crude_seed(crude *c, double *const states[6], double h)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
-        return 2;
-    }
-    const char *out = argv[1];
     /* the four plants by size */
     static const char *names[NPLANT] = {"plant002", "plant001", "plant003", "plant000"};
     static const double hs[NH] = {1.0, 10.0, 100.0};
     char path[NPLANT][512];
-    struct stat st;
+    const char *out = NULL;
     for (int p = 0; p < NPLANT; ++p) {
         snprintf(path[p], sizeof path[p], "%s/plants/%s.txt", PHC_SHARED_DATA, names[p]);
-        if (stat(path[p], &st) != 0) {
-            printf("skipped: %s is absent (the real-data folder ../shared/data is not here)\n", path[p]);
-            return 77;
-        }
-    }
-    if (nb_mkdirs(out) != 0) {
-        fprintf(stderr, "%s: cannot create the output directory: %s\n", out, strerror(errno));
-        return 1;
+        int started = nb_begin(argc, argv, path[p], &out);
+        if (started)
+            return started;
     }
     phc_error err;
     phc_error_clear(&err);

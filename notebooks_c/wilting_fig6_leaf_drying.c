@@ -45,21 +45,11 @@ static const phc_param_result *param(const phc_fit_result *r, const char *name)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2) {
-        fprintf(stderr, "usage: %s OUTPUT_DIR\n", argv[0]);
-        return 2;
-    }
-    const char *out = argv[1];
     const char *csv = PHC_SHARED_DATA "/leaf_drying/pvldcurve_leaf_drying.csv";
-    struct stat st;
-    if (stat(csv, &st) != 0) {
-        printf("skipped: %s is absent (the real-data folder ../shared/data is not here)\n", csv);
-        return 77;
-    }
-    if (nb_mkdirs(out) != 0) {
-        fprintf(stderr, "%s: cannot create the output directory: %s\n", out, strerror(errno));
-        return 1;
-    }
+    const char *out = NULL;
+    int started = nb_begin(argc, argv, csv, &out);
+    if (started)
+        return started;
     /* The configuration, kept next to the figure so the fit can be re-run
      * with `phytocal fit`. */
     char yaml[1024];
