@@ -44,6 +44,10 @@ typedef struct wc_impl {
     double dry_measured;       /* g, or NAN */
     int slot[N_SLOT_KINDS];    /* slot index of each quantity, -1 when fixed */
     double *t_model;           /* n: s since the start of the residual's piece */
+    double *t_unique;          /* m_unique sorted distinct values of t_model: the pieces
+                                  share δ and μ, so one unit response serves them all */
+    size_t m_unique;
+    size_t *t_at;              /* n: index of t_model[i] in t_unique */
     size_t n_pieces;
     piece *pieces;
     double seconds_per_x;      /* the user's time unit in s */
@@ -58,6 +62,8 @@ static void wc_free(void *p)
     phc_plant_graph_free(w->graph);
     phc_water_system_free(w->sys);
     free(w->t_model);
+    free(w->t_unique);
+    free(w->t_at);
     free(w->pieces);
     free(w->u);
     free(w->du);
@@ -105,15 +111,14 @@ static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
     const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
     if (!(delta >= 0) || !(mu > 0) || !isfinite(dry))
         return 1;
+    int rc = unit_response(w, delta, mu, w->t_unique, w->m_unique, w->u, jac ? w->du : NULL);
+    if (rc)
+        return rc;
     for (size_t k = 0; k < w->n_pieces; ++k) {
         const piece *pc = &w->pieces[k];
-        int rc = unit_response(w, delta, mu, w->t_model + pc->first, pc->count, w->u,
-                               jac ? w->du : NULL);
-        if (rc)
-            return rc;
         const double start = p[pc->slot];
-        for (size_t i = 0; i < pc->count; ++i) {
-            const size_t r = pc->first + i;
+        for (size_t r = pc->first; r < pc->first + pc->count; ++r) {
+            const size_t i = w->t_at[r];
             yhat[r] = dry + start * w->u[i];
             if (!jac)
                 continue;
@@ -179,6 +184,41 @@ static const phc_dataset_ops weight_curve_ops = {"weight_curve", wc_predict, wc_
                                                  wc_free, wc_report_section};
 
 /* ---- loading ------------------------------------------------------------- */
+
+static int by_value(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* t_unique and t_at from the n model times (every piece starts at 0, so
+ * after a watering the times repeat those of the first piece). */
+static int unique_times(wc_impl *w, size_t n, phc_error *err)
+{
+    w->t_unique = malloc(n * sizeof *w->t_unique);
+    w->t_at = malloc(n * sizeof *w->t_at);
+    if (!w->t_unique || !w->t_at)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    memcpy(w->t_unique, w->t_model, n * sizeof *w->t_unique);
+    qsort(w->t_unique, n, sizeof *w->t_unique, by_value);
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (m == 0 || w->t_unique[i] != w->t_unique[m - 1])
+            w->t_unique[m++] = w->t_unique[i];
+    w->m_unique = m;
+    for (size_t i = 0; i < n; ++i) {
+        size_t lo = 0, hi = m; /* first index with t_unique >= t_model[i] */
+        while (lo < hi) {
+            const size_t mid = lo + (hi - lo) / 2;
+            if (w->t_unique[mid] < w->t_model[i])
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        w->t_at[i] = lo;
+    }
+    return PHC_OK;
+}
 
 /* A `{column: NAME, unit: UNIT}` mapping (or a bare column name). */
 static int column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
@@ -680,8 +720,10 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     w->pieces[k].count = n_kept - w->pieces[k].first;
     w->n_pieces = n_pieces;
-    w->u = malloc(n * sizeof *w->u);
-    w->du = malloc(3 * n * sizeof *w->du);
+    if ((rc = unique_times(w, n, err)))
+        goto fail;
+    w->u = malloc(w->m_unique * sizeof *w->u);
+    w->du = malloc(3 * w->m_unique * sizeof *w->du);
     if (!w->u || !w->du) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
