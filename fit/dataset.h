@@ -30,6 +30,11 @@ typedef struct phc_dataset_ops {
      * parameters of every leaf, or the model set-up), at the fitted slot
      * values p.  *markdown is malloc'd; return PHC_OK or an error. */
     int (*report_section)(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
+    /* Optional (NULL = none): extra outputs of `phytocal simulate` at slot
+     * values p, written into directory dir with file names starting with
+     * `base` (for example gridded fields as NetCDF and slice plots). */
+    int (*simulate_outputs)(phc_dataset *ds, const double *p, const char *dir, const char *base,
+                            phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {

@@ -46,7 +46,10 @@ static int simulate_dataset(const phc_problem *pb, phc_dataset *ds, const char *
     snprintf(title, sizeof title, "%s: model at the start values", ds->name);
     phc_plot_labels lab = {title, ds->x_label, ds->y_label};
     snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, base);
-    rc = phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, ds->x, yhat, ds->n, err);
+    if ((rc = phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, ds->x, yhat, ds->n, err)))
+        goto done;
+    if (ds->ops->simulate_outputs)
+        rc = ds->ops->simulate_outputs(ds, p, tmpdir, base, err);
 done:
     free(x);
     free(p);

@@ -1,0 +1,395 @@
+/* `soil_probe` data sets: see soil_probe.h. */
+#include "fit/costs/soil_probe.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/costs/soil_fields.h"
+#include "fit/costs/soil_setup.h"
+#include "fit/costs/source_file.h"
+#include "measurements/soil_probes.h"
+#include "measurements/units.h"
+
+const char *const phc_soil_probe_keys[] = {"file", "time", "probe", "value", "quantity", "start", "probes",
+                                           "sigma", "soil", "x_label", "y_label", NULL};
+
+typedef struct sp_impl {
+    phc_soil_setup *su;
+    phc_probe_table *probes;
+    double *pz;              /* probe heights in the grid frame, m */
+    size_t *probe_of;        /* n: probe index of each reading */
+    double *t_unique;        /* sorted distinct model times, h */
+    size_t m_unique;
+    size_t *t_at;            /* n: index into t_unique */
+    int fill;                /* compare w/c instead of w */
+    /* during predict */
+    double *yhat, *jac;
+    size_t k;
+} sp_impl;
+
+static void sp_free(void *p)
+{
+    sp_impl *s = p;
+    if (!s)
+        return;
+    phc_soil_setup_free(s->su);
+    phc_probe_table_free(s->probes);
+    free(s->pz);
+    free(s->probe_of);
+    free(s->t_unique);
+    free(s->t_at);
+    free(s);
+}
+
+/* The model value (w or w/c) of probe pi and its derivatives. */
+static int probe_value(const sp_impl *im, const phc_soil *s, size_t pi, double *const *sw, double *y, double *row)
+{
+    const phc_probe *pr = &im->probes->probes[pi];
+    double wts[8], val;
+    size_t idx[8];
+    if (phc_soil_sample(s, s->w, pr->x, pr->y, im->pz[pi], &val, wts, idx))
+        return 1;
+    if (im->fill) {
+        val = 0;
+        for (int c = 0; c < 8; ++c)
+            val += wts[c] * s->w[idx[c]] / s->c[idx[c]];
+    }
+    *y = val;
+    if (!row || !sw)
+        return 0;
+    for (size_t q = 0; q < im->k; ++q) {
+        double d = 0;
+        for (int c = 0; c < 8; ++c) {
+            size_t v = idx[c];
+            if (!im->fill) {
+                d += wts[c] * sw[q][v];
+                continue;
+            }
+            double ic = 1.0 / s->c[v];
+            /* d(w/c) = sw / c + w d(1/c); d(1/c) = -1/c^2 for this voxel's capacity slot */
+            double dic = 0;
+            size_t k = v / (s->nx * s->ny);
+            if (im->su->slot_c[im->su->layer_of_k[k]] == (int)q)
+                dic = -ic * ic;
+            d += wts[c] * (sw[q][v] * ic + s->w[v] * dic);
+        }
+        row[q] = d;
+    }
+    return 0;
+}
+
+typedef struct visit_ctx {
+    phc_dataset *ds;
+    sp_impl *im;
+    int bad;
+} visit_ctx;
+
+static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
+{
+    visit_ctx *c = user;
+    phc_dataset *ds = c->ds;
+    sp_impl *im = c->im;
+    for (size_t r = 0; r < ds->n; ++r) {
+        if (im->t_at[r] != i)
+            continue;
+        double *row = im->jac ? im->jac + r * ds->k : NULL;
+        if (probe_value(im, s, im->probe_of[r], sw, &im->yhat[r], row)) {
+            c->bad = 1;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int sp_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    sp_impl *im = ds->impl;
+    im->yhat = yhat;
+    im->jac = jac;
+    im->k = ds->k;
+    for (size_t q = 0; q < ds->k; ++q)
+        if (!(p[q] > 0) && strcmp(ds->slot_names[q], "f_diff") && strcmp(ds->slot_names[q], "f_grav"))
+            return 1; /* p and c must stay positive: reject the trial step */
+    visit_ctx c = {ds, im, 0};
+    phc_error err;
+    phc_error_clear(&err);
+    int rc = phc_soil_setup_run(im->su, p, im->t_unique, im->m_unique, jac != NULL, visit, &c, NULL, &err);
+    if (rc == PHC_ERR_NOMEM)
+        return -1;
+    return rc ? 1 : 0;
+}
+
+static int sp_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
+{
+    sp_impl *im = ds->impl;
+    phc_soil *s = NULL;
+    int rc = phc_soil_setup_run(im->su, p, im->t_unique + im->m_unique - 1, 1, 0, NULL, NULL, &s, err);
+    if (rc)
+        return rc;
+    char *md = phc_soil_setup_markdown(im->su, p, s);
+    phc_soil_free(s);
+    if (!md)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    size_t extra = 256 + im->probes->n * 160;
+    char *out = malloc(strlen(md) + extra);
+    if (!out) {
+        free(md);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    size_t len = (size_t)sprintf(out, "%s\n| probe | x (m) | y (m) | depth (m) | placed from |\n|---|---|---|---|---|\n", md);
+    for (size_t i = 0; i < im->probes->n; ++i) {
+        const phc_probe *pr = &im->probes->probes[i];
+        char from[96];
+        if (pr->geographic)
+            snprintf(from, sizeof from, "%.6f, %.6f", pr->lat, pr->lon);
+        else
+            snprintf(from, sizeof from, "grid metres");
+        len += (size_t)snprintf(out + len, 160, "| %.40s | %.3f | %.3f | %.3f | %s |\n", pr->id, pr->x, pr->y,
+                                pr->depth, from);
+    }
+    free(md);
+    *markdown = out;
+    return PHC_OK;
+}
+
+static int sp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err)
+{
+    sp_impl *im = ds->impl;
+    return phc_soil_write_fields(im->su, p, im->t_unique[im->m_unique - 1], 24, dir, base, ds->name, err);
+}
+
+static const phc_dataset_ops soil_probe_ops = {"soil_probe", sp_predict, NULL, sp_free, sp_report_section,
+                                               sp_simulate_outputs};
+
+static int by_value(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* `{column: NAME, unit: UNIT}` or a bare column name. */
+static int column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *def_unit,
+                       const char **column, const char **unit, phc_error *err)
+{
+    static const char *const spec_keys[] = {"column", "unit", NULL};
+    const phc_yaml_node *v = phc_yaml_get(node, key);
+    char ctx[64];
+    int rc;
+    snprintf(ctx, sizeof ctx, "key '%s'", key);
+    *unit = def_unit;
+    if (!v)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil_probe data set: missing key '%s'", doc->path,
+                             node->line, key);
+    if (v->kind == PHC_YAML_SCALAR)
+        return phc_yaml_string(doc, v, key, column, err);
+    if ((rc = phc_yaml_check_keys(doc, v, spec_keys, ctx, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "column", 1, ctx, column, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, unit, err)))
+        return rc;
+    return PHC_OK;
+}
+
+int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
+                        phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
+{
+    static const char *const probe_keys[] = {"file", "id", "x", "y", "lat", "lon", "depth", "sigma", NULL};
+    const char *ctx = "soil_probe data set";
+    const char *file = NULL, *tcol = NULL, *tunit = NULL, *pcol = NULL, *vcol = NULL, *quantity = "water";
+    const char *x_label = NULL, *y_label = NULL;
+    phc_units *units = NULL;
+    phc_probe_series *ser = NULL;
+    phc_dataset *ds = NULL;
+    char *path = NULL, *ppath = NULL;
+    int rc;
+    *out = NULL;
+    sp_impl *im = calloc(1, sizeof *im);
+    if (!im)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    const phc_yaml_node *soil = phc_yaml_get(node, "soil"), *pn = phc_yaml_get(node, "probes");
+    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
+        (rc = column_spec(doc, node, "time", "h", &tcol, &tunit, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "probe", 1, ctx, &pcol, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "value", 1, ctx, &vcol, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "quantity", 0, ctx, &quantity, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
+        goto fail;
+    if (strcmp(quantity, "water") && strcmp(quantity, "fill")) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'quantity': '%s' is not one of water, fill", doc->path,
+                           phc_key_line(node, "quantity"), quantity);
+        goto fail;
+    }
+    im->fill = !strcmp(quantity, "fill");
+    if (!soil || !pn) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil_probe data set: missing key '%s'", doc->path, node->line,
+                           soil ? "probes" : "soil");
+        goto fail;
+    }
+    if ((rc = phc_soil_setup_parse(doc, soil, is_parameter, user_data, &im->su, err)))
+        goto fail;
+
+    /* Probe table. */
+    phc_probe_columns pc = {0};
+    const char *pfile = NULL;
+    if (pn->kind != PHC_YAML_MAPPING) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'probes': expected {file, id, x, y | lat, lon, depth}",
+                           doc->path, pn->line);
+        goto fail;
+    }
+    pc.id = "id";
+    pc.depth = "depth";
+    if ((rc = phc_yaml_check_keys(doc, pn, probe_keys, "probes", err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "file", 1, "probes", &pfile, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "id", 0, "probes", &pc.id, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "x", 0, "probes", &pc.x, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "y", 0, "probes", &pc.y, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "lat", 0, "probes", &pc.lat, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "lon", 0, "probes", &pc.lon, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "depth", 0, "probes", &pc.depth, err)) ||
+        (rc = phc_yaml_map_string(doc, pn, "sigma", 0, "probes", &pc.sigma, err)))
+        goto fail;
+    if (!pc.lat && !pc.lon && !pc.x && !pc.y) {
+        pc.x = "x";
+        pc.y = "y";
+    }
+    if (!(ppath = phc_join_path(base_dir, pfile)) || !(path = phc_join_path(base_dir, file))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((rc = phc_probe_table_read(ppath, &pc, im->su->has_geo ? &im->su->geo : NULL, &im->probes, err)))
+        goto fail;
+    const double top = im->su->nz * im->su->dx, ex = im->su->nx * im->su->dx, ey = im->su->ny * im->su->dx;
+    if (!(im->pz = malloc(im->probes->n * sizeof *im->pz))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < im->probes->n; ++i) {
+        const phc_probe *pr = &im->probes->probes[i];
+        if (!(pr->x >= 0 && pr->x <= ex && pr->y >= 0 && pr->y <= ey && pr->depth <= top)) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: probe '%s' at x = %.3f m, y = %.3f m, depth %.3f m%s is outside the soil grid "
+                               "(x 0..%g m, y 0..%g m, depth 0..%g m; config line %zu)",
+                               ppath, pr->line, pr->id, pr->x, pr->y, pr->depth,
+                               pr->geographic ? " (east, north of geo_origin)" : "", ex, ey, top, im->su->line);
+            goto fail;
+        }
+        im->pz[i] = top - pr->depth;
+    }
+
+    /* Readings. */
+    if (!(units = phc_units_new(err))) {
+        rc = err->status;
+        goto fail;
+    }
+    phc_unit_conversion tconv;
+    char where[256];
+    snprintf(where, sizeof where, "%s:%zu: time unit", doc->path, phc_key_line(node, "time"));
+    if ((rc = phc_units_conversion(units, tunit, "h", where, &tconv, err)))
+        goto fail;
+    if ((rc = phc_probe_series_read(path, tcol, tconv, pcol, vcol, im->probes, &ser, err)))
+        goto fail;
+    double start = ser->t[0];
+    if (phc_yaml_get(node, "start")) {
+        double st;
+        if ((rc = phc_yaml_map_number(doc, node, "start", 0, ctx, &st, err)))
+            goto fail;
+        start = phc_unit_apply(tconv, st);
+        if (ser->t[0] < start) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the first reading is before `start` (the model's t = 0)",
+                               path, ser->line[0]);
+            goto fail;
+        }
+    }
+
+    /* Sigma: per probe, or a scalar. */
+    double sigma = NAN;
+    const phc_yaml_node *sg = phc_yaml_get(node, "sigma");
+    if (sg) {
+        if ((rc = phc_yaml_number(doc, sg, "sigma", &sigma, err)))
+            goto fail;
+        if (!(sigma > 0)) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': must be > 0", doc->path, sg->line);
+            goto fail;
+        }
+    }
+
+    const size_t n = ser->n;
+    ds = phc_dataset_new(&soil_probe_ops, im->su->k);
+    if (!ds) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t q = 0; q < im->su->k; ++q)
+        if (!(ds->slot_names[q] = strdup(im->su->slot_names[q]))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+    ds->n = n;
+    ds->x = malloc(n * sizeof *ds->x);
+    ds->y = malloc(n * sizeof *ds->y);
+    ds->sigma = malloc(n * sizeof *ds->sigma);
+    ds->data_lines = malloc(n * sizeof *ds->data_lines);
+    ds->data_file = strdup(path);
+    im->probe_of = malloc(n * sizeof *im->probe_of);
+    im->t_unique = malloc(n * sizeof *im->t_unique);
+    im->t_at = malloc(n * sizeof *im->t_at);
+    if (!ds->x || !ds->y || !ds->sigma || !ds->data_lines || !ds->data_file || !im->probe_of || !im->t_unique ||
+        !im->t_at) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t r = 0; r < n; ++r) {
+        const phc_probe *pr = &im->probes->probes[ser->probe[r]];
+        double s = isnan(pr->sigma) ? sigma : pr->sigma;
+        if (isnan(s)) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil_probe data set: give `sigma:` or a sigma column in "
+                               "the probe table (probe '%s' has none)", doc->path, node->line, pr->id);
+            goto fail;
+        }
+        ds->x[r] = ser->t[r] - start;
+        ds->y[r] = ser->value[r];
+        ds->sigma[r] = s;
+        ds->data_lines[r] = ser->line[r];
+        im->probe_of[r] = ser->probe[r];
+        im->t_unique[r] = ds->x[r];
+    }
+    qsort(im->t_unique, n, sizeof *im->t_unique, by_value);
+    size_t m = 0;
+    for (size_t r = 0; r < n; ++r)
+        if (!m || im->t_unique[r] != im->t_unique[m - 1])
+            im->t_unique[m++] = im->t_unique[r];
+    im->m_unique = m;
+    for (size_t r = 0; r < n; ++r)
+        for (size_t i = 0; i < m; ++i)
+            if (im->t_unique[i] == ds->x[r]) {
+                im->t_at[r] = i;
+                break;
+            }
+    ds->x_label = strdup(x_label ? x_label : "time since start (h)");
+    ds->y_label = strdup(y_label ? y_label : im->fill ? "fill level w/c" : "water content w (m³/m³)");
+    if (!ds->x_label || !ds->y_label) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    ds->derivatives = PHC_DERIV_ANALYTIC;
+    ds->impl = im;
+    im = NULL;
+    phc_units_free(units);
+    phc_probe_series_free(ser);
+    free(path);
+    free(ppath);
+    *out = ds;
+    return PHC_OK;
+fail:
+    phc_units_free(units);
+    phc_probe_series_free(ser);
+    free(path);
+    free(ppath);
+    sp_free(im);
+    if (ds)
+        ds->impl = NULL;
+    phc_dataset_free(ds);
+    return rc;
+}

@@ -1,0 +1,1071 @@
+/* Soil water and nutrients (Rhizomorph §6): see soil.h. */
+#include "model/soil.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct phc_soil_work {
+    double *w_new, *v_new;     /* next state */
+    double *ic;                /* 1 / c */
+    double *kx, *ky, *kz;      /* face permeability (harmonic mean) to the +x, +y, +z
+                                  neighbour (wrapped); 0 across closed box faces */
+    double *sink_w, *sink_v;   /* sink hook buffers */
+    double *plane;             /* nz partial sums */
+    long *top;                 /* nx ny: highest permeable k of each column, -1 none */
+    double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
+    double damp_h;             /* h the damping factors were raised for */
+    double *src_w;             /* per source: normalised weights over its voxels */
+    size_t *src_idx, *src_first, src_total;
+    int nutrients;             /* 1 when nutrients move */
+};
+
+static size_t idx3(const phc_soil *s, size_t i, size_t j, size_t k)
+{
+    return i + s->nx * (j + s->ny * k);
+}
+
+phc_soil_params phc_soil_params_default(void)
+{
+    phc_soil_params p;
+    memset(&p, 0, sizeof p);
+    p.f_diff = 1.0;
+    p.f_grav = 1.0;
+    p.f_nutrient = 1.0;
+    for (int f = 0; f < PHC_SOIL_FACES; ++f)
+        p.boundary[f] = PHC_SOIL_BLOCK;
+    p.absorb_form = PHC_SOIL_ABSORB_CODE;
+    p.absorb_width = 5;
+    p.dt = 0.001; /* h: SoilParameters::m_deltaTime */
+    p.substep = 1;
+    p.safety = 0.9;
+    return p;
+}
+
+static void work_free(phc_soil_work *wk)
+{
+    if (!wk)
+        return;
+    free(wk->w_new);
+    free(wk->v_new);
+    free(wk->ic);
+    free(wk->kx);
+    free(wk->ky);
+    free(wk->kz);
+    free(wk->sink_w);
+    free(wk->sink_v);
+    free(wk->plane);
+    free(wk->top);
+    free(wk->damp_x);
+    free(wk->damp_y);
+    free(wk->damp_z);
+    free(wk->src_w);
+    free(wk->src_idx);
+    free(wk->src_first);
+    free(wk);
+}
+
+phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
+{
+    if (!nx || !ny || !nz || !(dx > 0) || !isfinite(dx) || nx > SIZE_MAX / ny / nz)
+        return NULL;
+    phc_soil *s = calloc(1, sizeof *s);
+    if (!s)
+        return NULL;
+    s->nx = nx;
+    s->ny = ny;
+    s->nz = nz;
+    s->n = nx * ny * nz;
+    s->dx = dx;
+    s->params = phc_soil_params_default();
+    size_t n = s->n;
+    s->w = calloc(n, sizeof *s->w);
+    s->v = calloc(n, sizeof *s->v);
+    s->c = malloc(n * sizeof *s->c);
+    s->p = calloc(n, sizeof *s->p);
+    s->d = malloc(n * sizeof *s->d);
+    s->work = calloc(1, sizeof *s->work);
+    phc_soil_work *wk = s->work;
+    if (!s->w || !s->v || !s->c || !s->p || !s->d || !wk) {
+        phc_soil_free(s);
+        return NULL;
+    }
+    wk->w_new = malloc(n * sizeof(double));
+    wk->v_new = malloc(n * sizeof(double));
+    wk->ic = malloc(n * sizeof(double));
+    wk->kx = malloc(n * sizeof(double));
+    wk->ky = malloc(n * sizeof(double));
+    wk->kz = malloc(n * sizeof(double));
+    wk->plane = malloc(nz * sizeof(double));
+    wk->top = malloc(nx * ny * sizeof(long));
+    wk->damp_x = malloc(nx * sizeof(double));
+    wk->damp_y = malloc(ny * sizeof(double));
+    wk->damp_z = malloc(nz * sizeof(double));
+    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane ||
+        !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
+        phc_soil_free(s);
+        return NULL;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        s->c[i] = 1.0;
+        s->d[i] = 1.0;
+    }
+    return s;
+}
+
+void phc_soil_free(phc_soil *s)
+{
+    if (!s)
+        return;
+    free(s->w);
+    free(s->v);
+    free(s->c);
+    free(s->p);
+    free(s->d);
+    free(s->rain);
+    free(s->sources);
+    work_free(s->work);
+    free(s);
+}
+
+/* ---- presets ----------------------------------------------------------- */
+
+/* Rhizomorph Fig. 7 (quoted in shared/data/README.md): capacity, permeability. */
+static const struct { const char *name; double c, p; } presets[] = {
+    {"clay", 10, 0.0015},           {"clay_loam", 5, 0.0015},  {"sandy_clay_loam", 75, 0.033},
+    {"sandy_loam", 150, 0.5},       {"silt_loam", 100, 0.5},   {"silt", 50, 0.033},
+};
+#define N_PRESETS (sizeof presets / sizeof presets[0])
+
+const char *phc_soil_preset_name(size_t i)
+{
+    return i < N_PRESETS ? presets[i].name : NULL;
+}
+
+int phc_soil_preset(const char *name, double *c, double *p)
+{
+    char key[64];
+    size_t m = 0;
+    for (; name && name[m] && m + 1 < sizeof key; ++m) {
+        char ch = (char)tolower((unsigned char)name[m]);
+        key[m] = (ch == ' ' || ch == '-') ? '_' : ch;
+    }
+    key[m] = '\0';
+    for (size_t i = 0; i < N_PRESETS; ++i)
+        if (!strcmp(key, presets[i].name)) {
+            *c = presets[i].c;
+            *p = presets[i].p;
+            return PHC_OK;
+        }
+    return PHC_ERR_INPUT;
+}
+
+/* ---- layers ------------------------------------------------------------ */
+
+void phc_soil_layer_of_planes(const phc_soil *s, const phc_soil_layer *layers, size_t n,
+                              size_t *layer_of_k)
+{
+    for (size_t k = 0; k < s->nz; ++k) {
+        double depth = ((double)(s->nz - 1 - k) + 0.5) * s->dx; /* centre below the top */
+        double bottom = 0;
+        size_t L = 0;
+        for (; L < n; ++L) {
+            if (layers[L].thickness <= 0 || L + 1 == n)
+                break;
+            bottom += layers[L].thickness;
+            if (depth < bottom)
+                break;
+        }
+        layer_of_k[k] = L < n ? L : n - 1;
+    }
+}
+
+int phc_soil_set_layers(phc_soil *s, const phc_soil_layer *layers, size_t n, phc_error *err)
+{
+    if (!n)
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: no layers given");
+    for (size_t L = 0; L < n; ++L) {
+        const phc_soil_layer *l = &layers[L];
+        if (!isfinite(l->thickness) || !isfinite(l->c) || !isfinite(l->p) || !isfinite(l->d) ||
+            !isfinite(l->water) || !isfinite(l->fill) || !isfinite(l->nutrient))
+            return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: a value is not finite", L + 1);
+        if (!(l->c > 0))
+            return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: capacity c must be > 0, found %g",
+                                 L + 1, l->c);
+        if (l->p < 0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "soil layer %zu: permeability p must be >= 0, found %g", L + 1, l->p);
+        if (l->d < 0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "soil layer %zu: growth resistance d must be >= 0, found %g", L + 1, l->d);
+        if ((l->fill < 0 && l->water < 0) || l->nutrient < 0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "soil layer %zu: initial water and nutrients must be >= 0", L + 1);
+        if (l->thickness <= 0 && L + 1 < n)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "soil layer %zu: only the last layer may have no thickness", L + 1);
+    }
+    size_t *of_k = malloc(s->nz * sizeof *of_k);
+    if (!of_k)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    phc_soil_layer_of_planes(s, layers, n, of_k);
+    size_t plane = s->nx * s->ny;
+    for (size_t k = 0; k < s->nz; ++k) {
+        const phc_soil_layer *l = &layers[of_k[k]];
+        double w0 = l->fill >= 0 ? l->fill * l->c : l->water;
+        for (size_t q = 0; q < plane; ++q) {
+            size_t i = q + plane * k;
+            s->c[i] = l->c;
+            s->p[i] = l->p;
+            s->d[i] = l->d;
+            s->w[i] = w0;
+            s->v[i] = l->nutrient;
+        }
+    }
+    free(of_k);
+    return PHC_OK;
+}
+
+/* ---- noise ------------------------------------------------------------- */
+
+static uint64_t splitmix64(uint64_t x)
+{
+    x += 0x9E3779B97F4A7C15ull;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+static double lattice(uint64_t seed, long ix, long iy, long iz)
+{
+    uint64_t h = splitmix64(seed);
+    h = splitmix64(h ^ (uint64_t)ix);
+    h = splitmix64(h ^ (uint64_t)iy);
+    h = splitmix64(h ^ (uint64_t)iz);
+    return (double)(h >> 11) * 0x1.0p-53;
+}
+
+double phc_soil_noise(uint64_t seed, double scale, double x, double y, double z)
+{
+    double fx = x / scale, fy = y / scale, fz = z / scale;
+    double x0 = floor(fx), y0 = floor(fy), z0 = floor(fz);
+    double tx = fx - x0, ty = fy - y0, tz = fz - z0;
+    long ix = (long)x0, iy = (long)y0, iz = (long)z0;
+    double r = 0;
+    for (int c = 0; c < 8; ++c) {
+        int a = c & 1, b = (c >> 1) & 1, e = (c >> 2) & 1;
+        double wgt = (a ? tx : 1 - tx) * (b ? ty : 1 - ty) * (e ? tz : 1 - tz);
+        r += wgt * lattice(seed, ix + a, iy + b, iz + e);
+    }
+    return r;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Marks the `fraction` of voxels with the highest noise: returns a threshold
+ * and fills vals (n) with the noise of every voxel centre. */
+static double noise_threshold(const phc_soil *s, uint64_t seed, double scale, double fraction,
+                              double *vals, double *sorted)
+{
+    for (size_t k = 0; k < s->nz; ++k)
+        for (size_t j = 0; j < s->ny; ++j)
+            for (size_t i = 0; i < s->nx; ++i)
+                vals[idx3(s, i, j, k)] = phc_soil_noise(seed, scale, (i + 0.5) * s->dx,
+                                                        (j + 0.5) * s->dx, (k + 0.5) * s->dx);
+    memcpy(sorted, vals, s->n * sizeof *vals);
+    qsort(sorted, s->n, sizeof *sorted, cmp_double);
+    size_t keep = (size_t)llround((1.0 - fraction) * (double)s->n);
+    return keep >= s->n ? INFINITY : sorted[keep];
+}
+
+static size_t noise_apply(phc_soil *s, uint64_t seed, double scale, double fraction, int rocks,
+                          double amount)
+{
+    if (!(fraction > 0) || !(scale > 0))
+        return 0;
+    double *vals = malloc(s->n * sizeof *vals), *sorted = malloc(s->n * sizeof *sorted);
+    size_t count = 0;
+    if (vals && sorted) {
+        double thr = noise_threshold(s, seed, scale, fraction > 1 ? 1 : fraction, vals, sorted);
+        for (size_t i = 0; i < s->n; ++i)
+            if (vals[i] >= thr) {
+                if (rocks)
+                    s->p[i] = 0;
+                else
+                    s->v[i] += amount;
+                ++count;
+            }
+    }
+    free(vals);
+    free(sorted);
+    return count;
+}
+
+size_t phc_soil_add_rocks(phc_soil *s, uint64_t seed, double scale, double fraction)
+{
+    return noise_apply(s, seed, scale, fraction, 1, 0);
+}
+
+size_t phc_soil_add_nutrient_pockets(phc_soil *s, uint64_t seed, double scale, double fraction,
+                                     double amount)
+{
+    return noise_apply(s, seed, scale, fraction, 0, amount);
+}
+
+/* ---- sources ----------------------------------------------------------- */
+
+int phc_soil_set_rain(phc_soil *s, const phc_soil_rain *rain, size_t n, phc_error *err)
+{
+    for (size_t r = 0; r < n; ++r)
+        if (!(rain[r].rate >= 0) || !(rain[r].end >= rain[r].start) || !(rain[r].nutrient >= 0) ||
+            !isfinite(rain[r].rate) || !isfinite(rain[r].start) || !isfinite(rain[r].end))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "rain %zu: needs rate >= 0, nutrient >= 0 and start <= end (found rate %g, "
+                                 "start %g h, end %g h)", r + 1, rain[r].rate, rain[r].start, rain[r].end);
+    phc_soil_rain *copy = n ? malloc(n * sizeof *copy) : NULL;
+    if (n && !copy)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (n)
+        memcpy(copy, rain, n * sizeof *copy);
+    free(s->rain);
+    s->rain = copy;
+    s->n_rain = n;
+    return PHC_OK;
+}
+
+int phc_soil_set_sources(phc_soil *s, const phc_soil_source *src, size_t n, phc_error *err)
+{
+    double ext[3] = {s->nx * s->dx, s->ny * s->dx, s->nz * s->dx};
+    for (size_t q = 0; q < n; ++q) {
+        const double pos[3] = {src[q].x, src[q].y, src[q].z};
+        for (int a = 0; a < 3; ++a)
+            if (!(pos[a] >= 0 && pos[a] < ext[a]))
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "source %zu: (%g, %g, %g) m is outside the soil box "
+                                     "[0, %g) x [0, %g) x [0, %g) m", q + 1, pos[0], pos[1], pos[2],
+                                     ext[0], ext[1], ext[2]);
+        if (!(src[q].radius >= 0) || !(src[q].end >= src[q].start) || !isfinite(src[q].water_rate) ||
+            !isfinite(src[q].nutrient_rate))
+            return phc_error_set(err, PHC_ERR_INPUT, "source %zu: needs radius >= 0, start <= end and "
+                                 "finite rates", q + 1);
+    }
+    phc_soil_source *copy = n ? malloc(n * sizeof *copy) : NULL;
+    if (n && !copy)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (n)
+        memcpy(copy, src, n * sizeof *copy);
+    free(s->sources);
+    s->sources = copy;
+    s->n_sources = n;
+    return PHC_OK;
+}
+
+/* Voxels and normalised weights of every source (Gaussian, sigma = radius/3,
+ * cut at the radius; the voxel holding the point when radius < dx/2). */
+static int prepare_sources(phc_soil *s)
+{
+    phc_soil_work *wk = s->work;
+    free(wk->src_w);
+    free(wk->src_idx);
+    free(wk->src_first);
+    wk->src_w = NULL;
+    wk->src_idx = NULL;
+    wk->src_first = calloc(s->n_sources + 1, sizeof *wk->src_first);
+    if (!wk->src_first)
+        return PHC_ERR_NOMEM;
+    size_t total = 0, cap = 0;
+    for (size_t q = 0; q < s->n_sources; ++q) {
+        const phc_soil_source *src = &s->sources[q];
+        double rad = src->radius < 0.5 * s->dx ? 0 : src->radius;
+        long c[3] = {(long)(src->x / s->dx), (long)(src->y / s->dx), (long)(src->z / s->dx)};
+        long r = (long)ceil(rad / s->dx);
+        long lo[3], hi[3], lim[3] = {(long)s->nx, (long)s->ny, (long)s->nz};
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = c[a] - r < 0 ? 0 : c[a] - r;
+            hi[a] = c[a] + r >= lim[a] ? lim[a] - 1 : c[a] + r;
+        }
+        size_t first = total;
+        double sum = 0, sig = rad / 3.0;
+        for (long k = lo[2]; k <= hi[2]; ++k)
+            for (long j = lo[1]; j <= hi[1]; ++j)
+                for (long i = lo[0]; i <= hi[0]; ++i) {
+                    double ddx = (i + 0.5) * s->dx - src->x, ddy = (j + 0.5) * s->dx - src->y,
+                           ddz = (k + 0.5) * s->dx - src->z;
+                    double r2 = ddx * ddx + ddy * ddy + ddz * ddz;
+                    double wgt = rad == 0 ? 1.0 : (r2 <= rad * rad ? exp(-r2 / (2 * sig * sig)) : 0);
+                    if (wgt <= 0)
+                        continue;
+                    if (total == cap) {
+                        cap = cap ? 2 * cap : 64;
+                        double *nw = realloc(wk->src_w, cap * sizeof *nw);
+                        if (!nw)
+                            return PHC_ERR_NOMEM;
+                        wk->src_w = nw;
+                        size_t *ni = realloc(wk->src_idx, cap * sizeof *ni);
+                        if (!ni)
+                            return PHC_ERR_NOMEM;
+                        wk->src_idx = ni;
+                    }
+                    wk->src_w[total] = wgt;
+                    wk->src_idx[total] = idx3(s, (size_t)i, (size_t)j, (size_t)k);
+                    sum += wgt;
+                    ++total;
+                }
+        for (size_t e = first; e < total; ++e)
+            wk->src_w[e] /= sum;
+        wk->src_first[q + 1] = total;
+    }
+    wk->src_total = total;
+    return PHC_OK;
+}
+
+/* Length of the overlap of [a, b) with [c, d). */
+static double overlap(double a, double b, double c, double d)
+{
+    double lo = a > c ? a : c, hi = b < d ? b : d;
+    return hi > lo ? hi - lo : 0;
+}
+
+/* ---- checks and set-up ------------------------------------------------- */
+
+static int check_impl(const phc_soil *s, int strict, phc_error *err)
+{
+    const phc_soil_params *pr = &s->params;
+    if (!(pr->f_diff >= 0) || !isfinite(pr->f_diff))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: f_diff must be finite and >= 0, found %g", pr->f_diff);
+    if (!(pr->f_grav >= 0) || !isfinite(pr->f_grav))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: f_grav must be finite and >= 0, found %g", pr->f_grav);
+    if (!(pr->f_nutrient >= 0) || !isfinite(pr->f_nutrient))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: f_nutrient must be finite and >= 0, found %g",
+                             pr->f_nutrient);
+    if (!(pr->dt > 0) || !isfinite(pr->dt))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: the time step dt must be > 0, found %g h", pr->dt);
+    if (!(pr->safety > 0 && pr->safety <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: safety must be in (0, 1], found %g", pr->safety);
+    size_t dims[3] = {s->nx, s->ny, s->nz};
+    static const char *axis = "xyz";
+    for (int f = 0; f < PHC_SOIL_FACES; ++f)
+        if (pr->boundary[f] == PHC_SOIL_ABSORB &&
+            (pr->absorb_width < 1 || (size_t)pr->absorb_width > dims[f / 2]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "soil: absorbing width %d does not fit the %zu voxels along %c",
+                                 pr->absorb_width, dims[f / 2], axis[f / 2]);
+    for (int a = 0; a < 3; ++a)
+        if ((pr->boundary[2 * a] == PHC_SOIL_PERIODIC) != (pr->boundary[2 * a + 1] == PHC_SOIL_PERIODIC))
+            return phc_error_set(err, PHC_ERR_INPUT, "soil: periodic boundaries come in pairs: both %c faces "
+                                 "or neither", axis[a]);
+    for (size_t k = 0; k < s->nz; ++k)
+        for (size_t j = 0; j < s->ny; ++j)
+            for (size_t i = 0; i < s->nx; ++i) {
+                size_t q = idx3(s, i, j, k);
+                const char *what = NULL;
+                double val = 0;
+                if (!(s->c[q] > 0) || !isfinite(s->c[q]))
+                    what = "capacity c must be finite and > 0", val = s->c[q];
+                else if (!(s->p[q] >= 0) || !isfinite(s->p[q]))
+                    what = "permeability p must be finite and >= 0", val = s->p[q];
+                else if (!isfinite(s->w[q]) || (strict && !(s->w[q] >= 0)))
+                    what = "water w must be finite and >= 0", val = s->w[q];
+                else if (!isfinite(s->v[q]) || (strict && !(s->v[q] >= 0)))
+                    what = "nutrients v must be finite and >= 0", val = s->v[q];
+                if (what)
+                    return phc_error_set(err, PHC_ERR_INPUT, "soil voxel (%zu, %zu, %zu): %s, found %g", i, j,
+                                         k, what, val);
+            }
+    return PHC_OK;
+}
+
+int phc_soil_check(const phc_soil *s, phc_error *err)
+{
+    return check_impl(s, 1, err);
+}
+
+static double harmonic(double a, double b)
+{
+    return (a > 0 && b > 0) ? 2 * a * b / (a + b) : 0;
+}
+
+/* 1/c, face permeabilities, surface voxels of every column. */
+static void prepare_fields(phc_soil *s)
+{
+    phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
+    const phc_soil_boundary *b = s->params.boundary;
+    int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
+                  b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; ++k)
+        for (size_t j = 0; j < ny; ++j)
+            for (size_t i = 0; i < nx; ++i) {
+                size_t q = idx3(s, i, j, k);
+                wk->ic[q] = 1.0 / s->c[q];
+                size_t qx = i + 1 < nx ? q + 1 : q + 1 - nx;
+                size_t qy = j + 1 < ny ? q + nx : q + nx - plane;
+                size_t qz = k + 1 < nz ? q + plane : q + plane - s->n;
+                wk->kx[q] = (i + 1 < nx || per[0]) ? harmonic(s->p[q], s->p[qx]) : 0;
+                wk->ky[q] = (j + 1 < ny || per[1]) ? harmonic(s->p[q], s->p[qy]) : 0;
+                wk->kz[q] = (k + 1 < nz || per[2]) ? harmonic(s->p[q], s->p[qz]) : 0;
+            }
+    for (size_t q = 0; q < plane; ++q) {
+        long top = -1;
+        for (long k = (long)nz - 1; k >= 0; --k)
+            if (s->p[q + plane * (size_t)k] > 0) {
+                top = k;
+                break;
+            }
+        wk->top[q] = top;
+    }
+    int nut = 0;
+    for (size_t r = 0; r < s->n_rain; ++r)
+        nut |= s->rain[r].nutrient > 0;
+    for (size_t q = 0; q < s->n_sources; ++q)
+        nut |= s->sources[q].nutrient_rate != 0;
+    for (size_t q = 0; q < s->n && !nut; ++q)
+        nut |= s->v[q] > 0;
+    wk->nutrients = nut;
+    wk->damp_h = -1;
+}
+
+double phc_soil_stable_dt(const phc_soil *s, size_t *voxel)
+{
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
+    const phc_soil_boundary *b = s->params.boundary;
+    int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
+                  b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
+    double best = INFINITY, dx2 = s->dx * s->dx;
+    size_t at = 0;
+    for (size_t k = 0; k < nz; ++k)
+        for (size_t j = 0; j < ny; ++j)
+            for (size_t i = 0; i < nx; ++i) {
+                size_t q = idx3(s, i, j, k);
+                double pq = s->p[q];
+                if (!(pq > 0))
+                    continue;
+                double sum = 0;
+                if (i + 1 < nx || per[0]) sum += harmonic(pq, s->p[i + 1 < nx ? q + 1 : q + 1 - nx]);
+                if (i > 0 || per[0]) sum += harmonic(pq, s->p[i > 0 ? q - 1 : q + nx - 1]);
+                if (j + 1 < ny || per[1]) sum += harmonic(pq, s->p[j + 1 < ny ? q + nx : q + nx - plane]);
+                if (j > 0 || per[1]) sum += harmonic(pq, s->p[j > 0 ? q - nx : q + plane - nx]);
+                if (k + 1 < nz || per[2]) sum += harmonic(pq, s->p[k + 1 < nz ? q + plane : q + plane - s->n]);
+                if (k > 0 || per[2]) sum += harmonic(pq, s->p[k > 0 ? q - plane : q + s->n - plane]);
+                /* a h^2 + b h = 1 */
+                double bb = s->params.f_diff * sum / (s->c[q] * dx2);
+                double g = s->params.f_grav * pq / s->dx, a = g * g;
+                double h = (a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY;
+                if (h < best) {
+                    best = h;
+                    at = q;
+                }
+            }
+    if (voxel)
+        *voxel = at;
+    return best;
+}
+
+/* ---- the step ------------------------------------------------------------ */
+
+/* The Lax-Wendroff face concentration of nutrients for water face flux F
+ * (from voxel a to voxel b, m/h). */
+static double nutrient_face_flux(double F, double wa, double wb, double va, double vb, double h,
+                                 double dx)
+{
+    if (F == 0)
+        return 0;
+    double ua = wa > 0 ? va / wa : 0, ub = wb > 0 ? vb / wb : 0;
+    double wm = 0.5 * (wa + wb);
+    double nu = wm > 0 ? F * h / (dx * wm) : 0;
+    return F * (0.5 * (ua + ub) - 0.5 * nu * (ub - ua));
+}
+
+/* Transport over one sub-step h: w_new (and v_new) from w (and v). */
+static void transport(phc_soil *s, double h)
+{
+    phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
+    const double *w = s->w, *v = s->v, *ic = wk->ic, *p = s->p;
+    const double *kx = wk->kx, *ky = wk->ky, *kz = wk->kz;
+    double *wn = wk->w_new, *vn = wk->v_new;
+    const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
+    const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
+    const double fn = s->params.f_nutrient;
+    const int nut = wk->nutrients;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
+        for (size_t j = 0; j < ny; ++j) {
+            const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+            const size_t row = nx * (j + ny * k);
+            for (size_t i = 0; i < nx; ++i) {
+                const size_t q = row + i;
+                const size_t qe = i + 1 < nx ? q + 1 : q + 1 - nx, qw = i > 0 ? q - 1 : q + nx - 1;
+                const size_t qn = q + jn, qs = q - js, qu = q + kup, qd = q - kdn;
+                const double l0 = w[q] * ic[q];
+                const double fe = kx[q] * (w[qe] * ic[qe] - l0), fw = kx[qw] * (w[qw] * ic[qw] - l0);
+                const double fnn = ky[q] * (w[qn] * ic[qn] - l0), fs = ky[qs] * (w[qs] * ic[qs] - l0);
+                const double fu = kz[q] * (w[qu] * ic[qu] - l0), fdn = kz[qd] * (w[qd] * ic[qd] - l0);
+                /* gravity: downward flux through the top face (from qu) and the bottom face (to qd) */
+                const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
+                const double gt = kz[q] > 0 ? 0.5 * (qU + q0) - lw * kz[q] * (q0 - qU) : 0;
+                const double gb = kz[qd] > 0 ? 0.5 * (q0 + qD) - lw * kz[qd] * (qD - q0) : 0;
+                wn[q] = w[q] + cd * (fe + fw + fnn + fs + fu + fdn) + cg * (gt - gb);
+                if (nut) {
+                    /* the water face fluxes out of q (m/h), then nutrients ride on them */
+                    const double dd = fd / dx;
+                    double acc = 0;
+                    acc -= nutrient_face_flux(-dd * fe, w[q], w[qe], v[q], v[qe], h, dx);
+                    acc -= nutrient_face_flux(-dd * fw, w[q], w[qw], v[q], v[qw], h, dx);
+                    acc -= nutrient_face_flux(-dd * fnn, w[q], w[qn], v[q], v[qn], h, dx);
+                    acc -= nutrient_face_flux(-dd * fs, w[q], w[qs], v[q], v[qs], h, dx);
+                    acc -= nutrient_face_flux(-dd * fu - gt, w[q], w[qu], v[q], v[qu], h, dx);
+                    acc -= nutrient_face_flux(-dd * fdn + gb, w[q], w[qd], v[q], v[qd], h, dx);
+                    vn[q] = v[q] + fn * cg * acc;
+                }
+            }
+        }
+    }
+    if (!nut)
+        memcpy(vn, v, n * sizeof *vn);
+}
+
+/* Rain, point sources and the sink hook on w_new / v_new; budget terms. */
+static int sources_and_sinks(phc_soil *s, double t, double h, phc_soil_budget *bud)
+{
+    phc_soil_work *wk = s->work;
+    const double vol = s->dx * s->dx * s->dx;
+    double *wn = wk->w_new, *vn = wk->v_new;
+    for (size_t r = 0; r < s->n_rain; ++r) {
+        const phc_soil_rain *rn = &s->rain[r];
+        double len = overlap(t, t + h, rn->start, rn->end);
+        if (len <= 0 || rn->rate <= 0)
+            continue;
+        double dw = rn->rate * len / s->dx; /* m^3/m^3 added to the surface voxel */
+        int whole = !(rn->x1 > rn->x0 && rn->y1 > rn->y0);
+        for (size_t j = 0; j < s->ny; ++j)
+            for (size_t i = 0; i < s->nx; ++i) {
+                double xc = (i + 0.5) * s->dx, yc = (j + 0.5) * s->dx;
+                if (!whole && !(xc >= rn->x0 && xc < rn->x1 && yc >= rn->y0 && yc < rn->y1))
+                    continue;
+                long k = wk->top[i + s->nx * j];
+                if (k < 0)
+                    continue;
+                size_t q = idx3(s, i, j, (size_t)k);
+                wn[q] += dw;
+                vn[q] += dw * rn->nutrient;
+                bud->water_in += dw * vol;
+                bud->nutrient_in += dw * rn->nutrient * vol;
+            }
+    }
+    for (size_t q = 0; q < s->n_sources; ++q) {
+        const phc_soil_source *src = &s->sources[q];
+        double len = overlap(t, t + h, src->start, src->end);
+        if (len <= 0)
+            continue;
+        for (size_t e = wk->src_first[q]; e < wk->src_first[q + 1]; ++e) {
+            size_t i = wk->src_idx[e];
+            double dw = src->water_rate * len * wk->src_w[e] / vol;
+            double dv = src->nutrient_rate * len * wk->src_w[e] / vol;
+            if (dw >= 0)
+                bud->water_in += dw * vol;
+            else {
+                dw = -dw > wn[i] ? -wn[i] : dw;
+                bud->water_sunk -= dw * vol;
+            }
+            if (dv >= 0)
+                bud->nutrient_in += dv * vol;
+            else {
+                dv = -dv > vn[i] ? -vn[i] : dv;
+                bud->nutrient_sunk -= dv * vol;
+            }
+            wn[i] += dw;
+            vn[i] += dv;
+        }
+    }
+    if (s->sink) {
+        if (!wk->sink_w) {
+            wk->sink_w = malloc(s->n * sizeof(double));
+            wk->sink_v = malloc(s->n * sizeof(double));
+            if (!wk->sink_w || !wk->sink_v)
+                return PHC_ERR_NOMEM;
+        }
+        memset(wk->sink_w, 0, s->n * sizeof(double));
+        memset(wk->sink_v, 0, s->n * sizeof(double));
+        if (s->sink(s->sink_user, t, h, wn, vn, wk->sink_w, wk->sink_v) != 0)
+            return PHC_ERR_DOMAIN;
+        double sw = 0, sv = 0;
+        for (size_t i = 0; i < s->n; ++i) {
+            double a = wk->sink_w[i] > 0 ? (wk->sink_w[i] < wn[i] ? wk->sink_w[i] : wn[i]) : 0;
+            double b = wk->sink_v[i] > 0 ? (wk->sink_v[i] < vn[i] ? wk->sink_v[i] : vn[i]) : 0;
+            wn[i] -= a;
+            vn[i] -= b;
+            sw += a;
+            sv += b;
+        }
+        bud->water_sunk += sw * vol;
+        bud->nutrient_sunk += sv * vol;
+    }
+    return PHC_OK;
+}
+
+/* Absorbing factor of the voxel `i` layers in from an absorbing face. */
+static double absorb_factor(phc_soil_absorb_form form, int width, int i)
+{
+    double x = form == PHC_SOIL_ABSORB_CODE ? (double)i * i : (double)i;
+    return 1.0 - exp(-x / (0.2 * width * width));
+}
+
+/* Per-axis damping factors a^(h/dt), products of the two faces' factors. */
+static void prepare_damping(phc_soil *s, double h)
+{
+    phc_soil_work *wk = s->work;
+    if (wk->damp_h == h)
+        return;
+    wk->damp_h = h;
+    size_t dims[3] = {s->nx, s->ny, s->nz};
+    double *out[3] = {wk->damp_x, wk->damp_y, wk->damp_z};
+    int W = s->params.absorb_width;
+    double e = h / s->params.dt;
+    for (int a = 0; a < 3; ++a)
+        for (size_t i = 0; i < dims[a]; ++i) {
+            double f = 1.0;
+            if (s->params.boundary[2 * a] == PHC_SOIL_ABSORB && i < (size_t)W)
+                f *= pow(absorb_factor(s->params.absorb_form, W, (int)i), e);
+            size_t from_max = dims[a] - 1 - i;
+            if (s->params.boundary[2 * a + 1] == PHC_SOIL_ABSORB && from_max < (size_t)W)
+                f *= pow(absorb_factor(s->params.absorb_form, W, (int)from_max), e);
+            out[a][i] = f;
+        }
+}
+
+static int any_absorb(const phc_soil *s)
+{
+    for (int f = 0; f < PHC_SOIL_FACES; ++f)
+        if (s->params.boundary[f] == PHC_SOIL_ABSORB)
+            return 1;
+    return 0;
+}
+
+/* Damps the field f in the absorbing layers; returns the amount removed
+ * (sum over voxels, per-plane partials in a fixed order).  With g (or NULL)
+ * a second field is damped the same way (no sum). */
+static double damp(phc_soil *s, double *f, double *g)
+{
+    phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; ++k) {
+        double part = 0, fz = wk->damp_z[k];
+        for (size_t j = 0; j < ny; ++j) {
+            double fyz = fz * wk->damp_y[j];
+            for (size_t i = 0; i < nx; ++i) {
+                double fac = fyz * wk->damp_x[i];
+                if (fac == 1.0)
+                    continue;
+                size_t q = i + nx * (j + ny * k);
+                part += (1.0 - fac) * f[q];
+                f[q] *= fac;
+                if (g)
+                    g[q] *= fac;
+            }
+        }
+        wk->plane[k] = part;
+    }
+    double sum = 0;
+    for (size_t k = 0; k < nz; ++k)
+        sum += wk->plane[k];
+    return sum;
+}
+
+static double field_total(const phc_soil *s, const double *f)
+{
+    phc_soil_work *wk = s->work;
+    const size_t plane = s->nx * s->ny;
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < s->nz; ++k) {
+        double part = 0;
+        for (size_t q = 0; q < plane; ++q)
+            part += f[q + plane * k];
+        wk->plane[k] = part;
+    }
+    double sum = 0;
+    for (size_t k = 0; k < s->nz; ++k)
+        sum += wk->plane[k];
+    return sum * s->dx * s->dx * s->dx;
+}
+
+double phc_soil_water_total(const phc_soil *s)
+{
+    return field_total(s, s->w);
+}
+
+double phc_soil_nutrient_total(const phc_soil *s)
+{
+    return field_total(s, s->v);
+}
+
+void phc_soil_budget_reset(phc_soil *s)
+{
+    memset(&s->budget, 0, sizeof s->budget);
+    s->budget.water_initial = s->budget.water_stored = phc_soil_water_total(s);
+    s->budget.nutrient_initial = s->budget.nutrient_stored = phc_soil_nutrient_total(s);
+}
+
+/* ---- the tangent ----------------------------------------------------------- */
+
+/* d harmonic(a, b) in the direction (da, db). */
+static double harmonic_dir(double a, double b, double da, double db)
+{
+    if (!(a > 0 && b > 0))
+        return 0;
+    double sab = a + b;
+    return 2 * (b * b * da + a * a * db) / (sab * sab);
+}
+
+/* One tangent sub-step for parameter q: sw_new = sw + h (L sw + dL w),
+ * written to out.  Uses the state w before the step. */
+static void tangent_step(phc_soil *s, double h, const phc_soil_tangent *tan, size_t m, double *out)
+{
+    phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
+    const double *w = s->w, *ic = wk->ic, *p = s->p, *kz = wk->kz, *kx = wk->kx, *ky = wk->ky;
+    const double *sw = tan->sw[m];
+    const double *dp = tan->dp ? tan->dp[m] : NULL, *dic = tan->dinv_c ? tan->dinv_c[m] : NULL;
+    const double dfd = tan->dfd ? tan->dfd[m] : 0, dfg = tan->dfg ? tan->dfg[m] : 0;
+    const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
+    const double cd = h / (dx * dx), cg = h / dx, lw = h / (2 * dx);
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
+        for (size_t j = 0; j < ny; ++j) {
+            const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+            for (size_t i = 0; i < nx; ++i) {
+                const size_t q = i + nx * (j + ny * k);
+                const size_t nb[6] = {i + 1 < nx ? q + 1 : q + 1 - nx, i > 0 ? q - 1 : q + nx - 1,
+                                      q + jn, q - js, q + kup, q - kdn};
+                const double kf[6] = {kx[q], kx[nb[1]], ky[q], ky[nb[3]], kz[q], kz[nb[5]]};
+                const double l0 = w[q] * ic[q], ls0 = sw[q] * ic[q];
+                const double dl0 = dic ? w[q] * dic[q] : 0;
+                double diff = 0;
+                for (int f = 0; f < 6; ++f) {
+                    size_t r = nb[f];
+                    if (kf[f] == 0)
+                        continue;
+                    double dk = dp ? harmonic_dir(p[q], p[r], dp[q], dp[r]) : 0;
+                    double lr = w[r] * ic[r], dlr = dic ? w[r] * dic[r] : 0;
+                    diff += fd * kf[f] * (sw[r] * ic[r] - ls0)               /* L sw */
+                          + dfd * kf[f] * (lr - l0) + fd * dk * (lr - l0)    /* dL w */
+                          + fd * kf[f] * (dlr - dl0);
+                }
+                /* gravity faces: top (from nb[4] down into q), bottom (q down to nb[5]) */
+                double grav = 0;
+                for (int f = 0; f < 2; ++f) {
+                    size_t up = f == 0 ? nb[4] : q, lo = f == 0 ? q : nb[5];
+                    double k_f = f == 0 ? kz[q] : kz[nb[5]];
+                    if (!(k_f > 0))
+                        continue;
+                    double dk = dp ? harmonic_dir(p[up], p[lo], dp[up], dp[lo]) : 0;
+                    double qu = a * p[up] * w[up], ql = a * p[lo] * w[lo];
+                    double squ = a * p[up] * sw[up], sql = a * p[lo] * sw[lo];
+                    double dqu = dfg * p[up] * w[up] + (dp ? a * dp[up] * w[up] : 0);
+                    double dql = dfg * p[lo] * w[lo] + (dp ? a * dp[lo] * w[lo] : 0);
+                    double G = 0.5 * (squ + sql) - lw * a * k_f * (sql - squ) + 0.5 * (dqu + dql) -
+                               lw * ((dfg * k_f + a * dk) * (ql - qu) + a * k_f * (dql - dqu));
+                    grav += f == 0 ? G : -G;
+                }
+                out[q] = sw[q] + cd * diff + cg * grav;
+            }
+        }
+    }
+}
+
+/* ---- running --------------------------------------------------------------- */
+
+static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_error *err)
+{
+    int rc;
+    /* Lax-Wendroff may leave round-off undershoots below 0 between runs:
+       the sign is checked on input (phc_soil_check), not here */
+    if ((rc = check_impl(s, 0, err)))
+        return rc;
+    if (!(t_end >= s->t) || !isfinite(t_end))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: cannot run from t = %g h back to %g h", s->t, t_end);
+    prepare_fields(s);
+    if (prepare_sources(s))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    double **tmp = NULL;
+    size_t swaps = 0; /* sub-steps done: tan->sw[m] and tmp[m] trade places on each */
+    if (tan && tan->m) {
+        tmp = calloc(tan->m, sizeof *tmp);
+        if (!tmp)
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t m = 0; m < tan->m; ++m)
+            if (!(tmp[m] = malloc(s->n * sizeof(double)))) {
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                goto done;
+            }
+    }
+    size_t at = 0;
+    const double limit = phc_soil_stable_dt(s, &at), dt = s->params.dt;
+    const double eps = 1e-12 * (fabs(t_end) > 1 ? fabs(t_end) : 1);
+    const int absorb = any_absorb(s);
+    phc_soil_work *wk = s->work;
+    while (t_end - s->t > eps) {
+        double h = t_end - s->t < dt ? t_end - s->t : dt;
+        size_t nsub = 1;
+        if (h > limit) {
+            if (!s->params.substep) {
+                size_t i = at % s->nx, j = (at / s->nx) % s->ny, k = at / (s->nx * s->ny);
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "soil: the time step dt = %g h exceeds the stability limit %g h set by voxel "
+                                   "(%zu, %zu, %zu) (p = %g m/h, c = %g); lower dt or allow sub-stepping",
+                                   h, limit, i, j, k, s->p[at], s->c[at]);
+                goto done;
+            }
+            nsub = (size_t)ceil(h / (s->params.safety * limit));
+        }
+        double hs = h / (double)nsub;
+        if (absorb)
+            prepare_damping(s, hs);
+        for (size_t sub = 0; sub < nsub; ++sub) {
+            double t0 = s->t;
+            if (tan)
+                for (size_t m = 0; m < tan->m; ++m)
+                    tangent_step(s, hs, tan, m, tmp[m]);
+            transport(s, hs);
+            if ((rc = sources_and_sinks(s, t0, hs, &s->budget))) {
+                rc = phc_error_set(err, rc, rc == PHC_ERR_NOMEM ? "out of memory"
+                                                                : "soil: the sink hook stopped the run at t = %g h",
+                                   t0);
+                goto done;
+            }
+            if (absorb) {
+                double vol = s->dx * s->dx * s->dx;
+                s->budget.water_absorbed += damp(s, wk->w_new, NULL) * vol;
+                s->budget.nutrient_absorbed += damp(s, wk->v_new, NULL) * vol;
+                if (tan)
+                    for (size_t m = 0; m < tan->m; ++m)
+                        damp(s, tmp[m], NULL);
+            }
+            double *swap = s->w;
+            s->w = wk->w_new;
+            wk->w_new = swap;
+            swap = s->v;
+            s->v = wk->v_new;
+            wk->v_new = swap;
+            if (tan)
+                for (size_t m = 0; m < tan->m; ++m) {
+                    swap = tan->sw[m];
+                    tan->sw[m] = tmp[m];
+                    tmp[m] = swap;
+                }
+            ++swaps;
+            s->t = t0 + hs;
+        }
+        s->budget.steps++;
+        s->budget.substeps += nsub;
+    }
+    s->t = t_end;
+    s->budget.water_stored = phc_soil_water_total(s);
+    s->budget.nutrient_stored = phc_soil_nutrient_total(s);
+    s->budget.water_closing = s->budget.water_stored - s->budget.water_initial - s->budget.water_in +
+                              s->budget.water_absorbed + s->budget.water_sunk;
+    s->budget.nutrient_closing = s->budget.nutrient_stored - s->budget.nutrient_initial -
+                                 s->budget.nutrient_in + s->budget.nutrient_absorbed + s->budget.nutrient_sunk;
+    if (!isfinite(s->budget.water_stored) || !isfinite(s->budget.nutrient_stored))
+        rc = phc_error_set(err, PHC_ERR_DOMAIN, "soil: the state is no longer finite at t = %g h", s->t);
+done:
+    if (tmp) {
+        for (size_t m = 0; m < tan->m; ++m) {
+            if (swaps % 2) {
+                /* tmp[m] is the caller's buffer: give it back holding the result */
+                memcpy(tmp[m], tan->sw[m], s->n * sizeof(double));
+                double *swap = tan->sw[m];
+                tan->sw[m] = tmp[m];
+                tmp[m] = swap;
+            }
+            free(tmp[m]);
+        }
+        free(tmp);
+    }
+    return rc;
+}
+
+int phc_soil_run(phc_soil *s, double t_end, phc_error *err)
+{
+    return run_impl(s, t_end, NULL, err);
+}
+
+int phc_soil_run_tangent(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_error *err)
+{
+    return run_impl(s, t_end, tan, err);
+}
+
+/* ---- observations ------------------------------------------------------------ */
+
+int phc_soil_sample(const phc_soil *s, const double *f, double x, double y, double z, double *value,
+                    double wts[8], size_t idx[8])
+{
+    double pos[3] = {x, y, z};
+    size_t dims[3] = {s->nx, s->ny, s->nz}, lo[3], hi[3];
+    double t[3];
+    for (int a = 0; a < 3; ++a) {
+        double ext = dims[a] * s->dx;
+        if (!(pos[a] >= 0 && pos[a] <= ext))
+            return PHC_ERR_DOMAIN;
+        double fi = pos[a] / s->dx - 0.5;
+        if (fi < 0)
+            fi = 0;
+        if (fi > (double)(dims[a] - 1))
+            fi = (double)(dims[a] - 1);
+        lo[a] = (size_t)floor(fi);
+        hi[a] = lo[a] + 1 < dims[a] ? lo[a] + 1 : lo[a];
+        t[a] = fi - (double)lo[a];
+    }
+    double val = 0;
+    for (int c = 0; c < 8; ++c) {
+        int bx = c & 1, by = (c >> 1) & 1, bz = (c >> 2) & 1;
+        double wgt = (bx ? t[0] : 1 - t[0]) * (by ? t[1] : 1 - t[1]) * (bz ? t[2] : 1 - t[2]);
+        size_t q = idx3(s, bx ? hi[0] : lo[0], by ? hi[1] : lo[1], bz ? hi[2] : lo[2]);
+        val += wgt * f[q];
+        if (wts)
+            wts[c] = wgt;
+        if (idx)
+            idx[c] = q;
+    }
+    *value = val;
+    return PHC_OK;
+}
+
+double phc_soil_infiltration_depth(const phc_soil *s, const double *w_ref, double frac, double total,
+                                   const double *ds, double *dd)
+{
+    const size_t plane = s->nx * s->ny;
+    const double vol = s->dx * s->dx * s->dx, target = frac * total;
+    double cum = 0, dcum = 0;
+    if (dd)
+        *dd = 0;
+    for (size_t m = 0; m < s->nz; ++m) {
+        size_t k = s->nz - 1 - m;
+        double e = 0, de = 0;
+        for (size_t q = 0; q < plane; ++q) {
+            e += s->w[q + plane * k] - (w_ref ? w_ref[q + plane * k] : 0);
+            if (ds)
+                de += ds[q + plane * k];
+        }
+        e *= vol;
+        de *= vol;
+        if (e > 0 && cum + e >= target) {
+            double rem = target - cum;
+            if (dd && ds)
+                *dd = s->dx * (-dcum * e - rem * de) / (e * e);
+            return s->dx * ((double)m + rem / e);
+        }
+        cum += e;
+        dcum += de;
+    }
+    return NAN;
+}
