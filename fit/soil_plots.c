@@ -348,7 +348,9 @@ int phc_plot_soil_slice(const char *path, const char *title,
     plimagefr((PLFLT_MATRIX)img, (PLINT)nh, (PLINT)nz, 0.0, width, 0.0,
               depth, vmin, vmax, vmin, vmax, NULL, NULL);
 
-    double xstep = nice_step(width, 6.0), ystep = nice_step(depth, 6.0);
+    /* about one x tick label per 0.1 of the page, so narrow slices stay readable */
+    double xticks = 10.0 * (vx1 - vx0) < 2.0 ? 2.0 : 10.0 * (vx1 - vx0) > 6.0 ? 6.0 : 10.0 * (vx1 - vx0);
+    double xstep = nice_step(width, xticks), ystep = nice_step(depth, 6.0);
     plcol0(COL_FG);
     plwidth(1.2);
     plbox("bcnst", xstep, 0, "bcnstv", ystep, 0);
@@ -370,7 +372,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
         PLFLT cb_w, cb_h;
         PLINT label_opts[1] = {PL_COLORBAR_LABEL_RIGHT};
         const char *labels[1] = {t_bar};
-        const char *axis_opts[1] = {"bcvmti"};
+        const char *axis_opts[1] = {"bcvmtif"}; /* f: fixed-point labels, no separate exponent */
         PLFLT ticks[1] = {0.0};
         PLINT sub_ticks[1] = {0};
         PLINT n_values[1] = {2};

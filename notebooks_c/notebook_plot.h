@@ -25,6 +25,7 @@ enum {
 };
 #define NB_MAX_SERIES 16
 #define NB_CHR 0.85 /* character height scale */
+#define NB_LOGX 2   /* flag in nb_panel.logy: log10 x axis (non-positive x skipped) */
 
 typedef struct nb_series {
     const double *x, *y;  /* n points; non-finite (or <= 0 on a log axis) skipped */
@@ -38,7 +39,7 @@ typedef struct nb_series {
 
 typedef struct nb_panel {
     const char *title, *xlab, *ylab;
-    int logy;             /* 1: log10 y axis */
+    int logy;             /* 1: log10 y axis; | NB_LOGX: log10 x axis as well (NB_LOGX alone: x only) */
     double ymin, ymax;    /* both 0: automatic */
     int legend;           /* 0 none, 1 top right, 2 top left, 3 bottom right, 4 bottom left,
                              5 right middle, 6 left middle */
@@ -64,11 +65,14 @@ static void nb_log_label(PLINT axis, PLFLT value, char *label, PLINT length, PLP
     (void)data;
     if (axis == PL_Y_AXIS)
         snprintf(label, (size_t)length, "10#u%d#d", (int)lround(value));
-    else
-        snprintf(label, (size_t)length, "%g", value);
+    else /* only called for a log x axis (NB_LOGX): the decade's value */
+        snprintf(label, (size_t)length, "%g", pow(10.0, value));
 }
 
 static int nb_ok(double v, int logy) { return isfinite(v) && (!logy || v > 0.0); }
+static int nb_logx(const nb_panel *p) { return (p->logy & NB_LOGX) != 0; }
+static int nb_logy(const nb_panel *p) { return (p->logy & 1) != 0; }
+static double nb_tx(const nb_panel *p, double x) { return nb_logx(p) ? log10(x) : x; }
 
 static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0, double vy1)
 {
@@ -76,18 +80,21 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
     for (size_t k = 0; k < p->ns; ++k)
         for (size_t i = 0; i < p->s[k].n; ++i) {
             double x = p->s[k].x[i], y = p->s[k].y[i];
-            if (!isfinite(x) || !nb_ok(y, p->logy))
+            if (!nb_ok(x, nb_logx(p)) || !nb_ok(y, nb_logy(p)))
                 continue;
-            y = p->logy ? log10(y) : y;
+            x = nb_tx(p, x);
+            y = nb_logy(p) ? log10(y) : y;
             xmin = fmin(xmin, x), xmax = fmax(xmax, x);
             ymin = fmin(ymin, y), ymax = fmax(ymax, y);
         }
     if (!(xmin < xmax))
         xmin -= 1.0, xmax += 1.0;
+    if (nb_logx(p))
+        xmin = floor(xmin), xmax = ceil(xmax);
     if (p->ymin != 0.0 || p->ymax != 0.0) {
-        ymin = p->logy ? log10(p->ymin) : p->ymin;
-        ymax = p->logy ? log10(p->ymax) : p->ymax;
-    } else if (p->logy) {
+        ymin = nb_logy(p) ? log10(p->ymin) : p->ymin;
+        ymax = nb_logy(p) ? log10(p->ymax) : p->ymax;
+    } else if (nb_logy(p)) {
         ymin = floor(ymin), ymax = ceil(ymax);
         if (ymin == ymax)
             ymin -= 1.0;
@@ -102,8 +109,8 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
     plcol0(NB_GRID);
     plwidth(1.0);
     pllsty(1);
-    double ystep = p->logy ? (ymax - ymin > 8.0 ? 2.0 : 1.0) : 0.0;
-    plbox("g", 0.0, 0, "g", ystep, 0);
+    double ystep = nb_logy(p) ? (ymax - ymin > 8.0 ? 2.0 : 1.0) : 0.0;
+    plbox("g", nb_logx(p) ? 1.0 : 0.0, 0, "g", ystep, 0);
     const char *lab[NB_MAX_SERIES];
     PLINT opt[NB_MAX_SERIES], col[NB_MAX_SERIES], sty[NB_MAX_SERIES], tcol[NB_MAX_SERIES];
     PLINT snum[NB_MAX_SERIES];
@@ -124,10 +131,10 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
         }
         size_t m = 0;
         for (size_t i = 0; i <= s->n; ++i) {
-            int good = i < s->n && isfinite(s->x[i]) && nb_ok(s->y[i], p->logy);
+            int good = i < s->n && nb_ok(s->x[i], nb_logx(p)) && nb_ok(s->y[i], nb_logy(p));
             if (good) {
-                px[m] = s->x[i];
-                py[m] = p->logy ? log10(s->y[i]) : s->y[i];
+                px[m] = nb_tx(p, s->x[i]);
+                py[m] = nb_logy(p) ? log10(s->y[i]) : s->y[i];
                 ++m;
             }
             if ((!good || i == s->n) && m > 0) {
@@ -160,10 +167,11 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
     plcol0(NB_FG);
     if (p->logy)
         plslabelfunc(nb_log_label, NULL);
-    plbox("bcnst", 0.0, 0, p->logy ? "bcnstvo" : "bcnstv", ystep, p->logy ? (int)ystep : 0);
+    plbox(nb_logx(p) ? "bcnstlo" : "bcnst", nb_logx(p) ? 1.0 : 0.0, 0, nb_logy(p) ? "bcnstvo" : "bcnstv", ystep,
+          nb_logy(p) ? (int)ystep : 0);
     plslabelfunc(NULL, NULL);
     plmtex("b", 3.0, 0.5, 0.5, p->xlab);
-    plmtex("l", p->logy ? 4.6 : 4.2, 0.5, 0.5, p->ylab);
+    plmtex("l", nb_logy(p) ? 4.6 : 4.2, 0.5, 0.5, p->ylab);
     if (p->title) {
         plschr(0.0, 1.1 * NB_CHR);
         plmtex("t", 2.0, 0.5, 0.5, p->title);

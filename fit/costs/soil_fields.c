@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "fit/soil_plots.h"
 #include "measurements/soil_netcdf.h"
@@ -13,19 +14,11 @@ typedef struct fields_ctx {
     const phc_soil_setup *su;
     const char *dir, *base, *name;
     size_t frames;
-    double vmax;
+    double *snap[3];   /* w at t = 0, t_end/2, t_end for the slices */
+    double t_snap[3];
     phc_error *err;
     int rc;
 } fields_ctx;
-
-static int slice_png(fields_ctx *c, const phc_soil *s, size_t i)
-{
-    char path[8192], title[512];
-    snprintf(path, sizeof path, "%s/%s_water_%zu.png", c->dir, c->base, i);
-    snprintf(title, sizeof title, "%s: water at t = %.3g h (x-z slice, y row %zu)", c->name, s->t, s->ny / 2);
-    return phc_plot_soil_slice(path, title, "water w (m³/m³)", s->w, s->nx, s->ny, s->nz, s->dx, 'y', s->ny / 2,
-                               0, c->vmax, c->err);
-}
 
 static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
 {
@@ -33,17 +26,32 @@ static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
     fields_ctx *c = user;
     if ((c->rc = phc_soil_nc_append(c->nc, s->t, s->w, s->v, c->err)))
         return 1;
-    if (i == 0 || i == c->frames / 2 || i == c->frames) {
-        if (i == 0) { /* one colour scale for every slice: up to the wettest voxel at t = 0 or after rain */
-            double m = 0;
-            for (size_t q = 0; q < s->n; ++q)
-                m = fmax(m, s->w[q]);
-            c->vmax = m > 0 ? m : 1;
-        }
-        if ((c->rc = slice_png(c, s, i == 0 ? 0 : i == c->frames ? 2 : 1)))
-            return 1;
+    int which = i == 0 ? 0 : i == c->frames ? 2 : i == c->frames / 2 ? 1 : -1;
+    if (which >= 0) {
+        memcpy(c->snap[which], s->w, s->n * sizeof *s->w);
+        c->t_snap[which] = s->t;
     }
     return 0;
+}
+
+/* The three slices on one colour scale (0 to the wettest voxel of the three). */
+static int slices(fields_ctx *c, const phc_soil_setup *su)
+{
+    const size_t n = su->nx * su->ny * su->nz;
+    double vmax = 0;
+    for (int q = 0; q < 3; ++q)
+        for (size_t i = 0; i < n; ++i)
+            vmax = fmax(vmax, c->snap[q][i]);
+    for (int q = 0; q < 3; ++q) {
+        char path[8192], title[512];
+        snprintf(path, sizeof path, "%s/%s_water_%d.png", c->dir, c->base, q);
+        snprintf(title, sizeof title, "%s: water at t = %.3g h", c->name, c->t_snap[q]);
+        int rc = phc_plot_soil_slice(path, title, "water w (m³/m³)", c->snap[q], su->nx, su->ny, su->nz, su->dx,
+                                     'x', su->ny / 2, 0, vmax > 0 ? vmax : 1, c->err);
+        if (rc)
+            return rc;
+    }
+    return PHC_OK;
 }
 
 int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_end, size_t frames,
@@ -57,7 +65,14 @@ int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_en
     snprintf(path, sizeof path, "%s/%s_fields.nc", dir, base);
     phc_soil_nc_grid g = {su->nx, su->ny, su->nz, su->dx, {0, 0, 0}, su->has_geo, su->geo.lat0, su->geo.lon0,
                           su->geo.h0, 1};
-    fields_ctx c = {NULL, su, dir, base, name, frames ? frames : 1, 0, err, 0};
+    fields_ctx c = {NULL, su, dir, base, name, frames ? frames : 1, {NULL, NULL, NULL}, {0, 0, 0}, err, 0};
+    for (int q = 0; q < 3; ++q)
+        if (!(c.snap[q] = malloc(s->n * sizeof(double)))) {
+            for (int r = 0; r < q; ++r)
+                free(c.snap[r]);
+            phc_soil_free(s);
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        }
     rc = phc_soil_nc_create(path, &g, name, NULL, s->c, s->p, &c.nc, err);
     /* the capacity and permeability at p; the run below builds its own soil */
     phc_soil_free(s);
@@ -79,6 +94,10 @@ int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_en
     int rc2 = phc_soil_nc_close(c.nc, rc ? NULL : err);
     if (!rc)
         rc = rc2;
+    if (!rc)
+        rc = slices(&c, su);
+    for (int q = 0; q < 3; ++q)
+        free(c.snap[q]);
     if (!rc) {
         char *md = phc_soil_setup_markdown(su, p, s);
         snprintf(path, sizeof path, "%s/%s_budget.md", dir, base);

@@ -12,7 +12,8 @@
 
 /* Runs the set-up at slot values p from 0 to t_end h and writes into dir:
  *   <base>_fields.nc        `frames` + 1 frames at equal spacing (t = 0 included)
- *   <base>_water_<i>.png    x-z slices through the middle row at t = 0, t_end/2, t_end
+ *   <base>_water_<i>.png    x-z slices through the middle row at t = 0, t_end/2, t_end,
+ *                           on one colour scale
  *   <base>_budget.md        the set-up, the stability limit and the budget
  * `name` titles the plots. */
 int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_end, size_t frames,

@@ -290,7 +290,13 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
         goto fail;
     if ((rc = phc_probe_series_read(path, tcol, tconv, pcol, vcol, im->probes, &ser, err)))
         goto fail;
-    double start = ser->t[0];
+    double start = phc_unit_apply(tconv, 0.0);
+    if (strstr(tunit, "since") && !phc_yaml_get(node, "start")) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the time unit '%s' is a timestamp: give `start:` (the "
+                           "reading time of the model's t = 0, in that unit)", doc->path, phc_key_line(node, "time"),
+                           tunit);
+        goto fail;
+    }
     if (phc_yaml_get(node, "start")) {
         double st;
         if ((rc = phc_yaml_map_number(doc, node, "start", 0, ctx, &st, err)))

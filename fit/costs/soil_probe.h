@@ -8,8 +8,8 @@
  *     probe: probe                  # column of probe ids
  *     value: theta                  # column of readings
  *     quantity: water               # water (w, m^3/m^3, default) | fill (w/c)
- *     start: 0                      # the reading time of model t = 0 (time unit;
- *                                   # default: the first reading's time)
+ *     start: 0                      # the reading time of model t = 0, in the time
+ *                                   # unit (default 0; required for timestamps)
  *     probes: {file: probes.csv, id: id, x: x, y: y, depth: depth, sigma: sigma}
  *                                   # or lat: and lon: instead of x: and y:
  *     sigma: 0.005                  # a scalar when the probe table has none
