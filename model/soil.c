@@ -587,9 +587,69 @@ static double nutrient_face_flux(double F, double wa, double wb, double va, doub
     return F * (0.5 * (ua + ub) - 0.5 * nu * (ub - ua));
 }
 
+/* The water update of voxel q (the same arithmetic, in the same order, as
+ * the general loop below). */
+static inline double water_voxel(const double *restrict w, const double *restrict ic,
+                                 const double *restrict p, const double *restrict kx,
+                                 const double *restrict ky, const double *restrict kz, size_t q,
+                                 size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
+                                 double a, double cd, double cg, double lw)
+{
+    const double l0 = w[q] * ic[q];
+    const double fe = kx[q] * (w[qe] * ic[qe] - l0), fw = kx[qw] * (w[qw] * ic[qw] - l0);
+    const double fnn = ky[q] * (w[qn] * ic[qn] - l0), fs = ky[qs] * (w[qs] * ic[qs] - l0);
+    const double fu = kz[q] * (w[qu] * ic[qu] - l0), fdn = kz[qd] * (w[qd] * ic[qd] - l0);
+    const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
+    const double gt = kz[q] > 0 ? 0.5 * (qU + q0) - lw * kz[q] * (q0 - qU) : 0;
+    const double gb = kz[qd] > 0 ? 0.5 * (q0 + qD) - lw * kz[qd] * (qD - q0) : 0;
+    return w[q] + cd * (fe + fw + fnn + fs + fu + fdn) + cg * (gt - gb);
+}
+
+/* Water only (no nutrients move): the x-interior of every row has no
+ * wrap-around and no branches, so the compiler vectorises it; the two
+ * ends of the row are done apart. */
+static void transport_water(phc_soil *s, double h)
+{
+    phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
+    const double *restrict w = s->w, *restrict ic = wk->ic, *restrict p = s->p;
+    const double *restrict kx = wk->kx, *restrict ky = wk->ky, *restrict kz = wk->kz;
+    double *restrict wn = wk->w_new;
+    const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
+    const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
+#pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
+        for (size_t j = 0; j < ny; ++j) {
+            const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+            const size_t row = nx * (j + ny * k);
+            {
+                const size_t q = row;
+                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
+                                    q - js, q + kup, q - kdn, a, cd, cg, lw);
+            }
+#pragma omp simd
+            for (size_t i = 1; i < nx - 1; ++i) {
+                const size_t q = row + i;
+                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
+                                    q - kdn, a, cd, cg, lw);
+            }
+            if (nx > 1) {
+                const size_t q = row + nx - 1;
+                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
+                                    q - kdn, a, cd, cg, lw);
+            }
+        }
+    }
+}
+
 /* Transport over one sub-step h: w_new (and v_new) from w (and v). */
 static void transport(phc_soil *s, double h)
 {
+    if (!s->work->nutrients) {
+        transport_water(s, h); /* v is left as it is: run_impl does not swap it */
+        return;
+    }
     phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
     const double *w = s->w, *v = s->v, *ic = wk->ic, *p = s->p;
@@ -633,8 +693,6 @@ static void transport(phc_soil *s, double h)
             }
         }
     }
-    if (!nut)
-        memcpy(vn, v, n * sizeof *vn);
 }
 
 /* Rain, point sources and the sink hook on w_new / v_new; budget terms. */
@@ -642,7 +700,7 @@ static int sources_and_sinks(phc_soil *s, double t, double h, phc_soil_budget *b
 {
     phc_soil_work *wk = s->work;
     const double vol = s->dx * s->dx * s->dx;
-    double *wn = wk->w_new, *vn = wk->v_new;
+    double *wn = wk->w_new, *vn = wk->nutrients ? wk->v_new : s->v;
     for (size_t r = 0; r < s->n_rain; ++r) {
         const phc_soil_rain *rn = &s->rain[r];
         double len = overlap(t, t + h, rn->start, rn->end);
@@ -950,7 +1008,7 @@ static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_
             if (absorb) {
                 double vol = s->dx * s->dx * s->dx;
                 s->budget.water_absorbed += damp(s, wk->w_new, NULL) * vol;
-                s->budget.nutrient_absorbed += damp(s, wk->v_new, NULL) * vol;
+                s->budget.nutrient_absorbed += damp(s, wk->nutrients ? wk->v_new : s->v, NULL) * vol;
                 if (tan)
                     for (size_t m = 0; m < tan->m; ++m)
                         damp(s, tmp[m], NULL);
@@ -958,9 +1016,11 @@ static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_
             double *swap = s->w;
             s->w = wk->w_new;
             wk->w_new = swap;
-            swap = s->v;
-            s->v = wk->v_new;
-            wk->v_new = swap;
+            if (wk->nutrients) {
+                swap = s->v;
+                s->v = wk->v_new;
+                wk->v_new = swap;
+            }
             if (tan)
                 for (size_t m = 0; m < tan->m; ++m) {
                     swap = tan->sw[m];

@@ -427,6 +427,37 @@ int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc
     if ((n = phc_yaml_get(soil, "geo_origin")) && (rc = parse_geo(doc, n, su, err)))
         goto fail;
 
+    /* Without sub-stepping, a step over the stability limit at the configured
+       soil is refused here, with the limit (trial points of a fit that cross
+       it are rejected as outside the model's domain). */
+    if (!pr->substep) {
+        phc_soil *tmp = phc_soil_new(su->nx, su->ny, su->nz, su->dx);
+        if (!tmp) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        tmp->params = *pr;
+        phc_error e2;
+        if (phc_soil_set_layers(tmp, su->layers, su->n_layers, &e2) == PHC_OK) {
+            for (size_t i = 0; su->rock && i < tmp->n; ++i)
+                if (su->rock[i])
+                    tmp->p[i] = 0;
+            size_t at = 0;
+            double lim = phc_soil_stable_dt(tmp, &at);
+            if (pr->dt > lim) {
+                size_t i = at % su->nx, j = (at / su->nx) % su->ny, k = at / (su->nx * su->ny);
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: soil: dt = %g h exceeds the stability limit %g h of the explicit step "
+                                   "(set by voxel (%zu, %zu, %zu), p = %g m/h, c = %g) and substep is false; lower "
+                                   "dt or allow sub-stepping", doc->path, phc_key_line(soil, "dt"), pr->dt, lim, i, j,
+                                   k, tmp->p[at], tmp->c[at]);
+            }
+        }
+        phc_soil_free(tmp);
+        if (rc)
+            goto fail;
+    }
+
     /* Slots. */
     su->slot_p = malloc(su->n_layers * sizeof *su->slot_p);
     su->slot_c = malloc(su->n_layers * sizeof *su->slot_c);

@@ -741,6 +741,113 @@ wc_config wc_sel.yaml wc_ok.csv '    leaf_area: 100
 fit_case "weight_curve: select names no column" "$C/wc_sel.yaml" "wc_sel.yaml:" "'plant'"
 # ---- end weight_curve ------------------------------------------------------
 
+# ---- soil_probe and infiltration -------------------------------------------
+# Soil-moisture probes and infiltration fronts against the Rhizomorph soil
+# (fit/costs/soil_probe.h, fit/costs/infiltration.h, fit/costs/soil_setup.h).
+printf 'id,x,y,depth\nP1,0.02,0.02,0.1\nP2,0.02,0.02,0.3\n' >"$C/probes_ok.csv"
+printf 'time_h,probe,theta\n1,P1,0.03\n1,P2,0.03\n2,P1,0.02\n' >"$C/sp_ok.csv"
+# sp_config FILE READINGS PROBES SOIL_EXTRA [DATASET_EXTRA]
+sp_config() {
+    printf 'name: t\nparameters:\n  p: {value: 0.05, lower: 1e-6}\n  c: {value: 50, lower: 1e-3}\ndatasets:\n  - kind: soil_probe\n    file: %s\n    time: {column: time_h, unit: h}\n    probe: probe\n    value: theta\n    sigma: 0.002\n    probes: {file: %s}\n%s    soil:\n      grid: {nx: 1, ny: 1, nz: 20, dx: 0.05}\n      dt: 0.05\n%s' \
+        "$2" "$3" "${5:-}" "$4" >"$C/$1"
+}
+LAYER_OK='      layers: [{soil: silt, fill: 0.001}]
+'
+sp_config sp_good.yaml sp_ok.csv probes_ok.csv "$LAYER_OK"
+run_phc fit "$C/sp_good.yaml" -o "$T/sp_good_out" --quiet
+if [ "$RC" -eq 0 ]; then pass "soil_probe: positive control fits"; else failc "soil_probe: positive control fits" "exit $RC: $ERR"; fi
+rm -rf "$T/sp_good_out"
+printf 'time_h,probe,theta\n1,P1,0.03\n1,P9,0.03\n' >"$C/sp_unknown.csv"
+sp_config sp_unknown.yaml sp_unknown.csv probes_ok.csv "$LAYER_OK"
+fit_case "soil_probe: unknown probe id" "$C/sp_unknown.yaml" "sp_unknown.csv:3:" "probe 'P9'"
+printf 'time_h,probe,theta\n2,P1,0.03\n3,P2,0.03\n1,P1,0.02\n' >"$C/sp_order.csv"
+sp_config sp_order.yaml sp_order.csv probes_ok.csv "$LAYER_OK"
+fit_case "soil_probe: times out of order" "$C/sp_order.yaml" "sp_order.csv:4:" "time order"
+printf 'time_h,probe,theta\n1,P1,wet\n' >"$C/sp_text.csv"
+sp_config sp_text.yaml sp_text.csv probes_ok.csv "$LAYER_OK"
+fit_case "soil_probe: non-numeric reading" "$C/sp_text.yaml" "sp_text.csv:2:" "'wet'"
+printf 'id,x,y,depth\nP1,0.02,0.02,0.1\nP2,3.5,0.02,0.3\n' >"$C/probes_out.csv"
+sp_config sp_out.yaml sp_ok.csv probes_out.csv "$LAYER_OK"
+fit_case "soil_probe: probe outside the grid" "$C/sp_out.yaml" "probes_out.csv:3:" "probe 'P2'" "outside the soil grid"
+printf 'id,x,y,depth\nP1,0.5,0.5,0.1\nP2,0.5,0.5,-0.3\n' >"$C/probes_neg.csv"
+sp_config sp_neg.yaml sp_ok.csv probes_neg.csv "$LAYER_OK"
+fit_case "soil_probe: negative probe depth" "$C/sp_neg.yaml" "probes_neg.csv:3:" "depth must be >= 0"
+printf 'id,x,y,depth\nP1,0.5,0.5,0.1\nP1,0.5,0.5,0.3\n' >"$C/probes_dup.csv"
+sp_config sp_dup.yaml sp_ok.csv probes_dup.csv "$LAYER_OK"
+fit_case "soil_probe: duplicate probe id" "$C/sp_dup.yaml" "probes_dup.csv:3:" "listed twice"
+printf 'id,lat,lon,depth\nP1,43.6481 N,79.3832 W,0.1\nP2,43.6481 E,79.3832 W,0.3\n' >"$C/probes_lat.csv"
+sp_config sp_lat.yaml sp_ok.csv probes_lat.csv "$LAYER_OK
+      geo_origin: {lat: \"43.6481 N\", lon: \"79.3832 W\"}
+"
+sed -i 's|probes: {file: probes_lat.csv}|probes: {file: probes_lat.csv, lat: lat, lon: lon}|' "$C/sp_lat.yaml"
+fit_case "soil_probe: unparseable latitude" "$C/sp_lat.yaml" "probes_lat.csv:3:" "as a latitude"
+printf 'id,lat,lon,depth\nP1,43.6481 N,79.3832 W,0.1\nP2,43.6491 N,79.3832 W,0.3\n' >"$C/probes_far.csv"
+sp_config sp_far.yaml sp_ok.csv probes_far.csv "$LAYER_OK
+      geo_origin: {lat: \"43.6481 N\", lon: \"79.3832 W\"}
+"
+sed -i 's|probes: {file: probes_far.csv}|probes: {file: probes_far.csv, lat: lat, lon: lon}|' "$C/sp_far.yaml"
+fit_case "soil_probe: GPS probe 111 m off the grid" "$C/sp_far.yaml" "probes_far.csv:3:" "probe 'P2'" "outside the soil grid"
+sp_config sp_nogeo.yaml sp_ok.csv probes_lat.csv "$LAYER_OK"
+sed -i 's|probes: {file: probes_lat.csv}|probes: {file: probes_lat.csv, lat: lat, lon: lon}|' "$C/sp_nogeo.yaml"
+fit_case "soil_probe: latitudes without geo_origin" "$C/sp_nogeo.yaml" "probes_lat.csv" "no geo_origin"
+sp_config sp_c0.yaml sp_ok.csv probes_ok.csv '      layers: [{c: 0, p: 0.03, fill: 0.001}]
+'
+fit_case "soil: zero capacity" "$C/sp_c0.yaml" "sp_c0.yaml:" "soil layer 1" "c > 0"
+sp_config sp_pneg.yaml sp_ok.csv probes_ok.csv '      layers: [{c: 10, p: 0.03, thickness: 0.5}, {c: 10, p: -0.1}]
+'
+fit_case "soil: negative permeability" "$C/sp_pneg.yaml" "sp_pneg.yaml:" "soil layer 2" "p >= 0"
+sp_config sp_nan.yaml sp_ok.csv probes_ok.csv '      layers: [{c: .nan, p: 0.03}]
+'
+fit_case "soil: NaN capacity" "$C/sp_nan.yaml" "sp_nan.yaml:" "'c'"
+sp_config sp_peat.yaml sp_ok.csv probes_ok.csv '      layers: [{soil: peat}]
+'
+fit_case "soil: unknown soil type" "$C/sp_peat.yaml" "sp_peat.yaml:" "unknown soil 'peat'" "silt_loam"
+sp_config sp_dt.yaml sp_ok.csv probes_ok.csv '      layers: [{soil: sandy_loam, fill: 0.001}]
+      substep: false
+' && sed -i 's/dt: 0.05/dt: 0.5/' "$C/sp_dt.yaml"
+fit_case "soil: time step over the stability limit, no sub-stepping" "$C/sp_dt.yaml" "sp_dt.yaml:" "stability limit" "substep"
+sp_config sp_abs.yaml sp_ok.csv probes_ok.csv "$LAYER_OK      boundaries: {sides: absorb}
+"
+fit_case "soil: absorbing layers wider than the grid" "$C/sp_abs.yaml" "sp_abs.yaml:" "absorbs over 5 layers"
+sp_config sp_per.yaml sp_ok.csv probes_ok.csv "$LAYER_OK      boundaries: {x_min: periodic}
+"
+fit_case "soil: one periodic face" "$C/sp_per.yaml" "sp_per.yaml:" "come in pairs"
+sp_config sp_src.yaml sp_ok.csv probes_ok.csv "$LAYER_OK      sources: [{x: 0.02, y: 0.02, depth: 2.5, water_rate: 1e-4}]
+"
+fit_case "soil: source below the grid" "$C/sp_src.yaml" "sp_src.yaml:" "source 1" "outside the soil grid"
+sp_config sp_grid.yaml sp_ok.csv probes_ok.csv "$LAYER_OK" && sed -i 's/nz: 20, //' "$C/sp_grid.yaml"
+fit_case "soil: grid without nz" "$C/sp_grid.yaml" "sp_grid.yaml:" "'nz'"
+sp_config sp_q.yaml sp_ok.csv probes_ok.csv "$LAYER_OK" '    quantity: suction
+'
+fit_case "soil_probe: unknown quantity" "$C/sp_q.yaml" "sp_q.yaml:" "not one of water, fill"
+sp_config sp_ts.yaml sp_ok.csv probes_ok.csv "$LAYER_OK" && sed -i 's/unit: h}/unit: "hours since 2026-05-01"}/' "$C/sp_ts.yaml"
+fit_case "soil_probe: timestamps without start" "$C/sp_ts.yaml" "sp_ts.yaml:" "give \`start:\`"
+# infiltration
+inf_config() {
+    printf 'name: t\nparameters:\n  p: {value: 0.05, lower: 1e-6}\n  c: {value: 50, lower: 1e-3}\ndatasets:\n  - kind: infiltration\n    file: %s\n    time: {column: t, unit: h}\n    depth: {column: d, unit: m}\n    sigma: 0.01\n    soil:\n      grid: {nx: 1, ny: 1, nz: 40, dx: 0.05}\n%s' \
+        "$2" "$3" >"$C/$1"
+}
+RAIN_OK='      layers: [{soil: silt, fill: 0.0001}]
+      rain: [{start: 0, end: 2, rate: 0.01}]
+'
+printf 't,d\n1,0.05\n2,0.1\n4,0.2\n' >"$C/inf_ok.csv"
+inf_config inf_norain.yaml inf_ok.csv '      layers: [{soil: silt, fill: 0.0001}]
+'
+fit_case "infiltration: no rain" "$C/inf_norain.yaml" "inf_norain.yaml:" "nothing infiltrates"
+printf 't,d\n1,0.05\n2,-0.1\n' >"$C/inf_neg.csv"
+inf_config inf_neg.yaml inf_neg.csv "$RAIN_OK"
+fit_case "infiltration: negative depth" "$C/inf_neg.yaml" "inf_neg.csv:3:" "depth must be >= 0"
+printf 't,d\n2,0.05\n1,0.1\n' >"$C/inf_order.csv"
+inf_config inf_order.yaml inf_order.csv "$RAIN_OK"
+fit_case "infiltration: times out of order" "$C/inf_order.yaml" "inf_order.csv:3:" "increasing"
+inf_config inf_frac.yaml inf_ok.csv "$RAIN_OK" && printf '    fraction: 1.5\n' >>"$C/inf_frac.yaml"
+fit_case "infiltration: fraction above 1" "$C/inf_frac.yaml" "inf_frac.yaml:" "fraction"
+inf_config inf_rain.yaml inf_ok.csv '      layers: [{soil: silt, fill: 0.0001}]
+      rain: [{start: 2, end: 1, rate: 0.01}]
+'
+fit_case "infiltration: rain ending before it starts" "$C/inf_rain.yaml" "inf_rain.yaml:" "rain 1"
+# ---- end soil ----------------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
