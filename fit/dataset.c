@@ -35,6 +35,7 @@ void phc_dataset_free(phc_dataset *ds)
         for (size_t j = 0; j < ds->k; ++j)
             free(ds->slot_names[j]);
     free(ds->slot_names);
+    free(ds->series);
     free(ds->param_index);
     free(ds->name);
     free(ds->x);

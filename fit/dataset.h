@@ -58,6 +58,9 @@ struct phc_dataset {
                                     raised to it, since the cost cannot be resolved further */
     char *data_file;             /* the file the observations came from (or NULL) */
     size_t *data_lines;          /* n 1-based line numbers in data_file (or NULL) */
+    size_t *series;              /* n series ids (e.g. the probe of each reading) when the
+                                    observations form several curves over x, or NULL: the
+                                    fit plot then draws one model line per series */
 };
 
 /* Allocates an empty data set with k slots (names and indices zeroed). */

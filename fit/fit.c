@@ -353,6 +353,37 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
             free(d->curve_y);
             d->curve_x = d->curve_y = NULL;
         }
+    } else if (ds->series && n > 0) {
+        /* several curves over x (one per probe, say): the predictions of each
+           series in x order, series separated by a NAN point (a line break) */
+        size_t n_series = 0;
+        for (size_t i = 0; i < n; ++i)
+            n_series = ds->series[i] + 1 > n_series ? ds->series[i] + 1 : n_series;
+        d->curve_x = malloc((n + n_series) * sizeof *d->curve_x);
+        d->curve_y = malloc((n + n_series) * sizeof *d->curve_y);
+        if (!d->curve_x || !d->curve_y) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        size_t m = 0;
+        for (size_t g = 0; g < n_series; ++g) {
+            size_t first = m;
+            for (size_t i = 0; i < n; ++i)
+                if (ds->series[i] == g) {
+                    size_t j = m++;
+                    for (; j > first && d->curve_x[j - 1] > d->x[i]; --j) { /* insertion by x */
+                        d->curve_x[j] = d->curve_x[j - 1];
+                        d->curve_y[j] = d->curve_y[j - 1];
+                    }
+                    d->curve_x[j] = d->x[i];
+                    d->curve_y[j] = d->yhat[i];
+                }
+            if (m > first) {
+                d->curve_x[m] = NAN;
+                d->curve_y[m++] = NAN;
+            }
+        }
+        d->curve_n = m;
     }
 fail:
     free(p);

@@ -379,6 +379,11 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    if (!(ds->series = malloc(n * sizeof *ds->series))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    memcpy(ds->series, im->probe_of, n * sizeof *ds->series);
     ds->derivatives = PHC_DERIV_ANALYTIC;
     ds->impl = im;
     im = NULL;
