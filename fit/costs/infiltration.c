@@ -154,26 +154,6 @@ static int inf_simulate_outputs(phc_dataset *ds, const double *p, const char *di
 static const phc_dataset_ops infiltration_ops = {"infiltration", inf_predict, inf_predict_at, inf_free,
                                                  inf_report_section, inf_simulate_outputs};
 
-static int column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *def_unit,
-                       const char **column, const char **unit, phc_error *err)
-{
-    static const char *const spec_keys[] = {"column", "unit", NULL};
-    const phc_yaml_node *v = phc_yaml_get(node, key);
-    char ctx[64];
-    int rc;
-    snprintf(ctx, sizeof ctx, "key '%s'", key);
-    *unit = def_unit;
-    if (!v)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: infiltration data set: missing key '%s'", doc->path,
-                             node->line, key);
-    if (v->kind == PHC_YAML_SCALAR)
-        return phc_yaml_string(doc, v, key, column, err);
-    if ((rc = phc_yaml_check_keys(doc, v, spec_keys, ctx, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "column", 1, ctx, column, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, unit, err)))
-        return rc;
-    return PHC_OK;
-}
 
 int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                           phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
@@ -194,8 +174,8 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
     im->fraction = 0.8;
     const phc_yaml_node *soil = phc_yaml_get(node, "soil");
     if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = column_spec(doc, node, "time", "h", &tcol, &tunit, err)) ||
-        (rc = column_spec(doc, node, "depth", "m", &dcol, &dunit, err)) ||
+        (rc = phc_column_spec(doc, node, "time", "infiltration data set", "h", &tcol, &tunit, err)) ||
+        (rc = phc_column_spec(doc, node, "depth", "infiltration data set", "m", &dcol, &dunit, err)) ||
         (rc = phc_yaml_map_number(doc, node, "fraction", 0, ctx, &im->fraction, err)) ||
         (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
         (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))

@@ -169,27 +169,6 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* `{column: NAME, unit: UNIT}` or a bare column name. */
-static int column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *def_unit,
-                       const char **column, const char **unit, phc_error *err)
-{
-    static const char *const spec_keys[] = {"column", "unit", NULL};
-    const phc_yaml_node *v = phc_yaml_get(node, key);
-    char ctx[64];
-    int rc;
-    snprintf(ctx, sizeof ctx, "key '%s'", key);
-    *unit = def_unit;
-    if (!v)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil_probe data set: missing key '%s'", doc->path,
-                             node->line, key);
-    if (v->kind == PHC_YAML_SCALAR)
-        return phc_yaml_string(doc, v, key, column, err);
-    if ((rc = phc_yaml_check_keys(doc, v, spec_keys, ctx, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "column", 1, ctx, column, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, unit, err)))
-        return rc;
-    return PHC_OK;
-}
 
 int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                         phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
@@ -209,7 +188,7 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     const phc_yaml_node *soil = phc_yaml_get(node, "soil"), *pn = phc_yaml_get(node, "probes");
     if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = column_spec(doc, node, "time", "h", &tcol, &tunit, err)) ||
+        (rc = phc_column_spec(doc, node, "time", "soil_probe data set", "h", &tcol, &tunit, err)) ||
         (rc = phc_yaml_map_string(doc, node, "probe", 1, ctx, &pcol, err)) ||
         (rc = phc_yaml_map_string(doc, node, "value", 1, ctx, &vcol, err)) ||
         (rc = phc_yaml_map_string(doc, node, "quantity", 0, ctx, &quantity, err)) ||

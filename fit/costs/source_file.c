@@ -56,3 +56,25 @@ int phc_need_column(const phc_yaml_doc *doc, const phc_yaml_node *node, const ch
     snprintf(what, sizeof what, "key '%s':", key);
     return phc_unknown_column(doc, phc_key_line(node, key), what, name, t, err);
 }
+
+int phc_column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                    const char *context, const char *default_unit, const char **column,
+                    const char **unit, phc_error *err)
+{
+    static const char *const spec_keys[] = {"column", "unit", NULL};
+    const phc_yaml_node *v = phc_yaml_get(node, key);
+    char ctx[64];
+    int rc;
+    snprintf(ctx, sizeof ctx, "key '%s'", key);
+    *unit = default_unit;
+    if (!v)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: missing key '%s' ({column: NAME, unit: UNIT})",
+                             doc->path, node->line, context, key);
+    if (v->kind == PHC_YAML_SCALAR)
+        return phc_yaml_string(doc, v, key, column, err);
+    if ((rc = phc_yaml_check_keys(doc, v, spec_keys, ctx, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "column", 1, ctx, column, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, unit, err)))
+        return rc;
+    return PHC_OK;
+}

@@ -24,6 +24,14 @@ int phc_unknown_column(const phc_yaml_doc *doc, size_t line, const char *what, c
 int phc_need_column(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
                     const char *name, const phc_table *t, phc_error *err);
 
+/* A `{column: NAME, unit: UNIT}` mapping (or a bare column name) under
+ * `key` of the data-set mapping `node`; *unit is default_unit when not
+ * given.  A missing key is PHC_ERR_INPUT "cfg.yaml:7: <context>: missing key
+ * 'time' ({column: NAME, unit: UNIT})". */
+int phc_column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                    const char *context, const char *default_unit, const char **column,
+                    const char **unit, phc_error *err);
+
 /* The line of `key` in a YAML mapping (the mapping's own line when absent). */
 size_t phc_key_line(const phc_yaml_node *map, const char *key);
 

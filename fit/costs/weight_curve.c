@@ -220,28 +220,6 @@ static int unique_times(wc_impl *w, size_t n, phc_error *err)
     return PHC_OK;
 }
 
-/* A `{column: NAME, unit: UNIT}` mapping (or a bare column name). */
-static int column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
-                       const char *default_unit, const char **column, const char **unit,
-                       phc_error *err)
-{
-    const phc_yaml_node *v = phc_yaml_get(node, key);
-    static const char *const spec_keys[] = {"column", "unit", NULL};
-    char ctx[64];
-    int rc;
-    snprintf(ctx, sizeof ctx, "key '%s'", key);
-    *unit = default_unit;
-    if (!v)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: weight_curve data set: missing key '%s' ({column: NAME, unit: UNIT})",
-                             doc->path, node->line, key);
-    if (v->kind == PHC_YAML_SCALAR)
-        return phc_yaml_string(doc, v, key, column, err);
-    if ((rc = phc_yaml_check_keys(doc, v, spec_keys, ctx, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "column", 1, ctx, column, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, unit, err)))
-        return rc;
-    return PHC_OK;
-}
 
 /* A quantity given as a number, or {value: X | column: NAME, unit: UNIT};
  * a column is read at the first selected row.  Converted to `model_unit`. */
@@ -350,8 +328,8 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
 
     *out = NULL;
     if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = column_spec(doc, node, "time", "s", &tcol, &tunit, err)) ||
-        (rc = column_spec(doc, node, "mass", "g", &mcol, &munit, err)) ||
+        (rc = phc_column_spec(doc, node, "time", "weight_curve data set", "s", &tcol, &tunit, err)) ||
+        (rc = phc_column_spec(doc, node, "mass", "weight_curve data set", "g", &mcol, &munit, err)) ||
         (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
         (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
         return rc;
