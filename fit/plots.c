@@ -21,6 +21,7 @@
  * label such as "run #3" prints as written; UTF-8 (±, σ, µ, °) renders
  * through cairo/pango. */
 #include "fit/plots.h"
+#include "fit/plot_file.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -113,26 +114,6 @@ static void legend_add(legend_spec *lg, PLINT opt, const char *text,
     e->line_width = line_width;
 }
 
-/* Copy of s with PLplot's escape character doubled; "" for NULL. */
-static char *escape_text(const char *s)
-{
-    if (!s)
-        s = "";
-    size_t len = strlen(s), extra = 0;
-    for (size_t i = 0; i < len; ++i)
-        extra += s[i] == '#';
-    char *out = malloc(len + extra + 1);
-    if (!out)
-        return NULL;
-    char *p = out;
-    for (size_t i = 0; i < len; ++i) {
-        *p++ = s[i];
-        if (s[i] == '#')
-            *p++ = '#';
-    }
-    *p = '\0';
-    return out;
-}
 
 /* Number of characters (UTF-8 code points) in s, for width estimates. */
 static size_t utf8_length(const char *s)
@@ -247,52 +228,7 @@ typedef struct plot_ctx {
     double ylab_disp;        /* y label distance from the frame (chars) */
 } plot_ctx;
 
-static int device_available(const char *name)
-{
-    enum { MAX_DEVS = 256 };
-    const char **menu = malloc(MAX_DEVS * sizeof *menu);
-    const char **names = malloc(MAX_DEVS * sizeof *names);
-    int found = -1; /* -1: could not tell (out of memory) */
-    if (menu && names) {
-        int ndev = MAX_DEVS;
-        plgDevs(&menu, &names, &ndev);
-        found = 0;
-        for (int i = 0; i < ndev && i < MAX_DEVS; ++i)
-            if (names[i] && strcmp(names[i], name) == 0)
-                found = 1;
-    }
-    free(menu);
-    free(names);
-    return found;
-}
 
-/* Creates the temporary output file next to `path` (O_EXCL, mode 0666 less
- * the umask) and stores its name in *out.  PLplot then reopens it by name;
- * the name never is "-", which PLplot would take for stdout. */
-static int make_temp_file(const char *path, char **out, phc_error *err)
-{
-    size_t len = strlen(path) + 64;
-    char *tmp = malloc(len);
-    *out = NULL;
-    if (!tmp)
-        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-    int saved = 0;
-    for (int i = 0; i < 100; ++i) {
-        snprintf(tmp, len, "%s.%ld.%d.tmp", path, (long)getpid(), i);
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd >= 0) {
-            close(fd);
-            *out = tmp;
-            return PHC_OK;
-        }
-        saved = errno;
-        if (saved != EEXIST)
-            break;
-    }
-    free(tmp);
-    return phc_error_set(err, PHC_ERR_IO, "%s: cannot create the plot file: "
-                         "%s", path, strerror(saved));
-}
 
 /* Opens a PLplot stream writing a PNG of PAGE_W x PAGE_H pixels to a
  * temporary file; on success ctx->page_f* hold the character height as a
@@ -303,7 +239,7 @@ static int plot_begin(plot_ctx *ctx, const char *path, phc_error *err)
     ctx->tmp_path = NULL;
     plgstrm(&ctx->old_stream);
 
-    int dev = device_available("pngcairo");
+    int dev = phc_plot_device_available("pngcairo");
     if (dev < 0)
         return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
     if (dev == 0)
@@ -311,7 +247,7 @@ static int plot_begin(plot_ctx *ctx, const char *path, phc_error *err)
                              "%s: PLplot has no 'pngcairo' device "
                              "(install plplot-driver-cairo)", path);
 
-    int status = make_temp_file(path, &ctx->tmp_path, err);
+    int status = phc_plot_temp_file(path, &ctx->tmp_path, err);
     if (status)
         return status;
 
@@ -373,24 +309,7 @@ static int plot_end(plot_ctx *ctx, const char *path, int status,
     if (!ctx->tmp_path)
         return status;
     if (status == PHC_OK) {
-        /* A complete PNG starts with the signature and ends with the IEND
-         * chunk; cairo reports no write errors through PLplot, so a full
-         * disk shows up here as a truncated file. */
-        static const unsigned char sig[8] = {0x89, 'P', 'N', 'G',
-                                             '\r', '\n', 0x1a, '\n'};
-        static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D',
-                                               0xae, 0x42, 0x60, 0x82};
-        unsigned char head[8] = {0}, tail[12] = {0};
-        int ok = 0;
-        FILE *f = fopen(ctx->tmp_path, "rb");
-        if (f) {
-            ok = fread(head, 1, sizeof head, f) == sizeof head &&
-                 memcmp(head, sig, sizeof sig) == 0 &&
-                 fseek(f, -(long)sizeof tail, SEEK_END) == 0 &&
-                 fread(tail, 1, sizeof tail, f) == sizeof tail &&
-                 memcmp(tail, iend, sizeof iend) == 0;
-            fclose(f);
-        }
+        int ok = phc_plot_png_complete(ctx->tmp_path);
         if (!ok)
             status = phc_error_set(err, PHC_ERR_IO,
                                    "%s: PLplot did not write a complete PNG "
@@ -705,9 +624,9 @@ static int text_make(plot_text *t, const phc_plot_labels *labels,
     const char *ti = labels ? labels->title : NULL;
     const char *xl = labels && labels->x_label ? labels->x_label : def_x;
     const char *yl = labels && labels->y_label ? labels->y_label : def_y;
-    t->title = escape_text(ti);
-    t->x = escape_text(xl);
-    t->y = escape_text(yl);
+    t->title = phc_plot_escape(ti);
+    t->x = phc_plot_escape(xl);
+    t->y = phc_plot_escape(yl);
     return t->title && t->x && t->y ? PHC_OK : PHC_ERR_NOMEM;
 }
 

@@ -7,6 +7,7 @@
  * and restores the caller's; the PNG goes to a temporary file that is
  * checked for a complete PNG and renamed into place. */
 #include "fit/soil_plots.h"
+#include "fit/plot_file.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -34,93 +35,9 @@ static const unsigned char BLUES[9][3] = {
     {158, 202, 225}, {107, 174, 214}, {66, 146, 198},
     {33, 113, 181},  {8, 81, 156},    {8, 48, 107}};
 
-/* Copy of s with PLplot's escape character doubled; "" for NULL. */
-static char *escape_text(const char *s)
-{
-    if (!s)
-        s = "";
-    size_t len = strlen(s), extra = 0;
-    for (size_t i = 0; i < len; ++i)
-        extra += s[i] == '#';
-    char *out = malloc(len + extra + 1);
-    if (!out)
-        return NULL;
-    char *p = out;
-    for (size_t i = 0; i < len; ++i) {
-        *p++ = s[i];
-        if (s[i] == '#')
-            *p++ = '#';
-    }
-    *p = '\0';
-    return out;
-}
 
-static int device_available(const char *name)
-{
-    enum { MAX_DEVS = 256 };
-    const char **menu = malloc(MAX_DEVS * sizeof *menu);
-    const char **names = malloc(MAX_DEVS * sizeof *names);
-    int found = -1;
-    if (menu && names) {
-        int ndev = MAX_DEVS;
-        plgDevs(&menu, &names, &ndev);
-        found = 0;
-        for (int i = 0; i < ndev && i < MAX_DEVS; ++i)
-            if (names[i] && strcmp(names[i], name) == 0)
-                found = 1;
-    }
-    free(menu);
-    free(names);
-    return found;
-}
 
-/* Creates the temporary output file next to `path` (O_EXCL). */
-static int make_temp_file(const char *path, char **out, phc_error *err)
-{
-    size_t len = strlen(path) + 64;
-    char *tmp = malloc(len);
-    *out = NULL;
-    if (!tmp)
-        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-    int saved = 0;
-    for (int i = 0; i < 100; ++i) {
-        snprintf(tmp, len, "%s.%ld.%d.tmp", path, (long)getpid(), i);
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd >= 0) {
-            close(fd);
-            *out = tmp;
-            return PHC_OK;
-        }
-        saved = errno;
-        if (saved != EEXIST)
-            break;
-    }
-    free(tmp);
-    return phc_error_set(err, PHC_ERR_IO, "%s: cannot create the plot file: "
-                         "%s", path, strerror(saved));
-}
 
-/* Checks the PNG signature and the final IEND chunk (cairo reports no
- * write errors through PLplot: a full disk shows as a truncated file). */
-static int png_complete(const char *file)
-{
-    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G',
-                                         '\r', '\n', 0x1a, '\n'};
-    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D',
-                                           0xae, 0x42, 0x60, 0x82};
-    unsigned char head[8] = {0}, tail[12] = {0};
-    int ok = 0;
-    FILE *f = fopen(file, "rb");
-    if (f) {
-        ok = fread(head, 1, sizeof head, f) == sizeof head &&
-             memcmp(head, sig, sizeof sig) == 0 &&
-             fseek(f, -(long)sizeof tail, SEEK_END) == 0 &&
-             fread(tail, 1, sizeof tail, f) == sizeof tail &&
-             memcmp(tail, iend, sizeof iend) == 0;
-        fclose(f);
-    }
-    return ok;
-}
 
 /* Tick interval of 1, 2 or 5 x 10^k giving about `target` intervals. */
 static double nice_step(double span, double target)
@@ -250,7 +167,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
     if (!isfinite(nodata))
         nodata = -HUGE_VAL;
 
-    char *t_title = escape_text(title), *t_bar = escape_text(colorbar_label);
+    char *t_title = phc_plot_escape(title), *t_bar = phc_plot_escape(colorbar_label);
     char sub[160];
     double pos = ((double)index + 0.5) * dx;
     snprintf(sub, sizeof sub, "slice at %s = %zu (%s = %.4g m)",
@@ -271,7 +188,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
     char *tmp = NULL;
     PLINT old_stream, strm = -1;
     plgstrm(&old_stream);
-    int dev = device_available("pngcairo");
+    int dev = phc_plot_device_available("pngcairo");
     if (dev <= 0) {
         status = dev < 0 ? phc_error_set(err, PHC_ERR_NOMEM,
                                          "%s: out of memory", path)
@@ -281,7 +198,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
                                          "plplot-driver-cairo)", path);
         goto done;
     }
-    status = make_temp_file(path, &tmp, err);
+    status = phc_plot_temp_file(path, &tmp, err);
     if (status)
         goto done;
     plmkstrm(&strm);
@@ -396,7 +313,7 @@ done:
     }
     if (tmp) {
         if (status == PHC_OK) {
-            if (!png_complete(tmp))
+            if (!phc_plot_png_complete(tmp))
                 status = phc_error_set(err, PHC_ERR_IO,
                                        "%s: PLplot did not write a complete "
                                        "PNG file (disk full?)", path);

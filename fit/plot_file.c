@@ -1,0 +1,98 @@
+/* The file side of a PLplot figure: see plot_file.h. */
+#include "fit/plot_file.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <plplot.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Copy of s with PLplot's escape character doubled; "" for NULL. */
+char *phc_plot_escape(const char *s)
+{
+    if (!s)
+        s = "";
+    size_t len = strlen(s), extra = 0;
+    for (size_t i = 0; i < len; ++i)
+        extra += s[i] == '#';
+    char *out = malloc(len + extra + 1);
+    if (!out)
+        return NULL;
+    char *p = out;
+    for (size_t i = 0; i < len; ++i) {
+        *p++ = s[i];
+        if (s[i] == '#')
+            *p++ = '#';
+    }
+    *p = '\0';
+    return out;
+}
+
+int phc_plot_device_available(const char *name)
+{
+    enum { MAX_DEVS = 256 };
+    const char **menu = malloc(MAX_DEVS * sizeof *menu);
+    const char **names = malloc(MAX_DEVS * sizeof *names);
+    int found = -1;
+    if (menu && names) {
+        int ndev = MAX_DEVS;
+        plgDevs(&menu, &names, &ndev);
+        found = 0;
+        for (int i = 0; i < ndev && i < MAX_DEVS; ++i)
+            if (names[i] && strcmp(names[i], name) == 0)
+                found = 1;
+    }
+    free(menu);
+    free(names);
+    return found;
+}
+
+/* Creates the temporary output file next to `path` (O_EXCL). */
+int phc_plot_temp_file(const char *path, char **out, phc_error *err)
+{
+    size_t len = strlen(path) + 64;
+    char *tmp = malloc(len);
+    *out = NULL;
+    if (!tmp)
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+    int saved = 0;
+    for (int i = 0; i < 100; ++i) {
+        snprintf(tmp, len, "%s.%ld.%d.tmp", path, (long)getpid(), i);
+        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
+        if (fd >= 0) {
+            close(fd);
+            *out = tmp;
+            return PHC_OK;
+        }
+        saved = errno;
+        if (saved != EEXIST)
+            break;
+    }
+    free(tmp);
+    return phc_error_set(err, PHC_ERR_IO, "%s: cannot create the plot file: "
+                         "%s", path, strerror(saved));
+}
+
+/* Checks the PNG signature and the final IEND chunk (cairo reports no
+ * write errors through PLplot: a full disk shows as a truncated file). */
+int phc_plot_png_complete(const char *file)
+{
+    static const unsigned char sig[8] = {0x89, 'P', 'N', 'G',
+                                         '\r', '\n', 0x1a, '\n'};
+    static const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D',
+                                           0xae, 0x42, 0x60, 0x82};
+    unsigned char head[8] = {0}, tail[12] = {0};
+    int ok = 0;
+    FILE *f = fopen(file, "rb");
+    if (f) {
+        ok = fread(head, 1, sizeof head, f) == sizeof head &&
+             memcmp(head, sig, sizeof sig) == 0 &&
+             fseek(f, -(long)sizeof tail, SEEK_END) == 0 &&
+             fread(tail, 1, sizeof tail, f) == sizeof tail &&
+             memcmp(tail, iend, sizeof iend) == 0;
+        fclose(f);
+    }
+    return ok;
+}
