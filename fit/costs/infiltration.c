@@ -238,24 +238,13 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
     } else if ((rc = phc_yaml_number(doc, sg, "sigma", &sigma, err))) {
         goto fail;
     }
-    ds = phc_dataset_new(&infiltration_ops, im->su->k);
+    ds = phc_soil_setup_dataset(im->su, &infiltration_ops, n, path);
     if (!ds) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    for (size_t q = 0; q < im->su->k; ++q)
-        if (!(ds->slot_names[q] = strdup(im->su->slot_names[q]))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-    ds->n = n;
-    ds->x = malloc(n * sizeof *ds->x);
-    ds->y = malloc(n * sizeof *ds->y);
-    ds->sigma = malloc(n * sizeof *ds->sigma);
-    ds->data_lines = malloc(n * sizeof *ds->data_lines);
-    ds->data_file = strdup(path);
     im->t = malloc(n * sizeof *im->t);
-    if (!ds->x || !ds->y || !ds->sigma || !ds->data_lines || !ds->data_file || !im->t) {
+    if (!im->t) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }

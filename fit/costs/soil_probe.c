@@ -301,27 +301,15 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
     }
 
     const size_t n = ser->n;
-    ds = phc_dataset_new(&soil_probe_ops, im->su->k);
+    ds = phc_soil_setup_dataset(im->su, &soil_probe_ops, n, path);
     if (!ds) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    for (size_t q = 0; q < im->su->k; ++q)
-        if (!(ds->slot_names[q] = strdup(im->su->slot_names[q]))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-    ds->n = n;
-    ds->x = malloc(n * sizeof *ds->x);
-    ds->y = malloc(n * sizeof *ds->y);
-    ds->sigma = malloc(n * sizeof *ds->sigma);
-    ds->data_lines = malloc(n * sizeof *ds->data_lines);
-    ds->data_file = strdup(path);
     im->probe_of = malloc(n * sizeof *im->probe_of);
     im->t_unique = malloc(n * sizeof *im->t_unique);
     im->t_at = malloc(n * sizeof *im->t_at);
-    if (!ds->x || !ds->y || !ds->sigma || !ds->data_lines || !ds->data_file || !im->probe_of || !im->t_unique ||
-        !im->t_at) {
+    if (!im->probe_of || !im->t_unique || !im->t_at) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }

@@ -626,6 +626,28 @@ done:
     return rc;
 }
 
+phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_ops *ops, size_t n,
+                                    const char *path)
+{
+    phc_dataset *ds = phc_dataset_new(ops, su->k);
+    if (!ds)
+        return NULL;
+    int bad = 0;
+    for (size_t q = 0; q < su->k && !bad; ++q)
+        bad = !(ds->slot_names[q] = strdup(su->slot_names[q]));
+    ds->n = n;
+    ds->x = malloc((n ? n : 1) * sizeof *ds->x);
+    ds->y = malloc((n ? n : 1) * sizeof *ds->y);
+    ds->sigma = malloc((n ? n : 1) * sizeof *ds->sigma);
+    ds->data_lines = malloc((n ? n : 1) * sizeof *ds->data_lines);
+    ds->data_file = strdup(path);
+    if (bad || !ds->x || !ds->y || !ds->sigma || !ds->data_lines || !ds->data_file) {
+        phc_dataset_free(ds);
+        return NULL;
+    }
+    return ds;
+}
+
 /* Appends printf text to a growing buffer. */
 static void cat(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
 {

@@ -37,6 +37,7 @@
 
 #include "fit/costs/curve.h"
 #include "fit/costs/source_file.h"
+#include "fit/dataset.h"
 #include "measurements/geo.h"
 #include "measurements/yaml_doc.h"
 #include "model/soil.h"
@@ -100,6 +101,12 @@ int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *
 /* The value of layer L's permeability and capacity at slot values p. */
 double phc_soil_setup_p(const phc_soil_setup *su, size_t layer, const double *p);
 double phc_soil_setup_c(const phc_soil_setup *su, size_t layer, const double *p);
+
+/* A new data set of kind `ops` with the set-up's k slots (names copied)
+ * and room for n observations: x, y, sigma, data_lines allocated, and
+ * data_file = path.  NULL when out of memory. */
+phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_ops *ops, size_t n,
+                                    const char *path);
 
 /* A markdown description of the set-up at p and of the run's budget
  * (s after a run); malloc'd. */
