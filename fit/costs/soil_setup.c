@@ -580,6 +580,21 @@ int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *
     int rc = phc_soil_setup_build(su, p, &s, err);
     if (rc)
         return rc;
+    /* A trial point of a fit can make the soil so fast (large p, tiny c) that
+       the stability limit needs millions of sub-steps: refuse runs of more
+       than PHC_SOIL_MAX_UPDATES voxel updates (a fit rejects the step). */
+    if (m > 0) {
+        double lim = phc_soil_stable_dt(s, NULL);
+        double h = fmin(s->params.dt, s->params.substep ? s->params.safety * lim : s->params.dt);
+        double updates = (t[m - 1] / h + (double)m) * (double)s->n * (1.0 + 3.0 * (tangents ? (double)su->k : 0));
+        if (updates > PHC_SOIL_MAX_UPDATES) {
+            rc = phc_error_set(err, PHC_ERR_DOMAIN,
+                               "soil: this run would take %.3g voxel updates (stability limit %.3g h over %g h); "
+                               "the soil is too fast for the grid at these parameters", updates, lim, t[m - 1]);
+            phc_soil_free(s);
+            return rc;
+        }
+    }
     const size_t k = tangents ? su->k : 0;
     double **dp = NULL, **dic = NULL, **sw = NULL, *dfd = NULL, *dfg = NULL;
     if (k) {
