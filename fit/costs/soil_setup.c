@@ -581,16 +581,20 @@ int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *
     if (rc)
         return rc;
     /* A trial point of a fit can make the soil so fast (large p, tiny c) that
-       the stability limit needs millions of sub-steps: refuse runs of more
-       than PHC_SOIL_MAX_UPDATES voxel updates (a fit rejects the step). */
-    if (m > 0) {
+       the stability limit needs millions of sub-steps (a bounded line search
+       visits the bounds): a run that would sub-step more than
+       PHC_SOIL_MAX_SUBSTEP_RATIO times the configured dt and take over 1e8
+       voxel updates is refused (a fit rejects the step). */
+    if (m > 0 && s->params.substep) {
         double lim = phc_soil_stable_dt(s, NULL);
-        double h = fmin(s->params.dt, s->params.substep ? s->params.safety * lim : s->params.dt);
-        double updates = (t[m - 1] / h + (double)m) * (double)s->n * (1.0 + 3.0 * (tangents ? (double)su->k : 0));
-        if (updates > PHC_SOIL_MAX_UPDATES) {
+        double ratio = s->params.dt / (s->params.safety * lim);
+        double updates = (t[m - 1] / fmin(s->params.dt, s->params.safety * lim) + (double)m) * (double)s->n *
+                         (1.0 + 3.0 * (tangents ? (double)su->k : 0));
+        if (ratio > PHC_SOIL_MAX_SUBSTEP_RATIO && updates > 1e8) {
             rc = phc_error_set(err, PHC_ERR_DOMAIN,
-                               "soil: this run would take %.3g voxel updates (stability limit %.3g h over %g h); "
-                               "the soil is too fast for the grid at these parameters", updates, lim, t[m - 1]);
+                               "soil: dt = %g h would need %.0f sub-steps each (stability limit %.3g h), %.3g voxel "
+                               "updates in all: the soil is too fast for the grid at these parameters; lower dt",
+                               s->params.dt, ceil(ratio), lim, updates);
             phc_soil_free(s);
             return rc;
         }

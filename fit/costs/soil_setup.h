@@ -93,10 +93,11 @@ void phc_soil_setup_tangent(const phc_soil_setup *su, const phc_soil *s, double 
  * holds the k sensitivity fields d w / d slot when `tangents` is nonzero
  * (else NULL).  visit returns 0 to go on.  With keep, the soil at t[m-1]
  * is handed to the caller (free with phc_soil_free).  Errors: those of
- * build and phc_soil_run, and PHC_ERR_DOMAIN when visit stops or the run
- * would need more than PHC_SOIL_MAX_UPDATES voxel updates (tangents counted
- * as 3 each) because the parameters make the soil too fast for the grid. */
-#define PHC_SOIL_MAX_UPDATES 2e9 /* about 20 s of stepping: a run that needs more is refused */
+ * build and phc_soil_run, and PHC_ERR_DOMAIN when visit stops or when the
+ * parameters make the soil so fast that each dt would need more than
+ * PHC_SOIL_MAX_SUBSTEP_RATIO sub-steps and the run more than 1e8 voxel
+ * updates (tangents counted as 3 each). */
+#define PHC_SOIL_MAX_SUBSTEP_RATIO 100.0 /* sub-steps per configured dt beyond which a large run is refused */
 typedef int (*phc_soil_visit_fn)(void *user, const phc_soil *s, size_t i, double *const *sw);
 int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *t, size_t m, int tangents,
                        phc_soil_visit_fn visit, void *user, phc_soil **keep, phc_error *err);
