@@ -735,13 +735,13 @@ static int sources_and_sinks(phc_soil *s, double t, double h, phc_soil_budget *b
             if (dw >= 0)
                 bud->water_in += dw * vol;
             else {
-                dw = -dw > wn[i] ? -wn[i] : dw;
+                dw = -dw > fmax(wn[i], 0.0) ? -fmax(wn[i], 0.0) : dw; /* never below what is there */
                 bud->water_sunk -= dw * vol;
             }
             if (dv >= 0)
                 bud->nutrient_in += dv * vol;
             else {
-                dv = -dv > vn[i] ? -vn[i] : dv;
+                dv = -dv > fmax(vn[i], 0.0) ? -fmax(vn[i], 0.0) : dv;
                 bud->nutrient_sunk -= dv * vol;
             }
             wn[i] += dw;
@@ -761,8 +761,8 @@ static int sources_and_sinks(phc_soil *s, double t, double h, phc_soil_budget *b
             return PHC_ERR_DOMAIN;
         double sw = 0, sv = 0;
         for (size_t i = 0; i < s->n; ++i) {
-            double a = wk->sink_w[i] > 0 ? (wk->sink_w[i] < wn[i] ? wk->sink_w[i] : wn[i]) : 0;
-            double b = wk->sink_v[i] > 0 ? (wk->sink_v[i] < vn[i] ? wk->sink_v[i] : vn[i]) : 0;
+            double a = wk->sink_w[i] > 0 ? fmin(wk->sink_w[i], fmax(wn[i], 0.0)) : 0;
+            double b = wk->sink_v[i] > 0 ? fmin(wk->sink_v[i], fmax(vn[i], 0.0)) : 0;
             wn[i] -= a;
             vn[i] -= b;
             sw += a;

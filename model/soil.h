@@ -264,8 +264,9 @@ int phc_soil_sample(const phc_soil *s, const double *f, double x, double y, doub
 /* Depth (m below the top of the box) above which a fraction `frac` of the
  * water excess sum(w - w_ref) lies, with the excess taken per z-plane and
  * linear within a plane; `total` is the amount (m^3) that counts as 100%
- * (for example the rain applied).  When ds and dtotal are given, ds (n) is a
- * sensitivity field and *dd receives d depth / d theta.  Returns NAN when
+ * (for example the rain applied, taken as independent of the parameters).
+ * When ds and dd are given, ds (n) is a sensitivity field of the excess and
+ * *dd receives d depth / d theta.  Returns NAN when
  * the box holds less than frac * total of excess. */
 double phc_soil_infiltration_depth(const phc_soil *s, const double *w_ref, double frac,
                                    double total, const double *ds, double *dd);
