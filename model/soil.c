@@ -6,10 +6,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Grids smaller than this run their loops on one thread: a parallel region
- * costs more than updating a few thousand voxels (measured: a 3000-voxel
- * fit ran 30x slower on two threads than on one). */
-#define PHC_SOIL_PARALLEL_MIN 32768
+/* Grids smaller than this run their loops on one thread.  Measured on an
+ * idle 2-core machine: the soil_probe example (3000 voxels) fits in 2.55 s
+ * with parallel loops against 4.5 s serial, while the Fig. 7 notebook's
+ * 200-voxel columns take 0.12 s parallel against 0.10 s serial.  (With
+ * other processes busy on the cores, parallel regions on small grids were
+ * far slower: that example's fit once took 39 s.) */
+#ifndef PHC_SOIL_PARALLEL_MIN
+#define PHC_SOIL_PARALLEL_MIN 2048
+#endif
 
 struct phc_soil_work {
     double *w_new, *v_new;     /* next state */
@@ -186,30 +191,34 @@ void phc_soil_layer_of_planes(const phc_soil *s, const phc_soil_layer *layers, s
     }
 }
 
+int phc_soil_layer_check(const phc_soil_layer *l, size_t index, int last, phc_error *err)
+{
+    if (!isfinite(l->thickness) || !isfinite(l->c) || !isfinite(l->p) || !isfinite(l->d) || !isfinite(l->water) ||
+        !isfinite(l->fill) || !isfinite(l->nutrient))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: a value is not finite", index);
+    if (!(l->c > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: the capacity must be c > 0, found %g", index, l->c);
+    if (l->p < 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: the permeability must be p >= 0 (m/h), found %g", index,
+                             l->p);
+    if (l->d < 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: growth resistance d must be >= 0, found %g",
+                             index, l->d);
+    if ((l->fill < 0 && l->water < 0) || l->nutrient < 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: initial water and nutrients must be >= 0", index);
+    if (l->thickness <= 0 && !last)
+        return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: only the last layer may have no thickness", index);
+    return PHC_OK;
+}
+
 int phc_soil_set_layers(phc_soil *s, const phc_soil_layer *layers, size_t n, phc_error *err)
 {
     if (!n)
         return phc_error_set(err, PHC_ERR_INPUT, "soil: no layers given");
     for (size_t L = 0; L < n; ++L) {
-        const phc_soil_layer *l = &layers[L];
-        if (!isfinite(l->thickness) || !isfinite(l->c) || !isfinite(l->p) || !isfinite(l->d) ||
-            !isfinite(l->water) || !isfinite(l->fill) || !isfinite(l->nutrient))
-            return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: a value is not finite", L + 1);
-        if (!(l->c > 0))
-            return phc_error_set(err, PHC_ERR_INPUT, "soil layer %zu: capacity c must be > 0, found %g",
-                                 L + 1, l->c);
-        if (l->p < 0)
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "soil layer %zu: permeability p must be >= 0, found %g", L + 1, l->p);
-        if (l->d < 0)
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "soil layer %zu: growth resistance d must be >= 0, found %g", L + 1, l->d);
-        if ((l->fill < 0 && l->water < 0) || l->nutrient < 0)
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "soil layer %zu: initial water and nutrients must be >= 0", L + 1);
-        if (l->thickness <= 0 && L + 1 < n)
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "soil layer %zu: only the last layer may have no thickness", L + 1);
+        int rc = phc_soil_layer_check(&layers[L], L + 1, L + 1 == n, err);
+        if (rc)
+            return rc;
     }
     size_t *of_k = malloc(s->nz * sizeof *of_k);
     if (!of_k)
@@ -324,6 +333,17 @@ size_t phc_soil_add_nutrient_pockets(phc_soil *s, uint64_t seed, double scale, d
 
 /* ---- sources ----------------------------------------------------------- */
 
+/* A malloc'd copy of n items of `size` bytes (NULL for n = 0); *ok = 0
+ * when out of memory. */
+static void *copy_items(const void *src, size_t n, size_t size, int *ok)
+{
+    void *copy = n ? malloc(n * size) : NULL;
+    *ok = !n || copy;
+    if (copy)
+        memcpy(copy, src, n * size);
+    return copy;
+}
+
 int phc_soil_set_rain(phc_soil *s, const phc_soil_rain *rain, size_t n, phc_error *err)
 {
     for (size_t r = 0; r < n; ++r)
@@ -332,11 +352,10 @@ int phc_soil_set_rain(phc_soil *s, const phc_soil_rain *rain, size_t n, phc_erro
             return phc_error_set(err, PHC_ERR_INPUT,
                                  "rain %zu: needs rate >= 0, nutrient >= 0 and start <= end (found rate %g, "
                                  "start %g h, end %g h)", r + 1, rain[r].rate, rain[r].start, rain[r].end);
-    phc_soil_rain *copy = n ? malloc(n * sizeof *copy) : NULL;
-    if (n && !copy)
+    int ok;
+    phc_soil_rain *copy = copy_items(rain, n, sizeof *rain, &ok);
+    if (!ok)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if (n)
-        memcpy(copy, rain, n * sizeof *copy);
     free(s->rain);
     s->rain = copy;
     s->n_rain = n;
@@ -359,11 +378,10 @@ int phc_soil_set_sources(phc_soil *s, const phc_soil_source *src, size_t n, phc_
             return phc_error_set(err, PHC_ERR_INPUT, "source %zu: needs radius >= 0, start <= end and "
                                  "finite rates", q + 1);
     }
-    phc_soil_source *copy = n ? malloc(n * sizeof *copy) : NULL;
-    if (n && !copy)
+    int ok;
+    phc_soil_source *copy = copy_items(src, n, sizeof *src, &ok);
+    if (!ok)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if (n)
-        memcpy(copy, src, n * sizeof *copy);
     free(s->sources);
     s->sources = copy;
     s->n_sources = n;
@@ -536,31 +554,29 @@ static void prepare_fields(phc_soil *s)
     wk->damp_h = -1;
 }
 
-double phc_soil_stable_dt(const phc_soil *s, size_t *voxel)
+/* The stability limit from the prepared face permeabilities and 1/c:
+ * for every permeable voxel the positive root of a h^2 + b h = 1 with
+ * b = f_diff (sum of its faces' p_f) / (c dx^2), a = (f_grav p / dx)^2. */
+static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
 {
+    const phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
-    const phc_soil_boundary *b = s->params.boundary;
-    int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
-                  b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
-    double best = INFINITY, dx2 = s->dx * s->dx;
+    const double dx2 = s->dx * s->dx;
+    double best = INFINITY;
     size_t at = 0;
     for (size_t k = 0; k < nz; ++k)
         for (size_t j = 0; j < ny; ++j)
             for (size_t i = 0; i < nx; ++i) {
                 size_t q = idx3(s, i, j, k);
-                double pq = s->p[q];
-                if (!(pq > 0))
+                if (!(s->p[q] > 0))
                     continue;
-                double sum = 0;
-                if (i + 1 < nx || per[0]) sum += harmonic(pq, s->p[i + 1 < nx ? q + 1 : q + 1 - nx]);
-                if (i > 0 || per[0]) sum += harmonic(pq, s->p[i > 0 ? q - 1 : q + nx - 1]);
-                if (j + 1 < ny || per[1]) sum += harmonic(pq, s->p[j + 1 < ny ? q + nx : q + nx - plane]);
-                if (j > 0 || per[1]) sum += harmonic(pq, s->p[j > 0 ? q - nx : q + plane - nx]);
-                if (k + 1 < nz || per[2]) sum += harmonic(pq, s->p[k + 1 < nz ? q + plane : q + plane - s->n]);
-                if (k > 0 || per[2]) sum += harmonic(pq, s->p[k > 0 ? q - plane : q + s->n - plane]);
-                /* a h^2 + b h = 1 */
-                double bb = s->params.f_diff * sum / (s->c[q] * dx2);
-                double g = s->params.f_grav * pq / s->dx, a = g * g;
+                /* the -x, -y, -z faces are the +faces of the wrapped neighbours
+                   (0 across closed box faces) */
+                size_t qw = i > 0 ? q - 1 : q + nx - 1, qs = j > 0 ? q - nx : q + plane - nx;
+                size_t qd = k > 0 ? q - plane : q + s->n - plane;
+                double sum = wk->kx[q] + wk->kx[qw] + wk->ky[q] + wk->ky[qs] + wk->kz[q] + wk->kz[qd];
+                double bb = s->params.f_diff * sum * wk->ic[q] / dx2;
+                double g = s->params.f_grav * s->p[q] / s->dx, a = g * g;
                 double h = (a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY;
                 if (h < best) {
                     best = h;
@@ -570,6 +586,13 @@ double phc_soil_stable_dt(const phc_soil *s, size_t *voxel)
     if (voxel)
         *voxel = at;
     return best;
+}
+
+double phc_soil_stable_dt(const phc_soil *s, size_t *voxel)
+{
+    /* the work arrays are scratch, not state: filling them leaves s as it was */
+    prepare_fields((phc_soil *)s);
+    return stable_dt_prepared(s, voxel);
 }
 
 /* ---- the step ------------------------------------------------------------ */
@@ -587,22 +610,39 @@ static double nutrient_face_flux(double F, double wa, double wb, double va, doub
     return F * (0.5 * (ua + ub) - 0.5 * nu * (ub - ua));
 }
 
-/* The water update of voxel q (the same arithmetic, in the same order, as
- * the general loop below). */
+/* The face terms of voxel q: f[0..5] = k_f (l_j - l_q) towards the east,
+ * west, north, south, up and down neighbours (l = w/c), f[6] the downward
+ * gravity flux through the top face and f[7] through the bottom face
+ * (Lax-Wendroff, 0 across a closed face).  One definition for the water
+ * update and for the nutrients riding on the same fluxes. */
+static inline void voxel_faces(const double *restrict w, const double *restrict ic,
+                               const double *restrict p, const double *restrict kx,
+                               const double *restrict ky, const double *restrict kz, size_t q,
+                               size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
+                               double a, double lw, double f[8])
+{
+    const double l0 = w[q] * ic[q];
+    f[0] = kx[q] * (w[qe] * ic[qe] - l0);
+    f[1] = kx[qw] * (w[qw] * ic[qw] - l0);
+    f[2] = ky[q] * (w[qn] * ic[qn] - l0);
+    f[3] = ky[qs] * (w[qs] * ic[qs] - l0);
+    f[4] = kz[q] * (w[qu] * ic[qu] - l0);
+    f[5] = kz[qd] * (w[qd] * ic[qd] - l0);
+    const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
+    f[6] = kz[q] > 0 ? 0.5 * (qU + q0) - lw * kz[q] * (q0 - qU) : 0;
+    f[7] = kz[qd] > 0 ? 0.5 * (q0 + qD) - lw * kz[qd] * (qD - q0) : 0;
+}
+
+/* The water update of voxel q from its face terms. */
 static inline double water_voxel(const double *restrict w, const double *restrict ic,
                                  const double *restrict p, const double *restrict kx,
                                  const double *restrict ky, const double *restrict kz, size_t q,
                                  size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
                                  double a, double cd, double cg, double lw)
 {
-    const double l0 = w[q] * ic[q];
-    const double fe = kx[q] * (w[qe] * ic[qe] - l0), fw = kx[qw] * (w[qw] * ic[qw] - l0);
-    const double fnn = ky[q] * (w[qn] * ic[qn] - l0), fs = ky[qs] * (w[qs] * ic[qs] - l0);
-    const double fu = kz[q] * (w[qu] * ic[qu] - l0), fdn = kz[qd] * (w[qd] * ic[qd] - l0);
-    const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
-    const double gt = kz[q] > 0 ? 0.5 * (qU + q0) - lw * kz[q] * (q0 - qU) : 0;
-    const double gb = kz[qd] > 0 ? 0.5 * (q0 + qD) - lw * kz[qd] * (qD - q0) : 0;
-    return w[q] + cd * (fe + fw + fnn + fs + fu + fdn) + cg * (gt - gb);
+    double f[8];
+    voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, f);
+    return w[q] + cd * (f[0] + f[1] + f[2] + f[3] + f[4] + f[5]) + cg * (f[6] - f[7]);
 }
 
 /* Water only (no nutrients move): the x-interior of every row has no
@@ -658,7 +698,6 @@ static void transport(phc_soil *s, double h)
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const double fn = s->params.f_nutrient;
-    const int nut = wk->nutrients;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
@@ -669,27 +708,18 @@ static void transport(phc_soil *s, double h)
                 const size_t q = row + i;
                 const size_t qe = i + 1 < nx ? q + 1 : q + 1 - nx, qw = i > 0 ? q - 1 : q + nx - 1;
                 const size_t qn = q + jn, qs = q - js, qu = q + kup, qd = q - kdn;
-                const double l0 = w[q] * ic[q];
-                const double fe = kx[q] * (w[qe] * ic[qe] - l0), fw = kx[qw] * (w[qw] * ic[qw] - l0);
-                const double fnn = ky[q] * (w[qn] * ic[qn] - l0), fs = ky[qs] * (w[qs] * ic[qs] - l0);
-                const double fu = kz[q] * (w[qu] * ic[qu] - l0), fdn = kz[qd] * (w[qd] * ic[qd] - l0);
-                /* gravity: downward flux through the top face (from qu) and the bottom face (to qd) */
-                const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
-                const double gt = kz[q] > 0 ? 0.5 * (qU + q0) - lw * kz[q] * (q0 - qU) : 0;
-                const double gb = kz[qd] > 0 ? 0.5 * (q0 + qD) - lw * kz[qd] * (qD - q0) : 0;
-                wn[q] = w[q] + cd * (fe + fw + fnn + fs + fu + fdn) + cg * (gt - gb);
-                if (nut) {
-                    /* the water face fluxes out of q (m/h), then nutrients ride on them */
-                    const double dd = fd / dx;
-                    double acc = 0;
-                    acc -= nutrient_face_flux(-dd * fe, w[q], w[qe], v[q], v[qe], h, dx);
-                    acc -= nutrient_face_flux(-dd * fw, w[q], w[qw], v[q], v[qw], h, dx);
-                    acc -= nutrient_face_flux(-dd * fnn, w[q], w[qn], v[q], v[qn], h, dx);
-                    acc -= nutrient_face_flux(-dd * fs, w[q], w[qs], v[q], v[qs], h, dx);
-                    acc -= nutrient_face_flux(-dd * fu - gt, w[q], w[qu], v[q], v[qu], h, dx);
-                    acc -= nutrient_face_flux(-dd * fdn + gb, w[q], w[qd], v[q], v[qd], h, dx);
-                    vn[q] = v[q] + fn * cg * acc;
-                }
+                double f[8];
+                voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, f);
+                wn[q] = w[q] + cd * (f[0] + f[1] + f[2] + f[3] + f[4] + f[5]) + cg * (f[6] - f[7]);
+                /* the water face fluxes out of q (m/h), then nutrients ride on them */
+                const double dd = fd / dx;
+                const size_t nb[6] = {qe, qw, qn, qs, qu, qd};
+                const double out[6] = {-dd * f[0], -dd * f[1], -dd * f[2], -dd * f[3], -dd * f[4] - f[6],
+                                       -dd * f[5] + f[7]};
+                double acc = 0;
+                for (int e = 0; e < 6; ++e)
+                    acc -= nutrient_face_flux(out[e], w[q], w[nb[e]], v[q], v[nb[e]], h, dx);
+                vn[q] = v[q] + fn * cg * acc;
             }
         }
     }
@@ -972,8 +1002,18 @@ static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_
             }
     }
     size_t at = 0;
-    const double limit = phc_soil_stable_dt(s, &at), dt = s->params.dt;
+    const double limit = stable_dt_prepared(s, &at), dt = s->params.dt;
     const double eps = 1e-12 * (fabs(t_end) > 1 ? fabs(t_end) : 1);
+    if (s->params.substep && s->params.max_substeps && t_end - s->t > eps) {
+        double first = fmin(dt, t_end - s->t), need = ceil(first / (s->params.safety * limit));
+        if (first > limit && need > (double)s->params.max_substeps) {
+            rc = phc_error_set(err, PHC_ERR_DOMAIN,
+                               "soil: a step of %g h would need %.0f sub-steps (stability limit %.3g h), more than "
+                               "max_substeps = %zu: the soil is too fast for the grid at these parameters",
+                               first, need, limit, s->params.max_substeps);
+            goto done;
+        }
+    }
     const int absorb = any_absorb(s);
     phc_soil_work *wk = s->work;
     while (t_end - s->t > eps) {

@@ -95,6 +95,7 @@ typedef struct phc_soil_params {
     double dt;                              /* h, the step; default 0.001 (authors) */
     int substep;                            /* 1 (default): sub-step over the limit; 0: refuse */
     double safety;                          /* fraction of the limit used when sub-stepping, 0.9 */
+    size_t max_substeps;                    /* most sub-steps per step of dt; 0 (default) = no limit */
 } phc_soil_params;
 
 /* The defaults listed above. */
@@ -184,6 +185,11 @@ typedef struct phc_soil_layer {
     double nutrient;        /* initial v (units/m^3) */
 } phc_soil_layer;
 
+/* Checks one layer (1-based `index` for the message; `last` allows no
+ * thickness): finite values, c > 0, p >= 0, d >= 0, initial water (fill or
+ * water) and nutrients >= 0.  PHC_OK or PHC_ERR_INPUT "soil layer 2: ...". */
+int phc_soil_layer_check(const phc_soil_layer *l, size_t index, int last, phc_error *err);
+
 /* Fills c, p, d, w, v from layers (surface first).  The voxel belongs to the
  * layer containing its centre's depth below the top of the box.  Layers
  * that stop above the bottom are extended by the last one.  Errors:
@@ -227,8 +233,9 @@ void phc_soil_budget_reset(phc_soil *s);
 /* Advances from s->t to t_end (h) in steps of params.dt (the last one
  * shortened to land on t_end), each sub-stepped if over the limit.  Errors:
  * PHC_ERR_INPUT when dt exceeds the limit and substep is 0 (the message
- * gives both and the voxel), PHC_ERR_DOMAIN when the state stops being
- * finite or the sink hook stops the run. */
+ * gives both and the voxel), PHC_ERR_DOMAIN when a step would need more
+ * than max_substeps sub-steps (checked before any step is taken), when the
+ * state stops being finite or the sink hook stops the run. */
 int phc_soil_run(phc_soil *s, double t_end, phc_error *err);
 
 /* Forward sensitivities of w for m parameters.  Parameter q moves the

@@ -37,9 +37,10 @@ static void inf_free(void *p)
     free(im);
 }
 
-static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
+static int visit(void *user, const phc_soil *s, size_t i, const phc_soil_tangent *tan)
 {
     inf_impl *im = user;
+    double *const *sw = tan ? tan->sw : NULL;
     if (i == 0) { /* t = 0: the reference state */
         memcpy(im->w_ref, s->w, s->n * sizeof *s->w);
         for (size_t q = 0; sw && q < im->k; ++q)
@@ -125,22 +126,21 @@ static int inf_predict_at(phc_dataset *ds, const double *p, const double *x, siz
 static int inf_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
 {
     inf_impl *im = ds->impl;
-    phc_soil *s = NULL;
-    int rc = phc_soil_setup_run(im->su, p, im->t + ds->n - 1, 1, 0, NULL, NULL, &s, err);
+    char *md = NULL;
+    int rc = phc_soil_setup_report(im->su, p, im->t[ds->n - 1], &md, err);
     if (rc)
         return rc;
-    char *md = phc_soil_setup_markdown(im->su, p, s);
-    phc_soil_free(s);
-    if (!md)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    size_t len = strlen(md);
-    char *out = realloc(md, len + 200);
-    if (!out) {
-        free(md);
+    char *out = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&out, &len);
+    if (f)
+        fprintf(f, "%s\nObserved: the depth above which %.0f%% of the water applied so far lies.\n", md,
+                100 * im->fraction);
+    free(md);
+    if (!f || (ferror(f) | (fclose(f) != 0))) {
+        free(out);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
-    snprintf(out + len, 200, "\nObserved: the depth above which %.0f%% of the water applied so far lies.\n",
-             100 * im->fraction);
     *markdown = out;
     return PHC_OK;
 }

@@ -13,6 +13,7 @@ typedef struct fields_ctx {
     phc_soil_nc *nc;
     const phc_soil_setup *su;
     const char *dir, *base, *name;
+    const char *nc_path;
     size_t frames;
     double *snap[3];   /* w at t = 0, t_end/2, t_end for the slices */
     double t_snap[3];
@@ -20,10 +21,17 @@ typedef struct fields_ctx {
     int rc;
 } fields_ctx;
 
-static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
+static int visit(void *user, const phc_soil *s, size_t i, const phc_soil_tangent *tan)
 {
-    (void)sw;
+    (void)tan;
     fields_ctx *c = user;
+    if (!c->nc) { /* t = 0: the file takes this soil's capacity and permeability */
+        const phc_soil_setup *su = c->su;
+        phc_soil_nc_grid g = {su->nx, su->ny, su->nz, su->dx, {0, 0, 0}, su->has_geo, su->geo.lat0, su->geo.lon0,
+                              su->geo.h0, 1};
+        if ((c->rc = phc_soil_nc_create(c->nc_path, &g, c->name, NULL, s->c, s->p, &c->nc, c->err)))
+            return 1;
+    }
     if ((c->rc = phc_soil_nc_append(c->nc, s->t, s->w, s->v, c->err)))
         return 1;
     int which = i == 0 ? 0 : i == c->frames ? 2 : i == c->frames / 2 ? 1 : -1;
@@ -58,30 +66,21 @@ int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_en
                           const char *dir, const char *base, const char *name, phc_error *err)
 {
     phc_soil *s = NULL;
-    int rc = phc_soil_setup_build(su, p, &s, err);
-    if (rc)
-        return rc;
+    int rc = PHC_OK;
     char path[8192];
     snprintf(path, sizeof path, "%s/%s_fields.nc", dir, base);
-    phc_soil_nc_grid g = {su->nx, su->ny, su->nz, su->dx, {0, 0, 0}, su->has_geo, su->geo.lat0, su->geo.lon0,
-                          su->geo.h0, 1};
-    fields_ctx c = {NULL, su, dir, base, name, frames ? frames : 1, {NULL, NULL, NULL}, {0, 0, 0}, err, 0};
+    const size_t n = su->nx * su->ny * su->nz;
+    fields_ctx c = {NULL, su, dir, base, name, path, frames ? frames : 1, {NULL, NULL, NULL}, {0, 0, 0}, err, 0};
     for (int q = 0; q < 3; ++q)
-        if (!(c.snap[q] = malloc(s->n * sizeof(double)))) {
+        if (!(c.snap[q] = malloc(n * sizeof(double)))) {
             for (int r = 0; r < q; ++r)
                 free(c.snap[r]);
-            phc_soil_free(s);
             return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         }
-    rc = phc_soil_nc_create(path, &g, name, NULL, s->c, s->p, &c.nc, err);
-    /* the capacity and permeability at p; the run below builds its own soil */
-    phc_soil_free(s);
-    s = NULL;
-    if (rc)
-        return rc;
     double *t = malloc((c.frames + 1) * sizeof *t);
     if (!t) {
-        phc_soil_nc_close(c.nc, NULL);
+        for (int q = 0; q < 3; ++q)
+            free(c.snap[q]);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     for (size_t i = 0; i <= c.frames; ++i)
@@ -91,7 +90,7 @@ int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_en
     free(t);
     if (c.rc)
         rc = c.rc;
-    int rc2 = phc_soil_nc_close(c.nc, rc ? NULL : err);
+    int rc2 = c.nc ? phc_soil_nc_close(c.nc, rc ? NULL : err) : PHC_OK;
     if (!rc)
         rc = rc2;
     if (!rc)

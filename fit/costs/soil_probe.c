@@ -9,6 +9,7 @@
 #include "fit/costs/soil_fields.h"
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
+#include "fit/costs/unique_times.h"
 #include "measurements/soil_probes.h"
 #include "measurements/units.h"
 
@@ -44,7 +45,8 @@ static void sp_free(void *p)
 }
 
 /* The model value (w or w/c) of probe pi and its derivatives. */
-static int probe_value(const sp_impl *im, const phc_soil *s, size_t pi, double *const *sw, double *y, double *row)
+static int probe_value(const sp_impl *im, const phc_soil *s, size_t pi, const phc_soil_tangent *tan, double *y,
+                       double *row)
 {
     const phc_probe *pr = &im->probes->probes[pi];
     double wts[8], val;
@@ -57,23 +59,15 @@ static int probe_value(const sp_impl *im, const phc_soil *s, size_t pi, double *
             val += wts[c] * s->w[idx[c]] / s->c[idx[c]];
     }
     *y = val;
-    if (!row || !sw)
+    if (!row || !tan)
         return 0;
     for (size_t q = 0; q < im->k; ++q) {
+        const double *sw = tan->sw[q], *dic = tan->dinv_c[q];
         double d = 0;
         for (int c = 0; c < 8; ++c) {
             size_t v = idx[c];
-            if (!im->fill) {
-                d += wts[c] * sw[q][v];
-                continue;
-            }
-            double ic = 1.0 / s->c[v];
-            /* d(w/c) = sw / c + w d(1/c); d(1/c) = -1/c^2 for this voxel's capacity slot */
-            double dic = 0;
-            size_t k = v / (s->nx * s->ny);
-            if (im->su->slot_c[im->su->layer_of_k[k]] == (int)q)
-                dic = -ic * ic;
-            d += wts[c] * (sw[q][v] * ic + s->w[v] * dic);
+            /* w: d w = sw; w/c: d(w/c) = sw / c + w d(1/c) */
+            d += wts[c] * (im->fill ? sw[v] / s->c[v] + s->w[v] * dic[v] : sw[v]);
         }
         row[q] = d;
     }
@@ -86,7 +80,7 @@ typedef struct visit_ctx {
     int bad;
 } visit_ctx;
 
-static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
+static int visit(void *user, const phc_soil *s, size_t i, const phc_soil_tangent *tan)
 {
     visit_ctx *c = user;
     phc_dataset *ds = c->ds;
@@ -95,7 +89,7 @@ static int visit(void *user, const phc_soil *s, size_t i, double *const *sw)
         if (im->t_at[r] != i)
             continue;
         double *row = im->jac ? im->jac + r * ds->k : NULL;
-        if (probe_value(im, s, im->probe_of[r], sw, &im->yhat[r], row)) {
+        if (probe_value(im, s, im->probe_of[r], tan, &im->yhat[r], row)) {
             c->bad = 1;
             return 1;
         }
@@ -124,30 +118,30 @@ static int sp_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
 static int sp_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
 {
     sp_impl *im = ds->impl;
-    phc_soil *s = NULL;
-    int rc = phc_soil_setup_run(im->su, p, im->t_unique + im->m_unique - 1, 1, 0, NULL, NULL, &s, err);
+    char *md = NULL;
+    int rc = phc_soil_setup_report(im->su, p, im->t_unique[im->m_unique - 1], &md, err);
     if (rc)
         return rc;
-    char *md = phc_soil_setup_markdown(im->su, p, s);
-    phc_soil_free(s);
-    if (!md)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    size_t extra = 256 + im->probes->n * 160;
-    char *out = malloc(strlen(md) + extra);
-    if (!out) {
+    char *out = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&out, &len);
+    if (!f) {
         free(md);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
-    size_t len = (size_t)sprintf(out, "%s\n| probe | x (m) | y (m) | depth (m) | placed from |\n|---|---|---|---|---|\n", md);
+    fprintf(f, "%s\n| probe | x (m) | y (m) | depth (m) | placed from |\n|---|---|---|---|---|\n", md);
     for (size_t i = 0; i < im->probes->n; ++i) {
         const phc_probe *pr = &im->probes->probes[i];
-        char from[96];
         if (pr->geographic)
-            snprintf(from, sizeof from, "%.6f, %.6f", pr->lat, pr->lon);
+            fprintf(f, "| %s | %.3f | %.3f | %.3f | %.6f, %.6f |\n", pr->id, pr->x, pr->y, pr->depth, pr->lat,
+                    pr->lon);
         else
-            snprintf(from, sizeof from, "grid metres");
-        len += (size_t)snprintf(out + len, 160, "| %.40s | %.3f | %.3f | %.3f | %s |\n", pr->id, pr->x, pr->y,
-                                pr->depth, from);
+            fprintf(f, "| %s | %.3f | %.3f | %.3f | grid metres |\n", pr->id, pr->x, pr->y, pr->depth);
+    }
+    if (ferror(f) | (fclose(f) != 0)) {
+        free(md);
+        free(out);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     free(md);
     *markdown = out;
@@ -163,11 +157,6 @@ static int sp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
 static const phc_dataset_ops soil_probe_ops = {"soil_probe", sp_predict, NULL, sp_free, sp_report_section,
                                                sp_simulate_outputs};
 
-static int by_value(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 
 int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
@@ -307,9 +296,7 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
         goto fail;
     }
     im->probe_of = malloc(n * sizeof *im->probe_of);
-    im->t_unique = malloc(n * sizeof *im->t_unique);
-    im->t_at = malloc(n * sizeof *im->t_at);
-    if (!im->probe_of || !im->t_unique || !im->t_at) {
+    if (!im->probe_of) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -326,20 +313,9 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
         ds->sigma[r] = s;
         ds->data_lines[r] = ser->line[r];
         im->probe_of[r] = ser->probe[r];
-        im->t_unique[r] = ds->x[r];
     }
-    qsort(im->t_unique, n, sizeof *im->t_unique, by_value);
-    size_t m = 0;
-    for (size_t r = 0; r < n; ++r)
-        if (!m || im->t_unique[r] != im->t_unique[m - 1])
-            im->t_unique[m++] = im->t_unique[r];
-    im->m_unique = m;
-    for (size_t r = 0; r < n; ++r)
-        for (size_t i = 0; i < m; ++i)
-            if (im->t_unique[i] == ds->x[r]) {
-                im->t_at[r] = i;
-                break;
-            }
+    if ((rc = phc_unique_times(ds->x, n, &im->t_unique, &im->m_unique, &im->t_at, err)))
+        goto fail;
     ds->x_label = strdup(x_label ? x_label : "time since start (h)");
     ds->y_label = strdup(y_label ? y_label : im->fill ? "fill level w/c" : "water content w (m³/m³)");
     if (!ds->x_label || !ds->y_label) {

@@ -2,12 +2,11 @@
 #include "fit/costs/soil_setup.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-const char *const phc_soil_setup_keys[] = {"grid", "dt", "substep", "f_diff", "f_grav", "f_nutrient",
+const char *const phc_soil_setup_keys[] = {"grid", "dt", "substep", "max_substeps", "f_diff", "f_grav", "f_nutrient",
                                            "boundaries", "absorb", "layers", "rocks", "nutrient_pockets",
                                            "rain", "sources", "geo_origin", NULL};
 
@@ -139,16 +138,11 @@ static int parse_layers(const phc_yaml_doc *doc, const phc_yaml_node *seq, phc_s
         if (L + 1 < seq->count && !(l->thickness > 0))
             return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: thickness must be > 0 m, found %g", doc->path,
                                  phc_key_line(n, "thickness"), ctx, l->thickness);
+        phc_error model_err;
+        if (phc_soil_layer_check(l, L + 1, L + 1 == seq->count, &model_err)) /* the model's checks, with the line */
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s", doc->path, n->line, model_err.message);
         if (!(su->layer_names[L] = strdup(preset ? preset : "custom")))
             return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    }
-    for (size_t L = 0; L < su->n_layers; ++L) { /* the model's own checks, with the config line */
-        const phc_soil_layer *l = &su->layers[L];
-        if (!(l->c > 0) || !(l->p >= 0) || !(l->d >= 0) || !(l->nutrient >= 0))
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: soil layer %zu: needs c > 0, p >= 0, d >= 0 and nutrient >= 0 "
-                                 "(found c = %g, p = %g, d = %g, nutrient = %g)",
-                                 doc->path, seq->items[L]->line, L + 1, l->c, l->p, l->d, l->nutrient);
     }
     return PHC_OK;
 }
@@ -309,6 +303,7 @@ int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc
     su->line = soil->line;
     su->params = phc_soil_params_default();
     su->params.dt = 0.01;
+    su->params.max_substeps = 100; /* a fit's trial point 100x too fast for dt is refused, not run */
     su->slot_fd = su->slot_fg = -1;
     const phc_yaml_node *grid = phc_yaml_get(soil, "grid");
     long nx = 1, ny = 1, nz = 0;
@@ -335,12 +330,20 @@ int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc
     su->nz = (size_t)nz;
     su->dx = dx;
     phc_soil_params *pr = &su->params;
+    long max_sub = (long)pr->max_substeps;
     if ((rc = phc_yaml_map_number(doc, soil, "dt", 0, ctx, &pr->dt, err)) ||
+        (rc = phc_yaml_map_integer(doc, soil, "max_substeps", 0, ctx, &max_sub, err)) ||
         (rc = phc_yaml_map_boolean(doc, soil, "substep", 0, ctx, &pr->substep, err)) ||
         (rc = phc_yaml_map_number(doc, soil, "f_diff", 0, ctx, &pr->f_diff, err)) ||
         (rc = phc_yaml_map_number(doc, soil, "f_grav", 0, ctx, &pr->f_grav, err)) ||
         (rc = phc_yaml_map_number(doc, soil, "f_nutrient", 0, ctx, &pr->f_nutrient, err)))
         goto fail;
+    if (max_sub < 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil: max_substeps must be >= 0 (0 = no limit)", doc->path,
+                           phc_key_line(soil, "max_substeps"));
+        goto fail;
+    }
+    pr->max_substeps = (size_t)max_sub;
     if (!(pr->dt > 0) || !(pr->f_diff >= 0) || !(pr->f_grav >= 0) || !(pr->f_nutrient >= 0)) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil: needs dt > 0 h and f_diff, f_grav, f_nutrient >= 0",
                            doc->path, soil->line);
@@ -431,27 +434,18 @@ int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc
        soil is refused here, with the limit (trial points of a fit that cross
        it are rejected as outside the model's domain). */
     if (!pr->substep) {
-        phc_soil *tmp = phc_soil_new(su->nx, su->ny, su->nz, su->dx);
-        if (!tmp) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        phc_soil *tmp = NULL;
+        if ((rc = phc_soil_setup_build(su, NULL, &tmp, err)))
             goto fail;
-        }
-        tmp->params = *pr;
-        phc_error e2;
-        if (phc_soil_set_layers(tmp, su->layers, su->n_layers, &e2) == PHC_OK) {
-            for (size_t i = 0; su->rock && i < tmp->n; ++i)
-                if (su->rock[i])
-                    tmp->p[i] = 0;
-            size_t at = 0;
-            double lim = phc_soil_stable_dt(tmp, &at);
-            if (pr->dt > lim) {
-                size_t i = at % su->nx, j = (at / su->nx) % su->ny, k = at / (su->nx * su->ny);
-                rc = phc_error_set(err, PHC_ERR_INPUT,
-                                   "%s:%zu: soil: dt = %g h exceeds the stability limit %g h of the explicit step "
-                                   "(set by voxel (%zu, %zu, %zu), p = %g m/h, c = %g) and substep is false; lower "
-                                   "dt or allow sub-stepping", doc->path, phc_key_line(soil, "dt"), pr->dt, lim, i, j,
-                                   k, tmp->p[at], tmp->c[at]);
-            }
+        size_t at = 0;
+        double lim = phc_soil_stable_dt(tmp, &at);
+        if (pr->dt > lim) {
+            size_t i = at % su->nx, j = (at / su->nx) % su->ny, k = at / (su->nx * su->ny);
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: soil: dt = %g h exceeds the stability limit %g h of the explicit step "
+                               "(set by voxel (%zu, %zu, %zu), p = %g m/h, c = %g) and substep is false; lower "
+                               "dt or allow sub-stepping", doc->path, phc_key_line(soil, "dt"), pr->dt, lim, i, j, k,
+                               tmp->p[at], tmp->c[at]);
         }
         phc_soil_free(tmp);
         if (rc)
@@ -580,25 +574,6 @@ int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *
     int rc = phc_soil_setup_build(su, p, &s, err);
     if (rc)
         return rc;
-    /* A trial point of a fit can make the soil so fast (large p, tiny c) that
-       the stability limit needs millions of sub-steps (a bounded line search
-       visits the bounds): a run that would sub-step more than
-       PHC_SOIL_MAX_SUBSTEP_RATIO times the configured dt and take over 1e8
-       voxel updates is refused (a fit rejects the step). */
-    if (m > 0 && s->params.substep) {
-        double lim = phc_soil_stable_dt(s, NULL);
-        double ratio = s->params.dt / (s->params.safety * lim);
-        double updates = (t[m - 1] / fmin(s->params.dt, s->params.safety * lim) + (double)m) * (double)s->n *
-                         (1.0 + 3.0 * (tangents ? (double)su->k : 0));
-        if (ratio > PHC_SOIL_MAX_SUBSTEP_RATIO && updates > 1e8) {
-            rc = phc_error_set(err, PHC_ERR_DOMAIN,
-                               "soil: dt = %g h would need %.0f sub-steps each (stability limit %.3g h), %.3g voxel "
-                               "updates in all: the soil is too fast for the grid at these parameters; lower dt",
-                               s->params.dt, ceil(ratio), lim, updates);
-            phc_soil_free(s);
-            return rc;
-        }
-    }
     const size_t k = tangents ? su->k : 0;
     double **dp = NULL, **dic = NULL, **sw = NULL, *dfd = NULL, *dfg = NULL;
     if (k) {
@@ -622,7 +597,7 @@ int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *
         rc = k ? phc_soil_run_tangent(s, t[i], &tan, err) : phc_soil_run(s, t[i], err);
         if (rc)
             goto done;
-        if (visit && visit(user, s, i, k ? tan.sw : NULL)) {
+        if (visit && visit(user, s, i, k ? &tan : NULL)) {
             rc = phc_error_set(err, PHC_ERR_DOMAIN, "soil: stopped at t = %g h", t[i]);
             goto done;
         }
@@ -667,53 +642,28 @@ phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_
     return ds;
 }
 
-/* Appends printf text to a growing buffer. */
-static void cat(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    char tmp[1024];
-    int m = vsnprintf(tmp, sizeof tmp, fmt, ap);
-    va_end(ap);
-    if (m < 0 || !*buf)
-        return;
-    if (*len + (size_t)m + 1 > *cap) {
-        size_t nc = (*cap + (size_t)m + 1) * 2;
-        char *nb = realloc(*buf, nc);
-        if (!nb) {
-            free(*buf);
-            *buf = NULL;
-            return;
-        }
-        *buf = nb;
-        *cap = nc;
-    }
-    memcpy(*buf + *len, tmp, (size_t)m + 1);
-    *len += (size_t)m;
-}
-
 char *phc_soil_setup_markdown(const phc_soil_setup *su, const double *p, const phc_soil *s)
 {
-    size_t len = 0, cap = 2048;
-    char *b = malloc(cap);
-    if (!b)
+    char *b = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&b, &len);
+    if (!f)
         return NULL;
-    b[0] = '\0';
     static const char *bn[] = {"block", "absorb", "periodic"};
     const phc_soil_params *pr = &s->params;
-    cat(&b, &len, &cap, "Soil (Rhizomorph §6): %zu x %zu x %zu voxels of %g m (%g x %g m, %g m deep); "
+    fprintf(f, "Soil (Rhizomorph §6): %zu x %zu x %zu voxels of %g m (%g x %g m, %g m deep); "
         "f_diff = %g m, f_grav = %g; dt = %g h, %s.\n\n", su->nx, su->ny, su->nz, su->dx, su->nx * su->dx,
         su->ny * su->dx, su->nz * su->dx, pr->f_diff, pr->f_grav, pr->dt,
         pr->substep ? "sub-stepped over the stability limit" : "no sub-stepping");
-    cat(&b, &len, &cap, "Boundaries: x %s/%s, y %s/%s, bottom %s, top %s", bn[pr->boundary[0]], bn[pr->boundary[1]],
+    fprintf(f, "Boundaries: x %s/%s, y %s/%s, bottom %s, top %s", bn[pr->boundary[0]], bn[pr->boundary[1]],
         bn[pr->boundary[2]], bn[pr->boundary[3]], bn[pr->boundary[4]], bn[pr->boundary[5]]);
-    for (int f = 0; f < PHC_SOIL_FACES; ++f)
-        if (pr->boundary[f] == PHC_SOIL_ABSORB) {
-            cat(&b, &len, &cap, "; absorbing layers: %d, %s form", pr->absorb_width,
+    for (int face = 0; face < PHC_SOIL_FACES; ++face)
+        if (pr->boundary[face] == PHC_SOIL_ABSORB) {
+            fprintf(f, "; absorbing layers: %d, %s form", pr->absorb_width,
                 pr->absorb_form == PHC_SOIL_ABSORB_CODE ? "the authors' code (i²)" : "the paper's eq. 31 (i)");
             break;
         }
-    cat(&b, &len, &cap, ".\n\n| layer | soil | thickness (m) | c | p (m/h) | D = f_diff p/c (m²/h) | gravity velocity f_grav p (m/h) |\n|---|---|---|---|---|---|---|\n");
+    fprintf(f, ".\n\n| layer | soil | thickness (m) | c | p (m/h) | D = f_diff p/c (m²/h) | gravity velocity f_grav p (m/h) |\n|---|---|---|---|---|---|---|\n");
     for (size_t L = 0; L < su->n_layers; ++L) {
         double pv = phc_soil_setup_p(su, L, p), cv = phc_soil_setup_c(su, L, p);
         char thick[32];
@@ -721,18 +671,34 @@ char *phc_soil_setup_markdown(const phc_soil_setup *su, const double *p, const p
             snprintf(thick, sizeof thick, "%g", su->layers[L].thickness);
         else
             snprintf(thick, sizeof thick, "to the bottom");
-        cat(&b, &len, &cap, "| %zu | %s | %s | %.6g%s | %.6g%s | %.4g | %.4g |\n", L + 1, su->layer_names[L], thick, cv,
+        fprintf(f, "| %zu | %s | %s | %.6g%s | %.6g%s | %.4g | %.4g |\n", L + 1, su->layer_names[L], thick, cv,
             su->slot_c[L] >= 0 ? " (fitted)" : "", pv, su->slot_p[L] >= 0 ? " (fitted)" : "", pr->f_diff * pv / cv,
             pr->f_grav * pv);
     }
     size_t at = 0;
     double lim = phc_soil_stable_dt(s, &at);
-    cat(&b, &len, &cap, "\nStability limit of the explicit step: %.4g h (voxel %zu); %zu steps, %zu sub-steps.\n\n",
+    fprintf(f, "\nStability limit of the explicit step: %.4g h (voxel %zu); %zu steps, %zu sub-steps.\n\n",
         lim, at, s->budget.steps, s->budget.substeps);
     const phc_soil_budget *bu = &s->budget;
-    cat(&b, &len, &cap, "Water budget (m³) over the run to t = %g h: initial %.6g, in %.6g, absorbed %.6g, "
+    fprintf(f, "Water budget (m³) over the run to t = %g h: initial %.6g, in %.6g, absorbed %.6g, "
         "taken by sinks %.6g, stored %.6g; closing error %.3g (%.2g of the water moved).\n", s->t, bu->water_initial,
         bu->water_in, bu->water_absorbed, bu->water_sunk, bu->water_stored, bu->water_closing,
         fabs(bu->water_closing) / fmax(1e-300, bu->water_initial + bu->water_in));
+    if (ferror(f) | (fclose(f) != 0)) {
+        free(b);
+        return NULL;
+    }
     return b;
+}
+
+int phc_soil_setup_report(const phc_soil_setup *su, const double *p, double t_end, char **markdown,
+                          phc_error *err)
+{
+    phc_soil *s = NULL;
+    int rc = phc_soil_setup_run(su, p, &t_end, 1, 0, NULL, NULL, &s, err);
+    if (rc)
+        return rc;
+    *markdown = phc_soil_setup_markdown(su, p, s);
+    phc_soil_free(s);
+    return *markdown ? PHC_OK : phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
 }

@@ -7,6 +7,8 @@
  *     grid: {nx: 1, ny: 1, nz: 60, dx: 0.02}     # voxels, m
  *     dt: 0.01                 # h, the step (sub-stepped over the stability limit)
  *     substep: true            # false: refuse a dt over the limit instead
+ *     max_substeps: 100        # more sub-steps per dt (a fit's trial point making the
+ *                              # soil far too fast for the grid) is refused; 0 = no limit
  *     f_diff: 1                # m; f_grav: 1; f_nutrient: 1
  *     boundaries: {sides: periodic, bottom: absorb, top: block}
  *                              # or x_min, x_max, y_min, y_max; block | absorb | periodic
@@ -89,16 +91,14 @@ void phc_soil_setup_tangent(const phc_soil_setup *su, const phc_soil *s, double 
                             double *dfd, double *dfg, double **sw);
 
 /* Builds a soil at slot values p and runs it through the sorted times
- * t[0..m-1] (h, >= 0), calling visit(user, s, i, sw) on reaching t[i]; sw
- * holds the k sensitivity fields d w / d slot when `tangents` is nonzero
- * (else NULL).  visit returns 0 to go on.  With keep, the soil at t[m-1]
+ * t[0..m-1] (h, >= 0), calling visit(user, s, i, tan) on reaching t[i];
+ * when `tangents` is nonzero tan holds the k slots' directions (dp,
+ * dinv_c, dfd, dfg) and sensitivity fields sw = d w / d slot, else it is
+ * NULL.  visit returns 0 to go on.  With keep, the soil at t[m-1]
  * is handed to the caller (free with phc_soil_free).  Errors: those of
- * build and phc_soil_run, and PHC_ERR_DOMAIN when visit stops or when the
- * parameters make the soil so fast that each dt would need more than
- * PHC_SOIL_MAX_SUBSTEP_RATIO sub-steps and the run more than 1e8 voxel
- * updates (tangents counted as 3 each). */
-#define PHC_SOIL_MAX_SUBSTEP_RATIO 100.0 /* sub-steps per configured dt beyond which a large run is refused */
-typedef int (*phc_soil_visit_fn)(void *user, const phc_soil *s, size_t i, double *const *sw);
+ * build and phc_soil_run (PHC_ERR_DOMAIN over max_substeps), and
+ * PHC_ERR_DOMAIN when visit stops. */
+typedef int (*phc_soil_visit_fn)(void *user, const phc_soil *s, size_t i, const phc_soil_tangent *tan);
 int phc_soil_setup_run(const phc_soil_setup *su, const double *p, const double *t, size_t m, int tangents,
                        phc_soil_visit_fn visit, void *user, phc_soil **keep, phc_error *err);
 
@@ -115,5 +115,10 @@ phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_
 /* A markdown description of the set-up at p and of the run's budget
  * (s after a run); malloc'd. */
 char *phc_soil_setup_markdown(const phc_soil_setup *su, const double *p, const phc_soil *s);
+
+/* The same after running the set-up at p from 0 to t_end h (the kinds'
+ * report sections): *markdown malloc'd; errors of the run. */
+int phc_soil_setup_report(const phc_soil_setup *su, const double *p, double t_end, char **markdown,
+                          phc_error *err);
 
 #endif /* PHC_COSTS_SOIL_SETUP_H */

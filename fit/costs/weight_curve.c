@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fit/costs/source_file.h"
+#include "fit/costs/unique_times.h"
 #include "measurements/c_number.h"
 #include "measurements/plant_io.h"
 #include "measurements/table.h"
@@ -184,42 +185,6 @@ static const phc_dataset_ops weight_curve_ops = {"weight_curve", wc_predict, wc_
                                                  wc_free, wc_report_section, NULL};
 
 /* ---- loading ------------------------------------------------------------- */
-
-static int by_value(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* t_unique and t_at from the n model times (every piece starts at 0, so
- * after a watering the times repeat those of the first piece). */
-static int unique_times(wc_impl *w, size_t n, phc_error *err)
-{
-    w->t_unique = malloc(n * sizeof *w->t_unique);
-    w->t_at = malloc(n * sizeof *w->t_at);
-    if (!w->t_unique || !w->t_at)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    memcpy(w->t_unique, w->t_model, n * sizeof *w->t_unique);
-    qsort(w->t_unique, n, sizeof *w->t_unique, by_value);
-    size_t m = 0;
-    for (size_t i = 0; i < n; ++i)
-        if (m == 0 || w->t_unique[i] != w->t_unique[m - 1])
-            w->t_unique[m++] = w->t_unique[i];
-    w->m_unique = m;
-    for (size_t i = 0; i < n; ++i) {
-        size_t lo = 0, hi = m; /* first index with t_unique >= t_model[i] */
-        while (lo < hi) {
-            const size_t mid = lo + (hi - lo) / 2;
-            if (w->t_unique[mid] < w->t_model[i])
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        w->t_at[i] = lo;
-    }
-    return PHC_OK;
-}
-
 
 /* A quantity given as a number, or {value: X | column: NAME, unit: UNIT};
  * a column is read at the first selected row.  Converted to `model_unit`. */
@@ -698,7 +663,7 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     w->pieces[k].count = n_kept - w->pieces[k].first;
     w->n_pieces = n_pieces;
-    if ((rc = unique_times(w, n, err)))
+    if ((rc = phc_unique_times(w->t_model, n, &w->t_unique, &w->m_unique, &w->t_at, err)))
         goto fail;
     w->u = malloc(w->m_unique * sizeof *w->u);
     w->du = malloc(3 * w->m_unique * sizeof *w->du);

@@ -274,8 +274,16 @@ static void test_stability(void)
     CHECK(rc == PHC_ERR_INPUT);
     CHECK_STR_CONTAINS(err.message, "stability limit");
     CHECK(s->t == 0 && !memcmp(s->w, w0, s->n * sizeof(double)));
+    /* a step needing 4 sub-steps with max_substeps 3 is refused before it runs */
     s->params.substep = 1;
-    phc_soil_budget_reset(s);
+    s->params.max_substeps = 3;
+    phc_error_clear(&err);
+    rc = phc_soil_run(s, 10 * s->params.dt, &err);
+    printf("   substep 1, max_substeps 3 -> rc %d: \"%s\"\n", rc, err.message);
+    CHECK(rc == PHC_ERR_DOMAIN);
+    CHECK_STR_CONTAINS(err.message, "max_substeps");
+    CHECK(s->t == 0 && !memcmp(s->w, w0, s->n * sizeof(double)));
+    s->params.max_substeps = 4;
     rc = phc_soil_run(s, 10 * s->params.dt, &err);
     double mx0 = maxv(w0, s->n), mn0 = minv(w0, s->n), mx = maxv(s->w, s->n), mn = minv(s->w, s->n);
     printf("   substep 1: rc %d, steps %zu, substeps %zu; w in [%.6f, %.6f] vs initial [%.6f, %.6f]\n", rc,
