@@ -13,6 +13,7 @@
 #include "model/status.h"
 
 typedef struct phc_dataset phc_dataset;
+struct phc_problem;
 
 typedef struct phc_dataset_ops {
     const char *kind; /* "curve", ... */
@@ -35,6 +36,11 @@ typedef struct phc_dataset_ops {
      * `base` (for example gridded fields as NetCDF and slice plots). */
     int (*simulate_outputs)(phc_dataset *ds, const double *p, const char *dir, const char *base,
                             phc_error *err);
+    /* Optional (NULL = none): extra files of `phytocal fit` at the fitted
+     * slot values p (for example observed beside simulated images), written
+     * into the run's directory dir with names starting with `base`. */
+    int (*fit_outputs)(phc_dataset *ds, const double *p, const char *dir, const char *base,
+                       phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {
@@ -61,6 +67,9 @@ struct phc_dataset {
     size_t *series;              /* n series ids (e.g. the probe of each reading) when the
                                     observations form several curves over x, or NULL: the
                                     fit plot then draws one model line per series */
+    const struct phc_problem *problem; /* the problem holding it (set when added): kinds
+                                    that refit themselves (cross-validation) read the
+                                    bounds and fixed flags of their slots there */
 };
 
 /* Allocates an empty data set with k slots (names and indices zeroed). */

@@ -95,6 +95,7 @@ int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err)
     }
     pb->datasets = grown;
     pb->datasets[pb->n_datasets++] = ds;
+    ds->problem = pb;
     return PHC_OK;
 }
 

@@ -235,7 +235,31 @@ int phc_run_dir_commit(const char *tmpdir, const char *dir, phc_error *err)
     return PHC_OK;
 }
 
-int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc_error *err)
+/* The kinds' own files at the fitted values (dataset.h, fit_outputs). */
+static int write_kind_outputs(const phc_fit_result *res, const phc_problem *pb, const char *tmpdir,
+                              phc_error *err)
+{
+    for (size_t d = 0; pb && d < pb->n_datasets; ++d) {
+        phc_dataset *ds = pb->datasets[d];
+        if (!ds->ops->fit_outputs)
+            continue;
+        double *p = malloc((ds->k ? ds->k : 1) * sizeof *p);
+        if (!p)
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t j = 0; j < ds->k; ++j)
+            p[j] = res->params[ds->param_index[j]].value;
+        char base[256];
+        phc_run_dir_safe_name(ds->name, base, sizeof base);
+        const int rc = ds->ops->fit_outputs(ds, p, tmpdir, base, err);
+        free(p);
+        if (rc)
+            return rc;
+    }
+    return PHC_OK;
+}
+
+int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const char *dir, int force,
+                      phc_error *err)
 {
     char tmpdir[4096], path[8192];
     int rc;
@@ -243,7 +267,8 @@ int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force, phc
         return rc;
     char *names[MAX_PLOTS] = {0};
     size_t n_names = 0;
-    if ((rc = write_plots(res, tmpdir, names, &n_names, err)))
+    if ((rc = write_plots(res, tmpdir, names, &n_names, err)) ||
+        (rc = write_kind_outputs(res, pb, tmpdir, err)))
         goto fail;
     snprintf(path, sizeof path, "%s/result.json", tmpdir);
     if ((rc = phc_result_write_json(res, path, err)))

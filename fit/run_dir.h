@@ -15,8 +15,10 @@
 int phc_run_dir_check(const char *dir, int force, phc_error *err);
 
 /* Writes a fit's run directory (result.json, report.md, plots) by the three
- * steps below. */
-int phc_run_dir_write(const phc_fit_result *res, const char *dir, int force,
+ * steps below.  pb (may be NULL) is the problem that was fitted: data sets
+ * whose kind writes its own files (dataset.h, fit_outputs) add them, at the
+ * fitted values. */
+int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const char *dir, int force,
                       phc_error *err);
 
 /* The steps, for any command that writes a run directory:

@@ -166,10 +166,13 @@ static int cmd_fit(int argc, char **argv)
     int tty = isatty(STDERR_FILENO);
     phc_fit_result *res = NULL;
     int rc = phc_fit_run(pb, o.quiet ? NULL : progress_cb, &tty, &res, &err);
-    phc_problem_free(pb);
-    if (rc)
+    if (rc) {
+        phc_problem_free(pb);
         return fail(&err);
-    if ((rc = phc_run_dir_write(res, dir, o.force, &err))) {
+    }
+    rc = phc_run_dir_write(res, pb, dir, o.force, &err);
+    phc_problem_free(pb);
+    if (rc) {
         phc_fit_result_free(res);
         return fail(&err);
     }

@@ -46,7 +46,7 @@ static void pv_extra_free(void *p)
 static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
 
 static const phc_dataset_ops pv_ops = {"pv_curve", phc_elasticity_predict, phc_elasticity_predict_at,
-                                       phc_elasticity_impl_free, pv_report_section, NULL};
+                                       phc_elasticity_impl_free, pv_report_section, NULL, NULL};
 
 static pv_extra *extra_of(const phc_dataset *ds)
 {

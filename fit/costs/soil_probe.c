@@ -155,7 +155,7 @@ static int sp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
 }
 
 static const phc_dataset_ops soil_probe_ops = {"soil_probe", sp_predict, NULL, sp_free, sp_report_section,
-                                               sp_simulate_outputs};
+                                               sp_simulate_outputs, NULL};
 
 
 

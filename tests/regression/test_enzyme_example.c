@@ -77,7 +77,7 @@ int main(void)
     CHECK(mkdtemp(dir) != NULL);
     char out[256], path[512];
     snprintf(out, sizeof out, "%s/run", dir);
-    CHECK(phc_run_dir_write(res, out, 0, &err) == PHC_OK);
+    CHECK(phc_run_dir_write(res, NULL, out, 0, &err) == PHC_OK);
     const char *files[] = {"result.json", "report.md", "assay_fit.png", "assay_residuals.png", "assay_qq.png",
                            "assay_acf.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
@@ -86,7 +86,7 @@ int main(void)
         CHECK(stat(path, &st) == 0 && st.st_size > 0);
     }
     /* a second write without force is refused and leaves the run intact */
-    CHECK(phc_run_dir_write(res, out, 0, &err) == PHC_ERR_EXISTS);
+    CHECK(phc_run_dir_write(res, NULL, out, 0, &err) == PHC_ERR_EXISTS);
     phc_fit_result *back = NULL;
     snprintf(path, sizeof path, "%s/result.json", out);
     CHECK(phc_result_read_json(path, &back, &err) == PHC_OK);

@@ -102,7 +102,7 @@ int main(void)
     CHECK(mkdtemp(dir) != NULL);
     char out[256], path[512];
     snprintf(out, sizeof out, "%s/run", dir);
-    CHECK(phc_run_dir_write(res, out, 0, &err) == PHC_OK);
+    CHECK(phc_run_dir_write(res, NULL, out, 0, &err) == PHC_OK);
     const char *files[] = {"result.json", "report.md", "moduli_fit.png", "moduli_residuals.png"};
     for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
         struct stat st;
