@@ -10,6 +10,7 @@
 #include "fit/costs/curve.h"
 #include "fit/costs/elasticity_curve.h"
 #include "fit/costs/infiltration.h"
+#include "fit/costs/leaf_photos.h"
 #include "fit/costs/pv_curve.h"
 #include "fit/costs/soil_probe.h"
 #include "fit/costs/weight_curve.h"
@@ -30,6 +31,7 @@ static const kind_entry kinds[] = {
     {"curve", phc_curve_keys, phc_curve_load},
     {"elasticity_curve", phc_elasticity_curve_keys, phc_elasticity_curve_load},
     {"infiltration", phc_infiltration_keys, phc_infiltration_load},
+    {"leaf_photos", phc_leaf_photos_keys, phc_leaf_photos_load},
     {"pv_curve", phc_pv_curve_keys, phc_pv_curve_load},
     {"soil_probe", phc_soil_probe_keys, phc_soil_probe_load},
     {"weight_curve", phc_weight_curve_keys, phc_weight_curve_load},

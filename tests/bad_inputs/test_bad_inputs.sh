@@ -848,6 +848,93 @@ inf_config inf_rain.yaml inf_ok.csv '      layers: [{soil: silt, fill: 0.0001}]
 fit_case "infiltration: rain ending before it starts" "$C/inf_rain.yaml" "inf_rain.yaml:" "rain 1"
 # ---- end soil ----------------------------------------------------------------
 
+# ---- leaf photos (leaf_photos data sets, measurements/photo_bridge.cc) --------
+# leaf_png FILE W H [LEAVES] [COLOUR]: green elliptical leaves with a darker
+# midrib on white paper, written with the Python standard library only.
+leaf_png() {
+    /usr/bin/python3 - "$@" <<'PY'
+import sys, zlib, struct
+path, w, h = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+leaves = int(sys.argv[4]) if len(sys.argv) > 4 else 1
+col = sys.argv[5] if len(sys.argv) > 5 else "green"
+base = {"green": (60, 140, 50), "yellow": (200, 190, 60), "white": (255, 255, 255)}[col]
+rows = []
+for y in range(h):
+    row = bytearray([0])
+    for x in range(w):
+        c = (255, 255, 255)
+        for k in range(leaves):
+            cx = (k + 0.5) * w / leaves
+            u, v = (x - cx) / (0.4 * w / leaves), (y - h / 2) / (0.4 * h)
+            if u * u + v * v < 1:
+                c = base
+                if abs(x - cx) < 1.5 and col != "white":
+                    c = tuple(int(0.7 * q) for q in base)
+        row += bytes(c)
+    rows.append(bytes(row))
+raw = zlib.compress(b"".join(rows))
+def chunk(t, d):
+    return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+with open(path, "wb") as f:
+    f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
+            chunk(b"IDAT", raw) + chunk(b"IEND", b""))
+PY
+}
+leaf_png "$C/leaf_a.png" 120 80
+leaf_png "$C/leaf_b.png" 120 80
+leaf_png "$C/leaf_old.png" 120 80 1 yellow
+leaf_png "$C/blank.png" 120 80 1 white
+leaf_png "$C/veins_small.png" 60 40
+head -c 300 "$C/leaf_a.png" >"$C/leaf_cut.png"
+echo "not an image" >"$C/leaf_text.png"
+# lp_config NAME CSV [EXTRA LINES]: a pixels-mode data set over leaf photos
+lp_config() {
+    printf 'name: t\nparameters:\n  stomata_scale: {value: 0.1, lower: 0}\ndatasets:\n  - kind: leaf_photos\n    file: %s\n    image: {column: image}\n    stage: {column: day}\n    reference: {image: leaf_old.png}\n    model_size: 32\n%s' \
+        "$2" "${3:-}" >"$C/$1"
+}
+printf 'day,image\n0,leaf_a.png\n2,leaf_b.png\n' >"$C/lp_ok.csv"
+lp_config lp_ok.yaml lp_ok.csv
+WHY=""
+run_phc simulate "$C/lp_ok.yaml" -o "$T/out_lp_ok"
+if [ "$RC" -eq 0 ]; then pass "leaf_photos: the valid base simulates"; else failc "leaf_photos: the valid base simulates" "exit $RC: $ERR"; fi
+printf 'day,image\n0,leaf_a.png\n2,leaf_cut.png\n' >"$C/lp_cut.csv"
+lp_config lp_cut.yaml lp_cut.csv
+fit_case "leaf_photos: truncated PNG" "$C/lp_cut.yaml" "lp_cut.csv:3" "leaf_cut.png" "truncated"
+printf 'day,image\n0,leaf_a.png\n2,leaf_text.png\n' >"$C/lp_text.csv"
+lp_config lp_text.yaml lp_text.csv
+fit_case "leaf_photos: a text file as a photo" "$C/lp_text.yaml" "lp_text.csv:3" "leaf_text.png"
+printf 'day,image\n0,leaf_a.png\n2,nowhere.png\n' >"$C/lp_missing.csv"
+lp_config lp_missing.yaml lp_missing.csv
+fit_case "leaf_photos: missing photo" "$C/lp_missing.yaml" "lp_missing.csv:3" "nowhere.png"
+printf 'day,image\n0,leaf_a.png\n2,blank.png\n' >"$C/lp_blank.csv"
+lp_config lp_blank.yaml lp_blank.csv
+fit_case "leaf_photos: no leaf in the photo" "$C/lp_blank.yaml" "lp_blank.csv:3" "blank.png" "no leaf found"
+printf 'day,image,leaf\n0,leaf_a.png,1\n2,leaf_b.png,3\n' >"$C/lp_num.csv"
+lp_config lp_num.yaml lp_num.csv '    leaf: leaf
+'
+fit_case "leaf_photos: leaf number beyond the leaves found" "$C/lp_num.yaml" "lp_num.csv:3" "leaf 3 requested, 1 leaf found"
+lp_config lp_veins.yaml lp_ok.csv '    veins: veins_small.png
+'
+fit_case "leaf_photos: vein map of another size" "$C/lp_veins.yaml" "veins_small.png" "60" "120"
+printf 'day,image\n0,leaf_a.png\n3,leaf_b.png\n2,leaf_b.png\n' >"$C/lp_order.csv"
+lp_config lp_order.yaml lp_order.csv
+fit_case "leaf_photos: stages out of order" "$C/lp_order.yaml" "lp_order.csv:4" "out of order"
+printf 'day,image\n0,leaf_a.png\n,leaf_b.png\n' >"$C/lp_nostage.csv"
+lp_config lp_nostage.yaml lp_nostage.csv
+fit_case "leaf_photos: missing stage" "$C/lp_nostage.yaml" "lp_nostage.csv:3" "'day'"
+lp_config lp_before.yaml lp_ok.csv '    initial: "3"
+    id: day
+'
+fit_case "leaf_photos: initial id not a row" "$C/lp_before.yaml" "lp_before.yaml:" "no row has id '3'"
+lp_config lp_resid.yaml lp_ok.csv '    residual: pixel
+'
+fit_case "leaf_photos: unknown residual" "$C/lp_resid.yaml" "lp_resid.yaml:" "not one of pixels, histogram"
+printf 'name: t\nparameters:\n  other: {value: 1}\ndatasets:\n  - kind: leaf_photos\n    file: lp_ok.csv\n    image: {column: image}\n    stage: {column: day}\n    reference: {image: leaf_old.png}\n' >"$C/lp_noslot.yaml"
+fit_case "leaf_photos: no parameter to fit" "$C/lp_noslot.yaml" "lp_noslot.yaml:" "no parameter to fit"
+lp_config lp_ref.yaml lp_ok.csv && sed -i 's/leaf_old.png/blank.png/' "$C/lp_ref.yaml"
+fit_case "leaf_photos: reference photo without a leaf" "$C/lp_ref.yaml" "lp_ref.yaml:" "blank.png" "no leaf found"
+# ---- end leaf photos -----------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

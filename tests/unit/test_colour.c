@@ -457,6 +457,55 @@ static void test_blend(void)
 
 /* ---- quantiles ----------------------------------------------------------- */
 
+static int cmp_dbl(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The multi-selection inside phc_colour_quantiles gives exactly the values
+ * of a full sort: random data with many ties, sizes 1..400, nq 1..40,
+ * against quantiles computed here from a qsort'ed copy with the same
+ * interpolation rule (positions (k + 1/2) n / nq - 1/2). */
+static void test_quantiles_against_sort(void)
+{
+    unsigned long long state = 12345;
+    double worst = 0;
+    for (size_t n = 1; n <= 400; n += (n < 20 ? 1 : 37)) {
+        double *c = malloc(3 * n * sizeof *c), *sorted = malloc(n * sizeof *sorted), *scr = malloc(n * sizeof *scr);
+        for (size_t i = 0; i < 3 * n; ++i) {
+            state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+            c[i] = (double)((state >> 33) % 17); /* ties everywhere */
+        }
+        for (size_t nq = 1; nq <= 40; nq += 3) {
+            double q[40];
+            phc_error err;
+            CHECK(phc_colour_quantiles(n, c, 1, nq, scr, q, &err) == PHC_OK);
+            for (size_t i = 0; i < n; ++i)
+                sorted[i] = c[3 * i + 1];
+            qsort(sorted, n, sizeof *sorted, cmp_dbl);
+            for (size_t k = 0; k < nq; ++k) {
+                double pos = ((double)k + 0.5) * (double)n / (double)nq - 0.5;
+                double want;
+                if (pos <= 0)
+                    want = sorted[0];
+                else if (pos >= (double)(n - 1))
+                    want = sorted[n - 1];
+                else {
+                    const size_t j = (size_t)pos;
+                    want = sorted[j] + (pos - (double)j) * (sorted[j + 1] - sorted[j]);
+                }
+                worst = fmax(worst, fabs(q[k] - want));
+            }
+        }
+        free(c);
+        free(sorted);
+        free(scr);
+    }
+    printf("quantiles_vs_sort_max_diff: %.3g\n", worst);
+    CHECK(worst <= 1e-12);
+}
+
 static void test_quantiles(void)
 {
     enum { N = 100 };
@@ -502,6 +551,7 @@ static void test_quantiles(void)
 
 int main(void)
 {
+    test_quantiles_against_sort();
     test_lab();
     test_differences();
     test_matching();

@@ -1,0 +1,77 @@
+/* Sheets of leaf images: see leaf_images.h. */
+#include "fit/costs/leaf_images.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Caption band height, px. */
+#define CAPTION_HEIGHT 22
+
+int phc_leaf_sheet(const phc_image *const *tiles, const char *const *captions, size_t n, size_t columns,
+                   size_t gap, phc_image *out, phc_error *err)
+{
+    if (!n || !columns)
+        return phc_error_set(err, PHC_ERR_INVALID, "a sheet needs at least one tile and one column");
+    size_t tw = 0, th = 0;
+    for (size_t i = 0; i < n; ++i) {
+        tw = tiles[i]->width > tw ? tiles[i]->width : tw;
+        th = tiles[i]->height > th ? tiles[i]->height : th;
+    }
+    const size_t cols = n < columns ? n : columns, rows = (n + columns - 1) / columns;
+    const size_t cap = captions ? CAPTION_HEIGHT : 0;
+    const size_t W = gap + cols * (tw + gap), H = gap + rows * (th + cap + gap);
+    int rc;
+    if ((rc = phc_image_alloc(out, W, H, err)))
+        return rc;
+    for (size_t i = 0; i < 3 * W * H; ++i)
+        out->data[i] = 1; /* white paper */
+    for (size_t i = 0; i < n; ++i) {
+        const phc_image *t = tiles[i];
+        const size_t ox = gap + (i % columns) * (tw + gap) + (tw - t->width) / 2;
+        const size_t oy = gap + (i / columns) * (th + cap + gap) + cap + (th - t->height) / 2;
+        for (size_t y = 0; y < t->height; ++y)
+            memcpy(out->data + 3 * (ox + W * (oy + y)), t->data + 3 * t->width * y, 3 * t->width * sizeof(double));
+        if (captions && captions[i]) {
+            const size_t cx = gap + (i % columns) * (tw + gap), cy = gap + (i / columns) * (th + cap + gap);
+            if ((rc = phc_photo_draw_text(out, captions[i], cx + 2, cy + cap - 6, 0.5, err))) {
+                phc_image_free(out);
+                return rc;
+            }
+        }
+    }
+    return PHC_OK;
+}
+
+int phc_leaf_map_image(size_t width, size_t height, const double *values, const unsigned char *mask,
+                       double lo, double hi, phc_image *out, phc_error *err)
+{
+    double lut[3 * 256];
+    int rc;
+    if ((rc = phc_photo_viridis(lut, err)) || (rc = phc_image_alloc(out, width, height, err)))
+        return rc;
+    for (size_t i = 0; i < width * height; ++i) {
+        double *o = out->data + 3 * i;
+        if (mask && !mask[i]) {
+            o[0] = o[1] = o[2] = 1;
+            continue;
+        }
+        const double u = hi > lo ? (values[i] - lo) / (hi - lo) : 0.5;
+        const size_t k = (size_t)lround(255 * fmin(fmax(u, 0), 1));
+        memcpy(o, lut + 3 * k, 3 * sizeof(double));
+    }
+    return PHC_OK;
+}
+
+int phc_leaf_enlarge(const phc_image *img, size_t factor, phc_image *out, phc_error *err)
+{
+    int rc;
+    if (!factor)
+        factor = 1;
+    if ((rc = phc_image_alloc(out, img->width * factor, img->height * factor, err)))
+        return rc;
+    for (size_t y = 0; y < out->height; ++y)
+        for (size_t x = 0; x < out->width; ++x)
+            memcpy(out->data + 3 * (x + out->width * y), img->data + 3 * (x / factor + img->width * (y / factor)),
+                   3 * sizeof(double));
+    return PHC_OK;
+}

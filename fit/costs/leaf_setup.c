@@ -1,0 +1,411 @@
+/* The leaf colour aging set-up: see leaf_setup.h. */
+#include "fit/costs/leaf_setup.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- photo cache ------------------------------------------------------------ */
+
+typedef struct cache_entry {
+    char *path;
+    phc_colour_correction_method method;
+    phc_image img; /* colour corrected */
+    phc_colour_correction correction;
+    phc_segmentation seg;
+} cache_entry;
+
+struct phc_photo_cache {
+    cache_entry *e;
+    size_t n;
+};
+
+phc_photo_cache *phc_photo_cache_new(void)
+{
+    return calloc(1, sizeof(phc_photo_cache));
+}
+
+void phc_photo_cache_free(phc_photo_cache *c)
+{
+    if (!c)
+        return;
+    for (size_t i = 0; i < c->n; ++i) {
+        free(c->e[i].path);
+        phc_image_free(&c->e[i].img);
+        phc_segmentation_free(&c->e[i].seg);
+    }
+    free(c->e);
+    free(c);
+}
+
+static int with_where(const char *where, phc_error *err)
+{
+    if (where && err && err->status) {
+        char msg[PHC_ERROR_MESSAGE_SIZE];
+        snprintf(msg, sizeof msg, "%s", err->message);
+        phc_error_set(err, err->status, "%s: %s", where, msg);
+    }
+    return err ? err->status : PHC_ERR_INPUT;
+}
+
+static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction_method method,
+                     const char *where, cache_entry **out, phc_error *err)
+{
+    for (size_t i = 0; i < c->n; ++i)
+        if (c->e[i].method == method && !strcmp(c->e[i].path, path)) {
+            *out = &c->e[i];
+            return PHC_OK;
+        }
+    cache_entry *grown = realloc(c->e, (c->n + 1) * sizeof *grown);
+    if (!grown)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    c->e = grown;
+    cache_entry *e = &c->e[c->n];
+    memset(e, 0, sizeof *e);
+    int rc;
+    if (!(e->path = strdup(path)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    e->method = method;
+    phc_segment_options so = phc_segment_options_default();
+    if ((rc = phc_photo_read(path, &e->img, err)) ||
+        (rc = phc_photo_colour_correct(&e->img, NULL, method, &e->correction, err)) ||
+        (rc = phc_photo_segment_leaves(&e->img, &so, &e->seg, err))) {
+        if (rc == PHC_ERR_INPUT || rc == PHC_ERR_IO) {
+            /* name the photo when the bridge's message does not */
+            if (err && !strstr(err->message, path)) {
+                char msg[PHC_ERROR_MESSAGE_SIZE];
+                snprintf(msg, sizeof msg, "%s", err->message);
+                phc_error_set(err, rc, "%s: %s", path, msg);
+            }
+        }
+        free(e->path);
+        phc_image_free(&e->img);
+        phc_segmentation_free(&e->seg);
+        with_where(where, err);
+        return rc;
+    }
+    c->n++;
+    *out = e;
+    return PHC_OK;
+}
+
+int phc_leaf_photo_load(phc_photo_cache *cache, const char *path, size_t number,
+                        phc_colour_correction_method correction, const char *where,
+                        phc_leaf_photo *out, phc_error *err)
+{
+    memset(out, 0, sizeof *out);
+    cache_entry *e;
+    int rc;
+    if ((rc = cache_get(cache, path, correction, where, &e, err)))
+        return rc;
+    if (number < 1 || number > e->seg.count)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s%s%s: leaf %zu requested, %zu lea%s found", where ? where : "",
+                             where ? ": " : "", path, number, e->seg.count, e->seg.count == 1 ? "f" : "ves");
+    const size_t margin = 2;
+    if ((rc = phc_photo_crop_leaf(&e->img, &e->seg, number, margin, &out->crop, &out->mask, err)))
+        return with_where(where, err);
+    const phc_leaf_box *b = &e->seg.leaf[number - 1];
+    out->x0 = b->x0 > margin ? b->x0 - margin : 0;
+    out->y0 = b->y0 > margin ? b->y0 - margin : 0;
+    out->photo_width = e->img.width;
+    out->photo_height = e->img.height;
+    out->number = number;
+    out->leaves = e->seg.count;
+    out->area = b->area;
+    out->correction = e->correction;
+    if (!(out->path = strdup(path))) {
+        phc_leaf_photo_free(out);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    return PHC_OK;
+}
+
+void phc_leaf_photo_free(phc_leaf_photo *p)
+{
+    if (!p)
+        return;
+    free(p->path);
+    phc_image_free(&p->crop);
+    free(p->mask);
+    memset(p, 0, sizeof *p);
+}
+
+static void grid_size(size_t w, size_t h, size_t size, size_t *gw, size_t *gh)
+{
+    if (w >= h) {
+        *gw = size;
+        *gh = (size_t)fmax(1.0, round((double)size * (double)h / (double)w));
+    } else {
+        *gh = size;
+        *gw = (size_t)fmax(1.0, round((double)size * (double)w / (double)h));
+    }
+}
+
+int phc_leaf_photo_grid(const phc_leaf_photo *p, size_t size, phc_image *img, unsigned char **mask,
+                        phc_error *err)
+{
+    size_t gw, gh;
+    grid_size(p->crop.width, p->crop.height, size, &gw, &gh);
+    int rc;
+    *mask = NULL;
+    if ((rc = phc_photo_resize(&p->crop, gw, gh, img, err)))
+        return rc;
+    if ((rc = phc_photo_resize_mask(p->mask, p->crop.width, p->crop.height, gw, gh, mask, err))) {
+        phc_image_free(img);
+        return rc;
+    }
+    for (size_t i = 0; i < gw * gh; ++i)
+        if (!(*mask)[i])
+            img->data[3 * i] = img->data[3 * i + 1] = img->data[3 * i + 2] = 0;
+    return PHC_OK;
+}
+
+/* ---- set-up ------------------------------------------------------------------- */
+
+phc_leaf_setup_options phc_leaf_setup_options_default(void)
+{
+    phc_leaf_setup_options o;
+    memset(&o, 0, sizeof o);
+    o.model_size = 128;
+    o.space = PHC_COLOUR_RGB;
+    o.vein_floor = 0.05;
+    o.veins = o.stomata = o.inflow = PHC_LEAF_MAP_AUTO;
+    o.dt = 0.1;
+    return o;
+}
+
+void phc_leaf_setup_free(phc_leaf_setup *s)
+{
+    if (!s)
+        return;
+    free(s->mask);
+    phc_image_free(&s->fresh);
+    free(s->original);
+    free(s->matched);
+    free(s->beta);
+    free(s->stomata);
+    free(s->inflow);
+    free(s->blend);
+    phc_leaf_free(s->leaf);
+    free(s);
+}
+
+/* A scalar map on the crop (cw x ch) averaged down to the model grid. */
+static int map_to_grid(const double *crop_map, size_t cw, size_t ch, size_t gw, size_t gh, double *out,
+                       phc_error *err)
+{
+    phc_image a = {0}, b = {0};
+    int rc;
+    if ((rc = phc_image_alloc(&a, cw, ch, err)))
+        return rc;
+    for (size_t i = 0; i < cw * ch; ++i)
+        a.data[3 * i] = a.data[3 * i + 1] = a.data[3 * i + 2] = crop_map[i];
+    rc = phc_photo_resize(&a, gw, gh, &b, err);
+    phc_image_free(&a);
+    if (rc)
+        return rc;
+    for (size_t i = 0; i < gw * gh; ++i)
+        out[i] = b.data[3 * i];
+    phc_image_free(&b);
+    return PHC_OK;
+}
+
+/* A map file: a grey image the size of the fresh leaf's photo, cropped with
+ * the leaf and averaged down to the grid. */
+static int map_from_file(const char *file, const char *what, const phc_leaf_photo *fresh, size_t gw, size_t gh,
+                         double *out, phc_error *err)
+{
+    double *full = NULL, *crop = NULL;
+    int rc = phc_photo_read_map(file, fresh->photo_width, fresh->photo_height, 0, &full, err);
+    if (rc) {
+        if (err && !strstr(err->message, what)) {
+            char msg[PHC_ERROR_MESSAGE_SIZE];
+            snprintf(msg, sizeof msg, "%s", err->message);
+            phc_error_set(err, rc, "%s map: %s (it must be the size of the photo %s)", what, msg, fresh->path);
+        }
+        return rc;
+    }
+    const size_t cw = fresh->crop.width, ch = fresh->crop.height;
+    if (!(crop = malloc(cw * ch * sizeof *crop))) {
+        free(full);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    for (size_t y = 0; y < ch; ++y)
+        for (size_t x = 0; x < cw; ++x)
+            crop[x + cw * y] = full[(fresh->x0 + x) + fresh->photo_width * (fresh->y0 + y)];
+    free(full);
+    rc = map_to_grid(crop, cw, ch, gw, gh, out, err);
+    free(crop);
+    return rc;
+}
+
+/* Packs the colours of the mask pixels (3 per pixel). */
+static void pack(const double *c, const unsigned char *mask, size_t n, double *out)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (mask[i]) {
+            memcpy(out + 3 * k, c + 3 * i, 3 * sizeof *c);
+            ++k;
+        }
+}
+
+int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *reference,
+                       const phc_leaf_setup_options *opt, phc_leaf_setup **out, phc_error *err)
+{
+    phc_leaf_setup *s = calloc(1, sizeof *s);
+    phc_image ref = {0};
+    unsigned char *ref_mask = NULL;
+    double *a = NULL, *b = NULL, *m = NULL, *ridge = NULL;
+    int rc;
+    *out = NULL;
+    if (!s)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    s->space = opt->space;
+    if ((rc = phc_leaf_photo_grid(fresh, opt->model_size, &s->fresh, &s->mask, err)) ||
+        (rc = phc_leaf_photo_grid(reference, opt->model_size, &ref, &ref_mask, err)))
+        goto fail;
+    const size_t w = s->w = s->fresh.width, h = s->h = s->fresh.height, n = w * h;
+    size_t n_ref = 0;
+    for (size_t i = 0; i < n; ++i)
+        s->cells += s->mask[i] != 0;
+    for (size_t i = 0; i < ref.width * ref.height; ++i)
+        n_ref += ref_mask[i] != 0;
+    if (!s->cells || !n_ref) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: leaf %zu has no pixels on a %zu px grid", s->cells ? reference->path : fresh->path,
+                           s->cells ? reference->number : fresh->number, opt->model_size);
+        goto fail;
+    }
+    s->original = calloc(3 * n, sizeof *s->original);
+    s->matched = calloc(3 * n, sizeof *s->matched);
+    s->blend = calloc(3 * n, sizeof *s->blend);
+    s->beta = calloc(n, sizeof *s->beta);
+    s->stomata = calloc(n, sizeof *s->stomata);
+    s->inflow = calloc(n, sizeof *s->inflow);
+    a = malloc(3 * s->cells * sizeof *a);
+    m = malloc(3 * s->cells * sizeof *m);
+    b = malloc(3 * n_ref * sizeof *b);
+    if (!s->original || !s->matched || !s->blend || !s->beta || !s->stomata || !s->inflow || !a || !m || !b) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    /* Colours in the matching space; eq. 8 on the leaf pixels only. */
+    phc_colour_convert(n, s->fresh.data, PHC_COLOUR_RGB, s->space, s->original);
+    phc_colour_convert(ref.width * ref.height, ref.data, PHC_COLOUR_RGB, s->space, ref.data);
+    for (size_t i = 0; i < n; ++i)
+        if (!s->mask[i])
+            s->original[3 * i] = s->original[3 * i + 1] = s->original[3 * i + 2] = 0;
+    pack(s->original, s->mask, n, a);
+    pack(ref.data, ref_mask, ref.width * ref.height, b);
+    if ((rc = phc_colour_match_histograms(s->cells, a, n_ref, b, m, err)))
+        goto fail;
+    for (size_t i = 0, k = 0; i < n; ++i)
+        if (s->mask[i]) {
+            memcpy(s->matched + 3 * i, m + 3 * k, 3 * sizeof *m);
+            ++k;
+        }
+
+    /* Venation map β = floor + (1 - floor) ridge on the leaf. */
+    if (opt->veins == PHC_LEAF_MAP_FILE) {
+        if ((rc = map_from_file(opt->veins_file, "veins", fresh, w, h, s->beta, err)))
+            goto fail;
+    } else if (opt->veins == PHC_LEAF_MAP_UNIFORM) {
+        for (size_t i = 0; i < n; ++i)
+            s->beta[i] = 1;
+    } else {
+        phc_vein_options vo = phc_vein_options_default();
+        if ((rc = phc_photo_vein_map(&fresh->crop, fresh->mask, &vo, &ridge, err)) ||
+            (rc = map_to_grid(ridge, fresh->crop.width, fresh->crop.height, w, h, s->beta, err)))
+            goto fail;
+    }
+    if (opt->veins != PHC_LEAF_MAP_UNIFORM)
+        for (size_t i = 0; i < n; ++i)
+            s->beta[i] = s->mask[i] ? opt->vein_floor + (1 - opt->vein_floor) * fmin(fmax(s->beta[i], 0), 1) : 0;
+    /* Stomata: uniform unless a file. */
+    if (opt->stomata == PHC_LEAF_MAP_FILE) {
+        if ((rc = map_from_file(opt->stomata_file, "stomata", fresh, w, h, s->stomata, err)))
+            goto fail;
+    } else
+        for (size_t i = 0; i < n; ++i)
+            s->stomata[i] = 1;
+    /* Inflow: through the veins unless told otherwise. */
+    switch (opt->inflow) {
+    case PHC_LEAF_MAP_FILE:
+        if ((rc = map_from_file(opt->inflow_file, "inflow", fresh, w, h, s->inflow, err)))
+            goto fail;
+        break;
+    case PHC_LEAF_MAP_UNIFORM:
+        for (size_t i = 0; i < n; ++i)
+            s->inflow[i] = 1;
+        break;
+    case PHC_LEAF_MAP_NONE:
+        break;
+    default:
+        memcpy(s->inflow, s->beta, n * sizeof *s->inflow);
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (!s->mask[i])
+            s->stomata[i] = s->inflow[i] = s->beta[i] = 0;
+    phc_leaf_params lp = phc_leaf_params_default();
+    lp.dt = opt->dt;
+    if ((rc = phc_leaf_new(w, h, s->mask, s->beta, s->stomata, s->inflow, lp, &s->leaf, err)))
+        goto fail;
+    phc_image_free(&ref);
+    free(ref_mask);
+    free(a);
+    free(b);
+    free(m);
+    free(ridge);
+    *out = s;
+    return PHC_OK;
+fail:
+    phc_image_free(&ref);
+    free(ref_mask);
+    free(a);
+    free(b);
+    free(m);
+    free(ridge);
+    phc_leaf_setup_free(s);
+    return rc;
+}
+
+int phc_leaf_setup_colours(phc_leaf_setup *s, phc_colour_transfer tf, double *lab, phc_image *srgb,
+                           phc_error *err)
+{
+    const size_t n = s->w * s->h;
+    const double *y = phc_leaf_fluid(s->leaf);
+    int rc;
+    /* eq. 9: blend in the matching space */
+    phc_colour_blend(n, s->original, s->matched, y, tf, s->blend);
+    if (lab) {
+        phc_colour_convert(n, s->blend, s->space, PHC_COLOUR_LAB, lab);
+        for (size_t i = 0; i < n; ++i)
+            if (!s->mask[i])
+                lab[3 * i] = lab[3 * i + 1] = lab[3 * i + 2] = 0;
+    }
+    if (srgb) {
+        if ((rc = phc_image_alloc(srgb, s->w, s->h, err)))
+            return rc;
+        phc_colour_convert(n, s->blend, s->space, PHC_COLOUR_RGB, srgb->data);
+        for (size_t i = 0; i < n; ++i)
+            if (!s->mask[i])
+                srgb->data[3 * i] = srgb->data[3 * i + 1] = srgb->data[3 * i + 2] = 1; /* white paper */
+    }
+    return PHC_OK;
+}
+
+int phc_leaf_lab_pixels(const phc_image *img, const unsigned char *mask, double **lab, size_t *n,
+                        phc_error *err)
+{
+    const size_t np = img->width * img->height;
+    size_t k = 0;
+    for (size_t i = 0; i < np; ++i)
+        k += mask[i] != 0;
+    *n = k;
+    if (!(*lab = malloc((k ? 3 * k : 1) * sizeof **lab)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    pack(img->data, mask, np, *lab);
+    phc_colour_convert(k, *lab, PHC_COLOUR_RGB, PHC_COLOUR_LAB, *lab);
+    return PHC_OK;
+}
