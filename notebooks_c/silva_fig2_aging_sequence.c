@@ -11,8 +11,8 @@
  * stomata map is uniform and the inflow map is the venation map, so sap
  * enters along the veins, spreads with conductance s_β β, and transpires
  * everywhere.  The ridge filter also answers the dark-leaf/white-paper step
- * at the margin; that response is faded out within TAPER_PX of the edge
- * before the model is built (otherwise the margin would behave as a vein).
+ * at the margin; the set-up (leaf_setup.h, vein_edge_taper) fades that
+ * response out near the edge, otherwise the margin would behave as a vein.
  *
  * What it shows: yellowing starts on the lamina between the veins and at
  * the margin, far from the veins, while the veins stay green, as in the
@@ -63,44 +63,6 @@
 #define VEIN_RIDGE 0.5     /* a pixel is vein when its ridge strength is at least this */
 #define FAR_PX 6.0         /* "far from the veins": at least this many px away */
 #define MARGIN_PX 2.0      /* "margin": within this many px of the leaf's edge */
-#define TAPER_PX 4.0       /* the ridge response is faded out within this many px of the edge */
-
-/* Chamfer (3-4) distance in px to the nearest pixel where src != 0, over
- * the whole grid. */
-static void chamfer(size_t w, size_t h, const unsigned char *src, double *d)
-{
-    const double big = 1e9;
-    for (size_t i = 0; i < w * h; ++i)
-        d[i] = src[i] ? 0 : big;
-    for (size_t y = 0; y < h; ++y)
-        for (size_t x = 0; x < w; ++x) {
-            double *p = &d[x + w * y];
-            if (x > 0)
-                *p = fmin(*p, d[x - 1 + w * y] + 3);
-            if (y > 0) {
-                *p = fmin(*p, d[x + w * (y - 1)] + 3);
-                if (x > 0)
-                    *p = fmin(*p, d[x - 1 + w * (y - 1)] + 4);
-                if (x + 1 < w)
-                    *p = fmin(*p, d[x + 1 + w * (y - 1)] + 4);
-            }
-        }
-    for (size_t y = h; y-- > 0;)
-        for (size_t x = w; x-- > 0;) {
-            double *p = &d[x + w * y];
-            if (x + 1 < w)
-                *p = fmin(*p, d[x + 1 + w * y] + 3);
-            if (y + 1 < h) {
-                *p = fmin(*p, d[x + w * (y + 1)] + 3);
-                if (x + 1 < w)
-                    *p = fmin(*p, d[x + 1 + w * (y + 1)] + 4);
-                if (x > 0)
-                    *p = fmin(*p, d[x - 1 + w * (y + 1)] + 4);
-            }
-        }
-    for (size_t i = 0; i < w * h; ++i)
-        d[i] /= 3.0;
-}
 
 /* A vertical viridis colour bar from lo (bottom) to hi (top) with labels,
  * as a tile of height `height`. */
@@ -195,26 +157,8 @@ int main(int argc, char **argv)
         outside[i] = !su->mask[i];
         n_vein_px += vein[i];
     }
-    chamfer(w, h, outside, dmargin);
-    /* The ridge filter also answers the step from the dark leaf to the white
-     * paper, so the raw map has a "vein" all along the margin; fade the
-     * ridge part of β out within TAPER_PX of the edge (the inflow map is β
-     * again) and rebuild the model with these maps. */
-    n_vein_px = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (!su->mask[i])
-            continue;
-        const double fade = fmin(1.0, fmax(0.0, (dmargin[i] - 1.0) / (TAPER_PX - 1.0)));
-        su->beta[i] = so.vein_floor + (su->beta[i] - so.vein_floor) * fade;
-        su->inflow[i] = su->beta[i];
-        vein[i] = su->beta[i] >= beta_vein;
-        n_vein_px += vein[i];
-    }
-    chamfer(w, h, vein, dvein);
-    phc_leaf_free(su->leaf);
-    su->leaf = NULL;
-    if (phc_leaf_new(w, h, su->mask, su->beta, su->stomata, su->inflow, lp, &su->leaf, &err))
-        goto fail;
+    phc_leaf_chamfer_distance(w, h, outside, dmargin);
+    phc_leaf_chamfer_distance(w, h, vein, dvein);
 
     stats st[NT], cur;
     double ymax = 1, ts[NS], cv[4][NS];
@@ -343,8 +287,8 @@ int main(int argc, char **argv)
             "venation map from the ridge filter of the full-resolution crop, β = 0.05 + 0.95 ridge\n"
             "(%zu pixels have ridge ≥ %.1f: the veins below), a uniform stomata map O = 1 and the inflow map\n"
             "I = β (sap enters along the veins). The ridge filter also answers the step from the dark leaf to\n"
-            "the white paper, which would put a \"vein\" all along the margin; the ridge part of β is faded\n"
-            "out linearly between 1 and %g px from the edge (the inflow map follows) before the model is built.\n\n"
+            "the white paper, which would put a \"vein\" all along the margin; the set-up fades the ridge\n"
+            "response out linearly between 1 and %g px (full-resolution crop) from the edge.\n\n"
             "| value | |\n|---|---|\n"
             "| s_β (diffusivity per unit venation) | %g px²/day |\n"
             "| s_O (transpiration) | %g /day |\n"
@@ -361,7 +305,7 @@ int main(int argc, char **argv)
             "Bottom row: the leaf's colours, and the reference leaf whose colours the dry pixels take.\n\n"
             "![mean fluid over time on the veins, near them, far from them and at the margin]"
             "(silva_fig2_aging_sequence_regions.png)\n\n",
-            FRESH_LEAF, REF_LEAF, w, h, MODEL_SIZE, su->cells, n_vein_px, VEIN_RIDGE, TAPER_PX, BETA_SCALE, STOMATA_SCALE,
+            FRESH_LEAF, REF_LEAF, w, h, MODEL_SIZE, su->cells, n_vein_px, VEIN_RIDGE, so.vein_edge_taper, BETA_SCALE, STOMATA_SCALE,
             INFLOW_SCALE, DT, T_STEP, Y_LO, Y_HI, BETA_SCALE * so.vein_floor,
             sqrt(BETA_SCALE * so.vein_floor * 2 * T_STEP), ymax);
     fprintf(f, "| t | mean y | mean L* | mean a* | mean b* | y on veins | y within 2 px of a vein | y ≥ %g px from "

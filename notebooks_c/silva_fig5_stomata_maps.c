@@ -51,7 +51,6 @@
 #define T_SHOW 8.0
 #define Y_LO 0.3
 #define Y_HI 0.8
-#define TAPER_PX 4.0
 /* map B */
 #define N_SPOTS 14
 #define SPOT_SIGMA 6.0
@@ -66,43 +65,6 @@ static uint64_t splitmix64(void)
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
     return z ^ (z >> 31);
-}
-
-/* Chamfer (3-4) distance in px to the nearest pixel where src != 0, over
- * the whole grid. */
-static void chamfer(size_t w, size_t h, const unsigned char *src, double *d)
-{
-    const double big = 1e9;
-    for (size_t i = 0; i < w * h; ++i)
-        d[i] = src[i] ? 0 : big;
-    for (size_t y = 0; y < h; ++y)
-        for (size_t x = 0; x < w; ++x) {
-            double *p = &d[x + w * y];
-            if (x > 0)
-                *p = fmin(*p, d[x - 1 + w * y] + 3);
-            if (y > 0) {
-                *p = fmin(*p, d[x + w * (y - 1)] + 3);
-                if (x > 0)
-                    *p = fmin(*p, d[x - 1 + w * (y - 1)] + 4);
-                if (x + 1 < w)
-                    *p = fmin(*p, d[x + 1 + w * (y - 1)] + 4);
-            }
-        }
-    for (size_t y = h; y-- > 0;)
-        for (size_t x = w; x-- > 0;) {
-            double *p = &d[x + w * y];
-            if (x + 1 < w)
-                *p = fmin(*p, d[x + 1 + w * y] + 3);
-            if (y + 1 < h) {
-                *p = fmin(*p, d[x + w * (y + 1)] + 3);
-                if (x + 1 < w)
-                    *p = fmin(*p, d[x + 1 + w * (y + 1)] + 4);
-                if (x > 0)
-                    *p = fmin(*p, d[x - 1 + w * (y + 1)] + 4);
-            }
-        }
-    for (size_t i = 0; i < w * h; ++i)
-        d[i] /= 3.0;
 }
 
 /* A vertical viridis colour bar from lo (bottom) to hi (top) with labels,
@@ -179,13 +141,7 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < n; ++i)
         outside[i] = !su->mask[i];
-    chamfer(w, h, outside, dmargin);
-    for (size_t i = 0; i < n; ++i)
-        if (su->mask[i]) {
-            const double fade = fmin(1.0, fmax(0.0, (dmargin[i] - 1.0) / (TAPER_PX - 1.0)));
-            su->beta[i] = so.vein_floor + (su->beta[i] - so.vein_floor) * fade;
-            su->inflow[i] = su->beta[i];
-        }
+    phc_leaf_chamfer_distance(w, h, outside, dmargin);
 
     /* the two stomata maps */
     size_t *leaf_px = malloc(su->cells * sizeof *leaf_px), nl = 0;
@@ -331,8 +287,8 @@ int main(int argc, char **argv)
             "**What we computed.** Ivy leaf %d of the scan `leaf_photos/ivy_spad/ivy_15_leaves_scan.jpg` (the\n"
             "greenest) as the fresh leaf and leaf %d (the most yellow) as the reference, through\n"
             "`phc_leaf_photo_load` and `phc_leaf_setup_new` (model_size %d: a %zu × %zu grid, %zu leaf\n"
-            "pixels), venation from the ridge filter with its margin response faded out within %g px of the\n"
-            "edge, inflow I = β, as in `silva_fig2_aging_sequence`. Two stomata maps, both with mean 1 over\n"
+            "pixels), venation from the ridge filter with its margin response faded out within %g px\n"
+            "(full-resolution crop) of the edge, inflow I = β, as in `silva_fig2_aging_sequence`. Two stomata maps, both with mean 1 over\n"
             "the leaf (the leaf as a whole transpires at the same rate):\n\n"
             "- **A**: uniform, O = 1;\n"
             "- **B**: random spots, O ∝ %g + Σ exp(−r²/(2·%g²)) over %d spot centres drawn uniformly among\n"
@@ -345,7 +301,7 @@ int main(int argc, char **argv)
             "colour scales and the reference leaf.\n\n"
             "| map | mean y | y in the spots | y off the spots | share of the lost fluid lost in the spots | mean a* "
             "| mean b* |\n|---|---:|---:|---:|---:|---:|---:|\n",
-            FRESH_LEAF, REF_LEAF, MODEL_SIZE, w, h, su->cells, TAPER_PX, SPOT_BASE, SPOT_SIGMA, N_SPOTS, SEED, omax,
+            FRESH_LEAF, REF_LEAF, MODEL_SIZE, w, h, su->cells, so.vein_edge_taper, SPOT_BASE, SPOT_SIGMA, N_SPOTS, SEED, omax,
             SPOT_LEVEL, 100.0 * (double)n_spot / (double)su->cells, BETA_SCALE, STOMATA_SCALE, INFLOW_SCALE, DT,
             T_SHOW, Y_LO, Y_HI, T_SHOW);
     for (int m = 0; m < 2; ++m)

@@ -572,9 +572,11 @@ static int lp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
         if ((rc = phc_photo_write_png(path, &colour[k], err)))
             goto done;
         snprintf(caption[k], sizeof caption[k], "colour, t = %.3g", t);
-        snprintf(caption[N_FRAMES + k], sizeof caption[k], "fluid, t = %.3g", t);
     }
     for (int k = 0; k < N_FRAMES; ++k) {
+        /* every fluid map on one scale, 0 (dark blue) to y_max (yellow) */
+        snprintf(caption[N_FRAMES + k], sizeof caption[k], "fluid 0..%.2g, t = %.3g", y_max,
+                 t_end * k / (N_FRAMES - 1));
         snprintf(path, sizeof path, "%s/%s_fluid_%02d.png", dir, base, k);
         if ((rc = phc_photo_write_map_png(path, su->w, su->h, y[k], su->mask, 0, y_max, 1, err)) ||
             (rc = phc_leaf_map_image(su->w, su->h, y[k], su->mask, 0, y_max, &fluid[k], err)) ||

@@ -170,6 +170,7 @@ phc_leaf_setup_options phc_leaf_setup_options_default(void)
     o.model_size = 128;
     o.space = PHC_COLOUR_RGB;
     o.vein_floor = 0.05;
+    o.vein_edge_taper = 9;
     o.veins = o.stomata = o.inflow = PHC_LEAF_MAP_AUTO;
     o.dt = 0.1;
     return o;
@@ -238,6 +239,69 @@ static int map_from_file(const char *file, const char *what, const phc_leaf_phot
     rc = map_to_grid(crop, cw, ch, gw, gh, out, err);
     free(crop);
     return rc;
+}
+
+void phc_leaf_chamfer_distance(size_t w, size_t h, const unsigned char *src, double *d)
+{
+    const double big = 1e9;
+    for (size_t i = 0; i < w * h; ++i)
+        d[i] = src[i] ? 0 : big;
+    /* forward then backward pass, steps 3 (edge) and 4 (diagonal) */
+    for (size_t y = 0; y < h; ++y)
+        for (size_t x = 0; x < w; ++x) {
+            double *p = &d[x + w * y];
+            if (x > 0)
+                *p = fmin(*p, d[x - 1 + w * y] + 3);
+            if (y > 0) {
+                *p = fmin(*p, d[x + w * (y - 1)] + 3);
+                if (x > 0)
+                    *p = fmin(*p, d[x - 1 + w * (y - 1)] + 4);
+                if (x + 1 < w)
+                    *p = fmin(*p, d[x + 1 + w * (y - 1)] + 4);
+            }
+        }
+    for (size_t y = h; y-- > 0;)
+        for (size_t x = w; x-- > 0;) {
+            double *p = &d[x + w * y];
+            if (x + 1 < w)
+                *p = fmin(*p, d[x + 1 + w * y] + 3);
+            if (y + 1 < h) {
+                *p = fmin(*p, d[x + w * (y + 1)] + 3);
+                if (x + 1 < w)
+                    *p = fmin(*p, d[x + 1 + w * (y + 1)] + 4);
+                if (x > 0)
+                    *p = fmin(*p, d[x - 1 + w * (y + 1)] + 4);
+            }
+        }
+    for (size_t i = 0; i < w * h; ++i)
+        d[i] /= 3.0;
+}
+
+/* Fades a ridge map (crop size) out near the leaf's edge: the Hessian
+ * answers the step from leaf to background there, which would make the
+ * whole margin a vein. */
+static int taper_edge(const phc_leaf_photo *fresh, double taper, double *ridge, phc_error *err)
+{
+    if (!(taper > 1))
+        return PHC_OK;
+    const size_t cw = fresh->crop.width, ch = fresh->crop.height, n = cw * ch;
+    unsigned char *outside = calloc(n ? n : 1, 1);
+    double *d = malloc(n * sizeof *d);
+    if (!outside || !d) {
+        free(outside);
+        free(d);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    /* the crop's own border counts as outside too */
+    for (size_t y = 0; y < ch; ++y)
+        for (size_t x = 0; x < cw; ++x)
+            outside[x + cw * y] = !fresh->mask[x + cw * y] || x == 0 || y == 0 || x + 1 == cw || y + 1 == ch;
+    phc_leaf_chamfer_distance(cw, ch, outside, d);
+    for (size_t i = 0; i < n; ++i)
+        ridge[i] *= fmin(1.0, fmax(0.0, (d[i] - 1.0) / (taper - 1.0)));
+    free(outside);
+    free(d);
+    return PHC_OK;
 }
 
 /* Packs the colours of the mask pixels (3 per pixel). */
@@ -316,6 +380,7 @@ int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *refere
     } else {
         phc_vein_options vo = phc_vein_options_default();
         if ((rc = phc_photo_vein_map(&fresh->crop, fresh->mask, &vo, &ridge, err)) ||
+            (rc = taper_edge(fresh, opt->vein_edge_taper, ridge, err)) ||
             (rc = map_to_grid(ridge, fresh->crop.width, fresh->crop.height, w, h, s->beta, err)))
             goto fail;
     }

@@ -69,6 +69,11 @@ typedef struct phc_leaf_setup_options {
     size_t model_size;         /* long side of the simulation grid, px (128) */
     phc_colour_space space;    /* histogram matching and blending space (RGB) */
     double vein_floor;         /* β on the lamina: β = floor + (1 - floor) ridge (0.05) */
+    double vein_edge_taper;    /* auto veins: the ridge response is faded out linearly from
+                                  1 to this many px (full-resolution crop) inside the
+                                  leaf's edge, where the filter answers the step from the
+                                  leaf to the background rather than a vein (9 = 2 sigma_max
+                                  + 1 of the default ridge filter; 0 = no fade) */
     phc_leaf_map_source veins, stomata, inflow;
     const char *veins_file, *stomata_file, *inflow_file; /* for PHC_LEAF_MAP_FILE */
     double dt;                 /* model step, time units (0.1) */
@@ -98,6 +103,10 @@ void phc_leaf_setup_free(phc_leaf_setup *s); /* accepts NULL */
  * and/or sRGB image (may be NULL; *srgb allocated here when non-NULL). */
 int phc_leaf_setup_colours(phc_leaf_setup *s, phc_colour_transfer tf, double *lab, phc_image *srgb,
                            phc_error *err);
+
+/* Chamfer (3-4) distance, px, from every pixel of a w x h grid to the
+ * nearest pixel where src != 0 (1e9/3 when there is none). */
+void phc_leaf_chamfer_distance(size_t w, size_t h, const unsigned char *src, double *d);
 
 /* CIELAB colours (3 per pixel) of the leaf pixels of an sRGB image with a
  * mask, packed; *n pixels; *lab malloc'd. */
