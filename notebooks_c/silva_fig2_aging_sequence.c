@@ -64,36 +64,6 @@
 #define FAR_PX 6.0         /* "far from the veins": at least this many px away */
 #define MARGIN_PX 2.0      /* "margin": within this many px of the leaf's edge */
 
-/* A vertical viridis colour bar from lo (bottom) to hi (top) with labels,
- * as a tile of height `height`. */
-static int colour_bar(size_t height, double lo, double hi, const char *title, phc_image *out, phc_error *err)
-{
-    const size_t W = 150, x0 = 12, x1 = 42, y0 = 24, y1 = height - 14;
-    double lut[3 * 256];
-    int rc;
-    if ((rc = phc_photo_viridis(lut, err)) || (rc = phc_image_alloc(out, W, height, err)))
-        return rc;
-    for (size_t i = 0; i < 3 * W * height; ++i)
-        out->data[i] = 1;
-    for (size_t y = y0; y <= y1; ++y) {
-        const size_t k = (size_t)lround(255.0 * (double)(y1 - y) / (double)(y1 - y0));
-        for (size_t x = x0; x <= x1; ++x)
-            memcpy(out->data + 3 * (x + W * y), lut + 3 * k, 3 * sizeof(double));
-    }
-    for (int q = 0; q <= 4; ++q) {
-        char lab[32];
-        const double v = lo + (hi - lo) * q / 4.0;
-        const size_t y = y1 - (size_t)lround((double)(y1 - y0) * q / 4.0);
-        for (size_t x = x1 + 1; x <= x1 + 5; ++x)
-            for (int c = 0; c < 3; ++c)
-                out->data[3 * (x + W * y) + c] = 0;
-        snprintf(lab, sizeof lab, "%.2g", v);
-        if ((rc = phc_photo_draw_text(out, lab, x1 + 9, y + 5, 0.45, err)))
-            return rc;
-    }
-    return phc_photo_draw_text(out, title, 4, 14, 0.45, err);
-}
-
 typedef struct stats {
     double mean_y, a, b, L, vein, near, far, margin;
     size_t n_vein, n_near, n_far, n_margin;
@@ -241,7 +211,7 @@ int main(int argc, char **argv)
         if (!refmask[i])
             refgrid.data[3 * i] = refgrid.data[3 * i + 1] = refgrid.data[3 * i + 2] = 1;
     if (phc_leaf_enlarge(&refgrid, ENLARGE, &big[2 * NT + 1], &err) ||
-        colour_bar(big[0].height, 0, ymax, "fluid y", &big[NT], &err))
+        phc_leaf_colour_bar(big[0].height, 0, ymax, "fluid y", &big[NT], &err))
         goto fail;
     snprintf(caption[NT], sizeof caption[NT], "scale (viridis)");
     snprintf(caption[2 * NT + 1], sizeof caption[NT], "reference: ivy leaf %d", REF_LEAF);

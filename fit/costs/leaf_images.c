@@ -2,6 +2,7 @@
 #include "fit/costs/leaf_images.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 /* Caption band height, px. */
@@ -74,4 +75,35 @@ int phc_leaf_enlarge(const phc_image *img, size_t factor, phc_image *out, phc_er
             memcpy(out->data + 3 * (x + out->width * y), img->data + 3 * (x / factor + img->width * (y / factor)),
                    3 * sizeof(double));
     return PHC_OK;
+}
+
+/* The colour bar: see leaf_images.h. */
+int phc_leaf_colour_bar(size_t height, double lo, double hi, const char *title, phc_image *out, phc_error *err)
+{
+    if (height < 60)
+        return phc_error_set(err, PHC_ERR_INVALID, "colour bar: height %zu px is below 60", height);
+    const size_t W = 150, x0 = 12, x1 = 42, y0 = 24, y1 = height - 14;
+    double lut[3 * 256];
+    int rc;
+    if ((rc = phc_photo_viridis(lut, err)) || (rc = phc_image_alloc(out, W, height, err)))
+        return rc;
+    for (size_t i = 0; i < 3 * W * height; ++i)
+        out->data[i] = 1;
+    for (size_t y = y0; y <= y1; ++y) {
+        const size_t k = (size_t)lround(255.0 * (double)(y1 - y) / (double)(y1 - y0));
+        for (size_t x = x0; x <= x1; ++x)
+            memcpy(out->data + 3 * (x + W * y), lut + 3 * k, 3 * sizeof(double));
+    }
+    for (int q = 0; q <= 4; ++q) {
+        char lab[32];
+        const double v = lo + (hi - lo) * q / 4.0;
+        const size_t y = y1 - (size_t)lround((double)(y1 - y0) * q / 4.0);
+        for (size_t x = x1 + 1; x <= x1 + 5; ++x)
+            for (int c = 0; c < 3; ++c)
+                out->data[3 * (x + W * y) + c] = 0;
+        snprintf(lab, sizeof lab, "%.2g", v);
+        if ((rc = phc_photo_draw_text(out, lab, x1 + 9, y + 5, 0.45, err)))
+            return rc;
+    }
+    return phc_photo_draw_text(out, title, 4, 14, 0.45, err);
 }

@@ -25,4 +25,9 @@ int phc_leaf_map_image(size_t width, size_t height, const double *values, const 
  * pixels stay visible as squares). */
 int phc_leaf_enlarge(const phc_image *img, size_t factor, phc_image *out, phc_error *err);
 
+/* A vertical viridis colour bar from lo (bottom) to hi (top), five labelled
+ * ticks and a title, as a 150 px wide tile of height `height` (>= 60). */
+int phc_leaf_colour_bar(size_t height, double lo, double hi, const char *title, phc_image *out,
+                        phc_error *err);
+
 #endif /* PHC_COSTS_LEAF_IMAGES_H */
