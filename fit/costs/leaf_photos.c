@@ -282,7 +282,8 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
             : im->de2000  ? "CIEDE2000 per grid cell"
                           : "ΔL*, Δa*, Δb* per grid cell (ΔE*ab)",
             im->sigma);
-    fprintf(f, "| row | %s | model time | residuals | RMS ΔE | %s\n|---|---|---|---|---|%s\n", im->stage_name,
+    fprintf(f, "| row | %s | model time | residuals | %s | %s\n|---|---|---|---|---|%s\n", im->stage_name,
+            im->histogram ? "RMS quantile difference (CIELAB)" : "RMS ΔE of the cells",
             im->histogram ? "" : "registration ECC |", im->histogram ? "" : "---|");
     double v[N_SLOTS];
     slot_values(im, p, v);
@@ -830,29 +831,37 @@ static int row_observations(lp_impl *im, lp_row *row, int do_register, phc_error
         if (!rm[i])
             raw.data[3 * i] = raw.data[3 * i + 1] = raw.data[3 * i + 2] = 0;
     if (do_register) {
+        /* Aligned by the leaf's outline: ECC on the two silhouettes (mask
+         * images), because aging changes exactly the colours that ECC on
+         * the photos would compare.  The warp then moves photo and mask. */
         double warp[6];
-        phc_image warped = {0}, mimg = {0}, mw = {0};
-        if ((rc = phc_photo_register(&su->fresh, &raw, NULL, NULL, &warped, warp, &row->correlation, err)) ||
-            (rc = phc_image_alloc(&mimg, su->w, su->h, err))) {
-            phc_image_free(&raw);
-            free(rm);
-            return rc;
+        phc_image sf = {0}, sr = {0}, aligned = {0}, warped = {0}, mw = {0};
+        if ((rc = phc_image_alloc(&sf, su->w, su->h, err)) || (rc = phc_image_alloc(&sr, su->w, su->h, err)))
+            goto reg_done;
+        for (size_t i = 0; i < n; ++i) {
+            sf.data[3 * i] = sf.data[3 * i + 1] = sf.data[3 * i + 2] = su->mask[i];
+            sr.data[3 * i] = sr.data[3 * i + 1] = sr.data[3 * i + 2] = rm[i];
         }
-        for (size_t i = 0; i < n; ++i)
-            mimg.data[3 * i] = mimg.data[3 * i + 1] = mimg.data[3 * i + 2] = rm[i];
-        rc = phc_photo_warp(&mimg, warp, su->w, su->h, &mw, err);
-        phc_image_free(&mimg);
-        if (rc) {
-            phc_image_free(&warped);
-            phc_image_free(&raw);
-            free(rm);
-            return rc;
-        }
+        if ((rc = phc_photo_register(&sf, &sr, NULL, NULL, &aligned, warp, &row->correlation, err)) ||
+            (rc = phc_photo_warp(&raw, warp, su->w, su->h, &warped, err)) ||
+            (rc = phc_photo_warp(&sr, warp, su->w, su->h, &mw, err)))
+            goto reg_done;
         for (size_t i = 0; i < n; ++i)
             rm[i] = mw.data[3 * i] >= 0.5;
-        phc_image_free(&mw);
         phc_image_free(&raw);
         raw = warped;
+        warped.data = NULL;
+    reg_done:
+        phc_image_free(&sf);
+        phc_image_free(&sr);
+        phc_image_free(&aligned);
+        phc_image_free(&warped);
+        phc_image_free(&mw);
+        if (rc) {
+            phc_image_free(&raw);
+            free(rm);
+            return rc;
+        }
     }
     full = raw;
     row->mask = rm;
