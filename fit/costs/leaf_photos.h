@@ -43,8 +43,9 @@
  * A row's model time is t = time_scale |stage - stage(initial)|; a stage on
  * the wrong side of the initial one is an error naming the row.
  *
- * Residuals.  pixels: the photo (registered to the fresh leaf when
- * `register`) and the simulated leaf, both in CIELAB, averaged over each
+ * Residuals.  pixels: the photo (aligned to the fresh leaf by ECC on the
+ * two silhouettes when `register`: aging changes the colours) and the
+ * simulated leaf, both in CIELAB, averaged over each
  * cell of a coarse grid where at least half of the cell is leaf in both.
  * histogram: the quantiles of L*, a*, b* over the leaf (the L2 distance of
  * quantile functions is the 2-Wasserstein distance between histograms), for
