@@ -36,3 +36,24 @@ int phc_error_set(phc_error *err, int status, const char *fmt, ...)
     }
     return status;
 }
+
+int phc_error_prefix(phc_error *err, int status, const char *fmt, ...)
+{
+    if (err) {
+        char msg[PHC_ERROR_MESSAGE_SIZE];
+        snprintf(msg, sizeof msg, "%s", err->message);
+        va_list ap;
+        va_start(ap, fmt);
+        int k = vsnprintf(err->message, sizeof err->message, fmt, ap);
+        va_end(ap);
+        /* the place, then ": " and the earlier message, truncated to fit */
+        size_t at = k < 0 ? 0 : (size_t)k < sizeof err->message ? (size_t)k : sizeof err->message - 1;
+        const char *parts[2] = {": ", msg};
+        for (int q = 0; q < 2; ++q)
+            for (const char *c = parts[q]; *c && at + 1 < sizeof err->message; ++c)
+                err->message[at++] = *c;
+        err->message[at] = '\0';
+        err->status = status;
+    }
+    return status;
+}

@@ -58,6 +58,15 @@ int phc_error_set(phc_error *err, int status, const char *fmt, ...)
 #endif
     ;
 
+/* Puts a printf-style place before the message already in err ("where:
+ * message"), sets the status and returns it: for callers that add the file
+ * and line to an error raised below them.  err may be NULL. */
+int phc_error_prefix(phc_error *err, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 #ifdef __cplusplus
 }
 #endif

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/costs/leaf_images.h"
+#include "fit/leaf_images.h"
 #include "fit/costs/leaf_setup.h"
 #include "fit/costs/source_file.h"
 #include "fit/costs/unique_times.h"
@@ -196,9 +196,20 @@ static int lp_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
         t_prev = t;
         if (phc_leaf_setup_colours(im->su, tf, im->lab, NULL, NULL))
             return -1;
-        for (size_t r = 0; r < im->n_rows; ++r)
-            if (im->rows[r].role == 0 && im->t_at[r] == u)
-                row_values(im, &im->rows[r], yhat + im->rows[r].first);
+        /* histogram residuals do not depend on the row: rows at the same
+         * time copy the first one's quantiles instead of sorting again */
+        const double *same = NULL;
+        for (size_t r = 0; r < im->n_rows; ++r) {
+            const lp_row *row = &im->rows[r];
+            if (row->role != 0 || im->t_at[r] != u)
+                continue;
+            if (same)
+                memcpy(yhat + row->first, same, row->count * sizeof *yhat);
+            else
+                row_values(im, row, yhat + row->first);
+            if (im->histogram)
+                same = yhat + row->first;
+        }
     }
     return 0;
 }
@@ -517,6 +528,18 @@ done:
 
 /* ---- images ---------------------------------------------------------------------------- */
 
+/* The slot values p applied to the model (for the output writers);
+ * PHC_ERR_DOMAIN naming the data set when they are outside its domain. */
+static int use_point(phc_dataset *ds, const double *p, double v[N_SLOTS], phc_colour_transfer *tf, phc_error *err)
+{
+    lp_impl *im = ds->impl;
+    slot_values(im, p, v);
+    if (apply_params(im, v, tf))
+        return phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the leaf parameters are outside the model's domain",
+                             ds->name);
+    return PHC_OK;
+}
+
 /* Enlargement so a model-grid image is about 256 px on its long side. */
 static size_t enlarge_factor(const phc_leaf_setup *su)
 {
@@ -535,10 +558,9 @@ static int lp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
     phc_leaf_setup *su = im->su;
     double v[N_SLOTS];
     phc_colour_transfer tf;
-    slot_values(im, p, v);
-    if (apply_params(im, v, &tf))
-        return phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the leaf parameters are outside the model's domain",
-                             ds->name);
+    int rc;
+    if ((rc = use_point(ds, p, v, &tf, err)))
+        return rc;
     const size_t n = su->w * su->h, fac = enlarge_factor(su);
     phc_image colour[N_FRAMES], fluid[N_FRAMES], big[2 * N_FRAMES], sheet = {0};
     char caption[2 * N_FRAMES][64], path[8192];
@@ -549,7 +571,7 @@ static int lp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
     memset(fluid, 0, sizeof fluid);
     memset(big, 0, sizeof big);
     memset(y, 0, sizeof y);
-    int rc = PHC_OK;
+    rc = PHC_OK;
     double t_end = v[SL_TIME] * im->t_unique[im->m_unique - 1], y_max = 1;
     if (!(t_end > 0))
         t_end = 10 * phc_leaf_get_params(su->leaf).dt;
@@ -625,10 +647,9 @@ static int lp_fit_outputs(phc_dataset *ds, const double *p, const char *dir, con
     phc_leaf_setup *su = im->su;
     double v[N_SLOTS];
     phc_colour_transfer tf;
-    slot_values(im, p, v);
-    if (apply_params(im, v, &tf))
-        return phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the leaf parameters are outside the model's domain",
-                             ds->name);
+    int rc;
+    if ((rc = use_point(ds, p, v, &tf, err)))
+        return rc;
     const size_t fac = enlarge_factor(su);
     size_t m = 0;
     for (size_t r = 0; r < im->n_rows; ++r)
@@ -637,7 +658,7 @@ static int lp_fit_outputs(phc_dataset *ds, const double *p, const char *dir, con
     const phc_image **tiles = calloc(2 * m, sizeof *tiles);
     char **caps = calloc(2 * m, sizeof *caps);
     char path[8192];
-    int rc = PHC_OK;
+    rc = PHC_OK;
     if (!big || !tiles || !caps) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
@@ -741,16 +762,6 @@ static int map_key(const phc_yaml_doc *doc, const phc_yaml_node *node, const cha
     if (!(*file = phc_join_path(base_dir, v)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     return PHC_OK;
-}
-
-/* Prefixes err's message with `where` (file:line). */
-static void prefix_error(phc_error *err, int rc, const char *where)
-{
-    if (!err)
-        return;
-    char msg[PHC_ERROR_MESSAGE_SIZE];
-    snprintf(msg, sizeof msg, "%s", err->message);
-    phc_error_set(err, rc, "%s: %s", where, msg);
 }
 
 /* The row whose id is `id`, or PHC_ERR_INPUT naming the key. */
@@ -1167,7 +1178,7 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
     if ((rc = phc_leaf_setup_new(&im->rows[im->initial].photo,
                                  im->reference < nr ? &im->rows[im->reference].photo : &im->ref_photo, &so, &im->su,
                                  err))) {
-        prefix_error(err, rc, where);
+        phc_error_prefix(err, rc, "%s", where);
         goto fail;
     }
     const phc_leaf_setup *su = im->su;
@@ -1197,7 +1208,7 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         }
         if ((rc = row_observations(im, row, do_register, err))) {
             snprintf(where, sizeof where, "%s:%zu: row '%s'", path, row->line, row->id);
-            prefix_error(err, rc, where);
+            phc_error_prefix(err, rc, "%s", where);
             goto fail;
         }
         if (!row->count) {

@@ -39,16 +39,6 @@ void phc_photo_cache_free(phc_photo_cache *c)
     free(c);
 }
 
-static int with_where(const char *where, phc_error *err)
-{
-    if (where && err && err->status) {
-        char msg[PHC_ERROR_MESSAGE_SIZE];
-        snprintf(msg, sizeof msg, "%s", err->message);
-        phc_error_set(err, err->status, "%s: %s", where, msg);
-    }
-    return err ? err->status : PHC_ERR_INPUT;
-}
-
 static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction_method method,
                      const char *where, cache_entry **out, phc_error *err)
 {
@@ -73,17 +63,13 @@ static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction
         (rc = phc_photo_segment_leaves(&e->img, &so, &e->seg, err))) {
         if (rc == PHC_ERR_INPUT || rc == PHC_ERR_IO) {
             /* name the photo when the bridge's message does not */
-            if (err && !strstr(err->message, path)) {
-                char msg[PHC_ERROR_MESSAGE_SIZE];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                phc_error_set(err, rc, "%s: %s", path, msg);
-            }
+            if (err && !strstr(err->message, path))
+                phc_error_prefix(err, rc, "%s", path);
         }
         free(e->path);
         phc_image_free(&e->img);
         phc_segmentation_free(&e->seg);
-        with_where(where, err);
-        return rc;
+        return where ? phc_error_prefix(err, rc, "%s", where) : rc;
     }
     c->n++;
     *out = e;
@@ -95,7 +81,7 @@ int phc_leaf_photo_load(phc_photo_cache *cache, const char *path, size_t number,
                         phc_leaf_photo *out, phc_error *err)
 {
     memset(out, 0, sizeof *out);
-    cache_entry *e;
+    cache_entry *e = NULL;
     int rc;
     if ((rc = cache_get(cache, path, correction, where, &e, err)))
         return rc;
@@ -104,7 +90,7 @@ int phc_leaf_photo_load(phc_photo_cache *cache, const char *path, size_t number,
                              where ? ": " : "", path, number, e->seg.count, e->seg.count == 1 ? "f" : "ves");
     const size_t margin = 2;
     if ((rc = phc_photo_crop_leaf(&e->img, &e->seg, number, margin, &out->crop, &out->mask, err)))
-        return with_where(where, err);
+        return where ? phc_error_prefix(err, rc, "%s", where) : rc;
     const phc_leaf_box *b = &e->seg.leaf[number - 1];
     out->x0 = b->x0 > margin ? b->x0 - margin : 0;
     out->y0 = b->y0 > margin ? b->y0 - margin : 0;
@@ -220,12 +206,7 @@ static int map_from_file(const char *file, const char *what, const phc_leaf_phot
     double *full = NULL, *crop = NULL;
     int rc = phc_photo_read_map(file, fresh->photo_width, fresh->photo_height, 0, &full, err);
     if (rc) {
-        if (err && !strstr(err->message, what)) {
-            char msg[PHC_ERROR_MESSAGE_SIZE];
-            snprintf(msg, sizeof msg, "%s", err->message);
-            phc_error_set(err, rc, "%s map: %s (it must be the size of the photo %s)", what, msg, fresh->path);
-        }
-        return rc;
+        return phc_error_prefix(err, rc, "%s map (the size of the photo %s)", what, fresh->path);
     }
     const size_t cw = fresh->crop.width, ch = fresh->crop.height;
     if (!(crop = malloc(cw * ch * sizeof *crop))) {

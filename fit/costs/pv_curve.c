@@ -407,9 +407,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         x->swc[L] = x->swc_se[L] = NAN;
         if (extrapolate) {
             if ((rc = phc_pv_extrapolate_saturation(lpsi, lwater, m, &x->swc[L], &x->swc_se[L], &x->swc_k[L], err))) {
-                char msg[PHC_ERROR_MESSAGE_SIZE];
-                snprintf(msg, sizeof msg, "%s", err->message);
-                rc = phc_error_set(err, rc, "%s:%zu: leaf '%s': %s", path, first, gname[g], msg);
+                rc = phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", path, first, gname[g]);
                 goto fail;
             }
             for (size_t j = 0; j < m; ++j)
@@ -428,9 +426,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
                     goto fail;
                 }
         if ((rc = phc_pv_analyse(lpsi, lrwc, m, &opt, &x->res[L], err))) {
-            char msg[PHC_ERROR_MESSAGE_SIZE];
-            snprintf(msg, sizeof msg, "%s", err->message);
-            rc = phc_error_set(err, rc, "%s:%zu: leaf '%s': %s", path, first, gname[g], msg);
+            rc = phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", path, first, gname[g]);
             goto fail;
         }
         n_obs += x->res[L]->n_modulus;

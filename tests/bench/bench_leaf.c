@@ -44,6 +44,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_machine.h"
 #include "model/leaf.h"
 
 #ifndef PHC_SOURCE_DIR
@@ -61,45 +62,6 @@
 #define TARGET_PEER 10.0
 #define PEER_TOL 1e-9
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-/* CPU seconds used by the whole machine (/proc/stat, not idle) and by this
- * process (as in bench_soil.c). */
-typedef struct cpu_mark {
-    double wall, machine, self;
-} cpu_mark;
-
-static cpu_mark cpu_now(void)
-{
-    cpu_mark m = {now(), NAN, NAN};
-    FILE *f = fopen("/proc/stat", "r");
-    if (f) {
-        unsigned long long v[8] = {0};
-        if (fscanf(f, "cpu %llu %llu %llu %llu %llu %llu %llu %llu", &v[0], &v[1], &v[2], &v[3], &v[4],
-                   &v[5], &v[6], &v[7]) == 8) {
-            unsigned long long busy = v[0] + v[1] + v[2] + v[5] + v[6] + v[7];
-            m.machine = (double)busy / (double)sysconf(_SC_CLK_TCK);
-        }
-        fclose(f);
-    }
-    struct rusage ru;
-    if (getrusage(RUSAGE_SELF, &ru) == 0)
-        m.self = ru.ru_utime.tv_sec + 1e-6 * ru.ru_utime.tv_usec + ru.ru_stime.tv_sec +
-                 1e-6 * ru.ru_stime.tv_usec;
-    return m;
-}
-
-static double other_load(cpu_mark a, cpu_mark b)
-{
-    double x = ((b.machine - a.machine) - (b.self - a.self)) / (b.wall - a.wall);
-    return x < 0 ? 0 : x;
-}
-
 static void print_loadavg(const char *when)
 {
     char buf[128] = "";
@@ -111,12 +73,6 @@ static void print_loadavg(const char *when)
     }
     buf[strcspn(buf, "\n")] = '\0';
     printf("machine_loadavg_%s: %s (1, 5, 15 min; %d CPUs)\n", when, buf, omp_get_num_procs());
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* The synthetic leaf of the header comment. */

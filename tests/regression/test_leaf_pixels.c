@@ -22,7 +22,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/costs/leaf_images.h"
+#include "fit/leaf_images.h"
 #include "fit/costs/leaf_setup.h"
 #include "fit/fit.h"
 #include "fit/run_dir.h"

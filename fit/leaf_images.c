@@ -1,5 +1,5 @@
 /* Sheets of leaf images: see leaf_images.h. */
-#include "fit/costs/leaf_images.h"
+#include "fit/leaf_images.h"
 
 #include <math.h>
 #include <stdio.h>

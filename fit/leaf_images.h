@@ -1,8 +1,8 @@
 /* Sheets of leaf images for people: the aging sequence as a contact sheet,
  * observed photos beside simulated leaves.  Tiles sit on white paper in a
  * grid, each with a caption above it. */
-#ifndef PHC_COSTS_LEAF_IMAGES_H
-#define PHC_COSTS_LEAF_IMAGES_H
+#ifndef PHC_LEAF_IMAGES_H
+#define PHC_LEAF_IMAGES_H
 
 #include <stddef.h>
 
@@ -30,4 +30,4 @@ int phc_leaf_enlarge(const phc_image *img, size_t factor, phc_image *out, phc_er
 int phc_leaf_colour_bar(size_t height, double lo, double hi, const char *title, phc_image *out,
                         phc_error *err);
 
-#endif /* PHC_COSTS_LEAF_IMAGES_H */
+#endif /* PHC_LEAF_IMAGES_H */

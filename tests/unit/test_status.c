@@ -1,0 +1,31 @@
+/* Status codes and error messages (model/status.h): phc_error_set and
+ * phc_error_prefix, including a prefix that overflows the message. */
+#include <string.h>
+
+#include "check.h"
+#include "model/status.h"
+
+int main(void)
+{
+    phc_error err;
+    phc_error_clear(&err);
+    CHECK(phc_error_set(&err, PHC_ERR_INPUT, "leaf %d not found", 3) == PHC_ERR_INPUT);
+    CHECK(phc_error_prefix(&err, PHC_ERR_IO, "%s:%d", "photos.csv", 4) == PHC_ERR_IO);
+    CHECK(err.status == PHC_ERR_IO);
+    CHECK(strcmp(err.message, "photos.csv:4: leaf 3 not found") == 0);
+    /* prefixes stack, outermost first */
+    phc_error_prefix(&err, PHC_ERR_IO, "cfg.yaml:7");
+    CHECK(strcmp(err.message, "cfg.yaml:7: photos.csv:4: leaf 3 not found") == 0);
+    /* a NULL error still returns the status */
+    CHECK(phc_error_prefix(NULL, PHC_ERR_INPUT, "x") == PHC_ERR_INPUT);
+    /* too long: truncated, terminated, the place kept whole */
+    char place[PHC_ERROR_MESSAGE_SIZE - 10];
+    memset(place, 'p', sizeof place - 1);
+    place[sizeof place - 1] = '\0';
+    phc_error_set(&err, PHC_ERR_INPUT, "the reason");
+    phc_error_prefix(&err, PHC_ERR_INPUT, "%s", place);
+    CHECK(strlen(err.message) == PHC_ERROR_MESSAGE_SIZE - 1);
+    CHECK(strncmp(err.message, place, strlen(place)) == 0);
+    CHECK(strncmp(err.message + strlen(place), ": the", 5) == 0);
+    return check_finish("test_status");
+}
