@@ -29,7 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/costs/leaf_images.h"
+#include "fit/leaf_images.h"
 #include "fit/costs/leaf_setup.h"
 #include "measurements/photo.h"
 #include "model/colour.h"
