@@ -12,6 +12,7 @@
 #include "fit/costs/infiltration.h"
 #include "fit/costs/leaf_photos.h"
 #include "fit/costs/pv_curve.h"
+#include "fit/costs/root_shoot.h"
 #include "fit/costs/soil_probe.h"
 #include "fit/costs/weight_curve.h"
 #include "measurements/suggest.h"
@@ -33,6 +34,7 @@ static const kind_entry kinds[] = {
     {"infiltration", phc_infiltration_keys, phc_infiltration_load},
     {"leaf_photos", phc_leaf_photos_keys, phc_leaf_photos_load},
     {"pv_curve", phc_pv_curve_keys, phc_pv_curve_load},
+    {"root_shoot", phc_root_shoot_keys, phc_root_shoot_load},
     {"soil_probe", phc_soil_probe_keys, phc_soil_probe_load},
     {"weight_curve", phc_weight_curve_keys, phc_weight_curve_load},
 };

@@ -141,7 +141,8 @@ const char *phc_growth_preset_name(size_t i)
 int phc_growth_preset(const char *name, phc_growth_params *p, phc_error *err)
 {
     int k = preset_index(name);
-    if (k < 0 || !p)
+    if (!p) return phc_error_set(err, PHC_ERR_INVALID, "growth preset: NULL output");
+    if (k < 0)
         return phc_error_set(err, PHC_ERR_INPUT,
                              "unknown species preset '%s' (known: oak, cherry, apple, poplar, "
                              "maple)",
@@ -812,6 +813,21 @@ static size_t events(phc_growth *g, double prob, double *sum)
     return k;
 }
 
+/* How far (m) a root tip may grow along its direction before its tail
+ * reaches a face of the soil box (new segments of a step keep roughly the
+ * tip's direction, so this bounds the whole step's growth). */
+static double room_in_soil(const phc_soil *s, const phc_growth_node *n)
+{
+    double hi[3] = {s->origin[0] + s->nx * s->dx, s->origin[1] + s->ny * s->dx,
+                    s->origin[2] + s->nz * s->dx}, room = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        double t = n->head[k] + n->length * n->dir[k];
+        if (n->dir[k] > 1e-12) room = fmin(room, (hi[k] - t) / n->dir[k]);
+        else if (n->dir[k] < -1e-12) room = fmin(room, (s->origin[k] - t) / n->dir[k]);
+    }
+    return room > 0 ? room : 0;
+}
+
 /* Elongation (eqs. 19, 22), bud numbers (eq. 21) and root branching (eq. 24). */
 static int elongate(phc_growth *g, double dt, phc_error *err)
 {
@@ -825,6 +841,7 @@ static int elongate(phc_growth *g, double dt, phc_error *err)
         double dl = shoot ? P * p->shoot_elongation * dt
                           : P * p->root_elongation * dt /
                                 (1 + p->root_resistance * g->node[i].resistance);
+        if (!shoot && g->soil) dl = fmin(dl, room_in_soil(g->soil, &g->node[i]));
         double L = seg_length(g, g->node[i].system);
         size_t cur = i;
         g->node[cur].length += dl;
@@ -839,6 +856,7 @@ static int elongate(phc_growth *g, double dt, phc_error *err)
             size_t nw = add_node(g, cur, g->node[cur].system, 1, d, excess, g->node[cur].roll);
             g->node[nw].fill = g->node[cur].fill;
             g->node[nw].resistance = g->node[cur].resistance;
+            g->node[nw].nutrient = g->node[cur].nutrient;
             if (shoot) {
                 double b = p->lateral_buds * P;
                 if (g->o.mode == PHC_GROWTH_STOCHASTIC) {

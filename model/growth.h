@@ -69,7 +69,8 @@
  *     at and above i of r_tip^a * length_j / segment length, a =
  *     pipe_exponent: each segment adds a pipe, so stems thicken as the plant
  *     above them grows, continuously in time; radii never shrink (pipes of
- *     pruned branches stay).  Root tips stop at the faces of the soil box.
+ *     pruned branches stay).  Root tips stop at the faces of the soil box
+ *     (a step's growth is cut to the tip's distance to the face).
  *
  * Randomness: STOCHASTIC draws angles, bud flushes and root branching from
  * a seeded xoshiro256** generator (same seed => same plant).  EXPECTED
@@ -252,8 +253,9 @@ void phc_growth_summarize(const phc_growth *g, phc_growth_summary *s);
 const phc_growth_node *phc_growth_nodes(const phc_growth *g, size_t *n);
 const phc_growth_params *phc_growth_parameters(const phc_growth *g);
 
-/* The whole plant as a plant graph (lengths in m): the root collar is the
- * graph's root, root segments hang below it, leaf-bearing internodes are
+/* The whole plant as a plant graph (lengths in m): the first shoot segment
+ * (whose head is the root collar) is the graph's root, the root system's
+ * first segment hangs from it (sharing its head, the collar), leaf-bearing internodes are
  * flagged leaf.  Zero-length tips are left out.  NULL when out of memory
  * (err says so) or the plant is empty. */
 phc_plant_graph *phc_growth_plant_graph(const phc_growth *g, phc_error *err);
