@@ -493,8 +493,10 @@ static int load_table(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
     }
     free(sel);
     if (!rc && out->n == 0)
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows%s", path,
-                           selc ? " match the select filter" : "");
+        rc = selc ? phc_error_set(err, PHC_ERR_INPUT,
+                                  "%s:%zu: select: no row of %s has %s = '%s'", doc->path,
+                                  phc_key_line(node, "select"), path, selc, selv)
+                  : phc_error_set(err, PHC_ERR_INPUT, "%s: no rows", path);
     if (!rc) {
         size_t cap = strlen(path) + 256;
         *source = malloc(cap);

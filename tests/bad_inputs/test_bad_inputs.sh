@@ -935,6 +935,146 @@ lp_config lp_ref.yaml lp_ok.csv && sed -i 's/leaf_old.png/blank.png/' "$C/lp_ref
 fit_case "leaf_photos: reference photo without a leaf" "$C/lp_ref.yaml" "lp_ref.yaml:" "blank.png" "no leaf found"
 # ---- end leaf photos -----------------------------------------------------------
 
+# ---- root_shoot (harvested plants against the shoot-root growth model) ------
+# fit/costs/root_shoot.h: a small harvest table (or a BAAD study folder), a
+# tiny soil pot and 30 simulated days, so that every case is fast.
+RS_SHARED=${2:-}
+case "$RS_SHARED" in /* | "") ;; *) RS_SHARED="$OLDPWD/$RS_SHARED" ;; esac
+printf 'd_mm,root_g,shoot_g,age_m,light\n1.0,0.05,0.10,1,L\n1.5,0.08,0.15,2,L\n2.0,0.12,0.22,3,H\n' >"$C/rs_ok.csv"
+RS_TABLE='    diameter: {column: d_mm, unit: mm}
+    root_mass: {column: root_g, unit: g}
+    shoot_mass: {column: shoot_g, unit: g}
+    age: {column: age_m, unit: month}
+'
+RS_SOIL='    soil:
+      grid: {nx: 4, ny: 4, nz: 4, dx: 0.05}
+      dt: 1
+      layers:
+        - {c: 10, p: 0.0015, water: 3}
+'
+# rs_config FILE SOURCE [EXTRA]: SOURCE is the data lines (file/baad and
+# columns), EXTRA further data-set lines (default: sigma 0.3, 30 days).
+rs_config() {
+    printf 'name: t\nparameters:\n  phi_rg: {value: 0.6, lower: 0.05, upper: 0.95}\ndatasets:\n  - kind: root_shoot\n%s%s%s' \
+        "$2" "${3-    sigma: 0.3
+    days: 30
+}" "$RS_SOIL" >"$C/$1"
+}
+# rs_table_config FILE CSV [EXTRA]: a table data set with the usual columns.
+rs_table_config() {
+    rs_config "$1" "    file: $2
+$RS_TABLE" "${3:-}    sigma: 0.3
+    days: 30
+"
+}
+rs_table_config rs_good.yaml rs_ok.csv
+WHY=""
+run_phc fit "$C/rs_good.yaml" -o "$T/rs_good_out" --quiet
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0 (stderr: $(head -c 300 "$T/stderr" | tr '\n' '|'))"
+[ -f "$T/rs_good_out/result.json" ] || add_why "no result.json"
+report_case "root_shoot: positive control fits"
+rm -rf "$T/rs_good_out"
+# 1. growth presets
+rs_table_config rs_preset.yaml rs_ok.csv '    preset: birch
+'
+fit_case "root_shoot: unknown preset" "$C/rs_preset.yaml" "rs_preset.yaml:" "'preset'" "birch" "oak" "cherry" "apple" "poplar" "maple"
+# 2-4. impossible plants in the table
+printf 'd_mm,root_g,shoot_g,age_m\n1.0,0.05,0.10,1\n0,0.08,0.15,2\n' >"$C/rs_d0.csv"
+rs_table_config rs_d0.yaml rs_d0.csv
+fit_case "root_shoot: zero basal diameter" "$C/rs_d0.yaml" "rs_d0.csv:3:" "basal diameter must be a positive number"
+printf 'd_mm,root_g,shoot_g,age_m\n1.0,0.05,0.10,1\n1.5,0.08,0.15,2\n2.0,-0.12,0.22,3\n' >"$C/rs_rneg.csv"
+rs_table_config rs_rneg.yaml rs_rneg.csv
+fit_case "root_shoot: negative root mass" "$C/rs_rneg.yaml" "rs_rneg.csv:4:" "root mass must be a positive number" "-0.12"
+printf 'd_mm,root_g,shoot_g,age_m\n1.0,0.05,0,1\n1.5,0.08,0.15,2\n' >"$C/rs_s0.csv"
+rs_table_config rs_s0.yaml rs_s0.csv
+fit_case "root_shoot: zero shoot mass" "$C/rs_s0.yaml" "rs_s0.csv:2:" "shoot mass must be a positive number"
+# 5. cells that are not numbers
+printf 'd_mm,root_g,shoot_g,age_m\n1.0,0.05,0.10,1\n,0.08,0.15,2\n' >"$C/rs_empty.csv"
+rs_table_config rs_empty.yaml rs_empty.csv
+fit_case "root_shoot: empty diameter cell" "$C/rs_empty.yaml" "rs_empty.csv:3" "'d_mm'"
+printf 'd_mm,root_g,shoot_g,age_m\n1.0,0.05,0.10,1\nn/a,0.08,0.15,2\n' >"$C/rs_text.csv"
+rs_table_config rs_text.yaml rs_text.csv
+fit_case "root_shoot: text in the diameter column" "$C/rs_text.yaml" "rs_text.csv:3" "'d_mm'" "'n/a'"
+# 6. a column that is not in the table
+rs_config rs_col.yaml "    file: rs_ok.csv
+$(printf '%s' "$RS_TABLE" | sed 's/column: d_mm/column: d_m/')
+"
+fit_case "root_shoot: unknown diameter column" "$C/rs_col.yaml" "rs_col.yaml:" "'d_m'" "d_mm"
+# 7. no shoot mass at all; leaf mass without stem mass
+rs_config rs_noshoot.yaml "    file: rs_ok.csv
+$(printf '%s' "$RS_TABLE" | grep -v shoot_mass)
+"
+fit_case "root_shoot: no shoot mass" "$C/rs_noshoot.yaml" "rs_noshoot.yaml:" "'shoot_mass'" "'leaf_mass'" "'stem_mass'"
+rs_config rs_leafonly.yaml "    file: rs_ok.csv
+$(printf '%s' "$RS_TABLE" | sed 's/shoot_mass: {column: shoot_g/leaf_mass: {column: shoot_g/')
+"
+fit_case "root_shoot: leaf mass without stem mass" "$C/rs_leafonly.yaml" "rs_leafonly.yaml:" "'shoot_mass'" "'stem_mass'"
+# 8. exactly one of file and baad
+mkdir -p "$C/rs_study"
+rs_config rs_both.yaml "    file: rs_ok.csv
+    baad: rs_study
+    species: Quercus rubra
+$RS_TABLE"
+fit_case "root_shoot: both file and baad" "$C/rs_both.yaml" "rs_both.yaml:" "exactly one of 'file'" "'baad'"
+rs_config rs_neither.yaml "$RS_TABLE"
+fit_case "root_shoot: neither file nor baad" "$C/rs_neither.yaml" "rs_neither.yaml:" "exactly one of 'file'" "'baad'"
+# 9. the plant outside the pot
+rs_table_config rs_plant.yaml rs_ok.csv '    plant: {x: 5, y: 0.1}
+'
+fit_case "root_shoot: plant seeded outside the soil grid" "$C/rs_plant.yaml" "rs_plant.yaml:" "plant" "outside the soil grid" "x = 5"
+# 10. growth parameters
+rs_table_config rs_gname.yaml rs_ok.csv '    growth: {phi_rgg: 1}
+'
+fit_case "root_shoot: unknown growth parameter" "$C/rs_gname.yaml" "rs_gname.yaml:" "unknown growth parameter 'phi_rgg'"
+rs_table_config rs_grange.yaml rs_ok.csv '    growth: {phi_rg: 1.5}
+'
+fit_case "root_shoot: growth parameter out of range" "$C/rs_grange.yaml" "rs_grange.yaml:" "phi_rg" "1.5"
+# 11. model options
+rs_table_config rs_mode.yaml rs_ok.csv '    mode: smooth
+'
+fit_case "root_shoot: unknown mode" "$C/rs_mode.yaml" "rs_mode.yaml:" "'mode'" "'smooth'" "stochastic"
+rs_table_config rs_uptake.yaml rs_ok.csv '    uptake: chemical
+'
+fit_case "root_shoot: unknown uptake" "$C/rs_uptake.yaml" "rs_uptake.yaml:" "'uptake'" "'chemical'" "'physical' or 'none'"
+rs_config rs_step.yaml "    file: rs_ok.csv
+$RS_TABLE" '    sigma: 0.3
+    days: 30
+    step: 40
+'
+fit_case "root_shoot: step longer than days" "$C/rs_step.yaml" "rs_step.yaml:" "step <= days" "step 40 d" "days 30 d"
+rs_config rs_sigma.yaml "    file: rs_ok.csv
+$RS_TABLE" '    sigma: 0
+    days: 30
+'
+fit_case "root_shoot: zero sigma" "$C/rs_sigma.yaml" "rs_sigma.yaml:" "'sigma'" "> 0"
+# 12. BAAD study folders
+rs_config rs_nobaad.yaml '    baad: no_such_study
+    species: Quercus rubra
+'
+fit_case "root_shoot: BAAD folder does not exist" "$C/rs_nobaad.yaml" "rs_nobaad.yaml:" "'baad'" "no_such_study"
+if [ -n "$RS_SHARED" ] && [ -f "$RS_SHARED/baad/Baltzer2007/data.csv" ]; then
+    RS_STUDY=$(cd "$RS_SHARED/baad/Baltzer2007" && pwd)
+    rs_config rs_species.yaml "    baad: $RS_STUDY
+    species: Quercus rubrum
+"
+    fit_case "root_shoot: species not in the BAAD study" "$C/rs_species.yaml" "rs_species.yaml:" "'Quercus rubrum'" "Baltzer2007" "Quercus rubra" "Acer rubrum"
+    rs_config rs_bsel.yaml "    baad: $RS_STUDY
+    species: Quercus rubra
+    select: {column: Shade, equals: L}
+"
+    fit_case "root_shoot: BAAD select column does not exist" "$C/rs_bsel.yaml" "rs_bsel.yaml:" "select" "'Shade'" "data.csv"
+else
+    echo "# skip - root_shoot BAAD study cases: no shared data folder (second argument)"
+fi
+rs_table_config rs_tsel.yaml rs_ok.csv '    select: {column: shade, equals: L}
+'
+fit_case "root_shoot: table select column does not exist" "$C/rs_tsel.yaml" "rs_tsel.yaml:" "'shade'" "light"
+# 13. a filter that keeps nothing
+rs_table_config rs_none.yaml rs_ok.csv '    select: {column: light, equals: M}
+'
+fit_case "root_shoot: select matches no rows" "$C/rs_none.yaml" "rs_ok.csv" "select: no row of" "light = 'M'"
+# ---- end root_shoot --------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
