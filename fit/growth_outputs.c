@@ -130,7 +130,7 @@ int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
     plschr(0.0, 1.0);
     double w = 1.0 / (double)n;
     for (size_t p = 0; p < n; ++p) {
-        plvpas(w * (double)p + 0.085 * w + 0.02, w * (double)(p + 1) - 0.02, 0.1, 0.9,
+        plvpas(w * (double)p + 0.12 * w + 0.035, w * (double)(p + 1) - 0.02, 0.24, 0.9,
                (z1 - z0) / (x1 - x0));
         plwind(x0, x1, z0, z1);
         if (soil_top > z0) { /* soil below the surface */
@@ -167,12 +167,12 @@ int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
     plvpor(0, 1, 0, 1);
     plwind(0, 1, 0, 1);
     plcol0(COL_SHOOT);
-    plptex(0.2, 0.025, 1, 0, 0.5, "green: shoot");
+    plptex(0.2, 0.06, 1, 0, 0.5, "green: shoot");
     plcol0(COL_ROOT);
-    plptex(0.5, 0.025, 1, 0, 0.5, "brown: roots");
+    plptex(0.5, 0.06, 1, 0, 0.5, "brown: roots");
     plcol0(COL_FG);
-    plptex(0.8, 0.025, 1, 0, 0.5, "tan: soil");
-    plptex(0.5, 0.0, 1, 0, 0.5, "line width grows with segment radius");
+    plptex(0.8, 0.06, 1, 0, 0.5, "tan: soil");
+    plptex(0.5, 0.02, 1, 0, 0.5, "line width grows with segment radius");
     plsstrm(strm);
     plend1();
     plsstrm(old_stream);

@@ -31,6 +31,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "fit/growth_outputs.h"
 #include "model/growth.h"
 #include "model/soil.h"
 
@@ -66,99 +67,10 @@ typedef struct result {
     double min_w, max_fill_top, mean_fill_top, mean_fill_bottom;
     size_t substeps;
     double seconds;
-    /* the drawing: segments */
-    size_t n;
-    double *x0, *z0, *x1, *z1, *r;
-    unsigned char *sys;
+    /* the grown plant and its soil, kept for the side view (freed after it) */
+    phc_growth *g;
+    phc_soil *s;
 } result;
-
-/* ---- side view: segments with width ~ radius -------------------------------- */
-static void draw_side_view(const result *R, const char *title, double vx0, double vx1, double vy0, double vy1,
-                           double xmin, double xmax, double zmin, double zmax, double surface, double box_x1,
-                           double box_z0, double rmax)
-{
-    plvpas(vx0, vx1, vy0, vy1, (zmax - zmin) / (xmax - xmin));
-    plwind(xmin, xmax, zmin, zmax);
-    plcol0(NB_GRID);
-    plwidth(1.0);
-    plbox("g", 0, 0, "g", 0, 0);
-    /* the pot */
-    plcol0(NB_GREY);
-    plwidth(1.5);
-    pllsty(2);
-    PLFLT bx[4] = {0.0, 0.0, box_x1, box_x1}, bz[4] = {surface, box_z0, box_z0, surface};
-    plline(4, bx, bz);
-    pllsty(1);
-    plcol0(NB_OLIVE);
-    plwidth(2.0);
-    pljoin(xmin, surface, xmax, surface);
-    for (size_t i = 0; i < R->n; ++i) {
-        double w = 0.6 + 6.0 * sqrt(R->r[i] / rmax);
-        plcol0(R->sys[i] == PHC_GROWTH_SHOOT ? NB_GREEN : NB_BROWN);
-        plwidth(w);
-        pljoin(R->x0[i], R->z0[i], R->x1[i], R->z1[i]);
-    }
-    plwidth(1.2);
-    plcol0(NB_FG);
-    plbox("bcnst", 0, 0, "bcnstv", 0, 0);
-    plmtex("b", 3.0, 0.5, 0.5, "x (m)");
-    plmtex("l", 4.2, 0.5, 0.5, "height z above the pot's bottom (m)");
-    plschr(0.0, 1.0 * NB_CHR);
-    plmtex("t", 1.5, 0.5, 0.5, title);
-    plschr(0.0, NB_CHR);
-}
-
-static int write_png(const char *path, const result *R, double surface)
-{
-    char tmp[1040];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    double xmin = -0.05, xmax = NX * DX + 0.05, zmin = -0.05, zmax = surface, rmax = 0;
-    for (int q = 0; q < NSOIL; ++q)
-        for (size_t i = 0; i < R[q].n; ++i) {
-            zmax = fmax(zmax, fmax(R[q].z0[i], R[q].z1[i]));
-            xmin = fmin(xmin, fmin(R[q].x0[i], R[q].x1[i]));
-            xmax = fmax(xmax, fmax(R[q].x0[i], R[q].x1[i]));
-            rmax = fmax(rmax, R[q].r[i]);
-        }
-    zmax += 0.05;
-    PLINT old, strm;
-    plgstrm(&old);
-    plmkstrm(&strm);
-    if (strm < 0)
-        return -1;
-    int W = 1650, H = 820;
-    plsdev("pngcairo");
-    plsfnam(tmp);
-    plspage(0.0, 0.0, W, H, 0, 0);
-    nb_colours();
-    plinit();
-    pladv(0);
-    plschr(0.0, NB_CHR);
-    for (int q = 0; q < NSOIL; ++q) {
-        char title[160];
-        snprintf(title, sizeof title, "%s (c = %g, p = %g m/h)", soil_name[q], R[q].c, R[q].p);
-        double cw = 1.0 / NSOIL, x0 = q * cw;
-        draw_side_view(&R[q], title, x0 + 95.0 / W, x0 + cw - 20.0 / W, 140.0 / H, 1.0 - 120.0 / H, xmin, xmax, zmin,
-                       zmax, surface, NX * DX, 0.0, rmax);
-    }
-    /* figure title and legend */
-    plvpor(0.0, 1.0, 0.0, 1.0);
-    plwind(0.0, 1.0, 0.0, 1.0);
-    plcol0(NB_FG);
-    plschr(0.0, 1.15 * NB_CHR);
-    plmtex("t", -1.4, 0.5, 0.5,
-           "Rhizomorph Fig. 15: oak (STOCHASTIC, seed 3) after 120 days in three soils, side view (x-z projection)");
-    plschr(0.0, NB_CHR);
-    plmtex("b", -1.5, 0.5, 0.5,
-           "brown: roots, green: shoot (line width ~ radius); olive line: soil surface; dashed: the pot (BLOCK faces)");
-    plend1();
-    plsstrm(old);
-    if (rename(tmp, path) != 0) {
-        unlink(tmp);
-        return -1;
-    }
-    return 0;
-}
 
 static int run_soil(int q, result *R, phc_error *err)
 {
@@ -210,12 +122,8 @@ static int run_soil(int q, result *R, phc_error *err)
     R->mean_fill_top = top / (NX * NY), R->mean_fill_bottom = bot / (NX * NY);
     size_t n;
     const phc_growth_node *N = phc_growth_nodes(g, &n);
-    R->x0 = malloc(n * sizeof *R->x0), R->z0 = malloc(n * sizeof *R->z0);
-    R->x1 = malloc(n * sizeof *R->x1), R->z1 = malloc(n * sizeof *R->z1);
-    R->r = malloc(n * sizeof *R->r), R->sys = malloc(n);
     unsigned char *has_root = calloc(s->n, 1);
-    if (!R->x0 || !R->z0 || !R->x1 || !R->z1 || !R->r || !R->sys || !has_root) {
-        free(has_root);
+    if (!has_root) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -224,10 +132,6 @@ static int run_soil(int q, result *R, phc_error *err)
         const phc_growth_node *m = &N[i];
         if (m->length <= 0)
             continue;
-        size_t k = R->n++;
-        R->x0[k] = m->head[0], R->z0[k] = m->head[2];
-        R->x1[k] = m->head[0] + m->length * m->dir[0], R->z1[k] = m->head[2] + m->length * m->dir[2];
-        R->r[k] = m->radius, R->sys[k] = m->system;
         if (m->system != PHC_GROWTH_ROOT)
             continue;
         double c[3];
@@ -248,6 +152,10 @@ static int run_soil(int q, result *R, phc_error *err)
     R->top_fraction = len > 0 ? top_len / len : NAN;
     R->root_density = R->root_voxels ? len / (R->root_voxels * DX * DX * DX) : NAN;
 done:
+    if (!rc) { /* kept for the side view; main frees them */
+        R->g = g, R->s = s;
+        return 0;
+    }
     phc_growth_free(g);
     phc_soil_free(s);
     return rc;
@@ -310,8 +218,20 @@ int main(int argc, char **argv)
     /* ---- PNG ---- */
     char png[1024];
     snprintf(png, sizeof png, "%s/rhizomorph_fig15_soils.png", out);
-    if (write_png(png, R, NZ * DX) != 0) {
-        fprintf(stderr, "%s: cannot write the plot\n", png);
+    char title[NSOIL][160];
+    const char *titles[NSOIL];
+    const phc_growth *plants[NSOIL];
+    for (int q = 0; q < NSOIL; ++q) {
+        snprintf(title[q], sizeof title[q], "%s (c = %g, p = %g m/h)", soil_name[q], R[q].c, R[q].p);
+        titles[q] = title[q], plants[q] = R[q].g;
+    }
+    int png_rc = phc_growth_plot_side(png, plants, titles, NSOIL, NZ * DX, 0.0, NX * DX, &err);
+    for (int q = 0; q < NSOIL; ++q) {
+        phc_growth_free(R[q].g), phc_soil_free(R[q].s);
+        R[q].g = NULL, R[q].s = NULL;
+    }
+    if (png_rc != 0) {
+        fprintf(stderr, "%s: cannot write the plot: %s\n", png, err.message);
         return 1;
     }
 
@@ -360,9 +280,6 @@ int main(int argc, char **argv)
     if (nb_close_md(f, md, mdtmp) != 0) {
         fprintf(stderr, "%s: cannot write the page\n", md);
         return 1;
-    }
-    for (int q = 0; q < NSOIL; ++q) {
-        free(R[q].x0), free(R[q].z0), free(R[q].x1), free(R[q].z1), free(R[q].r), free(R[q].sys);
     }
     printf("ok: %s\n", png);
     return 0;
