@@ -919,19 +919,11 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
             goto fail;
         }
 
-    free_reasons(reasons, s->n);
-    free(za);
-    free(idx);
-    free(lx);
-    free(work);
-    free(raw_lat);
-    free(raw_lon);
-    phc_units_free(units);
-    phc_table_free(match);
-    phc_table_free(nw);
-    phc_table_free(defs);
     *out = s;
-    return PHC_OK;
+    rc = PHC_OK;
+    free_reasons(reasons, s->n);
+    reasons = NULL;
+    s = NULL; /* the caller's now */
 
 fail:
     free_reasons(reasons, s ? s->n : 0);

@@ -96,11 +96,13 @@ int phc_growth_check(const phc_growth_params *p, phc_error *err)
 }
 
 /* ---- species presets -------------------------------------------------------
- * Rhizomorph Table 4 gives per species the apical dominance, branching
- * angles, internode lengths, bud counts and the root growth factor phi_RG;
- * the remaining numbers (densities, uptake, light use) are ours, chosen so
- * that seedlings reach the sizes of greenhouse harvests (Baltzer & Thomas
- * 2007) in one season. */
+ * The five species of Rhizomorph Table 4.  The paper's table was not at
+ * hand, so every number here is ours: the species differ in apical
+ * dominance, branching angles, internode lengths, bud counts, phi_RG, seed
+ * reserve and densities in the directions the species are known for, and
+ * the shared numbers (uptake, light use, maintenance) are chosen so that
+ * oak seedlings reach the sizes of greenhouse harvests (Baltzer & Thomas
+ * 2007) in one season.  Calibrate them (root_shoot) before trusting them. */
 static phc_growth_params preset_oak(void)
 {
     phc_growth_params p = {
@@ -425,10 +427,10 @@ static double seg_length(const phc_growth *g, int system)
 
 /* ---- the step ---------------------------------------------------------------- */
 
-/* Positions (top-down) and the soil under each root segment. */
-static void place_and_sample(phc_growth *g)
+/* Positions (top-down): heads from the parents' tails, branch lengths.
+ * Growing tips move the laterals they carry, so this ends every step. */
+static void place(phc_growth *g)
 {
-    phc_soil *s = g->soil;
     for (size_t i = 0; i < g->n; i++) {
         phc_growth_node *n = &g->node[i];
         if (n->parent != PHC_GROWTH_NONE) {
@@ -438,6 +440,16 @@ static void place_and_sample(phc_growth *g)
         } else {
             n->branch_length = n->length;
         }
+    }
+}
+
+/* The soil under each root segment: fill, growth resistance, nutrients and
+ * the voxel (positions must be current: place() ends every step). */
+static void sample_soil(phc_growth *g)
+{
+    phc_soil *s = g->soil;
+    for (size_t i = 0; i < g->n; i++) {
+        phc_growth_node *n = &g->node[i];
         g->voxel[i] = PHC_GROWTH_NONE;
         if (n->system != PHC_GROWTH_ROOT) continue;
         if (!s) { n->fill = g->p.soil_fill; n->resistance = 0; n->nutrient = 0; continue; }
@@ -939,7 +951,7 @@ int phc_growth_step(phc_growth *g, double dt, phc_error *err)
         return phc_error_set(err, PHC_ERR_INVALID, "growth: the step must be > 0 d, found %g", dt);
     int rc = reserve_scratch(g, err);
     if (rc) return rc;
-    place_and_sample(g);
+    sample_soil(g);
     if ((rc = shoot_flux(g, err))) return rc;
     root_flux(g);
     allocate(g, dt);
@@ -947,7 +959,7 @@ int phc_growth_step(phc_growth *g, double dt, phc_error *err)
     if ((rc = elongate(g, dt, err))) return rc;
     if ((rc = flush_buds(g, dt, err))) return rc;
     if ((rc = reserve_scratch(g, err))) return rc;
-    place_and_sample(g); /* new segments: positions for pruning's light and the radii */
+    place(g); /* laterals on grown tips move with them */
     prune(g);
     thicken(g);
     if (g->soil) {

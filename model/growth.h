@@ -13,6 +13,13 @@
  * parent and compaction keeps the order), so a forward loop is top-down and
  * a backward loop bottom-up: every pass is O(nodes).
  *
+ * Equation numbers follow the list of the paper's equations we worked from
+ * (signals 1-9, vigor 10-12, propagation 13-15, potentials 16-17, pruning
+ * 18, elongation 19/22, buds 20-21, roots 23-24); the paper's own formulas
+ * were not at hand, so each form below is ours, written to the paper's
+ * description and the authors' code (TreeModel.cpp: vigor = min of the two
+ * fluxes, maintenance before development, root flux summed over root nodes).
+ *
  * One step of dt days (phc_growth_step):
  *  1. organ state (eqs. 1-4): maintenance requirement M = mu * tissue volume
  *     per segment (vigor/d); growth requirement G = g per growing tip;
@@ -103,7 +110,8 @@ typedef enum phc_growth_system { PHC_GROWTH_SHOOT = 0, PHC_GROWTH_ROOT = 1 } phc
 typedef enum phc_growth_mode { PHC_GROWTH_EXPECTED = 0, PHC_GROWTH_STOCHASTIC } phc_growth_mode;
 typedef enum phc_growth_uptake { PHC_GROWTH_UPTAKE_PHYSICAL = 0, PHC_GROWTH_UPTAKE_NONE } phc_growth_uptake;
 
-/* Species parameters (Table 4 holds the presets' values).  Every number
+/* Species parameters (the presets hold our values for the species of
+ * Table 4; see growth.c).  Every number
  * must be finite; phc_growth_check names the first one out of range. */
 typedef struct phc_growth_params {
     /* shoot */
@@ -166,7 +174,7 @@ double *phc_growth_param_ref(phc_growth_params *p, size_t i);
 /* Index of a parameter by name, or -1. */
 long phc_growth_param_find(const char *name);
 
-/* Species presets (Rhizomorph Table 4 and §8): "oak", "cherry", "apple",
+/* Species presets (the species of Rhizomorph Table 4, with our values): "oak", "cherry", "apple",
  * "poplar", "maple".  Case is ignored.  PHC_ERR_INPUT naming the known
  * presets for another name. */
 int phc_growth_preset(const char *name, phc_growth_params *p, phc_error *err);

@@ -36,6 +36,7 @@
 #include "model/soil.h"
 
 #include "notebook_plot.h"
+#include "rhizomorph_pot.h"
 
 #define NSOIL 3
 #define DAYS 120
@@ -48,117 +49,14 @@
 #define SEED 3
 #define SOIL_D 0.25 /* growth resistance, the same in every soil */
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 static const char *soil_name[NSOIL] = {"sandy_clay_loam", "silt_loam", "clay"};
 
-typedef struct result {
-    double c, p;
-    phc_growth_summary S;
-    double root_density;  /* m of root per m^3 of the voxels that hold root */
-    double mean_depth;    /* m, root-length-weighted depth below the surface */
-    double top_fraction;  /* fraction of root length in the top 0.1 m */
-    size_t root_voxels;
-    double min_w, max_fill_top, mean_fill_top, mean_fill_bottom;
-    size_t substeps;
-    double seconds;
-    /* the grown plant and its soil, kept for the side view (freed after it) */
-    phc_growth *g;
-    phc_soil *s;
-} result;
+typedef rz_pot result;
 
 static int run_soil(int q, result *R, phc_error *err)
 {
-    memset(R, 0, sizeof *R);
-    if (phc_soil_preset(soil_name[q], &R->c, &R->p))
-        return phc_error_set(err, PHC_ERR_INPUT, "unknown soil preset %s", soil_name[q]);
-    phc_soil *s = phc_soil_new(NX, NY, NZ, DX);
-    if (!s)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    phc_soil_layer L = {0.0, R->c, R->p, SOIL_D, W0, -1.0, 0.0};
-    phc_soil_rain rain[DAYS];
-    for (int d = 0; d < DAYS; ++d)
-        rain[d] = (phc_soil_rain){24.0 * d, 24.0 * d + 1.0, RAIN_DEPTH, 0.0, 0.0, 0.0, 0.0, 0.0};
-    s->params.dt = 1.0;
-    s->params.substep = 1;
-    int rc = phc_soil_set_layers(s, &L, 1, err);
-    if (!rc)
-        rc = phc_soil_set_rain(s, rain, DAYS, err);
-    if (!rc)
-        rc = phc_soil_check(s, err);
-    phc_growth *g = NULL;
-    phc_growth_params P;
-    if (!rc)
-        rc = phc_growth_preset("oak", &P, err);
-    phc_growth_options o = phc_growth_options_default();
-    o.mode = PHC_GROWTH_STOCHASTIC;
-    o.seed = SEED;
-    o.base[0] = 0.5 * NX * DX, o.base[1] = 0.5 * NY * DX, o.base[2] = NZ * DX;
-    if (!rc)
-        rc = phc_growth_new(&P, &o, s, &g, err);
-    double t0 = now_s();
-    R->min_w = INFINITY;
-    for (int d = 0; d < DAYS && !rc; ++d) {
-        rc = phc_growth_step(g, 1.0, err);
-        for (size_t i = 0; i < s->n && !rc; ++i)
-            R->min_w = fmin(R->min_w, s->w[i]);
-    }
-    R->seconds = now_s() - t0;
-    if (rc)
-        goto done;
-    R->substeps = s->budget.substeps;
-    phc_growth_summarize(g, &R->S);
-    /* fill of the top and bottom planes at the end */
-    double top = 0, bot = 0;
-    for (size_t j = 0; j < NY * NX; ++j) {
-        top += s->w[j + NX * NY * (NZ - 1)] / s->c[j + NX * NY * (NZ - 1)];
-        bot += s->w[j] / s->c[j];
-    }
-    R->mean_fill_top = top / (NX * NY), R->mean_fill_bottom = bot / (NX * NY);
-    size_t n;
-    const phc_growth_node *N = phc_growth_nodes(g, &n);
-    unsigned char *has_root = calloc(s->n, 1);
-    if (!has_root) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    double len = 0, depth_sum = 0, top_len = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const phc_growth_node *m = &N[i];
-        if (m->length <= 0)
-            continue;
-        if (m->system != PHC_GROWTH_ROOT)
-            continue;
-        double c[3];
-        for (int a = 0; a < 3; ++a)
-            c[a] = m->head[a] + 0.5 * m->length * m->dir[a];
-        double depth = o.base[2] - c[2];
-        len += m->length, depth_sum += m->length * depth;
-        if (depth < 0.1)
-            top_len += m->length;
-        long ix = (long)floor(c[0] / DX), iy = (long)floor(c[1] / DX), iz = (long)floor(c[2] / DX);
-        if (ix >= 0 && iy >= 0 && iz >= 0 && ix < NX && iy < NY && iz < NZ)
-            has_root[ix + NX * (iy + NY * iz)] = 1;
-    }
-    for (size_t i = 0; i < s->n; ++i)
-        R->root_voxels += has_root[i];
-    free(has_root);
-    R->mean_depth = len > 0 ? depth_sum / len : NAN;
-    R->top_fraction = len > 0 ? top_len / len : NAN;
-    R->root_density = R->root_voxels ? len / (R->root_voxels * DX * DX * DX) : NAN;
-done:
-    if (!rc) { /* kept for the side view; main frees them */
-        R->g = g, R->s = s;
-        return 0;
-    }
-    phc_growth_free(g);
-    phc_soil_free(s);
-    return rc;
+    const rz_pot_setup setup = {NX, NY, NZ, DX, SOIL_D, W0, RAIN_DEPTH, DAYS, SEED, NULL, NULL};
+    return rz_pot_run(&setup, soil_name[q], R, err);
 }
 
 int main(int argc, char **argv)

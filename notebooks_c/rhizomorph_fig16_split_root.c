@@ -36,6 +36,7 @@
 #include "model/soil.h"
 
 #include "notebook_plot.h"
+#include "rhizomorph_pot.h"
 
 #define NSOIL 3 /* cases */
 #define DAYS 120
@@ -50,132 +51,50 @@
 #define V_LOW 0.2
 #define V_HIGH 3.0
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 static const char *soil_name[NSOIL] = {"low nutrients", "high nutrients", "split: left high, right low"};
 static const char *case_key[NSOIL] = {"low", "high", "split"};
 
 typedef struct result {
-    double c, p;
-    phc_growth_summary S;
-    double root_density;  /* m of root per m^3 of the voxels that hold root */
-    double mean_depth;    /* m, root-length-weighted depth below the surface */
-    double top_fraction;  /* fraction of root length in the top 0.1 m */
-    size_t root_voxels;
-    double min_w, max_fill_top, mean_fill_top, mean_fill_bottom;
-    size_t substeps;
+    rz_pot pot;
     double half_len[2];   /* root length (m) with centre at x < centre [0] and >= [1] */
     size_t half_tips[2], half_seg[2];
-    double seconds;
-    /* the grown plant and its soil, kept for the side view (freed after it) */
-    phc_growth *g;
-    phc_soil *s;
 } result;
 
-static int run_soil(int q, result *R, phc_error *err)
+/* Nutrients: low, high, or high on the left half and low on the right. */
+static void set_nutrients(phc_soil *s, void *user)
 {
-    memset(R, 0, sizeof *R);
-    if (phc_soil_preset("clay", &R->c, &R->p))
-        return phc_error_set(err, PHC_ERR_INPUT, "unknown soil preset clay");
-    phc_soil *s = phc_soil_new(NX, NY, NZ, DX);
-    if (!s)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    phc_soil_layer L = {0.0, R->c, R->p, SOIL_D, W0, -1.0, 0.0};
-    phc_soil_rain rain[DAYS];
-    for (int d = 0; d < DAYS; ++d)
-        rain[d] = (phc_soil_rain){24.0 * d, 24.0 * d + 1.0, RAIN_DEPTH, 0.0, 0.0, 0.0, 0.0, 0.0};
-    s->params.dt = 1.0;
-    s->params.substep = 1;
-    int rc = phc_soil_set_layers(s, &L, 1, err);
-    if (!rc)
-        rc = phc_soil_set_rain(s, rain, DAYS, err);
-    for (size_t k = 0; !rc && k < NZ; ++k)
+    int q = *(const int *)user;
+    for (size_t k = 0; k < NZ; ++k)
         for (size_t j = 0; j < NY; ++j)
             for (size_t i = 0; i < NX; ++i) {
                 int left = i < NX / 2;
                 s->v[i + NX * (j + NY * k)] = q == 0 ? V_LOW : q == 1 ? V_HIGH : left ? V_HIGH : V_LOW;
             }
-    if (!rc)
-        rc = phc_soil_check(s, err);
-    phc_growth *g = NULL;
-    phc_growth_params P;
-    if (!rc)
-        rc = phc_growth_preset("oak", &P, err);
-    phc_growth_options o = phc_growth_options_default();
-    o.mode = PHC_GROWTH_STOCHASTIC;
-    o.seed = SEED;
-    o.base[0] = 0.5 * NX * DX, o.base[1] = 0.5 * NY * DX, o.base[2] = NZ * DX;
-    if (!rc)
-        rc = phc_growth_new(&P, &o, s, &g, err);
-    double t0 = now_s();
-    R->min_w = INFINITY;
-    for (int d = 0; d < DAYS && !rc; ++d) {
-        rc = phc_growth_step(g, 1.0, err);
-        for (size_t i = 0; i < s->n && !rc; ++i)
-            R->min_w = fmin(R->min_w, s->w[i]);
-    }
-    R->seconds = now_s() - t0;
+}
+
+static int run_soil(int q, result *R, phc_error *err)
+{
+    memset(R, 0, sizeof *R);
+    const rz_pot_setup setup = {NX, NY, NZ, DX, SOIL_D, W0, RAIN_DEPTH, DAYS, SEED, set_nutrients, &q};
+    int rc = rz_pot_run(&setup, "clay", &R->pot, err);
     if (rc)
-        goto done;
-    R->substeps = s->budget.substeps;
-    phc_growth_summarize(g, &R->S);
-    /* fill of the top and bottom planes at the end */
-    double top = 0, bot = 0;
-    for (size_t j = 0; j < NY * NX; ++j) {
-        top += s->w[j + NX * NY * (NZ - 1)] / s->c[j + NX * NY * (NZ - 1)];
-        bot += s->w[j] / s->c[j];
-    }
-    R->mean_fill_top = top / (NX * NY), R->mean_fill_bottom = bot / (NX * NY);
+        return rc;
+    /* root length, segments and tips on each side of the plant's centre */
+    const double centre = 0.5 * NX * DX;
     size_t n;
-    const phc_growth_node *N = phc_growth_nodes(g, &n);
-    unsigned char *has_root = calloc(s->n, 1);
-    if (!has_root) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    double len = 0, depth_sum = 0, top_len = 0;
+    const phc_growth_node *N = phc_growth_nodes(R->pot.g, &n);
     for (size_t i = 0; i < n; ++i) {
         const phc_growth_node *m = &N[i];
-        if (m->length <= 0)
+        if (m->length <= 0 || m->system != PHC_GROWTH_ROOT)
             continue;
-        if (m->system != PHC_GROWTH_ROOT)
-            continue;
-        int hc = m->head[0] + 0.5 * m->length * m->dir[0] < o.base[0] ? 0 : 1;
-        int ht = m->head[0] + m->length * m->dir[0] < o.base[0] ? 0 : 1;
+        int hc = m->head[0] + 0.5 * m->length * m->dir[0] < centre ? 0 : 1;
+        int ht = m->head[0] + m->length * m->dir[0] < centre ? 0 : 1;
         R->half_len[hc] += m->length;
         R->half_seg[hc]++;
         if (m->tip)
             R->half_tips[ht]++;
-        double c[3];
-        for (int a = 0; a < 3; ++a)
-            c[a] = m->head[a] + 0.5 * m->length * m->dir[a];
-        double depth = o.base[2] - c[2];
-        len += m->length, depth_sum += m->length * depth;
-        if (depth < 0.1)
-            top_len += m->length;
-        long ix = (long)floor(c[0] / DX), iy = (long)floor(c[1] / DX), iz = (long)floor(c[2] / DX);
-        if (ix >= 0 && iy >= 0 && iz >= 0 && ix < NX && iy < NY && iz < NZ)
-            has_root[ix + NX * (iy + NY * iz)] = 1;
     }
-    for (size_t i = 0; i < s->n; ++i)
-        R->root_voxels += has_root[i];
-    free(has_root);
-    R->mean_depth = len > 0 ? depth_sum / len : NAN;
-    R->top_fraction = len > 0 ? top_len / len : NAN;
-    R->root_density = R->root_voxels ? len / (R->root_voxels * DX * DX * DX) : NAN;
-done:
-    if (!rc) { /* kept for the side view; main frees them */
-        R->g = g, R->s = s;
-        return 0;
-    }
-    phc_growth_free(g);
-    phc_soil_free(s);
-    return rc;
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -202,8 +121,8 @@ int main(int argc, char **argv)
            "spread_m", "length_m", "tips", "len_left_m", "len_right_m", "tips_left", "tips_right", "L/R_len");
     for (int q = 0; q < NSOIL; ++q)
         printf("%-8s %10.4g %10.4g %9.3f %9.3f %10.4g %6zu | %12.4g %12.4g %10zu %10zu %9.3f\n", case_key[q],
-               R[q].S.root_mass, R[q].S.shoot_mass, R[q].S.rooting_depth, R[q].S.root_spread, R[q].S.root_length,
-               R[q].S.root_tips, R[q].half_len[0], R[q].half_len[1], R[q].half_tips[0], R[q].half_tips[1],
+               R[q].pot.S.root_mass, R[q].pot.S.shoot_mass, R[q].pot.S.rooting_depth, R[q].pot.S.root_spread, R[q].pot.S.root_length,
+               R[q].pot.S.root_tips, R[q].half_len[0], R[q].half_len[1], R[q].half_tips[0], R[q].half_tips[1],
                R[q].half_len[1] > 0 ? R[q].half_len[0] / R[q].half_len[1] : NAN);
 
     /* ---- CSV ---- */
@@ -241,12 +160,12 @@ int main(int argc, char **argv)
             snprintf(title[q], sizeof title[q], "%s nutrients: v = %g units/m^3", case_key[q], q == 1 ? V_HIGH : V_LOW);
         else
             snprintf(title[q], sizeof title[q], "split: v = %g left | %g right", V_HIGH, V_LOW);
-        titles[q] = title[q], plants[q] = R[q].g;
+        titles[q] = title[q], plants[q] = R[q].pot.g;
     }
     int png_rc = phc_growth_plot_side(png, plants, titles, NSOIL, NZ * DX, 0.0, NX * DX, &err);
     for (int q = 0; q < NSOIL; ++q) {
-        phc_growth_free(R[q].g), phc_soil_free(R[q].s);
-        R[q].g = NULL, R[q].s = NULL;
+        phc_growth_free(R[q].pot.g), phc_soil_free(R[q].pot.s);
+        R[q].pot.g = NULL, R[q].pot.s = NULL;
     }
     if (png_rc != 0) {
         fprintf(stderr, "%s: cannot write the plot: %s\n", png, err.message);
@@ -264,8 +183,8 @@ int main(int argc, char **argv)
              "asymmetry due to the nutrients alone is %.2f. More root on the rich side: %s. "
              "Whole plant: high nutrients %.3g m of root, low %.3g m.",
              sl, sr, sr > 0 ? sl / sr : NAN, R[2].half_tips[0], R[2].half_tips[1], cl, cr, cr > 0 ? cl / cr : NAN,
-             (sr > 0 && cr > 0 && cl > 0) ? (sl / sr) / (cl / cr) : NAN, sl > sr ? "yes" : "NO", R[1].S.root_length,
-             R[0].S.root_length);
+             (sr > 0 && cr > 0 && cl > 0) ? (sl / sr) / (cl / cr) : NAN, sl > sr ? "yes" : "NO", R[1].pot.S.root_length,
+             R[0].pot.S.root_length);
     printf("%s\n", summary);
 
     /* ---- markdown ---- */
@@ -285,8 +204,8 @@ int main(int argc, char **argv)
             "|---|---:|---:|---:|---:|---:|---:|\n", SEED, DAYS, NX * DX, NY * DX, NZ * DX, DX, W0, V_LOW, V_HIGH,
             0.5 * NX * DX);
     for (int q = 0; q < NSOIL; ++q)
-        fprintf(f, "| %s | %.4g | %zu | %.4g | %.4g | %zu | %zu |\n", soil_name[q], R[q].S.root_length,
-                R[q].S.root_tips, R[q].half_len[0], R[q].half_len[1], R[q].half_tips[0], R[q].half_tips[1]);
+        fprintf(f, "| %s | %.4g | %zu | %.4g | %.4g | %zu | %zu |\n", soil_name[q], R[q].pot.S.root_length,
+                R[q].pot.S.root_tips, R[q].half_len[0], R[q].half_len[1], R[q].half_tips[0], R[q].half_tips[1]);
     fprintf(f, "\n%s\n", summary);
     if (nb_close_md(f, md, mdtmp) != 0) {
         fprintf(stderr, "%s: cannot write the page\n", md);

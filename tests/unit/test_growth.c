@@ -838,6 +838,34 @@ static void test_smoothness(void)
     CHECK(fabs(ratio) <= 3 && fabs(ratio) >= 1.0 / 3);
 }
 
+/* Expected and stochastic plants: the README's numbers on how much less an
+ * expected plant branches (probabilities accumulate per bud).  Both grow. */
+static void test_modes(void)
+{
+    const char *names[3] = {"apple", "maple", "poplar"};
+    for (int k = 0; k < 3; ++k) {
+        phc_growth_params p = preset(names[k]);
+        size_t nodes[2], branches[2];
+        for (int m = 0; m < 2; ++m) {
+            phc_growth_options o = phc_growth_options_default();
+            o.mode = m ? PHC_GROWTH_STOCHASTIC : PHC_GROWTH_EXPECTED;
+            o.seed = 1;
+            phc_growth *g = grow(&p, &o, NULL, 90);
+            size_t *first = NULL, *parent = NULL;
+            branches[m] = phc_growth_branches(g, PHC_GROWTH_SHOOT, &first, &parent);
+            phc_growth_nodes(g, &nodes[m]);
+            free(first);
+            free(parent);
+            phc_growth_free(g);
+        }
+        printf("  modes (%s, 90 d, no soil): expected %zu nodes, %zu shoot branches; stochastic "
+               "(seed 1) %zu nodes, %zu shoot branches\n",
+               names[k], nodes[0], branches[0], nodes[1], branches[1]);
+        CHECK(nodes[0] > 2 && nodes[1] > 2);
+        CHECK(branches[0] >= 1 && branches[1] >= 1);
+    }
+}
+
 int main(void)
 {
     struct { const char *name; void (*fn)(void); } groups[] = {
@@ -846,7 +874,7 @@ int main(void)
         {"limits", test_limits},       {"uptake", test_uptake},
         {"exports", test_exports},     {"nutrients", test_nutrients},
         {"nutrient scaling", test_nutrient_scaling}, {"pot walls", test_pot_walls},
-        {"smoothness", test_smoothness},
+        {"smoothness", test_smoothness}, {"modes", test_modes},
     };
     for (size_t i = 0; i < sizeof groups / sizeof groups[0]; ++i) {
         clock_t t0 = clock();
