@@ -257,6 +257,22 @@ class AbortOnFatal final : public ceres::IterationCallback {
     const SolveState *state_;
 };
 
+// Reports each iteration to the caller's hook; a non-zero answer cancels.
+class ReportIteration final : public ceres::IterationCallback {
+  public:
+    explicit ReportIteration(const phc_nls_options *o) : o_(o) {}
+    ceres::CallbackReturnType operator()(const ceres::IterationSummary &it) override
+    {
+        if (!o_->on_iteration)
+            return ceres::SOLVER_CONTINUE;
+        return o_->on_iteration(it.iteration, it.cost, o_->on_iteration_data) ? ceres::SOLVER_ABORT
+                                                                            : ceres::SOLVER_CONTINUE;
+    }
+
+  private:
+    const phc_nls_options *o_;
+};
+
 // Everything a ceres::Problem built for one solve points into.
 struct Assembly {
     std::vector<std::unique_ptr<ceres::CostFunction>> costs;
@@ -294,6 +310,8 @@ extern "C" phc_nls_options phc_nls_options_default(void)
     o.parameter_tolerance = 1e-15;
     o.method = PHC_LEVENBERG_MARQUARDT;
     o.num_threads = 1;
+    o.on_iteration = nullptr;
+    o.on_iteration_data = nullptr;
     return o;
 }
 
@@ -477,6 +495,9 @@ extern "C" int phc_nls_solve(phc_nls *nls, const phc_nls_options *options, doubl
         o.minimizer_progress_to_stdout = false;
         AbortOnFatal abort_cb(&state);
         o.callbacks.push_back(&abort_cb);
+        ReportIteration report_cb(options);
+        if (options->on_iteration)
+            o.callbacks.push_back(&report_cb);
 
         ceres::Solver::Summary s;
         ceres::Solve(o, &problem, &s);

@@ -73,6 +73,11 @@ typedef struct phc_nls_options {
     double parameter_tolerance;/* |du| / (|u| + tol); default 1e-15 */
     phc_trust_region method;   /* default Levenberg–Marquardt */
     int num_threads;           /* default 1 */
+    /* Called after every iteration with the iteration number and the cost
+     * (1/2 sum rho(r^2)); return non-zero to stop the solve (its outcome is
+     * then PHC_NLS_FAILED with "cancelled").  Default NULL. */
+    int (*on_iteration)(int iteration, double cost, void *user_data);
+    void *on_iteration_data;
 } phc_nls_options;
 
 phc_nls_options phc_nls_options_default(void);

@@ -2,6 +2,7 @@
 #include "fit/dataset.h"
 
 #include <math.h>
+#include <string.h>
 #include <stdlib.h>
 
 phc_dataset *phc_dataset_new(const phc_dataset_ops *ops, size_t k)
@@ -45,7 +46,25 @@ void phc_dataset_free(phc_dataset *ds)
     free(ds->data_lines);
     free(ds->x_label);
     free(ds->y_label);
+    for (size_t i = 0; i < ds->n_inputs; ++i)
+        free(ds->inputs[i]);
+    free(ds->inputs);
     free(ds);
+}
+
+int phc_dataset_add_input(phc_dataset *ds, const char *path)
+{
+    for (size_t i = 0; i < ds->n_inputs; ++i)
+        if (strcmp(ds->inputs[i], path) == 0)
+            return PHC_OK;
+    char **grown = realloc(ds->inputs, (ds->n_inputs + 1) * sizeof *grown);
+    if (!grown)
+        return PHC_ERR_NOMEM;
+    ds->inputs = grown;
+    if (!(ds->inputs[ds->n_inputs] = strdup(path)))
+        return PHC_ERR_NOMEM;
+    ds->n_inputs++;
+    return PHC_OK;
 }
 
 int phc_dataset_residuals(const double *p, double *r, double *jac, void *user_data)

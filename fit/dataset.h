@@ -10,6 +10,7 @@
 #include <stddef.h>
 
 #include "fit/ceres_bridge.h"
+#include "fit/progress.h"
 #include "model/status.h"
 
 typedef struct phc_dataset phc_dataset;
@@ -70,11 +71,21 @@ struct phc_dataset {
     const struct phc_problem *problem; /* the problem holding it (set when added): kinds
                                     that refit themselves (cross-validation) read the
                                     bounds and fixed flags of their slots there */
+    char **inputs;               /* every file the loader read, as opened (paths relative to
+                                    the working directory or absolute), for provenance */
+    size_t n_inputs;
+    phc_progress_fn progress;    /* set by the caller for the duration of long work (a
+                                    kind's own refits in fit_outputs); may be NULL */
+    void *progress_data;
 };
 
 /* Allocates an empty data set with k slots (names and indices zeroed). */
 phc_dataset *phc_dataset_new(const phc_dataset_ops *ops, size_t k);
 void phc_dataset_free(phc_dataset *ds); /* accepts NULL; frees impl via ops */
+
+/* Records that the loader read file `path` (kept once; provenance hashes
+ * it).  PHC_OK or PHC_ERR_NOMEM. */
+int phc_dataset_add_input(phc_dataset *ds, const char *path);
 
 /* The phc_residual_fn that the fit hands to the bridge, with the data set as
  * user_data: r = (y - yhat)/sigma, d r / d p = -(d yhat / d p)/sigma. */

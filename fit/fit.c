@@ -522,6 +522,22 @@ done:
     return rc;
 }
 
+/* Passes the solver's iterations on as progress of start `step` of `steps`. */
+typedef struct iteration_relay {
+    phc_progress_fn progress;
+    void *user_data;
+    size_t step, steps;
+    int cancelled;
+} iteration_relay;
+
+static int relay_iteration(int iteration, double cost, void *user_data)
+{
+    iteration_relay *r = user_data;
+    if (phc_progress_report(r->progress, r->user_data, "start", r->step, r->steps, iteration, cost, NULL))
+        r->cancelled = 1;
+    return r->cancelled;
+}
+
 int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
                 phc_fit_result **out, phc_error *err)
 {
@@ -571,8 +587,16 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    iteration_relay relay = {progress, user_data, 0, planned, 0};
+    phc_nls_options nls_opt = opt->nls;
+    if (progress) {
+        nls_opt.on_iteration = relay_iteration;
+        nls_opt.on_iteration_data = &relay;
+    }
     for (size_t s = 0; s < planned; ++s) {
-        if (progress && progress("fitting", (double)s / (double)planned, user_data)) {
+        relay.step = s + 1;
+        relay.steps = planned;
+        if (phc_progress_report(progress, user_data, "start", s + 1, planned, -1, NAN, NULL)) {
             rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
             goto fail_costs;
         }
@@ -585,8 +609,12 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             goto fail_costs;
         }
         phc_nls_summary sum;
-        if ((rc = phc_nls_solve(nls, &opt->nls, x, &sum, err)))
+        if ((rc = phc_nls_solve(nls, &nls_opt, x, &sum, err)))
             goto fail_costs;
+        if (relay.cancelled) {
+            rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+            goto fail_costs;
+        }
         res->total_time += sum.wall_time;
         costs[s] = sum.outcome == PHC_NLS_FAILED ? INFINITY : sum.final_cost;
         const int better = costs[s] < best_cost ||
@@ -610,8 +638,10 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             res->starts_at_best++;
     free(costs);
     costs = NULL;
-    if (progress)
-        progress("uncertainty", 1.0, user_data);
+    if (phc_progress_report(progress, user_data, "uncertainty", 0, 0, -1, NAN, NULL)) {
+        rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+        goto fail;
+    }
 
     /* Everything else is judged at the best point. */
     const size_t m = phc_nls_residual_count(nls);

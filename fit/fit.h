@@ -92,9 +92,6 @@ typedef struct phc_fit_result {
     char **warnings;             /* verdict: empty = nothing to distrust */
 } phc_fit_result;
 
-/* Progress of long work: stage text and fraction done; return non-zero to
- * cancel.  May be NULL. */
-typedef int (*phc_progress_fn)(const char *stage, double fraction, void *user_data);
 
 /* Fits pb (validated first) and fills *out.  Returns PHC_OK when a result
  * was produced, even if the solver did not converge (look at

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "fit/ceres_bridge.h"
@@ -105,23 +106,59 @@ static int parse_args(int argc, char **argv, cli_options *o, const char *allowed
     return 0;
 }
 
-/* Progress: a bar on a terminal, plain lines otherwise. */
-static int progress_cb(const char *stage, double fraction, void *user_data)
+/* Progress (DESIGN.md §3): on a terminal one line that updates in place
+ * (stage, step k of n, solver iteration and cost, elapsed time); otherwise
+ * plain lines, one per stage or step and at most one every 5 s within a
+ * step, so that logs stay short but long work still shows it is alive. */
+typedef struct progress_state {
+    int tty;
+    double t0, last_line;
+    char last_stage[32];
+    size_t last_step;
+    int open_line; /* a terminal line is drawn and not yet ended */
+} progress_state;
+
+static double now_seconds(void)
 {
-    const int tty = *(const int *)user_data;
-    if (tty) {
-        const int width = 30, done = (int)(fraction * width + 0.5);
-        fprintf(stderr, "\r%-12s [", stage);
-        for (int i = 0; i < width; ++i)
-            fputc(i < done ? '#' : ' ', stderr);
-        fprintf(stderr, "] %3d%%", (int)(fraction * 100 + 0.5));
-        if (fraction >= 1.0)
-            fputc('\n', stderr);
-    } else {
-        fprintf(stderr, "%s: %3d%%\n", stage, (int)(fraction * 100 + 0.5));
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int progress_cb(const phc_progress *p, void *user_data)
+{
+    progress_state *st = user_data;
+    const double t = now_seconds(), elapsed = t - st->t0;
+    const int new_step = strcmp(p->stage, st->last_stage) != 0 || p->step != st->last_step;
+    char line[256];
+    int len = snprintf(line, sizeof line, "%s", p->stage);
+    if (p->steps > 0)
+        len += snprintf(line + len, sizeof line - (size_t)len, " %zu/%zu", p->step, p->steps);
+    if (p->detail)
+        len += snprintf(line + len, sizeof line - (size_t)len, " (%s)", p->detail);
+    if (p->iteration >= 0)
+        len += snprintf(line + len, sizeof line - (size_t)len, "  iteration %d  cost %.6g", p->iteration, p->cost);
+    snprintf(line + len, sizeof line - (size_t)len, "  %.1f s", elapsed);
+    if (st->tty) {
+        fprintf(stderr, "\r%-78.78s", line);
+        st->open_line = 1;
+    } else if (new_step || t - st->last_line >= 5.0) {
+        fprintf(stderr, "%s\n", line);
+        st->last_line = t;
     }
+    snprintf(st->last_stage, sizeof st->last_stage, "%s", p->stage);
+    st->last_step = p->step;
     fflush(stderr);
     return 0;
+}
+
+/* Ends a terminal progress line before other output. */
+static void progress_end(progress_state *st)
+{
+    if (st->tty && st->open_line) {
+        fputc('\n', stderr);
+        st->open_line = 0;
+    }
 }
 
 /* The start of `fit` and `simulate`: options, the config, the run
@@ -163,9 +200,10 @@ static int cmd_fit(int argc, char **argv)
         phc_problem_free(pb);
         return fail(&err);
     }
-    int tty = isatty(STDERR_FILENO);
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
     phc_fit_result *res = NULL;
-    int rc = phc_fit_run(pb, o.quiet ? NULL : progress_cb, &tty, &res, &err);
+    int rc = phc_fit_run(pb, o.quiet ? NULL : progress_cb, &prog, &res, &err);
+    progress_end(&prog);
     if (rc) {
         phc_problem_free(pb);
         return fail(&err);

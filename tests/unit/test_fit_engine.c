@@ -743,16 +743,22 @@ static void test_read_errors(void)
 /* ---- progress and cancellation ---------------------------------------------------- */
 
 typedef struct progress_log {
-    int calls, cancel_at;
-    double last;
+    int calls, cancel_at, iterations, starts;
+    const char *last;
 } progress_log;
 
-static int on_progress(const char *stage, double fraction, void *ud)
+static int on_progress(const phc_progress *p, void *ud)
 {
-    progress_log *p = ud;
-    CHECK(stage != NULL && fraction >= 0 && fraction <= 1);
-    p->last = fraction;
-    return ++p->calls == p->cancel_at;
+    progress_log *log = ud;
+    CHECK(p->stage != NULL && (p->steps == 0 || (p->step >= 1 && p->step <= p->steps)));
+    log->last = p->stage;
+    if (p->iteration >= 0) {
+        CHECK(isfinite(p->cost) && p->cost >= 0);
+        log->iterations++;
+    } else if (strcmp(p->stage, "start") == 0) {
+        log->starts++;
+    }
+    return ++log->calls == log->cancel_at;
 }
 
 static void test_progress(void)
@@ -762,13 +768,16 @@ static void test_progress(void)
     CHECK(phc_config_load(path_in("line8.yaml"), &pb, &err) == PHC_OK);
     if (!pb)
         return;
-    progress_log log = {0, 0, -1};
+    progress_log log = {0};
     phc_fit_result *res = NULL;
     CHECK(phc_fit_run(pb, on_progress, &log, &res, &err) == PHC_OK);
-    CHECK(log.calls >= 8 && log.last == 1.0);
+    /* every start announced, the solver's iterations passed on, the
+     * uncertainty stage last */
+    CHECK(res && log.starts == (int)res->starts && log.iterations >= 1);
+    CHECK(log.last && strcmp(log.last, "uncertainty") == 0);
     phc_fit_result_free(res);
     res = NULL;
-    progress_log cancel = {0, 3, -1};
+    progress_log cancel = {0, 3, 0, 0, NULL};
     phc_error_clear(&err);
     CHECK(phc_fit_run(pb, on_progress, &cancel, &res, &err) != PHC_OK);
     CHECK(res == NULL);

@@ -1,0 +1,11 @@
+/* Progress reports: see progress.h. */
+#include "fit/progress.h"
+
+int phc_progress_report(phc_progress_fn fn, void *user_data, const char *stage, size_t step,
+                        size_t steps, int iteration, double cost, const char *detail)
+{
+    if (!fn)
+        return 0;
+    const phc_progress p = {stage, step, steps, iteration, cost, detail};
+    return fn(&p, user_data);
+}
