@@ -15,6 +15,7 @@
 #include "fit/costs/root_shoot.h"
 #include "fit/costs/soil_probe.h"
 #include "fit/costs/weight_curve.h"
+#include "fit/costs/source_file.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
@@ -367,6 +368,57 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     return phc_problem_add_dataset(pb, ds, err);
 }
 
+/* A run's name names its folder runs/<name>/: a plain name, never a path. */
+static int check_run_name(const phc_yaml_doc *doc, const phc_yaml_node *root, const char *name,
+                          phc_error *err)
+{
+    size_t len = strlen(name);
+    int ok = len > 0 && len <= 100 && name[0] != '.';
+    for (size_t i = 0; ok && i < len; ++i) {
+        const char c = name[i];
+        ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+             c == '-' || c == '_';
+    }
+    if (ok)
+        return PHC_OK;
+    return phc_error_set(err, PHC_ERR_INPUT,
+                         "%s:%zu: name: '%s' is not a plain name: it names the folder runs/<name>/, so use 1 to "
+                         "100 letters, digits, '.', '-' and '_', not starting with '.' (to write elsewhere, give "
+                         "-o DIR)", doc->path, phc_key_line(root, "name"), name);
+}
+
+/* Every `seed:` in the document, as "datasets[1].soil.rocks.seed: 7", for
+ * provenance (a run that draws random numbers says from which seed). */
+static int collect_seeds(const phc_yaml_node *node, const char *where, phc_problem *pb)
+{
+    char sub[512];
+    if (node->kind == PHC_YAML_SEQUENCE) {
+        for (size_t i = 0; i < node->count; ++i) {
+            snprintf(sub, sizeof sub, "%s[%zu]", where, i + 1);
+            if (collect_seeds(node->items[i], sub, pb))
+                return -1;
+        }
+    } else if (node->kind == PHC_YAML_MAPPING) {
+        for (size_t i = 0; i < node->count; ++i) {
+            snprintf(sub, sizeof sub, "%s%s%s", where, where[0] ? "." : "", node->keys[i]);
+            const phc_yaml_node *v = node->values[i];
+            if (strcmp(node->keys[i], "seed") == 0 && v->kind == PHC_YAML_SCALAR) {
+                char **grown = realloc(pb->seeds, (pb->n_seeds + 1) * sizeof *grown);
+                if (!grown)
+                    return -1;
+                pb->seeds = grown;
+                const size_t size = strlen(sub) + strlen(v->scalar) + 3;
+                if (!(pb->seeds[pb->n_seeds] = malloc(size)))
+                    return -1;
+                snprintf(pb->seeds[pb->n_seeds++], size, "%s: %s", sub, v->scalar);
+            } else if (collect_seeds(v, sub, pb)) {
+                return -1;
+            }
+        }
+    }
+    return 0;
+}
+
 static char *stem_of(const char *path)
 {
     const char *base = strrchr(path, '/');
@@ -399,6 +451,8 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
         goto fail;
     const char *name = NULL;
     if ((rc = phc_yaml_map_string(doc, root, "name", 0, "configuration", &name, err)))
+        goto fail;
+    if (name && (rc = check_run_name(doc, root, name, err)))
         goto fail;
     stem = stem_of(path);
     pb = phc_problem_new(name ? name : stem);
@@ -455,6 +509,10 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
         for (size_t t = 0; t < 3; ++t)
             if (!solver || !phc_yaml_get(solver, tol_keys[t]))
                 *tols[t] = fmax(*tols[t], model_tol);
+    }
+    if (collect_seeds(root, "", pb)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
     }
     if ((rc = phc_problem_validate(pb, err)))
         goto fail;

@@ -1,5 +1,6 @@
 /* Running a calibration: see fit.h. */
 #include "fit/fit.h"
+#include "fit/provenance.h"
 
 #include <gsl/gsl_cdf.h>
 #include <lapacke.h>
@@ -46,6 +47,7 @@ void phc_fit_result_free(phc_fit_result *res)
 {
     if (!res)
         return;
+    phc_provenance_free(res->provenance);
     for (size_t i = 0; i < res->n_params; ++i) {
         free(res->params[i].name);
         free(res->params[i].unit);

@@ -61,8 +61,11 @@ typedef struct phc_param_result {
     double sens_l1, sens_l2;     /* FME summaries (NAN for fixed) */
 } phc_param_result;
 
+struct phc_provenance;
+
 typedef struct phc_fit_result {
     char *name;
+    struct phc_provenance *provenance; /* what produced it (provenance.h; owned, may be NULL) */
     phc_nls_summary summary;     /* of the best start */
     double total_time;           /* all starts, seconds */
     size_t starts;               /* starts run */

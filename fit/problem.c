@@ -51,6 +51,9 @@ void phc_problem_free(phc_problem *pb)
     free(pb->datasets);
     free(pb->name);
     free(pb->source);
+    for (size_t i = 0; i < pb->n_seeds; ++i)
+        free(pb->seeds[i]);
+    free(pb->seeds);
     free(pb);
 }
 

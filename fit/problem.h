@@ -42,6 +42,9 @@ typedef struct phc_problem {
     phc_dataset **datasets;
     size_t n_datasets;
     phc_fit_options options;
+    char **seeds;                 /* every `seed:` of the config as "datasets[1].soil.rocks.seed: 7",
+                                     for provenance */
+    size_t n_seeds;
 } phc_problem;
 
 phc_problem *phc_problem_new(const char *name);

@@ -1,5 +1,6 @@
 /* The residual report: see report.h. */
 #include "fit/report.h"
+#include "fit/provenance.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -194,6 +195,17 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
                "- **shapiro_wilk** / **anderson_darling**: residuals far from normal make the intervals unreliable.\n"
                "- **breusch_pagan**: residual variance that grows or shrinks with the fitted value; "
                "consider per-point sigmas.\n");
+    if (res->provenance) {
+        char *md = NULL;
+        int prc = phc_provenance_markdown(res->provenance, &md, err);
+        if (prc) {
+            fclose(f);
+            unlink(tmp);
+            return prc;
+        }
+        fprintf(f, "\n%s", md);
+        free(md);
+    }
     int bad = ferror(f);
     if (fclose(f) != 0 || bad) {
         unlink(tmp);

@@ -1,5 +1,6 @@
 /* result.json writer and reader (jansson): see result_json.h. */
 #include "fit/result_json.h"
+#include "fit/provenance.h"
 
 #include <jansson.h>
 #include <math.h>
@@ -62,6 +63,8 @@ static json_t *result_json(const phc_fit_result *res)
 {
     json_t *root = json_object();
     json_object_set_new(root, "name", json_string(res->name));
+    if (res->provenance)
+        json_object_set_new(root, "provenance", phc_provenance_to_json(res->provenance));
     json_object_set_new(root, "status", json_string(phc_fit_status_name(res->summary.outcome)));
     json_object_set_new(root, "termination", json_string(res->summary.termination));
     json_object_set_new(root, "iterations", json_integer(res->summary.iterations));
@@ -321,6 +324,9 @@ int phc_result_read_json(const char *path, phc_fit_result **out, phc_error *err)
     res->level = level;
     json_t *it = json_object_get(root, "iterations");
     res->summary.iterations = json_is_integer(it) ? (int)json_integer_value(it) : 0;
+    json_t *prov = json_object_get(root, "provenance");
+    if (prov && (rc = phc_provenance_from_json(prov, path, &res->provenance, err)))
+        goto fail_strings;
 
     json_t *params = json_object_get(root, "parameters");
     if (!json_is_object(params) || json_object_size(params) == 0) {

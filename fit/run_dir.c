@@ -1,9 +1,11 @@
 /* Run directories: see run_dir.h. */
-#define _XOPEN_SOURCE 700 /* nftw */
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "fit/run_dir.h"
 
+#include <dirent.h>
 #include <errno.h>
-#include <ftw.h>
+#include <jansson.h>
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,28 +19,264 @@
 
 #define MAX_PLOTS 512
 
-static int remove_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
+#define MANIFEST_VERSION 1
+
+/* ---- walking a directory ------------------------------------------------------------ */
+
+/* Calls visit(rel, is_dir, ctx) for every entry below root (rel is the path
+ * relative to root), parents before children; symbolic links are reported as
+ * files and not followed.  Stops at the first non-zero return. */
+typedef int (*visit_fn)(const char *rel, int is_dir, void *ctx);
+
+static int walk(const char *root, const char *rel, visit_fn visit, void *ctx)
 {
-    (void)sb;
-    (void)flag;
-    (void)ftw;
-    return remove(path);
+    char path[8192];
+    snprintf(path, sizeof path, "%s%s%s", root, rel[0] ? "/" : "", rel);
+    DIR *d = opendir(path);
+    if (!d)
+        return -1;
+    int rc = 0;
+    struct dirent *e;
+    while (!rc && (e = readdir(d))) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        char sub[4096], full[8192];
+        if ((size_t)snprintf(sub, sizeof sub, "%s%s%s", rel, rel[0] ? "/" : "", e->d_name) >= sizeof sub)
+            continue; /* deeper than any path phytocal writes */
+        snprintf(full, sizeof full, "%s/%s", root, sub);
+        struct stat st;
+        const int is_dir = lstat(full, &st) == 0 && S_ISDIR(st.st_mode);
+        rc = visit(sub, is_dir, ctx);
+        if (!rc && is_dir)
+            rc = walk(root, sub, visit, ctx);
+    }
+    closedir(d);
+    return rc;
 }
 
+/* Removes a directory that phytocal created itself (a temporary one). */
 static void remove_tree(const char *path)
 {
-    nftw(path, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    DIR *d = opendir(path);
+    if (!d)
+        return;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        char full[8192];
+        snprintf(full, sizeof full, "%s/%s", path, e->d_name);
+        struct stat st;
+        if (lstat(full, &st) == 0 && S_ISDIR(st.st_mode))
+            remove_tree(full);
+        else
+            unlink(full);
+    }
+    closedir(d);
+    rmdir(path);
 }
 
-int phc_run_dir_check(const char *dir, int force, phc_error *err)
+/* ---- the manifest ------------------------------------------------------------------- */
+
+/* The entries a manifest lists: relative paths, directories flagged. */
+typedef struct entry_list {
+    char **paths;
+    int *is_dir;
+    size_t n, cap;
+} entry_list;
+
+static void entries_free(entry_list *l)
+{
+    for (size_t i = 0; i < l->n; ++i)
+        free(l->paths[i]);
+    free(l->paths);
+    free(l->is_dir);
+    memset(l, 0, sizeof *l);
+}
+
+static int entries_add(const char *rel, int is_dir, void *ctx)
+{
+    entry_list *l = ctx;
+    if (l->n == l->cap) {
+        const size_t cap = l->cap ? 2 * l->cap : 32;
+        char **p = realloc(l->paths, cap * sizeof *p);
+        if (p)
+            l->paths = p;
+        int *d = realloc(l->is_dir, cap * sizeof *d);
+        if (d)
+            l->is_dir = d;
+        if (!p || !d)
+            return -1;
+        l->cap = cap;
+    }
+    if (!(l->paths[l->n] = strdup(rel)))
+        return -1;
+    l->is_dir[l->n++] = is_dir;
+    return 0;
+}
+
+static int by_path(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* Sorts a list by path (the manifest lists files in a stable order). */
+static void entries_sort(entry_list *l)
+{
+    /* sort the paths with their flags: flags ride along as a suffix-free pair */
+    for (size_t i = 0; i < l->n; ++i) /* directories are few: mark them in the path */
+        if (l->is_dir[i]) {
+            char *marked = malloc(strlen(l->paths[i]) + 2);
+            if (!marked)
+                return;
+            sprintf(marked, "%s/", l->paths[i]);
+            free(l->paths[i]);
+            l->paths[i] = marked;
+        }
+    qsort(l->paths, l->n, sizeof *l->paths, by_path);
+    for (size_t i = 0; i < l->n; ++i) {
+        const size_t len = strlen(l->paths[i]);
+        l->is_dir[i] = len > 0 && l->paths[i][len - 1] == '/';
+        if (l->is_dir[i])
+            l->paths[i][len - 1] = '\0';
+    }
+}
+
+static int entries_has(const entry_list *l, const char *rel, int is_dir)
+{
+    for (size_t i = 0; i < l->n; ++i)
+        if (l->is_dir[i] == is_dir && strcmp(l->paths[i], rel) == 0)
+            return 1;
+    return 0;
+}
+
+/* Reads DIR/phytocal-run.json into the list of what phytocal wrote there.
+ * PHC_ERR_EXISTS with a message saying why the directory is not one of
+ * ours. */
+static int read_manifest(const char *dir, entry_list *l, phc_error *err)
+{
+    char path[8192];
+    snprintf(path, sizeof path, "%s/%s", dir, PHC_RUN_MANIFEST);
+    json_error_t jerr;
+    json_t *root = json_load_file(path, 0, &jerr);
+    if (!root)
+        return phc_error_set(err, PHC_ERR_EXISTS,
+                             "%s: exists and is not a phytocal run directory (it has no readable %s); "
+                             "--force replaces only directories that phytocal wrote: choose another -o, "
+                             "or move or remove it yourself", dir, PHC_RUN_MANIFEST);
+    int rc = PHC_OK;
+    const json_t *version = json_object_get(root, "phytocal_run_directory");
+    const json_t *files = json_object_get(root, "files");
+    const json_t *dirs = json_object_get(root, "directories");
+    if (!json_is_integer(version) || !json_is_array(files) || (dirs && !json_is_array(dirs))) {
+        rc = phc_error_set(err, PHC_ERR_EXISTS,
+                           "%s: its %s is not a phytocal run manifest (needs phytocal_run_directory, files); "
+                           "--force will not touch it", dir, PHC_RUN_MANIFEST);
+        goto done;
+    }
+    for (int pass = 0; pass < 2; ++pass) {
+        const json_t *arr = pass ? dirs : files;
+        for (size_t i = 0; arr && i < json_array_size(arr); ++i) {
+            const json_t *e = json_array_get(arr, i);
+            const json_t *p = json_is_object(e) ? json_object_get(e, "path") : e;
+            const char *rel = json_string_value(p);
+            /* a manifest that names a path outside the directory is not ours */
+            if (!rel || !rel[0] || rel[0] == '/' || strstr(rel, "..")) {
+                rc = phc_error_set(err, PHC_ERR_EXISTS, "%s: %s lists an invalid path; --force will not touch it",
+                                   dir, PHC_RUN_MANIFEST);
+                goto done;
+            }
+            if (entries_add(rel, pass, l)) {
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                goto done;
+            }
+        }
+    }
+done:
+    json_decref(root);
+    return rc;
+}
+
+/* Collects the entries of a directory that its manifest does not list. */
+typedef struct foreign_scan {
+    const entry_list *listed;
+    char names[512];
+    size_t count;
+} foreign_scan;
+
+static int note_foreign(const char *rel, int is_dir, void *ctx)
+{
+    foreign_scan *f = ctx;
+    if (strcmp(rel, PHC_RUN_MANIFEST) == 0 || entries_has(f->listed, rel, is_dir))
+        return 0;
+    if (f->count < 5) {
+        const size_t used = strlen(f->names);
+        snprintf(f->names + used, sizeof f->names - used, "%s%s%s", f->count ? ", " : "", rel, is_dir ? "/" : "");
+    }
+    f->count++;
+    return 0;
+}
+
+/* PHC_OK when DIR holds nothing but what its manifest lists (*listed filled). */
+static int check_only_ours(const char *dir, entry_list *listed, phc_error *err)
+{
+    int rc;
+    if ((rc = read_manifest(dir, listed, err)))
+        return rc;
+    foreign_scan scan = {listed, "", 0};
+    if (walk(dir, "", note_foreign, &scan) < 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot list: %s", dir, strerror(errno));
+    if (scan.count)
+        return phc_error_set(err, PHC_ERR_EXISTS,
+                             "%s: holds %zu file%s that phytocal did not write (%s%s); --force replaces only "
+                             "what phytocal wrote: move %s or choose another -o", dir, scan.count,
+                             scan.count == 1 ? "" : "s", scan.names, scan.count > 5 ? ", ..." : "",
+                             scan.count == 1 ? "it" : "them");
+    return PHC_OK;
+}
+
+/* The run's own config and data files must never be inside what a run
+ * directory may replace. */
+static int check_inputs_outside(const char *dir, const phc_problem *pb, phc_error *err)
+{
+    char rdir[PATH_MAX];
+    if (!pb || !realpath(dir, rdir))
+        return PHC_OK; /* nothing there yet: nothing of the user's inside */
+    const size_t len = strlen(rdir);
+    for (size_t d = 0; d <= pb->n_datasets; ++d) {
+        const size_t n = d == pb->n_datasets ? 1 : pb->datasets[d]->n_inputs;
+        for (size_t i = 0; i < n; ++i) {
+            const char *in = d == pb->n_datasets ? pb->source : pb->datasets[d]->inputs[i];
+            char rin[PATH_MAX];
+            if (!in || !realpath(in, rin))
+                continue;
+            if (strncmp(rin, rdir, len) == 0 && (rin[len] == '/' || rin[len] == '\0' || len == 1))
+                return phc_error_set(err, PHC_ERR_EXISTS,
+                                     "%s: holds %s '%s', an input of this run; phytocal never writes "
+                                     "over its inputs: choose another -o", dir,
+                                     d == pb->n_datasets ? "the config" : "the data file", in);
+        }
+    }
+    return PHC_OK;
+}
+
+int phc_run_dir_check(const char *dir, int force, const phc_problem *pb, phc_error *err)
 {
     struct stat st;
     if (stat(dir, &st) == 0) {
         if (!S_ISDIR(st.st_mode))
             return phc_error_set(err, PHC_ERR_EXISTS, "%s: exists and is not a directory", dir);
+        int rc;
+        if ((rc = check_inputs_outside(dir, pb, err)))
+            return rc;
         if (!force)
             return phc_error_set(err, PHC_ERR_EXISTS,
                                  "%s: output directory exists; use --force to replace it or -o to choose another", dir);
+        entry_list listed = {0};
+        rc = check_only_ours(dir, &listed, err);
+        entries_free(&listed);
+        if (rc)
+            return rc;
     }
     /* The nearest existing ancestor must be a writable directory, so that a
      * long fit is not wasted on an output path that cannot be created. */
@@ -189,10 +427,11 @@ static int write_plots(const phc_fit_result *res, const char *tmpdir, char **nam
     return PHC_OK;
 }
 
-int phc_run_dir_begin(const char *dir, int force, char *tmpdir, size_t size, phc_error *err)
+int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *tmpdir, size_t size,
+                      phc_error *err)
 {
     int rc;
-    if ((rc = phc_run_dir_check(dir, force, err)) || (rc = make_parents(dir, err)))
+    if ((rc = phc_run_dir_check(dir, force, pb, err)) || (rc = make_parents(dir, err)))
         return rc;
     if ((size_t)snprintf(tmpdir, size, "%s.tmp-XXXXXX", dir) >= size)
         return phc_error_set(err, PHC_ERR_IO, "%s: output path too long", dir);
@@ -206,31 +445,124 @@ void phc_run_dir_discard(const char *tmpdir)
     remove_tree(tmpdir);
 }
 
-int phc_run_dir_commit(const char *tmpdir, const char *dir, phc_error *err)
+/* Writes tmpdir's manifest: every file (with its SHA-256) and directory in
+ * it, and the provenance. */
+static int write_manifest(const char *tmpdir, const phc_provenance *pv, phc_error *err)
 {
-    /* Swap into place: the old run (with --force) is removed only now. */
+    entry_list l = {0};
+    json_t *root = NULL;
+    int rc = PHC_OK;
+    if (walk(tmpdir, "", entries_add, &l) < 0) {
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot list the new run", tmpdir);
+        goto done;
+    }
+    entries_sort(&l);
+    root = json_object();
+    json_t *files = json_array(), *dirs = json_array();
+    json_object_set_new(root, "phytocal_run_directory", json_integer(MANIFEST_VERSION));
+    json_object_set_new(root, "about", json_string("the files phytocal wrote here; `phytocal fit --force` "
+                                                   "replaces this directory only while it holds nothing else"));
+    json_object_set_new(root, "files", files);
+    json_object_set_new(root, "directories", dirs);
+    for (size_t i = 0; i < l.n; ++i) {
+        if (l.is_dir[i]) {
+            json_array_append_new(dirs, json_string(l.paths[i]));
+            continue;
+        }
+        char path[8192], hex[65];
+        long long bytes = 0;
+        snprintf(path, sizeof path, "%s/%s", tmpdir, l.paths[i]);
+        if ((rc = phc_file_sha256(path, hex, &bytes, err)))
+            goto done;
+        json_t *f = json_object();
+        json_object_set_new(f, "path", json_string(l.paths[i]));
+        json_object_set_new(f, "sha256", json_string(hex));
+        json_object_set_new(f, "bytes", json_integer(bytes));
+        json_array_append_new(files, f);
+    }
+    if (pv)
+        json_object_set_new(root, "provenance", phc_provenance_to_json(pv));
+    char path[8192];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, PHC_RUN_MANIFEST);
+    if (json_dump_file(root, path, JSON_INDENT(2)) != 0)
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+done:
+    json_decref(root);
+    entries_free(&l);
+    return rc;
+}
+
+/* Removes from an earlier run (moved aside to `old`) exactly the entries
+ * its manifest lists, deepest first, then the manifest and the directory.
+ * Anything else found there stays (and so does the directory). */
+static void remove_listed(const char *old, const entry_list *l)
+{
+    char path[8192];
+    for (size_t i = 0; i < l->n; ++i)
+        if (!l->is_dir[i]) {
+            snprintf(path, sizeof path, "%s/%s", old, l->paths[i]);
+            unlink(path);
+        }
+    for (size_t pass = 0; pass < l->n; ++pass) { /* directories, longest path first */
+        size_t best = l->n, best_len = 0;
+        for (size_t i = 0; i < l->n; ++i)
+            if (l->is_dir[i] && l->paths[i][0] && strlen(l->paths[i]) >= best_len) {
+                best = i;
+                best_len = strlen(l->paths[i]);
+            }
+        if (best == l->n)
+            break;
+        snprintf(path, sizeof path, "%s/%s", old, l->paths[best]);
+        rmdir(path);
+        l->paths[best][0] = '\0';
+    }
+    snprintf(path, sizeof path, "%s/%s", old, PHC_RUN_MANIFEST);
+    unlink(path);
+    rmdir(old);
+}
+
+int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
+{
+    int rc;
+    if ((rc = write_manifest(tmpdir, pv, err))) {
+        remove_tree(tmpdir);
+        return rc;
+    }
+    /* Swap into place: an earlier run (with --force) is looked at again now
+     * (a fit takes time: the user may have added a file meanwhile) and
+     * removed only now, and only what its manifest lists. */
     char old[4096];
     struct stat st;
+    entry_list listed = {0};
     old[0] = '\0';
     if (stat(dir, &st) == 0) {
+        if ((rc = check_only_ours(dir, &listed, err))) {
+            entries_free(&listed);
+            char msg[sizeof err->message];
+            snprintf(msg, sizeof msg, "%s", err->message);
+            remove_tree(tmpdir);
+            return phc_error_set(err, rc, "%s (checked again before replacing it; the new run was discarded)",
+                                 msg);
+        }
         snprintf(old, sizeof old, "%s.old-XXXXXX", dir);
         if (!mkdtemp(old) || rmdir(old) != 0 || rename(dir, old) != 0) {
-            const int rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot move the earlier run aside: %s", dir,
-                                         strerror(errno));
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot move the earlier run aside: %s", dir, strerror(errno));
+            entries_free(&listed);
             remove_tree(tmpdir);
             return rc;
         }
     }
     if (rename(tmpdir, dir) != 0) {
-        const int rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename the new run into place: %s", dir,
-                                     strerror(errno));
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename the new run into place: %s", dir, strerror(errno));
         if (old[0])
             rename(old, dir); /* put the earlier run back */
+        entries_free(&listed);
         remove_tree(tmpdir);
         return rc;
     }
     if (old[0])
-        remove_tree(old);
+        remove_listed(old, &listed);
+    entries_free(&listed);
     chmod(dir, 0755); /* mkdtemp made it private; results are for sharing */
     return PHC_OK;
 }
@@ -263,7 +595,7 @@ int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const ch
 {
     char tmpdir[4096], path[8192];
     int rc;
-    if ((rc = phc_run_dir_begin(dir, force, tmpdir, sizeof tmpdir, err)))
+    if ((rc = phc_run_dir_begin(dir, force, pb, tmpdir, sizeof tmpdir, err)))
         return rc;
     char *names[MAX_PLOTS] = {0};
     size_t n_names = 0;
@@ -276,7 +608,7 @@ int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const ch
     snprintf(path, sizeof path, "%s/report.md", tmpdir);
     if ((rc = phc_report_write_markdown(res, path, (const char *const *)names, err)))
         goto fail;
-    rc = phc_run_dir_commit(tmpdir, dir, err);
+    rc = phc_run_dir_commit(tmpdir, dir, res->provenance, err);
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return rc;
@@ -285,4 +617,85 @@ fail:
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return rc;
+}
+
+/* ---- verifying ---------------------------------------------------------------------- */
+
+static int add_item(phc_run_dir_item **items, size_t *n, const char *role, const char *path,
+                    phc_file_state state)
+{
+    phc_run_dir_item *grown = realloc(*items, (*n + 1) * sizeof *grown);
+    if (!grown)
+        return PHC_ERR_NOMEM;
+    *items = grown;
+    grown[*n].role = role;
+    grown[*n].state = state;
+    if (!(grown[*n].path = strdup(path)))
+        return PHC_ERR_NOMEM;
+    (*n)++;
+    return PHC_OK;
+}
+
+int phc_run_dir_verify(const char *dir, phc_run_dir_item **items, size_t *n, phc_error *err)
+{
+    char path[8192];
+    *items = NULL;
+    *n = 0;
+    snprintf(path, sizeof path, "%s/%s", dir, PHC_RUN_MANIFEST);
+    json_error_t jerr;
+    json_t *root = json_load_file(path, 0, &jerr);
+    if (!root)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: cannot read the run's manifest: %s (runs written before "
+                             "phytocal recorded provenance have none)", path, jerr.text);
+    int rc = PHC_OK;
+    phc_provenance *pv = NULL;
+    const json_t *prov = json_object_get(root, "provenance");
+    if (prov && (rc = phc_provenance_from_json(prov, path, &pv, err)))
+        goto done;
+    for (size_t i = 0; pv && i <= pv->n_inputs; ++i) {
+        const phc_provenance_file *f = i == 0 ? pv->config : &pv->inputs[i - 1];
+        if (!f)
+            continue;
+        const char *found;
+        if (add_item(items, n, i == 0 ? "config" : "data", f->path, phc_provenance_file_state(f, &found))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    }
+    const json_t *files = json_object_get(root, "files");
+    for (size_t i = 0; i < json_array_size(files); ++i) {
+        phc_provenance_file f = {0};
+        const json_t *e = json_array_get(files, i);
+        const char *rel = json_string_value(json_object_get(e, "path"));
+        const char *sha = json_string_value(json_object_get(e, "sha256"));
+        if (!rel || !sha) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s: files[%zu]: expected {path, sha256}", path, i);
+            goto done;
+        }
+        char full[8192];
+        snprintf(full, sizeof full, "%s/%s", dir, rel);
+        f.path = full;
+        snprintf(f.sha256, sizeof f.sha256, "%s", sha);
+        const char *found;
+        if (add_item(items, n, "output", rel, phc_provenance_file_state(&f, &found))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    }
+done:
+    phc_provenance_free(pv);
+    json_decref(root);
+    if (rc) {
+        phc_run_dir_verify_free(*items, *n);
+        *items = NULL;
+        *n = 0;
+    }
+    return rc;
+}
+
+void phc_run_dir_verify_free(phc_run_dir_item *items, size_t n)
+{
+    for (size_t i = 0; items && i < n; ++i)
+        free(items[i].path);
+    free(items);
 }

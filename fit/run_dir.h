@@ -1,36 +1,66 @@
-/* Writing a run directory: result.json, report.md and the diagnostic plots.
+/* Writing a run directory: result.json, report.md, the diagnostic plots and
+ * the manifest.
  *
  * Everything is written into a temporary sibling directory (DIR.tmp-XXXXXX)
  * that is renamed to DIR only when complete, so a failed run leaves no
- * partial output.  An existing DIR is an error (PHC_ERR_EXISTS) unless
- * `force` is set; then it is replaced only after the new run is complete. */
+ * partial output.
+ *
+ * Safety (nothing of the user's is ever removed):
+ * - every run directory carries a manifest, phytocal-run.json, listing each
+ *   file (with its SHA-256) and folder phytocal wrote there, and the run's
+ *   provenance (provenance.h);
+ * - an existing DIR is an error (PHC_ERR_EXISTS) unless `force` is set;
+ * - with force, DIR is replaced only when it carries a manifest and holds
+ *   nothing the manifest does not list (checked before the run and again just
+ *   before replacing it); then only the listed entries are removed;
+ * - DIR may never hold the run's config or any of its data files (force or
+ *   not). */
 #ifndef PHC_RUN_DIR_H
 #define PHC_RUN_DIR_H
 
 #include "fit/fit.h"
+#include "fit/provenance.h"
 #include "model/status.h"
 
-/* Checks up front that DIR can be written (absent, or force), so a long fit
- * is not wasted on a directory that will be refused. */
-int phc_run_dir_check(const char *dir, int force, phc_error *err);
+#define PHC_RUN_MANIFEST "phytocal-run.json"
 
-/* Writes a fit's run directory (result.json, report.md, plots) by the three
- * steps below.  pb (may be NULL) is the problem that was fitted: data sets
- * whose kind writes its own files (dataset.h, fit_outputs) add them, at the
- * fitted values. */
+/* Checks up front that DIR can be written (absent, or force and a run
+ * directory of phytocal's own holding nothing else, and not holding the
+ * inputs of pb, which may be NULL), so a long fit is not wasted on a
+ * directory that will be refused. */
+int phc_run_dir_check(const char *dir, int force, const phc_problem *pb, phc_error *err);
+
+/* Writes a fit's run directory (result.json, report.md, plots, manifest with
+ * res->provenance when set) by the three steps below.  pb (may be NULL) is
+ * the problem that was fitted: data sets whose kind writes its own files
+ * (dataset.h, fit_outputs) add them, at the fitted values. */
 int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const char *dir, int force,
                       phc_error *err);
 
 /* The steps, for any command that writes a run directory:
  * begin checks DIR (as phc_run_dir_check), creates its parents and a
  * temporary sibling, whose path goes to tmpdir (size bytes);
- * commit renames the temporary directory to DIR (replacing an earlier run
- * only now) or, on failure, removes it and keeps the earlier run;
+ * commit writes the manifest (with provenance pv, may be NULL) and renames
+ * the temporary directory to DIR (replacing an earlier run only now) or, on
+ * failure, removes it and keeps the earlier run;
  * discard removes the temporary directory after a failure. */
-int phc_run_dir_begin(const char *dir, int force, char *tmpdir, size_t size,
+int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *tmpdir, size_t size,
                       phc_error *err);
-int phc_run_dir_commit(const char *tmpdir, const char *dir, phc_error *err);
+int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err);
 void phc_run_dir_discard(const char *tmpdir);
+
+/* `phytocal report --check DIR`: each file the run read (its config and
+ * data, from the manifest's provenance) and each file it wrote (from the
+ * manifest), and whether it still has the bytes it had.  *items is
+ * malloc'd (free with phc_run_dir_verify_free).  PHC_ERR_INPUT when DIR has
+ * no readable manifest. */
+typedef struct phc_run_dir_item {
+    const char *role; /* "config", "data" or "output" */
+    char *path;       /* as recorded; outputs relative to DIR */
+    phc_file_state state;
+} phc_run_dir_item;
+int phc_run_dir_verify(const char *dir, phc_run_dir_item **items, size_t *n, phc_error *err);
+void phc_run_dir_verify_free(phc_run_dir_item *items, size_t n);
 
 /* A file-name-safe copy of a data-set name: characters other than letters,
  * digits, '-', '_' and '.' become '_'. */

@@ -57,16 +57,17 @@ done:
     return rc;
 }
 
-int phc_simulate_write(const phc_problem *pb, const char *dir, int force, phc_error *err)
+int phc_simulate_write(const phc_problem *pb, const phc_provenance *pv, const char *dir, int force,
+                       phc_error *err)
 {
     char tmpdir[4096];
     int rc;
-    if ((rc = phc_run_dir_begin(dir, force, tmpdir, sizeof tmpdir, err)))
+    if ((rc = phc_run_dir_begin(dir, force, pb, tmpdir, sizeof tmpdir, err)))
         return rc;
     for (size_t d = 0; d < pb->n_datasets; ++d)
         if ((rc = simulate_dataset(pb, pb->datasets[d], tmpdir, err))) {
             phc_run_dir_discard(tmpdir);
             return rc;
         }
-    return phc_run_dir_commit(tmpdir, dir, err);
+    return phc_run_dir_commit(tmpdir, dir, pv, err);
 }

@@ -7,8 +7,11 @@
 #define PHC_SIMULATE_H
 
 #include "fit/problem.h"
+#include "fit/provenance.h"
 #include "model/status.h"
 
-int phc_simulate_write(const phc_problem *pb, const char *dir, int force, phc_error *err);
+/* pv (may be NULL) goes into the directory's manifest (run_dir.h). */
+int phc_simulate_write(const phc_problem *pb, const phc_provenance *pv, const char *dir, int force,
+                       phc_error *err);
 
 #endif /* PHC_SIMULATE_H */

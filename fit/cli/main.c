@@ -1,26 +1,32 @@
 /* The phytocal command (DESIGN.md §4).  The only place that prints.
  *
  *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
- *   phytocal simulate CONFIG.yaml [-o DIR] [--force]
+ *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal report DIR/result.json [--strict] [--level L]
- *   phytocal version
+ *   phytocal report --check DIR
+ *   phytocal help [COMMAND | KIND]      phytocal COMMAND --help
+ *   phytocal version                    phytocal --version
  *
  * Exit codes: 0 success; 1 usage; 2 bad input; 3 the fit did not converge or
- * (with --strict) a report check failed; 4 internal error. */
+ * (with --strict) a report check failed, or (--check) an input or output
+ * changed; 4 internal error. */
 #include <gsl/gsl_errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "fit/ceres_bridge.h"
 #include "fit/config.h"
 #include "fit/fit.h"
+#include "fit/provenance.h"
 #include "fit/report.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
 #include "fit/simulate.h"
+#include "phc_git_commit.h"
 
 #ifndef PHC_VERSION
 #define PHC_VERSION "dev"
@@ -28,14 +34,132 @@
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2, EXIT_FIT = 3, EXIT_INTERNAL = 4 };
 
+/* ---- help ------------------------------------------------------------------------------ */
+
+typedef struct command_help {
+    const char *name, *synopsis, *text;
+} command_help;
+
+static const command_help commands[] = {
+    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]",
+     "Fits the configuration's parameters to its data sets (Ceres Solver), then judges\n"
+     "the residuals and parameters, and writes a run directory:\n"
+     "  result.json        machine-readable result (README: result.json)\n"
+     "  report.md          verdict, parameters with intervals, checks, provenance\n"
+     "  *.png              data and fit, residuals, normal QQ, autocorrelation\n"
+     "  phytocal-run.json  manifest: the files written here (SHA-256) and provenance\n"
+     "and prints a summary table.\n"
+     "\n"
+     "options:\n"
+     "  -o, --output DIR   run directory (default runs/<name>/, name from the config)\n"
+     "  --force            replace DIR if it is an earlier phytocal run directory that\n"
+     "                     holds nothing but what phytocal wrote (its manifest lists\n"
+     "                     it); anything else in DIR, and any DIR holding the run's\n"
+     "                     config or data, is refused and left untouched\n"
+     "  -q, --quiet        print nothing on success (no progress, no summary)\n"
+     "  -h, --help         this text\n"
+     "\n"
+     "Progress goes to stderr: one updating line on a terminal (start k of n, solver\n"
+     "iteration and cost, elapsed time), plain lines otherwise."},
+    {"simulate", "phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]",
+     "Runs every data set's model at the configured start values, without fitting, and\n"
+     "writes a run directory (default runs/<name>-simulation/) with <data set>_simulated.csv\n"
+     "(x, observed, model) and <data set>_simulated.png, plus each kind's own outputs\n"
+     "(fields, frames, plant files), so start values can be checked before a fit.\n"
+     "\n"
+     "options: -o DIR, --force, --quiet, --help as for fit."},
+    {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
+               "       phytocal report --check DIR",
+     "Prints the summary of an earlier fit from its result.json; with --level L the\n"
+     "residual checks and the verdict are recomputed at level L (0 < L < 1).\n"
+     "\n"
+     "options:\n"
+     "  --strict           exit 3 when any check of the verdict fails\n"
+     "  --level L          significance level of the residual checks (default: the fit's)\n"
+     "  --check DIR        verify a run directory against its manifest: the config and\n"
+     "                     every data file still have the SHA-256 recorded when the run\n"
+     "                     read them, and every file the run wrote is unchanged; exit 3\n"
+     "                     when anything changed or is missing\n"
+     "  -h, --help         this text"},
+    {"help", "phytocal help [COMMAND | KIND | kinds]",
+     "Without an argument: the commands, exit codes and data-set kinds.  With a command:\n"
+     "its options.  With a data-set kind (e.g. weight_curve): the configuration keys of\n"
+     "that kind.  `phytocal help kinds`: the configuration reference of every key that is\n"
+     "not a kind's own."},
+    {"version", "phytocal version | phytocal --version",
+     "Prints the version, the git commit it was built from (when built from a checkout)\n"
+     "and the Ceres Solver version."},
+};
+#define N_COMMANDS (sizeof commands / sizeof commands[0])
+
+static const char exit_codes[] = "exit codes:\n"
+                                 "  0  success\n"
+                                 "  1  usage error (unknown command or option, missing argument)\n"
+                                 "  2  bad input: the message names the file and line or key, and why\n"
+                                 "  3  the fit did not converge, or report --strict found a failed check,\n"
+                                 "     or report --check found a changed or missing file\n"
+                                 "  4  internal error\n";
+
 static void usage(FILE *out)
 {
-    fprintf(out, "usage:\n"
-                 "  phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]\n"
-                 "  phytocal simulate CONFIG.yaml [-o DIR] [--force]\n"
-                 "  phytocal report DIR/result.json [--strict] [--level L]\n"
-                 "  phytocal version\n");
+    fprintf(out, "usage:\n");
+    for (size_t i = 0; i < N_COMMANDS; ++i)
+        fprintf(out, "  %s\n", commands[i].synopsis);
 }
+
+static void print_overview(FILE *out)
+{
+    fprintf(out, "phytocal %s: calibrate and validate plant-physiology models against measurements.\n\n",
+            PHC_VERSION);
+    usage(out);
+    fprintf(out, "\n%s\n", exit_codes);
+    fprintf(out, "data-set kinds (phytocal help KIND for the keys of one):\n");
+    (void)0; /* MERGE-HELP: kinds list */
+    fprintf(out, "\nMore: phytocal help COMMAND, phytocal help KIND, phytocal help kinds;\n"
+                 "the README has a walk-through of each model.\n");
+}
+
+static const command_help *find_command(const char *name)
+{
+    for (size_t i = 0; i < N_COMMANDS; ++i)
+        if (strcmp(commands[i].name, name) == 0)
+            return &commands[i];
+    return NULL;
+}
+
+static void print_command_help(const command_help *c, FILE *out)
+{
+    fprintf(out, "usage: %s\n\n%s\n\n%s", c->synopsis, c->text, exit_codes);
+}
+
+static int cmd_help(int argc, char **argv)
+{
+    if (argc == 0) {
+        print_overview(stdout);
+        return EXIT_OK;
+    }
+    const command_help *c = find_command(argv[0]);
+    if (c) {
+        print_command_help(c, stdout);
+        return EXIT_OK;
+    }
+    phc_error err;
+    phc_error_clear(&err);
+    /* MERGE-HELP */
+    fprintf(stderr, "phytocal: help: '%s' is neither a command (fit, simulate, report, help, version) nor a "
+                    "data-set kind: %s\n", argv[0], err.message);
+    return EXIT_USAGE;
+}
+
+static int wants_help(int argc, char **argv)
+{
+    for (int i = 0; i < argc; ++i)
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0)
+            return 1;
+    return 0;
+}
+
+/* ---- errors and options ---------------------------------------------------------------- */
 
 static int exit_code_for(int status)
 {
@@ -60,12 +184,13 @@ static int fail(const phc_error *err)
 typedef struct cli_options {
     const char *input;
     const char *out_dir;
-    int force, quiet, strict;
+    int force, quiet, strict, check;
     double level;
 } cli_options;
 
-/* Parses the arguments after the command; returns -1 on a usage error. */
-static int parse_args(int argc, char **argv, cli_options *o, const char *allowed)
+/* Parses the arguments after the command; returns -1 on a usage error.
+ * `allowed` holds a letter per accepted option: o f q s l c. */
+static int parse_args(const char *cmd, int argc, char **argv, cli_options *o, const char *allowed)
 {
     memset(o, 0, sizeof *o);
     o->level = -1;
@@ -73,38 +198,45 @@ static int parse_args(int argc, char **argv, cli_options *o, const char *allowed
         const char *a = argv[i];
         if ((strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) && strchr(allowed, 'o')) {
             if (i + 1 >= argc) {
-                fprintf(stderr, "phytocal: %s needs a directory\n", a);
+                fprintf(stderr, "phytocal %s: %s needs a directory\n", cmd, a);
                 return -1;
             }
             o->out_dir = argv[++i];
         } else if (strcmp(a, "--force") == 0 && strchr(allowed, 'f')) {
             o->force = 1;
-        } else if (strcmp(a, "--quiet") == 0 && strchr(allowed, 'q')) {
+        } else if ((strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) && strchr(allowed, 'q')) {
             o->quiet = 1;
         } else if (strcmp(a, "--strict") == 0 && strchr(allowed, 's')) {
             o->strict = 1;
+        } else if (strcmp(a, "--check") == 0 && strchr(allowed, 'c')) {
+            o->check = 1;
         } else if (strcmp(a, "--level") == 0 && strchr(allowed, 'l')) {
             char *end = NULL;
             if (i + 1 >= argc || (o->level = strtod(argv[++i], &end), *end != '\0') || !(o->level > 0 && o->level < 1)) {
-                fprintf(stderr, "phytocal: --level needs a number between 0 and 1\n");
+                fprintf(stderr, "phytocal %s: --level needs a number between 0 and 1\n", cmd);
                 return -1;
             }
         } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "phytocal: unknown option '%s'\n", a);
+            fprintf(stderr, "phytocal %s: unknown option '%s' (phytocal %s --help lists the options)\n", cmd, a,
+                    cmd);
             return -1;
         } else if (!o->input) {
             o->input = a;
         } else {
-            fprintf(stderr, "phytocal: unexpected argument '%s'\n", a);
+            fprintf(stderr, "phytocal %s: unexpected argument '%s'\n", cmd, a);
             return -1;
         }
     }
     if (!o->input) {
-        fprintf(stderr, "phytocal: missing input file\n");
+        fprintf(stderr, "phytocal %s: missing %s\n", cmd,
+                strcmp(cmd, "report") == 0 ? "the result.json (or, with --check, the run directory)"
+                                           : "the configuration file");
         return -1;
     }
     return 0;
 }
+
+/* ---- progress -------------------------------------------------------------------------- */
 
 /* Progress (DESIGN.md §3): on a terminal one line that updates in place
  * (stage, step k of n, solver iteration and cost, elapsed time); otherwise
@@ -161,17 +293,22 @@ static void progress_end(progress_state *st)
     }
 }
 
+/* ---- commands -------------------------------------------------------------------------- */
+
 /* The start of `fit` and `simulate`: options, the config, the run
- * directory (-o, or runs/<name><suffix>).  Returns -1 when *exit_code is
- * set (usage or bad input), 0 with *pb loaded otherwise. */
-static int load_for_run(int argc, char **argv, const char *allowed, const char *suffix, cli_options *o,
-                        phc_problem **pb, char *dir, size_t size, int *exit_code)
+ * directory (-o, or runs/<name><suffix>), its check, and the provenance
+ * (inputs hashed now, as read).  Returns -1 when *exit_code is set (usage
+ * or bad input), 0 with *pb and *pv made otherwise. */
+static int load_for_run(const char *cmd, int full_argc, char **full_argv, int argc, char **argv,
+                        const char *suffix, cli_options *o, phc_problem **pb, phc_provenance **pv, char *dir,
+                        size_t size, int *exit_code)
 {
     phc_error err;
     phc_error_clear(&err);
     *pb = NULL;
-    if (parse_args(argc, argv, o, allowed) != 0) {
-        usage(stderr);
+    *pv = NULL;
+    if (parse_args(cmd, argc, argv, o, "ofq") != 0) {
+        fprintf(stderr, "usage: %s\n", find_command(cmd)->synopsis);
         *exit_code = EXIT_USAGE;
         return -1;
     }
@@ -183,32 +320,47 @@ static int load_for_run(int argc, char **argv, const char *allowed, const char *
         snprintf(dir, size, "%s", o->out_dir);
     else
         snprintf(dir, size, "runs/%s%s", (*pb)->name, suffix);
+    if (phc_run_dir_check(dir, o->force, *pb, &err) ||
+        phc_provenance_begin(*pb, full_argc, full_argv, PHC_VERSION, PHC_GIT_COMMIT, pv, &err)) {
+        phc_problem_free(*pb);
+        *pb = NULL;
+        *exit_code = fail(&err);
+        return -1;
+    }
     return 0;
 }
 
-static int cmd_fit(int argc, char **argv)
+static int cmd_fit(int full_argc, char **full_argv, int argc, char **argv)
 {
     cli_options o;
     phc_problem *pb = NULL;
+    phc_provenance *pv = NULL;
     char dir[4096];
     int code;
-    if (load_for_run(argc, argv, "ofq", "", &o, &pb, dir, sizeof dir, &code))
+    if (load_for_run("fit", full_argc, full_argv, argc, argv, "", &o, &pb, &pv, dir, sizeof dir, &code))
         return code;
     phc_error err;
     phc_error_clear(&err);
-    if (phc_run_dir_check(dir, o.force, &err)) {
-        phc_problem_free(pb);
-        return fail(&err);
-    }
     progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    phc_progress_fn progress = o.quiet ? NULL : progress_cb;
     phc_fit_result *res = NULL;
-    int rc = phc_fit_run(pb, o.quiet ? NULL : progress_cb, &prog, &res, &err);
-    progress_end(&prog);
+    int rc = phc_fit_run(pb, progress, &prog, &res, &err);
     if (rc) {
+        progress_end(&prog);
+        phc_provenance_free(pv);
         phc_problem_free(pb);
         return fail(&err);
     }
+    /* kinds that refit themselves while writing (cross-validation) report too */
+    for (size_t d = 0; d < pb->n_datasets; ++d) {
+        pb->datasets[d]->progress = progress;
+        pb->datasets[d]->progress_data = &prog;
+    }
+    phc_progress_report(progress, &prog, "writing", 0, 0, -1, 0, dir);
+    phc_provenance_end(pv);
+    res->provenance = pv;
     rc = phc_run_dir_write(res, pb, dir, o.force, &err);
+    progress_end(&prog);
     phc_problem_free(pb);
     if (rc) {
         phc_fit_result_free(res);
@@ -228,30 +380,73 @@ static int cmd_fit(int argc, char **argv)
 }
 
 /* simulate: each data set's model at the start values (simulate.h). */
-static int cmd_simulate(int argc, char **argv)
+static int cmd_simulate(int full_argc, char **full_argv, int argc, char **argv)
 {
     cli_options o;
     phc_problem *pb = NULL;
+    phc_provenance *pv = NULL;
     char dir[4096];
     int code;
-    if (load_for_run(argc, argv, "of", "-simulation", &o, &pb, dir, sizeof dir, &code))
+    if (load_for_run("simulate", full_argc, full_argv, argc, argv, "-simulation", &o, &pb, &pv, dir, sizeof dir,
+                     &code))
         return code;
     phc_error err;
     phc_error_clear(&err);
-    const int rc = phc_simulate_write(pb, dir, o.force, &err);
-    if (rc == PHC_OK)
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    if (!o.quiet)
+        phc_progress_report(progress_cb, &prog, "simulating", 0, 0, -1, 0, dir);
+    const int rc = phc_simulate_write(pb, pv, dir, o.force, &err);
+    progress_end(&prog);
+    if (rc == PHC_OK && !o.quiet)
         printf("simulated %zu data set%s: %s/\n", pb->n_datasets, pb->n_datasets == 1 ? "" : "s", dir);
+    phc_provenance_free(pv);
     phc_problem_free(pb);
     return rc ? fail(&err) : EXIT_OK;
+}
+
+/* report --check DIR: the run's inputs and outputs against its manifest. */
+static int check_run(const char *arg)
+{
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", arg);
+    struct stat st;
+    if (stat(dir, &st) == 0 && !S_ISDIR(st.st_mode)) { /* DIR/result.json given: its folder */
+        char *slash = strrchr(dir, '/');
+        if (slash)
+            *slash = '\0';
+        else
+            snprintf(dir, sizeof dir, ".");
+    }
+    phc_error err;
+    phc_error_clear(&err);
+    phc_run_dir_item *items = NULL;
+    size_t n = 0;
+    if (phc_run_dir_verify(dir, &items, &n, &err))
+        return fail(&err);
+    static const char *const state_names[] = {"unchanged", "CHANGED", "MISSING"};
+    size_t bad = 0;
+    for (size_t i = 0; i < n; ++i) {
+        printf("%-9s %-10s %s\n", state_names[items[i].state], items[i].role, items[i].path);
+        bad += items[i].state != PHC_FILE_SAME;
+    }
+    phc_run_dir_verify_free(items, n);
+    if (bad) {
+        printf("check: %zu of %zu files changed or missing since the run\n", bad, n);
+        return EXIT_FIT;
+    }
+    printf("check: all %zu files match the run's record\n", n);
+    return EXIT_OK;
 }
 
 static int cmd_report(int argc, char **argv)
 {
     cli_options o;
-    if (parse_args(argc, argv, &o, "sl") != 0) {
-        usage(stderr);
+    if (parse_args("report", argc, argv, &o, "slc") != 0) {
+        fprintf(stderr, "usage: %s\n", find_command("report")->synopsis);
         return EXIT_USAGE;
     }
+    if (o.check)
+        return check_run(o.input);
     phc_error err;
     phc_error_clear(&err);
     phc_fit_result *res = NULL;
@@ -271,6 +466,13 @@ static int cmd_report(int argc, char **argv)
     return rc;
 }
 
+static int cmd_version(void)
+{
+    printf("phytocal %s%s%s (Ceres Solver %s)\n", PHC_VERSION, PHC_GIT_COMMIT[0] ? ", git " : "", PHC_GIT_COMMIT,
+           phc_nls_version());
+    return EXIT_OK;
+}
+
 int main(int argc, char **argv)
 {
     /* GSL's default error handler aborts; the library checks its inputs and
@@ -278,23 +480,25 @@ int main(int argc, char **argv)
     gsl_set_error_handler_off();
     if (argc < 2) {
         usage(stderr);
+        fprintf(stderr, "(phytocal --help explains the commands, exit codes and data-set kinds)\n");
         return EXIT_USAGE;
     }
     const char *cmd = argv[1];
+    if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0 || strcmp(cmd, "help") == 0)
+        return cmd_help(argc - 2, argv + 2);
+    if (strcmp(cmd, "version") == 0 || strcmp(cmd, "--version") == 0 || strcmp(cmd, "-V") == 0)
+        return cmd_version();
+    const command_help *c = find_command(cmd);
+    if (c && wants_help(argc - 2, argv + 2)) {
+        print_command_help(c, stdout);
+        return EXIT_OK;
+    }
     if (strcmp(cmd, "fit") == 0)
-        return cmd_fit(argc - 2, argv + 2);
+        return cmd_fit(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "simulate") == 0)
-        return cmd_simulate(argc - 2, argv + 2);
+        return cmd_simulate(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "report") == 0)
         return cmd_report(argc - 2, argv + 2);
-    if (strcmp(cmd, "version") == 0) {
-        printf("phytocal %s (Ceres Solver %s)\n", PHC_VERSION, phc_nls_version());
-        return EXIT_OK;
-    }
-    if (strcmp(cmd, "-h") == 0 || strcmp(cmd, "--help") == 0 || strcmp(cmd, "help") == 0) {
-        usage(stdout);
-        return EXIT_OK;
-    }
     fprintf(stderr, "phytocal: unknown command '%s'\n", cmd);
     usage(stderr);
     return EXIT_USAGE;

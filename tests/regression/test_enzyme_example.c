@@ -40,14 +40,14 @@ int main(void)
     CHECK(mkdtemp(sim_root) != NULL);
     char sim[300], sim_file[400];
     snprintf(sim, sizeof sim, "%s/sim", sim_root);
-    CHECK(phc_simulate_write(pb, sim, 0, &err) == PHC_OK);
+    CHECK(phc_simulate_write(pb, NULL, sim, 0, &err) == PHC_OK);
     struct stat sst;
     snprintf(sim_file, sizeof sim_file, "%s/assay_simulated.csv", sim);
     CHECK(stat(sim_file, &sst) == 0 && sst.st_size > 0);
     snprintf(sim_file, sizeof sim_file, "%s/assay_simulated.png", sim);
     CHECK(stat(sim_file, &sst) == 0 && sst.st_size > 0);
-    CHECK(phc_simulate_write(pb, sim, 0, &err) == PHC_ERR_EXISTS);
-    CHECK(phc_simulate_write(pb, sim, 1, &err) == PHC_OK);
+    CHECK(phc_simulate_write(pb, NULL, sim, 0, &err) == PHC_ERR_EXISTS);
+    CHECK(phc_simulate_write(pb, NULL, sim, 1, &err) == PHC_OK);
     char sim_cmd[400];
     snprintf(sim_cmd, sizeof sim_cmd, "rm -rf %s", sim_root);
     if (system(sim_cmd) != 0)

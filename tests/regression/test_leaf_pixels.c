@@ -216,7 +216,7 @@ int main(void)
         snprintf(path, sizeof path, "%s/leaf_observed_vs_simulated.png", out);
         CHECK(access(path, R_OK) == 0);
         snprintf(out, sizeof out, "%s/sim", dir);
-        CHECK(phc_simulate_write(pb, out, 0, &err) == PHC_OK);
+        CHECK(phc_simulate_write(pb, NULL, out, 0, &err) == PHC_OK);
         snprintf(path, sizeof path, "%s/leaf_contact_sheet.png", out);
         CHECK(access(path, R_OK) == 0);
         snprintf(path, sizeof path, "%s/leaf_fluid_07.png", out);
