@@ -1,0 +1,188 @@
+#!/usr/bin/python3
+"""The README's output blocks are what the commands print now (issue 13).
+
+    python3 check_readme.py README.md BUILD_DIR SHARED_DATA_DIR [--only LINE]
+
+Every fenced block without a language tag must be preceded (blank lines
+allowed) by one of two HTML comments, invisible on a rendered page:
+
+    <!-- output: COMMAND [| option ...] -->    the block is COMMAND's output
+    <!-- not output: why -->                    a file format, a schema, a layout
+
+COMMAND runs with /bin/sh in a scratch folder laid out like a checkout
+(build/, measurements/, tests/, notebooks_c/, scripts/ link to the real ones;
+../shared/ to the shared data), so the README's own paths work and nothing is
+written into the checkout.  Its stdout is compared with the block:
+  - a block line starting with "$ " is the command as shown to the reader
+    and is skipped;
+  - a line that is just "..." stands for any number of lines (an excerpt);
+  - "..." inside a line stands for any text within that line;
+  - trailing blanks are ignored.
+Options:
+  stderr        compare stdout and stderr together (2>&1)
+  exit=N        the exit code expected (default 0)
+  timings       a benchmark's lines: numbers are measurements of one machine
+                (the text before the block says which) and are not compared,
+                nor are words after a number; the line keys and their order are
+  skip-without-shared   skip (with a message) when the shared data is absent
+
+Prints "ok - ..." / "not ok - ..." per block with a diff, then
+"N passed, M failed, K skipped"; exits 1 when any block differs.
+"""
+import difflib
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+MARK = re.compile(r"^<!--\s*(output|not output):\s*(.*?)\s*-->\s*$")
+NUMBER = re.compile(r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
+
+
+def parse(readme):
+    """Yields (line_no, fence_lang, body_lines, marker) for each fenced block."""
+    lines = open(readme, encoding="utf-8").read().split("\n")
+    i = 0
+    while i < len(lines):
+        line = lines[i]
+        if line.startswith("```"):
+            lang = line[3:].strip()
+            start = i
+            body = []
+            i += 1
+            while i < len(lines) and not lines[i].startswith("```"):
+                body.append(lines[i])
+                i += 1
+            marker = None
+            j = start - 1
+            while j >= 0 and lines[j].strip() == "":
+                j -= 1
+            if j >= 0:
+                m = MARK.match(lines[j])
+                if m:
+                    marker = (m.group(1), m.group(2))
+            yield start + 1, lang, body, marker
+        i += 1
+
+
+def mask_timing(line):
+    """Keeps a benchmark line's key and the words before its first number."""
+    m = NUMBER.search(line)
+    return line if not m else line[: m.start()] + "<measured>"
+
+
+def line_matches(want, got):
+    if "..." not in want:
+        return want == got
+    parts = [re.escape(p) for p in want.split("...")]
+    return re.fullmatch(".*".join(parts), got) is not None
+
+
+def block_matches(want, got):
+    """Matches block lines against output lines; "..." lines match any run."""
+    memo = {}
+
+    def match(i, j):
+        key = (i, j)
+        if key in memo:
+            return memo[key]
+        if i == len(want):
+            r = j == len(got)
+        elif want[i] == "...":
+            r = any(match(i + 1, k) for k in range(j, len(got) + 1))
+        else:
+            r = j < len(got) and line_matches(want[i], got[j]) and match(i + 1, j + 1)
+        memo[key] = r
+        return r
+
+    return match(0, 0)
+
+
+def scratch(build, shared):
+    root = tempfile.mkdtemp(prefix="phc_readme.")
+    work = os.path.join(root, "checkout")
+    os.mkdir(work)
+    source = os.path.dirname(os.path.abspath(README))
+    for name in ("measurements", "tests", "notebooks_c", "scripts", "fit", "model", "README.md"):
+        os.symlink(os.path.join(source, name), os.path.join(work, name))
+    os.symlink(os.path.abspath(build), os.path.join(work, "build"))
+    if shared and os.path.isdir(shared):
+        os.symlink(os.path.abspath(os.path.join(shared, "..")), os.path.join(root, "shared"))
+    return root, work
+
+
+def main():
+    global README
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    only = None
+    if "--only" in sys.argv:
+        only = int(sys.argv[sys.argv.index("--only") + 1])
+        args = [a for a in args if a != str(only)]
+    if len(args) < 2:
+        print(__doc__)
+        return 2
+    README, build = args[0], args[1]
+    shared = args[2] if len(args) > 2 else ""
+    have_shared = bool(shared) and os.path.isdir(shared)
+    passed = failed = skipped = 0
+    root, work = scratch(build, shared)
+    try:
+        for line_no, lang, body, marker in parse(README):
+            if lang:
+                continue  # yaml, sh, ... are inputs, not outputs
+            if only is not None and line_no != only:
+                continue
+            name = f"README.md:{line_no}"
+            if marker is None:
+                failed += 1
+                print(f"not ok - {name}: an output block without <!-- output: COMMAND --> "
+                      f"or <!-- not output: why --> before it")
+                continue
+            if marker[0] == "not output":
+                continue
+            command, *options = [p.strip() for p in marker[1].split("|")]
+            want_exit = 0
+            for o in options:
+                if o.startswith("exit="):
+                    want_exit = int(o[5:])
+            if "skip-without-shared" in options and not have_shared:
+                skipped += 1
+                print(f"ok - {name} # SKIP no shared data folder: {command}")
+                continue
+            t0 = time.time()
+            proc = subprocess.run(["/bin/sh", "-c", command + (" 2>&1" if "stderr" in options else "")],
+                                  cwd=work, stdout=subprocess.PIPE,
+                                  stderr=None if "stderr" in options else subprocess.PIPE,
+                                  timeout=1800)
+            seconds = time.time() - t0
+            got = proc.stdout.decode("utf-8", "replace").rstrip("\n").split("\n")
+            got = [g.rstrip() for g in got]
+            want = [w.rstrip() for w in body if not w.startswith("$ ")]
+            if "timings" in options:
+                got = [mask_timing(g) for g in got]
+                want = [w if w == "..." else mask_timing(w) for w in want]
+            problems = []
+            if proc.returncode != want_exit:
+                problems.append(f"exit code {proc.returncode}, expected {want_exit}")
+                if proc.stderr:
+                    problems.append("stderr: " + proc.stderr.decode("utf-8", "replace")[-600:])
+            if not block_matches(want, got):
+                diff = "\n".join(difflib.unified_diff(want, got, "README", "now", lineterm="", n=1))
+                problems.append("output differs:\n" + diff)
+            if problems:
+                failed += 1
+                print(f"not ok - {name}: {command} ({seconds:.1f} s)\n  " + "\n  ".join(problems))
+            else:
+                passed += 1
+                print(f"ok - {name}: {command} ({seconds:.1f} s)")
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+    print(f"{passed} passed, {failed} failed, {skipped} skipped")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
