@@ -552,6 +552,12 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     *out = NULL;
     if ((rc = phc_problem_validate(pb, err)))
         return rc;
+    /* kinds that refit themselves (cross-validation in their report
+     * section) report progress through their data set while the fit runs */
+    for (size_t d = 0; d < pb->n_datasets; ++d) {
+        pb->datasets[d]->progress = progress;
+        pb->datasets[d]->progress_data = user_data;
+    }
     const size_t np = pb->n_params;
     const phc_fit_options *opt = &pb->options;
 
@@ -801,6 +807,10 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
 fail_costs:
     free(costs);
 fail:
+    for (size_t d = 0; d < pb->n_datasets; ++d) {
+        pb->datasets[d]->progress = NULL;
+        pb->datasets[d]->progress_data = NULL;
+    }
     phc_covariance_clear(&cov);
     phc_multistart_free(ms);
     phc_nls_free(nls);

@@ -353,7 +353,23 @@ static int loo_residuals(const double *p, double *r, double *jac, void *user)
 
 /* Refits the data set's free slots with row `left_out` excluded, from p;
  * the result overwrites p. */
-static int refit_without(phc_dataset *ds, double *p, phc_error *err)
+/* The refits' solver iterations, reported as progress of fold `fold` of `folds`. */
+typedef struct fold_relay {
+    phc_dataset *ds;
+    size_t fold, folds;
+    int cancelled;
+} fold_relay;
+
+static int relay_fold_iteration(int iteration, double cost, void *user_data)
+{
+    fold_relay *r = user_data;
+    if (phc_progress_report(r->ds->progress, r->ds->progress_data, "leave-one-out", r->fold, r->folds, iteration,
+                            cost, r->ds->name))
+        r->cancelled = 1;
+    return r->cancelled;
+}
+
+static int refit_without(phc_dataset *ds, double *p, size_t fold, size_t folds, phc_error *err)
 {
     const phc_problem *pb = ds->problem;
     phc_nls *nls = phc_nls_new(ds->k);
@@ -376,8 +392,15 @@ static int refit_without(phc_dataset *ds, double *p, phc_error *err)
                                 err)))
         goto done;
     phc_nls_options opt = pb->options.nls;
+    fold_relay relay = {ds, fold, folds, 0};
+    if (ds->progress) {
+        opt.on_iteration = relay_fold_iteration;
+        opt.on_iteration_data = &relay;
+    }
     phc_nls_summary sum;
     rc = phc_nls_solve(nls, &opt, p, &sum, err);
+    if (rc == PHC_OK && relay.cancelled)
+        rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
 done:
     phc_nls_free(nls);
     free(idx);
@@ -459,7 +482,9 @@ int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_r
         goto done;
     }
     double s2[2] = {0, 0};
-    size_t m = 0;
+    size_t m = 0, folds = 0, fold = 0;
+    for (size_t j = 0; j < n; ++j)
+        folds += im->rows[j].role == 0;
     for (size_t j = 0; j < n; ++j) {
         const lp_row *row = &im->rows[j];
         if (!((*ids)[j] = strdup(row->id))) {
@@ -473,7 +498,14 @@ int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_r
         /* model: refit without row j, then read its stage off the model */
         memcpy(pj, p, ds->k * sizeof *pj);
         im->left_out = j;
-        rc = refit_without(ds, pj, err);
+        ++fold;
+        if (phc_progress_report(ds->progress, ds->progress_data, "leave-one-out", fold, folds, -1, NAN,
+                                ds->name)) {
+            im->left_out = n;
+            rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+            goto done;
+        }
+        rc = refit_without(ds, pj, fold, folds, err);
         im->left_out = n;
         if (rc)
             goto done;
