@@ -14,43 +14,177 @@
 #include "fit/costs/pv_curve.h"
 #include "fit/costs/root_shoot.h"
 #include "fit/costs/soil_probe.h"
+#include "fit/costs/soil_setup.h"
 #include "fit/costs/weight_curve.h"
 #include "fit/costs/source_file.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
-/* The data-set kinds this build knows. */
+/* The data-set kinds this build knows: name, summary, keys and their help
+ * (phc_config_kind_at), and the loader. */
 typedef int (*kind_loader)(const phc_yaml_doc *doc, const phc_yaml_node *node,
                            const char *base_dir, phc_is_parameter_fn is_parameter,
                            void *user_data, phc_dataset **out, phc_error *err);
 typedef struct kind_entry {
-    const char *kind;
-    const char *const *keys;
+    phc_config_section info;
     kind_loader load;
 } kind_entry;
 
 static const kind_entry kinds[] = {
-    {"curve", phc_curve_keys, phc_curve_load},
-    {"elasticity_curve", phc_elasticity_curve_keys, phc_elasticity_curve_load},
-    {"infiltration", phc_infiltration_keys, phc_infiltration_load},
-    {"leaf_photos", phc_leaf_photos_keys, phc_leaf_photos_load},
-    {"pv_curve", phc_pv_curve_keys, phc_pv_curve_load},
-    {"root_shoot", phc_root_shoot_keys, phc_root_shoot_load},
-    {"soil_probe", phc_soil_probe_keys, phc_soil_probe_load},
-    {"weight_curve", phc_weight_curve_keys, phc_weight_curve_load},
+    {{"curve", "any expression of columns and parameters (muparser) fitted to a column; "
+               "the NIST StRD problems, enzyme kinetics",
+      phc_curve_keys, phc_curve_help}, phc_curve_load},
+    {{"elasticity_curve", "bulk moduli against water content -> the logistic elasticity "
+                          "kappa, chi0, e_min, e_max (wilting eq. 9)",
+      phc_elasticity_curve_keys, phc_elasticity_curve_help}, phc_elasticity_curve_load},
+    {{"infiltration", "the depth reached by a fraction of the applied rain over time -> soil "
+                      "permeability p and capacity c (Rhizomorph §6, Fig. 7)",
+      phc_infiltration_keys, phc_infiltration_help}, phc_infiltration_load},
+    {{"leaf_photos", "photos of an aging leaf -> vein, stomata, inflow and time scales and the "
+                     "colour transfer of the leaf colour aging model (Silva et al. §3)",
+      phc_leaf_photos_keys, phc_leaf_photos_help}, phc_leaf_photos_load},
+    {{"pv_curve", "pressure-volume data (water potential and mass along a bench dry-down) -> "
+                  "PV traits per leaf and the logistic elasticity (wilting eq. 9)",
+      phc_pv_curve_keys, phc_pv_curve_help}, phc_pv_curve_load},
+    {{"root_shoot", "harvested plants' root:shoot against basal diameter -> growth parameters "
+                    "(phi_rg, ...) and soil p, c (Rhizomorph §5-6)",
+      phc_root_shoot_keys, phc_root_shoot_help}, phc_root_shoot_load},
+    {{"soil_probe", "soil-moisture probe readings over time -> soil permeability p and "
+                    "capacity c, globally or per layer (Rhizomorph §6)",
+      phc_soil_probe_keys, phc_soil_probe_help}, phc_soil_probe_load},
+    {{"weight_curve", "a plant or detached leaf weighed on a balance while it dries -> "
+                      "water-loss rate delta, initial water, dry mass (wilting §3-4)",
+      phc_weight_curve_keys, phc_weight_curve_help}, phc_weight_curve_load},
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])
 
+/* The blocks' key tables (what the parsers below accept) and their help. */
 static const char *const common_dataset_keys[] = {"kind", "name", "parameters", "loss",
                                                   "loss_scale", "derivatives", NULL};
+static const phc_key_help common_dataset_help[] = {
+    {"kind", "The data set's kind: one of the kinds listed by `phytocal help`; `phytocal help "
+             "KIND` lists its own keys. Required."},
+    {"name", "Name used in reports, plots and output file names; unique among the data sets. "
+             "Default: <kind>-<index>, counting from 1."},
+    {"parameters", "Binding {slot: global_name, ...}: which global parameter each of the kind's "
+                   "parameter slots uses (two data sets bound to one name share it: a joint fit). "
+                   "A key that names no slot is an error. Default: each slot uses the global "
+                   "parameter of its own name."},
+    {"loss", "Robust loss on each weighted residual: none, huber, cauchy, soft_l1 or arctan. "
+             "Default: none."},
+    {"loss_scale", "Scale of the robust loss, > 0, in units of the weighted residual. "
+                   "Default: 1."},
+    {"derivatives", "How the Jacobian is computed: central or ridders (numerical differences), "
+                    "or analytic for kinds that provide it. Default: analytic where the kind "
+                    "has it, else central."},
+    {NULL, NULL}};
+
 static const char *const top_keys[] = {"name", "parameters", "datasets", "solver", "report", NULL};
+static const phc_key_help top_help[] = {
+    {"name", "Run name, used for the output directory runs/<name>/ and in the report. "
+             "Default: the config file's name without its extension."},
+    {"parameters", "The global parameters: {NAME: {value, lower, upper, fixed, unit, scale, "
+                   "range}, ...} or NAME: number (the start value). Required."},
+    {"datasets", "Non-empty list of data sets, each with `kind`, the common data-set keys and "
+                 "its kind's keys. Required."},
+    {"solver", "Mapping: how the fit is solved (keys below). Optional."},
+    {"report", "Mapping: the report's checks (keys below). Optional."},
+    {NULL, NULL}};
+
 static const char *const parameter_keys[] = {"value", "lower", "upper", "fixed", "unit",
                                              "scale", "range", NULL};
+static const phc_key_help parameter_help[] = {
+    {"value", "Start value, within the bounds. Required (or write NAME: number)."},
+    {"lower", "Lower bound; not above upper. Default: none (-inf)."},
+    {"upper", "Upper bound. Default: none (+inf)."},
+    {"fixed", "true: the parameter keeps its start value and is not fitted. Default: false."},
+    {"unit", "Unit text for tables and plots (a label, not converted). Default: none."},
+    {"scale", "Typical magnitude, > 0: the solver works on value/scale. Default: |value|, or 1 "
+              "when value is 0."},
+    {"range", "[low, high], low < high: the box in which multi-start draws start points "
+              "(solver starts and rescue_starts). Default: the bounds when both are finite, "
+              "else a decade either side of value."},
+    {NULL, NULL}};
+
 static const char *const solver_keys[] = {"method", "max_iterations", "function_tolerance",
                                           "gradient_tolerance", "parameter_tolerance",
                                           "threads", "starts", "rescue_starts", NULL};
+static const phc_key_help solver_help[] = {
+    {"method", "Ceres trust-region strategy: levenberg_marquardt or dogleg. "
+               "Default: levenberg_marquardt."},
+    {"max_iterations", "Most iterations per start, 1 to 1e6. Default: 1000."},
+    {"function_tolerance", "Stop when the relative change of the cost falls below this, >= 0. "
+                           "Default: 1e-15, raised to a model's relative accuracy when a data "
+                           "set has one (weight_curve, root_shoot) and this key is not given."},
+    {"gradient_tolerance", "Stop when the scaled gradient falls below this, >= 0. Default: 1e-15, "
+                           "raised like function_tolerance."},
+    {"parameter_tolerance", "Stop when the relative step falls below this, >= 0. Default: 1e-15, "
+                            "raised like function_tolerance."},
+    {"threads", "Threads the solver uses, 1 to 256. Default: 1."},
+    {"starts", "Number of starts, 1 to 1e5; more than 1 adds Sobol points in the parameters' "
+               "range boxes, the best fit is kept and the report says how many reached it. "
+               "Default: 1."},
+    {"rescue_starts", "With a single start: Sobol starts added when it fails to converge or "
+                      "stalls where a parameter has no effect; 0 to 1e5, 0 turns this off. "
+                      "Default: 16."},
+    {NULL, NULL}};
+
 static const char *const report_keys[] = {"level", "absolute_sigma", "collinearity_threshold",
                                           "correlation_threshold", NULL};
+static const phc_key_help report_help[] = {
+    {"level", "Significance level of the residual checks, in (0, 1). Default: 0.05."},
+    {"absolute_sigma", "true: the sigmas are the true standard deviations (s^2 = 1); false: "
+                       "standard errors are scaled by s^2 = weighted RSS / dof. Default: false."},
+    {"collinearity_threshold", "Collinearity index above which a parameter set is reported as "
+                               "not identifiable, > 1 (FME's rule of thumb). Default: 20."},
+    {"correlation_threshold", "|correlation| of two parameters above which the pair is "
+                              "reported, in (0, 1]. Default: 0.95."},
+    {NULL, NULL}};
+
+static const phc_config_section blocks[PHC_CONFIG_N_BLOCKS] = {
+    [PHC_CONFIG_TOP] = {"top level", "the configuration file is a YAML mapping with these keys; "
+                                     "unknown keys anywhere are errors naming the nearest valid key",
+                        top_keys, top_help},
+    [PHC_CONFIG_PARAMETER] = {"parameters", "NAME: {value, lower, upper, fixed, unit, scale, "
+                                            "range} or NAME: number (the start value)",
+                              parameter_keys, parameter_help},
+    [PHC_CONFIG_DATASET] = {"datasets", "a list; every data set has these keys besides its "
+                                        "kind's own",
+                            common_dataset_keys, common_dataset_help},
+    [PHC_CONFIG_SOLVER] = {"solver", "how the fit is solved (Ceres Solver)", solver_keys,
+                           solver_help},
+    [PHC_CONFIG_REPORT] = {"report", "the report's checks of residuals and parameters",
+                           report_keys, report_help},
+    [PHC_CONFIG_SOIL] = {"soil", "the Rhizomorph soil (model/soil.h, §6) of soil_probe, "
+                                 "infiltration and root_shoot data sets: grid, layers, "
+                                 "boundaries, rain and sources; parameters named p, c, p_<L>, "
+                                 "c_<L> (layer L from 1 at the surface), f_diff, f_grav are "
+                                 "fitted, otherwise the values here are used",
+                         phc_soil_setup_keys, phc_soil_setup_help},
+};
+
+size_t phc_config_kind_count(void)
+{
+    return N_KINDS;
+}
+
+const phc_config_section *phc_config_kind_at(size_t i)
+{
+    return i < N_KINDS ? &kinds[i].info : NULL;
+}
+
+const phc_config_section *phc_config_kind_find(const char *name)
+{
+    for (size_t i = 0; name && i < N_KINDS; ++i)
+        if (strcmp(kinds[i].info.name, name) == 0)
+            return &kinds[i].info;
+    return NULL;
+}
+
+const phc_config_section *phc_config_block(phc_config_block_id id)
+{
+    return (int)id >= 0 && id < PHC_CONFIG_N_BLOCKS ? &blocks[id] : NULL;
+}
 
 static int expect_kind(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_yaml_kind kind,
                        const char *what, phc_error *err)
@@ -313,8 +447,8 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     const kind_entry *entry = NULL;
     const char *kind_names[N_KINDS];
     for (size_t i = 0; i < N_KINDS; ++i) {
-        kind_names[i] = kinds[i].kind;
-        if (strcmp(kinds[i].kind, kind) == 0)
+        kind_names[i] = kinds[i].info.name;
+        if (strcmp(kinds[i].info.name, kind) == 0)
             entry = &kinds[i];
     }
     if (!entry) {
@@ -333,8 +467,8 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     size_t na = 0;
     for (size_t i = 0; common_dataset_keys[i] && na < 63; ++i)
         allowed[na++] = common_dataset_keys[i];
-    for (size_t i = 0; entry->keys[i] && na < 63; ++i)
-        allowed[na++] = entry->keys[i];
+    for (size_t i = 0; entry->info.keys[i] && na < 63; ++i)
+        allowed[na++] = entry->info.keys[i];
     allowed[na] = NULL;
     if ((rc = phc_yaml_check_keys(doc, node, allowed, ctx, err)))
         return rc;

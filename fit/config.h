@@ -20,14 +20,44 @@
  *                collinearity_threshold (20), correlation_threshold (0.95)
  *
  * Every error names the config file and the line, and for unknown keys the
- * nearest valid key. */
+ * nearest valid key.  The keys and what they mean are also described by the
+ * registry below, from the tables the loader checks (config_help.h). */
 #ifndef PHC_CONFIG_H
 #define PHC_CONFIG_H
 
+#include <stddef.h>
+
+#include "fit/config_help.h"
 #include "fit/problem.h"
 #include "model/status.h"
 
 /* Loads and validates (phc_problem_validate) a configuration file. */
 int phc_config_load(const char *path, phc_problem **out, phc_error *err);
+
+/* A set of configuration keys: a data-set kind, or a block of the file. */
+typedef struct phc_config_section {
+    const char *name;          /* the kind ("weight_curve") or block ("solver") */
+    const char *summary;       /* one line: what it is (a kind: what it fits) */
+    const char *const *keys;   /* the keys the loader accepts, NULL-terminated */
+    const phc_key_help *help;  /* one entry per key, {NULL, NULL}-terminated */
+} phc_config_section;
+
+/* The data-set kinds this build knows, in the registry's (alphabetical)
+ * order; a kind's keys are those besides the common data-set keys. */
+size_t phc_config_kind_count(void);
+const phc_config_section *phc_config_kind_at(size_t i);          /* NULL past the end */
+const phc_config_section *phc_config_kind_find(const char *name); /* NULL when unknown */
+
+/* The blocks of a configuration file. */
+typedef enum phc_config_block_id {
+    PHC_CONFIG_TOP,        /* the top-level mapping */
+    PHC_CONFIG_PARAMETER,  /* one entry of `parameters:` */
+    PHC_CONFIG_DATASET,    /* the keys common to every entry of `datasets:` */
+    PHC_CONFIG_SOLVER,     /* `solver:` */
+    PHC_CONFIG_REPORT,     /* `report:` */
+    PHC_CONFIG_SOIL,       /* a data set's `soil:` (fit/costs/soil_setup.h) */
+    PHC_CONFIG_N_BLOCKS
+} phc_config_block_id;
+const phc_config_section *phc_config_block(phc_config_block_id id); /* NULL when out of range */
 
 #endif /* PHC_CONFIG_H */

@@ -18,6 +18,21 @@
 
 const char *const phc_curve_keys[] = {"file", "x", "y", "expression", "sigma",
                                       "x_label", "y_label", NULL};
+const phc_key_help phc_curve_help[] = {
+    {"file", "CSV table of the observations (header line, then rows), relative to the config "
+             "file. Required."},
+    {"x", "Column used as abscissa in plots and to order the residuals. Required."},
+    {"y", "Column of observed values. Required."},
+    {"expression", "The model, in muparser syntax: numbers, parameter and column names, "
+                   "+ - * / ^, parentheses, exp log sqrt sin cos tan atan abs (and muparser's "
+                   "other functions), pi. A name is a parameter slot when it is a global "
+                   "parameter or a key of the data set's `parameters:` binding, otherwise a "
+                   "column of the file (both is an error). Required."},
+    {"sigma", "A positive number (one sigma for every point, in y units) or the name of a "
+              "column of per-point sigmas. Default: unweighted."},
+    {"x_label", "Axis label of x in plots. Default: the x column's name."},
+    {"y_label", "Axis label of y in plots. Default: the y column's name."},
+    {NULL, NULL}};
 
 typedef struct curve_impl {
     muParserHandle_t parser;

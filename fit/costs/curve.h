@@ -17,12 +17,15 @@
 #ifndef PHC_COSTS_CURVE_H
 #define PHC_COSTS_CURVE_H
 
+#include "fit/config_help.h"
 #include "fit/dataset.h"
 #include "measurements/yaml_doc.h"
 #include "model/status.h"
 
 /* Keys specific to `curve` (NULL-terminated). */
 extern const char *const phc_curve_keys[];
+/* Help on each of those keys (fit/config_help.h). */
+extern const phc_key_help phc_curve_help[];
 
 /* Decides whether an expression name is a parameter slot. */
 typedef int (*phc_is_parameter_fn)(const char *name, void *user_data);

@@ -13,6 +13,20 @@
 
 const char *const phc_elasticity_curve_keys[] = {"file", "water", "water_content", "modulus", "sigma",
                                                  "x_label", "y_label", NULL};
+const phc_key_help phc_elasticity_curve_help[] = {
+    {"file", "CSV table of the measurements, relative to the config file. Required."},
+    {"water", "Column of water contents. Required."},
+    {"water_content", "What the water column holds: rwc (relative water content as a fraction "
+                      "0 to 1; values above 1.5 are refused as probably percent) or absolute "
+                      "(water in any unit, >= 0; chi0 then has that unit and kappa its "
+                      "inverse). Required."},
+    {"modulus", "Column of bulk moduli of elasticity, MPa. Required."},
+    {"sigma", "A positive number (MPa) or the name of a column of per-point sigmas. "
+              "Default: unweighted."},
+    {"x_label", "Axis label of the water content. Default: \"relative water content (RWC)\" "
+                "or \"water content (COLUMN)\"."},
+    {"y_label", "Axis label of the modulus. Default: \"bulk modulus of elasticity (MPa)\"."},
+    {NULL, NULL}};
 
 static const char *const slot_base[PHC_ELASTICITY_NPARAMS] = {"kappa", "chi0", "e_min", "e_max"};
 

@@ -15,6 +15,22 @@
 
 const char *const phc_infiltration_keys[] = {"file", "time", "depth", "fraction", "sigma", "soil",
                                              "x_label", "y_label", NULL};
+const phc_key_help phc_infiltration_help[] = {
+    {"file", "CSV table of the infiltration front, relative to the config file. Required."},
+    {"time", "{column: NAME, unit: UNIT} or a column name: time since the start of the run, "
+             "> 0 and increasing; any UDUNITS-2 time unit, default h. Required."},
+    {"depth", "{column: NAME, unit: UNIT} or a column name: the depth above which `fraction` "
+              "of the water applied so far lies, >= 0; any length unit, default m. Required."},
+    {"fraction", "The fraction of the applied water above the depth, in (0, 1]. "
+                 "Default: 0.8 (Rhizomorph Fig. 7)."},
+    {"sigma", "Standard deviation of the depth, > 0: a number or the name of a column, both in "
+              "the depth column's unit. Required."},
+    {"soil", "The soil set-up (the soil: keys below); it must have rain or a source. "
+             "Required."},
+    {"x_label", "Axis label of time. Default: \"time since the start (h)\"."},
+    {"y_label", "Axis label of depth. Default: \"depth of 80% of the applied water (m)\" "
+                "(with the fraction given)."},
+    {NULL, NULL}};
 
 typedef struct inf_impl {
     phc_soil_setup *su;

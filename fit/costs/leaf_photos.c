@@ -19,6 +19,52 @@ const char *const phc_leaf_photos_keys[] = {
     "file", "image", "leaf", "id", "stage", "initial", "reference", "residual", "difference", "grid",
     "quantiles", "sigma", "colour_space", "colour_correction", "register", "model_size", "dt", "veins",
     "vein_floor", "stomata", "inflow", "cross_validate", "x_label", "y_label", NULL};
+const phc_key_help phc_leaf_photos_help[] = {
+    {"file", "CSV table with one row per photographed leaf, relative to the config file: the "
+             "fresh leaf and at least one more. Required."},
+    {"image", "The photo of every row (a file relative to the config file), or {column: NAME}: "
+              "a column naming each row's photo. Required."},
+    {"leaf", "Column: the leaf's number in its photo, a whole number >= 1 in reading order. "
+             "Default: 1 for every row."},
+    {"id", "Column naming the rows (for initial and reference). Default: the leaf column, "
+           "else the row's line number."},
+    {"stage", "{column: NAME, direction: increasing | decreasing} or a column name: each "
+              "photo's stage, a time (increasing, the default) or a measured stage such as "
+              "SPAD chlorophyll (decreasing); with residual pixels the rows are in stage order. "
+              "Required."},
+    {"initial", "Id of the row of the fresh leaf the model ages. Default: the row with the "
+                "earliest stage."},
+    {"reference", "The senescent reference leaf (eq. 8): a row id (not the initial one), or "
+                  "{image: FILE, leaf: N} (N default 1). Required."},
+    {"residual", "pixels (CIELAB means over grid cells of the photo and the simulated leaf) or "
+                 "histogram (quantiles of L*, a*, b* over the leaf; for photos of different "
+                 "leaves or that cannot be registered). Default: pixels."},
+    {"difference", "pixels: de76 (3 residuals per cell, dL*, da*, db*) or ciede2000 (one per "
+                   "cell). Default: de76."},
+    {"grid", "pixels: grid cells on the long side of the leaf, 2 to 512. Default: 24."},
+    {"quantiles", "histogram: quantiles per CIELAB channel, 2 to 256. Default: 16."},
+    {"sigma", "Standard deviation of each residual, delta-E units, > 0. Default: 2."},
+    {"colour_space", "Space in which the fresh leaf's colours are matched to the reference's: "
+                     "rgb (the paper's) or lab. Default: rgb."},
+    {"colour_correction", "Colour correction of every photo: none, gray_world or colorchecker "
+                          "(a 24-patch ColorChecker Classic in the frame). Default: none."},
+    {"register", "pixels: align each photo to the fresh leaf's (ECC on the silhouettes). "
+                 "Default: true."},
+    {"model_size", "Simulation grid, px on the long side of the leaf, 16 to 4096. "
+                   "Default: 128."},
+    {"dt", "Model step, in model time units, > 0. Default: 0.1."},
+    {"veins", "Venation map: auto (ridge map of the fresh photo), uniform, or an image file the "
+              "size of the fresh leaf's photo. Default: auto."},
+    {"vein_floor", "Venation value on the lamina between veins, 0 to 1. Default: 0.05."},
+    {"stomata", "Stomata map: uniform or an image file. Default: uniform."},
+    {"inflow", "Inflow map: veins (the venation map), uniform, none or an image file. "
+               "Default: veins."},
+    {"cross_validate", "After the fit, predict each row's stage with that row left out, beside "
+                       "a greenness baseline, in the report. Default: false."},
+    {"x_label", "Axis label of the stage. Default: the stage column's name."},
+    {"y_label", "Axis label of the residuals. Default: names the residual (e.g. \"CIELAB cell "
+                "mean (L*, a*, b*)\")."},
+    {NULL, NULL}};
 
 /* Parameter slots and their defaults when no parameter of that name exists. */
 enum { SL_BETA, SL_STOMATA, SL_INFLOW, SL_TIME, SL_YLO, SL_YHI, N_SLOTS };

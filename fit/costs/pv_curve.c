@@ -16,6 +16,29 @@
 
 const char *const phc_pv_curve_keys[] = {"file", "psi", "psi_unit", "fresh_mass", "bag_mass", "dry_mass",
                                          "saturated_mass", "group", "leaf", "breakpoint", "sigma", NULL};
+const phc_key_help phc_pv_curve_help[] = {
+    {"file", "CSV table of the pressure-volume points, at least 6 per leaf, relative to the "
+             "config file. Required."},
+    {"psi", "Column of water potentials, every value < 0 (enter pressure-chamber balance "
+            "pressures with a minus sign). Required."},
+    {"psi_unit", "Unit of psi: MPa, bar or kPa (case ignored). Default: MPa."},
+    {"fresh_mass", "Column of weighed masses, g: the leaf, or the leaf in its bag when bag_mass "
+                   "is given. Required."},
+    {"bag_mass", "A column or a number, g, subtracted from fresh_mass (the bagged-leaf "
+                 "protocol). Default: none."},
+    {"dry_mass", "A column or a number, g, below every leaf mass. Required."},
+    {"saturated_mass", "The turgid leaf mass, g: a column or a number; or extrapolate (the "
+                       "saturated water from psi against leaf water at psi = 0 over the wettest "
+                       "3 to 5 points). Required."},
+    {"group", "Column of leaf ids, for a table of several leaves. Default: one leaf."},
+    {"leaf", "With group: one leaf id, each (one logistic per leaf: slots kappa_<id>, "
+             "chi0_<id>, e_min_<id>, e_max_<id>) or pooled (one logistic for all leaves). "
+             "Required when the group column holds more than one id."},
+    {"breakpoint", "How the linear (osmotic) region is chosen: min_rss, max_r2, or a whole "
+                   "number >= 3 of driest points. Default: min_rss."},
+    {"sigma", "Standard deviation of the moduli, a positive number, MPa. "
+              "Default: unweighted."},
+    {NULL, NULL}};
 
 typedef struct pv_extra {
     size_t count;

@@ -36,6 +36,7 @@
 #ifndef PHC_COSTS_PV_CURVE_H
 #define PHC_COSTS_PV_CURVE_H
 
+#include "fit/config_help.h"
 #include "fit/costs/curve.h"
 #include "fit/dataset.h"
 #include "measurements/yaml_doc.h"
@@ -43,6 +44,8 @@
 #include "model/status.h"
 
 extern const char *const phc_pv_curve_keys[];
+/* Help on each of those keys (fit/config_help.h). */
+extern const phc_key_help phc_pv_curve_help[];
 
 int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                       phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out,

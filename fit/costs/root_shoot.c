@@ -19,6 +19,46 @@ const char *const phc_root_shoot_keys[] = {
     "file", "diameter", "root_mass", "shoot_mass", "leaf_mass", "stem_mass", "age", "baad",
     "species", "suspicious", "select", "sigma", "preset", "growth", "mode", "seed", "uptake",
     "days", "step", "plant", "soil", "x_label", "y_label", NULL};
+const phc_key_help phc_root_shoot_help[] = {
+    {"file", "CSV table of harvested plants, relative to the config file. Give exactly one of "
+             "file and baad."},
+    {"diameter", "With file: {column: NAME, unit: UNIT} or a column name: basal diameters, "
+                 "> 0; default unit mm. Required with file."},
+    {"root_mass", "With file: {column, unit} or a column: root masses, > 0; default unit g. "
+                  "Required with file."},
+    {"shoot_mass", "With file: {column, unit} or a column: shoot masses (stem and leaves), > 0; "
+                   "default unit g. Required with file unless leaf_mass and stem_mass are "
+                   "given."},
+    {"leaf_mass", "With file, instead of shoot_mass: {column, unit} or a column of leaf masses, "
+                  "default unit g, added to stem_mass. Optional."},
+    {"stem_mass", "With file, instead of shoot_mass: {column, unit} or a column of stem masses, "
+                  "default unit g, added to leaf_mass. Optional."},
+    {"age", "With file: {column, unit} or a column of plant ages, default unit d, compared "
+            "with the simulated ages in the report. Optional."},
+    {"baad", "A BAAD study folder (its data.csv), relative to the config file. Give exactly one "
+             "of file and baad."},
+    {"species", "With baad: the species whose plants are used. Required with baad."},
+    {"suspicious", "With baad: exclude or keep the rows BAAD flags as suspicious (listed in the "
+                   "report). Default: exclude."},
+    {"select", "{column: NAME, equals: VALUE}: keep only the rows whose column (of the table, "
+               "or a raw BAAD column) equals VALUE. Default: every row."},
+    {"sigma", "Standard deviation of ln(root mass / shoot mass), > 0. Required."},
+    {"preset", "Growth preset: oak, cherry, apple, poplar or maple. Default: oak."},
+    {"growth", "{NAME: value, ...}: growth parameters (model/growth.h names, e.g. phi_rg) "
+               "overriding the preset's. Default: none."},
+    {"mode", "expected (smooth) or stochastic (branching drawn with seed). "
+             "Default: expected."},
+    {"seed", "Random seed of stochastic mode, a whole number >= 0. Default: 1."},
+    {"uptake", "Root water uptake: physical or none (the authors' code). Default: physical."},
+    {"days", "Longest simulated age, d, > 0. Default: 365."},
+    {"step", "Growth step, d, 0 < step <= days. Default: 1."},
+    {"plant", "{x, y, depth}: where the seed is planted in the soil grid, m. Default: the "
+              "centre of the surface."},
+    {"soil", "The soil the plant grows in, e.g. a pot (the soil: keys below). Default: none "
+             "(the roots see the growth parameter soil_fill as fill level)."},
+    {"x_label", "Axis label of the diameter. Default: \"basal diameter (mm)\"."},
+    {"y_label", "Axis label of the ratio. Default: \"ln(root mass / shoot mass)\"."},
+    {NULL, NULL}};
 
 typedef struct rs_impl {
     phc_soil_setup *su;          /* NULL: no soil (fill = soil_fill) */

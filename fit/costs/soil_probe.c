@@ -15,6 +15,30 @@
 
 const char *const phc_soil_probe_keys[] = {"file", "time", "probe", "value", "quantity", "start", "probes",
                                            "sigma", "soil", "x_label", "y_label", NULL};
+const phc_key_help phc_soil_probe_help[] = {
+    {"file", "CSV table of readings (time, probe, value; in time order), relative to the "
+             "config file. Required."},
+    {"time", "{column: NAME, unit: UNIT} or a column name: reading times; any UDUNITS-2 time "
+             "unit, or a timestamp unit such as \"hours since 2024-05-01\" (then start is "
+             "required); default h. Required."},
+    {"probe", "Column of probe ids, each in the probe table. Required."},
+    {"value", "Column of readings, in the quantity's unit. Required."},
+    {"quantity", "What the readings are: water (w, m³/m³) or fill (w/c). Default: water."},
+    {"start", "The reading time of the model's t = 0, in the time unit; no reading may be "
+              "earlier. Default: 0; required with a timestamp unit."},
+    {"probes", "The probe table, one row per probe: {file, id, x, y, depth, sigma}, its CSV "
+               "file (required, relative to the config file) and the names of its columns "
+               "(defaults id, x, y, depth; sigma optional: per-probe standard deviations); lat "
+               "and lon instead of x and y place probes by latitude and longitude (needs the "
+               "soil's geo_origin). x, y in m from the grid's west-south corner, depth in m "
+               "below the surface. Required."},
+    {"sigma", "Standard deviation of a reading, > 0, in the readings' unit, for probes without "
+              "a sigma column. Required unless every probe has one."},
+    {"soil", "The soil set-up (the soil: keys below). Required."},
+    {"x_label", "Axis label of time. Default: \"time since start (h)\"."},
+    {"y_label", "Axis label of the readings. Default: \"water content w (m³/m³)\" or "
+                "\"fill level w/c\"."},
+    {NULL, NULL}};
 
 typedef struct sp_impl {
     phc_soil_setup *su;

@@ -22,11 +22,14 @@
 #ifndef PHC_COSTS_SOIL_PROBE_H
 #define PHC_COSTS_SOIL_PROBE_H
 
+#include "fit/config_help.h"
 #include "fit/costs/curve.h"
 #include "fit/dataset.h"
 #include "measurements/yaml_doc.h"
 
 extern const char *const phc_soil_probe_keys[];
+/* Help on each of those keys (fit/config_help.h). */
+extern const phc_key_help phc_soil_probe_help[];
 
 int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                         phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err);

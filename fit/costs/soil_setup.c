@@ -9,6 +9,45 @@
 const char *const phc_soil_setup_keys[] = {"grid", "dt", "substep", "max_substeps", "f_diff", "f_grav", "f_nutrient",
                                            "boundaries", "absorb", "layers", "rocks", "nutrient_pockets",
                                            "rain", "sources", "geo_origin", NULL};
+const phc_key_help phc_soil_setup_help[] = {
+    {"grid", "{nx, ny, nz, dx}: voxels along x (east), y (north) (default 1 each) and z "
+             "(required), and the voxel side dx in m (required); at most 5e8 voxels. "
+             "Required."},
+    {"dt", "Time step, h, > 0 (sub-stepped over the stability limit unless substep is false). "
+           "Default: 0.01."},
+    {"substep", "true: sub-step a dt over the explicit step's stability limit; false: refuse "
+                "such a dt. Default: true."},
+    {"max_substeps", "Most sub-steps per dt (a fit's trial point needing more is refused); 0 = "
+                     "no limit. Default: 100."},
+    {"f_diff", "Diffusion force, m, >= 0 (fitted when there is a parameter f_diff). "
+               "Default: 1."},
+    {"f_grav", "Gravity force, >= 0 (fitted when there is a parameter f_grav). Default: 1."},
+    {"f_nutrient", "Nutrient transport factor, >= 0. Default: 1."},
+    {"boundaries", "{sides, x_min, x_max, y_min, y_max, bottom, top}: each block, absorb or "
+                   "periodic; sides sets the four vertical faces, periodic faces come in "
+                   "pairs. Default: block everywhere."},
+    {"absorb", "{form, width}: the damping of absorbing faces, form code (the authors' code) or "
+               "paper (eq. 31), over width voxel layers, 1 to 1000. Default: code, 5."},
+    {"layers", "List of layers from the surface down, each {soil: PRESET or c and p (m/h), "
+               "thickness (m; not for the last, which reaches the bottom), fill (w/c) or water "
+               "(m³/m³) (default water 0), d (default 1), nutrient (default 0)}. Presets: clay, "
+               "clay_loam, sandy_clay_loam, sandy_loam, silt_loam, silt. Required."},
+    {"rocks", "{seed, scale, fraction}: random rocks (p = 0), scale the noise's length in m "
+              "(> 0), fraction the share of the soil they fill (0 <= fraction < 1), seed a "
+              "whole number (default 1). Default: none."},
+    {"nutrient_pockets", "{seed, scale, fraction, amount}: random nutrient pockets as for rocks, "
+                         "with amount >= 0 (required). Default: none."},
+    {"rain", "List of {start, end, rate, nutrient, x0, x1, y0, y1}: rain of rate m/h from start "
+             "to end h carrying nutrient units/m³ (default 0), on the rectangle x0..x1, y0..y1 "
+             "m (default the whole surface). Default: none."},
+    {"sources", "List of {x, y, depth, radius, water_rate, nutrient_rate, start, end}: point "
+                "sources (negative rates: sinks) at x, y, depth m (required), spread over "
+                "radius m (default 0), water_rate m³/h, nutrient_rate units/h, from start "
+                "(default 0) to end (default never) h. Default: none."},
+    {"geo_origin", "{lat, lon, height}: where the grid's west-south corner at the surface is, "
+                   "e.g. lat: \"43.6481 N\", lon: \"79.3832 W\" (height default 0); needed for "
+                   "probes placed by latitude and longitude. Default: none."},
+    {NULL, NULL}};
 
 void phc_soil_setup_free(phc_soil_setup *su)
 {

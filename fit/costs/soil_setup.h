@@ -37,6 +37,7 @@
 
 #include <stddef.h>
 
+#include "fit/config_help.h"
 #include "fit/costs/curve.h"
 #include "fit/costs/source_file.h"
 #include "fit/dataset.h"
@@ -46,6 +47,8 @@
 #include "model/status.h"
 
 extern const char *const phc_soil_setup_keys[];
+/* Help on each of those keys (fit/config_help.h). */
+extern const phc_key_help phc_soil_setup_help[];
 
 typedef struct phc_soil_setup {
     size_t nx, ny, nz;

@@ -23,6 +23,53 @@ const char *const phc_weight_curve_keys[] = {
     "file", "time", "mass", "select", "plant", "plant_format", "plant_unit", "leaf_area",
     "chain_segments", "vein_radius", "dry_mass", "sigma", "exclude", "jumps", "jump_threshold",
     "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
+const phc_key_help phc_weight_curve_help[] = {
+    {"file", "CSV table of weighings, in time order, relative to the config file. Required."},
+    {"time", "{column: NAME, unit: UNIT} or a column name: the time of each weighing; any "
+             "UDUNITS-2 time unit (also \"seconds since 1970-01-01\" for POSIX times), "
+             "default s. Required."},
+    {"mass", "{column: NAME, unit: UNIT} or a column name: the masses, > 0; any mass unit, "
+             "default g. Required."},
+    {"select", "{COLUMN: VALUE, ...}: keep only the rows matching every pair (one plant of a "
+               "long table; \"1\" matches \"1.0\"). Default: every row."},
+    {"plant", "A plant-graph file (paper, TreeQSM, SWC or native CSV), relative to the config "
+              "file. Give exactly one of plant and leaf_area."},
+    {"plant_format", "Format of the plant file: auto (by extension and content), paper, "
+                     "treeqsm, swc or native. Default: auto."},
+    {"plant_unit", "Length unit of the plant file (UDUNITS-2, e.g. mm). Default: the format's "
+                   "(paper, TreeQSM: m; SWC: um; native: its `# unit:` line, else m)."},
+    {"leaf_area", "A detached leaf instead of plant, modelled as a venation chain: its area, a "
+                  "number or {value: A | column: NAME, unit: UNIT} (a column is read at the "
+                  "first selected row); default unit cm2. Give exactly one of plant and "
+                  "leaf_area."},
+    {"chain_segments", "With leaf_area: segments of the venation chain, 2 to 100000. "
+                       "Default: 20."},
+    {"vein_radius", "With leaf_area: radius of the chain's segments, a number or {value | "
+                    "column, unit}; default unit mm. Default: 0.5 mm."},
+    {"dry_mass", "Measured dry mass, a number or {value | column, unit} (default: the mass "
+                 "unit), below every mass: fixes the dry_mass slot. Default: dry_mass is a "
+                 "fitted slot."},
+    {"sigma", "Balance standard deviation, > 0: a number in the mass unit or the name of a "
+              "column of per-point sigmas. Default: unweighted."},
+    {"exclude", "[[from, to], ...], from < to: time windows to drop, in the time unit, counted "
+                "from the first selected row. Default: none."},
+    {"jumps", "What a rise of the mass above jump_threshold (an irrigation) does: error (stop "
+              "and name the line), split (the curve restarts; piece k = 2, 3, ... gets its "
+              "own slot initial_water_<k>) or keep. Default: error."},
+    {"jump_threshold", "The rise between weighings that counts as a jump, > 0, in the mass "
+                       "unit. Default: max(5 sigma, 0.5% of the largest mass)."},
+    {"conductance", "Edge weights of the water model: poiseuille, mean, paper, reference or "
+                    "reference_2024 (model/water.h). Default: poiseuille."},
+    {"method", "Evaluator: auto (exact up to 400 segments when not stiff, else BDF6), exact "
+               "or bdf6. Default: auto."},
+    {"step", "BDF6 time step in the time unit, >= 0; 0 = a thousandth of the time span. "
+             "Default: 0."},
+    {"viscosity", "Sap viscosity, mPa s, > 0, when no parameter named viscosity makes it a "
+                  "fitted slot. Default: 0.89 (water at 25 °C); 0.9 with the reference "
+                  "conductances."},
+    {"x_label", "Axis label of time. Default: \"time since the first weighing (<time unit>)\"."},
+    {"y_label", "Axis label of mass. Default: \"mass (g)\"."},
+    {NULL, NULL}};
 
 /* A stretch of the curve between irrigations.  Piece 0 starts from the
  * `initial_water` slot, piece k > 0 from its own slot `initial_water_<k+1>`. */

@@ -53,12 +53,15 @@
 #ifndef PHC_COSTS_WEIGHT_CURVE_H
 #define PHC_COSTS_WEIGHT_CURVE_H
 
+#include "fit/config_help.h"
 #include "fit/costs/curve.h"
 #include "fit/dataset.h"
 #include "measurements/yaml_doc.h"
 #include "model/status.h"
 
 extern const char *const phc_weight_curve_keys[];
+/* Help on each of those keys (fit/config_help.h). */
+extern const phc_key_help phc_weight_curve_help[];
 
 int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                           const char *base_dir, phc_is_parameter_fn is_parameter,
