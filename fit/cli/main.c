@@ -4,7 +4,7 @@
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal report DIR/result.json [--strict] [--level L]
  *   phytocal report --check DIR
- *   phytocal help [COMMAND | KIND]      phytocal COMMAND --help
+ *   phytocal help [COMMAND | KIND | config | soil]   phytocal COMMAND --help
  *   phytocal version                    phytocal --version
  *
  * Exit codes: 0 success; 1 usage; 2 bad input; 3 the fit did not converge or
@@ -20,6 +20,7 @@
 
 #include "fit/ceres_bridge.h"
 #include "fit/config.h"
+#include "fit/config_help.h"
 #include "fit/fit.h"
 #include "fit/provenance.h"
 #include "fit/report.h"
@@ -69,7 +70,7 @@ static const command_help commands[] = {
      "\n"
      "options: -o DIR, --force, --quiet, --help as for fit."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
-               "       phytocal report --check DIR",
+               "  phytocal report --check DIR",
      "Prints the summary of an earlier fit from its result.json; with --level L the\n"
      "residual checks and the verdict are recomputed at level L (0 < L < 1).\n"
      "\n"
@@ -81,11 +82,13 @@ static const command_help commands[] = {
      "                     read them, and every file the run wrote is unchanged; exit 3\n"
      "                     when anything changed or is missing\n"
      "  -h, --help         this text"},
-    {"help", "phytocal help [COMMAND | KIND | kinds]",
+    {"help", "phytocal help [COMMAND | KIND | config | soil]",
      "Without an argument: the commands, exit codes and data-set kinds.  With a command:\n"
-     "its options.  With a data-set kind (e.g. weight_curve): the configuration keys of\n"
-     "that kind.  `phytocal help kinds`: the configuration reference of every key that is\n"
-     "not a kind's own."},
+     "its options.  With a data-set kind (e.g. weight_curve): that kind's configuration\n"
+     "keys.  `phytocal help config`: every key of a configuration file that is not a\n"
+     "kind's own (top level, parameters, solver, report, common data-set keys) and\n"
+     "what each kind fits; `phytocal help soil`: the keys of a data set's soil: block.\n"
+     "The key lists come from the tables the configuration loader checks."},
     {"version", "phytocal version | phytocal --version",
      "Prints the version, the git commit it was built from (when built from a checkout)\n"
      "and the Ceres Solver version."},
@@ -114,9 +117,22 @@ static void print_overview(FILE *out)
     usage(out);
     fprintf(out, "\n%s\n", exit_codes);
     fprintf(out, "data-set kinds (phytocal help KIND for the keys of one):\n");
-    (void)0; /* MERGE-HELP: kinds list */
-    fprintf(out, "\nMore: phytocal help COMMAND, phytocal help KIND, phytocal help kinds;\n"
-                 "the README has a walk-through of each model.\n");
+    size_t col = 0;
+    for (size_t i = 0; i < phc_config_kind_count(); ++i) {
+        const char *name = phc_config_kind_at(i)->name;
+        if (col == 0 || col + strlen(name) + 2 > 78) {
+            fprintf(out, "%s  ", col ? "\n" : "");
+            col = 2;
+        } else {
+            fprintf(out, " ");
+            col++;
+        }
+        col += (size_t)fprintf(out, "%s%s", name, i + 1 < phc_config_kind_count() ? "," : "");
+    }
+    fputc('\n', out);
+    fprintf(out, "\nMore: phytocal help COMMAND (its options), phytocal help KIND (its keys),\n"
+                 "phytocal help config (every key of a configuration file, what each kind fits);\n"
+                 "the README walks through each model.\n");
 }
 
 static const command_help *find_command(const char *name)
@@ -145,9 +161,9 @@ static int cmd_help(int argc, char **argv)
     }
     phc_error err;
     phc_error_clear(&err);
-    /* MERGE-HELP */
-    fprintf(stderr, "phytocal: help: '%s' is neither a command (fit, simulate, report, help, version) nor a "
-                    "data-set kind: %s\n", argv[0], err.message);
+    if (phc_config_write_help(stdout, strcmp(argv[0], "config") == 0 ? NULL : argv[0], &err) == PHC_OK)
+        return EXIT_OK;
+    fprintf(stderr, "phytocal: %s; commands: fit, simulate, report, help, version\n", err.message);
     return EXIT_USAGE;
 }
 
