@@ -241,8 +241,11 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     path = phc_join_path(base_dir, file);
     if (!path)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err)))
+    if ((rc = phc_table_read(path, &table, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     if (phc_table_rows(table) == 0) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
         goto fail;
@@ -407,7 +410,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     ds->data_file = strdup(path);
     ds->data_lines = malloc(ds->n * sizeof *ds->data_lines);
-    if (!ds->data_file || !ds->data_lines) {
+    if (!ds->data_file || !ds->data_lines || phc_dataset_add_input(ds, path)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
