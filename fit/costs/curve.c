@@ -247,7 +247,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     }
     if (phc_table_rows(table) == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
 

@@ -135,7 +135,7 @@ int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node
     }
     const size_t n = phc_table_rows(table);
     if (n == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
     if ((rc = phc_need_column(doc, node, "water", water, table, err)) ||

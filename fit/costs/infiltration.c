@@ -225,7 +225,7 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
         goto fail;
     const size_t n = phc_table_rows(table);
     if (n < 1) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
     const phc_yaml_node *sg = phc_yaml_get(node, "sigma");

@@ -1045,8 +1045,8 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
     }
     const size_t nr = phc_table_rows(t);
     if (nr < 2) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: %zu row%s: a leaf_photos data set needs a fresh leaf and at least "
-                           "one more photo", path, nr, nr == 1 ? "" : "s");
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: %zu data row%s below the header: a leaf_photos data set needs a "
+                           "fresh leaf and at least one more photo", path, nr, nr == 1 ? "" : "s");
         goto fail;
     }
     if ((rc = phc_need_column(doc, sn->kind == PHC_YAML_MAPPING ? sn : node, sn->kind == PHC_YAML_MAPPING ? "column" : "stage",
@@ -1247,7 +1247,8 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         ++m_data;
     }
     if (!m_data) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows left besides the fresh leaf and the reference", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: no row of %s is left to fit besides the fresh leaf "
+                           "(initial) and the reference", doc->path, node->line, ctx, path);
         goto fail;
     }
     /* distinct model times over the data rows */

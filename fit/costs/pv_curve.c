@@ -274,7 +274,7 @@ int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
     }
     const size_t n = phc_table_rows(t);
     if (n == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
     if ((rc = phc_need_column(doc, node, "psi", psi_col, t, err)) ||

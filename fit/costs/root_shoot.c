@@ -506,7 +506,8 @@ static int load_table(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         rc = selc ? phc_error_set(err, PHC_ERR_INPUT,
                                   "%s:%zu: select: no row of %s has %s = '%s'", doc->path,
                                   phc_key_line(node, "select"), path, selc, selv)
-                  : phc_error_set(err, PHC_ERR_INPUT, "%s: no rows", path);
+                  : phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                                  path);
     if (!rc) {
         size_t cap = strlen(path) + 256;
         *source = malloc(cap);

@@ -376,8 +376,10 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         if (row_selected(table, r, sel, sel_cols))
             keep[n_sel++] = r;
     if (n_sel == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows%s", path,
-                           sel ? " match the data set's `select`" : "");
+        rc = sel ? phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'select': no row of %s matches", doc->path,
+                                 phc_key_line(node, "select"), path)
+                 : phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                                 path);
         goto fail;
     }
     if ((rc = phc_table_column_numbers_rows(table, tcol, keep, n_sel, &tv, err)) ||
