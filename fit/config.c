@@ -220,6 +220,7 @@ static int parse_parameter(const phc_yaml_doc *doc, phc_problem *pb, const char 
         return rc;
     }
     phc_parameter *p = &pb->params[index];
+    p->config_line = key_line; /* phc_problem_validate's messages name it */
     if (spec->kind == PHC_YAML_SCALAR)
         return PHC_OK;
     const char *unit = NULL;

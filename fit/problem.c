@@ -2,6 +2,7 @@
 #include "fit/problem.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -112,26 +113,70 @@ double phc_problem_scale(const phc_problem *pb, size_t i)
     return 1.0;
 }
 
+/* Where a parameter or data set was given: "cfg.yaml:4" when it came from
+ * line 4 of a config, else the config (or the problem's name). */
+static const char *place(const phc_problem *pb, size_t line, char *buf, size_t size)
+{
+    const char *src = pb->source ? pb->source : pb->name;
+    if (pb->source && line > 0)
+        snprintf(buf, size, "%s:%zu", src, line);
+    else
+        snprintf(buf, size, "%s", src);
+    return buf;
+}
+
+/* A finite start value, bound or range end the fit can work with: within
+ * +-PHC_PARAMETER_MAX, and so once divided by an explicit scale.  Infinite
+ * values (open bounds, automatic ranges) pass. */
+static int check_magnitude(const char *at, const phc_parameter *p, const char *what, double v, phc_error *err)
+{
+    if (!isfinite(v))
+        return PHC_OK;
+    if (fabs(v) > PHC_PARAMETER_MAX)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: parameter '%s': %s %g is too large in magnitude: starts, bounds and ranges must be between "
+                             "%g and %g, so that the search box built on them (up to 10 times the start, or "
+                             "upper - lower) stays finite; express the parameter in a larger unit",
+                             at, p->name, what, v, -PHC_PARAMETER_MAX, PHC_PARAMETER_MAX);
+    if (p->scale > 0 && fabs(v) / p->scale > PHC_PARAMETER_MAX)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: parameter '%s': %s %g divided by its scale %g is not below %g (the solver works "
+                             "on value / scale); give a larger scale",
+                             at, p->name, what, v, p->scale, PHC_PARAMETER_MAX);
+    return PHC_OK;
+}
+
 int phc_problem_validate(const phc_problem *pb, phc_error *err)
 {
     const char *src = pb->source ? pb->source : pb->name;
+    char at[1024];
+    int rc;
     if (pb->n_datasets == 0)
         return phc_error_set(err, PHC_ERR_INPUT, "%s: no data sets to fit", src);
     size_t n_free = 0, n_obs = 0;
     for (size_t i = 0; i < pb->n_params; ++i) {
         const phc_parameter *p = &pb->params[i];
+        place(pb, p->config_line, at, sizeof at);
+        if (p->scale < 0 || !isfinite(p->scale))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: parameter '%s': scale must be positive and finite, found %g",
+                                 at, p->name, p->scale);
         if (!isfinite(p->value))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s: parameter '%s': value is not finite", src, p->name);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: parameter '%s': start value %g is not finite", at, p->name,
+                                 p->value);
+        if ((rc = check_magnitude(at, p, "start value", p->value, err)) ||
+            (rc = check_magnitude(at, p, "lower bound", p->lower, err)) ||
+            (rc = check_magnitude(at, p, "upper bound", p->upper, err)) ||
+            (rc = check_magnitude(at, p, "range start", p->range_lo, err)) ||
+            (rc = check_magnitude(at, p, "range end", p->range_hi, err)))
+            return rc;
         if (!(p->lower < p->upper) && !(p->fixed && p->lower <= p->upper))
             return phc_error_set(err, PHC_ERR_INPUT,
                                  "%s: parameter '%s': lower bound %g is not below upper bound %g",
-                                 src, p->name, p->lower, p->upper);
+                                 at, p->name, p->lower, p->upper);
         if (p->value < p->lower || p->value > p->upper)
             return phc_error_set(err, PHC_ERR_INPUT,
                                  "%s: parameter '%s': start value %g is outside its bounds [%g, %g]",
-                                 src, p->name, p->value, p->lower, p->upper);
-        if (p->scale < 0 || !isfinite(p->scale))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s: parameter '%s': scale must be positive", src, p->name);
+                                 at, p->name, p->value, p->lower, p->upper);
         int used = 0;
         for (size_t d = 0; d < pb->n_datasets && !used; ++d)
             for (size_t j = 0; j < pb->datasets[d]->k; ++j)
@@ -140,19 +185,25 @@ int phc_problem_validate(const phc_problem *pb, phc_error *err)
         if (!used)
             return phc_error_set(err, PHC_ERR_INPUT,
                                  "%s: parameter '%s' is not used by any data set (remove it or bind it)",
-                                 src, p->name);
+                                 at, p->name);
         if (!p->fixed)
             ++n_free;
     }
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         const phc_dataset *ds = pb->datasets[d];
         if (ds->n == 0)
-            return phc_error_set(err, PHC_ERR_INPUT, "%s: data set '%s' has no observations", src, ds->name);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: data set '%s' has no observations",
+                                 place(pb, ds->config_line, at, sizeof at), ds->name);
         for (size_t i = 0; ds->sigma && i < ds->n; ++i)
-            if (!(ds->sigma[i] > 0) || !isfinite(ds->sigma[i]))
+            if (!(ds->sigma[i] > 0) || !isfinite(ds->sigma[i])) {
+                if (ds->data_file && ds->data_lines)
+                    snprintf(at, sizeof at, "%s:%zu", ds->data_file, ds->data_lines[i]);
+                else
+                    place(pb, ds->config_line, at, sizeof at);
                 return phc_error_set(err, PHC_ERR_INPUT,
                                      "%s: data set '%s': sigma of observation %zu is %g; sigmas must be positive and finite",
-                                     src, ds->name, i + 1, ds->sigma[i]);
+                                     at, ds->name, i + 1, ds->sigma[i]);
+            }
         n_obs += ds->n;
     }
     if (n_free == 0)

@@ -18,7 +18,14 @@ typedef struct phc_parameter {
     char *unit;          /* free text for reports, e.g. "g s-1 cm-1"; may be NULL */
     double scale;        /* typical magnitude; 0 = automatic (|value| or 1) */
     double range_lo, range_hi; /* multi-start box; NAN = automatic */
+    size_t config_line;  /* line of its key in the config (problem->source), 0 when
+                            built by hand: messages about it name that line */
 } phc_parameter;
+
+/* The largest magnitude of a start value, finite bound or range end.  The
+ * fit works on multiples of these (the automatic multi-start box spans 10x
+ * the start, and a box's width is upper - lower), which must stay finite. */
+#define PHC_PARAMETER_MAX 1e300
 
 typedef struct phc_fit_options {
     phc_nls_options nls;   /* solver settings for every start */
@@ -58,10 +65,12 @@ long phc_problem_find_parameter(const phc_problem *pb, const char *name);
 /* Takes ownership of ds (also on failure). */
 int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err);
 
-/* Checks the whole problem before a fit: bounds are intervals, starts inside
- * them, every parameter used by some data set, at least as many
- * observations as free parameters, positive sigmas. Messages name the
- * parameter or data set. */
+/* Checks the whole problem before a fit: starts, finite bounds and ranges
+ * within +-PHC_PARAMETER_MAX, bounds are intervals, starts inside them,
+ * every parameter used by some data set, at least as many observations as
+ * free parameters, positive sigmas.  Messages name the parameter or data
+ * set, and the config line of either when it came from a config
+ * ("cfg.yaml:4: parameter 'vmax': ..."). */
 int phc_problem_validate(const phc_problem *pb, phc_error *err);
 
 /* The scale used for parameter i (explicit, or |value|, or 1). */

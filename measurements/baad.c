@@ -37,6 +37,8 @@ struct phc_baad_study {
     phc_baad_change *changes;
     size_t n_changes;
     double site_shift;
+    char *inputs[4]; /* the files read, as opened (phc_baad_inputs) */
+    size_t n_inputs;
 };
 
 /* ---- small helpers ------------------------------------------------------ */
@@ -227,9 +229,9 @@ static int add_flag(phc_baad_study *s, size_t i, int flag, const char *reason)
 /* ---- the steps of phc_baad_read ----------------------------------------- */
 
 /* Reads one CSV of the folder; `optional` files that do not exist give
- * *t = NULL and success. */
-static int read_csv(const char *dir, const char *file, int optional, phc_table **t,
-                    phc_error *err)
+ * *t = NULL and success.  A file read is added to s->inputs. */
+static int read_csv(phc_baad_study *s, const char *dir, const char *file, int optional,
+                    phc_table **t, phc_error *err)
 {
     char path[4096];
     FILE *f;
@@ -242,7 +244,14 @@ static int read_csv(const char *dir, const char *file, int optional, phc_table *
             return PHC_OK;
         fclose(f);
     }
-    return phc_table_read(path, t, err);
+    int rc = phc_table_read(path, t, err);
+    if (rc)
+        return rc;
+    if (s->n_inputs >= sizeof s->inputs / sizeof s->inputs[0] ||
+        !(s->inputs[s->n_inputs] = dup_str(path)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    s->n_inputs++;
+    return PHC_OK;
 }
 
 static int need_column(const phc_table *t, const char *name, long *col, phc_error *err)
@@ -793,10 +802,10 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
     else
         strcpy(parent, ".");
 
-    if ((rc = read_csv(study_dir, "data.csv", 0, &s->data, err)) ||
-        (rc = read_csv(study_dir, "dataMatchColumns.csv", 0, &match, err)) ||
-        (rc = read_csv(study_dir, "dataNew.csv", 1, &nw, err)) ||
-        (rc = read_csv(parent, "variableDefinitions.csv", 0, &defs, err)))
+    if ((rc = read_csv(s, study_dir, "data.csv", 0, &s->data, err)) ||
+        (rc = read_csv(s, study_dir, "dataMatchColumns.csv", 0, &match, err)) ||
+        (rc = read_csv(s, study_dir, "dataNew.csv", 1, &nw, err)) ||
+        (rc = read_csv(s, parent, "variableDefinitions.csv", 0, &defs, err)))
         goto fail;
     s->n = phc_table_rows(s->data);
     if (!(units = phc_units_new(err))) {
@@ -960,8 +969,17 @@ void phc_baad_free(phc_baad_study *s)
     free(s->species);
     free(s->changes);
     phc_table_free(s->data);
+    for (k = 0; k < s->n_inputs; ++k)
+        free(s->inputs[k]);
     free(s->name);
     free(s);
+}
+
+size_t phc_baad_inputs(const phc_baad_study *s, const char *const **paths)
+{
+    if (paths)
+        *paths = s ? (const char *const *)s->inputs : NULL;
+    return s ? s->n_inputs : 0;
 }
 
 const char *phc_baad_name(const phc_baad_study *s)

@@ -110,6 +110,10 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err);
 void phc_baad_free(phc_baad_study *s); /* accepts NULL */
 
 const char *phc_baad_name(const phc_baad_study *s); /* folder name, e.g. "Baltzer2007" */
+/* The files the study was read from, as opened (data.csv,
+ * dataMatchColumns.csv, dataNew.csv when present, ../variableDefinitions.csv),
+ * for provenance; *paths (may be NULL) points into the study. */
+size_t phc_baad_inputs(const phc_baad_study *s, const char *const **paths);
 size_t phc_baad_rows(const phc_baad_study *s);
 const phc_baad_row *phc_baad_row_at(const phc_baad_study *s, size_t i); /* NULL if i is out of range */
 

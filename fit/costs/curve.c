@@ -14,6 +14,7 @@
 
 #include "fit/costs/expression.h"
 #include "fit/costs/source_file.h"
+#include "measurements/suggest.h"
 #include "measurements/table.h"
 
 const char *const phc_curve_keys[] = {"file", "x", "y", "expression", "sigma",
@@ -153,6 +154,76 @@ static int bind_tape(curve_impl *c, const char *expr, const char *const *slot_na
     return PHC_OK;
 }
 
+/* The functions muparser 2.3.3 defines (muParser.cpp, Parser::InitFun; all
+ * checked by tests/unit/test_curve_messages.c): named in the message about an
+ * unknown function. */
+static const char *const known_functions[] = {
+    "exp", "log", "ln", "log2", "log10", "sqrt", "abs", "sign", "rint", "sin", "cos", "tan", "asin", "acos",
+    "atan", "atan2", "sinh", "cosh", "tanh", "asinh", "acosh", "atanh", "min", "max", "sum", "avg"};
+#define N_KNOWN_FUNCTIONS (sizeof known_functions / sizeof known_functions[0])
+/* mu::ecUNEXPECTED_PARENS of muParserDef.h (C++ only): a "(" where no
+ * function name precedes it */
+#define MUP_ERR_UNEXPECTED_PARENS 7
+
+static int is_name_char(char c)
+{
+    return c == '_' || (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+}
+
+/* 1-based character of the first whole-word use of `name` in expr, 0 if none. */
+static int name_column(const char *expr, const char *name)
+{
+    const size_t len = strlen(name);
+    for (const char *p = strstr(expr, name); p && len; p = strstr(p + 1, name))
+        if ((p == expr || !is_name_char(p[-1])) && !is_name_char(p[len]))
+            return (int)(p - expr) + 1;
+    return 0;
+}
+
+/* muparser's message about an expression it cannot parse, at the config
+ * line of `expression:` and the character in the expression.  A name
+ * followed by "(" that is not a function is reported as such, with the
+ * functions there are (muparser itself says only "Unexpected parenthesis"). */
+static int expression_error(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *expr,
+                            muParserHandle_t parser, phc_is_parameter_fn is_parameter, void *user_data,
+                            phc_error *err)
+{
+    const size_t line = phc_key_line(node, "expression");
+    const int len = (int)strlen(expr);
+    int pos = (int)mupGetErrorPos(parser);
+    if (pos > len)
+        pos = len; /* muparser may point past the end */
+    if (pos >= 0 && pos < len && expr[pos] == '(' && mupGetErrorCode(parser) == MUP_ERR_UNEXPECTED_PARENS) {
+        int end = pos, start;
+        while (end > 0 && expr[end - 1] == ' ')
+            --end;
+        for (start = end; start > 0 && is_name_char(expr[start - 1]); --start)
+            ;
+        if (start < end && !(expr[start] >= '0' && expr[start] <= '9')) {
+            char name[128];
+            snprintf(name, sizeof name, "%.*s", end - start, expr + start);
+            char known[512] = "";
+            for (size_t i = 0; i < N_KNOWN_FUNCTIONS; ++i) {
+                const size_t used = strlen(known);
+                snprintf(known + used, sizeof known - used, "%s%s", i ? " " : "", known_functions[i]);
+            }
+            if (is_parameter(name, user_data))
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s:%zu: expression \"%s\": '%s' at character %d is a parameter, not a "
+                                     "function (write '*' for a product); known functions: %s",
+                                     doc->path, line, expr, name, start + 1, known);
+            const char *near = phc_suggest(name, known_functions, N_KNOWN_FUNCTIONS);
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: expression \"%s\": unknown function '%s' at character %d;%s%s%s "
+                                 "known functions: %s",
+                                 doc->path, line, expr, name, start + 1, near ? " did you mean '" : "",
+                                 near ? near : "", near ? "'?" : "", known);
+        }
+    }
+    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)", doc->path, line, expr,
+                         mupGetErrorMsg(parser), pos + 1);
+}
+
 static char *label_or(const char *given, const char *fallback)
 {
     return strdup(given ? given : fallback);
@@ -185,10 +256,13 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     path = phc_join_path(base_dir, file);
     if (!path)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err)))
+    if ((rc = phc_table_read(path, &table, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     if (phc_table_rows(table) == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
 
@@ -207,12 +281,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     mupSetExpr(c->parser, expr);
     int n_vars = mupGetExprVarNum(c->parser);
     if (mupError(c->parser)) {
-        const size_t line = phc_key_line(node, "expression");
-        int pos = (int)mupGetErrorPos(c->parser);
-        if (pos > (int)strlen(expr))
-            pos = (int)strlen(expr); /* muparser may point past the end */
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)",
-                           doc->path, line, expr, mupGetErrorMsg(c->parser), pos + 1);
+        rc = expression_error(doc, node, expr, c->parser, is_parameter, user_data, err);
         goto fail;
     }
     if (n_vars <= 0) {
@@ -250,8 +319,9 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         const size_t line = phc_key_line(node, "expression");
         if (is_param && col >= 0) {
             rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: expression name '%s' is both a parameter and a column of %s; rename one",
-                               doc->path, line, name, path);
+                               "%s:%zu: expression name '%s' (character %d) is both a parameter and a column of %s; "
+                               "rename one",
+                               doc->path, line, name, name_column(expr, name), path);
         } else if (is_param) {
             slot_names[n_slots] = strdup(name);
             if (!slot_names[n_slots])
@@ -273,7 +343,9 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                 mupDefineVar(c->parser, name, &c->row[c->n_cols++]);
             }
         } else {
-            rc = phc_unknown_column(doc, line, "expression name", name, table, err);
+            char what[64];
+            snprintf(what, sizeof what, "expression (character %d): name", name_column(expr, name));
+            rc = phc_unknown_column(doc, line, what, name, table, err);
             if (rc == PHC_ERR_INPUT)
                 strncat(err->message, " (not a parameter either)",
                         sizeof err->message - strlen(err->message) - 1);
@@ -353,7 +425,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     ds->data_file = strdup(path);
     ds->data_lines = malloc(ds->n * sizeof *ds->data_lines);
-    if (!ds->data_file || !ds->data_lines) {
+    if (!ds->data_file || !ds->data_lines || phc_dataset_add_input(ds, path)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }

@@ -142,11 +142,14 @@ int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node
                              doc->path, phc_key_line(node, "water_content"), content);
     if (!(path = phc_join_path(base_dir, file)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err)))
+    if ((rc = phc_table_read(path, &table, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     const size_t n = phc_table_rows(table);
     if (n == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no data rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
     if ((rc = phc_need_column(doc, node, "water", water, table, err)) ||
@@ -210,7 +213,7 @@ int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node
     ds->x_label = strdup(x_label ? x_label : xl);
     ds->y_label = strdup(y_label ? y_label : "bulk modulus of elasticity (MPa)");
     ds->data_file = strdup(path);
-    if (!ds->x_label || !ds->y_label || !ds->data_file) {
+    if (!ds->x_label || !ds->y_label || !ds->data_file || phc_dataset_add_input(ds, path)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }

@@ -229,8 +229,11 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if ((rc = phc_table_read(path, &table, err)))
+    if ((rc = phc_table_read(path, &table, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     if ((rc = phc_need_column(doc, node, "time", tcol, table, err)) ||
         (rc = phc_need_column(doc, node, "depth", dcol, table, err)) ||
         (rc = phc_table_column_numbers(table, tcol, &tv, err)) ||
@@ -238,7 +241,7 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
         goto fail;
     const size_t n = phc_table_rows(table);
     if (n < 1) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
         goto fail;
     }
     const phc_yaml_node *sg = phc_yaml_get(node, "sigma");
@@ -255,7 +258,7 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
         goto fail;
     }
     ds = phc_soil_setup_dataset(im->su, &infiltration_ops, n, path);
-    if (!ds) {
+    if (!ds || phc_dataset_add_input(ds, path)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -293,6 +296,7 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
         goto fail;
     }
     ds->derivatives = PHC_DERIV_ANALYTIC;
+    ds->config_line = node->line;
     ds->impl = im;
     im = NULL;
     *out = ds;

@@ -1116,12 +1116,15 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if ((rc = phc_table_read(path, &t, err)))
+    if ((rc = phc_table_read(path, &t, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     const size_t nr = phc_table_rows(t);
     if (nr < 2) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: %zu row%s: a leaf_photos data set needs a fresh leaf and at least "
-                           "one more photo", path, nr, nr == 1 ? "" : "s");
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: %zu data row%s below the header: a leaf_photos data set needs a "
+                           "fresh leaf and at least one more photo", path, nr, nr == 1 ? "" : "s");
         goto fail;
     }
     if ((rc = phc_need_column(doc, sn->kind == PHC_YAML_MAPPING ? sn : node, sn->kind == PHC_YAML_MAPPING ? "column" : "stage",
@@ -1197,7 +1200,12 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        snprintf(where, sizeof where, "%s:%zu: reference", doc->path, rf->line);
+        /* the file's errors at `image:`, a leaf number beyond its leaves at `leaf:` */
+        snprintf(where, sizeof where, "%s:%zu: reference: key 'image'", doc->path, phc_key_line(rf, "image"));
+        if ((rc = phc_photo_cache_read(im->cache, img_path, cc_method, where, err)))
+            goto fail;
+        if (phc_yaml_get(rf, "leaf"))
+            snprintf(where, sizeof where, "%s:%zu: reference: key 'leaf'", doc->path, phc_key_line(rf, "leaf"));
         if ((rc = phc_leaf_photo_load(im->cache, img_path, (size_t)rleaf, cc_method, where, &im->ref_photo, err)))
             goto fail;
         free(img_path);
@@ -1228,7 +1236,17 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        snprintf(where, sizeof where, "%s:%zu", path, row->line);
+        /* The photo's own errors where its name was given: the row's image
+         * column, or the config's `image:`; a leaf number beyond its leaves
+         * at the row's leaf column. */
+        if (image_col)
+            snprintf(where, sizeof where, "%s:%zu: column '%s'", path, row->line, image_col);
+        else
+            snprintf(where, sizeof where, "%s:%zu: key 'image'", doc->path, phc_key_line(node, "image"));
+        if ((rc = phc_photo_cache_read(im->cache, img_path, cc_method, where, err)))
+            goto fail;
+        if (leafno)
+            snprintf(where, sizeof where, "%s:%zu: column '%s'", path, row->line, leaf_col);
         if ((rc = phc_leaf_photo_load(im->cache, img_path, leafno ? (size_t)leafno[r] : 1, cc_method, where,
                                       &row->photo, err)))
             goto fail;
@@ -1251,12 +1269,19 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
             goto fail;
         }
     }
-    /* the model */
-    snprintf(where, sizeof where, "%s:%zu", doc->path, node->line);
+    /* the model; errors about a map file at its key, the others at the data set */
+    char map_where[3][256];
+    snprintf(map_where[0], sizeof map_where[0], "%s:%zu: key 'veins'", doc->path, phc_key_line(node, "veins"));
+    snprintf(map_where[1], sizeof map_where[1], "%s:%zu: key 'stomata'", doc->path, phc_key_line(node, "stomata"));
+    snprintf(map_where[2], sizeof map_where[2], "%s:%zu: key 'inflow'", doc->path, phc_key_line(node, "inflow"));
+    so.veins_where = map_where[0];
+    so.stomata_where = map_where[1];
+    so.inflow_where = map_where[2];
     if ((rc = phc_leaf_setup_new(&im->rows[im->initial].photo,
                                  im->reference < nr ? &im->rows[im->reference].photo : &im->ref_photo, &so, &im->su,
                                  err))) {
-        phc_error_prefix(err, rc, "%s", where);
+        if (strncmp(err->message, doc->path, strlen(doc->path)) != 0) /* not placed yet */
+            phc_error_prefix(err, rc, "%s:%zu", doc->path, node->line);
         goto fail;
     }
     const phc_leaf_setup *su = im->su;
@@ -1300,7 +1325,8 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         ++m_data;
     }
     if (!m_data) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows left besides the fresh leaf and the reference", path);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: no row of %s is left to fit besides the fresh leaf "
+                           "(initial) and the reference", doc->path, node->line, ctx, path);
         goto fail;
     }
     /* distinct model times over the data rows */
@@ -1357,6 +1383,20 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    /* every file read: the table, the photos, the reference photo, map files */
+    rc = phc_dataset_add_input(ds, path);
+    for (size_t r = 0; r < nr && !rc; ++r)
+        rc = phc_dataset_add_input(ds, im->rows[r].photo.path);
+    if (!rc && im->reference == nr)
+        rc = phc_dataset_add_input(ds, im->ref_photo.path);
+    const char *const map_files[] = {veins_file, stomata_file, inflow_file};
+    for (size_t q = 0; q < 3 && !rc; ++q)
+        if (map_files[q])
+            rc = phc_dataset_add_input(ds, map_files[q]);
+    if (rc) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
     for (size_t r = 0; r < nr; ++r) {
         const lp_row *row = &im->rows[r];
         if (row->role)
@@ -1384,6 +1424,7 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         goto fail;
     }
     ds->derivatives = PHC_DERIV_CENTRAL;
+    ds->config_line = node->line;
     ds->impl = im;
     im = NULL;
     phc_table_free(t);

@@ -76,6 +76,13 @@ static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction
     return PHC_OK;
 }
 
+int phc_photo_cache_read(phc_photo_cache *cache, const char *path, phc_colour_correction_method correction,
+                         const char *where, phc_error *err)
+{
+    cache_entry *e = NULL;
+    return cache_get(cache, path, correction, where, &e, err);
+}
+
 int phc_leaf_photo_load(phc_photo_cache *cache, const char *path, size_t number,
                         phc_colour_correction_method correction, const char *where,
                         phc_leaf_photo *out, phc_error *err)
@@ -200,13 +207,14 @@ static int map_to_grid(const double *crop_map, size_t cw, size_t ch, size_t gw, 
 
 /* A map file: a grey image the size of the fresh leaf's photo, cropped with
  * the leaf and averaged down to the grid. */
-static int map_from_file(const char *file, const char *what, const phc_leaf_photo *fresh, size_t gw, size_t gh,
-                         double *out, phc_error *err)
+static int map_from_file(const char *file, const char *what, const char *where, const phc_leaf_photo *fresh,
+                         size_t gw, size_t gh, double *out, phc_error *err)
 {
     double *full = NULL, *crop = NULL;
     int rc = phc_photo_read_map(file, fresh->photo_width, fresh->photo_height, 0, &full, err);
     if (rc) {
-        return phc_error_prefix(err, rc, "%s map (the size of the photo %s)", what, fresh->path);
+        return phc_error_prefix(err, rc, "%s%s%s map (the size of the photo %s)", where ? where : "",
+                                where ? ": " : "", what, fresh->path);
     }
     const size_t cw = fresh->crop.width, ch = fresh->crop.height;
     if (!(crop = malloc(cw * ch * sizeof *crop))) {
@@ -353,7 +361,7 @@ int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *refere
 
     /* Venation map β = floor + (1 - floor) ridge on the leaf. */
     if (opt->veins == PHC_LEAF_MAP_FILE) {
-        if ((rc = map_from_file(opt->veins_file, "veins", fresh, w, h, s->beta, err)))
+        if ((rc = map_from_file(opt->veins_file, "veins", opt->veins_where, fresh, w, h, s->beta, err)))
             goto fail;
     } else if (opt->veins == PHC_LEAF_MAP_UNIFORM) {
         for (size_t i = 0; i < n; ++i)
@@ -370,7 +378,7 @@ int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *refere
             s->beta[i] = s->mask[i] ? opt->vein_floor + (1 - opt->vein_floor) * fmin(fmax(s->beta[i], 0), 1) : 0;
     /* Stomata: uniform unless a file. */
     if (opt->stomata == PHC_LEAF_MAP_FILE) {
-        if ((rc = map_from_file(opt->stomata_file, "stomata", fresh, w, h, s->stomata, err)))
+        if ((rc = map_from_file(opt->stomata_file, "stomata", opt->stomata_where, fresh, w, h, s->stomata, err)))
             goto fail;
     } else
         for (size_t i = 0; i < n; ++i)
@@ -378,7 +386,7 @@ int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *refere
     /* Inflow: through the veins unless told otherwise. */
     switch (opt->inflow) {
     case PHC_LEAF_MAP_FILE:
-        if ((rc = map_from_file(opt->inflow_file, "inflow", fresh, w, h, s->inflow, err)))
+        if ((rc = map_from_file(opt->inflow_file, "inflow", opt->inflow_where, fresh, w, h, s->inflow, err)))
             goto fail;
         break;
     case PHC_LEAF_MAP_UNIFORM:

@@ -52,6 +52,13 @@ int phc_leaf_photo_load(phc_photo_cache *cache, const char *path, size_t number,
                         phc_leaf_photo *out, phc_error *err);
 void phc_leaf_photo_free(phc_leaf_photo *p); /* the contents; accepts NULL */
 
+/* Reads, colour corrects and segments photo `path` into the cache (once),
+ * without cutting out a leaf: for callers that place errors about the file
+ * (unreadable, not an image, no leaf found) apart from errors about a leaf
+ * number.  `where` as for phc_leaf_photo_load. */
+int phc_photo_cache_read(phc_photo_cache *cache, const char *path, phc_colour_correction_method correction,
+                         const char *where, phc_error *err);
+
 /* The leaf's pixels on a grid whose long side is `size` px (aspect kept):
  * *img (sRGB), *mask (malloc'd).  Pixels off the resized mask are black. */
 int phc_leaf_photo_grid(const phc_leaf_photo *p, size_t size, phc_image *img, unsigned char **mask,
@@ -76,6 +83,9 @@ typedef struct phc_leaf_setup_options {
                                   + 1 of the default ridge filter; 0 = no fade) */
     phc_leaf_map_source veins, stomata, inflow;
     const char *veins_file, *stomata_file, *inflow_file; /* for PHC_LEAF_MAP_FILE */
+    const char *veins_where, *stomata_where, *inflow_where; /* where each file was named
+                                  ("cfg.yaml:12: key 'veins'"), put before an error
+                                  about that file; NULL = nothing */
     double dt;                 /* model step, time units (0.1) */
 } phc_leaf_setup_options;
 phc_leaf_setup_options phc_leaf_setup_options_default(void);

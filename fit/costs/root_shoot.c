@@ -439,8 +439,10 @@ static int read_select(const phc_yaml_doc *doc, const phc_yaml_node *node, const
     return rc;
 }
 
+/* The harvest table `file`: rows into *out, the table recorded as an input
+ * of ds. */
 static int load_table(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                      const char *file, rows *out, char **source, phc_error *err)
+                      const char *file, phc_dataset *ds, rows *out, char **source, phc_error *err)
 {
     const char *ctx = "root_shoot data set";
     const char *dcol, *dunit, *rcol, *runit, *scol = NULL, *sunit = NULL, *lcol = NULL,
@@ -498,7 +500,15 @@ static int load_table(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    if ((rc = phc_table_read(path, &t, err))) goto done;
+    if ((rc = phc_table_read(path, &t, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
+        goto done;
+    }
+    if ((rc = phc_dataset_add_input(ds, path))) {
+        phc_error_set(err, rc, "out of memory");
+        goto done;
+    }
     if ((rc = phc_need_column(doc, node, "diameter", dcol, t, err)) ||
         (rc = phc_need_column(doc, node, "root_mass", rcol, t, err)) ||
         (scol && (rc = phc_need_column(doc, node, "shoot_mass", scol, t, err))) ||
@@ -536,7 +546,8 @@ static int load_table(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         rc = selc ? phc_error_set(err, PHC_ERR_INPUT,
                                   "%s:%zu: select: no row of %s has %s = '%s'", doc->path,
                                   phc_key_line(node, "select"), path, selc, selv)
-                  : phc_error_set(err, PHC_ERR_INPUT, "%s: no rows", path);
+                  : phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                                  path);
     if (!rc) {
         size_t cap = strlen(path) + 256;
         *source = malloc(cap);
@@ -553,8 +564,11 @@ done:
     return rc;
 }
 
+/* The BAAD study folder `dir`: rows into *out, the folder's files read
+ * recorded as inputs of ds. */
 static int load_baad(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                     const char *dir, rows *out, char **source, char **notes, phc_error *err)
+                     const char *dir, phc_dataset *ds, rows *out, char **source, char **notes,
+                     phc_error *err)
 {
     const char *ctx = "root_shoot data set", *species = NULL, *susp = "exclude", *selc, *selv;
     int rc;
@@ -576,6 +590,10 @@ static int load_baad(const phc_yaml_doc *doc, const phc_yaml_node *node, const c
         free(path);
         return rc;
     }
+    const char *const *read_files = NULL;
+    for (size_t i = 0, m = phc_baad_inputs(st, &read_files); !rc && i < m; ++i)
+        if ((rc = phc_dataset_add_input(ds, read_files[i])))
+            phc_error_set(err, rc, "out of memory");
     char *nb = NULL;
     size_t nlen = 0;
     FILE *nf = open_memstream(&nb, &nlen);
@@ -797,12 +815,12 @@ int phc_root_shoot_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
     if (!im->gslot) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
     for (size_t q = 0; q < phc_growth_param_count(); ++q)
         if (is_parameter(phc_growth_param_name(q), user_data)) im->gslot[im->k_growth++] = (long)q;
-    /* the data */
-    if (file) rc = load_table(doc, node, base_dir, file, &r, &im->source, err);
-    else rc = load_baad(doc, node, base_dir, baad, &r, &im->source, &im->notes, err);
-    if (rc) goto fail;
+    /* the data (the data set first: the loaders record the files they read) */
     ds = phc_dataset_new(&root_shoot_ops, im->k_soil + im->k_growth);
     if (!ds) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
+    if (file) rc = load_table(doc, node, base_dir, file, ds, &r, &im->source, err);
+    else rc = load_baad(doc, node, base_dir, baad, ds, &r, &im->source, &im->notes, err);
+    if (rc) goto fail;
     int bad = 0;
     for (size_t q = 0; q < im->k_soil && !bad; ++q)
         bad = !(ds->slot_names[q] = strdup(im->su->slot_names[q]));
@@ -839,6 +857,7 @@ int phc_root_shoot_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
     }
     ds->derivatives = PHC_DERIV_ANALYTIC; /* our own wide central differences */
     ds->model_tolerance = 1e-4;
+    ds->config_line = node->line;
     ds->impl = im;
     im = NULL;
     *out = ds;

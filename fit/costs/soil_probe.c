@@ -250,8 +250,11 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if ((rc = phc_probe_table_read(ppath, &pc, im->su->has_geo ? &im->su->geo : NULL, &im->probes, err)))
+    if ((rc = phc_probe_table_read(ppath, &pc, im->su->has_geo ? &im->su->geo : NULL, &im->probes, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: probes: key 'file'", doc->path, phc_key_line(pn, "file"));
         goto fail;
+    }
     const double top = im->su->nz * im->su->dx, ex = im->su->nx * im->su->dx, ey = im->su->ny * im->su->dx;
     if (!(im->pz = malloc(im->probes->n * sizeof *im->pz))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -280,8 +283,11 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
     snprintf(where, sizeof where, "%s:%zu: time unit", doc->path, phc_key_line(node, "time"));
     if ((rc = phc_units_conversion(units, tunit, "h", where, &tconv, err)))
         goto fail;
-    if ((rc = phc_probe_series_read(path, tcol, tconv, pcol, vcol, im->probes, &ser, err)))
+    if ((rc = phc_probe_series_read(path, tcol, tconv, pcol, vcol, im->probes, &ser, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     double start = phc_unit_apply(tconv, 0.0);
     if (strstr(tunit, "since") && !phc_yaml_get(node, "start")) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the time unit '%s' is a timestamp: give `start:` (the "
@@ -315,7 +321,7 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
 
     const size_t n = ser->n;
     ds = phc_soil_setup_dataset(im->su, &soil_probe_ops, n, path);
-    if (!ds) {
+    if (!ds || phc_dataset_add_input(ds, path) || phc_dataset_add_input(ds, ppath)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -352,6 +358,7 @@ int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
     }
     memcpy(ds->series, im->probe_of, n * sizeof *ds->series);
     ds->derivatives = PHC_DERIV_ANALYTIC;
+    ds->config_line = node->line;
     ds->impl = im;
     im = NULL;
     phc_units_free(units);

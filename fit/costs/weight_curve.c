@@ -332,7 +332,7 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     phc_table *table = NULL;
     phc_dataset *ds = NULL;
     wc_impl *w = NULL;
-    char *path = NULL;
+    char *path = NULL, *gpath = NULL; /* the data file; the plant-graph file (or NULL) */
     double *tv = NULL, *mv = NULL, *sv = NULL;
     size_t *keep = NULL;
     long *sel_cols = NULL;
@@ -372,8 +372,11 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if ((rc = phc_table_read(path, &table, err)))
+    if ((rc = phc_table_read(path, &table, err))) {
+        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto fail;
+    }
     const size_t rows = phc_table_rows(table);
     if (phc_table_find(table, tcol) < 0) {
         rc = phc_unknown_column(doc, phc_yaml_get(node, "time")->line, "time column", tcol, table, err);
@@ -420,8 +423,10 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         if (row_selected(table, r, sel, sel_cols))
             keep[n_sel++] = r;
     if (n_sel == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no rows%s", path,
-                           sel ? " match the data set's `select`" : "");
+        rc = sel ? phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'select': no row of %s matches", doc->path,
+                                 phc_key_line(node, "select"), path)
+                 : phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                                 path);
         goto fail;
     }
     if ((rc = phc_table_column_numbers_rows(table, tcol, keep, n_sel, &tv, err)) ||
@@ -511,15 +516,15 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                 goto fail;
             to_m = lc.scale;
         }
-        char *gpath = phc_join_path(base_dir, pfile);
-        if (!gpath) {
+        if (!(gpath = phc_join_path(base_dir, pfile))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        rc = phc_plant_io_read(gpath, (phc_plant_format)fmt, to_m, &w->graph, err);
-        free(gpath);
-        if (rc)
+        if ((rc = phc_plant_io_read(gpath, (phc_plant_format)fmt, to_m, &w->graph, err))) {
+            if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
+                phc_error_prefix(err, rc, "%s:%zu: key 'plant'", doc->path, phc_key_line(node, "plant"));
             goto fail;
+        }
         if (phc_plant_graph_leaf_count(w->graph) == 0) {
             rc = phc_error_set(err, PHC_ERR_INPUT,
                                "%s:%zu: plant '%s' has no leaf segments, so it cannot lose water",
@@ -686,7 +691,8 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     ds->data_lines = malloc(n * sizeof *ds->data_lines);
     ds->data_file = strdup(path);
     if (!w->t_model || !ds->x || !ds->y || !ds->data_lines || !ds->data_file ||
-        ((sv || !isnan(sigma_scalar)) && !ds->sigma)) {
+        ((sv || !isnan(sigma_scalar)) && !ds->sigma) || phc_dataset_add_input(ds, path) ||
+        (gpath && phc_dataset_add_input(ds, gpath))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -742,6 +748,7 @@ fail:
     phc_table_free(table);
     phc_units_free(units);
     free(path);
+    free(gpath);
     free(tv);
     free(mv);
     free(sv);

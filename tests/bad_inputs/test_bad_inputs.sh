@@ -304,11 +304,12 @@ fit_case "parameter value not a number" "$C/valnum.yaml" "valnum.yaml:3" "abc"
 
 # ---- missing and unreadable files -------------------------------------------
 write_config "$C/missing.yaml" "$PARAMS_OK" "$(dataset_block nope.csv "a*x + b")"
-fit_case "missing CSV file" "$C/missing.yaml" "nope.csv"
+# A file that cannot be read names the config line and key that named it.
+fit_case "missing CSV file" "$C/missing.yaml" "missing.yaml:7" "key 'file'" "nope.csv" "No such file"
 
 mkdir -p "$C/adir.csv"
 write_config "$C/dirfile.yaml" "$PARAMS_OK" "$(dataset_block adir.csv "a*x + b")"
-fit_case "directory given as the CSV file" "$C/dirfile.yaml" "adir.csv"
+fit_case "directory given as the CSV file" "$C/dirfile.yaml" "dirfile.yaml:7" "key 'file'" "adir.csv"
 
 fit_case "missing config file" "$C/no_such_config.yaml" "no_such_config.yaml"
 
@@ -319,7 +320,7 @@ if [ "$(id -u)" -ne 0 ]; then
     cp "$C/data.csv" "$C/noread.csv"
     chmod 000 "$C/noread.csv"
     write_config "$C/noread.yaml" "$PARAMS_OK" "$(dataset_block noread.csv "a*x + b")"
-    fit_case "CSV file without read permission" "$C/noread.yaml" "noread.csv"
+    fit_case "CSV file without read permission" "$C/noread.yaml" "noread.yaml:7" "key 'file'" "noread.csv"
 fi
 
 # ---- CSV contents -------------------------------------------------------------
@@ -361,7 +362,17 @@ write_config "$C/expr_paren.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*(x +
 fit_case "expression: unbalanced parenthesis" "$C/expr_paren.yaml" "expr_paren.yaml:10" "character "
 
 write_config "$C/expr_name.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b + zeta")"
-fit_case "expression: unknown name" "$C/expr_name.yaml" "expr_name.yaml:10" "zeta"
+fit_case "expression: unknown name" "$C/expr_name.yaml" "expr_name.yaml:10" "zeta" "character 11"
+
+# muparser alone says 'Unexpected parenthesis': name the function, its
+# character (5) and the functions there are
+write_config "$C/expr_fun.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a * expp(x) + b")"
+fit_case "expression: unknown function" "$C/expr_fun.yaml" "expr_fun.yaml:10" "unknown function 'expp' at character 5" \
+    "did you mean 'exp'?" "known functions: exp log"
+
+write_config "$C/expr_pfun.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a(x) + b")"
+fit_case "expression: a parameter used as a function" "$C/expr_pfun.yaml" "expr_pfun.yaml:10" \
+    "'a' at character 1 is a parameter, not a function"
 
 write_config "$C/expr_ambig.yaml" 'parameters:
   a: {value: 1}
@@ -395,6 +406,22 @@ write_config "$C/start2.yaml" 'parameters:
   a: {value: -1, lower: 0}
   b: {value: 0.5}'
 fit_case "start below its lower bound" "$C/start2.yaml" "start2.yaml:3"
+
+# 1e308 is finite, but the multi-start box (10 times the start) is not
+write_config "$C/huge.yaml" 'parameters:
+  a: {value: 1e308, lower: 0}
+  b: {value: 0.5}'
+fit_case "start value 1e308" "$C/huge.yaml" "huge.yaml:3" "parameter 'a'" "1e+308" "too large"
+
+write_config "$C/hugebound.yaml" 'parameters:
+  a: {value: 1}
+  b: {value: 0.5, lower: -1e305}'
+fit_case "lower bound -1e305" "$C/hugebound.yaml" "hugebound.yaml:4" "parameter 'b'" "lower bound -1e+305"
+
+write_config "$C/tinyscale.yaml" 'parameters:
+  a: {value: 1, scale: 1e-305}
+  b: {value: 0.5}'
+fit_case "start value over its scale overflows" "$C/tinyscale.yaml" "tinyscale.yaml:3" "parameter 'a'" "scale 1e-305"
 
 write_config "$C/unused.yaml" 'parameters:
   a: {value: 1, lower: 0, upper: 10}
@@ -678,6 +705,11 @@ pv_config pv_unit.yaml pv_ok.csv '    dry_mass: dry
     psi_unit: psi
 '
 fit_case "pv_curve: unknown potential unit" "$C/pv_unit.yaml" "pv_unit.yaml:16" "psi_unit"
+pv_config pv_nofile.yaml pv_none.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+'
+fit_case "pv_curve: missing data file" "$C/pv_nofile.yaml" "pv_nofile.yaml:9" "key 'file'" "pv_none.csv" "No such file"
 # ---- end pv_curve -------------------------------------------------------------
 
 # ---- weight_curve and plant graphs -----------------------------------------
@@ -739,6 +771,16 @@ wc_config wc_sel.yaml wc_ok.csv '    leaf_area: 100
     select: {plant: 3}
 '
 fit_case "weight_curve: select names no column" "$C/wc_sel.yaml" "wc_sel.yaml:" "'plant'"
+wc_config wc_nofile.yaml wc_none.csv '    leaf_area: 100
+'
+fit_case "weight_curve: missing data file" "$C/wc_nofile.yaml" "wc_nofile.yaml:8" "key 'file'" "wc_none.csv" "No such file"
+wc_config wc_noplant.yaml wc_ok.csv '    plant: no_graph.csv
+'
+fit_case "weight_curve: missing plant graph" "$C/wc_noplant.yaml" "wc_noplant.yaml:11" "key 'plant'" "no_graph.csv" "No such file"
+wc_config wc_selnone.yaml wc_ok.csv '    leaf_area: 100
+    select: {t: 99}
+'
+fit_case "weight_curve: select keeps no row" "$C/wc_selnone.yaml" "wc_selnone.yaml:12" "key 'select'" "wc_ok.csv"
 # ---- end weight_curve ------------------------------------------------------
 
 # ---- soil_probe and infiltration -------------------------------------------
@@ -822,6 +864,10 @@ sp_config sp_q.yaml sp_ok.csv probes_ok.csv "$LAYER_OK" '    quantity: suction
 fit_case "soil_probe: unknown quantity" "$C/sp_q.yaml" "sp_q.yaml:" "not one of water, fill"
 sp_config sp_ts.yaml sp_ok.csv probes_ok.csv "$LAYER_OK" && sed -i 's/unit: h}/unit: "hours since 2026-05-01"}/' "$C/sp_ts.yaml"
 fit_case "soil_probe: timestamps without start" "$C/sp_ts.yaml" "sp_ts.yaml:" "give \`start:\`"
+sp_config sp_nofile.yaml sp_none.csv probes_ok.csv "$LAYER_OK"
+fit_case "soil_probe: missing readings file" "$C/sp_nofile.yaml" "sp_nofile.yaml:7" "key 'file'" "sp_none.csv" "No such file"
+sp_config sp_noprobes.yaml sp_ok.csv probes_none.csv "$LAYER_OK"
+fit_case "soil_probe: missing probe table" "$C/sp_noprobes.yaml" "sp_noprobes.yaml:12" "probes: key 'file'" "probes_none.csv"
 # infiltration
 inf_config() {
     printf 'name: t\nparameters:\n  p: {value: 0.05, lower: 1e-6}\n  c: {value: 50, lower: 1e-3}\ndatasets:\n  - kind: infiltration\n    file: %s\n    time: {column: t, unit: h}\n    depth: {column: d, unit: m}\n    sigma: 0.01\n    soil:\n      grid: {nx: 1, ny: 1, nz: 40, dx: 0.05}\n%s' \
@@ -846,6 +892,8 @@ inf_config inf_rain.yaml inf_ok.csv '      layers: [{soil: silt, fill: 0.0001}]
       rain: [{start: 2, end: 1, rate: 0.01}]
 '
 fit_case "infiltration: rain ending before it starts" "$C/inf_rain.yaml" "inf_rain.yaml:" "rain 1"
+inf_config inf_nofile.yaml inf_none.csv "$RAIN_OK"
+fit_case "infiltration: missing data file" "$C/inf_nofile.yaml" "inf_nofile.yaml:7" "key 'file'" "inf_none.csv"
 # ---- end soil ----------------------------------------------------------------
 
 # ---- leaf photos (leaf_photos data sets, measurements/photo_bridge.cc) --------
@@ -933,6 +981,21 @@ printf 'name: t\nparameters:\n  other: {value: 1}\ndatasets:\n  - kind: leaf_pho
 fit_case "leaf_photos: no parameter to fit" "$C/lp_noslot.yaml" "lp_noslot.yaml:" "no parameter to fit"
 lp_config lp_ref.yaml lp_ok.csv && sed -i 's/leaf_old.png/blank.png/' "$C/lp_ref.yaml"
 fit_case "leaf_photos: reference photo without a leaf" "$C/lp_ref.yaml" "lp_ref.yaml:" "blank.png" "no leaf found"
+# A photo named by the config is the config's fault (line 7, image:), not the
+# table's first row; a photo named in the table gives the row and column.
+printf 'day\n0\n2\n' >"$C/lp_days.csv"
+lp_config lp_cfgimg.yaml lp_days.csv && sed -i 's/image: {column: image}/image: nowhere.png/' "$C/lp_cfgimg.yaml"
+fit_case "leaf_photos: config image missing" "$C/lp_cfgimg.yaml" "lp_cfgimg.yaml:7" "key 'image'" "nowhere.png" "No such file"
+lp_config lp_cfgtext.yaml lp_days.csv && sed -i 's/image: {column: image}/image: leaf_text.png/' "$C/lp_cfgtext.yaml"
+fit_case "leaf_photos: config image not an image" "$C/lp_cfgtext.yaml" "lp_cfgtext.yaml:7" "key 'image'" "leaf_text.png"
+fit_case "leaf_photos: table image missing (row and column)" "$C/lp_missing.yaml" "lp_missing.csv:3" "column 'image'" "nowhere.png"
+lp_config lp_refmiss.yaml lp_ok.csv && sed -i 's/leaf_old.png/no_ref.png/' "$C/lp_refmiss.yaml"
+fit_case "leaf_photos: reference image missing" "$C/lp_refmiss.yaml" "lp_refmiss.yaml:9" "reference: key 'image'" "no_ref.png" "No such file"
+lp_config lp_veinmiss.yaml lp_ok.csv '    veins: no_veins.png
+'
+fit_case "leaf_photos: vein map missing" "$C/lp_veinmiss.yaml" "lp_veinmiss.yaml:11" "key 'veins'" "no_veins.png" "No such file"
+lp_config lp_nofile.yaml lp_none.csv
+fit_case "leaf_photos: missing table" "$C/lp_nofile.yaml" "lp_nofile.yaml:6" "key 'file'" "lp_none.csv" "No such file"
 # ---- end leaf photos -----------------------------------------------------------
 
 # ---- root_shoot (harvested plants against the shoot-root growth model) ------
@@ -1073,6 +1136,8 @@ fit_case "root_shoot: table select column does not exist" "$C/rs_tsel.yaml" "rs_
 rs_table_config rs_none.yaml rs_ok.csv '    select: {column: light, equals: M}
 '
 fit_case "root_shoot: select matches no rows" "$C/rs_none.yaml" "rs_ok.csv" "select: no row of" "light = 'M'"
+rs_table_config rs_nofile.yaml rs_none.csv
+fit_case "root_shoot: missing table" "$C/rs_nofile.yaml" "rs_nofile.yaml:6" "key 'file'" "rs_none.csv" "No such file"
 # ---- end root_shoot --------------------------------------------------------
 
 # ----------------------------------------------------------------------------
