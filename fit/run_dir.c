@@ -243,10 +243,10 @@ static int check_inputs_outside(const char *dir, const phc_problem *pb, phc_erro
     if (!pb || !realpath(dir, rdir))
         return PHC_OK; /* nothing there yet: nothing of the user's inside */
     const size_t len = strlen(rdir);
-    for (size_t d = 0; d <= pb->n_datasets; ++d) {
-        const size_t n = d == pb->n_datasets ? 1 : pb->datasets[d]->n_inputs;
+    for (size_t d = 0; d <= pb->n_datasets; ++d) { /* d = 0: the config; then data set d - 1 */
+        const size_t n = d == 0 ? 1 : pb->datasets[d - 1]->n_inputs;
         for (size_t i = 0; i < n; ++i) {
-            const char *in = d == pb->n_datasets ? pb->source : pb->datasets[d]->inputs[i];
+            const char *in = d == 0 ? pb->source : pb->datasets[d - 1]->inputs[i];
             char rin[PATH_MAX];
             if (!in || !realpath(in, rin))
                 continue;
@@ -254,7 +254,7 @@ static int check_inputs_outside(const char *dir, const phc_problem *pb, phc_erro
                 return phc_error_set(err, PHC_ERR_EXISTS,
                                      "%s: holds %s '%s', an input of this run; phytocal never writes "
                                      "over its inputs: choose another -o", dir,
-                                     d == pb->n_datasets ? "the config" : "the data file", in);
+                                     d == 0 ? "the config" : "the data file", in);
         }
     }
     return PHC_OK;

@@ -9,7 +9,9 @@
 
 char *phc_join_path(const char *dir, const char *file)
 {
-    if (file[0] == '/' || !dir || !dir[0])
+    /* a config in the working directory: its files keep their own names in
+     * messages ("data.csv", not "./data.csv") */
+    if (file[0] == '/' || !dir || !dir[0] || strcmp(dir, ".") == 0)
         return strdup(file);
     size_t len = strlen(dir) + strlen(file) + 2;
     char *s = malloc(len);

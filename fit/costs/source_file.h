@@ -9,8 +9,8 @@
 #include "measurements/yaml_doc.h"
 #include "model/status.h"
 
-/* `file` relative to `dir` (the config file's directory) unless absolute;
- * malloc'd, NULL when out of memory. */
+/* `file` relative to `dir` (the config file's directory) unless absolute
+ * (or dir is "."); malloc'd, NULL when out of memory. */
 char *phc_join_path(const char *dir, const char *file);
 
 /* PHC_ERR_INPUT for a column name that is not in the table, at config line
