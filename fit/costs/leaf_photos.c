@@ -717,8 +717,26 @@ done:
     return rc;
 }
 
+/* Histogram residuals: the series are the quantiles of L*, a* and b*
+ * (observation c nq + k of a photo is quantile k of channel c, at the
+ * probability (k + 1/2)/nq: model/colour.h). */
+static void lp_series_name(const phc_dataset *ds, size_t g, char *buf, size_t size)
+{
+    static const char *const channel[3] = {"L*", "a*", "b*"};
+    const size_t nq = ((const lp_impl *)ds->impl)->nq;
+    snprintf(buf, size, "%s, %.3g %%", channel[g / nq % 3], 100.0 * ((double)(g % nq) + 0.5) / (double)nq);
+}
+
+static int lp_name_series(phc_dataset *ds, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    if (!ds->series || !im->histogram)
+        return PHC_OK;
+    return phc_dataset_name_series(ds, "quantile", 3 * im->nq, lp_series_name, err);
+}
+
 static const phc_dataset_ops leaf_photos_ops = {"leaf_photos", lp_predict, NULL, lp_free, lp_report_section,
-                                                lp_simulate_outputs, lp_fit_outputs};
+                                                lp_simulate_outputs, lp_fit_outputs, lp_name_series};
 
 /* ---- loading ------------------------------------------------------------------------------ */
 
