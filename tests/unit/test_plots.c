@@ -130,13 +130,13 @@ int main(void)
 
     phc_error err;
     phc_plot_labels lab = {"Shoot #3: water loss on the balance",
-                           "time since cut (h)", "mass (g)"};
+                           "time since cut (h)", "mass (g)", NULL};
     phc_plot_labels lab_res = {"Residuals of the exponential fit",
-                               "time since cut (h)", "residual (g)"};
-    phc_plot_labels lab_qq = {"Normal QQ plot of the residuals", NULL, NULL};
+                               "time since cut (h)", "residual (g)", NULL};
+    phc_plot_labels lab_qq = {"Normal QQ plot of the residuals", NULL, NULL, NULL};
     phc_plot_labels lab_acf = {"Autocorrelation of the residuals",
                                "lag (readings, 0.5 h apart)",
-                               "autocorrelation (\xe2\x80\x93)"};
+                               "autocorrelation (\xe2\x80\x93)", NULL};
 
     /* The four plots. */
     CHECK(phc_plot_fit(p_fit, &lab, t, m, sig, N, ct, cm, CURVE_N, &err) ==
