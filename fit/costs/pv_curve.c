@@ -10,6 +10,7 @@
 #include <strings.h>
 
 #include "fit/costs/elasticity_curve.h"
+#include "fit/pv_plots.h"
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"
@@ -44,10 +45,11 @@ static void pv_extra_free(void *p)
 }
 
 static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
+static int pv_fit_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err);
 static int pv_name_series(phc_dataset *ds, phc_error *err);
 
 static const phc_dataset_ops pv_ops = {"pv_curve", phc_elasticity_predict, phc_elasticity_predict_at,
-                                       phc_elasticity_impl_free, pv_report_section, NULL, NULL,
+                                       phc_elasticity_impl_free, pv_report_section, NULL, pv_fit_outputs,
                                        pv_name_series};
 
 static pv_extra *extra_of(const phc_dataset *ds)
@@ -508,6 +510,15 @@ static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, 
 {
     (void)p;
     return phc_pv_curve_markdown(ds, markdown, err);
+}
+
+/* fit: the classic pressure–volume plot of every leaf (fit/pv_plots.h). */
+static int pv_fit_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err)
+{
+    (void)p;
+    const pv_extra *x = extra_of(ds);
+    return phc_pv_plot_write(ds->name, (const phc_pv_result *const *)x->res, (const char *const *)x->labels,
+                             x->count, dir, base, err);
 }
 
 /* The leaves are the series: the moduli of leaf L follow those of leaf L - 1. */
