@@ -610,7 +610,7 @@ static void draw_legend(const legend_spec *lg, PLINT position)
         line_widths[i] = e->line_width;
         sym_colors[i] = e->color;
         sym_numbers[i] = 1;
-        sym_scales[i] = e->symbol_scale;
+        sym_scales[i] = CHAR_SCALE * e->symbol_scale; /* as plotted (pllegend: plschr(0, scale)) */
         symbols[i] = e->symbol;
     }
     PLFLT lw, lh;
