@@ -917,7 +917,7 @@ static void key_plan_make(key_plan *kp, plot_ctx *ctx, size_t entry_chars, size_
     if (!(names_w <= KEY_MAX_WIDTH)) {
         /* a colour bar: every cell, a name every step cells */
         kp->s = ks;
-        const size_t fit_rows = (size_t)fmax(1.0, floor(room / (KEY_ROW * kp->s * fy)));
+        const size_t fit_rows = (size_t)fmax(1.0, floor(room / (KEY_ROW * kp->s * fy) - 0.3));
         kp->cols = 1;
         kp->rows = fit_rows;
         kp->step = (count + fit_rows - 1) / fit_rows;
@@ -1010,6 +1010,7 @@ static void draw_key(const plot_ctx *ctx, const key_plan *kp, const phc_plot_lay
         }
         bottom = y - (double)kp->rows * row;
     } else {
+        y -= 0.3 * row; /* clear of the heading */
         const double bar_h = (double)kp->rows * row, cell = bar_h / (double)count;
         const double bx0 = x0 + KEY_PAD * ks * fx, bx1 = bx0 + 1.6 * kp->s * fx;
         for (size_t g = 0; g < count; ++g) {
