@@ -656,21 +656,6 @@ static void draw_frame_axes(const plot_ctx *ctx, const plot_axes *ax,
     }
 }
 
-/* Markers at the finite points. */
-static void draw_markers(const double *x, const double *y, size_t n,
-                         PLINT color)
-{
-    plcol0(color);
-    plschr(0.0, CHAR_SCALE * MARKER_SCALE);
-    for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(x[i]) || !isfinite(y[i]))
-            continue;
-        PLFLT px = x[i], py = y[i];
-        plstring(1, &px, &py, MARKER);
-    }
-    plschr(0.0, CHAR_SCALE);
-}
-
 static void draw_segment(double x0, double y0, double x1, double y1)
 {
     PLFLT px[2] = {x0, x1}, py[2] = {y0, y1};
@@ -1239,6 +1224,35 @@ static int check_groups(const char *path, const char *what, const phc_plot_group
     return PHC_OK;
 }
 
+/* The working memory of a grouped plot: `arrays` arrays of n values, room
+ * for `max_layers` layers, and the observations in group order. */
+typedef struct group_work {
+    double *buf;
+    phc_plot_layer *layers;
+    size_t *order, *start;
+} group_work;
+
+static void group_work_free(group_work *gp)
+{
+    free(gp->buf);
+    free(gp->layers);
+    free(gp->order);
+    free(gp->start);
+}
+
+static int group_work_make(group_work *gp, const double *x, size_t n, const phc_plot_groups *groups, size_t count,
+                        size_t arrays, size_t max_layers)
+{
+    *gp = (group_work){0};
+    gp->buf = malloc(arrays * n * sizeof *gp->buf);
+    gp->layers = calloc(max_layers, sizeof *gp->layers);
+    if (!gp->buf || !gp->layers || group_order(x, n, groups, count, &gp->order, &gp->start)) {
+        group_work_free(gp);
+        return PHC_ERR_NOMEM;
+    }
+    return PHC_OK;
+}
+
 int phc_plot_fit_groups(const char *path, const phc_plot_labels *labels, const double *x, const double *y,
                         const double *sigma, size_t n, const phc_plot_groups *groups, const double *yhat,
                         const double *curve_x, const double *curve_y, size_t curve_n, phc_error *err)
@@ -1276,14 +1290,12 @@ int phc_plot_fit_groups(const char *path, const phc_plot_labels *labels, const d
     const size_t count = groups ? groups->count : 1;
     const char *model = labels && labels->model ? labels->model : "fit";
     const char *data = sigma ? "data (\xc2\xb1" "1 \xcf\x83)" : "data";
-    size_t *order = NULL, *start = NULL;
-    double *buf = malloc(4 * n * sizeof *buf);
-    phc_plot_layer *layers = calloc(2 * count + 3, sizeof *layers);
-    if (!buf || !layers || group_order(x, n, groups, count, &order, &start)) {
-        status = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-        goto done;
-    }
-    double *ox = buf, *oy = buf + n, *os = buf + 2 * n, *om = buf + 3 * n;
+    group_work gp;
+    if (group_work_make(&gp, x, n, groups, count, 4, 2 * count + 3))
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+    const size_t *order = gp.order, *start = gp.start;
+    phc_plot_layer *layers = gp.layers;
+    double *ox = gp.buf, *oy = gp.buf + n, *os = gp.buf + 2 * n, *om = gp.buf + 3 * n;
     for (size_t i = 0; i < n; ++i) {
         const size_t j = order[i];
         ox[i] = x[j];
@@ -1313,11 +1325,7 @@ int phc_plot_fit_groups(const char *path, const phc_plot_labels *labels, const d
             layers[nl++] = (phc_plot_layer){PHC_MARK_LINE, grouped ? (int)g : PHC_COLOUR_FIT, ox + start[g],
                                             om + start[g], start[g + 1] - start[g], NULL, grouped ? NULL : model};
     status = phc_plot_layers(path, labels, layers, nl, groups, err);
-done:
-    free(buf);
-    free(layers);
-    free(order);
-    free(start);
+    group_work_free(&gp);
     return status;
 }
 
@@ -1352,14 +1360,12 @@ int phc_plot_residuals_groups(const char *path, const phc_plot_labels *labels, c
     const size_t count = groups ? groups->count : 1;
     const int band = isfinite(s) && s > 0.0, grouped = groups != NULL;
     const double zero = 0.0, up = 2.0 * s, down = -2.0 * s;
-    size_t *order = NULL, *start = NULL;
-    double *buf = malloc(2 * n * sizeof *buf);
-    phc_plot_layer *layers = calloc(count + 4, sizeof *layers);
-    if (!buf || !layers || group_order(x, n, groups, count, &order, &start)) {
-        status = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-        goto done;
-    }
-    double *ox = buf, *orr = buf + n;
+    group_work gp;
+    if (group_work_make(&gp, x, n, groups, count, 2, count + 4))
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+    const size_t *order = gp.order, *start = gp.start;
+    phc_plot_layer *layers = gp.layers;
+    double *ox = gp.buf, *orr = gp.buf + n;
     for (size_t i = 0; i < n; ++i) {
         ox[i] = x[order[i]];
         orr[i] = r[order[i]];
@@ -1377,11 +1383,7 @@ int phc_plot_residuals_groups(const char *path, const phc_plot_labels *labels, c
         layers[nl++] = (phc_plot_layer){PHC_MARK_DOTS, grouped ? (int)g : PHC_COLOUR_DATA, ox + start[g],
                                         orr + start[g], start[g + 1] - start[g], NULL, NULL};
     status = phc_plot_layers(path, labels, layers, nl, groups, err);
-done:
-    free(buf);
-    free(layers);
-    free(order);
-    free(start);
+    group_work_free(&gp);
     return status;
 }
 
@@ -1495,7 +1497,8 @@ int phc_plot_qq(const char *path, const phc_plot_labels *labels,
     plcol0(COL_FIT);
     plwidth(2.0);
     draw_segment(lo, lo, hi, hi); /* clipped to the viewport by PLplot */
-    draw_markers(q, z, m, COL_DATA);
+    plcol0(COL_DATA);
+    draw_glyphs(q, z, m, MARKER, MARKER_SCALE);
     draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
     draw_legend(&lg, pos);
 
