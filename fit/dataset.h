@@ -73,7 +73,7 @@ struct phc_dataset {
     size_t *data_lines;          /* n 1-based line numbers in data_file (or NULL) */
     size_t *series;              /* n series ids (e.g. the probe of each reading) when the
                                     observations form several curves over x, or NULL: the
-                                    fit plot then draws one model line per series */
+                                    plots then draw one colour and model line per series */
     size_t n_series;             /* with series: 1 + the largest id; else 0 */
     char **series_names;         /* n_series names (probe ids, leaf ids, "L* 4%"...) or NULL */
     char *series_title;          /* what one series is ("probe", "leaf", ...) or NULL */

@@ -46,9 +46,9 @@ int phc_plot_fit(const char *path, const phc_plot_labels *labels,
  * markers in their group's colour, and the model either as
  *   - yhat (n model values at the observations, may be NULL): one line per
  *     group through its observations in x order, in the group's colour; or
- *   - the curve (curve_n > 0): one model line for all groups, in black.
- * With both, both are drawn.  The key says what markers and lines are and
- * names the groups. */
+ *   - the curve (curve_n > 0): one model line for all groups, in black
+ *     (labelled "<model> (shared)"); given both, only the curve is drawn.
+ * The key says what markers and lines are and names the groups. */
 int phc_plot_fit_groups(const char *path, const phc_plot_labels *labels,
                         const double *x, const double *y, const double *sigma,
                         size_t n, const phc_plot_groups *groups,
@@ -93,7 +93,7 @@ enum {
 typedef struct phc_plot_layer {
     phc_plot_mark mark;
     int colour;            /* a group index or PHC_COLOUR_* */
-    const double *x, *y;   /* n points (x unused for PHC_MARK_HLINE) */
+    const double *x, *y;   /* n points (x unused for PHC_MARK_HLINE, _HDASHED) */
     size_t n;              /* 0: an entry of the key only */
     const double *sigma;   /* PHC_MARK_DOTS: n error bar half-lengths, or NULL */
     const char *label;     /* the key's text for this layer, or NULL: none */
