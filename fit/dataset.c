@@ -5,6 +5,26 @@
 #include <string.h>
 #include <stdlib.h>
 
+/* 1 + the largest series id (0 without series). */
+static size_t series_count(const phc_dataset *ds)
+{
+    size_t count = 0;
+    for (size_t i = 0; ds->series && i < ds->n; ++i)
+        if (ds->series[i] >= count)
+            count = ds->series[i] + 1;
+    return count;
+}
+
+static void free_series_names(phc_dataset *ds)
+{
+    for (size_t g = 0; ds->series_names && g < ds->n_series; ++g)
+        free(ds->series_names[g]);
+    free(ds->series_names);
+    free(ds->series_title);
+    ds->series_names = NULL;
+    ds->series_title = NULL;
+}
+
 phc_dataset *phc_dataset_new(const phc_dataset_ops *ops, size_t k)
 {
     phc_dataset *ds = calloc(1, sizeof *ds);
@@ -36,6 +56,7 @@ void phc_dataset_free(phc_dataset *ds)
         for (size_t j = 0; j < ds->k; ++j)
             free(ds->slot_names[j]);
     free(ds->slot_names);
+    free_series_names(ds);
     free(ds->series);
     free(ds->param_index);
     free(ds->name);
@@ -64,6 +85,44 @@ int phc_dataset_add_input(phc_dataset *ds, const char *path)
     if (!(ds->inputs[ds->n_inputs] = strdup(path)))
         return PHC_ERR_NOMEM;
     ds->n_inputs++;
+    return PHC_OK;
+}
+
+int phc_dataset_name_series(phc_dataset *ds, const char *title, size_t count, phc_series_name_fn name,
+                            phc_error *err)
+{
+    const size_t need = series_count(ds);
+    if (!ds->series || count < need)
+        return phc_error_set(err, PHC_ERR_INVALID, "data set '%s': %zu series names for series ids up to %zu",
+                             ds->name ? ds->name : "?", count, need ? need - 1 : 0);
+    free_series_names(ds);
+    ds->n_series = count;
+    if (!(ds->series_names = calloc(count ? count : 1, sizeof *ds->series_names)) ||
+        (title && !(ds->series_title = strdup(title))))
+        goto nomem;
+    for (size_t g = 0; g < count; ++g) {
+        char buf[128];
+        buf[0] = '\0';
+        name(ds, g, buf, sizeof buf);
+        if (!(ds->series_names[g] = strdup(buf)))
+            goto nomem;
+    }
+    return PHC_OK;
+nomem:
+    free_series_names(ds);
+    ds->n_series = need;
+    return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+}
+
+int phc_dataset_describe_series(phc_dataset *ds, phc_error *err)
+{
+    if (ds->ops && ds->ops->name_series) {
+        const int rc = ds->ops->name_series(ds, err);
+        if (rc)
+            return rc;
+    }
+    if (!ds->series_names)
+        ds->n_series = series_count(ds);
     return PHC_OK;
 }
 

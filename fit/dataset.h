@@ -42,6 +42,12 @@ typedef struct phc_dataset_ops {
      * into the run's directory dir with names starting with `base`. */
     int (*fit_outputs)(phc_dataset *ds, const double *p, const char *dir, const char *base,
                        phc_error *err);
+    /* Optional (NULL = none): names the series of the observations (the
+     * probes of soil readings, the leaves of PV curves, the quantiles of
+     * colour histograms) so that plots can draw one colour per series with a
+     * key.  Sets ds->series when the loader did not, then calls
+     * phc_dataset_name_series.  phc_problem_add_dataset calls it once. */
+    int (*name_series)(phc_dataset *ds, phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {
@@ -67,7 +73,10 @@ struct phc_dataset {
     size_t *data_lines;          /* n 1-based line numbers in data_file (or NULL) */
     size_t *series;              /* n series ids (e.g. the probe of each reading) when the
                                     observations form several curves over x, or NULL: the
-                                    fit plot then draws one model line per series */
+                                    plots then draw one colour and model line per series */
+    size_t n_series;             /* with series: 1 + the largest id; else 0 */
+    char **series_names;         /* n_series names (probe ids, leaf ids, "L* 4%"...) or NULL */
+    char *series_title;          /* what one series is ("probe", "leaf", ...) or NULL */
     const struct phc_problem *problem; /* the problem holding it (set when added): kinds
                                     that refit themselves (cross-validation) read the
                                     bounds and fixed flags of their slots there */
@@ -86,6 +95,20 @@ void phc_dataset_free(phc_dataset *ds); /* accepts NULL; frees impl via ops */
 /* Records that the loader read file `path` (kept once; provenance hashes
  * it).  PHC_OK or PHC_ERR_NOMEM. */
 int phc_dataset_add_input(phc_dataset *ds, const char *path);
+
+/* Writes the name of series g into buf (size bytes, NUL-terminated). */
+typedef void (*phc_series_name_fn)(const phc_dataset *ds, size_t g, char *buf, size_t size);
+
+/* Names the series g = 0 .. count-1 of ds (count >= 1 + the largest id in
+ * ds->series) by name(), and says what one series is (`title`, e.g.
+ * "probe"; may be NULL), replacing earlier names.  PHC_OK, PHC_ERR_INVALID
+ * (no series, or too few names) or PHC_ERR_NOMEM. */
+int phc_dataset_name_series(phc_dataset *ds, const char *title, size_t count, phc_series_name_fn name,
+                            phc_error *err);
+
+/* Sets ds->n_series from ds->series and lets the kind name its series
+ * (ops->name_series).  Called by phc_problem_add_dataset. */
+int phc_dataset_describe_series(phc_dataset *ds, phc_error *err);
 
 /* The phc_residual_fn that the fit hands to the bridge, with the data set as
  * user_data: r = (y - yhat)/sigma, d r / d p = -(d yhat / d p)/sigma. */

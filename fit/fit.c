@@ -41,6 +41,36 @@ static void dataset_result_clear(phc_dataset_result *d)
     free(d->curve_x);
     free(d->curve_y);
     free(d->extra_markdown);
+    free(d->series);
+    for (size_t g = 0; d->series_names && g < d->n_series; ++g)
+        free(d->series_names[g]);
+    free(d->series_names);
+    free(d->series_title);
+}
+
+/* The data set's series (ids, names, title) into its result; PHC_OK or
+ * PHC_ERR_NOMEM. */
+static int copy_series(const phc_dataset *ds, phc_dataset_result *d)
+{
+    if (!ds->series || !ds->n)
+        return PHC_OK;
+    if (!(d->series = malloc(ds->n * sizeof *d->series)))
+        return PHC_ERR_NOMEM;
+    memcpy(d->series, ds->series, ds->n * sizeof *d->series);
+    d->n_series = ds->n_series;
+    for (size_t i = 0; i < ds->n; ++i) /* a data set not added to a problem has no count yet */
+        if (d->series[i] >= d->n_series)
+            d->n_series = d->series[i] + 1;
+    if (ds->series_title && !(d->series_title = strdup(ds->series_title)))
+        return PHC_ERR_NOMEM;
+    if (!ds->series_names || ds->n_series != d->n_series)
+        return PHC_OK;
+    if (!(d->series_names = calloc(ds->n_series, sizeof *d->series_names)))
+        return PHC_ERR_NOMEM;
+    for (size_t g = 0; g < ds->n_series; ++g)
+        if (!(d->series_names[g] = strdup(ds->series_names[g])))
+            return PHC_ERR_NOMEM;
+    return PHC_OK;
 }
 
 void phc_fit_result_free(phc_fit_result *res)
@@ -292,7 +322,7 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
     d->residual = calloc(n, sizeof *d->residual);
     d->std_residual = calloc(n, sizeof *d->std_residual);
     if (!p || !cols || !d->name || !d->kind || !d->x_label || !d->y_label || !d->x || !d->y ||
-        (ds->sigma && !d->sigma) || !d->yhat || !d->residual || !d->std_residual) {
+        (ds->sigma && !d->sigma) || !d->yhat || !d->residual || !d->std_residual || copy_series(ds, d)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -355,37 +385,6 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
             free(d->curve_y);
             d->curve_x = d->curve_y = NULL;
         }
-    } else if (ds->series && n > 0) {
-        /* several curves over x (one per probe, say): the predictions of each
-           series in x order, series separated by a NAN point (a line break) */
-        size_t n_series = 0;
-        for (size_t i = 0; i < n; ++i)
-            n_series = ds->series[i] + 1 > n_series ? ds->series[i] + 1 : n_series;
-        d->curve_x = malloc((n + n_series) * sizeof *d->curve_x);
-        d->curve_y = malloc((n + n_series) * sizeof *d->curve_y);
-        if (!d->curve_x || !d->curve_y) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        size_t m = 0;
-        for (size_t g = 0; g < n_series; ++g) {
-            size_t first = m;
-            for (size_t i = 0; i < n; ++i)
-                if (ds->series[i] == g) {
-                    size_t j = m++;
-                    for (; j > first && d->curve_x[j - 1] > d->x[i]; --j) { /* insertion by x */
-                        d->curve_x[j] = d->curve_x[j - 1];
-                        d->curve_y[j] = d->curve_y[j - 1];
-                    }
-                    d->curve_x[j] = d->x[i];
-                    d->curve_y[j] = d->yhat[i];
-                }
-            if (m > first) {
-                d->curve_x[m] = NAN;
-                d->curve_y[m++] = NAN;
-            }
-        }
-        d->curve_n = m;
     }
 fail:
     free(p);

@@ -44,8 +44,14 @@ typedef struct phc_dataset_result {
     double *residual;            /* y - yhat (data units) */
     double *std_residual;        /* (y - yhat) / (sigma s) or / s: for checks and QQ */
     double *sigma;               /* copy of the data set's sigmas or NULL */
-    double *curve_x, *curve_y;   /* dense fitted curve (curve_n points) or NULL */
+    double *curve_x, *curve_y;   /* dense fitted curve (curve_n points) or NULL: one curve
+                                    for every observation (not one per series) */
     size_t curve_n;
+    size_t *series;              /* n series ids (the probe, leaf, quantile of each
+                                    observation) or NULL: plots draw one colour per series */
+    size_t n_series;             /* with series: how many (every id is below it) */
+    char **series_names;         /* n_series names, or NULL (plots number them) */
+    char *series_title;          /* what one series is ("probe", "leaf") or NULL */
     double acf[PHC_ACF_MAX_LAG + 1];
     size_t acf_lags;             /* lags computed (0 when n too small) */
     char *extra_markdown;        /* the kind's own report section, or NULL */

@@ -15,9 +15,13 @@ int phc_leaf_sheet(const phc_image *const *tiles, const char *const *captions, s
         return phc_error_set(err, PHC_ERR_INVALID, "a sheet needs at least one tile and one column");
     size_t tw = 0, th = 0;
     for (size_t i = 0; i < n; ++i) {
+        if (!tiles[i])
+            continue; /* an empty cell */
         tw = tiles[i]->width > tw ? tiles[i]->width : tw;
         th = tiles[i]->height > th ? tiles[i]->height : th;
     }
+    if (!tw || !th)
+        return phc_error_set(err, PHC_ERR_INVALID, "a sheet needs at least one tile");
     const size_t cols = n < columns ? n : columns, rows = (n + columns - 1) / columns;
     const size_t cap = captions ? CAPTION_HEIGHT : 0;
     const size_t W = gap + cols * (tw + gap), H = gap + rows * (th + cap + gap);
@@ -28,6 +32,8 @@ int phc_leaf_sheet(const phc_image *const *tiles, const char *const *captions, s
         out->data[i] = 1; /* white paper */
     for (size_t i = 0; i < n; ++i) {
         const phc_image *t = tiles[i];
+        if (!t)
+            continue;
         const size_t ox = gap + (i % columns) * (tw + gap) + (tw - t->width) / 2;
         const size_t oy = gap + (i / columns) * (th + cap + gap) + cap + (th - t->height) / 2;
         for (size_t y = 0; y < t->height; ++y)

@@ -12,6 +12,7 @@
 /* Tiles n images (any sizes; each cell is as large as the largest tile)
  * `columns` per row with `gap` px of white between them and a caption
  * band above each tile (captions may be NULL, or single entries NULL).
+ * A NULL tile leaves its cell white.
  * *out is allocated here. */
 int phc_leaf_sheet(const phc_image *const *tiles, const char *const *captions, size_t n, size_t columns,
                    size_t gap, phc_image *out, phc_error *err);

@@ -35,6 +35,8 @@
 #include <gsl/gsl_cdf.h>
 #include <plplot.h>
 
+#include "measurements/photo.h"
+
 /* Output size in pixels (plots.h). */
 enum { PAGE_W = 1000, PAGE_H = 700 };
 
@@ -48,8 +50,22 @@ enum {
     COL_REF = 5,   /* dark grey zero line */
     COL_BAND = 6,  /* orange-red dashed bands */
     COL_EBAR = 7,  /* lighter blue error bars */
-    COL_COUNT = 8
+    COL_COUNT = 8,
+    COL_GROUP0 = COL_COUNT /* group g's colour is slot COL_GROUP0 + group_slot(g) */
 };
+
+/* Distinct group colours up to this many groups (matplotlib's "tab10"),
+ * a viridis ramp beyond; at most MAX_GROUP_COLOURS slots of the ramp. */
+#define TAB10_COUNT 10
+#define MAX_GROUP_COLOURS 256
+static const unsigned char TAB10[TAB10_COUNT][3] = {
+    {31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},  {148, 103, 189},
+    {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
+/* The ramp stops before viridis's light yellow end, which is hard to see on
+ * white paper. */
+static const double RAMP_END = 0.88;
+/* Longest group name shown in a key (longer ones are cut with an ellipsis). */
+#define KEY_NAME_MAX 28
 
 /* Character height scale (PLplot's default ~ 10 px is too small on a
  * 1000-pixel-wide image). */
@@ -59,8 +75,12 @@ static const double MARKER_SCALE = 0.6;  /* marker glyph, relative */
 /* Filled circle marker (U+25CF), drawn with plstring so the legend can use
  * the very same glyph. */
 static const char MARKER[] = "\xe2\x97\x8f";
+/* Diamonds (U+25C6 filled, U+25C7 outline) for points to point out. */
+static const char DIAMOND[] = "\xe2\x97\x86";
+static const char DIAMOND_EDGE[] = "\xe2\x97\x87";
+static const double DIAMOND_SCALE = 1.3; /* relative to CHAR_SCALE */
 
-#define MAX_LEGEND 4
+#define MAX_LEGEND 8
 
 typedef struct plot_window {
     double xmin, xmax, ymin, ymax;
@@ -84,6 +104,8 @@ typedef struct legend_entry {
     PLINT color;
     PLINT line_style;   /* pllsty number */
     double line_width;
+    const char *symbol; /* glyph of PL_LEGEND_SYMBOL entries */
+    double symbol_scale;
 } legend_entry;
 
 typedef struct legend_spec {
@@ -112,6 +134,8 @@ static void legend_add(legend_spec *lg, PLINT opt, const char *text,
     e->color = color;
     e->line_style = line_style;
     e->line_width = line_width;
+    e->symbol = MARKER;
+    e->symbol_scale = MARKER_SCALE;
 }
 
 
@@ -226,18 +250,52 @@ typedef struct plot_ctx {
     double page_fx, page_fy; /* one character height as a page fraction */
     double ch_fx, ch_fy;     /* ... and as a viewport fraction */
     double ylab_disp;        /* y label distance from the frame (chars) */
+    size_t groups;           /* groups with a colour each (0: none) */
+    double key_w;            /* page width kept right of the axes for a key */
+    double vx0, vx1, vy0, vy1; /* the axes' viewport (page fractions) */
 } plot_ctx;
 
+/* Colour map 0 slot of group g of `count`. */
+static PLINT group_colour(size_t count, size_t g)
+{
+    const size_t slot = count <= MAX_GROUP_COLOURS ? g : g * MAX_GROUP_COLOURS / count;
+    return (PLINT)(COL_GROUP0 + slot);
+}
 
+/* Sets the colours of `count` groups into colour map 0 (which has room for
+ * them); lut is viridis (phc_photo_viridis), used beyond TAB10_COUNT. */
+static void set_group_colours(size_t count, const double *lut)
+{
+    if (count <= TAB10_COUNT) {
+        for (size_t g = 0; g < count; ++g)
+            plscol0((PLINT)(COL_GROUP0 + g), TAB10[g][0], TAB10[g][1], TAB10[g][2]);
+        return;
+    }
+    const size_t slots = count < MAX_GROUP_COLOURS ? count : MAX_GROUP_COLOURS;
+    for (size_t k = 0; k < slots; ++k) {
+        const size_t i = (size_t)lround(255.0 * RAMP_END * (double)k / (double)(slots - 1));
+        plscol0((PLINT)(COL_GROUP0 + k), (PLINT)lround(255 * lut[3 * i]),
+                (PLINT)lround(255 * lut[3 * i + 1]), (PLINT)lround(255 * lut[3 * i + 2]));
+    }
+}
 
 /* Opens a PLplot stream writing a PNG of PAGE_W x PAGE_H pixels to a
  * temporary file; on success ctx->page_f* hold the character height as a
  * fraction of the page.  The viewport is set later by plot_layout(). */
-static int plot_begin(plot_ctx *ctx, const char *path, phc_error *err)
+static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error *err)
 {
     ctx->stream = -1;
     ctx->tmp_path = NULL;
+    ctx->groups = groups;
+    ctx->key_w = 0.0;
     plgstrm(&ctx->old_stream);
+
+    double lut[3 * 256] = {0};
+    if (groups > TAB10_COUNT) {
+        const int rc = phc_photo_viridis(lut, err);
+        if (rc)
+            return rc;
+    }
 
     int dev = phc_plot_device_available("pngcairo");
     if (dev < 0)
@@ -279,9 +337,11 @@ static int plot_begin(plot_ctx *ctx, const char *path, phc_error *err)
         {230, 97, 1},    /* COL_BAND */
         {120, 160, 215}, /* COL_EBAR */
     };
-    plscmap0n(16);
+    const size_t slots = groups < MAX_GROUP_COLOURS ? groups : MAX_GROUP_COLOURS;
+    plscmap0n(COL_COUNT + (PLINT)slots > 16 ? COL_COUNT + (PLINT)slots : 16);
     for (int i = 0; i < COL_COUNT; ++i)
         plscol0(i, rgb[i][0], rgb[i][1], rgb[i][2]);
+    set_group_colours(groups, lut);
 
     plinit();
     pladv(0);
@@ -463,11 +523,15 @@ static void plot_layout(plot_ctx *ctx, const plot_window *w, plot_axes *ax,
     ctx->ylab_disp = 0.6 + ywidth + 1.5;
     double left = ctx->ylab_disp + 1.0;
     double right = fmax(2.0, 0.5 * xwidth + 0.6);
-    double vx0 = left * ctx->page_fx, vx1 = 1.0 - right * ctx->page_fx;
+    double vx0 = left * ctx->page_fx, vx1 = 1.0 - right * ctx->page_fx - ctx->key_w;
     double vy0 = 4.8 * ctx->page_fy, vy1 = 1.0 - 3.4 * ctx->page_fy;
     if (vx0 > 0.4)
         vx0 = 0.4;
     plvpor(vx0, vx1, vy0, vy1);
+    ctx->vx0 = vx0;
+    ctx->vx1 = vx1;
+    ctx->vy0 = vy0;
+    ctx->vy1 = vy1;
     ctx->ch_fx = ctx->page_fx / (vx1 - vx0);
     ctx->ch_fy = ctx->page_fy / (vy1 - vy0);
 }
@@ -546,8 +610,8 @@ static void draw_legend(const legend_spec *lg, PLINT position)
         line_widths[i] = e->line_width;
         sym_colors[i] = e->color;
         sym_numbers[i] = 1;
-        sym_scales[i] = MARKER_SCALE;
-        symbols[i] = MARKER;
+        sym_scales[i] = CHAR_SCALE * e->symbol_scale; /* as plotted (pllegend: plschr(0, scale)) */
+        symbols[i] = e->symbol;
     }
     PLFLT lw, lh;
     pllsty(1);
@@ -592,21 +656,6 @@ static void draw_frame_axes(const plot_ctx *ctx, const plot_axes *ax,
     }
 }
 
-/* Markers at the finite points. */
-static void draw_markers(const double *x, const double *y, size_t n,
-                         PLINT color)
-{
-    plcol0(color);
-    plschr(0.0, CHAR_SCALE * MARKER_SCALE);
-    for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(x[i]) || !isfinite(y[i]))
-            continue;
-        PLFLT px = x[i], py = y[i];
-        plstring(1, &px, &py, MARKER);
-    }
-    plschr(0.0, CHAR_SCALE);
-}
-
 static void draw_segment(double x0, double y0, double x1, double y1)
 {
     PLFLT px[2] = {x0, x1}, py[2] = {y0, y1};
@@ -648,10 +697,565 @@ static int check_path(const char *path, phc_error *err)
 /* ------------------------------------------------------------------ */
 /* Public functions                                                     */
 
-int phc_plot_fit(const char *path, const phc_plot_labels *labels,
-                 const double *x, const double *y, const double *sigma,
-                 size_t n, const double *curve_x, const double *curve_y,
-                 size_t curve_n, phc_error *err)
+/* ------------------------------------------------------------------ */
+/* Layers                                                               */
+
+static PLINT layer_colour(int colour, size_t groups)
+{
+    switch (colour) {
+    case PHC_COLOUR_DATA: return COL_DATA;
+    case PHC_COLOUR_FIT: return COL_FIT;
+    case PHC_COLOUR_REF: return COL_REF;
+    case PHC_COLOUR_BAND: return COL_BAND;
+    case PHC_COLOUR_BLACK: return COL_FG;
+    default: return group_colour(groups, (size_t)colour);
+    }
+}
+
+static double layer_width(const phc_plot_layer *l)
+{
+    switch (l->colour) {
+    case PHC_COLOUR_FIT: return 3.0;
+    case PHC_COLOUR_REF: return 1.5;
+    case PHC_COLOUR_BLACK: return 2.5;
+    default: return 2.0;
+    }
+}
+
+static int mark_is_line(phc_plot_mark m)
+{
+    return m == PHC_MARK_LINE || m == PHC_MARK_DASHED || m == PHC_MARK_HLINE || m == PHC_MARK_HDASHED;
+}
+
+static PLINT mark_style(phc_plot_mark m)
+{
+    return m == PHC_MARK_DASHED || m == PHC_MARK_HDASHED ? 3 : 1;
+}
+
+/* A glyph at each finite point. */
+static void draw_glyphs(const double *x, const double *y, size_t n, const char *glyph, double scale)
+{
+    plschr(0.0, CHAR_SCALE * scale);
+    for (size_t i = 0; i < n; ++i) {
+        if (!isfinite(x[i]) || !isfinite(y[i]))
+            continue;
+        PLFLT px = x[i], py = y[i];
+        plstring(1, &px, &py, glyph);
+    }
+    plschr(0.0, CHAR_SCALE);
+}
+
+/* A line through the points, broken at non-finite ones; a lone finite
+ * point is drawn as a marker. */
+static void draw_polyline(const double *x, const double *y, size_t n)
+{
+    for (size_t j = 0; j < n;) {
+        while (j < n && (!isfinite(x[j]) || !isfinite(y[j])))
+            ++j;
+        size_t start = j;
+        while (j < n && isfinite(x[j]) && isfinite(y[j]))
+            ++j;
+        size_t len = j - start;
+        if (len >= 2)
+            plline((PLINT)len, x + start, y + start);
+        else if (len == 1)
+            draw_glyphs(x + start, y + start, 1, MARKER, MARKER_SCALE);
+    }
+}
+
+static void draw_layer(const phc_plot_layer *l, const plot_window *w, size_t groups)
+{
+    if (l->n == 0)
+        return;
+    const PLINT col = layer_colour(l->colour, groups);
+    switch (l->mark) {
+    case PHC_MARK_DOTS:
+        if (l->sigma) { /* error bars under the markers */
+            plcol0(l->colour == PHC_COLOUR_DATA ? COL_EBAR : col);
+            plwidth(l->colour == PHC_COLOUR_DATA ? 1.5 : 1.0);
+            for (size_t i = 0; i < l->n; ++i) {
+                if (!isfinite(l->x[i]) || !isfinite(l->y[i]) || !isfinite(l->sigma[i]) || l->sigma[i] <= 0.0)
+                    continue;
+                PLFLT px = l->x[i], lo = l->y[i] - l->sigma[i], hi = l->y[i] + l->sigma[i];
+                plerry(1, &px, &lo, &hi);
+            }
+        }
+        plcol0(col);
+        draw_glyphs(l->x, l->y, l->n, MARKER, MARKER_SCALE);
+        break;
+    case PHC_MARK_DIAMONDS:
+        plcol0(col);
+        draw_glyphs(l->x, l->y, l->n, DIAMOND, DIAMOND_SCALE);
+        plcol0(COL_FG);
+        draw_glyphs(l->x, l->y, l->n, DIAMOND_EDGE, DIAMOND_SCALE);
+        break;
+    default:
+        plcol0(col);
+        plwidth(layer_width(l));
+        pllsty(mark_style(l->mark));
+        if (l->mark == PHC_MARK_HLINE || l->mark == PHC_MARK_HDASHED) {
+            if (isfinite(l->y[0]))
+                draw_segment(w->xmin, l->y[0], w->xmax, l->y[0]);
+        } else {
+            draw_polyline(l->x, l->y, l->n);
+        }
+        pllsty(1);
+        break;
+    }
+}
+
+/* Scores what a layer draws against the legend's corner boxes. */
+static void legend_score_layer(legend_boxes *lb, const plot_window *w, const phc_plot_layer *l)
+{
+    if (l->n == 0)
+        return;
+    if (l->mark == PHC_MARK_HLINE || l->mark == PHC_MARK_HDASHED) {
+        legend_score_segment(lb, w, w->xmin, l->y[0], w->xmax, l->y[0]);
+        return;
+    }
+    for (size_t i = 0; i < l->n; ++i) {
+        if (mark_is_line(l->mark)) {
+            if (i > 0)
+                legend_score_segment(lb, w, l->x[i - 1], l->y[i - 1], l->x[i], l->y[i]);
+        } else if (l->sigma && isfinite(l->sigma[i])) {
+            legend_score_segment(lb, w, l->x[i], l->y[i] - l->sigma[i], l->x[i], l->y[i] + l->sigma[i]);
+        } else {
+            legend_score_point(lb, w, l->x[i], l->y[i]);
+        }
+    }
+}
+
+/* ------------------------------------------------------------------ */
+/* The key beside the axes of a grouped plot                            */
+
+/* Vertical space of a row of the key, in character heights. */
+static const double KEY_ROW = 1.5;
+/* A sample line in the key, and the gap before its text (chars). */
+static const double KEY_SAMPLE = 2.4, KEY_GAP = 0.6, KEY_PAD = 0.6;
+/* Width of one character (average advance, DejaVu Sans), in heights. */
+static const double CHAR_ADVANCE = 0.69;
+/* The key takes at most this much of the page width; its text is smaller
+ * than the axes' by KEY_SCALE. */
+static const double KEY_MAX_WIDTH = 0.38, KEY_SCALE = 0.85;
+
+typedef struct key_plan {
+    double s;          /* character scale of the group names, relative */
+    size_t cols, rows; /* list of names: columns and rows */
+    size_t step;       /* > 0: a colour bar with every step-th name */
+    double col_w;      /* page width of one column of names */
+    double width;      /* page width of the key */
+    double top_h;      /* page height of the labelled layers and the heading */
+} key_plan;
+
+/* Characters shown of a group name (cut to KEY_NAME_MAX). */
+static size_t key_chars(const char *s)
+{
+    const size_t n = utf8_length(s);
+    return n > KEY_NAME_MAX ? KEY_NAME_MAX : n;
+}
+
+/* A copy of s cut to KEY_NAME_MAX characters with an ellipsis, escaped for
+ * PLplot; NULL when out of memory. */
+static char *key_text(const char *s)
+{
+    char buf[4 * KEY_NAME_MAX + 8];
+    size_t chars = 0, i = 0;
+    for (; s[i] && i + 4 < sizeof buf - 4; ++i) {
+        if (((unsigned char)s[i] & 0xC0) != 0x80 && ++chars > KEY_NAME_MAX - 1 && utf8_length(s) > KEY_NAME_MAX)
+            break;
+        buf[i] = s[i];
+    }
+    buf[i] = '\0';
+    if (s[i])
+        strcat(buf, "\xe2\x80\xa6"); /* … */
+    return phc_plot_escape(buf);
+}
+
+/* Plans the key: the group names in up to three columns at a scale that
+ * fits the height of the axes, else a colour bar labelled every k-th cell;
+ * sets ctx->key_w. */
+static void key_plan_make(key_plan *kp, plot_ctx *ctx, size_t entry_chars, size_t n_entries, size_t count,
+                          size_t name_chars)
+{
+    const double fx = ctx->page_fx, fy = ctx->page_fy, ks = KEY_SCALE;
+    const double height = 1.0 - 8.2 * fy; /* the axes' height (plot_layout) */
+    kp->top_h = (KEY_PAD + KEY_ROW * (double)(n_entries + 1) + (n_entries ? 0.5 : 0.0)) * ks * fy;
+    const double room = height - kp->top_h - KEY_PAD * fy;
+    const double entries_w = (3 * KEY_PAD + KEY_SAMPLE + KEY_GAP + CHAR_ADVANCE * (double)entry_chars) * ks * fx;
+    static const double scales[3] = {KEY_SCALE, 0.75, 0.65};
+    double names_w = INFINITY;
+    for (int k = 0; k < 3 && !(names_w <= KEY_MAX_WIDTH); ++k) {
+        const double s = scales[k];
+        const size_t fit_rows = (size_t)floor(room / (KEY_ROW * s * fy));
+        if (fit_rows < 1)
+            continue;
+        const size_t cols = (count + fit_rows - 1) / fit_rows;
+        if (cols > 3)
+            continue;
+        kp->s = s;
+        kp->cols = cols;
+        kp->rows = (count + cols - 1) / cols;
+        kp->step = 0;
+        kp->col_w = (KEY_SAMPLE + KEY_GAP + CHAR_ADVANCE * (double)name_chars + 1.0) * s * fx;
+        names_w = 3 * KEY_PAD * ks * fx + (double)cols * kp->col_w;
+    }
+    if (!(names_w <= KEY_MAX_WIDTH)) {
+        /* a colour bar: every cell, a name every step cells */
+        kp->s = ks;
+        const size_t fit_rows = (size_t)fmax(1.0, floor(room / (KEY_ROW * kp->s * fy) - 0.3));
+        kp->cols = 1;
+        kp->rows = fit_rows;
+        kp->step = (count + fit_rows - 1) / fit_rows;
+        kp->col_w = (1.6 + 0.8 + CHAR_ADVANCE * (double)name_chars) * kp->s * fx;
+        names_w = 3 * KEY_PAD * ks * fx + kp->col_w;
+    }
+    kp->width = fmin(fmax(entries_w, names_w), KEY_MAX_WIDTH);
+    ctx->key_w = kp->width;
+}
+
+/* A key row's sample: a line, a marker or both. */
+static void key_sample(phc_plot_mark mark, PLINT col, PLINT style, double width, int line, int dot, double x0,
+                       double x1, double y)
+{
+    plcol0(col);
+    if (line) {
+        plwidth(width);
+        pllsty(style);
+        draw_segment(x0, y, x1, y);
+        pllsty(1);
+    }
+    if (dot) {
+        PLFLT px = 0.5 * (x0 + x1), py = y;
+        if (mark == PHC_MARK_DIAMONDS) {
+            plschr(0.0, CHAR_SCALE * DIAMOND_SCALE);
+            plstring(1, &px, &py, DIAMOND);
+            plcol0(COL_FG);
+            plstring(1, &px, &py, DIAMOND_EDGE);
+        } else {
+            plschr(0.0, CHAR_SCALE * MARKER_SCALE);
+            plstring(1, &px, &py, MARKER);
+        }
+        plschr(0.0, CHAR_SCALE);
+    }
+}
+
+/* Draws the key right of the axes in page coordinates: the labelled
+ * layers, the heading, the group names (or the colour bar). */
+static void draw_key(const plot_ctx *ctx, const key_plan *kp, const phc_plot_layer *layers, size_t n_layers,
+                     char *const *layer_text, size_t count, char *const *names, const char *heading)
+{
+    /* a group's sample shows what the groups are drawn with */
+    int group_line = 0, group_dot = 0;
+    for (size_t i = 0; i < n_layers; ++i)
+        if (layers[i].colour >= 0 && layers[i].n) {
+            group_line |= mark_is_line(layers[i].mark);
+            group_dot |= layers[i].mark == PHC_MARK_DOTS;
+        }
+    if (!group_line && !group_dot)
+        group_dot = 1;
+    const double fx = ctx->page_fx, fy = ctx->page_fy, ks = KEY_SCALE;
+    const double x0 = 1.0 - kp->width + 0.5 * KEY_PAD * fx, top = ctx->vy1;
+    plvpor(0.0, 1.0, 0.0, 1.0);
+    plwind(0.0, 1.0, 0.0, 1.0);
+    plschr(0.0, CHAR_SCALE * ks);
+    double y = top - KEY_PAD * ks * fy;
+    /* what markers and lines mean */
+    for (size_t i = 0; i < n_layers; ++i) {
+        const phc_plot_layer *l = &layers[i];
+        if (!layer_text[i])
+            continue;
+        y -= 0.5 * KEY_ROW * ks * fy;
+        const double sx = x0 + KEY_PAD * ks * fx;
+        key_sample(l->mark, layer_colour(l->colour, count), mark_style(l->mark), layer_width(l),
+                   mark_is_line(l->mark), !mark_is_line(l->mark), sx, sx + KEY_SAMPLE * ks * fx, y);
+        plschr(0.0, CHAR_SCALE * ks);
+        plcol0(COL_FG);
+        plptex(sx + (KEY_SAMPLE + KEY_GAP) * ks * fx, y, 1.0, 0.0, 0.0, layer_text[i]);
+        y -= 0.5 * KEY_ROW * ks * fy;
+    }
+    if (y < top - KEY_PAD * ks * fy)
+        y -= 0.5 * ks * fy;
+    /* heading */
+    y -= 0.5 * KEY_ROW * ks * fy;
+    plcol0(COL_FG);
+    plptex(x0 + KEY_PAD * ks * fx, y, 1.0, 0.0, 0.0, heading);
+    y -= 0.5 * KEY_ROW * ks * fy;
+    const double row = KEY_ROW * kp->s * fy;
+    plschr(0.0, CHAR_SCALE * kp->s);
+    double bottom = y;
+    if (kp->step == 0) {
+        for (size_t g = 0; g < count; ++g) {
+            const size_t c = g / kp->rows, r = g % kp->rows;
+            const double sx = x0 + KEY_PAD * ks * fx + (double)c * kp->col_w, sy = y - ((double)r + 0.5) * row;
+            key_sample(PHC_MARK_DOTS, group_colour(count, g), 1, 2.0, group_line, group_dot, sx,
+                       sx + KEY_SAMPLE * kp->s * fx, sy);
+            plschr(0.0, CHAR_SCALE * kp->s);
+            plcol0(COL_FG);
+            plptex(sx + (KEY_SAMPLE + KEY_GAP) * kp->s * fx, sy, 1.0, 0.0, 0.0, names[g]);
+        }
+        bottom = y - (double)kp->rows * row;
+    } else {
+        y -= 0.3 * row; /* clear of the heading */
+        const double bar_h = (double)kp->rows * row, cell = bar_h / (double)count;
+        const double bx0 = x0 + KEY_PAD * ks * fx, bx1 = bx0 + 1.6 * kp->s * fx;
+        for (size_t g = 0; g < count; ++g) {
+            PLFLT cx[4] = {bx0, bx1, bx1, bx0};
+            PLFLT cy[4] = {y - (double)(g + 1) * cell, y - (double)(g + 1) * cell, y - (double)g * cell,
+                           y - (double)g * cell};
+            plcol0(group_colour(count, g));
+            plfill(4, cx, cy);
+        }
+        plcol0(COL_FG);
+        plwidth(1.0);
+        for (size_t g = 0; g < count; g += kp->step) {
+            const double cy = y - ((double)g + 0.5) * cell;
+            draw_segment(bx1, cy, bx1 + 0.4 * kp->s * fx, cy);
+            plptex(bx1 + 0.8 * kp->s * fx, cy, 1.0, 0.0, 0.0, names[g]);
+        }
+        bottom = y - bar_h;
+    }
+    plschr(0.0, CHAR_SCALE);
+    /* a frame like the legend's */
+    const double fb = bottom - 0.5 * KEY_PAD * fy, fr = fmin(1.0 - 0.3 * KEY_PAD * fx, x0 + kp->width - KEY_PAD * fx);
+    PLFLT bx[5] = {x0, fr, fr, x0, x0}, by[5] = {top, top, fb, fb, top};
+    plcol0(COL_FG);
+    plwidth(1.0);
+    plline(5, bx, by);
+}
+
+/* Default group names "1", "2", ... when the caller gives none. */
+static const char *group_name(const phc_plot_groups *g, size_t i, char *buf, size_t size)
+{
+    if (g->names && g->names[i])
+        return g->names[i];
+    snprintf(buf, size, "%zu", i + 1);
+    return buf;
+}
+
+int phc_plot_layers(const char *path, const phc_plot_labels *labels, const phc_plot_layer *layers,
+                    size_t n_layers, const phc_plot_groups *groups, phc_error *err)
+{
+    phc_error_clear(err);
+    int status = check_path(path, err);
+    if (status)
+        return status;
+    if (!layers || n_layers == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: no layers to draw", path);
+    if (groups && groups->count == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: groups: expected count >= 1, found 0", path);
+    const size_t count = groups ? groups->count : 0;
+    plot_window w = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+    size_t finite = 0;
+    for (size_t k = 0; k < n_layers; ++k) {
+        const phc_plot_layer *l = &layers[k];
+        const int hline = l->mark == PHC_MARK_HLINE || l->mark == PHC_MARK_HDASHED;
+        if (l->colour >= 0 ? (size_t)l->colour >= count : l->colour < PHC_COLOUR_BLACK)
+            return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: layer %zu: colour %d is neither a group (of %zu) "
+                                 "nor a PHC_COLOUR_ constant", path, k, l->colour, count);
+        if (l->n && (!l->y || (!hline && !l->x)))
+            return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: layer %zu: %zu points but a NULL array", path, k,
+                                 l->n);
+        if (hline) {
+            if (l->n)
+                range_add(&w.ymin, &w.ymax, l->y[0]);
+            continue;
+        }
+        for (size_t i = 0; i < l->n; ++i) {
+            if (!isfinite(l->x[i]) || !isfinite(l->y[i]))
+                continue;
+            const double sg = l->mark == PHC_MARK_DOTS && l->sigma ? l->sigma[i] : NAN;
+            if (sg < 0.0)
+                return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: layer %zu: sigma[%zu]: expected a value >= 0, "
+                                     "found %g", path, k, i, sg);
+            ++finite;
+            range_add(&w.xmin, &w.xmax, l->x[i]);
+            range_add(&w.ymin, &w.ymax, l->y[i]);
+            if (isfinite(sg)) {
+                range_add(&w.ymin, &w.ymax, l->y[i] - sg);
+                range_add(&w.ymin, &w.ymax, l->y[i] + sg);
+            }
+        }
+    }
+    if (finite == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: expected at least one finite point, found none",
+                             path);
+    if (range_pad(&w.xmin, &w.xmax, 0.04) || range_pad(&w.ymin, &w.ymax, 0.06))
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: plot: values too large to plot", path);
+
+    /* escaped texts: the layers' labels, then the group names and heading */
+    plot_text t = {0};
+    char **text = calloc(n_layers + count + 1, sizeof *text);
+    int nomem = !text || text_make(&t, labels, "x", "y");
+    size_t entry_chars = 0, name_chars = 1, n_entries = 0;
+    for (size_t k = 0; !nomem && k < n_layers; ++k)
+        if (layers[k].label) {
+            nomem = !(text[k] = phc_plot_escape(layers[k].label));
+            entry_chars = fmax(entry_chars, utf8_length(layers[k].label));
+            ++n_entries;
+        }
+    for (size_t g = 0; !nomem && g < count; ++g) {
+        char buf[32];
+        const char *nm = group_name(groups, g, buf, sizeof buf);
+        nomem = !(text[n_layers + g] = key_text(nm));
+        name_chars = fmax(name_chars, key_chars(nm));
+    }
+    if (!nomem && groups) {
+        const char *heading = groups->title && *groups->title ? groups->title : "group";
+        nomem = !(text[n_layers + count] = phc_plot_escape(heading));
+        entry_chars = fmax(entry_chars, utf8_length(heading));
+    }
+    legend_spec lg = {0};
+    for (size_t k = 0; !nomem && !groups && k < n_layers; ++k) {
+        const phc_plot_layer *l = &layers[k];
+        if (!text[k])
+            continue;
+        if (mark_is_line(l->mark)) {
+            legend_add(&lg, PL_LEGEND_LINE, text[k], layer_colour(l->colour, 0), mark_style(l->mark),
+                       layer_width(l));
+        } else {
+            legend_add(&lg, PL_LEGEND_SYMBOL, text[k], layer_colour(l->colour, 0), 1, 1.0);
+            if (l->mark == PHC_MARK_DIAMONDS) {
+                lg.e[lg.n - 1].symbol = DIAMOND;
+                lg.e[lg.n - 1].symbol_scale = DIAMOND_SCALE;
+            }
+        }
+    }
+    if (nomem) {
+        status = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+        goto done;
+    }
+
+    plot_ctx ctx;
+    if ((status = plot_begin(&ctx, path, count, err)))
+        goto done;
+    key_plan kp = {0};
+    if (groups)
+        key_plan_make(&kp, &ctx, entry_chars, n_entries, count, name_chars);
+    plot_axes ax;
+    plot_layout(&ctx, &w, &ax, 0.0);
+    PLINT pos = 0;
+    if (lg.n) {
+        legend_boxes lb;
+        legend_boxes_init(&lb, &ctx, &lg);
+        for (size_t k = 0; k < n_layers; ++k)
+            legend_score_layer(&lb, &w, &layers[k]);
+        pos = legend_place(&lb, &w);
+        plot_layout(&ctx, &w, &ax, 0.0);
+    }
+    draw_frame_grid(&w, &ax);
+    for (size_t k = 0; k < n_layers; ++k)
+        draw_layer(&layers[k], &w, count);
+    draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
+    if (lg.n)
+        draw_legend(&lg, pos);
+    if (groups)
+        draw_key(&ctx, &kp, layers, n_layers, text, count, text + n_layers, text[n_layers + count]);
+    status = plot_end(&ctx, path, PHC_OK, err);
+done:
+    for (size_t i = 0; text && i < n_layers + count + 1; ++i)
+        free(text[i]);
+    free(text);
+    text_free(&t);
+    return status;
+}
+
+/* ------------------------------------------------------------------ */
+/* Fit and residual plots                                               */
+
+typedef struct ordered {
+    size_t group;
+    double x;
+    size_t index;
+} ordered;
+
+static int compare_ordered(const void *a, const void *b)
+{
+    const ordered *p = a, *q = b;
+    if (p->group != q->group)
+        return p->group < q->group ? -1 : 1;
+    /* non-finite x last within a group */
+    const int fp = isfinite(p->x), fq = isfinite(q->x);
+    if (fp != fq)
+        return fq - fp;
+    if (fp && p->x != q->x)
+        return p->x < q->x ? -1 : 1;
+    return (p->index > q->index) - (p->index < q->index);
+}
+
+/* The observations sorted by group, then x: order[0..n-1] (malloc'd) and
+ * start[0..count] (group g is order[start[g] .. start[g+1]-1]). */
+static int group_order(const double *x, size_t n, const phc_plot_groups *g, size_t count, size_t **order,
+                       size_t **start)
+{
+    ordered *o = malloc(n * sizeof *o);
+    *order = malloc(n * sizeof **order);
+    *start = calloc(count + 1, sizeof **start);
+    if (!o || !*order || !*start) {
+        free(o);
+        free(*order);
+        free(*start);
+        *order = *start = NULL;
+        return PHC_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; ++i)
+        o[i] = (ordered){g ? g->id[i] : 0, x[i], i};
+    qsort(o, n, sizeof *o, compare_ordered);
+    for (size_t i = 0; i < n; ++i) {
+        (*order)[i] = o[i].index;
+        (*start)[o[i].group + 1]++;
+    }
+    for (size_t k = 0; k < count; ++k)
+        (*start)[k + 1] += (*start)[k];
+    free(o);
+    return PHC_OK;
+}
+
+/* Checks the ids of groups (NULL is fine) against n observations. */
+static int check_groups(const char *path, const char *what, const phc_plot_groups *g, size_t n, phc_error *err)
+{
+    if (!g)
+        return PHC_OK;
+    if (g->count == 0 || !g->id)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: %s: groups need count >= 1 and ids", path, what);
+    for (size_t i = 0; i < n; ++i)
+        if (g->id[i] >= g->count)
+            return phc_error_set(err, PHC_ERR_INVALID, "%s: %s: group id[%zu] = %zu: expected below %zu", path, what,
+                                 i, g->id[i], g->count);
+    return PHC_OK;
+}
+
+/* The working memory of a grouped plot: `arrays` arrays of n values, room
+ * for `max_layers` layers, and the observations in group order. */
+typedef struct group_work {
+    double *buf;
+    phc_plot_layer *layers;
+    size_t *order, *start;
+} group_work;
+
+static void group_work_free(group_work *gp)
+{
+    free(gp->buf);
+    free(gp->layers);
+    free(gp->order);
+    free(gp->start);
+}
+
+static int group_work_make(group_work *gp, const double *x, size_t n, const phc_plot_groups *groups, size_t count,
+                        size_t arrays, size_t max_layers)
+{
+    *gp = (group_work){0};
+    gp->buf = malloc(arrays * n * sizeof *gp->buf);
+    gp->layers = calloc(max_layers, sizeof *gp->layers);
+    if (!gp->buf || !gp->layers || group_order(x, n, groups, count, &gp->order, &gp->start)) {
+        group_work_free(gp);
+        return PHC_ERR_NOMEM;
+    }
+    return PHC_OK;
+}
+
+int phc_plot_fit_groups(const char *path, const phc_plot_labels *labels, const double *x, const double *y,
+                        const double *sigma, size_t n, const phc_plot_groups *groups, const double *yhat,
+                        const double *curve_x, const double *curve_y, size_t curve_n, phc_error *err)
 {
     phc_error_clear(err);
     int status = check_path(path, err);
@@ -666,8 +1270,8 @@ int phc_plot_fit(const char *path, const phc_plot_labels *labels,
         return phc_error_set(err, PHC_ERR_INVALID,
                              "%s: fit plot: curve_n = %zu but curve_x or "
                              "curve_y is NULL", path, curve_n);
-
-    plot_window w = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+    if ((status = check_groups(path, "fit plot", groups, n, err)))
+        return status;
     size_t finite = 0;
     for (size_t i = 0; i < n; ++i) {
         if (!isfinite(x[i]) || !isfinite(y[i]))
@@ -677,116 +1281,63 @@ int phc_plot_fit(const char *path, const phc_plot_labels *labels,
                                  "%s: fit plot: sigma[%zu]: expected a "
                                  "value >= 0, found %g", path, i, sigma[i]);
         ++finite;
-        range_add(&w.xmin, &w.xmax, x[i]);
-        range_add(&w.ymin, &w.ymax, y[i]);
-        if (sigma && isfinite(sigma[i])) {
-            range_add(&w.ymin, &w.ymax, y[i] - sigma[i]);
-            range_add(&w.ymin, &w.ymax, y[i] + sigma[i]);
-        }
-    }
-    size_t curve_finite = 0;
-    for (size_t j = 0; j < curve_n; ++j) {
-        if (!isfinite(curve_x[j]) || !isfinite(curve_y[j]))
-            continue;
-        ++curve_finite;
-        range_add(&w.xmin, &w.xmax, curve_x[j]);
-        range_add(&w.ymin, &w.ymax, curve_y[j]);
     }
     if (finite == 0)
         return phc_error_set(err, PHC_ERR_INVALID,
                              "%s: fit plot: expected at least one finite "
                              "data point, found none of %zu", path, n);
-    if (range_pad(&w.xmin, &w.xmax, 0.04) || range_pad(&w.ymin, &w.ymax, 0.06))
-        return phc_error_set(err, PHC_ERR_INVALID,
-                             "%s: fit plot: values too large to plot", path);
 
-    plot_text t = {0};
-    const char *leg_data = sigma ? "data (\xc2\xb1" "1 \xcf\x83)" : "data";
-    if (text_make(&t, labels, "x", "y")) {
-        text_free(&t);
+    const size_t count = groups ? groups->count : 1;
+    const char *model = labels && labels->model ? labels->model : "fit";
+    const char *data = sigma ? "data (\xc2\xb1" "1 \xcf\x83)" : "data";
+    group_work gp;
+    if (group_work_make(&gp, x, n, groups, count, 4, 2 * count + 3))
         return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-    }
-    legend_spec lg = {0};
-    legend_add(&lg, PL_LEGEND_SYMBOL, leg_data, COL_DATA, 1, 1.0);
-    if (curve_finite > 0)
-        legend_add(&lg, PL_LEGEND_LINE, "fit", COL_FIT, 1, 3.0);
-
-    plot_ctx ctx;
-    status = plot_begin(&ctx, path, err);
-    if (status) {
-        text_free(&t);
-        return status;
-    }
-
-    plot_axes ax;
-    plot_layout(&ctx, &w, &ax, 0.0);
-    legend_boxes lb;
-    legend_boxes_init(&lb, &ctx, &lg);
+    const size_t *order = gp.order, *start = gp.start;
+    phc_plot_layer *layers = gp.layers;
+    double *ox = gp.buf, *oy = gp.buf + n, *os = gp.buf + 2 * n, *om = gp.buf + 3 * n;
     for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(x[i]) || !isfinite(y[i]))
-            continue;
-        if (sigma && isfinite(sigma[i]))
-            legend_score_segment(&lb, &w, x[i], y[i] - sigma[i], x[i],
-                                 y[i] + sigma[i]);
-        else
-            legend_score_point(&lb, &w, x[i], y[i]);
+        const size_t j = order[i];
+        ox[i] = x[j];
+        oy[i] = y[j];
+        os[i] = sigma ? sigma[j] : NAN;
+        om[i] = yhat ? yhat[j] : NAN;
     }
-    for (size_t j = 1; j < curve_n; ++j)
-        legend_score_segment(&lb, &w, curve_x[j - 1], curve_y[j - 1],
-                             curve_x[j], curve_y[j]);
-    if (curve_finite == 1)
-        for (size_t j = 0; j < curve_n; ++j)
-            legend_score_point(&lb, &w, curve_x[j], curve_y[j]);
-    PLINT pos = legend_place(&lb, &w);
-
-    plot_layout(&ctx, &w, &ax, 0.0);
-    draw_frame_grid(&w, &ax);
-
-    /* Error bars under the markers. */
-    if (sigma) {
-        plcol0(COL_EBAR);
-        plwidth(1.5);
-        for (size_t i = 0; i < n; ++i) {
-            if (!isfinite(x[i]) || !isfinite(y[i]) || !isfinite(sigma[i]) ||
-                sigma[i] <= 0.0)
-                continue;
-            PLFLT px = x[i], lo = y[i] - sigma[i], hi = y[i] + sigma[i];
-            plerry(1, &px, &lo, &hi);
-        }
+    size_t nl = 0;
+    const int grouped = groups != NULL;
+    if (grouped) { /* the key: what markers and lines are */
+        layers[nl++] = (phc_plot_layer){PHC_MARK_DOTS, PHC_COLOUR_REF, NULL, NULL, 0, NULL, data};
+        if (yhat && !curve_n)
+            layers[nl++] = (phc_plot_layer){PHC_MARK_LINE, PHC_COLOUR_REF, NULL, NULL, 0, NULL, model};
     }
-    draw_markers(x, y, n, COL_DATA);
-
-    /* Fit line over the markers, broken at non-finite values. */
-    plcol0(COL_FIT);
-    plwidth(3.0);
-    for (size_t j = 0; j < curve_n;) {
-        while (j < curve_n && (!isfinite(curve_x[j]) || !isfinite(curve_y[j])))
-            ++j;
-        size_t start = j;
-        while (j < curve_n && isfinite(curve_x[j]) && isfinite(curve_y[j]))
-            ++j;
-        size_t len = j - start;
-        if (len >= 2) {
-            plline((PLINT)len, curve_x + start, curve_y + start);
-        } else if (len == 1) {
-            PLFLT px = curve_x[start], py = curve_y[start];
-            plschr(0.0, CHAR_SCALE * MARKER_SCALE);
-            plstring(1, &px, &py, MARKER);
-            plschr(0.0, CHAR_SCALE);
-        }
+    for (size_t g = 0; g < count; ++g) {
+        const size_t a = start[g], m = start[g + 1] - a;
+        layers[nl++] = (phc_plot_layer){PHC_MARK_DOTS, grouped ? (int)g : PHC_COLOUR_DATA, ox + a, oy + a, m,
+                                        sigma ? os + a : NULL, grouped ? NULL : data};
     }
-
-    draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
-    draw_legend(&lg, pos);
-
-    status = plot_end(&ctx, path, PHC_OK, err);
-    text_free(&t);
+    char shared[256]; /* one model line for every group */
+    snprintf(shared, sizeof shared, "%s (shared)", model);
+    if (curve_n > 0)
+        layers[nl++] = (phc_plot_layer){PHC_MARK_LINE, grouped ? PHC_COLOUR_BLACK : PHC_COLOUR_FIT, curve_x,
+                                        curve_y, curve_n, NULL, grouped ? shared : model};
+    else if (yhat)
+        for (size_t g = 0; g < count; ++g)
+            layers[nl++] = (phc_plot_layer){PHC_MARK_LINE, grouped ? (int)g : PHC_COLOUR_FIT, ox + start[g],
+                                            om + start[g], start[g + 1] - start[g], NULL, grouped ? NULL : model};
+    status = phc_plot_layers(path, labels, layers, nl, groups, err);
+    group_work_free(&gp);
     return status;
 }
 
-int phc_plot_residuals(const char *path, const phc_plot_labels *labels,
-                       const double *x, const double *r, size_t n, double s,
-                       phc_error *err)
+int phc_plot_fit(const char *path, const phc_plot_labels *labels, const double *x, const double *y,
+                 const double *sigma, size_t n, const double *curve_x, const double *curve_y, size_t curve_n,
+                 phc_error *err)
+{
+    return phc_plot_fit_groups(path, labels, x, y, sigma, n, NULL, NULL, curve_x, curve_y, curve_n, err);
+}
+
+int phc_plot_residuals_groups(const char *path, const phc_plot_labels *labels, const double *x, const double *r,
+                              size_t n, double s, const phc_plot_groups *groups, phc_error *err)
 {
     phc_error_clear(err);
     int status = check_path(path, err);
@@ -797,82 +1348,49 @@ int phc_plot_residuals(const char *path, const phc_plot_labels *labels,
                              "%s: residual plot: expected n >= 1 residuals "
                              "with x and r, found n = %zu%s", path, n,
                              (n && (!x || !r)) ? " and a NULL array" : "");
-
-    plot_window w = {INFINITY, -INFINITY, 0.0, 0.0}; /* y range holds 0 */
+    if ((status = check_groups(path, "residual plot", groups, n, err)))
+        return status;
     size_t finite = 0;
-    for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(x[i]) || !isfinite(r[i]))
-            continue;
-        ++finite;
-        range_add(&w.xmin, &w.xmax, x[i]);
-        range_add(&w.ymin, &w.ymax, r[i]);
-    }
+    for (size_t i = 0; i < n; ++i)
+        finite += isfinite(x[i]) && isfinite(r[i]);
     if (finite == 0)
         return phc_error_set(err, PHC_ERR_INVALID,
                              "%s: residual plot: expected at least one "
                              "finite residual, found none of %zu", path, n);
-    int band = isfinite(s) && s > 0.0;
-    if (band) {
-        range_add(&w.ymin, &w.ymax, -2.0 * s);
-        range_add(&w.ymin, &w.ymax, 2.0 * s);
-    }
-    if (range_pad(&w.xmin, &w.xmax, 0.04) || range_pad(&w.ymin, &w.ymax, 0.08))
-        return phc_error_set(err, PHC_ERR_INVALID,
-                             "%s: residual plot: values too large to plot",
-                             path);
-
-    plot_text t = {0};
-    if (text_make(&t, labels, "x", "residual")) {
-        text_free(&t);
+    const size_t count = groups ? groups->count : 1;
+    const int band = isfinite(s) && s > 0.0, grouped = groups != NULL;
+    const double zero = 0.0, up = 2.0 * s, down = -2.0 * s;
+    group_work gp;
+    if (group_work_make(&gp, x, n, groups, count, 2, count + 4))
         return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+    const size_t *order = gp.order, *start = gp.start;
+    phc_plot_layer *layers = gp.layers;
+    double *ox = gp.buf, *orr = gp.buf + n;
+    for (size_t i = 0; i < n; ++i) {
+        ox[i] = x[order[i]];
+        orr[i] = r[order[i]];
     }
-    legend_spec lg = {0};
-    legend_add(&lg, PL_LEGEND_SYMBOL, "residual", COL_DATA, 1, 1.0);
-    legend_add(&lg, PL_LEGEND_LINE, "0", COL_REF, 1, 1.5);
-    if (band)
-        legend_add(&lg, PL_LEGEND_LINE, "\xc2\xb1" "2 s", COL_BAND, 3, 2.0);
-
-    plot_ctx ctx;
-    status = plot_begin(&ctx, path, err);
-    if (status) {
-        text_free(&t);
-        return status;
-    }
-
-    plot_axes ax;
-    plot_layout(&ctx, &w, &ax, 0.0);
-    legend_boxes lb;
-    legend_boxes_init(&lb, &ctx, &lg);
-    for (size_t i = 0; i < n; ++i)
-        legend_score_point(&lb, &w, x[i], r[i]);
-    /* The horizontal lines run across the whole plot. */
-    legend_score_segment(&lb, &w, w.xmin, 0.0, w.xmax, 0.0);
+    /* the key's order: residual, 0, +-2 s; the lines under the markers */
+    size_t nl = 0;
+    layers[nl++] = (phc_plot_layer){PHC_MARK_DOTS, grouped ? PHC_COLOUR_REF : PHC_COLOUR_DATA, NULL, NULL, 0,
+                                    NULL, "residual"};
+    layers[nl++] = (phc_plot_layer){PHC_MARK_HLINE, PHC_COLOUR_REF, NULL, &zero, 1, NULL, "0"};
     if (band) {
-        legend_score_segment(&lb, &w, w.xmin, 2.0 * s, w.xmax, 2.0 * s);
-        legend_score_segment(&lb, &w, w.xmin, -2.0 * s, w.xmax, -2.0 * s);
+        layers[nl++] = (phc_plot_layer){PHC_MARK_HDASHED, PHC_COLOUR_BAND, NULL, &up, 1, NULL, "\xc2\xb1" "2 s"};
+        layers[nl++] = (phc_plot_layer){PHC_MARK_HDASHED, PHC_COLOUR_BAND, NULL, &down, 1, NULL, NULL};
     }
-    PLINT pos = legend_place(&lb, &w);
-
-    plot_layout(&ctx, &w, &ax, 0.0);
-    draw_frame_grid(&w, &ax);
-    plcol0(COL_REF);
-    plwidth(1.5);
-    draw_segment(w.xmin, 0.0, w.xmax, 0.0);
-    if (band) {
-        plcol0(COL_BAND);
-        plwidth(2.0);
-        pllsty(3);
-        draw_segment(w.xmin, 2.0 * s, w.xmax, 2.0 * s);
-        draw_segment(w.xmin, -2.0 * s, w.xmax, -2.0 * s);
-        pllsty(1);
-    }
-    draw_markers(x, r, n, COL_DATA);
-    draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
-    draw_legend(&lg, pos);
-
-    status = plot_end(&ctx, path, PHC_OK, err);
-    text_free(&t);
+    for (size_t g = 0; g < count; ++g)
+        layers[nl++] = (phc_plot_layer){PHC_MARK_DOTS, grouped ? (int)g : PHC_COLOUR_DATA, ox + start[g],
+                                        orr + start[g], start[g + 1] - start[g], NULL, NULL};
+    status = phc_plot_layers(path, labels, layers, nl, groups, err);
+    group_work_free(&gp);
     return status;
+}
+
+int phc_plot_residuals(const char *path, const phc_plot_labels *labels, const double *x, const double *r, size_t n,
+                       double s, phc_error *err)
+{
+    return phc_plot_residuals_groups(path, labels, x, r, n, s, NULL, err);
 }
 
 static int compare_double(const void *a, const void *b)
@@ -955,7 +1473,7 @@ int phc_plot_qq(const char *path, const phc_plot_labels *labels,
     legend_add(&lg, PL_LEGEND_LINE, "y = x (normal)", COL_FIT, 1, 2.0);
 
     plot_ctx ctx;
-    status = plot_begin(&ctx, path, err);
+    status = plot_begin(&ctx, path, 0, err);
     if (status) {
         text_free(&t);
         free(z);
@@ -979,7 +1497,8 @@ int phc_plot_qq(const char *path, const phc_plot_labels *labels,
     plcol0(COL_FIT);
     plwidth(2.0);
     draw_segment(lo, lo, hi, hi); /* clipped to the viewport by PLplot */
-    draw_markers(q, z, m, COL_DATA);
+    plcol0(COL_DATA);
+    draw_glyphs(q, z, m, MARKER, MARKER_SCALE);
     draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
     draw_legend(&lg, pos);
 
@@ -1040,7 +1559,7 @@ int phc_plot_acf(const char *path, const phc_plot_labels *labels,
                2, 2.0);
 
     plot_ctx ctx;
-    status = plot_begin(&ctx, path, err);
+    status = plot_begin(&ctx, path, 0, err);
     if (status) {
         text_free(&t);
         return status;

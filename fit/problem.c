@@ -92,6 +92,12 @@ int phc_problem_add_parameter(phc_problem *pb, const char *name, double value,
 
 int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err)
 {
+    /* the series (probes, leaves, ...) with their names, for the plots */
+    const int rc = phc_dataset_describe_series(ds, err);
+    if (rc) {
+        phc_dataset_free(ds);
+        return rc;
+    }
     phc_dataset **grown = realloc(pb->datasets, (pb->n_datasets + 1) * sizeof *grown);
     if (!grown) {
         phc_dataset_free(ds);

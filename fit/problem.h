@@ -62,7 +62,8 @@ int phc_problem_add_parameter(phc_problem *pb, const char *name, double value,
                               size_t *index, phc_error *err);
 /* Index of a parameter by name, or -1. */
 long phc_problem_find_parameter(const phc_problem *pb, const char *name);
-/* Takes ownership of ds (also on failure). */
+/* Takes ownership of ds (also on failure); names its series first
+ * (phc_dataset_describe_series). */
 int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err);
 
 /* Checks the whole problem before a fit: starts, finite bounds and ranges

@@ -33,6 +33,18 @@ static json_t *goodness_json(const phc_goodness *g)
                      num(g->log_likelihood), "aic", num(g->aic), "aicc", num(g->aicc), "bic", num(g->bic));
 }
 
+/* {"ids": [n series ids], "names": [...] or null, "title": "..." or null} */
+static json_t *series_json(const phc_dataset_result *d)
+{
+    json_t *ids = json_array(), *names = d->series_names ? json_array() : json_null();
+    for (size_t i = 0; ids && i < d->n; ++i)
+        json_array_append_new(ids, json_integer((json_int_t)d->series[i]));
+    for (size_t g = 0; names && d->series_names && g < d->n_series; ++g)
+        json_array_append_new(names, json_string(d->series_names[g]));
+    return json_pack("{s:o, s:o, s:o}", "ids", ids, "names", names, "title",
+                     d->series_title ? json_string(d->series_title) : json_null());
+}
+
 static json_t *dataset_json(const phc_dataset_result *d)
 {
     json_t *checks = json_object();
@@ -56,6 +68,8 @@ static json_t *dataset_json(const phc_dataset_result *d)
     json_object_set_new(o, "acf", num_array(d->acf, d->acf_lags ? d->acf_lags + 1 : 0));
     if (d->extra_markdown)
         json_object_set_new(o, "extra_markdown", json_string(d->extra_markdown));
+    if (d->series)
+        json_object_set_new(o, "series", series_json(d));
     return o;
 }
 
@@ -220,6 +234,46 @@ static int get_string(reader *rd, json_t *obj, const char *key, const char *wher
     return *out ? PHC_OK : phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
 }
 
+/* The optional "series" object of a data set (written by series_json). */
+static int read_series(reader *rd, json_t *o, const char *where, phc_dataset_result *d)
+{
+    char field[128];
+    json_t *ids = json_object_get(o, "ids"), *names = json_object_get(o, "names"),
+           *title = json_object_get(o, "title");
+    snprintf(field, sizeof field, "%sseries", where);
+    if (!json_is_object(o) || !json_is_array(ids) || json_array_size(ids) != d->n ||
+        (names && !json_is_null(names) && !json_is_array(names)) || (title && !json_is_null(title) && !json_is_string(title)))
+        return fail_field(rd, field, "{ids: [one integer per observation], names: [strings] or null, title: a string "
+                          "or null}");
+    if (!(d->series = malloc(d->n * sizeof *d->series)))
+        return phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < d->n; ++i) {
+        json_t *v = json_array_get(ids, i);
+        if (!json_is_integer(v) || json_integer_value(v) < 0 || json_integer_value(v) >= (json_int_t)1 << 40)
+            return fail_field(rd, field, "ids that are integers >= 0");
+        d->series[i] = (size_t)json_integer_value(v);
+        if (d->series[i] >= d->n_series)
+            d->n_series = d->series[i] + 1;
+    }
+    if (json_is_array(names)) {
+        if (json_array_size(names) < d->n_series)
+            return fail_field(rd, field, "a name for every series id");
+        d->n_series = json_array_size(names);
+        if (!(d->series_names = calloc(d->n_series, sizeof *d->series_names)))
+            return phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t g = 0; g < d->n_series; ++g) {
+            const char *nm = json_string_value(json_array_get(names, g));
+            if (!nm)
+                return fail_field(rd, field, "names that are strings");
+            if (!(d->series_names[g] = strdup(nm)))
+                return phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
+        }
+    }
+    if (json_is_string(title) && !(d->series_title = strdup(json_string_value(title))))
+        return phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
 static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result *d)
 {
     char where[64];
@@ -242,6 +296,9 @@ static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result 
         return rc;
     json_t *extra = json_object_get(o, "extra_markdown");
     if (extra && (rc = get_string(rd, o, "extra_markdown", where, &d->extra_markdown)))
+        return rc;
+    json_t *series = json_object_get(o, "series");
+    if (series && !json_is_null(series) && (rc = read_series(rd, series, where, d)))
         return rc;
     json_t *g = json_object_get(o, "goodness");
     if (!json_is_object(g))

@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "fit/plots.h"
+#include "fit/fit_plots.h"
 #include "fit/report.h"
 #include "fit/result_json.h"
 
@@ -321,17 +321,6 @@ static int make_parents(const char *dir, phc_error *err)
     return PHC_OK;
 }
 
-static int add_plot(char **names, size_t *n, const char *name)
-{
-    if (*n + 1 >= MAX_PLOTS)
-        return PHC_OK;
-    names[*n] = strdup(name);
-    if (!names[*n])
-        return PHC_ERR_NOMEM;
-    (*n)++;
-    return PHC_OK;
-}
-
 void phc_run_dir_safe_name(const char *in, char *out, size_t size)
 {
     size_t j = 0;
@@ -343,88 +332,6 @@ void phc_run_dir_safe_name(const char *in, char *out, size_t size)
                        : '_';
     }
     out[j] = '\0';
-}
-
-static int write_plots(const phc_fit_result *res, const char *tmpdir, char **names, size_t *n_names,
-                       phc_error *err)
-{
-    char path[8192], file[512], title[512], label[512];
-    int rc;
-    for (size_t d = 0; d < res->n_datasets; ++d) {
-        const phc_dataset_result *ds = &res->datasets[d];
-        char base[256];
-        phc_run_dir_safe_name(ds->name, base, sizeof base);
-        /* the report links plots by data-set name; keep names consistent */
-        snprintf(title, sizeof title, "%s: data and fit", ds->name);
-        phc_plot_labels lab = {title, ds->x_label, ds->y_label};
-        snprintf(file, sizeof file, "%s_fit.png", base);
-        snprintf(path, sizeof path, "%s/%s", tmpdir, file);
-        const double *cx = ds->curve_x, *cy = ds->curve_y;
-        size_t cn = ds->curve_n;
-        double *sx = NULL, *sy = NULL;
-        if (!cx) {
-            /* no dense curve: connect the predictions in x order */
-            sx = malloc(ds->n * sizeof *sx);
-            sy = malloc(ds->n * sizeof *sy);
-            if (!sx || !sy) {
-                free(sx);
-                free(sy);
-                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            }
-            for (size_t i = 0; i < ds->n; ++i) {
-                sx[i] = ds->x[i];
-                sy[i] = ds->yhat[i];
-            }
-            for (size_t i = 1; i < ds->n; ++i) /* insertion sort: plots are small */
-                for (size_t j = i; j > 0 && sx[j - 1] > sx[j]; --j) {
-                    double t = sx[j];
-                    sx[j] = sx[j - 1];
-                    sx[j - 1] = t;
-                    t = sy[j];
-                    sy[j] = sy[j - 1];
-                    sy[j - 1] = t;
-                }
-            cx = sx;
-            cy = sy;
-            cn = ds->n;
-        }
-        rc = phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, cx, cy, cn, err);
-        free(sx);
-        free(sy);
-        if (rc || (rc = add_plot(names, n_names, file)))
-            return rc;
-
-        double s = 0;
-        for (size_t i = 0; i < ds->n; ++i)
-            s += ds->residual[i] * ds->residual[i];
-        s = ds->n > ds->k ? sqrt(s / (double)(ds->n - ds->k)) : NAN;
-        snprintf(title, sizeof title, "%s: residuals", ds->name);
-        snprintf(label, sizeof label, "residual: %s", ds->y_label);
-        phc_plot_labels rl = {title, ds->x_label, label};
-        snprintf(file, sizeof file, "%s_residuals.png", base);
-        snprintf(path, sizeof path, "%s/%s", tmpdir, file);
-        if ((rc = phc_plot_residuals(path, &rl, ds->x, ds->residual, ds->n, s, err)) ||
-            (rc = add_plot(names, n_names, file)))
-            return rc;
-
-        snprintf(title, sizeof title, "%s: normal QQ plot of residuals", ds->name);
-        phc_plot_labels ql = {title, NULL, NULL};
-        snprintf(file, sizeof file, "%s_qq.png", base);
-        snprintf(path, sizeof path, "%s/%s", tmpdir, file);
-        if ((rc = phc_plot_qq(path, &ql, ds->std_residual, ds->n, err)) || (rc = add_plot(names, n_names, file)))
-            return rc;
-
-        if (ds->acf_lags > 0) {
-            snprintf(title, sizeof title, "%s: residual autocorrelation (ordered by x)", ds->name);
-            phc_plot_labels al = {title, "lag (observations)", "autocorrelation"};
-            snprintf(file, sizeof file, "%s_acf.png", base);
-            snprintf(path, sizeof path, "%s/%s", tmpdir, file);
-            if ((rc = phc_plot_acf(path, &al, ds->acf, ds->acf_lags, ds->n, err)) ||
-                (rc = add_plot(names, n_names, file)))
-                return rc;
-        }
-    }
-    return PHC_OK;
 }
 
 int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *tmpdir, size_t size,
@@ -599,9 +506,30 @@ int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const ch
         return rc;
     char *names[MAX_PLOTS] = {0};
     size_t n_names = 0;
-    if ((rc = write_plots(res, tmpdir, names, &n_names, err)) ||
+    if ((rc = phc_fit_plots_write(res, tmpdir, names, &n_names, MAX_PLOTS, err)) ||
         (rc = write_kind_outputs(res, pb, tmpdir, err)))
         goto fail;
+    /* the kinds' own plots (the classic PV plot, photos beside the model)
+     * are linked in the report too, after the standard ones */
+    entry_list extra = {0};
+    if (walk(tmpdir, "", entries_add, &extra) < 0) {
+        entries_free(&extra);
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot list the new run", tmpdir);
+        goto fail;
+    }
+    entries_sort(&extra);
+    for (size_t i = 0; i < extra.n && n_names + 1 < MAX_PLOTS; ++i) {
+        const size_t len = strlen(extra.paths[i]);
+        int known = extra.is_dir[i] || len < 4 || strcmp(extra.paths[i] + len - 4, ".png") != 0;
+        for (size_t j = 0; j < n_names && !known; ++j)
+            known = strcmp(names[j], extra.paths[i]) == 0;
+        if (!known && !(names[n_names++] = strdup(extra.paths[i]))) {
+            entries_free(&extra);
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+    }
+    entries_free(&extra);
     snprintf(path, sizeof path, "%s/result.json", tmpdir);
     if ((rc = phc_result_write_json(res, path, err)))
         goto fail;

@@ -44,9 +44,14 @@ static int simulate_dataset(const phc_problem *pb, phc_dataset *ds, const char *
         goto done;
     }
     snprintf(title, sizeof title, "%s: model at the start values", ds->name);
-    phc_plot_labels lab = {title, ds->x_label, ds->y_label};
+    phc_plot_labels lab = {title, ds->x_label, ds->y_label, "model at start values"};
     snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, base);
-    if ((rc = phc_plot_fit(path, &lab, ds->x, ds->y, ds->sigma, ds->n, ds->x, yhat, ds->n, err)))
+    /* the model through the observations in x order, one line (and colour)
+       per series when the observations form several (probes, leaves, ...) */
+    const phc_plot_groups groups = {ds->n_series, ds->series, (const char *const *)ds->series_names,
+                                    ds->series_title};
+    if ((rc = phc_plot_fit_groups(path, &lab, ds->x, ds->y, ds->sigma, ds->n,
+                                  ds->series && ds->n_series > 1 ? &groups : NULL, yhat, NULL, NULL, 0, err)))
         goto done;
     if (ds->ops->simulate_outputs)
         rc = ds->ops->simulate_outputs(ds, p, tmpdir, base, err);

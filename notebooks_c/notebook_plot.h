@@ -26,6 +26,8 @@ enum {
 #define NB_MAX_SERIES 16
 #define NB_CHR 0.85 /* character height scale */
 #define NB_LOGX 2   /* flag in nb_panel.logy: log10 x axis (non-positive x skipped) */
+#define NB_LOG2X 4  /* flag in nb_panel.logy: log2 x axis fitted to the data, ticks at powers of
+                       two (grid sizes 128, 256, ...; non-positive x skipped) */
 
 typedef struct nb_series {
     const double *x, *y;  /* n points; non-finite (or <= 0 on a log axis) skipped */
@@ -58,21 +60,22 @@ static void nb_colours(void)
         plscol0(i, rgb[i][0], rgb[i][1], rgb[i][2]);
 }
 
-/* Log-axis tick labels as 10 with a superscript exponent (custom labels,
- * so the decade step can be chosen). */
+static int nb_ok(double v, int logy) { return isfinite(v) && (!logy || v > 0.0); }
+static int nb_log2x(const nb_panel *p) { return (p->logy & NB_LOG2X) != 0; }
+static int nb_logx(const nb_panel *p) { return (p->logy & (NB_LOGX | NB_LOG2X)) != 0; }
+static int nb_logy(const nb_panel *p) { return (p->logy & 1) != 0; }
+static double nb_tx(const nb_panel *p, double x) { return nb_log2x(p) ? log2(x) : nb_logx(p) ? log10(x) : x; }
+
+/* Log-axis tick labels (custom labels, so the step can be chosen): y as 10
+ * with a superscript exponent; x as the value at the tick (data: the panel). */
 static void nb_log_label(PLINT axis, PLFLT value, char *label, PLINT length, PLPointer data)
 {
-    (void)data;
+    const nb_panel *p = data;
     if (axis == PL_Y_AXIS)
         snprintf(label, (size_t)length, "10#u%d#d", (int)lround(value));
-    else /* only called for a log x axis (NB_LOGX): the decade's value */
-        snprintf(label, (size_t)length, "%g", pow(10.0, value));
+    else /* only called for a log x axis */
+        snprintf(label, (size_t)length, "%g", pow(nb_log2x(p) ? 2.0 : 10.0, value));
 }
-
-static int nb_ok(double v, int logy) { return isfinite(v) && (!logy || v > 0.0); }
-static int nb_logx(const nb_panel *p) { return (p->logy & NB_LOGX) != 0; }
-static int nb_logy(const nb_panel *p) { return (p->logy & 1) != 0; }
-static double nb_tx(const nb_panel *p, double x) { return nb_logx(p) ? log10(x) : x; }
 
 static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0, double vy1)
 {
@@ -87,10 +90,21 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
             xmin = fmin(xmin, x), xmax = fmax(xmax, x);
             ymin = fmin(ymin, y), ymax = fmax(ymax, y);
         }
+    int markers = 0;
+    for (size_t k = 0; k < p->ns; ++k)
+        markers |= p->s[k].markers && p->s[k].n > 0;
     if (!(xmin < xmax))
         xmin -= 1.0, xmax += 1.0;
-    if (nb_logx(p))
+    if (nb_log2x(p)) {
+        /* the powers of two of the data, and room for markers at the ends */
+        xmin = floor(xmin + 1e-9) - 0.3, xmax = ceil(xmax - 1e-9) + 0.3;
+    } else if (nb_logx(p)) {
         xmin = floor(xmin), xmax = ceil(xmax);
+    } else if (markers) {
+        /* markers at the first and last x stay whole inside the frame */
+        double pad = 0.025 * (xmax - xmin);
+        xmin -= pad, xmax += pad;
+    }
     if (p->ymin != 0.0 || p->ymax != 0.0) {
         ymin = nb_logy(p) ? log10(p->ymin) : p->ymin;
         ymax = nb_logy(p) ? log10(p->ymax) : p->ymax;
@@ -110,7 +124,7 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
     plwidth(1.0);
     pllsty(1);
     double ystep = nb_logy(p) ? (ymax - ymin > 8.0 ? 2.0 : 1.0) : 0.0;
-    plbox("g", nb_logx(p) ? 1.0 : 0.0, 0, "g", ystep, 0);
+    plbox("g", nb_logx(p) ? 1.0 : 0.0, nb_log2x(p) ? 1 : 0, "g", ystep, 0);
     const char *lab[NB_MAX_SERIES];
     PLINT opt[NB_MAX_SERIES], col[NB_MAX_SERIES], sty[NB_MAX_SERIES], tcol[NB_MAX_SERIES];
     PLINT snum[NB_MAX_SERIES];
@@ -156,7 +170,7 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
             tcol[nl] = NB_FG;
             sty[nl] = style;
             wid[nl] = w;
-            ssc[nl] = 0.75;
+            ssc[nl] = 0.7 * NB_CHR; /* as plotted: pllegend sizes symbols by plschr(0, ssc) */
             snum[nl] = 1;
             sym[nl] = "\xe2\x97\x8f";
             ++nl;
@@ -166,9 +180,9 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
     plwidth(1.2);
     plcol0(NB_FG);
     if (p->logy)
-        plslabelfunc(nb_log_label, NULL);
-    plbox(nb_logx(p) ? "bcnstlo" : "bcnst", nb_logx(p) ? 1.0 : 0.0, 0, nb_logy(p) ? "bcnstvo" : "bcnstv", ystep,
-          nb_logy(p) ? (int)ystep : 0);
+        plslabelfunc(nb_log_label, (PLPointer)p);
+    plbox(nb_log2x(p) ? "bcnsto" : nb_logx(p) ? "bcnstlo" : "bcnst", nb_logx(p) ? 1.0 : 0.0, nb_log2x(p) ? 1 : 0,
+          nb_logy(p) ? "bcnstvo" : "bcnstv", ystep, nb_logy(p) ? (int)ystep : 0);
     plslabelfunc(NULL, NULL);
     plmtex("b", 3.0, 0.5, 0.5, p->xlab);
     plmtex("l", nb_logy(p) ? 4.6 : 4.2, 0.5, 0.5, p->ylab);
@@ -215,13 +229,22 @@ static int nb_plot(const char *path, int width, int height, int cols, int rows,
     plinit();
     pladv(0);
     plschr(0.0, NB_CHR);
+    /* one character height as a fraction of the page height: the margins
+       above and below a panel hold its title and its x axis (tick labels,
+       label) whatever the page size, so stacked panels do not collide */
+    PLFLT def_ht, ch_ht, sx0, sx1, sy0, sy1;
+    plgchr(&def_ht, &ch_ht);
+    plgspa(&sx0, &sx1, &sy0, &sy1);
+    const double chy = sy1 > sy0 ? ch_ht / (sy1 - sy0) : 0.03;
     for (size_t k = 0; k < np; ++k) {
         int c = (int)(k % (size_t)cols), r = (int)(k / (size_t)cols);
         double cw = 1.0 / cols, chh = 1.0 / rows;
         double x0 = c * cw, y1 = 1.0 - r * chh;
-        /* margins in pixels: room for tick labels, axis labels, a title */
+        /* margins: 120 px left for tick labels and the y label; the x
+           label's centre is 3 character heights below the frame, the
+           title's 2 above it */
         double vx0 = x0 + 120.0 / width, vx1 = x0 + cw - 35.0 / width;
-        double vy0 = y1 - chh + 80.0 / height, vy1 = y1 - 60.0 / height;
+        double vy0 = y1 - chh + fmax(80.0 / height, 4.3 * chy), vy1 = y1 - fmax(60.0 / height, 3.3 * chy);
         nb_draw_panel(&panels[k], vx0, vx1, vy0, vy1);
     }
     plend1();

@@ -142,6 +142,7 @@ static void log_label(PLINT axis, PLFLT value, char *label, PLINT length, PLPoin
 #define SYM_TRIANGLE "\xe2\x96\xb2" /* U+25B2 filled triangle */
 #define SYM_CIRCLE_O "\xe2\x97\x8b" /* U+25CB hollow circle */
 #define SYM_TRIANGLE_O "\xe2\x96\xb3" /* U+25B3 hollow triangle */
+#define SYM_SQUARE "\xe2\x96\xa0"     /* U+25A0 filled square */
 
 static int plot(const char *path, const curve *cv, const plant *pl, size_t np, int have_data, const char *title)
 {
@@ -185,7 +186,7 @@ static int plot(const char *path, const curve *cv, const plant *pl, size_t np, i
         /* the end of the 300 d run */
         if (m > 0) {
             plschr(0.0, 0.6 * NB_CHR);
-            plstring(1, &x[m - 1], &y[m - 1], "\xe2\x96\xa0"); /* U+25A0 square */
+            plstring(1, &x[m - 1], &y[m - 1], SYM_SQUARE);
             plschr(0.0, NB_CHR);
         }
     }
@@ -224,27 +225,41 @@ static int plot(const char *path, const curve *cv, const plant *pl, size_t np, i
     plmtex("t", 1.0, 0.5, 0.5, title);
     plschr(0.0, NB_CHR);
     /* legend */
-    enum { NL = NPHI + 5 };
+    enum { NL = NPHI + 6 };
     const char *lab[NL];
     char phil[NPHI][64];
     PLINT opt[NL], col[NL], sty[NL], tcol[NL], snum[NL];
     PLFLT wid[NL], ssc[NL];
     const char *sym[NL];
     int nl = 0;
+    /* every marker as plotted: the same glyph, colour and size (pllegend
+       sizes symbols by plschr(0, scale), so the scale is the plotted one) */
     for (int k = 0; k < NPHI; ++k) {
         snprintf(phil[k], sizeof phil[k], "model, #gf#dRG#u = %.2g%s", cv[k].phi, k == 0 ? " (oak preset)" : "");
-        lab[nl] = phil[k], opt[nl] = PL_LEGEND_LINE, col[nl] = line_col[k], sty[nl] = line_sty[k];
-        wid[nl] = k == 0 ? 3.0 : 2.5, sym[nl] = "", ssc[nl] = 1, snum[nl] = 1, ++nl;
+        lab[nl] = phil[k], opt[nl] = PL_LEGEND_LINE | PL_LEGEND_SYMBOL, col[nl] = line_col[k],
+        sty[nl] = line_sty[k], wid[nl] = k == 0 ? 3.0 : 2.5, sym[nl] = SYM_SQUARE, ssc[nl] = 0.6 * NB_CHR,
+        snum[nl] = 1, ++nl;
     }
-    lab[nl] = "model at 300 d", opt[nl] = PL_LEGEND_SYMBOL, col[nl] = NB_FG, sty[nl] = 1, wid[nl] = 1,
-    sym[nl] = "\xe2\x96\xa0", ssc[nl] = 0.6, snum[nl] = 1, ++nl;
+    lab[nl] = SYM_SQUARE " on a line: the model at 300 d", opt[nl] = PL_LEGEND_NONE, col[nl] = NB_FG,
+    sty[nl] = 1, wid[nl] = 1, sym[nl] = "", ssc[nl] = 1, snum[nl] = 1, ++nl;
     if (have_data) {
+        int flagged_high = 0, flagged_low = 0;
+        for (size_t i = 0; i < np; ++i) {
+            flagged_high |= pl[i].suspicious && pl[i].high;
+            flagged_low |= pl[i].suspicious && !pl[i].high;
+        }
         lab[nl] = "Q. rubra, high light (L)", opt[nl] = PL_LEGEND_SYMBOL, col[nl] = NB_ORANGE, sty[nl] = 1;
-        wid[nl] = 1, sym[nl] = SYM_CIRCLE, ssc[nl] = 0.75, snum[nl] = 1, ++nl;
+        wid[nl] = 1, sym[nl] = SYM_CIRCLE, ssc[nl] = 0.75 * NB_CHR, snum[nl] = 1, ++nl;
         lab[nl] = "Q. rubra, low light (S)", opt[nl] = PL_LEGEND_SYMBOL, col[nl] = NB_BLUE, sty[nl] = 1;
-        wid[nl] = 1, sym[nl] = SYM_TRIANGLE, ssc[nl] = 0.75, snum[nl] = 1, ++nl;
-        lab[nl] = "hollow: flagged suspicious", opt[nl] = PL_LEGEND_SYMBOL, col[nl] = NB_FG, sty[nl] = 1;
-        wid[nl] = 1, sym[nl] = SYM_CIRCLE_O, ssc[nl] = 1.0, snum[nl] = 1, ++nl;
+        wid[nl] = 1, sym[nl] = SYM_TRIANGLE, ssc[nl] = 0.75 * NB_CHR, snum[nl] = 1, ++nl;
+        if (flagged_high) {
+            lab[nl] = "high light, flagged suspicious", opt[nl] = PL_LEGEND_SYMBOL, col[nl] = NB_ORANGE;
+            sty[nl] = 1, wid[nl] = 1, sym[nl] = SYM_CIRCLE_O, ssc[nl] = 1.1 * NB_CHR, snum[nl] = 1, ++nl;
+        }
+        if (flagged_low) {
+            lab[nl] = "low light, flagged suspicious", opt[nl] = PL_LEGEND_SYMBOL, col[nl] = NB_BLUE;
+            sty[nl] = 1, wid[nl] = 1, sym[nl] = SYM_TRIANGLE_O, ssc[nl] = 1.1 * NB_CHR, snum[nl] = 1, ++nl;
+        }
     }
     for (int i = 0; i < nl; ++i)
         tcol[i] = NB_FG;

@@ -754,7 +754,7 @@ int main(int argc, char **argv)
     nb_panel pan[4] = {
         {"p fitted / true (bars: ±2 SE; dashed: truth)", xl, "p fitted / p true", 0, 0.0, 3.2, 0, sp, np},
         {"c fitted / true (bars: ±2 SE; dashed: truth)", xl, "c fitted / c true", 0, 0.0, 1.7, 0, sc, nc},
-        {"collinearity index γ{p, c} (dashed: 20)", xl, "γ", 1, 1.0, 1000.0, 1, sg, NDES + 2},
+        {"collinearity index γ{p, c} (dashed: 20)", xl, "γ", 1, 0.5, 1000.0, 1, sg, NDES + 2},
         {"|corr(p, c)| (dashed: 0.95)", xl, "|corr(p, c)|", 0, 0.0, 1.05, 0, sr, NDES + 1}};
     char png[1000];
     snprintf(png, sizeof png, "%s/rhizomorph_soil_identifiability.png", out);

@@ -159,7 +159,7 @@ int main(int argc, char **argv)
                               {px, py, 2, "paper, GeForce 9400M (118-174 ms)", NB_RED, 0, 1, 0},
                               {px, py, 2, NULL, NB_RED, 0, 0, 1.5}};
     const nb_panel pan = {"Time per step of the leaf model", "grid side (px; grid = side x side)",
-                          "milliseconds per step", 1 | NB_LOGX, 0, 0, 2, ser, 4};
+                          "milliseconds per step", 1 | NB_LOG2X, 0, 0, 2, ser, 4};
     char png[1024];
     snprintf(png, sizeof png, "%s/silva_table1_step_time.png", out);
     if (nb_plot(png, 800, 520, 1, 1, &pan, 1) != 0) {

@@ -9,8 +9,8 @@
  * one loss rate delta shared by the twelve leaves, an initial water per leaf,
  * the measured dry weight as the dry mass; each leaf is a venation chain
  * built from its measured area (weight_curve `leaf_area`).  Plotted: the
- * measurements and the fitted curves for six leaves (three per treatment),
- * and the residuals.
+ * measurements and the fitted curves of all twelve leaves, one panel per
+ * treatment (soil moisture during growth), and their residuals.
  *
  * Checks (exit 1 when one fails): the fit converges, delta is positive and
  * determined, every fitted initial water lies between 0 and the first
@@ -33,7 +33,6 @@
 #include "notebook_plot.h"
 
 #define N_LEAVES 12
-#define N_SHOW 6
 
 static const phc_param_result *param(const phc_fit_result *r, const char *name)
 {
@@ -153,52 +152,57 @@ int main(int argc, char **argv)
     printf("mean residual at the last weighing: 10%% leaves %+.3f g, 40%% leaves %+.3f g\n", end10, end40);
     printf("leaves whose residual checks find structure: %d of %d\n", leaves_with_structure, N_LEAVES);
 
-    /* Plot: six leaves (samples 1, 3, 5: 10%; 2, 4, 6: 40%), hours. */
-    static const int show[N_SHOW] = {0, 2, 4, 1, 3, 5};
-    static const int col[N_SHOW] = {NB_BLUE, NB_GREEN, NB_CYAN, NB_RED, NB_ORANGE, NB_PURPLE};
-    static double hx[N_SHOW][64], cx[N_SHOW][512], res[N_SHOW][64];
-    static char lab[N_SHOW][48];
-    nb_series sa[2 * N_SHOW + 2], sb[2 * N_SHOW];
-    size_t ma = 0, mb = 0;
-    for (int k = 0; k < N_SHOW; ++k) {
-        const phc_dataset_result *d = &r->datasets[show[k]];
+    /* Plot: all twelve leaves, hours.  Columns: the two treatments (pvldcurve's
+       labels "10%" and "40%": soil moisture 10-30 % or 40-60 % during the
+       last 6 days of growth; odd samples are "10%", even ones "40%"); rows:
+       mass, residuals.  Both columns share their y ranges. */
+    static const int col[N_LEAVES / 2] = {NB_BLUE, NB_RED, NB_GREEN, NB_ORANGE, NB_PURPLE, NB_BROWN};
+    static double hx[N_LEAVES][64], cx[N_LEAVES][512], res[N_LEAVES][64];
+    static char lab[N_LEAVES][48];
+    nb_series sa[2][N_LEAVES + 3], sb[2][N_LEAVES + 1]; /* per treatment: 6 leaves x 2 + the key */
+    size_t ma[2] = {0, 0}, mb[2] = {0, 0};
+    double ylo = INFINITY, yhi = -INFINITY, rlo = 0.0, rhi = 0.0, tmax = 0.0;
+    for (int l = 0; l < N_LEAVES; ++l) {
+        const phc_dataset_result *d = &r->datasets[l];
+        const int t = l % 2, k = l / 2; /* treatment, colour */
         size_t n = d->n < 64 ? d->n : 64, cn = d->curve_n < 512 ? d->curve_n : 512;
         for (size_t i = 0; i < n; ++i) {
-            hx[k][i] = d->x[i] / 3600.0;
-            res[k][i] = d->residual[i];
-        }
-        for (size_t j = 0; j < cn; ++j)
-            cx[k][j] = d->curve_x[j] / 3600.0;
-        snprintf(lab[k], sizeof lab[k], "leaf %d (%s)", show[k] + 1, show[k] % 2 == 0 ? "10%" : "40%");
-        sa[ma++] = (nb_series){hx[k], d->y, n, lab[k], col[k], 0, 1, 0};
-        sa[ma++] = (nb_series){cx[k], d->curve_y, cn, NULL, col[k], 0, 0, 2.0};
-        sb[mb++] = (nb_series){hx[k], res[k], n, lab[k], col[k], 0, 1, 0};
-        sb[mb++] = (nb_series){hx[k], res[k], n, NULL, col[k], 2, 0, 1.0};
-    }
-    sa[ma++] = (nb_series){NULL, NULL, 0, "measured", NB_BLACK, 0, 1, 0};
-    sa[ma++] = (nb_series){NULL, NULL, 0, "fitted (shared \xce\xb4)", NB_BLACK, 0, 0, 2.0};
-    double ylo = INFINITY, yhi = -INFINITY, rlo = 0.0, rhi = 0.0;
-    for (int k = 0; k < N_SHOW; ++k) {
-        const phc_dataset_result *d = &r->datasets[show[k]];
-        for (size_t i = 0; i < d->n; ++i) {
+            hx[l][i] = d->x[i] / 3600.0;
+            res[l][i] = d->residual[i];
             ylo = fmin(ylo, fmin(d->y[i], d->yhat[i])), yhi = fmax(yhi, fmax(d->y[i], d->yhat[i]));
             rlo = fmin(rlo, d->residual[i]), rhi = fmax(rhi, d->residual[i]);
+            tmax = fmax(tmax, hx[l][i]);
         }
+        for (size_t j = 0; j < cn; ++j)
+            cx[l][j] = d->curve_x[j] / 3600.0;
+        snprintf(lab[l], sizeof lab[l], "leaf %d", l + 1);
+        /* the leaves' colours are keyed in the residual panels below */
+        sa[t][ma[t]++] = (nb_series){hx[l], d->y, n, NULL, col[k], 0, 1, 0};
+        sa[t][ma[t]++] = (nb_series){cx[l], d->curve_y, cn, NULL, col[k], 0, 0, 2.0};
+        sb[t][mb[t]++] = (nb_series){hx[l], res[l], n, lab[l], col[k], 0, 1, 0};
+        sb[t][mb[t]++] = (nb_series){hx[l], res[l], n, NULL, col[k], 2, 0, 1.0};
+    }
+    static const double zy[2] = {0.0, 0.0};
+    double zx[2] = {0.0, tmax};
+    static const char *const grown[2] = {"\"10%\": grown at 10\xe2\x80\x93" "30 % soil moisture",
+                                         "\"40%\": grown at 40\xe2\x80\x93" "60 % soil moisture"};
+    for (int t = 0; t < 2; ++t) {
+        sa[t][ma[t]++] = (nb_series){NULL, NULL, 0, "measured", NB_BLACK, 0, 1, 0};
+        sa[t][ma[t]++] = (nb_series){NULL, NULL, 0, "fitted (one \xce\xb4 for all 12)", NB_BLACK, 0, 0, 2.0};
+        sa[t][ma[t]++] = (nb_series){NULL, NULL, 0, grown[t], NB_BG, 0, 0, 0.1}; /* text only */
+        sb[t][mb[t]++] = (nb_series){zx, zy, 2, NULL, NB_GREY, 0, 0, 1.2};
     }
     /* room for the legends above (masses) and below (residuals) the data */
-    double ytop = yhi + 0.75 * (yhi - ylo), rbot = rlo - 1.1 * (rhi - rlo);
-    double zx[2] = {0.0, 12.0}, zy[2] = {0.0, 0.0};
-    nb_series sb0[2 * N_SHOW + 1];
-    memcpy(sb0, sb, mb * sizeof *sb);
-    sb0[mb] = (nb_series){zx, zy, 2, NULL, NB_GREY, 0, 0, 1.2};
-    nb_panel pan[2] = {
-        {"detached kohlrabi leaves: measured and fitted mass", "time since the first weighing (h)",
-         "fresh mass (g)", 0, ylo - 0.05 * (yhi - ylo), ytop, 1, sa, ma},
-        {"residuals (measured \xe2\x88\x92 fitted)", "time since the first weighing (h)", "residual (g)",
-         0, rbot, rhi + 0.05 * (rhi - rlo), 3, sb0, mb + 1}};
+    double ytop = yhi + 0.55 * (yhi - ylo), rbot = rlo - 1.4 * (rhi - rlo);
+    const char *xl = "time since the first weighing (h)", *rl = "measured \xe2\x88\x92 fitted (g)";
+    nb_panel pan[4] = {
+        {"\"10%\" leaves: fresh mass", xl, "fresh mass (g)", 0, ylo - 0.05 * (yhi - ylo), ytop, 1, sa[0], ma[0]},
+        {"\"40%\" leaves: fresh mass", xl, "fresh mass (g)", 0, ylo - 0.05 * (yhi - ylo), ytop, 1, sa[1], ma[1]},
+        {"\"10%\" leaves: residuals", xl, rl, 0, rbot, rhi + 0.05 * (rhi - rlo), 3, sb[0], mb[0]},
+        {"\"40%\" leaves: residuals", xl, rl, 0, rbot, rhi + 0.05 * (rhi - rlo), 3, sb[1], mb[1]}};
     char png[1024];
     snprintf(png, sizeof png, "%s/wilting_fig6_leaf_drying.png", out);
-    if (nb_plot(png, 1500, 650, 2, 1, pan, 2) != 0) {
+    if (nb_plot(png, 1500, 1100, 2, 2, pan, 4) != 0) {
         fprintf(stderr, "%s: cannot write the plot\n", png);
         return 1;
     }
@@ -216,13 +220,19 @@ int main(int argc, char **argv)
             "modelling the internal water flow follows the measurements better than ignoring it.\n\n"
             "**What we computed.** The authors' measurements are not in phytocal's shared data; we use real balance data\n"
             "phytocal ships a reader for: twelve detached kohlrabi leaves drying on a balance for about\n"
-            "11 h (R package pvldcurve 1.2.6, `leaf_drying_data`, two treatments, 10%% and 40%%). Each leaf is\n"
+            "11 h (R package pvldcurve 1.2.6, `leaf_drying_data`). The leaves come from two treatments, which\n"
+            "the package labels \"10%%\" and \"40%%\": the plants grew at a soil moisture of 10–30 %% or of\n"
+            "40–60 %% during their last 6 days; samples 1, 3, ..., 11 are \"10%%\", 2, 4, ..., 12 \"40%%\". Each leaf is\n"
             "a venation chain of 20 segments built from its measured area; its measured dry weight is the\n"
             "dry mass. One joint fit (`%s`, the same configuration path a user takes): **one loss rate δ\n"
             "for all twelve leaves, one initial water per leaf**.\n\n"
             "- δ = %.4e ± %.2e s⁻¹ cm⁻² (95%% interval [%.4e, %.4e]); %s after %d iterations;\n"
             "- %zu weighings, RMSE %.4f g over all of them.\n\n"
             "![measured and fitted mass](wilting_fig6_leaf_drying.png)\n\n"
+            "*The figure:* all twelve leaves, the \"10%%\" leaves on the left, the \"40%%\" leaves on the right\n"
+            "(one colour per leaf within a column, keyed in the residual panels). Top: the measured fresh mass\n"
+            "(dots) and the fitted curve (line, one δ for all twelve leaves); bottom: the residuals,\n"
+            "measured − fitted (dots joined by dotted lines, in time order). Both columns share their y axes.\n\n"
             "| leaf | treatment | first weighing (g) | last (g) | fitted last (g) | dry (g) | fitted W0 (g) | RMSE (g) | residual at first weighing / most negative (at h) / at last weighing (g) | residual checks failed |\n"
             "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
             "wilting_fig6_leaf_drying.yaml", delta ? delta->value : NAN, delta ? delta->stderr_ : NAN,

@@ -117,7 +117,7 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     return 0;
 }
 
-static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free, NULL, NULL, NULL};
+static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free, NULL, NULL, NULL, NULL};
 
 /* Compiles the derivative tape and binds its names to the slots and to the
  * columns muparser registered (same names, same order as c->cols). */

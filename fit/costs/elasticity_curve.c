@@ -107,7 +107,8 @@ nomem:
 }
 
 static const phc_dataset_ops elasticity_ops = {"elasticity_curve", phc_elasticity_predict,
-                                               phc_elasticity_predict_at, phc_elasticity_impl_free, NULL, NULL, NULL};
+                                               phc_elasticity_predict_at, phc_elasticity_impl_free, NULL, NULL, NULL,
+                                               NULL};
 
 
 int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,

@@ -168,7 +168,7 @@ static int inf_simulate_outputs(phc_dataset *ds, const double *p, const char *di
 }
 
 static const phc_dataset_ops infiltration_ops = {"infiltration", inf_predict, inf_predict_at, inf_free,
-                                                 inf_report_section, inf_simulate_outputs, NULL};
+                                                 inf_report_section, inf_simulate_outputs, NULL, NULL};
 
 
 int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,

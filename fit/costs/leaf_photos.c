@@ -640,10 +640,11 @@ static int lp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
     if ((rc = use_point(ds, p, v, &tf, err)))
         return rc;
     const size_t n = su->w * su->h, fac = enlarge_factor(su);
-    phc_image colour[N_FRAMES], fluid[N_FRAMES], big[2 * N_FRAMES], sheet = {0};
+    phc_image colour[N_FRAMES], fluid[N_FRAMES], big[2 * N_FRAMES], sheet = {0}, bar = {0};
     char caption[2 * N_FRAMES][64], path[8192];
-    const char *caps[2 * N_FRAMES];
-    const phc_image *tiles[2 * N_FRAMES];
+    /* the sheet: N_FRAMES / 2 frames and one more cell per row */
+    const char *caps[2 * N_FRAMES + 4] = {0};
+    const phc_image *tiles[2 * N_FRAMES + 4] = {0};
     double *y[N_FRAMES];
     memset(colour, 0, sizeof colour);
     memset(fluid, 0, sizeof fluid);
@@ -672,12 +673,12 @@ static int lp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
         snprintf(path, sizeof path, "%s/%s_frame_%02d.png", dir, base, k);
         if ((rc = phc_photo_write_png(path, &colour[k], err)))
             goto done;
-        snprintf(caption[k], sizeof caption[k], "colour, t = %.3g", t);
+        snprintf(caption[k], sizeof caption[k], "colour, t = %.3g d", t);
     }
     for (int k = 0; k < N_FRAMES; ++k) {
-        /* every fluid map on one scale, 0 (dark blue) to y_max (yellow) */
-        snprintf(caption[N_FRAMES + k], sizeof caption[k], "fluid 0..%.2g, t = %.3g", y_max,
-                 t_end * k / (N_FRAMES - 1));
+        /* every fluid map on one scale, 0 (dark blue) to y_max (yellow):
+           the colour bar beside them */
+        snprintf(caption[N_FRAMES + k], sizeof caption[k], "fluid y, t = %.3g d", t_end * k / (N_FRAMES - 1));
         snprintf(path, sizeof path, "%s/%s_fluid_%02d.png", dir, base, k);
         if ((rc = phc_photo_write_map_png(path, su->w, su->h, y[k], su->mask, 0, y_max, 1, err)) ||
             (rc = phc_leaf_map_image(su->w, su->h, y[k], su->mask, 0, y_max, &fluid[k], err)) ||
@@ -685,13 +686,21 @@ static int lp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
             (rc = phc_leaf_enlarge(&fluid[k], fac, &big[N_FRAMES + k], err)))
             goto done;
     }
+    /* contact sheet: colour frames in the first two rows, fluid maps in
+       the next two, the fluid's colour bar right of the first fluid row
+       (model time t in days, the unit of phytocal's rates) */
+    if ((rc = phc_leaf_colour_bar(big[N_FRAMES].height, 0, y_max, "fluid y", &bar, err)))
+        goto done;
+    const size_t cols = N_FRAMES / 2 + 1;
     for (int k = 0; k < 2 * N_FRAMES; ++k) {
-        tiles[k] = &big[k];
-        caps[k] = caption[k];
+        const size_t cell = (size_t)k / (N_FRAMES / 2) * cols + (size_t)k % (N_FRAMES / 2);
+        tiles[cell] = &big[k];
+        caps[cell] = caption[k];
     }
-    /* contact sheet: colour frames in the first row(s), fluid maps below */
+    tiles[2 * cols + cols - 1] = &bar;
+    caps[2 * cols + cols - 1] = "scale of all fluid maps";
     snprintf(path, sizeof path, "%s/%s_contact_sheet.png", dir, base);
-    if ((rc = phc_leaf_sheet(tiles, caps, 2 * N_FRAMES, N_FRAMES / 2, 8, &sheet, err)) ||
+    if ((rc = phc_leaf_sheet(tiles, caps, 4 * cols, cols, 8, &sheet, err)) ||
         (rc = phc_photo_write_png(path, &sheet, err)))
         goto done;
     const struct {
@@ -715,6 +724,7 @@ done:
     for (int k = 0; k < 2 * N_FRAMES; ++k)
         phc_image_free(&big[k]);
     phc_image_free(&sheet);
+    phc_image_free(&bar);
     return rc;
 }
 
@@ -773,7 +783,7 @@ static int lp_fit_outputs(phc_dataset *ds, const double *p, const char *dir, con
                 goto done;
             }
             snprintf(caps[2 * k], 64, "photo %s, %s %g", row->id, im->stage_name, row->stage);
-            snprintf(caps[2 * k + 1], 64, "model, t = %.3g", t);
+            snprintf(caps[2 * k + 1], 64, "model, t = %.3g d", t);
             ++k;
         }
     }
@@ -795,8 +805,26 @@ done:
     return rc;
 }
 
+/* Histogram residuals: the series are the quantiles of L*, a* and b*
+ * (observation c nq + k of a photo is quantile k of channel c, at the
+ * probability (k + 1/2)/nq: model/colour.h). */
+static void lp_series_name(const phc_dataset *ds, size_t g, char *buf, size_t size)
+{
+    static const char *const channel[3] = {"L*", "a*", "b*"};
+    const size_t nq = ((const lp_impl *)ds->impl)->nq;
+    snprintf(buf, size, "%s, %.3g %%", channel[g / nq % 3], 100.0 * ((double)(g % nq) + 0.5) / (double)nq);
+}
+
+static int lp_name_series(phc_dataset *ds, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    if (!ds->series || !im->histogram)
+        return PHC_OK;
+    return phc_dataset_name_series(ds, "quantile", 3 * im->nq, lp_series_name, err);
+}
+
 static const phc_dataset_ops leaf_photos_ops = {"leaf_photos", lp_predict, NULL, lp_free, lp_report_section,
-                                                lp_simulate_outputs, lp_fit_outputs};
+                                                lp_simulate_outputs, lp_fit_outputs, lp_name_series};
 
 /* ---- loading ------------------------------------------------------------------------------ */
 

@@ -10,6 +10,7 @@
 #include <strings.h>
 
 #include "fit/costs/elasticity_curve.h"
+#include "fit/pv_plots.h"
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"
@@ -67,9 +68,12 @@ static void pv_extra_free(void *p)
 }
 
 static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
+static int pv_fit_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err);
+static int pv_name_series(phc_dataset *ds, phc_error *err);
 
 static const phc_dataset_ops pv_ops = {"pv_curve", phc_elasticity_predict, phc_elasticity_predict_at,
-                                       phc_elasticity_impl_free, pv_report_section, NULL, NULL};
+                                       phc_elasticity_impl_free, pv_report_section, NULL, pv_fit_outputs,
+                                       pv_name_series};
 
 static pv_extra *extra_of(const phc_dataset *ds)
 {
@@ -532,4 +536,30 @@ static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, 
 {
     (void)p;
     return phc_pv_curve_markdown(ds, markdown, err);
+}
+
+/* fit: the classic pressure–volume plot of every leaf (fit/pv_plots.h). */
+static int pv_fit_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err)
+{
+    (void)p;
+    const pv_extra *x = extra_of(ds);
+    return phc_pv_plot_write(ds->name, (const phc_pv_result *const *)x->res, (const char *const *)x->labels,
+                             x->count, dir, base, err);
+}
+
+/* The leaves are the series: the moduli of leaf L follow those of leaf L - 1. */
+static void pv_series_name(const phc_dataset *ds, size_t g, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s", extra_of(ds)->labels[g]);
+}
+
+static int pv_name_series(phc_dataset *ds, phc_error *err)
+{
+    const pv_extra *x = extra_of(ds);
+    if (!ds->series && !(ds->series = malloc((ds->n ? ds->n : 1) * sizeof *ds->series)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t L = 0, o = 0; L < x->count; ++L)
+        for (size_t j = 0; j < x->res[L]->n_modulus && o < ds->n; ++j)
+            ds->series[o++] = L;
+    return phc_dataset_name_series(ds, "leaf", x->count, pv_series_name, err);
 }

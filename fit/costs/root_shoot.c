@@ -361,7 +361,7 @@ done:
 }
 
 static const phc_dataset_ops root_shoot_ops = {"root_shoot", rs_predict, rs_predict_at, rs_free,
-                                               rs_report_section, rs_outputs, rs_outputs};
+                                               rs_report_section, rs_outputs, rs_outputs, NULL};
 
 /* ---- loading ------------------------------------------------------------------- */
 

@@ -178,8 +178,21 @@ static int sp_simulate_outputs(phc_dataset *ds, const double *p, const char *dir
     return phc_soil_write_fields(im->su, p, im->t_unique[im->m_unique - 1], 24, dir, base, ds->name, err);
 }
 
+/* The probes are the series: the plots name each by its id and depth. */
+static void sp_series_name(const phc_dataset *ds, size_t g, char *buf, size_t size)
+{
+    const phc_probe *pr = &((const sp_impl *)ds->impl)->probes->probes[g];
+    snprintf(buf, size, "%s, %.2f m deep", pr->id, pr->depth);
+}
+
+static int sp_name_series(phc_dataset *ds, phc_error *err)
+{
+    const sp_impl *im = ds->impl;
+    return phc_dataset_name_series(ds, "probe", im->probes->n, sp_series_name, err);
+}
+
 static const phc_dataset_ops soil_probe_ops = {"soil_probe", sp_predict, NULL, sp_free, sp_report_section,
-                                               sp_simulate_outputs, NULL};
+                                               sp_simulate_outputs, NULL, sp_name_series};
 
 
 

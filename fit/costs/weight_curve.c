@@ -229,7 +229,7 @@ done:
 static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
 
 static const phc_dataset_ops weight_curve_ops = {"weight_curve", wc_predict, wc_predict_at,
-                                                 wc_free, wc_report_section, NULL, NULL};
+                                                 wc_free, wc_report_section, NULL, NULL, NULL};
 
 /* ---- loading ------------------------------------------------------------- */
 

@@ -16,6 +16,7 @@
  *  (g) result.json round trip and re-checking at other levels. */
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_multifit.h>
+#include <jansson.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -680,6 +681,16 @@ static void test_round_trip(const phc_fit_result *res, const char *file)
         }
         CHECK(same_number(y->goodness.rmse, x->goodness.rmse, 1e-15));
         CHECK(same_number(y->goodness.aic, x->goodness.aic, 1e-15));
+        /* the series (probes, leaves, ...) of the plots */
+        CHECK((x->series == NULL) == (y->series == NULL) && x->n_series == y->n_series);
+        for (size_t i = 0; x->series && y->series && i < x->n && i < y->n; ++i)
+            CHECK(x->series[i] == y->series[i]);
+        CHECK((x->series_names == NULL) == (y->series_names == NULL));
+        for (size_t g = 0; x->series_names && y->series_names && g < x->n_series && g < y->n_series; ++g)
+            CHECK(strcmp(x->series_names[g], y->series_names[g]) == 0);
+        CHECK((x->series_title == NULL) == (y->series_title == NULL));
+        if (x->series_title && y->series_title)
+            CHECK(strcmp(x->series_title, y->series_title) == 0);
     }
     if (back->n_warnings != res->n_warnings) {
         print_warnings("written", res);
@@ -720,6 +731,29 @@ static void test_round_trip(const phc_fit_result *res, const char *file)
     CHECK(phc_fit_recheck(back, 1.0, &err) == PHC_ERR_INVALID);
     CHECK(phc_fit_recheck(back, NAN, &err) == PHC_ERR_INVALID);
     phc_fit_result_free(back);
+}
+
+/* A result.json whose series do not fit its data set: an error naming it. */
+static void test_bad_series(const char *file)
+{
+    json_error_t jerr;
+    json_t *root = json_load_file(path_in(file), 0, &jerr);
+    json_t *series = json_object_get(json_array_get(json_object_get(root, "datasets"), 0), "series");
+    CHECK(json_is_object(series));
+    if (!json_is_object(series)) {
+        json_decref(root);
+        return;
+    }
+    json_object_set_new(series, "ids", json_pack("[i]", 0)); /* one id for many observations */
+    const char *bad = path_in("bad_series.json");
+    CHECK(json_dump_file(root, bad, 0) == 0);
+    remember(bad);
+    json_decref(root);
+    phc_fit_result *res = NULL;
+    phc_error err;
+    CHECK(phc_result_read_json(bad, &res, &err) == PHC_ERR_INPUT);
+    CHECK_STR_CONTAINS(err.message, "datasets[0].series");
+    CHECK(res == NULL);
 }
 
 static void test_read_errors(void)
@@ -799,8 +833,28 @@ int main(void)
     test_at_bound();
     test_rank_deficient(&sum);
     test_sigmas();
-    if (joint)
+    if (joint && joint->n_datasets > 1) {
+        /* series written and read back: the first data set in two series
+           with names and a title, the second with ids only */
+        for (size_t k = 0; k < 2; ++k) {
+            phc_dataset_result *d = &joint->datasets[k];
+            d->series = malloc(d->n * sizeof *d->series);
+            for (size_t i = 0; d->series && i < d->n; ++i)
+                d->series[i] = k == 0 ? i % 2 : i / 3;
+            d->n_series = k == 0 ? 2 : (d->n - 1) / 3 + 1;
+        }
+        phc_dataset_result *d = &joint->datasets[0];
+        d->series_names = calloc(2, sizeof *d->series_names);
+        if (d->series_names) {
+            d->series_names[0] = strdup("even, 0.10 m");
+            d->series_names[1] = strdup("odd \"#2\"");
+        }
+        d->series_title = strdup("probe");
+    }
+    if (joint) {
         test_round_trip(joint, "joint.json");
+        test_bad_series("joint.json");
+    }
     if (sum)
         test_round_trip(sum, "sum.json");
     test_read_errors();
