@@ -21,9 +21,11 @@ written into the checkout.  Its stdout is compared with the block:
 Options:
   stderr        compare stdout and stderr together (2>&1)
   exit=N        the exit code expected (default 0)
-  timings       a benchmark's "key: value" lines: values are measurements of
-                one machine (the text before the block says which and when)
-                and are not compared; the keys and their order are
+  timings       a benchmark's "key: value" lines: values that are times,
+                rates, ratios of times or verdicts drawn from them are one
+                machine's measurements (the text before the block says which
+                and when) and are not compared; the keys, their order and
+                every other value (a model's number, a checksum) are
   skip-without-shared   skip (with a message) when the shared data is absent
 
 Prints "ok - ..." / "not ok - ..." per block with a diff, then
@@ -67,12 +69,20 @@ def parse(readme):
         i += 1
 
 
+# In a benchmark's "key: value" line, the value is one machine's measurement
+# when the key or the value's unit says it is a time, a rate, a ratio of
+# times, a memory size or a verdict drawn from them; other values (a model's
+# number, a checksum, a count) are compared like any output.
+MEASURED_KEY = re.compile(r"time|_ns|ns_|_ms|ms_|_us|vups|_bw|bw_|speed|ratio|memory|load|overhead|per_s|"
+                          r"s_per|target|linear|quiet|mpix|fraction|cost|threads|version|timed|lre")
+MEASURED_UNIT = re.compile(r"\d\s*(s|ms|us|ns|x|B|GB/s|voxel/s|digits|CPUs)(?=$|[\s,;()])")
+
+
 def mask_timing(line):
-    """Keeps a benchmark line's key (the text before its first ':'): the
-    value, and any verdict drawn from timings (met / not met), is one
-    machine's measurement."""
-    key, colon, _ = line.partition(":")
-    return key + ": <measured>" if colon else line
+    key, colon, value = line.partition(":")
+    if colon and (MEASURED_KEY.search(key) or MEASURED_UNIT.search(value)):
+        return key + ": <measured>"
+    return line
 
 
 def line_matches(want, got):
