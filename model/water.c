@@ -139,9 +139,11 @@ int phc_water_system_new(const phc_plant_graph *g, const phc_water_params *p,
      * -1 (the resistance forms of the paper and the 2023 code); g ~ 1/mu. */
     s->mu_power = (p->weights == PHC_WATER_PAPER || p->weights == PHC_WATER_REFERENCE) ? 1.0 : -1.0;
 
-    /* K: pressure per (g/cm^3).  Physical: R T / M_w in Ba cm^3/g
-     * (J/g * 1e7 erg/J).  Reference: the authors' 11.538 (T in Celsius). */
-    double K = reference ? 1.0 / PHC_WATER_REFERENCE_PRESS_CONST
+    /* K: pressure per (g/cm^3), P = K theta / V.  Physical: R T / M_w in
+     * Ba cm^3/g (J/g * 1e7 erg/J).  Reference: the authors' PRESS_CONST
+     * 11.538 (T in Celsius), which multiplies: their S = PRESS_CONST * Adj *
+     * diag(V)^-1 - diag(loss * Area), so d = V / PRESS_CONST. */
+    double K = reference ? PHC_WATER_REFERENCE_PRESS_CONST
                          : PHC_WATER_GAS_CONSTANT * PHC_WATER_TEMPERATURE / PHC_WATER_MOLAR_MASS * 1e7;
     /* mu: physical modes in poise (1 mPa s = 1e-2 P) so that g is in
      * cm^3/(s Ba); reference: their 1e6 * pi r^4 / (8 * 0.9 * L). */
@@ -156,8 +158,7 @@ int phc_water_system_new(const phc_plant_graph *g, const phc_water_params *p,
         s->vol[k] = M_PI * r * r * h;
         int loses = g->leaf && g->leaf[i] && !(p->no_loss && p->no_loss[i]);
         s->area[k] = loses ? r * h : 0.0;
-        /* reference: S = Adj diag(PC V)^-1 so d = PC V; physical d = V / K */
-        s->d[k] = reference ? s->vol[k] / K : s->vol[k] / K;
+        s->d[k] = s->vol[k] / K; /* capacity: theta / pressure */
         gi[k] = g_scale * M_PI * r * r * r * r / (8.0 * mu_unit * h);
     }
     if (g->parent[s->perm[0]] != PHC_PLANT_NO_PARENT) {

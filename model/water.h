@@ -13,7 +13,8 @@
  *     theta' = S theta,   S = R D^-1 - D_l,   theta(0) = W0 V / sum(V)
  * where R is the weighted Laplacian of the tree (R_ij = w_ij for tree
  * neighbours, R_ii = -sum_j w_ij), D = diag(d) with d_i = V_i / K the water
- * "capacity" (pressure P_i = theta_i / d_i), and D_l = diag(l).
+ * "capacity" (pressure P_i = theta_i / d_i = K theta_i / V_i: the pressure
+ * constant K multiplies, in every mode), and D_l = diag(l).
  *
  * Edge weights (phc_water_weights):
  *   PHC_WATER_POISEUILLE (default, the physical reading).  The two half
@@ -37,13 +38,20 @@
  *     w_ij = 1 / ((g_i + g_j) / 2).  Dimensionally inconsistent; offered to
  *     compare with the paper.  K as in the default.
  *   PHC_WATER_REFERENCE: the authors' public C++ code
- *     (filthynobleman/plant-water-diffusion, src/watermodel/watermodel.cpp,
- *     every stored version): FlowRes_i = 1e6 pi r^4 / (8 * 0.9 * L) with r, L
- *     in cm, w = 1 / (0.5 (FlowRes_i + FlowRes_j)), S = Adj diag(PC V)^-1 -
- *     diag(loss * Area), PC = 11.538249539485484 (R T / M_w with T = 25 taken
- *     in degrees Celsius), Area = L r, Volume = pi r^2 L, graph metres * 100.
- *   PHC_WATER_REFERENCE_2024: as PHC_WATER_REFERENCE but w = 0.5 (FlowRes_i
- *     + FlowRes_j) (mean used as a conductance, DESIGN §5 "2024 code").
+ *     (filthynobleman/plant-water-diffusion, src/watermodel/watermodel.cpp)
+ *     as it was in 2023 (commits up to 827aab6): FlowRes_i = 1e6 pi r^4 /
+ *     (8 * 0.9 * L) with r, L in cm, w = 1 / (0.5 (FlowRes_i + FlowRes_j)),
+ *     S = PC * Adj * diag(V)^-1 - diag(loss * Area): the pressure is
+ *     PC theta / V, so d = V / PC.  PC = 11.538249539485484 (R T / M_w with
+ *     T = 25 taken in degrees Celsius), Area = L r, Volume = pi r^2 L, graph
+ *     metres * 100.  tests/realdata/test_water_reference checks W and theta
+ *     against their code on plant000 and plant002.
+ *   PHC_WATER_REFERENCE_2024: their current code (commit 583c49a, August
+ *     2024, drops the inversion): w = 0.5 (FlowRes_i + FlowRes_j), the mean
+ *     used as a conductance; otherwise as PHC_WATER_REFERENCE.
+ *   Both reference modes are stiff too (fastest rate of S 1.4e6 to 2.7e8
+ *     1/s on plant000 and plant002): use BDF6 or mind the exact evaluator's
+ *     accuracy there.
  *
  * Options: mu (mPa s; 0 = default 0.89 for water at 25 C, 0.9 in the
  * reference modes), per-edge conductance factors (paper Fig. 10: 0 = cut,
@@ -88,7 +96,7 @@ typedef enum phc_water_method {
 #define PHC_WATER_GAS_CONSTANT 8.314462618
 #define PHC_WATER_MOLAR_MASS 18.01528
 #define PHC_WATER_TEMPERATURE 298.15
-/* The authors' constant: R * 25 / M_w (T in Celsius), pressure per g/cm^3. */
+/* The authors' PRESS_CONST: R * 25 / M_w (T in Celsius); pressure = PC * theta / V. */
 #define PHC_WATER_REFERENCE_PRESS_CONST 11.538249539485484
 
 typedef struct phc_water_params {

@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """SciPy peer of the water-model benchmark (tests/bench/bench_water.c).
 
-The same model as model/water.c in its `reference` mode (the authors' C++
-code, filthynobleman/plant-water-diffusion: FlowRes = 1e6 pi r^4/(8*0.9*L),
-edge weight 1/mean(FlowRes), S = R diag(PC V)^-1 - diag(delta * A),
+The same model as model/water.c in its `reference` mode (the authors' 2023
+C++ code, filthynobleman/plant-water-diffusion: FlowRes = 1e6 pi r^4/(8*0.9*L),
+edge weight 1/mean(FlowRes), S = PC R diag(V)^-1 - diag(delta * A),
 PC = 11.538249539485484, graph metres * 100 to cm, theta(0) = W0 V/sum V),
 written with numpy/scipy only, run with Debian's system python3:
 
@@ -11,8 +11,11 @@ written with numpy/scipy only, run with Debian's system python3:
         [--curve CSV --dry G --delta0 D --w00 W] [--repeat R]
 
 Prints `name: value unit` lines on stdout (prefix scipy_):
-  * W(1e4) exact (scipy.linalg.eigh of the symmetric form) in the reference
-    setting (delta 6e-3, W0 8), to check that S is the same as C's;
+  * W(1e4) in the reference setting (delta 6e-3, W0 8) by scipy.linalg.eigh
+    of the symmetric form and by BDF6, to check that S is the same as C's
+    (the eigen values are good to about 1e-16 x stiffness x t only, 5e-6
+    here; this BDF6, with splu's elimination, to 5e-9: C's agrees with the
+    authors' matrix to 4e-13);
   * BDF6 (paper eq. 8) with a fixed step of 10 s: I - alpha h S factorised
     once with scipy.sparse.linalg.splu, 1000 steps; the start (theta at
     h..5h) is computed as in C, by extrapolated implicit Euler (sub-steps
@@ -96,7 +99,7 @@ class Model:
         self.n = n
         vol = np.pi * r * r * h
         self.area = np.where(leaf, r * h, 0.0)
-        self.d = PC * vol
+        self.d = vol / PC  # pressure PC theta / V: S = PC R diag(V)^-1
         g = 1e6 * np.pi * r ** 4 / (8.0 * mu * h)
         k = np.nonzero(parent >= 0)[0]
         p = parent[k]
@@ -142,7 +145,13 @@ def exact_w_only(m):
     q -= (u @ q) * u
     A -= 2.0 * (np.outer(u, q) + np.outer(q, u))
     c, dd, e, tau, info = scipy.linalg.lapack.dsytrd(A, lower=1, overwrite_a=1)
-    lam, Z = scipy.linalg.eigh_tridiagonal(dd, e, check_finite=False)
+    try:
+        lam, Z = scipy.linalg.eigh_tridiagonal(dd, e, check_finite=False)
+    except np.linalg.LinAlgError:
+        # SciPy's default driver (dstemr) does not converge on the stiffer
+        # reference systems (eigenvalues from 1e-5 to 2.7e8 1/s); dstev
+        # (implicit QL/QR) does
+        lam, Z = scipy.linalg.eigh_tridiagonal(dd, e, check_finite=False, lapack_driver="stev")
     return lam, m.w0 * Z[0, :] ** 2
 
 
@@ -274,7 +283,10 @@ def main():
     print(f"scipy_exact_w_eval_plant000: {t_eval * 1e3:.2f} us")
     print(f"scipy_reference_W_1e4_exact: {We:.6f} g")
     print(f"scipy_reference_W_1e4_w_only: {total(lam2, ab2, 1e4):.6f} g")
-    print(f"scipy_bdf6_rel_error_vs_exact_reference_setting: {abs(Wb - We) / We:.2e} 1")
+    # eigh loses about 1e-16 x stiffness x t (stiffness 3.2e8 1/s here):
+    # BDF6 with its accurate start is the closer value to compare with C's
+    print(f"scipy_reference_W_1e4_bdf6: {Wb:.10f} g")
+    print(f"scipy_bdf6_rel_error_vs_eigh_reference_setting: {abs(Wb - We) / We:.2e} 1")
 
     if a.curve:
         data = np.genfromtxt(a.curve, delimiter=",", names=True)

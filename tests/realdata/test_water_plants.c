@@ -1,6 +1,7 @@
 /* The water model on the wilting paper's four plants (../shared/data/plants):
- * BDF6 (accurate start) against the exact evaluator, and the reference
- * mode on plant000 (loss 6e-3, initial water 8, t = 1e4 s). */
+ * BDF6 (accurate start) against the exact evaluator in both reference modes
+ * (loss 6e-3, initial water 8, t <= 1e4 s).  The numbers of the authors'
+ * code are checked in test_water_reference. */
 #include "check.h"
 
 #include <stdlib.h>
@@ -57,11 +58,7 @@ int main(void)
                    W, worst, phc_water_system_stiffness(s) * 1e4);
             /* exact loses ~1e-16 * stiffness * t relative accuracy */
             CHECK(worst < 1e-9 + 1e-15 * phc_water_system_stiffness(s) * 1e4);
-            if (k == 0 && mode == PHC_WATER_REFERENCE)
-                CHECK_NEAR(W, 7.294852, 5e-7, 0); /* every stored version of watermodel.cpp */
-            if (k == 0 && mode == PHC_WATER_REFERENCE_2024)
-                /* the brief's 7.186406 is not reproduced: 7.186414 (see report) */
-                CHECK_NEAR(W, 7.186414, 1e-6, 0);
+            /* the authors' numbers are checked in test_water_reference */
             phc_water_bdf6_free(b);
             phc_water_exact_free(e);
             phc_water_system_free(s);
