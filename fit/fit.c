@@ -523,22 +523,6 @@ done:
     return rc;
 }
 
-/* Passes the solver's iterations on as progress of start `step` of `steps`. */
-typedef struct iteration_relay {
-    phc_progress_fn progress;
-    void *user_data;
-    size_t step, steps;
-    int cancelled;
-} iteration_relay;
-
-static int relay_iteration(int iteration, double cost, void *user_data)
-{
-    iteration_relay *r = user_data;
-    if (phc_progress_report(r->progress, r->user_data, "start", r->step, r->steps, iteration, cost, NULL))
-        r->cancelled = 1;
-    return r->cancelled;
-}
-
 int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
                 phc_fit_result **out, phc_error *err)
 {
@@ -594,10 +578,10 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    iteration_relay relay = {progress, user_data, 0, planned, 0};
+    phc_progress_relay relay = {progress, user_data, "start", NULL, 0, planned, 0};
     phc_nls_options nls_opt = opt->nls;
     if (progress) {
-        nls_opt.on_iteration = relay_iteration;
+        nls_opt.on_iteration = phc_progress_relay_iteration;
         nls_opt.on_iteration_data = &relay;
     }
     for (size_t s = 0; s < planned; ++s) {

@@ -21,4 +21,17 @@ typedef int (*phc_progress_fn)(const phc_progress *p, void *user_data);
 int phc_progress_report(phc_progress_fn fn, void *user_data, const char *stage, size_t step,
                         size_t steps, int iteration, double cost, const char *detail);
 
+/* Passes a solver's iterations on (phc_nls_options.on_iteration with this
+ * struct as its data) as progress of `stage` step `step` of `steps`; a
+ * cancel sets `cancelled` and stops the solve. */
+typedef struct phc_progress_relay {
+    phc_progress_fn progress;
+    void *user_data;
+    const char *stage, *detail;
+    size_t step, steps;
+    int cancelled;
+} phc_progress_relay;
+
+int phc_progress_relay_iteration(int iteration, double cost, void *relay);
+
 #endif /* PHC_PROGRESS_H */

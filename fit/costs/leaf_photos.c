@@ -399,22 +399,6 @@ static int loo_residuals(const double *p, double *r, double *jac, void *user)
 
 /* Refits the data set's free slots with row `left_out` excluded, from p;
  * the result overwrites p. */
-/* The refits' solver iterations, reported as progress of fold `fold` of `folds`. */
-typedef struct fold_relay {
-    phc_dataset *ds;
-    size_t fold, folds;
-    int cancelled;
-} fold_relay;
-
-static int relay_fold_iteration(int iteration, double cost, void *user_data)
-{
-    fold_relay *r = user_data;
-    if (phc_progress_report(r->ds->progress, r->ds->progress_data, "leave-one-out", r->fold, r->folds, iteration,
-                            cost, r->ds->name))
-        r->cancelled = 1;
-    return r->cancelled;
-}
-
 static int refit_without(phc_dataset *ds, double *p, size_t fold, size_t folds, phc_error *err)
 {
     const phc_problem *pb = ds->problem;
@@ -438,9 +422,9 @@ static int refit_without(phc_dataset *ds, double *p, size_t fold, size_t folds, 
                                 err)))
         goto done;
     phc_nls_options opt = pb->options.nls;
-    fold_relay relay = {ds, fold, folds, 0};
+    phc_progress_relay relay = {ds->progress, ds->progress_data, "leave-one-out", ds->name, fold, folds, 0};
     if (ds->progress) {
-        opt.on_iteration = relay_fold_iteration;
+        opt.on_iteration = phc_progress_relay_iteration;
         opt.on_iteration_data = &relay;
     }
     phc_nls_summary sum;
