@@ -336,6 +336,9 @@ static int load_for_run(const char *cmd, int full_argc, char **full_argv, int ar
         snprintf(dir, size, "%s", o->out_dir);
     else
         snprintf(dir, size, "runs/%s%s", (*pb)->name, suffix);
+    /* "out/" is the folder "out": its temporary sibling must not land inside */
+    for (size_t n = strlen(dir); n > 1 && dir[n - 1] == '/'; --n)
+        dir[n - 1] = '\0';
     if (phc_run_dir_check(dir, o->force, *pb, &err) ||
         phc_provenance_begin(*pb, full_argc, full_argv, PHC_VERSION, PHC_GIT_COMMIT, pv, &err)) {
         phc_problem_free(*pb);

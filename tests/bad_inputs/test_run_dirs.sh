@@ -220,6 +220,14 @@ want_rc 1
 err_has "unknown option '--frobnicate'"
 finish "unknown option names itself"
 
+# 12b. a trailing slash names the same folder
+run fit ex/enzyme.yaml -o run1/ --force --quiet
+want_rc 0
+exists run1/result.json
+[ -z "$(ls -A run1 | grep -e '^\.tmp' -e '^run1')" ] || why "a temporary folder landed inside run1/"
+no_leftovers run1
+finish "-o DIR/ (trailing slash) replaces DIR itself"
+
 # 13. progress: plain lines when stderr is not a terminal
 run fit ex/enzyme.yaml -o run4
 want_rc 0
