@@ -65,6 +65,7 @@ void phc_dataset_free(phc_dataset *ds)
     free(ds->sigma);
     free(ds->data_file);
     free(ds->data_lines);
+    free(ds->time_of_day);
     free(ds->x_label);
     free(ds->y_label);
     for (size_t i = 0; i < ds->n_inputs; ++i)

@@ -83,6 +83,12 @@ struct phc_dataset {
     char **inputs;               /* every file the loader read, as opened (paths relative to
                                     the working directory or absolute), for provenance */
     size_t n_inputs;
+    double x_seconds;            /* seconds per unit of x when x is a time (weight curves,
+                                    soil readings), else 0: residual checks then look for
+                                    serial correlation over time lags out to 1.5 days */
+    double *time_of_day;         /* n local clock times of the observations, hours in
+                                    [0, 24), or NULL when the clock time is not known:
+                                    the report then cannot look for a daily cycle */
     phc_progress_fn progress;    /* set by the caller for the duration of long work (a
                                     kind's own refits in fit_outputs); may be NULL */
     void *progress_data;
