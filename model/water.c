@@ -6,6 +6,7 @@
  * then runs over contiguous arrays, leaves first (k = n-1 .. 1) and back
  * (k = 1 .. n-1), without fill-in. */
 #include "model/water.h"
+#include "model/water_internal.h"
 
 #include <cblas.h>
 #include <float.h>
@@ -17,21 +18,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-struct phc_water_system {
-    size_t n;
-    size_t *perm;        /* n: graph index of position k */
-    size_t *par;         /* n: parent position (par[0] unused) */
-    double *w;           /* n: weight of edge (k, par[k]), w[0] = 0 */
-    double *wsum;        /* n: sum of the weights at k */
-    double *d;           /* n: capacity, theta / pressure (cm^3 per pressure unit) */
-    double *vol;         /* n: V, cm^3 */
-    double *area;        /* n: A (masked: 0 on stem and no-loss segments), cm^2 */
-    double *ell;         /* n: delta * area, 1/s */
-    double *theta0;      /* n: g */
-    double delta, w0, mu, mu_power; /* R is proportional to mu^mu_power */
-    phc_water_weights weights;
-};
 
 phc_water_params phc_water_params_default(void)
 {
@@ -527,28 +513,6 @@ int phc_water_exact_state(const phc_water_exact *e, double t, double *theta, phc
     return PHC_OK;
 }
 
-/* Divided difference of exp(. t) at lambda_i, lambda_j (Frechet derivative
- * of the matrix exponential in the eigenbasis): (E_i - E_j)/(l_i - l_j),
- * t E on the diagonal; written with expm1 around the larger eigenvalue. */
-static double phi(double li, double lj, double Ei, double Ej, double t)
-{
-    if (li > lj) {
-        double tmp = li;
-        li = lj;
-        lj = tmp;
-        tmp = Ei;
-        Ei = Ej;
-        Ej = tmp;
-    }
-    double dl = li - lj; /* <= 0 */
-    if (dl == 0.0)
-        return t * Ej;
-    double x = dl * t;
-    if (fabs(x) < 1e-300)
-        return t * Ej;
-    return Ej * expm1(x) / dl;
-}
-
 int phc_water_exact_sensitivity(const phc_water_exact *e, double t, double *dW,
                                 double *dtheta_ddelta, phc_error *err)
 {
@@ -570,7 +534,7 @@ int phc_water_exact_sensitivity(const phc_water_exact *e, double t, double *dW,
         double acc = 0.0;
         const double *Mi = e->M + i * n; /* column i = row i (symmetric) */
         for (size_t j = 0; j < n; ++j)
-            acc += phi(e->lambda[i], e->lambda[j], E[i], E[j], t) * Mi[j] * e->b[j];
+            acc += phc_water_expm_divided_difference(e->lambda[i], e->lambda[j], E[i], E[j], t) * Mi[j] * e->b[j];
         y[i] = acc;
         dWd -= e->a[i] * acc;
         lamterm += e->ab[i] * t * e->lambda[i] * E[i];
@@ -616,45 +580,18 @@ struct phc_water_bdf6 {
     size_t Wcap;
 };
 
-/* Factorises M = I - c S (S = R D^-1 - D_l) by elimination leaves first:
- * row k (after its children) holds only M_kk and M_k,par, so there is no
- * fill-in.  M is column diagonally dominant (column sums 1 + c l_k), so no
- * pivoting is needed; the pivots are computed GTH-style (Grassmann, Taksar
- * & Heyman 1985) from the running column sums sigma of the Schur complement,
- * pivot_k = sigma_k + |M_par,k|, which involves no cancellation: stiff
- * systems (c w / d ~ 1e15 in the physical mode) stay exactly conservative. */
+/* I - c S factorised over the tree (model/water_tree.c). */
 static void tree_factor(phc_water_bdf6 *b, double c)
 {
     const phc_water_system *s = b->s;
-    size_t n = b->n;
-    double *sig = b->ipiv;
-    for (size_t k = 0; k < n; ++k)
-        sig[k] = 1.0 + c * s->ell[k];
-    for (size_t k = n - 1; k >= 1; --k) {
-        size_t pk = s->par[k];
-        double akp = c * s->w[k] / s->d[pk]; /* -M(k, par) */
-        double apk = c * s->w[k] / s->d[k];  /* -M(par, k) */
-        double piv = sig[k] + apk;
-        b->l[k] = -apk / piv;
-        b->u[k] = -akp;
-        sig[pk] += akp * sig[k] / piv;
-        sig[k] = 1.0 / piv;
-    }
-    sig[0] = 1.0 / sig[0];
+    phc_water_tree_factor(b->n, s->par, s->w, s->d, s->ell, c, b->l, b->u, b->ipiv);
     b->c = c;
 }
 
 /* y <- M^-1 y. */
 static void tree_solve(const phc_water_bdf6 *b, double *restrict y)
 {
-    const size_t *restrict par = b->s->par;
-    const double *restrict l = b->l, *restrict u = b->u, *restrict ip = b->ipiv;
-    size_t n = b->n;
-    for (size_t k = n - 1; k >= 1; --k)
-        y[par[k]] -= l[k] * y[k];
-    y[0] *= ip[0];
-    for (size_t k = 1; k < n; ++k)
-        y[k] = (y[k] - u[k] * y[par[k]]) * ip[k];
+    phc_water_tree_solve(b->n, b->s->par, b->l, b->u, b->ipiv, y);
 }
 
 /* Implicit step for the augmented system: x[0] = theta (rhs given), then
