@@ -92,7 +92,7 @@ static const phc_key_help top_help[] = {
     {NULL, NULL}};
 
 static const char *const parameter_keys[] = {"value", "lower", "upper", "fixed", "unit",
-                                             "scale", "range", NULL};
+                                             "scale", "range", "per_piece", NULL};
 static const phc_key_help parameter_help[] = {
     {"value", "Start value, within the bounds. Required (or write NAME: number)."},
     {"lower", "Lower bound; not above upper. Default: none (-inf)."},
@@ -104,6 +104,9 @@ static const phc_key_help parameter_help[] = {
     {"range", "[low, high], low < high: the box in which multi-start draws start points "
               "(solver starts and rescue_starts). Default: the bounds when both are finite, "
               "else a decade either side of value."},
+    {"per_piece", "true: the slots NAME_2, NAME_3, ... of a weight curve split at irrigations "
+                  "(jumps: split) get their own copies of this parameter, with its start, "
+                  "bounds, unit and scale, named as the slots. Default: false."},
     {NULL, NULL}};
 
 static const char *const solver_keys[] = {"method", "max_iterations", "function_tolerance",
@@ -227,6 +230,7 @@ static int parse_parameter(const phc_yaml_doc *doc, phc_problem *pb, const char 
     if ((rc = phc_yaml_map_number(doc, spec, "lower", 0, ctx, &p->lower, err)) ||
         (rc = phc_yaml_map_number(doc, spec, "upper", 0, ctx, &p->upper, err)) ||
         (rc = phc_yaml_map_boolean(doc, spec, "fixed", 0, ctx, &p->fixed, err)) ||
+        (rc = phc_yaml_map_boolean(doc, spec, "per_piece", 0, ctx, &p->per_piece, err)) ||
         (rc = phc_yaml_map_number(doc, spec, "scale", 0, ctx, &p->scale, err)) ||
         (rc = phc_yaml_map_string(doc, spec, "unit", 0, ctx, &unit, err)))
         return rc;
@@ -339,6 +343,41 @@ static int is_parameter(const char *name, void *user_data)
     return phc_problem_find_parameter(b->pb, name) >= 0;
 }
 
+/* A slot NAME_<k> (k >= 2) with no parameter of its own, where NAME is a
+ * parameter marked per_piece: adds NAME_<k> as a copy of NAME and sets *idx
+ * to it (left -1 otherwise). */
+static int per_piece_copy(phc_problem *pb, const char *global, long *idx, phc_error *err)
+{
+    const char *us = strrchr(global, '_');
+    if (!us || !us[1] || strspn(us + 1, "0123456789") != strlen(us + 1) || atol(us + 1) < 2)
+        return PHC_OK;
+    char base[256];
+    if ((size_t)(us - global) >= sizeof base)
+        return PHC_OK;
+    memcpy(base, global, (size_t)(us - global));
+    base[us - global] = '\0';
+    long b = phc_problem_find_parameter(pb, base);
+    if (b < 0 || !pb->params[b].per_piece)
+        return PHC_OK;
+    phc_parameter copy = pb->params[b]; /* by value: adding may move the array */
+    size_t index;
+    int rc = phc_problem_add_parameter(pb, global, copy.value, &index, err);
+    if (rc)
+        return rc;
+    phc_parameter *p = &pb->params[index];
+    p->lower = copy.lower;
+    p->upper = copy.upper;
+    p->fixed = copy.fixed;
+    p->scale = copy.scale;
+    p->range_lo = copy.range_lo;
+    p->range_hi = copy.range_hi;
+    p->config_line = copy.config_line;
+    if (copy.unit && !(p->unit = strdup(copy.unit)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    *idx = (long)index;
+    return PHC_OK;
+}
+
 static int bind_slots(const phc_yaml_doc *doc, const phc_yaml_node *binding, phc_problem *pb,
                       phc_dataset *ds, size_t line, phc_error *err)
 {
@@ -353,6 +392,8 @@ static int bind_slots(const phc_yaml_doc *doc, const phc_yaml_node *binding, phc
             where = b->line;
         }
         long idx = phc_problem_find_parameter(pb, global);
+        if (idx < 0 && (rc = per_piece_copy(pb, global, &idx, err)))
+            return rc;
         if (idx < 0) {
             const char **names = malloc((pb->n_params + 1) * sizeof *names);
             if (!names)

@@ -20,6 +20,9 @@ typedef struct phc_parameter {
     double range_lo, range_hi; /* multi-start box; NAN = automatic */
     size_t config_line;  /* line of its key in the config (problem->source), 0 when
                             built by hand: messages about it name that line */
+    int per_piece;       /* the config's `per_piece: true`: a slot NAME_<k> (k >= 2) of a
+                            curve split at irrigations gets its own copy of this
+                            parameter (same start, bounds, unit and scale) */
 } phc_parameter;
 
 /* The largest magnitude of a start value, finite bound or range end.  The
