@@ -14,6 +14,10 @@
 #include "fit/residual_checks.h"
 #include "fit/uncertainty.h"
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 #define CURVE_POINTS 400
 #define MAX_COLLIN_SETS 200000
 
@@ -46,6 +50,8 @@ static void dataset_result_clear(phc_dataset_result *d)
         free(d->series_names[g]);
     free(d->series_names);
     free(d->series_title);
+    free(d->time_of_day);
+    free(d->acf_time);
 }
 
 /* The data set's series (ids, names, title) into its result; PHC_OK or
@@ -154,6 +160,116 @@ static void set_check(phc_check_result *c, const char *name, const char *what, i
     c->pass = !c->applicable || p >= level;
 }
 
+/* Local clock hour (0-24) at which a + b cos(w h) + c sin(w h), w = 2 pi / 24,
+ * fitted by least squares to the standardised residuals against their clock
+ * times, is largest; NAN when the fit is degenerate (times at one phase). */
+static double cycle_peak_hour(const phc_dataset_result *d)
+{
+    double A[3][3] = {{0}}, y[3] = {0};
+    for (size_t i = 0; i < d->n; ++i) {
+        const double h = d->time_of_day[i], r = d->std_residual[i];
+        if (!isfinite(h) || !isfinite(r))
+            continue;
+        const double v[3] = {1.0, cos(2.0 * M_PI * h / 24.0), sin(2.0 * M_PI * h / 24.0)};
+        for (int a = 0; a < 3; ++a) {
+            y[a] += v[a] * r;
+            for (int b = 0; b < 3; ++b)
+                A[a][b] += v[a] * v[b];
+        }
+    }
+    /* Cramer's rule on the 3 x 3 normal equations */
+#define DET3(M) ((M)[0][0] * ((M)[1][1] * (M)[2][2] - (M)[1][2] * (M)[2][1]) - \
+                 (M)[0][1] * ((M)[1][0] * (M)[2][2] - (M)[1][2] * (M)[2][0]) + \
+                 (M)[0][2] * ((M)[1][0] * (M)[2][1] - (M)[1][1] * (M)[2][0]))
+    const double det = DET3(A);
+    if (!(fabs(det) > 1e-9 * A[0][0] * A[0][0] * A[0][0]))
+        return NAN;
+    double coef[3];
+    for (int k = 1; k < 3; ++k) {
+        double M[3][3];
+        memcpy(M, A, sizeof M);
+        for (int a = 0; a < 3; ++a)
+            M[a][k] = y[a];
+        coef[k] = DET3(M) / det;
+    }
+#undef DET3
+    double h = atan2(coef[2], coef[1]) * 24.0 / (2.0 * M_PI);
+    return h < 0 ? h + 24.0 : h;
+}
+
+/* The checks of time series (x_seconds > 0) spanning >= 1.5 days: the
+ * daily-cycle test, the time-lag autocorrelation and the highest
+ * periodogram peak.  r: the standardised residuals in the x order of
+ * `order`.  Sets the daily_cycle check (not applicable for other data). */
+static int time_series_checks(phc_dataset_result *d, const keyed *order, const double *r, double level)
+{
+    const size_t n = d->n;
+    free(d->acf_time);
+    d->acf_time = NULL;
+    d->acf_time_bins = 0;
+    d->acf_time_bin_h = d->cycle_period_h = d->cycle_peak_hour = NAN;
+    d->peak_period_h = d->peak_power = d->peak_fap = NAN;
+    int rc = PHC_ERR_INVALID;
+    double stat = NAN, p = NAN;
+    double *t = NULL;
+    int ts = d->x_seconds > 0 && isfinite(d->x_seconds) && n >= 3;
+    if (ts) {
+        if (!(t = malloc(n * sizeof *t)))
+            return PHC_ERR_NOMEM;
+        for (size_t i = 0; i < n && ts; ++i) {
+            t[i] = order[i].x * d->x_seconds / 3600.0; /* hours */
+            ts = isfinite(t[i]);
+        }
+        ts = ts && t[n - 1] - t[0] >= PHC_DAILY_MIN_SPAN_H; /* sorted by x */
+    }
+    if (ts) {
+        rc = phc_check_daily_cycle(t, r, n, &stat, &p, &d->cycle_period_h);
+        if (rc == PHC_ERR_NOMEM)
+            goto nomem;
+        if (rc == PHC_OK && d->time_of_day)
+            d->cycle_peak_hour = cycle_peak_hour(d);
+        const double bin = phc_check_acf_time_bin(t, n, 1.0);
+        if (isfinite(bin)) {
+            const size_t bins = (size_t)floor(PHC_ACF_TIME_MAX_LAG_H / bin + 1e-9) + 1;
+            if (!(d->acf_time = malloc(bins * sizeof *d->acf_time)))
+                goto nomem;
+            int arc = phc_check_acf_time(t, r, n, bin, bins, d->acf_time, NULL);
+            if (arc == PHC_ERR_NOMEM)
+                goto nomem;
+            if (arc == PHC_OK) {
+                d->acf_time_bins = bins;
+                d->acf_time_bin_h = bin;
+            } else {
+                free(d->acf_time);
+                d->acf_time = NULL;
+            }
+            /* highest peak from the span down to two lag bins (>= 2 h) */
+            const double f_lo = 1.0 / (t[n - 1] - t[0]), f_hi = 1.0 / (2.0 * bin);
+            phc_periodogram_peak pk;
+            if (f_hi > f_lo) {
+                int prc = phc_check_periodogram_peak(t, r, n, f_lo, f_hi, 5.0, &pk);
+                if (prc == PHC_ERR_NOMEM)
+                    goto nomem;
+                if (prc == PHC_OK) {
+                    d->peak_period_h = pk.period;
+                    d->peak_power = pk.power;
+                    d->peak_fap = pk.fap;
+                }
+            }
+        }
+    }
+    set_check(&d->checks[PHC_CHECK_DAILY_CYCLE], "daily_cycle", "a 24-hour cycle in the residuals (Lomb–Scargle)",
+              rc, stat, p, level);
+    free(t);
+    return PHC_OK;
+nomem:
+    free(t);
+    free(d->acf_time);
+    d->acf_time = NULL;
+    d->acf_time_bins = 0;
+    return PHC_ERR_NOMEM;
+}
+
 /* Residual checks of one data set.  X: n x kx rows of the weighted Jacobian
  * in data order (for Durbin–Watson's exact moments), or NULL to keep the
  * stored Durbin–Watson p-value (recheck from a saved result). */
@@ -218,6 +334,13 @@ static int compute_checks(phc_dataset_result *d, const double *X, size_t kx, dou
     if (lags > n / 2)
         lags = n / 2;
     d->acf_lags = (lags > 0 && phc_check_acf(r, n, lags, d->acf) == PHC_OK) ? lags : 0;
+    if (time_series_checks(d, order, r, level)) {
+        free(order);
+        free(r);
+        free(Xs);
+        free(fitted);
+        return PHC_ERR_NOMEM;
+    }
     free(order);
     free(r);
     free(Xs);
@@ -270,7 +393,19 @@ static int build_verdict(phc_fit_result *res)
     for (size_t d = 0; d < res->n_datasets; ++d)
         for (size_t c = 0; c < PHC_CHECK_COUNT; ++c) {
             const phc_check_result *ck = &res->datasets[d].checks[c];
-            if (ck->applicable && !ck->pass)
+            const phc_dataset_result *ds = &res->datasets[d];
+            if (c == PHC_CHECK_DAILY_CYCLE && ck->applicable && !ck->pass) {
+                char when[128] = "";
+                if (isfinite(ds->cycle_peak_hour)) {
+                    const int minutes = (int)lround(ds->cycle_peak_hour * 60.0) % (24 * 60);
+                    snprintf(when, sizeof when, "; the residuals (data minus model) are highest around "
+                                                "%02d:%02d local time", minutes / 60, minutes % 60);
+                }
+                rc |= add_warning(res, "data set '%s': the residuals follow a daily cycle (periodogram peak at "
+                                       "%.1f h, p = %.2g): the model misses a difference between day and night, "
+                                       "for example faster water loss by day than by night%s",
+                                  ds->name, ds->cycle_period_h, ck->p_value, when);
+            } else if (ck->applicable && !ck->pass)
                 rc |= add_warning(res, "data set '%s': %s check failed (%s, p = %.3g < %g)",
                                   res->datasets[d].name, ck->name, ck->what, ck->p_value, res->level);
         }
@@ -318,11 +453,13 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
     d->x = dup_array(ds->x, n);
     d->y = dup_array(ds->y, n);
     d->sigma = dup_array(ds->sigma, n);
+    d->x_seconds = ds->x_seconds;
+    d->time_of_day = dup_array(ds->time_of_day, n);
     d->yhat = calloc(n, sizeof *d->yhat);
     d->residual = calloc(n, sizeof *d->residual);
     d->std_residual = calloc(n, sizeof *d->std_residual);
     if (!p || !cols || !d->name || !d->kind || !d->x_label || !d->y_label || !d->x || !d->y ||
-        (ds->sigma && !d->sigma) || !d->yhat || !d->residual || !d->std_residual || copy_series(ds, d)) {
+        (ds->sigma && !d->sigma) || (ds->time_of_day && !d->time_of_day) || !d->yhat || !d->residual || !d->std_residual || copy_series(ds, d)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }

@@ -20,6 +20,8 @@ typedef enum phc_check_id {
     PHC_CHECK_LJUNG_BOX,
     PHC_CHECK_NORMALITY,     /* Shapiro–Wilk (n <= 5000) or Anderson–Darling */
     PHC_CHECK_BREUSCH_PAGAN,
+    PHC_CHECK_DAILY_CYCLE,   /* Lomb–Scargle peak at 22-26 h; applicable to time series
+                                (x_seconds > 0) spanning >= 36 h (PHC_DAILY_MIN_SPAN_H) */
     PHC_CHECK_COUNT
 } phc_check_id;
 
@@ -33,6 +35,9 @@ typedef struct phc_check_result {
 } phc_check_result;
 
 #define PHC_ACF_MAX_LAG 20
+/* Largest lag of the time-lag autocorrelation of time series, hours (two
+ * days: the 24 h lag and the half-day either side of it). */
+#define PHC_ACF_TIME_MAX_LAG_H 48.0
 
 typedef struct phc_dataset_result {
     char *name, *kind;
@@ -54,6 +59,22 @@ typedef struct phc_dataset_result {
     char *series_title;          /* what one series is ("probe", "leaf") or NULL */
     double acf[PHC_ACF_MAX_LAG + 1];
     size_t acf_lags;             /* lags computed (0 when n too small) */
+    double x_seconds;            /* seconds per unit of x when x is a time, else 0 (copied
+                                    from the data set; saved in result.json) */
+    double *time_of_day;         /* n local clock times, hours in [0, 24), or NULL (owned) */
+    /* Time series spanning >= 1.5 days (x_seconds > 0, PHC_DAILY_MIN_SPAN_H);
+     * recomputed by every check pass, NULL / 0 / NAN otherwise: */
+    double *acf_time;            /* acf_time_bins values (owned): autocorrelation of the
+                                    standardised residuals at lags k acf_time_bin_h hours
+                                    (phc_check_acf_time; NAN where a bin holds no pair) */
+    size_t acf_time_bins;
+    double acf_time_bin_h;       /* lag bin, hours: max(median sampling interval, 1 h) */
+    double cycle_period_h;       /* daily_cycle: period of the periodogram peak in 22-26 h */
+    double cycle_peak_hour;      /* with time_of_day: local clock hour at which a 24 h
+                                    sinusoid fitted to the standardised residuals peaks */
+    double peak_period_h;        /* highest periodogram peak over periods from 2 sampling
+                                    bins (>= 2 h) to the span, hours, */
+    double peak_power, peak_fap; /* its normalised power and Baluev false-alarm probability */
     char *extra_markdown;        /* the kind's own report section, or NULL */
 } phc_dataset_result;
 

@@ -66,12 +66,31 @@ int phc_fit_plots_write(const phc_fit_result *res, const char *dir, char **names
             (rc = add_name(names, n_names, max_names, file)))
             return rc;
 
-        if (ds->acf_lags > 0) {
+        if (ds->acf_time && ds->acf_time_bins > 1) {
+            /* a time series over >= 1.5 days: correlation over time lags in hours */
+            snprintf(title, sizeof title, "%s: residual autocorrelation over time lags", ds->name);
+            phc_plot_labels al = {title, "lag (h)", "autocorrelation", NULL};
+            snprintf(file, sizeof file, "%s_acf.png", base);
+            snprintf(path, sizeof path, "%s/%s", dir, file);
+            if ((rc = phc_plot_acf_time(path, &al, ds->acf_time, ds->acf_time_bins, ds->acf_time_bin_h, ds->n,
+                                        err)) ||
+                (rc = add_name(names, n_names, max_names, file)))
+                return rc;
+        } else if (ds->acf_lags > 0) {
             snprintf(title, sizeof title, "%s: residual autocorrelation (ordered by x)", ds->name);
             phc_plot_labels al = {title, "lag (observations)", "autocorrelation", NULL};
             snprintf(file, sizeof file, "%s_acf.png", base);
             snprintf(path, sizeof path, "%s/%s", dir, file);
             if ((rc = phc_plot_acf(path, &al, ds->acf, ds->acf_lags, ds->n, err)) ||
+                (rc = add_name(names, n_names, max_names, file)))
+                return rc;
+        }
+        if (ds->time_of_day) {
+            snprintf(title, sizeof title, "%s: residuals by time of day", ds->name);
+            phc_plot_labels tl = {title, "local clock time (h)", "standardised residual", NULL};
+            snprintf(file, sizeof file, "%s_time_of_day.png", base);
+            snprintf(path, sizeof path, "%s/%s", dir, file);
+            if ((rc = phc_plot_time_of_day(path, &tl, ds->time_of_day, ds->std_residual, ds->n, err)) ||
                 (rc = add_name(names, n_names, max_names, file)))
                 return rc;
         }

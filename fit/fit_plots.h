@@ -2,7 +2,10 @@
  * fitted model (<name>_fit.png), the residuals against x
  * (<name>_residuals.png), a normal QQ plot of the standardised residuals
  * (<name>_qq.png) and the residual autocorrelation (<name>_acf.png, when
- * there are enough residuals).  <name> is the data set's file-name-safe
+ * there are enough residuals; over time lags in hours for a time series
+ * spanning >= 1.5 days) and, when the local clock time of the observations
+ * is known, the standardised residuals by time of day
+ * (<name>_time_of_day.png).  <name> is the data set's file-name-safe
  * name (phc_run_dir_safe_name).  A data set whose observations form series
  * (probes, leaves, quantiles: phc_dataset_result.series) is drawn with one
  * colour per series and a key naming them, in the fit and residual plots. */

@@ -1509,8 +1509,12 @@ int phc_plot_qq(const char *path, const phc_plot_labels *labels,
     return status;
 }
 
-int phc_plot_acf(const char *path, const phc_plot_labels *labels,
-                 const double *acf, size_t max_lag, size_t n, phc_error *err)
+/* Bars acf[h] at lags h * step (h = 0..max_lag), the white-noise band, and
+ * when mark is finite a dotted vertical line at lag `mark` labelled
+ * mark_label.  hours = 0: integer lags (ticks never between them); 1: lags
+ * in hours (ticks every 6 h when they reach 18-100 h). */
+static int acf_plot(const char *path, const phc_plot_labels *labels, const double *acf, size_t max_lag,
+                    size_t n, double step, int hours, double mark, const char *mark_label, phc_error *err)
 {
     phc_error_clear(err);
     int status = check_path(path, err);
@@ -1529,7 +1533,7 @@ int phc_plot_acf(const char *path, const phc_plot_labels *labels,
                              "plot", path, max_lag);
 
     double bound = 1.96 / sqrt((double)n);
-    plot_window w = {-0.5, (double)max_lag + 0.5, -bound, bound};
+    plot_window w = {-0.5 * step, ((double)max_lag + 0.5) * step, -bound, bound};
     w.ymax = fmax(w.ymax, 0.0);
     size_t finite = 0;
     for (size_t h = 0; h <= max_lag; ++h) {
@@ -1557,6 +1561,9 @@ int phc_plot_acf(const char *path, const phc_plot_labels *labels,
     legend_add(&lg, PL_LEGEND_LINE,
                "\xc2\xb1" "1.96/\xe2\x88\x9an (white noise, 95 %)", COL_BAND,
                2, 2.0);
+    const int marked = isfinite(mark);
+    if (marked)
+        legend_add(&lg, PL_LEGEND_LINE, mark_label, COL_FIT, 3, 2.0);
 
     plot_ctx ctx;
     status = plot_begin(&ctx, path, 0, err);
@@ -1565,31 +1572,37 @@ int phc_plot_acf(const char *path, const phc_plot_labels *labels,
         return status;
     }
 
-    const double half = 0.3; /* bar half-width in lags */
+    const double half = 0.3 * step; /* bar half-width */
     plot_axes ax;
-    plot_layout(&ctx, &w, &ax, 1.0); /* integer lags */
+    plot_layout(&ctx, &w, &ax, hours ? 0.0 : 1.0); /* integer lags */
     legend_boxes lb;
     legend_boxes_init(&lb, &ctx, &lg);
     for (size_t h = 0; h <= max_lag; ++h) {
         if (!isfinite(acf[h]))
             continue;
-        double hx = (double)h;
+        double hx = (double)h * step;
         legend_score_segment(&lb, &w, hx - half, acf[h], hx + half, acf[h]);
         legend_score_segment(&lb, &w, hx - half, 0.0, hx - half, acf[h]);
         legend_score_segment(&lb, &w, hx + half, 0.0, hx + half, acf[h]);
     }
     legend_score_segment(&lb, &w, w.xmin, bound, w.xmax, bound);
     legend_score_segment(&lb, &w, w.xmin, -bound, w.xmax, -bound);
+    if (marked)
+        legend_score_segment(&lb, &w, mark, w.ymin, mark, w.ymax);
     PLINT pos = legend_place(&lb, &w);
 
-    plot_layout(&ctx, &w, &ax, 1.0); /* integer lags */
+    plot_layout(&ctx, &w, &ax, hours ? 0.0 : 1.0); /* integer lags */
+    if (hours && w.xmax - w.xmin > 18.0 && w.xmax - w.xmin < 100.0) {
+        ax.x.step = 6.0; /* lags in hours: ticks every 6 h, minor every hour */
+        ax.x.nsub = 6;
+    }
     draw_frame_grid(&w, &ax);
 
     plcol0(COL_DATA);
     for (size_t h = 0; h <= max_lag; ++h) {
         if (!isfinite(acf[h]) || acf[h] == 0.0)
             continue;
-        double hx = (double)h;
+        double hx = (double)h * step;
         PLFLT bx[4] = {hx - half, hx + half, hx + half, hx - half};
         PLFLT by[4] = {0.0, 0.0, acf[h], acf[h]};
         plfill(4, bx, by);
@@ -1603,6 +1616,12 @@ int phc_plot_acf(const char *path, const phc_plot_labels *labels,
     draw_segment(w.xmin, bound, w.xmax, bound);
     draw_segment(w.xmin, -bound, w.xmax, -bound);
     pllsty(1);
+    if (marked) {
+        plcol0(COL_FIT);
+        pllsty(3);
+        draw_segment(mark, w.ymin, mark, w.ymax);
+        pllsty(1);
+    }
 
     draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
     draw_legend(&lg, pos);
@@ -1610,4 +1629,73 @@ int phc_plot_acf(const char *path, const phc_plot_labels *labels,
     status = plot_end(&ctx, path, PHC_OK, err);
     text_free(&t);
     return status;
+}
+
+int phc_plot_acf(const char *path, const phc_plot_labels *labels,
+                 const double *acf, size_t max_lag, size_t n, phc_error *err)
+{
+    return acf_plot(path, labels, acf, max_lag, n, 1.0, 0, NAN, NULL, err);
+}
+
+int phc_plot_acf_time(const char *path, const phc_plot_labels *labels, const double *acf, size_t bins,
+                      double bin_h, size_t n, phc_error *err)
+{
+    phc_error_clear(err);
+    if (bins == 0 || !(bin_h > 0.0) || !isfinite(bin_h))
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: time-lag ACF plot: expected bins >= 1 and a lag bin > 0 h, "
+                             "found %zu bins of %g h", path ? path : "(null)", bins, bin_h);
+    const phc_plot_labels def = {labels ? labels->title : NULL,
+                                 labels && labels->x_label ? labels->x_label : "lag (h)",
+                                 labels ? labels->y_label : NULL, NULL};
+    const double last = (double)(bins - 1) * bin_h;
+    return acf_plot(path, &def, acf, bins - 1, n, bin_h, 1, last >= 24.0 ? 24.0 : NAN, "24 h (one day)", err);
+}
+
+int phc_plot_time_of_day(const char *path, const phc_plot_labels *labels, const double *hour, const double *r,
+                         size_t n, phc_error *err)
+{
+    phc_error_clear(err);
+    int status = check_path(path, err);
+    if (status)
+        return status;
+    if (n == 0 || !hour || !r)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: time-of-day plot: expected n >= 1 residuals with clock "
+                             "times, found n = %zu%s", path, n, (n && (!hour || !r)) ? " and a NULL array" : "");
+    /* hourly means at the bin centres, closed over midnight: the line runs
+     * from 0 h to 24 h through the value midway between 23:30 and 00:30 */
+    double sum[24] = {0}, mx[26], my[26];
+    size_t cnt[24] = {0}, finite = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!isfinite(hour[i]) || !isfinite(r[i]) || hour[i] < 0.0 || hour[i] >= 24.0)
+            continue;
+        const size_t b = (size_t)hour[i];
+        sum[b] += r[i];
+        cnt[b]++;
+        ++finite;
+    }
+    if (finite == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: time-of-day plot: expected at least one finite residual "
+                             "with a clock time in [0, 24), found none of %zu", path, n);
+    for (size_t b = 0; b < 24; ++b) {
+        mx[b + 1] = (double)b + 0.5;
+        my[b + 1] = cnt[b] ? sum[b] / (double)cnt[b] : NAN;
+    }
+    const double wrap = cnt[0] && cnt[23] ? 0.5 * (my[1] + my[24]) : NAN;
+    mx[0] = 0.0;
+    my[0] = wrap;
+    mx[25] = 24.0;
+    my[25] = wrap;
+    const double zero = 0.0, up = 2.0, down = -2.0;
+    phc_plot_layer layers[] = {
+        {PHC_MARK_DOTS, PHC_COLOUR_DATA, hour, r, n, NULL, "standardised residual"},
+        {PHC_MARK_HLINE, PHC_COLOUR_REF, NULL, &zero, 1, NULL, "0"},
+        {PHC_MARK_HDASHED, PHC_COLOUR_BAND, NULL, &up, 1, NULL, "\xc2\xb1" "2 (2 standard deviations)"},
+        {PHC_MARK_HDASHED, PHC_COLOUR_BAND, NULL, &down, 1, NULL, NULL},
+        {PHC_MARK_DOTS, PHC_COLOUR_FIT, mx + 1, my + 1, 24, NULL, NULL},
+        {PHC_MARK_LINE, PHC_COLOUR_FIT, mx, my, 26, NULL, "mean of each clock hour"},
+    };
+    const phc_plot_labels def = {labels ? labels->title : NULL,
+                                 labels && labels->x_label ? labels->x_label : "local clock time (h)",
+                                 labels && labels->y_label ? labels->y_label : "standardised residual", NULL};
+    return phc_plot_layers(path, &def, layers, sizeof layers / sizeof layers[0], NULL, err);
 }

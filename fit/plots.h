@@ -120,4 +120,24 @@ int phc_plot_qq(const char *path, const phc_plot_labels *labels,
 int phc_plot_acf(const char *path, const phc_plot_labels *labels,
                  const double *acf, size_t max_lag, size_t n, phc_error *err);
 
+/* Autocorrelation of a time series over time lags (phc_check_acf_time):
+ * bars acf[k] at lags k bin_h hours, k < bins (NAN bins left empty), the
+ * +-1.96/sqrt(n) band of white noise (n residuals; the usual band: for bins
+ * holding N_k > n pairs the exact white-noise band 1.96/sqrt(N_k) is
+ * narrower), ticks every 6 h when the lags reach 18-100 h, and a dotted
+ * line at 24 h ("24 h (one day)") when the lags reach it.  x label default
+ * "lag (h)". */
+int phc_plot_acf_time(const char *path, const phc_plot_labels *labels,
+                      const double *acf, size_t bins, double bin_h, size_t n,
+                      phc_error *err);
+
+/* Residuals by local clock time: r[i] (standardised residuals) against
+ * hour[i] in [0, 24) as markers, the mean of each clock hour (bins
+ * [h, h + 1)) as a line closed over midnight, a zero line and dashed lines
+ * at +-2.  Observations with a non-finite or out-of-range hour are not
+ * drawn.  Default labels "local clock time (h)", "standardised residual". */
+int phc_plot_time_of_day(const char *path, const phc_plot_labels *labels,
+                         const double *hour, const double *r, size_t n,
+                         phc_error *err);
+
 #endif /* PHC_PLOTS_H */

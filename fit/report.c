@@ -56,8 +56,28 @@ static void print_checks_md(const phc_dataset_result *d, double level, FILE *f)
     fprintf(f, "|---|---|---:|---:|---|\n");
     for (size_t c = 0; c < PHC_CHECK_COUNT; ++c) {
         const phc_check_result *ck = &d->checks[c];
+        const char *na = c == PHC_CHECK_DAILY_CYCLE ? "n/a (needs a time series over ≥ 1.5 days)" : "n/a (too few points)";
         fprintf(f, "| %s | %s | %s | %s | %s |\n", ck->name, ck->what, fmt_num(a, sizeof a, ck->statistic),
-                fmt_p(b, sizeof b, ck->p_value), !ck->applicable ? "n/a (too few points)" : ck->pass ? "pass" : "**FAIL**");
+                fmt_p(b, sizeof b, ck->p_value), !ck->applicable ? na : ck->pass ? "pass" : "**FAIL**");
+    }
+    /* time series: what the periodogram and the time-lag ACF saw */
+    const phc_check_result *dc = &d->checks[PHC_CHECK_DAILY_CYCLE];
+    char e[32];
+    if (dc->applicable) {
+        fprintf(f, "\nDaily cycle: the Lomb–Scargle periodogram of the standardised residuals (a line in time "
+                   "removed) peaks at %s h within 22–26 h (normalised power %s, p = %s",
+                fmt_num(a, sizeof a, d->cycle_period_h), fmt_num(b, sizeof b, dc->statistic),
+                fmt_p(e, sizeof e, dc->p_value));
+        if (isfinite(d->cycle_peak_hour))
+            fprintf(f, "; a 24 h sinusoid fitted against the local clock peaks at %02d:%02d",
+                    (int)lround(d->cycle_peak_hour * 60.0) % 1440 / 60, (int)lround(d->cycle_peak_hour * 60.0) % 60);
+        fprintf(f, ").");
+        if (isfinite(d->peak_period_h))
+            fprintf(f, " Highest peak over all periods from %s h to the span: %s h (false-alarm probability %s, "
+                       "Baluev 2008).",
+                    fmt_num(a, sizeof a, 2.0 * d->acf_time_bin_h), fmt_num(b, sizeof b, d->peak_period_h),
+                    fmt_p(e, sizeof e, d->peak_fap));
+        fprintf(f, "\n");
     }
 }
 
@@ -194,7 +214,14 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
                "- **ljung_box**: autocorrelation over the first lags together.\n"
                "- **shapiro_wilk** / **anderson_darling**: residuals far from normal make the intervals unreliable.\n"
                "- **breusch_pagan**: residual variance that grows or shrinks with the fitted value; "
-               "consider per-point sigmas.\n");
+               "consider per-point sigmas.\n"
+               "- **daily_cycle** (time series over at least 1.5 days): the highest peak of the Lomb–Scargle "
+               "periodogram of the residuals (Lomb 1976, Scargle 1982) with a period of 22–26 h, after removing "
+               "a straight line in time; p is Baluev's (2008) false-alarm probability over that band. A failure "
+               "means the residuals follow a 24-hour rhythm: the model misses something that differs between day "
+               "and night (transpiration, light, temperature). The autocorrelation plot of a time series is drawn "
+               "over time lags in hours (±1.96/√n band, 24 h marked), and when the local clock time is known the "
+               "residuals are also plotted by time of day.\n");
     if (res->provenance) {
         char *md = NULL;
         int prc = phc_provenance_markdown(res->provenance, &md, err);

@@ -21,6 +21,22 @@
  *           Econometrica 47, 1287-1294.
  *   [GVL13] Golub, G. H. & Van Loan, C. F. (2013).  Matrix Computations, 4th
  *           ed., §5.4.2 (QR with column pivoting).
+ *   [EK88]  Edelson, R. A. & Krolik, J. H. (1988).  The discrete correlation
+ *           function: a new method for analyzing unevenly sampled
+ *           variability data.  Astrophys. J. 333, 646-659.
+ *   [R11]   Rehfeld, K., Marwan, N., Heitzig, J. & Kurths, J. (2011).
+ *           Comparison of correlation analysis techniques for irregularly
+ *           sampled time series.  Nonlin. Processes Geophys. 18, 389-404.
+ *   [L76]   Lomb, N. R. (1976).  Least-squares frequency analysis of unequally
+ *           spaced data.  Astrophys. Space Sci. 39, 447-462.
+ *   [S82]   Scargle, J. D. (1982).  Studies in astronomical time series
+ *           analysis II.  Statistical aspects of spectral analysis of
+ *           unevenly spaced data.  Astrophys. J. 263, 835-853.
+ *   [B08]   Baluev, R. V. (2008).  Assessing the statistical significance of
+ *           periodogram peaks.  Mon. Not. R. Astron. Soc. 385, 1279-1285.
+ *   [HB86]  Horne, J. H. & Baliunas, S. L. (1986).  A prescription for
+ *           period analysis of unevenly sampled time series.  Astrophys. J.
+ *           302, 757-763.
  *
  * Linear algebra and distribution functions come from GSL.  GSL reports
  * errors through a process-wide handler that aborts by default; the library
@@ -764,4 +780,408 @@ fail:
     free(U);
     free(u);
     return status;
+}
+
+/* ------------------------------------------------------------------------ */
+/* time series: time-lag autocorrelation and Lomb-Scargle                    */
+
+typedef struct timed_index {
+    double t;
+    size_t i;
+} timed_index;
+
+static int cmp_timed(const void *pa, const void *pb)
+{
+    const timed_index *a = pa, *b = pb;
+    if (a->t != b->t)
+        return (a->t > b->t) - (a->t < b->t);
+    return (a->i > b->i) - (a->i < b->i);
+}
+
+/* [EK88], [R11] (rectangular kernel): see the header. */
+int phc_check_acf_time(const double *t, const double *r, size_t n,
+                       double bin_h, size_t n_bins, double *acf,
+                       size_t *pairs)
+{
+    if (!acf || n_bins == 0)
+        return PHC_ERR_INVALID;
+    for (size_t k = 0; k < n_bins; ++k) {
+        acf[k] = NAN;
+        if (pairs)
+            pairs[k] = 0;
+    }
+    if (!t || !r || n < 3 || !(bin_h > 0.0) || !isfinite(bin_h) ||
+        !all_finite(t, n) || !all_finite(r, n) || is_constant(r, n))
+        return PHC_ERR_INVALID;
+    double mean = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        mean += r[i];
+    mean /= (double)n;
+    double c0 = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        c0 += (r[i] - mean) * (r[i] - mean);
+    c0 /= (double)n;
+    if (!(c0 > 0.0) || !isfinite(c0))
+        return PHC_ERR_INVALID;
+    timed_index *o = malloc(n * sizeof *o);
+    double *sum = calloc(n_bins, sizeof *sum);
+    size_t *count = calloc(n_bins, sizeof *count);
+    if (!o || !sum || !count) {
+        free(o);
+        free(sum);
+        free(count);
+        return PHC_ERR_NOMEM;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        o[i].t = t[i];
+        o[i].i = i;
+    }
+    qsort(o, n, sizeof *o, cmp_timed);
+    /* pairs (a, b), a < b in time order, lag below the last bin's edge */
+    const double edge = ((double)n_bins - 0.5) * bin_h;
+    for (size_t a = 0; a < n; ++a) {
+        const double ra = r[o[a].i] - mean;
+        for (size_t b = a + 1; b < n; ++b) {
+            const double lag = o[b].t - o[a].t;
+            if (!(lag < edge))
+                break;
+            const double kk = floor(lag / bin_h + 0.5);
+            if (kk < 1.0)
+                continue; /* closer than half a bin: counts as lag 0 */
+            const size_t k = (size_t)kk;
+            if (k >= n_bins)
+                break;
+            sum[k] += ra * (r[o[b].i] - mean);
+            count[k]++;
+        }
+    }
+    acf[0] = 1.0;
+    if (pairs)
+        pairs[0] = n;
+    for (size_t k = 1; k < n_bins; ++k) {
+        if (count[k])
+            acf[k] = sum[k] / ((double)count[k] * c0);
+        if (pairs)
+            pairs[k] = count[k];
+    }
+    free(o);
+    free(sum);
+    free(count);
+    return PHC_OK;
+}
+
+double phc_check_acf_time_bin(const double *t, size_t n, double min_h)
+{
+    if (!t || n < 2)
+        return NAN;
+    double *s = malloc(n * sizeof *s);
+    if (!s)
+        return NAN;
+    size_t m = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (isfinite(t[i]))
+            s[m++] = t[i];
+    qsort(s, m, sizeof *s, cmp_double);
+    size_t k = 0;
+    for (size_t i = 1; i < m; ++i)
+        if (s[i] > s[i - 1])
+            s[k++] = s[i] - s[i - 1]; /* overwrites entries already read */
+    double med = NAN;
+    if (k > 0) {
+        qsort(s, k, sizeof *s, cmp_double);
+        med = k % 2 ? s[k / 2] : 0.5 * (s[k / 2 - 1] + s[k / 2]);
+    }
+    free(s);
+    if (isnan(med))
+        return NAN;
+    return med > min_h ? med : min_h;
+}
+
+/* Common preconditions of the periodogram functions; fills the centred sum
+ * of squares and the smallest time. */
+static int ls_prepare(const double *t, const double *r, size_t n,
+                      double *mean, double *ss, double *t0)
+{
+    if (!t || !r || n < 3 || !all_finite(t, n) || !all_finite(r, n) ||
+        is_constant(r, n))
+        return PHC_ERR_INVALID;
+    double m = 0.0, lo = t[0];
+    for (size_t i = 0; i < n; ++i) {
+        m += r[i];
+        lo = fmin(lo, t[i]);
+    }
+    m /= (double)n;
+    double q = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        q += (r[i] - m) * (r[i] - m);
+    if (!(q > 0.0) || !isfinite(q))
+        return PHC_ERR_INVALID;
+    *mean = m;
+    *ss = q;
+    *t0 = lo;
+    return PHC_OK;
+}
+
+/* Scargle's power from the four sums over the observations at one
+ * frequency: yc = sum r_c cos wt, ys = sum r_c sin wt, c2 = sum cos 2wt,
+ * s2 = sum sin 2wt.  With tan 2 w tau = s2 / c2 [S82 eq. 11]:
+ *   sum r_c cos w(t - tau) = cos(w tau) yc + sin(w tau) ys,
+ *   sum cos^2 w(t - tau) = (n + c2 cos 2 w tau + s2 sin 2 w tau) / 2,
+ * and the sine terms likewise. */
+static double ls_power_from_sums(size_t n, double yc, double ys, double c2,
+                                 double s2, double ss)
+{
+    const double h = hypot(c2, s2);
+    double cos2 = 1.0, sin2 = 0.0; /* of 2 w tau */
+    if (h > 0.0) {
+        cos2 = c2 / h;
+        sin2 = s2 / h;
+    }
+    /* half-angle: w tau = atan2(sin2, cos2) / 2 */
+    const double wt = 0.5 * atan2(sin2, cos2);
+    const double c = cos(wt), s = sin(wt);
+    const double yct = c * yc + s * ys, yst = c * ys - s * yc;
+    const double cc = 0.5 * ((double)n + h), sq = 0.5 * ((double)n - h);
+    const double tiny = 1e-12 * (double)n;
+    double p = 0.0;
+    if (cc > tiny)
+        p += yct * yct / cc;
+    if (sq > tiny)
+        p += yst * yst / sq;
+    p /= ss;
+    return p < 0.0 ? 0.0 : p > 1.0 ? 1.0 : p;
+}
+
+static double ls_power_at(const double *t, const double *r, size_t n,
+                          double mean, double ss, double t0, double f)
+{
+    const double w = 2.0 * M_PI * f;
+    double yc = 0.0, ys = 0.0, c2 = 0.0, s2 = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double a = w * (t[i] - t0);
+        const double c = cos(a), s = sin(a), y = r[i] - mean;
+        yc += y * c;
+        ys += y * s;
+        c2 += c * c - s * s;
+        s2 += 2.0 * c * s;
+    }
+    return ls_power_from_sums(n, yc, ys, c2, s2, ss);
+}
+
+int phc_check_lomb_scargle(const double *t, const double *r, size_t n,
+                           const double *freq, size_t m, double *power)
+{
+    if (!freq || !power)
+        return PHC_ERR_INVALID;
+    for (size_t k = 0; k < m; ++k)
+        power[k] = NAN;
+    double mean, ss, t0;
+    int rc = ls_prepare(t, r, n, &mean, &ss, &t0);
+    if (rc)
+        return rc;
+    for (size_t k = 0; k < m; ++k)
+        if (!(freq[k] > 0.0) || !isfinite(freq[k]))
+            return PHC_ERR_INVALID;
+    for (size_t k = 0; k < m; ++k)
+        power[k] = ls_power_at(t, r, n, mean, ss, t0, freq[k]);
+    return PHC_OK;
+}
+
+/* log of gamma(N) = sqrt(2/N) Gamma(N/2) / Gamma((N-1)/2) of [B08]. */
+static double baluev_log_gamma(double N)
+{
+    return 0.5 * log(2.0 / N) + lgamma(0.5 * N) - lgamma(0.5 * (N - 1.0));
+}
+
+/* [B08] Table 1 ("z_1" = standard normalisation): dH parameters under H0
+ * (1: the mean; 2: mean and linear trend), dK = dH + 2 with the sinusoid. */
+static double baluev_fap(double Z, size_t n, double W, double dH)
+{
+    const double N = (double)n, NH = N - dH, NK = N - dH - 2.0;
+    if (!(Z > 0.0))
+        return 1.0;
+    if (Z >= 1.0)
+        return 0.0;
+    const double log1mz = log1p(-Z);
+    const double fap_single = exp(0.5 * NK * log1mz);
+    const double tau = exp(baluev_log_gamma(NH) + log(W) + 0.5 * (NK - 1.0) * log1mz +
+                           0.5 * log(0.5 * NH * Z));
+    /* 1 - (1 - fap_single) e^-tau, written without cancellation */
+    double fap = -expm1(-tau) + fap_single * exp(-tau);
+    return fap < 0.0 ? 0.0 : fap > 1.0 ? 1.0 : fap;
+}
+
+static int periodogram_peak(const double *t, const double *r, size_t n,
+                            double f_lo, double f_hi, double oversample,
+                            double dH, phc_periodogram_peak *peak)
+{
+    if (!peak)
+        return PHC_ERR_INVALID;
+    peak->period = peak->frequency = peak->power = peak->fap = NAN;
+    peak->n_freq = 0;
+    peak->local_max = 0;
+    double mean, ss, t0;
+    if (n < 5 || !(f_lo > 0.0) || !(f_hi > f_lo) || !isfinite(f_hi) ||
+        !(oversample >= 1.0) || !isfinite(oversample))
+        return PHC_ERR_INVALID;
+    int rc = ls_prepare(t, r, n, &mean, &ss, &t0);
+    if (rc)
+        return rc;
+    double hi = t[0], tm = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        hi = fmax(hi, t[i]);
+        tm += t[i] - t0;
+    }
+    const double span = hi - t0;
+    if (!(span > 0.0))
+        return PHC_ERR_INVALID;
+    tm /= (double)n;
+    double var_t = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        var_t += (t[i] - t0 - tm) * (t[i] - t0 - tm);
+    var_t /= (double)n;
+    const double df = 1.0 / (oversample * span);
+    const double steps = ceil((f_hi - f_lo) / df);
+    if (!(steps < 1e7))
+        return PHC_ERR_NOMEM; /* a grid this fine is a caller's mistake */
+    /* grid f_lo + k df, k = -1 .. K + 1, with f_lo + K df >= f_hi */
+    const size_t K = (size_t)steps, m = K + 3;
+    double *pw = malloc(m * sizeof *pw);
+    double *cs = malloc(4 * n * sizeof *cs); /* cos, sin of the point, of the step */
+    if (!pw || !cs) {
+        free(pw);
+        free(cs);
+        return PHC_ERR_NOMEM;
+    }
+    /* Trigonometric recurrence over the uniform grid (Press et al.,
+     * Numerical Recipes §13.8): each point's phase advances by 2 pi df t
+     * per step; re-seeded from sin/cos every 64 steps against drift. */
+    const double f_first = f_lo - df;
+    for (size_t k = 0; k < m; ++k) {
+        const double f = f_first + (double)k * df;
+        if (k % 64 == 0) {
+            for (size_t i = 0; i < n; ++i) {
+                const double a = 2.0 * M_PI * f * (t[i] - t0), d = 2.0 * M_PI * df * (t[i] - t0);
+                cs[4 * i] = cos(a);
+                cs[4 * i + 1] = sin(a);
+                cs[4 * i + 2] = cos(d);
+                cs[4 * i + 3] = sin(d);
+            }
+        }
+        double yc = 0.0, ys = 0.0, c2 = 0.0, s2 = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            double *q = cs + 4 * i;
+            const double c = q[0], s = q[1], y = r[i] - mean;
+            yc += y * c;
+            ys += y * s;
+            c2 += c * c - s * s;
+            s2 += 2.0 * c * s;
+            q[0] = c * q[2] - s * q[3];
+            q[1] = s * q[2] + c * q[3];
+        }
+        pw[k] = f > 0.0 ? ls_power_from_sums(n, yc, ys, c2, s2, ss) : 0.0;
+    }
+    /* best grid point inside the band [f_lo, f_hi] */
+    size_t best = 0;
+    for (size_t k = 1; k < m; ++k) {
+        const double f = f_first + (double)k * df;
+        if (f < f_lo - 1e-12 * df || f > f_hi + 1e-12 * df)
+            continue;
+        if (!best || pw[k] > pw[best])
+            best = k;
+    }
+    const double fb = f_first + (double)best * df;
+    peak->local_max = pw[best] >= pw[best - 1] && pw[best] >= pw[best + 1];
+    /* golden-section refinement within one grid step, kept in the band */
+    double a = fmax(fb - df, f_lo), b = fmin(fb + df, f_hi);
+    const double g = 0.5 * (sqrt(5.0) - 1.0);
+    double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    double p1 = ls_power_at(t, r, n, mean, ss, t0, x1), p2 = ls_power_at(t, r, n, mean, ss, t0, x2);
+    for (int it = 0; it < 60 && b - a > 1e-12 * fb; ++it) {
+        if (p1 >= p2) {
+            b = x2;
+            x2 = x1;
+            p2 = p1;
+            x1 = b - g * (b - a);
+            p1 = ls_power_at(t, r, n, mean, ss, t0, x1);
+        } else {
+            a = x1;
+            x1 = x2;
+            p1 = p2;
+            x2 = a + g * (b - a);
+            p2 = ls_power_at(t, r, n, mean, ss, t0, x2);
+        }
+    }
+    double f_best = fb, p_best = pw[best];
+    const double fr = 0.5 * (a + b), pr = ls_power_at(t, r, n, mean, ss, t0, fr);
+    if (pr > p_best) {
+        f_best = fr;
+        p_best = pr;
+    }
+    peak->frequency = f_best;
+    peak->period = 1.0 / f_best;
+    peak->power = p_best;
+    peak->n_freq = m;
+    peak->fap = baluev_fap(p_best, n, (f_hi - f_lo) * sqrt(4.0 * M_PI * var_t), dH);
+    free(pw);
+    free(cs);
+    return PHC_OK;
+}
+
+int phc_check_periodogram_peak(const double *t, const double *r, size_t n,
+                               double f_lo, double f_hi, double oversample,
+                               phc_periodogram_peak *peak)
+{
+    return periodogram_peak(t, r, n, f_lo, f_hi, oversample, 1.0, peak);
+}
+
+int phc_check_daily_cycle(const double *t, const double *r, size_t n,
+                          double *statistic, double *p_value,
+                          double *period_h)
+{
+    set_nan2(statistic, p_value);
+    if (period_h)
+        *period_h = NAN;
+    if (!t || !r || !statistic || !p_value || n < 5 || !all_finite(t, n))
+        return PHC_ERR_INVALID;
+    double lo = t[0], hi = t[0];
+    for (size_t i = 1; i < n; ++i) {
+        lo = fmin(lo, t[i]);
+        hi = fmax(hi, t[i]);
+    }
+    if (!(hi - lo >= PHC_DAILY_MIN_SPAN_H))
+        return PHC_ERR_INVALID;
+    if (!all_finite(r, n))
+        return PHC_ERR_INVALID;
+    /* residuals minus their least-squares line in time: a drift is not a
+     * cycle (the runs test reports it), but its periodogram reaches into
+     * 22-26 h when the span is a few days */
+    double *d = malloc(n * sizeof *d);
+    if (!d)
+        return PHC_ERR_NOMEM;
+    double tm = 0.0, rm = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        tm += t[i] - lo;
+        rm += r[i];
+    }
+    tm /= (double)n;
+    rm /= (double)n;
+    double stt = 0.0, str = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        stt += (t[i] - lo - tm) * (t[i] - lo - tm);
+        str += (t[i] - lo - tm) * (r[i] - rm);
+    }
+    const double slope = str / stt; /* stt > 0: the span is >= 36 h */
+    for (size_t i = 0; i < n; ++i)
+        d[i] = r[i] - rm - slope * (t[i] - lo - tm);
+    phc_periodogram_peak pk;
+    int rc = periodogram_peak(t, d, n, 1.0 / PHC_DAILY_PERIOD_MAX_H, 1.0 / PHC_DAILY_PERIOD_MIN_H, 10.0, 2.0, &pk);
+    free(d);
+    if (rc)
+        return rc;
+    *statistic = pk.power;
+    *p_value = pk.local_max ? pk.fap : 1.0;
+    if (period_h)
+        *period_h = pk.period;
+    return PHC_OK;
 }

@@ -76,4 +76,111 @@ int phc_check_breusch_pagan(const double *r, const double *Z, size_t n,
  * entries.  Needs n > max_lag and non-constant r. */
 int phc_check_acf(const double *r, size_t n, size_t max_lag, double *acf);
 
+/* ---- time series: correlation over time lags, daily cycles ------------
+ *
+ * The functions below take observation times t (any order, finite, in
+ * hours: the report converts x with the data set's x_seconds) beside the
+ * residuals, so that irregular sampling, gaps and several series sharing one
+ * clock are handled without assuming one observation per time step. */
+
+/* Autocorrelation of r over time lags, by slotting (binning) the pairs of
+ * observations by their time lag: the "slotting" estimator of Edelson &
+ * Krolik (1988, their discrete correlation function without measurement
+ * error) and of Rehfeld et al. (2011, rectangular kernel):
+ *     acf[k] = sum_{(i,j) in bin k} (r_i - rbar)(r_j - rbar) / (N_k c0),
+ *     c0 = (1/n) sum_i (r_i - rbar)^2,
+ * where bin k >= 1 holds the pairs i != j (each once) whose lag |t_j - t_i|
+ * lies in [(k - 1/2) bin_h, (k + 1/2) bin_h) and N_k is their number;
+ * acf[0] = 1 (lag 0).  For regular sampling with bin_h equal to the step
+ * this is the ACF with the 1/(n - k) ("adjusted") normalisation, so a
+ * sinusoid gives ~ cos(2 pi lag / period) at every lag, not a damped one.
+ * bin_h > 0 (hours); n_bins >= 1 entries of acf (lag k bin_h, k < n_bins).
+ * acf[k] is NAN when bin k holds no pair.  pairs (may be NULL) receives
+ * N_k (pairs[0] = n).  Needs n >= 3, finite t and r, r not constant (else
+ * PHC_ERR_INVALID, acf all NAN).  Time O(n log n + P), P the pairs within
+ * the largest lag; allocates n indices. */
+int phc_check_acf_time(const double *t, const double *r, size_t n,
+                       double bin_h, size_t n_bins, double *acf,
+                       size_t *pairs);
+
+/* The lag bin the report uses for phc_check_acf_time: the larger of the
+ * median interval between successive distinct times (hours) and min_h.
+ * NAN when fewer than two distinct finite times (or out of memory). */
+double phc_check_acf_time_bin(const double *t, size_t n, double min_h);
+
+/* Lomb–Scargle periodogram (Lomb 1976; Scargle 1982, eq. 10, with the time
+ * offset tau of his eq. 11) of r at m frequencies freq[] (cycles per hour;
+ * > 0), the mean of r removed, in the "standard" normalisation
+ *     power = [ (sum r_c cos w(t - tau))^2 / sum cos^2 w(t - tau)
+ *             + (sum r_c sin w(t - tau))^2 / sum sin^2 w(t - tau) ] / sum r_c^2,
+ * r_c = r - rbar, w = 2 pi f: the fraction of the residual sum of squares
+ * that one sinusoid of that frequency explains, in [0, 1].  A term whose
+ * denominator vanishes (all times at one phase: the frequency is aliased
+ * to zero) contributes 0.  Needs n >= 3, finite t and r, r not constant,
+ * freq > 0.  Times are taken relative to their minimum (long clocks lose
+ * no digits).  Uses no memory beyond the outputs. */
+int phc_check_lomb_scargle(const double *t, const double *r, size_t n,
+                           const double *freq, size_t m, double *power);
+
+/* The highest periodogram peak with a frequency in [f_lo, f_hi] (cycles per
+ * hour, 0 < f_lo < f_hi) and its false-alarm probability. */
+typedef struct phc_periodogram_peak {
+    double period;     /* of the peak, hours (1 / frequency) */
+    double frequency;  /* cycles per hour */
+    double power;      /* standard-normalised power, [0, 1] */
+    double fap;        /* false-alarm probability: p-value of the peak under
+                          H0 = Gaussian white noise, over the whole band */
+    size_t n_freq;     /* frequencies on the grid */
+    int local_max;     /* 1 when the peak is a local maximum of the
+                          periodogram (not a band edge on a slope that keeps
+                          rising outside the band) */
+} phc_periodogram_peak;
+
+/* Scans the band on a grid spaced 1 / (oversample T) (T = time span, hours;
+ * oversample >= 1, 5-10 usual), includes one grid step beyond each band
+ * edge to tell a true peak from a slope, refines the best grid point by a
+ * golden-section search within one step, and returns the peak.  The FAP is
+ * Baluev's (2008, MNRAS 385, 1279, Table 1 "standard" row and eq. 5) upper
+ * bound for the maximum over the band, with dH = 1 (mean) and dK = 3 (mean
+ * + sinusoid) degrees of freedom, N = n:
+ *     FAP_single(Z) = (1 - Z)^((N - 3)/2),
+ *     tau(Z) = gamma(N - 1) W (1 - Z)^((N - 4)/2) sqrt((N - 1) Z / 2),
+ *     gamma(N) = sqrt(2/N) Gamma(N/2) / Gamma((N - 1)/2),
+ *     W = (f_hi - f_lo) T_eff, T_eff = sqrt(4 pi Var(t)),
+ *     FAP = 1 - (1 - FAP_single) exp(-tau)
+ * (the same formulas as astropy's LombScargle.false_alarm_probability(
+ * method="baluev"), with the band width in place of f_max).  Unlike Horne &
+ * Baliunas's (1986) empirical count of independent frequencies it needs no
+ * regular sampling, and it is conservative (never below the true FAP for
+ * white noise; Baluev 2008 §5).  Needs n >= 5 and the checks of
+ * phc_check_lomb_scargle; PHC_ERR_NOMEM when the grid cannot be held.  On
+ * error every field is NAN / 0. */
+int phc_check_periodogram_peak(const double *t, const double *r, size_t n,
+                               double f_lo, double f_hi, double oversample,
+                               phc_periodogram_peak *peak);
+
+/* Search band of the daily-cycle test, hours. */
+#define PHC_DAILY_PERIOD_MIN_H 22.0
+#define PHC_DAILY_PERIOD_MAX_H 26.0
+/* Shortest span of times (hours) over which the daily-cycle test and the
+ * report's time-lag ACF are computed: 1.5 days, so that at least one and a
+ * half cycles are seen and a 24 h period is resolved from a trend. */
+#define PHC_DAILY_MIN_SPAN_H 36.0
+
+/* Test for a 24-hour cycle in residuals r observed at times t (hours): the
+ * residuals minus their least-squares line in time (a drift is not a cycle,
+ * but over a few days its periodogram reaches into 22-26 h), then the
+ * Lomb–Scargle peak in periods 22-26 h (as phc_check_periodogram_peak,
+ * grid oversampled 10 times, Baluev's FAP with dH = 2 for mean and line,
+ * dK = 4).  *statistic: its normalised power; *period_h: its
+ * period (hours); *p_value: its Baluev FAP over the band, or 1 when the
+ * band holds no local maximum of the periodogram (the power there is the
+ * flank of a longer-period trend, which runs and Ljung–Box report; it is
+ * not a daily cycle).  H0: no periodic signal (white noise).  Needs n >= 5
+ * and a span of times >= PHC_DAILY_MIN_SPAN_H, else PHC_ERR_INVALID with
+ * NAN outputs.  period_h may be NULL. */
+int phc_check_daily_cycle(const double *t, const double *r, size_t n,
+                          double *statistic, double *p_value,
+                          double *period_h);
+
 #endif /* PHC_RESIDUAL_CHECKS_H */

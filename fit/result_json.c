@@ -66,6 +66,19 @@ static json_t *dataset_json(const phc_dataset_result *d)
     json_object_set_new(o, "standardised_residuals", num_array(d->std_residual, d->n));
     json_object_set_new(o, "sigma", d->sigma ? num_array(d->sigma, d->n) : json_null());
     json_object_set_new(o, "acf", num_array(d->acf, d->acf_lags ? d->acf_lags + 1 : 0));
+    /* time series: what phc_fit_recheck needs (x_seconds, time_of_day) and
+     * what the checks of time series found (recomputed on reading) */
+    json_object_set_new(o, "x_seconds", num(d->x_seconds));
+    json_object_set_new(o, "time_of_day", d->time_of_day ? num_array(d->time_of_day, d->n) : json_null());
+    if (d->acf_time)
+        json_object_set_new(o, "acf_time", json_pack("{s:o, s:o}", "bin_h", num(d->acf_time_bin_h), "acf",
+                                                     num_array(d->acf_time, d->acf_time_bins)));
+    if (d->checks[PHC_CHECK_DAILY_CYCLE].applicable)
+        json_object_set_new(o, "periodogram",
+                            json_pack("{s:o, s:o, s:o, s:o, s:o}", "daily_period_h", num(d->cycle_period_h),
+                                      "daily_peak_clock_hour", num(d->cycle_peak_hour), "peak_period_h",
+                                      num(d->peak_period_h), "peak_power", num(d->peak_power), "peak_fap",
+                                      num(d->peak_fap)));
     if (d->extra_markdown)
         json_object_set_new(o, "extra_markdown", json_string(d->extra_markdown));
     if (d->series)
@@ -293,6 +306,17 @@ static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result 
         return rc;
     json_t *sig = json_object_get(o, "sigma");
     if (sig && !json_is_null(sig) && (rc = get_array(rd, o, "sigma", where, d->n, &d->sigma)))
+        return rc;
+    /* optional (results written before the daily-cycle checks have neither) */
+    json_t *xs = json_object_get(o, "x_seconds");
+    if (xs && !json_is_null(xs)) {
+        if ((rc = get_number(rd, o, "x_seconds", where, &d->x_seconds)))
+            return rc;
+        if (!(d->x_seconds >= 0))
+            return fail_field(rd, "datasets[].x_seconds", "a number >= 0");
+    }
+    json_t *tod = json_object_get(o, "time_of_day");
+    if (tod && !json_is_null(tod) && (rc = get_array(rd, o, "time_of_day", where, d->n, &d->time_of_day)))
         return rc;
     json_t *extra = json_object_get(o, "extra_markdown");
     if (extra && (rc = get_string(rd, o, "extra_markdown", where, &d->extra_markdown)))

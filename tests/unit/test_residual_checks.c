@@ -22,6 +22,10 @@
 
 #define N30 30
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 /* Residuals of R: lm(y ~ t + I(t^2)), t = 1..30, with
  * y = c(2.474, 2.925, 3.618, 3.779, 4.738, 5.449, 6.06, 7.049, 7.232, 8.376,
  *       9.22, 10.62, 11.92, 12.5, 13.271, 13.901, 15.095, 16.921, 18.87,
@@ -531,6 +535,223 @@ static void test_runs(void)
     CHECK(phc_check_runs(cst, 0, &z, &p, &runs) == PHC_ERR_INVALID);
 }
 
+/* ---- time series: time-lag ACF, Lomb–Scargle, daily cycle ---- */
+
+/* Fixed-seed uniform (0, 1) (64-bit LCG, Knuth's MMIX constants) and
+ * Box–Muller normals: the same numbers on every machine. */
+static unsigned long long lcg_state;
+static double lcg_uniform(void)
+{
+    lcg_state = lcg_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return ((double)(lcg_state >> 11) + 0.5) / 9007199254740992.0;
+}
+static double lcg_normal(void)
+{
+    const double u = lcg_uniform(), v = lcg_uniform();
+    return sqrt(-2.0 * log(u)) * cos(2.0 * M_PI * v);
+}
+
+#define NT 240
+
+static void test_acf_time(void)
+{
+    double t[NT], r[NT], acf[49];
+    size_t pairs[49];
+    /* hourly for 10 days, a 24 h sinusoid: with the per-pair normalisation
+     * rho(12 h) = -1 and rho(24 h) = +1 exactly (228 and 216 pairs span
+     * whole half-periods of sin^2) */
+    for (size_t i = 0; i < NT; ++i) {
+        t[i] = (double)i;
+        r[i] = sin(2.0 * M_PI * t[i] / 24.0);
+    }
+    CHECK(phc_check_acf_time(t, r, NT, 1.0, 49, acf, pairs) == PHC_OK);
+    CHECK(acf[0] == 1.0 && pairs[0] == NT);
+    CHECK_NEAR(acf[12], -1.0, 1e-12, 0);
+    CHECK_NEAR(acf[24], 1.0, 1e-12, 0);
+    CHECK_NEAR(acf[6], 0.0, 0.02, 0); /* 234 pairs: 19.5 periods of sin a cos a */
+    CHECK(pairs[12] == NT - 12 && pairs[48] == NT - 48);
+    CHECK_NEAR(phc_check_acf_time_bin(t, NT, 1.0), 1.0, 0, 1e-15);
+    CHECK_NEAR(phc_check_acf_time_bin(t, NT, 2.5), 2.5, 0, 1e-15);
+
+    /* regular sampling, bin = step: the ACF with 1/(n - h) normalisation,
+     * i.e. phc_check_acf's (1/n) values times n/(n - h); the times given in
+     * reverse order (the function sorts them) */
+    double tr[N30], acf_n[8], acf_t[8];
+    for (size_t i = 0; i < N30; ++i)
+        tr[i] = 3.0 * (double)(N30 - 1 - i);
+    double rr[N30];
+    for (size_t i = 0; i < N30; ++i)
+        rr[i] = res1[N30 - 1 - i];
+    CHECK(phc_check_acf(res1, N30, 7, acf_n) == PHC_OK);
+    CHECK(phc_check_acf_time(tr, rr, N30, 3.0, 8, acf_t, NULL) == PHC_OK);
+    for (size_t h = 1; h < 8; ++h)
+        CHECK_NEAR(acf_t[h], acf_n[h] * N30 / (double)(N30 - h), 1e-14, 1e-12);
+
+    /* irregular times (fixed seed), 1 h bins: within a bin the lag varies by
+     * +-0.5 h, so rho ~ cos(2 pi lag / 24) averaged over the bin (0.9986),
+     * and the pairs of a bin weight the points unevenly (the mean of sin^2
+     * over them differs from c0 by a few per cent): ~ -1 at 12 h, ~ +1 at
+     * 24 h */
+    lcg_state = 17;
+    double ti[600], ri[600], acf_i[49];
+    for (size_t i = 0; i < 600; ++i) {
+        ti[i] = 240.0 * lcg_uniform();
+        ri[i] = sin(2.0 * M_PI * ti[i] / 24.0);
+    }
+    CHECK(phc_check_acf_time(ti, ri, 600, 1.0, 49, acf_i, NULL) == PHC_OK);
+    CHECK_NEAR(acf_i[12], -1.0, 0.07, 0);
+    CHECK_NEAR(acf_i[24], 1.0, 0.07, 0);
+    const double bin = phc_check_acf_time_bin(ti, 600, 1.0);
+    CHECK(bin == 1.0); /* median interval 0.4 h < 1 h */
+
+    /* limit cases: n < 3, constant residuals, no pair in a bin, bad bin */
+    CHECK(phc_check_acf_time(t, r, 2, 1.0, 49, acf, NULL) == PHC_ERR_INVALID);
+    CHECK(isnan(acf[0]) && isnan(acf[24]));
+    const double cst[5] = {1, 1, 1, 1, 1}, t5[5] = {0, 1, 2, 3, 4};
+    CHECK(phc_check_acf_time(t5, cst, 5, 1.0, 3, acf, NULL) == PHC_ERR_INVALID);
+    CHECK(phc_check_acf_time(t, r, NT, 0.0, 3, acf, NULL) == PHC_ERR_INVALID);
+    const double tg[4] = {0, 1, 100, 101}, rg[4] = {1, -1, 2, 0};
+    CHECK(phc_check_acf_time(tg, rg, 4, 1.0, 50, acf, pairs) == PHC_OK);
+    CHECK(pairs[1] == 2 && isnan(acf[2]) && pairs[2] == 0);
+    CHECK(isnan(phc_check_acf_time_bin(cst, 5, 1.0))); /* one distinct time */
+}
+
+/* t_i = 0.37 i + 0.2 sin i (h), r_i = 0.4 sin(2 pi t_i / 24) + sin(7.3 i^2),
+ * i < 200.  Reference: a direct transcription in Python 3.11 (math module
+ * only) of Scargle's power (with tau from atan2) and of astropy's
+ * fap_baluev (astropy/timeseries/periodograms/lombscargle/_statistics.py,
+ * normalization "standard", dH = 1, dK = 3, W = (f_hi - f_lo) T_eff),
+ * evaluated at the frequency this code found. */
+static void test_lomb_scargle_reference(void)
+{
+    double t[200], r[200];
+    for (size_t i = 0; i < 200; ++i) {
+        t[i] = 0.37 * (double)i + 0.2 * sin((double)i);
+        r[i] = 0.4 * sin(2.0 * M_PI * t[i] / 24.0) + sin(7.3 * (double)i * (double)i);
+    }
+    phc_periodogram_peak pk;
+    CHECK(phc_check_periodogram_peak(t, r, 200, 1.0 / 60.0, 1.0 / 2.0, 5.0, &pk) == PHC_OK);
+    /* the 24 h component is found (to within the grid: 1 / (5 T)) */
+    CHECK_NEAR(pk.frequency, 1.0 / 24.0, 1.0 / (5.0 * 73.63), 0);
+    /* power at the found frequency 0.040692184202909376: 0.12794185457963606
+     * (Python); the refined peak is a maximum there (Python: no larger power
+     * within +-2e-4 cycles/h) */
+    CHECK_NEAR(pk.frequency, 0.040692184202909376, 0, 1e-9);
+    CHECK_NEAR(pk.power, 0.12794185457963606, 0, 1e-12);
+    double pw;
+    CHECK(phc_check_lomb_scargle(t, r, 200, &pk.frequency, 1, &pw) == PHC_OK);
+    CHECK_NEAR(pw, pk.power, 0, 1e-13);
+    /* Baluev FAP (Python transcription of astropy): 0.0001953246767788222 */
+    CHECK_NEAR(pk.fap, 0.0001953246767788222, 0, 1e-11);
+    CHECK(pk.local_max);
+}
+
+static void test_lomb_scargle(void)
+{
+    double t[NT], r[NT];
+    for (size_t i = 0; i < NT; ++i) {
+        t[i] = 1e5 + (double)i; /* a large clock offset loses no digits */
+        r[i] = 2.0 + sin(2.0 * M_PI * t[i] / 24.0 + 0.3);
+    }
+    /* regular sampling, Fourier frequencies: the sinusoid explains all of
+     * the variance at 1/24 h and none at 1/12 h or 1/40 h */
+    const double f[3] = {1.0 / 24.0, 1.0 / 12.0, 1.0 / 40.0};
+    double pw[3];
+    CHECK(phc_check_lomb_scargle(t, r, NT, f, 3, pw) == PHC_OK);
+    CHECK_NEAR(pw[0], 1.0, 1e-12, 0);
+    CHECK_NEAR(pw[1], 0.0, 1e-12, 0);
+    CHECK_NEAR(pw[2], 0.0, 1e-12, 0);
+
+    /* irregular times, a 17.3 h sinusoid plus a little noise: the highest
+     * peak over periods 2 h .. 240 h is at its period, to within the grid
+     * spacing (1 / (5 T) cycles per hour), and highly significant */
+    lcg_state = 4242;
+    double ti[300], ri[300];
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < 300; ++i) {
+        ti[i] = 240.0 * lcg_uniform();
+        ri[i] = sin(2.0 * M_PI * ti[i] / 17.3) + 0.1 * lcg_normal();
+        lo = fmin(lo, ti[i]);
+        hi = fmax(hi, ti[i]);
+    }
+    phc_periodogram_peak pk;
+    CHECK(phc_check_periodogram_peak(ti, ri, 300, 1.0 / 240.0, 0.5, 5.0, &pk) == PHC_OK);
+    const double df = 1.0 / (5.0 * (hi - lo));
+    CHECK_NEAR(pk.frequency, 1.0 / 17.3, df, 0);
+    CHECK_NEAR(pk.period, 17.3, 17.3 * 17.3 * df, 0);
+    CHECK(pk.power > 0.95 && pk.fap < 1e-50 && pk.local_max);
+    CHECK(pk.n_freq > 100);
+    /* the refined peak is within 1e-3 h of the true period here */
+    CHECK_NEAR(pk.period, 17.3, 1e-2, 0);
+
+    /* Deterministic irregular case for an independent check of the power
+     * and of Baluev's FAP: see test_lomb_scargle_reference. */
+    /* white noise (fixed seed) at irregular times: no significant peak */
+    lcg_state = 99;
+    for (size_t i = 0; i < 300; ++i) {
+        ti[i] = 240.0 * lcg_uniform();
+        ri[i] = lcg_normal();
+    }
+    CHECK(phc_check_periodogram_peak(ti, ri, 300, 1.0 / 240.0, 0.5, 5.0, &pk) == PHC_OK);
+    CHECK(pk.fap > 0.05 && pk.fap <= 1.0);
+    printf("white noise: highest peak %.3f h, power %.4f, FAP %.3f\n", pk.period, pk.power, pk.fap);
+
+    double s, p, per;
+    /* daily cycle: the 24 h sinusoid hourly over 10 days */
+    CHECK(phc_check_daily_cycle(t, r, NT, &s, &p, &per) == PHC_OK);
+    CHECK_NEAR(per, 24.0, 1e-3, 0);
+    CHECK_NEAR(s, 1.0, 1e-3, 0); /* the line in time removed first takes a little */
+    CHECK(p < 1e-100);
+    /* a weak daily cycle in noise is still found; white noise is not */
+    lcg_state = 7;
+    for (size_t i = 0; i < 300; ++i) {
+        ti[i] = 120.0 * lcg_uniform();
+        ri[i] = 0.5 * sin(2.0 * M_PI * (ti[i] - 14.0) / 24.0) + lcg_normal();
+    }
+    CHECK(phc_check_daily_cycle(ti, ri, 300, &s, &p, &per) == PHC_OK);
+    CHECK(p < 1e-4 && fabs(per - 24.0) < 1.5);
+    printf("weak daily cycle: period %.3f h, power %.4f, p %.3g\n", per, s, p);
+    lcg_state = 99;
+    for (size_t i = 0; i < 300; ++i) {
+        ti[i] = 240.0 * lcg_uniform();
+        ri[i] = lcg_normal();
+    }
+    CHECK(phc_check_daily_cycle(ti, ri, 300, &s, &p, &per) == PHC_OK);
+    CHECK(p > 0.05);
+    printf("white noise, daily test: period %.3f h, power %.4f, p %.3g\n", per, s, p);
+    /* a slow drift over two days (an exponential decay left in the
+     * residuals): after the line in time is removed, what is left reaches
+     * into 22-26 h only as the flank of the low-frequency peak */
+    double tl[48], rl[48];
+    for (size_t i = 0; i < 48; ++i) {
+        tl[i] = (double)i;
+        rl[i] = exp(-(double)i / 15.0);
+    }
+    CHECK(phc_check_daily_cycle(tl, rl, 48, &s, &p, &per) == PHC_OK);
+    printf("exponential drift over 48 h, daily test: period %.3f h, power %.4f, p %.3g\n", per, s, p);
+    CHECK(p == 1.0);
+    /* a slow cycle (period 10 days) over 10 days: the band holds only its
+     * sidelobes (power ~ 1e-3), not significant */
+    for (size_t i = 0; i < NT; ++i)
+        r[i] = sin(2.0 * M_PI * (double)i / 240.0 + 1.0);
+    CHECK(phc_check_daily_cycle(t, r, NT, &s, &p, &per) == PHC_OK);
+    CHECK(p > 0.05);
+
+    /* limit cases */
+    CHECK(phc_check_daily_cycle(t, r, 2, &s, &p, &per) == PHC_ERR_INVALID);
+    CHECK(isnan(s) && isnan(p) && isnan(per));
+    CHECK(phc_check_daily_cycle(t, r, 30, &s, &p, &per) == PHC_ERR_INVALID); /* 29 h < 36 h */
+    CHECK(isnan(s) && isnan(p) && isnan(per));
+    CHECK(phc_check_daily_cycle(t, r, 37, &s, &p, NULL) == PHC_OK); /* 36 h: applicable */
+    const double cst[6] = {3, 3, 3, 3, 3, 3}, t6[6] = {0, 10, 20, 30, 40, 50};
+    CHECK(phc_check_daily_cycle(t6, cst, 6, &s, &p, &per) == PHC_ERR_INVALID);
+    CHECK(phc_check_periodogram_peak(t, r, 4, 0.01, 0.1, 5.0, &pk) == PHC_ERR_INVALID);
+    CHECK(isnan(pk.period) && isnan(pk.fap));
+    CHECK(phc_check_periodogram_peak(t, r, NT, 0.1, 0.01, 5.0, &pk) == PHC_ERR_INVALID);
+    CHECK(phc_check_lomb_scargle(t, r, 2, f, 3, pw) == PHC_ERR_INVALID);
+    CHECK(isnan(pw[0]));
+}
+
 int main(void)
 {
     test_shapiro_wilk();
@@ -539,5 +760,8 @@ int main(void)
     test_acf_ljung_box();
     test_breusch_pagan();
     test_runs();
+    test_acf_time();
+    test_lomb_scargle();
+    test_lomb_scargle_reference();
     return check_finish("test_residual_checks");
 }
