@@ -429,6 +429,28 @@ int phc_local_clock(const char *tz, double t_posix, double *seconds_since_local_
     return phc_local_clocks(tz, &t_posix, 1, seconds_since_local_midnight, err);
 }
 
+int phc_local_iso(const char *tz, double t_posix, char *buf, size_t size, phc_error *err)
+{
+    zone_env z;
+    int rc;
+    if ((rc = check_time(t_posix, err)) || (rc = zone_enter(tz, &z, err)))
+        return rc;
+    const long long s = (long long)floor(t_posix), off = offset_at(&z, s);
+    const long long local = s + off, day = floor_div(local, DAY), sec = local - day * DAY;
+    /* civil_from_days (H. Hinnant) */
+    const long long zd = day + 719468, era = (zd >= 0 ? zd : zd - 146096) / 146097;
+    const long long doe = zd - era * 146097;
+    const long long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+    const long long doy = doe - (365 * yoe + yoe / 4 - yoe / 100), mp = (5 * doy + 2) / 153;
+    const int d = (int)(doy - (153 * mp + 2) / 5 + 1), m = (int)(mp < 10 ? mp + 3 : mp - 9);
+    const long long y = yoe + era * 400 + (m <= 2);
+    const long long aoff = off < 0 ? -off : off;
+    snprintf(buf, size, "%04lld-%02d-%02dT%02lld:%02lld:%02lld%c%02lld:%02lld", y, m, d, sec / 3600,
+             sec / 60 % 60, sec % 60, off < 0 ? '-' : '+', aoff / 3600, aoff / 60 % 60);
+    zone_leave(&z);
+    return PHC_OK;
+}
+
 int phc_local_daily_times(const char *tz, double t0, double t1, double seconds_of_day,
                           double **times, size_t *n, phc_error *err)
 {

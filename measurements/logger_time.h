@@ -91,6 +91,11 @@ int phc_local_clock(const char *tz, double t_posix, double *seconds_since_local_
 int phc_local_clocks(const char *tz, const double *t_posix, size_t n, double *seconds,
                      phc_error *err);
 
+/* Writes t_posix as the local time of zone tz (NULL = UTC) in ISO 8601 with
+ * its offset, "2024-10-25T16:00:00+02:00" (whole seconds, rounded down),
+ * into buf (at least 26 bytes).  Errors as phc_local_clock. */
+int phc_local_iso(const char *tz, double t_posix, char *buf, size_t size, phc_error *err);
+
 /* The POSIX times at which the local clock of zone tz (NULL = UTC) reads
  * `seconds_of_day` (in [0, 86400)), one per local day, for every such time
  * within [t0 - 86400, t1 + 86400], sorted; *times is malloc'd (the caller

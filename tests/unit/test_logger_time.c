@@ -208,6 +208,13 @@ static void test_local_clock(void)
     CHECK(phc_local_clock(NULL, -1.0, &s, &err) == PHC_OK);
     CHECK_NEAR(s, 86399, 0, 0);
     CHECK(phc_local_clock(NULL, NAN, &s, &err) == PHC_ERR_INVALID);
+    char iso[40];
+    CHECK(phc_local_iso("Europe/Berlin", T_1024_1105_07 + 0.9, iso, sizeof iso, &err) == PHC_OK);
+    CHECK(strcmp(iso, "2024-10-24T13:05:07+02:00") == 0);
+    CHECK(phc_local_iso("America/New_York", T_0330_0600, iso, sizeof iso, &err) == PHC_OK);
+    CHECK(strcmp(iso, "2024-03-30T02:00:00-04:00") == 0);
+    CHECK(phc_local_iso(NULL, -1.0, iso, sizeof iso, &err) == PHC_OK);
+    CHECK(strcmp(iso, "1969-12-31T23:59:59+00:00") == 0);
     double ts[3] = {T_0330_0600, T_0701_0500, T_1027_0000}, out[3];
     CHECK(phc_local_clocks("Europe/Berlin", ts, 3, out, &err) == PHC_OK);
     CHECK_NEAR(out[0], 7 * H, 0, 0);
