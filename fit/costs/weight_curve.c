@@ -9,6 +9,7 @@
 #include "fit/costs/source_file.h"
 #include "fit/costs/unique_times.h"
 #include "measurements/c_number.h"
+#include "measurements/logger_time.h"
 #include "measurements/plant_io.h"
 #include "measurements/table.h"
 #include "measurements/units.h"
@@ -22,16 +23,27 @@
 const char *const phc_weight_curve_keys[] = {
     "file", "time", "mass", "select", "plant", "plant_format", "plant_unit", "leaf_area",
     "chain_segments", "vein_radius", "dry_mass", "sigma", "exclude", "jumps", "jump_threshold",
-    "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
+    "tare", "max_gap", "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
 const phc_key_help phc_weight_curve_help[] = {
     {"file", "CSV table of weighings, in time order, relative to the config file. Required."},
-    {"time", "{column: NAME, unit: UNIT} or a column name: the time of each weighing; any "
-             "UDUNITS-2 time unit (also \"seconds since 1970-01-01\" for POSIX times), "
-             "default s. Required."},
+    {"time", "{column: NAME, unit: UNIT} or a column name: the time of each weighing as a "
+             "number; any UDUNITS-2 time unit (also \"seconds since 1970-01-01\" for POSIX "
+             "times), default s. Or logger timestamps: {columns: [DATE, TIME], format: F, "
+             "timezone: Z} (two columns joined by a space) or {column: STAMP, format: F, "
+             "timezone: Z}; a `columns`, `format` or `timezone` key (without `unit`) makes the "
+             "time a timestamp. F: a strptime format such as \"%d/%m/%Y %H:%M:%S\" (a fraction "
+             "after %S is accepted), default ISO 8601 (2024-10-24T13:05:00, optional fraction, "
+             "Z or +02:00). Z: the logger clock's IANA zone (Europe/Berlin) so daylight-saving "
+             "steps are handled (a time in the repeated hour takes the instant that keeps the "
+             "series in order); without it times are taken as written (UTC) and a step back is "
+             "an error. With timestamps the time unit is h since the first weighing (exclude, "
+             "step, max_gap). With a numeric absolute unit, timezone only sets the local "
+             "clock. Required."},
     {"mass", "{column: NAME, unit: UNIT} or a column name: the masses, > 0; any mass unit, "
              "default g. Required."},
     {"select", "{COLUMN: VALUE, ...}: keep only the rows matching every pair (one plant of a "
-               "long table; \"1\" matches \"1.0\"). Default: every row."},
+               "long table; \"1\" matches \"1.0\"; a logger's stable readings: "
+               "{Status: ST}). Default: every row."},
     {"plant", "A plant-graph file (paper, TreeQSM, SWC or native CSV), relative to the config "
               "file. Give exactly one of plant and leaf_area."},
     {"plant_format", "Format of the plant file: auto (by extension and content), paper, "
@@ -58,6 +70,12 @@ const phc_key_help phc_weight_curve_help[] = {
               "own slot initial_water_<k>) or keep. Default: error."},
     {"jump_threshold", "The rise between weighings that counts as a jump, > 0, in the mass "
                        "unit. Default: max(5 sigma, 0.5% of the largest mass)."},
+    {"tare", "auto: drop the readings at the start of the selected rows that are below 50% of "
+             "the median of the next 10 (the empty balance, a pot without its plant) and list "
+             "them in the report; keep: use every row. Default: auto."},
+    {"max_gap", "Longest expected pause between weighings, a number in the time unit or "
+                "{value: V, unit: U}; longer gaps (logger off) are listed in the report. "
+                "Default: 6 h."},
     {"conductance", "Edge weights of the water model: poiseuille, mean, paper, reference or "
                     "reference_2024 (model/water.h). Default: poiseuille."},
     {"method", "Evaluator: auto (exact up to 400 segments when not stiff, else BDF6), exact "
@@ -99,6 +117,14 @@ typedef struct wc_impl {
     size_t n_pieces;
     piece *pieces;
     double seconds_per_x;      /* the user's time unit in s */
+    double t0_posix;           /* POSIX time (s) at x = 0, the first weighing kept; NAN when
+                                  the time is a plain number (not timestamps or an absolute unit) */
+    char *timezone;            /* IANA zone of the clock (malloc'd), NULL = UTC / as written */
+    size_t tare_n, tare_line[2]; /* tare readings dropped, their first and last lines */
+    double max_gap;            /* s */
+    size_t n_gaps;             /* gaps longer than max_gap: their lengths (s) and the line */
+    double *gap_s;             /*   of the weighing before each */
+    size_t *gap_line;
     double *u, *du;            /* workspace: unit response and its derivatives */
 } wc_impl;
 
@@ -115,6 +141,9 @@ static void wc_free(void *p)
     free(w->pieces);
     free(w->u);
     free(w->du);
+    free(w->timezone);
+    free(w->gap_s);
+    free(w->gap_line);
     free(w);
 }
 
@@ -319,6 +348,215 @@ static int parse_choice(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
                          phc_yaml_get(node, key)->line, key, s, list);
 }
 
+/* The `time` key: a numeric column ({column, unit} or a bare name), or logger
+ * timestamps ({column: STAMP | columns: [DATE, TIME], format, timezone}); a
+ * `columns` or `format` key, or `timezone` without `unit`, makes timestamps. */
+typedef struct time_spec {
+    const char *col[2], *unit, *format, *tz; /* col[1]: NULL or the second column */
+    int stamp;
+    size_t line;
+} time_spec;
+
+static int time_spec_read(const phc_yaml_doc *doc, const phc_yaml_node *node, time_spec *ts,
+                          phc_error *err)
+{
+    static const char *const keys[] = {"column", "columns", "unit", "format", "timezone", NULL};
+    const phc_yaml_node *v = phc_yaml_get(node, "time"), *cols = phc_yaml_get(v, "columns");
+    const char *ctx = "key 'time'";
+    int rc;
+    memset(ts, 0, sizeof *ts);
+    if (!v || v->kind != PHC_YAML_MAPPING || (!cols && !phc_yaml_get(v, "format") && !phc_yaml_get(v, "timezone")))
+        return phc_column_spec(doc, node, "time", "weight_curve data set", "s", &ts->col[0], &ts->unit, err);
+    ts->line = v->line;
+    if ((rc = phc_yaml_check_keys(doc, v, keys, ctx, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "column", !cols, ctx, &ts->col[0], err)) ||
+        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, &ts->unit, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "format", 0, ctx, &ts->format, err)) ||
+        (rc = phc_yaml_map_string(doc, v, "timezone", 0, ctx, &ts->tz, err)))
+        return rc;
+    ts->stamp = cols || ts->format || !ts->unit;
+    if (cols && (ts->col[0] || cols->kind != PHC_YAML_SEQUENCE || cols->count < 1 || cols->count > 2 ||
+                 cols->items[0]->kind != PHC_YAML_SCALAR || cols->items[cols->count - 1]->kind != PHC_YAML_SCALAR))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'time': give either column: STAMP or columns: [DATE, TIME] (one or two column names)",
+                             doc->path, phc_key_line(v, "columns"));
+    for (size_t i = 0; cols && i < cols->count; ++i)
+        ts->col[i] = cols->items[i]->scalar;
+    if (ts->stamp && ts->unit)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'time': 'unit' is for numeric times; timestamps (format, columns) become hours since the first weighing",
+                             doc->path, phc_key_line(v, "unit"));
+    if ((rc = phc_time_zone_check(ts->tz, err)))
+        return phc_error_prefix(err, rc, "%s:%zu: key 'timezone'", doc->path, phc_key_line(v, "timezone"));
+    if (!ts->stamp && !strstr(ts->unit, "since"))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'timezone': needs timestamps (format or columns) or an absolute time unit such as \"seconds since 1970-01-01\"",
+                             doc->path, phc_key_line(v, "timezone"));
+    return PHC_OK;
+}
+
+/* The times of the selected rows: numbers in the time unit, or for
+ * timestamps hours since the first selected row.  *origin is the POSIX time
+ * at tv = 0 (NAN when unknown); w->timezone is set. */
+static int time_values(const phc_yaml_doc *doc, const time_spec *ts, const phc_table *t,
+                       const size_t *keep, size_t n, phc_units *units, wc_impl *w, double **tv,
+                       double *origin, phc_error *err)
+{
+    int rc = PHC_OK;
+    *origin = NAN;
+    if (ts->tz && !(w->timezone = strdup(ts->tz)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (!ts->stamp) {
+        phc_unit_conversion ac;
+        phc_error ignore;
+        if ((rc = phc_table_column_numbers_rows(t, ts->col[0], keep, n, tv, err))) {
+            const char *found = err ? strstr(err->message, "found '") : NULL;
+            if (found && strpbrk(found + 8, ":/")) /* a date or a clock time */
+                snprintf(err->message + strlen(err->message), sizeof err->message - strlen(err->message),
+                         "; for date and time text give time: {column: NAME, format: ..., timezone: ...}");
+            return rc;
+        }
+        if (strstr(ts->unit, "since") && !phc_units_conversion(units, ts->unit, "seconds since 1970-01-01 00:00:00 UTC", "", &ac, &ignore))
+            *origin = ac.offset;
+        return PHC_OK;
+    }
+    long c[2] = {phc_table_find(t, ts->col[0]), ts->col[1] ? phc_table_find(t, ts->col[1]) : -1};
+    if (ts->col[1] && c[1] < 0)
+        return phc_unknown_column(doc, ts->line, "time column", ts->col[1], t, err);
+    char what[160];
+    if (ts->col[1])
+        snprintf(what, sizeof what, "columns '%s' and '%s'", ts->col[0], ts->col[1]);
+    else
+        snprintf(what, sizeof what, "column '%s'", ts->col[0]);
+    char **text = calloc(n ? n : 1, sizeof *text);
+    size_t *lines = malloc((n ? n : 1) * sizeof *lines);
+    *tv = malloc((n ? n : 1) * sizeof **tv);
+    if (!text || !lines || !*tv)
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < n && !rc; ++i) {
+        const char *a = phc_table_cell(t, keep[i], (size_t)c[0]);
+        const char *b = ts->col[1] ? phc_table_cell(t, keep[i], (size_t)c[1]) : NULL;
+        lines[i] = phc_table_row_line(t, keep[i]);
+        if (!(text[i] = malloc(strlen(a) + (b ? strlen(b) + 2 : 1))))
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        else
+            sprintf(text[i], b ? "%s %s" : "%s", a, b);
+    }
+    phc_logger_clock clock = {ts->format, ts->tz, phc_table_source(t), what};
+    if (!rc && !(rc = phc_logger_times(&clock, (const char *const *)text, lines, n, *tv, err)) && n) {
+        *origin = (*tv)[0];
+        for (size_t i = n; i-- > 0;)
+            (*tv)[i] = ((*tv)[i] - *origin) / 3600.0;
+    }
+    for (size_t i = 0; text && i < n; ++i)
+        free(text[i]);
+    free(text);
+    free(lines);
+    return rc;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* `tare` and `max_gap`: drops the tare readings at the start of the selected
+ * rows (each below 50% of the median of the 10 readings after it; at least 2
+ * rows stay) and lists the pauses longer than max_gap. */
+static int tare_and_gaps(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_units *units,
+                         const phc_table *t, size_t *keep, double *tv, double *mv, size_t *n_sel,
+                         wc_impl *w, phc_error *err)
+{
+    static const char *const tare_names[] = {"auto", "keep", NULL};
+    int tare = 0, rc;
+    const phc_yaml_node *mg = phc_yaml_get(node, "max_gap");
+    w->max_gap = 6 * 3600.0;
+    if ((rc = parse_choice(doc, node, "tare", tare_names, &tare, err)))
+        return rc;
+    if (mg && mg->kind == PHC_YAML_SCALAR) {
+        if ((rc = phc_yaml_number(doc, mg, "max_gap", &w->max_gap, err)))
+            return rc;
+        w->max_gap *= w->seconds_per_x;
+    } else if (mg && (rc = quantity(doc, mg, "max_gap", "h", "s", units, t, keep[0], &w->max_gap, err))) {
+        return rc;
+    }
+    if (!(w->max_gap > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'max_gap': must be positive", doc->path, mg->line);
+    size_t k = 0, n = *n_sel;
+    while (tare == 0 && k + 2 < n) {
+        double next[10];
+        size_t m = 0;
+        for (size_t j = k + 1; j < n && m < 10; ++j)
+            next[m++] = mv[j];
+        qsort(next, m, sizeof *next, cmp_double);
+        const double median = m % 2 ? next[m / 2] : 0.5 * (next[m / 2 - 1] + next[m / 2]);
+        if (!(mv[k] < 0.5 * median))
+            break;
+        ++k;
+    }
+    if (k > 0) {
+        w->tare_n = k;
+        w->tare_line[0] = phc_table_row_line(t, keep[0]);
+        w->tare_line[1] = phc_table_row_line(t, keep[k - 1]);
+        memmove(keep, keep + k, (n - k) * sizeof *keep);
+        memmove(tv, tv + k, (n - k) * sizeof *tv);
+        memmove(mv, mv + k, (n - k) * sizeof *mv);
+        *n_sel = n -= k;
+    }
+    for (size_t i = 1; i < n; ++i)
+        if ((tv[i] - tv[i - 1]) * w->seconds_per_x > w->max_gap) {
+            double *g = realloc(w->gap_s, (w->n_gaps + 1) * sizeof *g);
+            size_t *l = g ? realloc(w->gap_line, (w->n_gaps + 1) * sizeof *l) : NULL;
+            if (g)
+                w->gap_s = g;
+            if (!l)
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            w->gap_line = l;
+            w->gap_s[w->n_gaps] = (tv[i] - tv[i - 1]) * w->seconds_per_x;
+            w->gap_line[w->n_gaps++] = phc_table_row_line(t, keep[i - 1]);
+        }
+    return PHC_OK;
+}
+
+/* The report rows of a logger file: the clock, tare readings, long gaps. */
+static void logger_rows(const wc_impl *w, char *buf, size_t size)
+{
+    size_t used = strlen(buf);
+    char iso[64];
+    if (!isnan(w->t0_posix) && used < size && !phc_local_iso(w->timezone, w->t0_posix, iso, sizeof iso, NULL))
+        used += snprintf(buf + used, size - used, "| clock | %s; time 0 (the first weighing kept) is %s |\n",
+                         w->timezone ? w->timezone : "UTC (times as written)", iso);
+    if (w->tare_n == 1 && used < size)
+        used += snprintf(buf + used, size - used, "| tare readings dropped | 1 (line %zu) |\n", w->tare_line[0]);
+    else if (w->tare_n > 1 && used < size)
+        used += snprintf(buf + used, size - used, "| tare readings dropped | %zu (lines %zu–%zu) |\n",
+                         w->tare_n, w->tare_line[0], w->tare_line[1]);
+    if (w->n_gaps && used < size) {
+        used += snprintf(buf + used, size - used, "| logger gaps longer than %g h | %zu:", w->max_gap / 3600,
+                         w->n_gaps);
+        for (size_t i = 0; i < w->n_gaps && i < 10 && used < size; ++i)
+            used += snprintf(buf + used, size - used, "%s %.1f h after line %zu", i ? "," : "",
+                             w->gap_s[i] / 3600, w->gap_line[i]);
+        if (used < size)
+            snprintf(buf + used, size - used, "%s |\n", w->n_gaps > 10 ? ", ..." : "");
+    }
+}
+
+/* x_seconds, t0_posix and the local clock of every weighing kept. */
+static int set_clock(phc_dataset *ds, wc_impl *w, double origin, double first, phc_error *err)
+{
+    ds->x_seconds = w->seconds_per_x;
+    w->t0_posix = origin + first * w->seconds_per_x;
+    if (isnan(w->t0_posix))
+        return PHC_OK;
+    if (!(ds->time_of_day = malloc(ds->n * sizeof *ds->time_of_day)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < ds->n; ++i)
+        ds->time_of_day[i] = w->t0_posix + ds->x[i] * w->seconds_per_x;
+    int rc = phc_local_clocks(w->timezone, ds->time_of_day, ds->n, ds->time_of_day, err);
+    for (size_t i = 0; i < ds->n && !rc; ++i)
+        ds->time_of_day[i] /= 3600.0;
+    return rc;
+}
+
 enum { JUMPS_ERROR, JUMPS_SPLIT, JUMPS_KEEP };
 
 int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
@@ -337,14 +575,18 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     size_t *keep = NULL;
     long *sel_cols = NULL;
     int rc;
+    time_spec ts;
+    double t_origin = NAN; /* POSIX time at tv = 0, NAN when unknown */
 
     *out = NULL;
     if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_column_spec(doc, node, "time", "weight_curve data set", "s", &tcol, &tunit, err)) ||
+        (rc = time_spec_read(doc, node, &ts, err)) ||
         (rc = phc_column_spec(doc, node, "mass", "weight_curve data set", "g", &mcol, &munit, err)) ||
         (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
         (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
         return rc;
+    tcol = ts.col[0];
+    tunit = ts.stamp ? "h" : ts.unit; /* timestamps: hours since the first weighing */
     if (!(units = phc_units_new(err)))
         return err->status;
     w = calloc(1, sizeof *w);
@@ -429,8 +671,9 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                                  path);
         goto fail;
     }
-    if ((rc = phc_table_column_numbers_rows(table, tcol, keep, n_sel, &tv, err)) ||
-        (rc = phc_table_column_numbers_rows(table, mcol, keep, n_sel, &mv, err)))
+    if ((rc = time_values(doc, &ts, table, keep, n_sel, units, w, &tv, &t_origin, err)) ||
+        (rc = phc_table_column_numbers_rows(table, mcol, keep, n_sel, &mv, err)) ||
+        (rc = tare_and_gaps(doc, node, units, table, keep, tv, mv, &n_sel, w, err)))
         goto fail;
     for (size_t i = 0; i < n_sel; ++i) {
         if (i > 0 && !(tv[i] > tv[i - 1])) {
@@ -720,6 +963,8 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     w->u = malloc(w->m_unique * sizeof *w->u);
     w->du = malloc(3 * w->m_unique * sizeof *w->du);
+    if ((rc = set_clock(ds, w, t_origin, tv[0], err)))
+        goto fail;
     if (!w->u || !w->du) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
@@ -791,7 +1036,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
             av += r * h * v;
     }
     const double abar = vsum > 0 ? av / vsum : 0;
-    char *buf = malloc(2048);
+    char *buf = malloc(4096);
     if (!buf)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     snprintf(buf, 2048,
@@ -813,6 +1058,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
              w->n_pieces > 1 ? " (split at irrigations; each piece has its own initial water, initial_water_2, ...)" : "",
              w0, start * u_end, 100 * u_end, abar,
              delta > 0 && abar > 0 ? log(2.0) / (delta * abar) / 3600.0 : INFINITY);
+    logger_rows(w, buf, 4096);
     *markdown = buf;
     return PHC_OK;
 }

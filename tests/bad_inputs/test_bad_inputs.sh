@@ -783,6 +783,31 @@ wc_config wc_selnone.yaml wc_ok.csv '    leaf_area: 100
     select: {t: 99}
 '
 fit_case "weight_curve: select keeps no row" "$C/wc_selnone.yaml" "wc_selnone.yaml:12" "key 'select'" "wc_ok.csv"
+# Balance-logger files: date and time columns through a strptime format and a time zone
+# (measurements/logger_time.h); the time key is on line 9.
+wcl_config() { # FILE CSV TIME_SPEC
+    printf 'name: t\n%s\ndatasets:\n  - kind: weight_curve\n    file: %s\n    time: %s\n    mass: Weight\n    leaf_area: 100\n' \
+        "$WC_PARAMS" "$2" "$3" >"$C/$1"
+}
+WCL_DMY='{columns: [Date, Time], format: "%d/%m/%Y %H:%M:%S"'
+printf 'Date,Time,Weight\n30/01/2024,10:00:00,4.0\n31/02/2024,10:10:00,3.9\n' >"$C/wcl_date.csv"
+wcl_config wcl_date.yaml wcl_date.csv "$WCL_DMY}"
+fit_case "weight_curve: date not matching the format" "$C/wcl_date.yaml" "wcl_date.csv:3:" \
+    "columns 'Date' and 'Time'" "'31/02/2024 10:10:00'" "format '%d/%m/%Y %H:%M:%S'"
+printf 'Date,Time,Weight\n24.10.2024,10:00:00,4.0\n' >"$C/wcl_sep.csv"
+wcl_config wcl_sep.yaml wcl_sep.csv "$WCL_DMY}"
+fit_case "weight_curve: date with the wrong separators" "$C/wcl_sep.yaml" "wcl_sep.csv:2:" "'24.10.2024 10:00:00'" "does not match the format"
+printf 'Date,Time,Weight\n27/10/2024,02:30:00,4.0\n27/10/2024,02:50:00,3.9\n27/10/2024,02:10:00,3.8\n' >"$C/wcl_dst.csv"
+wcl_config wcl_tz.yaml wcl_dst.csv "$WCL_DMY, timezone: Europe/Berln}"
+fit_case "weight_curve: unknown time zone" "$C/wcl_tz.yaml" "wcl_tz.yaml:9" "key 'timezone'" "'Europe/Berln'"
+wcl_config wcl_tzdots.yaml wcl_dst.csv "$WCL_DMY, timezone: ../zoneinfo/UTC}"
+fit_case "weight_curve: time zone outside the database" "$C/wcl_tzdots.yaml" "wcl_tzdots.yaml:9" "key 'timezone'"
+wcl_config wcl_dst.yaml wcl_dst.csv "$WCL_DMY}"
+fit_case "weight_curve: clock steps back without timezone" "$C/wcl_dst.yaml" "wcl_dst.csv:4:" "line 3" "daylight saving" "timezone:"
+wcl_config wcl_col.yaml wcl_dst.csv '{columns: [Date, Tim], timezone: Europe/Berlin}'
+fit_case "weight_curve: columns names no column" "$C/wcl_col.yaml" "wcl_col.yaml:9" "'Tim'" "'Time'"
+wcl_config wcl_unit.yaml wcl_dst.csv "$WCL_DMY, unit: h}"
+fit_case "weight_curve: unit with timestamps" "$C/wcl_unit.yaml" "wcl_unit.yaml:9" "'unit' is for numeric times"
 # ---- end weight_curve ------------------------------------------------------
 
 # ---- soil_probe and infiltration -------------------------------------------
