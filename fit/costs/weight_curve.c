@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fit/costs/source_file.h"
+#include "fit/costs/weight_drivers.h"
 #include "fit/costs/unique_times.h"
 #include "measurements/c_number.h"
 #include "measurements/logger_time.h"
@@ -15,6 +16,7 @@
 #include "measurements/units.h"
 #include "model/plant_graph.h"
 #include "model/water.h"
+#include "model/water_balance.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -23,7 +25,7 @@
 const char *const phc_weight_curve_keys[] = {
     "file", "time", "mass", "select", "plant", "plant_format", "plant_unit", "leaf_area",
     "chain_segments", "vein_radius", "dry_mass", "sigma", "exclude", "jumps", "jump_threshold",
-    "tare", "max_gap", "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
+    "tare", "max_gap", "day", "covariates", "pot", "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
 const phc_key_help phc_weight_curve_help[] = {
     {"file", "CSV table of weighings, in time order, relative to the config file. Required."},
     {"time", "{column: NAME, unit: UNIT} or a column name: the time of each weighing as a "
@@ -76,6 +78,20 @@ const phc_key_help phc_weight_curve_help[] = {
     {"max_gap", "Longest expected pause between weighings, a number in the time unit or "
                 "{value: V, unit: U}; longer gaps (logger off) are listed in the report. "
                 "Default: 6 h."},
+    {"day", "{start: \"07:00\", end: \"23:00\", night_factor: F, clock: \"HH:MM\"}: a light "
+            "schedule, local clock times, start before end; leaves lose night_factor times the "
+            "day's rate by night (left out: a fitted slot night_factor). With logger timestamps "
+            "the hours follow the time zone (daylight saving included); with a plain numeric time "
+            "give clock, the local time of the first weighing. Default: one rate all day."},
+    {"covariates", "{columns: [PAR, VPD, ...], law: linear}: the loss rate follows columns "
+                   "read at every weighing, g = 1 + sum loss_<column> x column (one fitted slot "
+                   "per column; each interval between weighings takes the mean of its two "
+                   "readings; a reading missing is an error). Not with day. Default: none."},
+    {"pot", "{capacity: C, conductance: k}: the pot's soil as a water store joined to the "
+            "plant's root segment; C (g) is the soil water at which its pressure equals that "
+            "of a full plant segment, k (g/s) the exchange per unit difference of relative "
+            "fill; a key left out is a fitted slot (pot_capacity, pot_conductance); plant and "
+            "soil start in equilibrium, sharing initial_water. Default: no pot."},
     {"conductance", "Edge weights of the water model: poiseuille, mean, paper, reference or "
                     "reference_2024 (model/water.h). Default: poiseuille."},
     {"method", "Evaluator: auto (exact up to 400 segments when not stiff, else BDF6), exact "
@@ -125,7 +141,12 @@ typedef struct wc_impl {
     size_t n_gaps;             /* gaps longer than max_gap: their lengths (s) and the line */
     double *gap_s;             /*   of the weighing before each */
     size_t *gap_line;
-    double *u, *du;            /* workspace: unit response and its derivatives */
+    double *u, *du;            /* workspace: unit response and its derivatives
+                                  (m_unique, or the largest piece, x (PHC_WB_COEF + coefs)) */
+    phc_weight_drivers drv;    /* day and night, covariates, pot (weight_drivers.h) */
+    int drv_slot;              /* slot of the drivers' first slot (-1: none) */
+    size_t n_coef;             /* coefficients of g */
+    double *t_abs;             /* n: s since the first weighing (time-varying loss) */
 } wc_impl;
 
 static void wc_free(void *p)
@@ -142,6 +163,8 @@ static void wc_free(void *p)
     free(w->u);
     free(w->du);
     free(w->timezone);
+    phc_weight_drivers_free(&w->drv);
+    free(w->t_abs);
     free(w->gap_s);
     free(w->gap_line);
     free(w);
@@ -152,11 +175,9 @@ static double slot_value(const wc_impl *w, const double *p, int kind, double fal
     return w->slot[kind] >= 0 ? p[w->slot[kind]] : fallback;
 }
 
-/* The unit response u(t) = W(t)/W(0) of the water model at m sorted times
- * (s) and, when du is given, du (m x 3: d/dδ, d/dW0, d/dμ).  The system is
- * built once and rebuilt only when μ changes (δ is set in place, O(n)). */
-static int unit_response(wc_impl *w, double delta, double mu, const double *t, size_t m,
-                         double *u, double *du)
+/* Builds the water system for viscosity mu (rebuilt only when mu changes;
+ * delta is set in place, O(n)).  1 = outside the model's domain. */
+static int water_system(wc_impl *w, double delta, double mu)
 {
     phc_error err;
     phc_error_clear(&err);
@@ -174,10 +195,77 @@ static int unit_response(wc_impl *w, double delta, double mu, const double *t, s
     }
     if (phc_water_system_set_loss_rate(w->sys, delta, &err))
         return 1; /* a trial point outside the model's domain: reject the step */
-    int rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err);
+    return 0;
+}
+
+/* The unit response u(t) = W(t)/W(0) of the water model (plant, and pot
+ * when there is one) at m sorted times t (s) of a piece starting at t_start
+ * (s since the first weighing), and, when du is given, du (m x (PHC_WB_COEF
+ * + n_coef): d/dδ, d/dW0, d/dμ, d/dC, d/dk, d/dc_j; model/water_balance.h).
+ * p: the slot values. */
+static int unit_response(wc_impl *w, const double *p, double delta, double mu, double t_start,
+                         const double *t, size_t m, double *u, double *du)
+{
+    int rc = water_system(w, delta, mu);
+    if (rc)
+        return rc;
+    phc_error err;
+    phc_error_clear(&err);
+    if (!w->drv.pot && !phc_weight_drivers_time_varying(&w->drv)) {
+        /* the plant alone with a constant loss: model/water.h (du m x 3) */
+        rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err);
+        if (!rc && du) /* spread to the balance's columns, back to front */
+            for (size_t i = m; i-- > 0;) {
+                double d0 = du[3 * i], d1 = du[3 * i + 1], d2 = du[3 * i + 2];
+                double *row = du + i * (PHC_WB_COEF + w->n_coef);
+                for (size_t c = 0; c < PHC_WB_COEF + w->n_coef; ++c)
+                    row[c] = 0;
+                row[PHC_WB_DELTA] = d0;
+                row[PHC_WB_W0] = d1;
+                row[PHC_WB_MU] = d2;
+            }
+    } else {
+        const phc_water_loss_pattern *loss;
+        const phc_water_pot *pot;
+        phc_water_loss_pattern loss_buf;
+        phc_water_pot pot_buf;
+        phc_weight_drivers_model(&w->drv, w->drv_slot >= 0 ? p + w->drv_slot : NULL, &loss,
+                                 &loss_buf, &pot, &pot_buf);
+        if (pot && !(pot->capacity > 0 && pot->conductance >= 0))
+            return 1;
+        for (size_t k = 0; loss && k < loss->n; ++k)
+            if (!(loss->g[k] >= 0))
+                return 1; /* a negative loss: outside the domain */
+        rc = phc_water_balance_curve(w->sys, pot, loss, t_start, w->method, w->step, t, m, u, du, &err);
+    }
     if (rc == PHC_ERR_NOMEM || rc == PHC_ERR_INTERNAL || rc == PHC_ERR_INVALID)
         return -1;
     return rc ? 1 : 0;
+}
+
+/* Fills a Jacobian row from the piece's unit response (start: the piece's
+ * initial water; d: du row). */
+static void jacobian_row(const wc_impl *w, const phc_dataset *ds, const piece *pc, double start,
+                         double u, const double *d, double *row)
+{
+    for (size_t j = 0; j < ds->k; ++j)
+        row[j] = 0;
+    if (w->slot[SLOT_DELTA] >= 0)
+        row[w->slot[SLOT_DELTA]] = start * d[PHC_WB_DELTA];
+    if (w->slot[SLOT_MU] >= 0)
+        row[w->slot[SLOT_MU]] = start * d[PHC_WB_MU];
+    row[pc->slot] = u;
+    if (w->slot[SLOT_DRY] >= 0)
+        row[w->slot[SLOT_DRY]] = 1.0;
+    if (w->drv_slot >= 0) {
+        int s = w->drv_slot;
+        for (size_t j = 0; j < w->n_coef; ++j)
+            row[s++] = start * d[PHC_WB_COEF + j];
+        if (w->drv.pot && isnan(w->drv.capacity))
+            row[s++] = start * d[PHC_WB_CAPACITY];
+        if (w->drv.pot && isnan(w->drv.conductance))
+            row[s++] = start * d[PHC_WB_CONDUCTANCE];
+    }
 }
 
 static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
@@ -186,32 +274,27 @@ static int wc_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
     const double delta = slot_value(w, p, SLOT_DELTA, 0);
     const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
     const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
+    const size_t nw = PHC_WB_COEF + w->n_coef;
     if (!(delta >= 0) || !(mu > 0) || !isfinite(dry))
         return 1;
-    int rc = unit_response(w, delta, mu, w->t_unique, w->m_unique, w->u, jac ? w->du : NULL);
-    if (rc)
-        return rc;
-    for (size_t k = 0; k < w->n_pieces; ++k) {
+    const int varying = phc_weight_drivers_time_varying(&w->drv);
+    int rc = 0;
+    if (!varying) /* the pieces share one response over the time since their start */
+        rc = unit_response(w, p, delta, mu, 0, w->t_unique, w->m_unique, w->u, jac ? w->du : NULL);
+    for (size_t k = 0; k < w->n_pieces && !rc; ++k) {
         const piece *pc = &w->pieces[k];
         const double start = p[pc->slot];
-        for (size_t r = pc->first; r < pc->first + pc->count; ++r) {
-            const size_t i = w->t_at[r];
+        if (varying) /* the loss depends on the clock: each piece from its own start */
+            rc = unit_response(w, p, delta, mu, w->t_abs[pc->first], w->t_abs + pc->first, pc->count,
+                               w->u, jac ? w->du : NULL);
+        for (size_t r = pc->first; r < pc->first + pc->count && !rc; ++r) {
+            const size_t i = varying ? r - pc->first : w->t_at[r];
             yhat[r] = dry + start * w->u[i];
-            if (!jac)
-                continue;
-            double *row = jac + r * ds->k;
-            for (size_t j = 0; j < ds->k; ++j)
-                row[j] = 0;
-            if (w->slot[SLOT_DELTA] >= 0)
-                row[w->slot[SLOT_DELTA]] = start * w->du[3 * i];
-            if (w->slot[SLOT_MU] >= 0)
-                row[w->slot[SLOT_MU]] = start * w->du[3 * i + 2];
-            row[pc->slot] = w->u[i];
-            if (w->slot[SLOT_DRY] >= 0)
-                row[w->slot[SLOT_DRY]] = 1.0;
+            if (jac)
+                jacobian_row(w, ds, pc, start, w->u[i], w->du + i * nw, jac + r * ds->k);
         }
     }
-    return 0;
+    return rc;
 }
 
 /* The fitted curve at arbitrary x (user time unit since the first row),
@@ -243,7 +326,12 @@ static int wc_predict_at(phc_dataset *ds, const double *p, const double *x, size
             y[i++] = NAN;
             continue;
         }
-        rc = unit_response(w, delta, mu, t, j - i, u, NULL);
+        const double t_start = w->pieces[k].start_x * w->seconds_per_x;
+        if (phc_weight_drivers_time_varying(&w->drv))
+            for (size_t q = i; q < j; ++q) /* the clock since the first weighing */
+                t[q - i] += t_start;
+        rc = unit_response(w, p, delta, mu, phc_weight_drivers_time_varying(&w->drv) ? t_start : 0,
+                           t, j - i, u, NULL);
         const double start = p[w->pieces[k].slot];
         for (size_t q = i; q < j && !rc; ++q)
             y[q] = dry + start * u[q - i];
@@ -887,10 +975,27 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
                 ++n_pieces;
         }
 
+    /* Day and night, covariates, a pot (weight_drivers.h), over the kept
+     * weighings' times since the first (s). */
+    w->t_abs = malloc(n_kept * sizeof *w->t_abs);
+    if (!w->t_abs) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t i = 0; i < n_kept; ++i)
+        w->t_abs[i] = (tv[i] - tv[0]) * w->seconds_per_x;
+    if ((rc = phc_weight_drivers_load(doc, node, table, keep, w->t_abs, n_kept,
+                                      t_origin + tv[0] * w->seconds_per_x, w->timezone, &w->drv, err)))
+        goto fail;
+    w->n_coef = phc_weight_drivers_coef_count(&w->drv);
+    const size_t n_drv = phc_weight_drivers_slot_count(&w->drv);
+
     /* Slots: delta, one initial water per piece (initial_water, then
      * initial_water_2, ...), dry_mass unless measured, viscosity when the
-     * user made it a parameter. */
-    const size_t k_slots = 1 + n_pieces + isnan(w->dry_measured) + is_parameter("viscosity", user_data);
+     * user made it a parameter, then the drivers' (night_factor, loss_<col>,
+     * pot_capacity, pot_conductance). */
+    const size_t k_slots =
+        1 + n_pieces + isnan(w->dry_measured) + is_parameter("viscosity", user_data) + n_drv;
     for (int q = 0; q < N_SLOT_KINDS; ++q)
         w->slot[q] = -1;
     w->pieces = calloc(n_pieces, sizeof *w->pieces);
@@ -915,10 +1020,16 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         w->slot[SLOT_DRY] = (int)js;
         ds->slot_names[js++] = strdup("dry_mass");
     }
-    if (js < k_slots) {
+    if (js + n_drv < k_slots) {
         w->slot[SLOT_MU] = (int)js;
         ds->slot_names[js++] = strdup("viscosity");
     }
+    w->drv_slot = n_drv ? (int)js : -1;
+    if (n_drv && phc_weight_drivers_slot_names(&w->drv, ds->slot_names + js)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    js += n_drv;
     for (size_t j = 0; j < k_slots; ++j)
         if (!ds->slot_names[j]) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -961,8 +1072,11 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     w->n_pieces = n_pieces;
     if ((rc = phc_unique_times(w->t_model, n, &w->t_unique, &w->m_unique, &w->t_at, err)))
         goto fail;
-    w->u = malloc(w->m_unique * sizeof *w->u);
-    w->du = malloc(3 * w->m_unique * sizeof *w->du);
+    {
+        const size_t rows = w->m_unique > n ? w->m_unique : n;
+        w->u = malloc(rows * sizeof *w->u);
+        w->du = malloc(rows * (PHC_WB_COEF + w->n_coef) * sizeof *w->du);
+    }
     if ((rc = set_clock(ds, w, t_origin, tv[0], err)))
         goto fail;
     if (!w->u || !w->du) {
@@ -1002,6 +1116,45 @@ fail:
     return rc;
 }
 
+/* Report rows of the drivers: the night's loss, the covariates' law, the pot. */
+static void driver_rows(const wc_impl *w, const double *p, double abar, char *buf, size_t size)
+{
+    const phc_weight_drivers *d = &w->drv;
+    size_t used = strlen(buf);
+    int s = w->drv_slot;
+    if (d->schedule && used < size) {
+        const int fitted = isnan(d->night_factor);
+        const double f = fitted ? p[s++] : d->night_factor;
+        used += (size_t)snprintf(buf + used, size - used,
+                                 "| day and night | day %02d:%02d–%02d:%02d local; by night the leaves "
+                                 "lose %.3g× the day's rate (night_factor, %s) |\n",
+                                 (int)(d->day_start / 3600), (int)fmod(d->day_start / 60, 60),
+                                 (int)(d->day_end / 3600), (int)fmod(d->day_end / 60, 60), f,
+                                 fitted ? "fitted" : "fixed");
+    }
+    if (d->n_cov && used < size) {
+        used += (size_t)snprintf(buf + used, size - used, "| loss law | g = 1");
+        for (size_t j = 0; j < d->n_cov && used < size; ++j)
+            used += (size_t)snprintf(buf + used, size - used, " %+.4g × %s", p[s++], d->cov_names[j]);
+        if (used < size)
+            used += (size_t)snprintf(buf + used, size - used,
+                                     " (loss = δ A g; covariates averaged over each interval) |\n");
+    }
+    if (d->pot && used < size) {
+        const double C = isnan(d->capacity) ? p[s++] : d->capacity;
+        const double k = isnan(d->conductance) ? p[s++] : d->conductance;
+        double vsum = phc_plant_graph_volume(w->graph) * 1e6;
+        (void)abar;
+        used += (size_t)snprintf(buf + used, size - used,
+                                 "| pot | capacity %.4g g (%s), root–soil conductance %.4g g/s (%s); "
+                                 "soil holds %.1f%% of the water at each start; soil–plant exchange "
+                                 "time C/k = %.3g h |\n",
+                                 C, isnan(d->capacity) ? "fitted" : "fixed", k,
+                                 isnan(d->conductance) ? "fitted" : "fixed", 100 * C / (C + vsum),
+                                 k > 0 ? C / k / 3600 : INFINITY);
+    }
+}
+
 /* The report hook: what the model was (graph, weights, evaluator) and what
  * the fitted curve means in plain numbers. */
 static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
@@ -1016,9 +1169,11 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
     const double dry = slot_value(w, p, SLOT_DRY, w->dry_measured);
     const double mu = slot_value(w, p, SLOT_MU, w->viscosity);
     const piece *last = &w->pieces[w->n_pieces - 1];
-    const double t_end = w->t_model[last->first + last->count - 1];
+    const int varying = phc_weight_drivers_time_varying(&w->drv);
+    const double t_end = varying ? w->t_abs[last->first + last->count - 1]
+                                 : w->t_model[last->first + last->count - 1];
     double u_end = NAN;
-    if (unit_response(w, delta, mu, &t_end, 1, &u_end, NULL) != 0)
+    if (unit_response(w, p, delta, mu, varying ? w->t_abs[last->first] : 0, &t_end, 1, &u_end, NULL) != 0)
         u_end = NAN;
     const double start = p[last->slot];
     /* Initial loss rate: dW/dt(0) = -Σ ℓ_i θ_i(0) = -δ Σ A_i V_i / Σ V_i · W0. */
@@ -1059,6 +1214,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
              w0, start * u_end, 100 * u_end, abar,
              delta > 0 && abar > 0 ? log(2.0) / (delta * abar) / 3600.0 : INFINITY);
     logger_rows(w, buf, 4096);
+    driver_rows(w, p, abar, buf, 4096);
     *markdown = buf;
     return PHC_OK;
 }
