@@ -77,7 +77,7 @@ const phc_key_help phc_weight_curve_help[] = {
              "them in the report; keep: use every row. Default: auto."},
     {"max_gap", "Longest expected pause between weighings, a number in the time unit or "
                 "{value: V, unit: U}; longer gaps (logger off) are listed in the report. "
-                "Default: 6 h."},
+                "Default: 6 h, or 3 times the median step when weighings are sparser."},
     {"day", "{start: \"07:00\", end: \"23:00\", night_factor: F, clock: \"HH:MM\"}: a light "
             "schedule, local clock times, start before end; leaves lose night_factor times the "
             "day's rate by night (left out: a fitted slot night_factor). With logger timestamps "
@@ -548,7 +548,8 @@ static int cmp_double(const void *a, const void *b)
 
 /* `tare` and `max_gap`: drops the tare readings at the start of the selected
  * rows (each below 50% of the median of the 10 readings after it; at least 2
- * rows stay) and lists the pauses longer than max_gap. */
+ * rows stay) and lists the pauses longer than max_gap (default 6 h, or 3
+ * median steps, so that daily weighings are not all gaps). */
 static int tare_and_gaps(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_units *units,
                          const phc_table *t, size_t *keep, double *tv, double *mv, size_t *n_sel,
                          wc_impl *w, phc_error *err)
@@ -588,6 +589,14 @@ static int tare_and_gaps(const phc_yaml_doc *doc, const phc_yaml_node *node, phc
         memmove(tv, tv + k, (n - k) * sizeof *tv);
         memmove(mv, mv + k, (n - k) * sizeof *mv);
         *n_sel = n -= k;
+    }
+    double *step = mg || n < 2 ? NULL : malloc((n - 1) * sizeof *step);
+    if (step) { /* default: 6 h, or 3 times the median step of sparse weighings */
+        for (size_t i = 1; i < n; ++i)
+            step[i - 1] = tv[i] - tv[i - 1];
+        qsort(step, n - 1, sizeof *step, cmp_double);
+        w->max_gap = fmax(w->max_gap, 3 * step[(n - 1) / 2] * w->seconds_per_x);
+        free(step);
     }
     for (size_t i = 1; i < n; ++i)
         if ((tv[i] - tv[i - 1]) * w->seconds_per_x > w->max_gap) {
