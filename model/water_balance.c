@@ -544,7 +544,14 @@ int phc_water_balance_curve(const phc_water_system *s, const phc_water_pot *pot,
         ++i;
     }
     while (i < m) {
-        const double end = k + 1 < loss->n && loss->start[k + 1] < t_end ? loss->start[k + 1] : t_end;
+        /* the interval, merged with the following ones while g and dg stay
+         * the same (a schedule's or a covariate's plateaus): fewer restarts */
+        size_t k_next = k + 1;
+        while (k_next < loss->n && loss->start[k_next] < t_end && loss->g[k_next] == loss->g[k] &&
+               (loss->n_coef == 0 || memcmp(loss->dg + k_next * loss->n_coef, loss->dg + k * loss->n_coef,
+                                           loss->n_coef * sizeof *loss->dg) == 0))
+            ++k_next;
+        const double end = k_next < loss->n && loss->start[k_next] < t_end ? loss->start[k_next] : t_end;
         size_t i1 = i;
         while (i1 < m && t[i1] <= end)
             ++i1;
@@ -593,9 +600,7 @@ int phc_water_balance_curve(const phc_water_system *s, const phc_water_pot *pot,
         }
         i = i1;
         a = end;
-        ++k;
-        if (k >= loss->n)
-            k = loss->n - 1;
+        k = k_next < loss->n ? k_next : loss->n - 1;
     }
     for (size_t q = 0; q < m; ++q) {
         W[q] = out[q * nv];
