@@ -1156,10 +1156,12 @@ static void driver_rows(const wc_impl *w, const double *p, double abar, char *bu
         (void)abar;
         used += (size_t)snprintf(buf + used, size - used,
                                  "| pot | capacity %.4g g (%s), root–soil conductance %.4g g/s (%s); "
-                                 "soil holds %.1f%% of the water at each start; soil–plant exchange "
-                                 "time C/k = %.3g h |\n",
+                                 "soil holds %.1f%% of the water at each start; the plant refills "
+                                 "from the soil with time constant V/k = %.3g h (V = %.4g cm³), the "
+                                 "soil empties into it over C/k = %.3g h |\n",
                                  C, isnan(d->capacity) ? "fitted" : "fixed", k,
                                  isnan(d->conductance) ? "fitted" : "fixed", 100 * C / (C + vsum),
+                                 k > 0 ? vsum / k / 3600 : INFINITY, vsum,
                                  k > 0 ? C / k / 3600 : INFINITY);
     }
 }

@@ -808,6 +808,45 @@ wcl_config wcl_col.yaml wcl_dst.csv '{columns: [Date, Tim], timezone: Europe/Ber
 fit_case "weight_curve: columns names no column" "$C/wcl_col.yaml" "wcl_col.yaml:9" "'Tim'" "'Time'"
 wcl_config wcl_unit.yaml wcl_dst.csv "$WCL_DMY, unit: h}"
 fit_case "weight_curve: unit with timestamps" "$C/wcl_unit.yaml" "wcl_unit.yaml:9" "'unit' is for numeric times"
+# Day and night, covariates and the pot (fit/costs/weight_drivers.h): the
+# extra keys start on line 12, after leaf_area on line 11.
+wc_config wc_day.yaml wc_ok.csv '    leaf_area: 100
+    day: {start: "23:00", end: "07:00", clock: "09:00", night_factor: 0.1}
+'
+fit_case "weight_curve: day starting after it ends" "$C/wc_day.yaml" "wc_day.yaml:12" "start (23:00) must be before end (07:00)"
+wc_config wc_dayclock.yaml wc_ok.csv '    leaf_area: 100
+    day: {start: "07:00", end: "23:00", night_factor: 0.1}
+'
+fit_case "weight_curve: day on a numeric time without clock" "$C/wc_dayclock.yaml" "wc_dayclock.yaml:12" "clock: \"HH:MM\"" "first weighing"
+wc_config wc_dayfmt.yaml wc_ok.csv '    leaf_area: 100
+    day: {start: "7h", end: "23:00", clock: "09:00", night_factor: 0.1}
+'
+fit_case "weight_curve: day start not a clock time" "$C/wc_dayfmt.yaml" "wc_dayfmt.yaml:12" "'7h' is not a clock time"
+wc_config wc_night.yaml wc_ok.csv '    leaf_area: 100
+    day: {start: "07:00", end: "23:00", clock: "09:00", night_factor: -0.5}
+'
+fit_case "weight_curve: negative night_factor" "$C/wc_night.yaml" "wc_night.yaml:12" "night_factor must be >= 0"
+printf 't,m,PAR\n0,4.0,600\n1,3.9,\n2,3.8,0\n' >"$C/wc_cov.csv"
+wc_config wc_cov.yaml wc_cov.csv '    leaf_area: 100
+    covariates: {columns: [PAR], law: linear}
+'
+fit_case "weight_curve: covariate with a gap" "$C/wc_cov.yaml" "wc_cov.csv:3:" "column 'PAR'" "needs a number at every kept weighing"
+wc_config wc_covcol.yaml wc_cov.csv '    leaf_area: 100
+    covariates: {columns: [PAT]}
+'
+fit_case "weight_curve: covariate column missing" "$C/wc_covcol.yaml" "wc_covcol.yaml:12" "'PAT'" "'PAR'"
+wc_config wc_covlaw.yaml wc_cov.csv '    leaf_area: 100
+    covariates: {columns: [PAR], law: exponential}
+'
+fit_case "weight_curve: unknown covariate law" "$C/wc_covlaw.yaml" "wc_covlaw.yaml:12" "law 'exponential'"
+wc_config wc_pot.yaml wc_ok.csv '    leaf_area: 100
+    pot: {capacity: 0, conductance: 0.01}
+'
+fit_case "weight_curve: pot capacity 0" "$C/wc_pot.yaml" "wc_pot.yaml:12" "capacity must be > 0 g"
+wc_config wc_potk.yaml wc_ok.csv '    leaf_area: 100
+    pot: {capacity: 100, conductance: -1}
+'
+fit_case "weight_curve: negative pot conductance" "$C/wc_potk.yaml" "wc_potk.yaml:12" "conductance must be >= 0"
 # ---- end weight_curve ------------------------------------------------------
 
 # ---- soil_probe and infiltration -------------------------------------------
