@@ -662,37 +662,19 @@ void phc_water_bdf6_free(phc_water_bdf6 *b)
     free(b);
 }
 
-#define START_ORDERS 8   /* implicit Euler with 1..8 sub-steps, extrapolated */
+#define START_ORDERS PHC_WATER_START_ORDERS
 #define START_SUBINTERVALS 2
+#define BDF6_ALPHA PHC_WATER_BDF6_ALPHA
+#define bdf6_beta phc_water_bdf6_beta
 
-/* One interval of length H from x (nv*n) by extrapolated implicit Euler
- * (harmonic sequence n_j = j, Aitken-Neville in h; Deuflhard 1985). */
+static void factor_cb(void *b, double c) { tree_factor(b, c); }
+static void step_cb(void *b, double *y) { augmented_solve(b, y); }
+
+/* One interval of length H from x (nv*n): model/water_tree.c. */
 static void extrapolated_euler(phc_water_bdf6 *b, double H, double *x, double *T, double *y)
 {
-    size_t len = b->nv * b->n;
-    for (int j = 0; j < START_ORDERS; ++j) {
-        int nj = j + 1;
-        tree_factor(b, H / nj);
-        memcpy(y, x, len * sizeof *y);
-        for (int r = 0; r < nj; ++r)
-            augmented_solve(b, y);
-        for (int k = 1; k <= j; ++k) {
-            double f = (double)nj / (double)(nj - k) - 1.0;
-            double *Tk = T + (size_t)(k - 1) * len;
-            for (size_t q = 0; q < len; ++q) {
-                double cur = y[q];
-                y[q] = cur + (cur - Tk[q]) / f;
-                Tk[q] = cur;
-            }
-        }
-        memcpy(T + (size_t)j * len, y, len * sizeof *y);
-    }
-    memcpy(x, T + (size_t)(START_ORDERS - 1) * len, len * sizeof *x);
+    phc_water_extrapolated_euler(b->nv * b->n, H, x, T, y, factor_cb, step_cb, b);
 }
-
-static const double bdf6_beta[6] = {-10.0 / 147, 72.0 / 147, -225.0 / 147,
-                                    400.0 / 147, -450.0 / 147, 360.0 / 147};
-#define BDF6_ALPHA (60.0 / 147.0)
 
 int phc_water_bdf6_new(const phc_water_system *s, double h, int sensitivities,
                        phc_water_bdf6 **out, phc_error *err)

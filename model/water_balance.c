@@ -175,36 +175,22 @@ static void implicit_solve(stepper *st, double *x)
     }
 }
 
-#define START_ORDERS 8
+#define START_ORDERS PHC_WATER_START_ORDERS
 #define START_SUBINTERVALS 2
-static const double bdf6_beta[6] = {-10.0 / 147, 72.0 / 147, -225.0 / 147,
-                                    400.0 / 147, -450.0 / 147, 360.0 / 147};
-#define BDF6_ALPHA (60.0 / 147.0)
+#define BDF6_ALPHA PHC_WATER_BDF6_ALPHA
+#define bdf6_beta phc_water_bdf6_beta
 
-/* Extrapolated implicit Euler over H (harmonic sequence, Aitken-Neville;
- * Deuflhard 1985), as the start of model/water.c. */
+static void factor_cb(void *st, double c)
+{
+    ((stepper *)st)->c = -1.0; /* always refactor */
+    stepper_factor(st, c);
+}
+static void step_cb(void *st, double *y) { implicit_solve(st, y); }
+
+/* One interval of length H from x (nv * n): model/water_tree.c. */
 static void extrapolated_euler(stepper *st, double H, double *x, double *T, double *y)
 {
-    const size_t len = st->b->nv * st->b->n;
-    for (int j = 0; j < START_ORDERS; ++j) {
-        int nj = j + 1;
-        st->c = -1.0;
-        stepper_factor(st, H / nj);
-        memcpy(y, x, len * sizeof *y);
-        for (int r = 0; r < nj; ++r)
-            implicit_solve(st, y);
-        for (int k = 1; k <= j; ++k) {
-            double f = (double)nj / (double)(nj - k) - 1.0;
-            double *Tk = T + (size_t)(k - 1) * len;
-            for (size_t q = 0; q < len; ++q) {
-                double cur = y[q];
-                y[q] = cur + (cur - Tk[q]) / f;
-                Tk[q] = cur;
-            }
-        }
-        memcpy(T + (size_t)j * len, y, len * sizeof *y);
-    }
-    memcpy(x, T + (size_t)(START_ORDERS - 1) * len, len * sizeof *x);
+    phc_water_extrapolated_euler(st->b->nv * st->b->n, H, x, T, y, factor_cb, step_cb, st);
 }
 
 static void totals(const balance *b, const double *x, double *sums)

@@ -45,4 +45,19 @@ void phc_water_tree_solve(size_t n, const size_t *par, const double *l, const do
  * the larger eigenvalue. */
 double phc_water_expm_divided_difference(double li, double lj, double Ei, double Ej, double t);
 
+/* The start of BDF6 (both evaluators): one interval of length H from x
+ * (len values) by extrapolated implicit Euler, harmonic sequence n_j = j,
+ * j = 1..PHC_WATER_START_ORDERS, Aitken-Neville in h (Deuflhard 1985).
+ * factor(ctx, c) prepares the implicit step (I - c S) y_new = y_old, and
+ * step(ctx, y) takes it in place.  T: PHC_WATER_START_ORDERS * len
+ * workspace, y: len. */
+#define PHC_WATER_START_ORDERS 8
+void phc_water_extrapolated_euler(size_t len, double H, double *x, double *T, double *y,
+                                  void (*factor)(void *ctx, double c),
+                                  void (*step)(void *ctx, double *y), void *ctx);
+
+/* BDF6 (paper eq. 8): (I - alpha h S) x_{n+1} = sum_j beta_j x_{n-5+j}. */
+#define PHC_WATER_BDF6_ALPHA (60.0 / 147.0)
+extern const double phc_water_bdf6_beta[6];
+
 #endif /* PHC_WATER_INTERNAL_H */

@@ -1,6 +1,7 @@
 /* Elimination over a tree and the exponential's divided difference, shared
  * by the water model's evaluators (model/water_internal.h).  Pure C. */
 #include <math.h>
+#include <string.h>
 
 #include "model/water_internal.h"
 
@@ -50,4 +51,31 @@ double phc_water_expm_divided_difference(double li, double lj, double Ei, double
     if (fabs(x) < 1e-300)
         return t * Ej;
     return Ej * expm1(x) / dl;
+}
+
+const double phc_water_bdf6_beta[6] = {-10.0 / 147, 72.0 / 147, -225.0 / 147,
+                                       400.0 / 147, -450.0 / 147, 360.0 / 147};
+
+void phc_water_extrapolated_euler(size_t len, double H, double *x, double *T, double *y,
+                                  void (*factor)(void *ctx, double c),
+                                  void (*step)(void *ctx, double *y), void *ctx)
+{
+    for (int j = 0; j < PHC_WATER_START_ORDERS; ++j) {
+        int nj = j + 1;
+        factor(ctx, H / nj);
+        memcpy(y, x, len * sizeof *y);
+        for (int r = 0; r < nj; ++r)
+            step(ctx, y);
+        for (int k = 1; k <= j; ++k) {
+            double f = (double)nj / (double)(nj - k) - 1.0;
+            double *Tk = T + (size_t)(k - 1) * len;
+            for (size_t q = 0; q < len; ++q) {
+                double cur = y[q];
+                y[q] = cur + (cur - Tk[q]) / f;
+                Tk[q] = cur;
+            }
+        }
+        memcpy(T + (size_t)j * len, y, len * sizeof *y);
+    }
+    memcpy(x, T + (size_t)(PHC_WATER_START_ORDERS - 1) * len, len * sizeof *x);
 }
