@@ -930,8 +930,9 @@ int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     }
     size_t n_kept = 0;
+    const double t_first = tv[0]; /* the loop below overwrites tv[0] once a row is dropped */
     for (size_t i = 0; i < n_sel; ++i) {
-        const double rel = tv[i] - tv[0];
+        const double rel = tv[i] - t_first;
         int drop = 0;
         for (size_t e = 0; excl && e < excl->count && !drop; ++e) {
             const phc_yaml_node *win = excl->items[e];
