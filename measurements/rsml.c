@@ -1020,7 +1020,7 @@ int phc_rsml_write(const phc_rsml *r, const char *path, phc_error *err)
 
     /* plant_first/last, child_first/last, next, cursor in one block. */
     n_links = 2 * r->n_plants + 4 * r->n_roots;
-    if (n_links && !(links = malloc(n_links * sizeof *links))) {
+    if (!(links = malloc((n_links ? n_links : 1) * sizeof *links))) { /* a document without plants too */
         rc = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
         goto fail;
     }

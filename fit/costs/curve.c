@@ -180,6 +180,26 @@ static int name_column(const char *expr, const char *name)
     return 0;
 }
 
+/* The expression as a message shows it: whole when short, else the 60
+ * characters around character pos (0-based; -1 = the start) between
+ * ellipses, so that a long expression does not push the reason out of the
+ * message (PHC_ERROR_MESSAGE_SIZE). */
+#define EXPR_SHOWN_MAX 80
+static const char *expr_shown(const char *expr, int pos, char *buf, size_t size)
+{
+    const int len = (int)strlen(expr);
+    if (len <= EXPR_SHOWN_MAX)
+        return expr;
+    int from = pos < 0 ? 0 : pos - 30;
+    if (from < 0)
+        from = 0;
+    if (from > len - 60)
+        from = len - 60;
+    snprintf(buf, size, "%s%.60s%s (%d characters)", from > 0 ? "..." : "", expr + from,
+             from + 60 < len ? "..." : "", len);
+    return buf;
+}
+
 /* muparser's message about an expression it cannot parse, at the config
  * line of `expression:` and the character in the expression.  A name
  * followed by "(" that is not a function is reported as such, with the
@@ -193,6 +213,8 @@ static int expression_error(const phc_yaml_doc *doc, const phc_yaml_node *node, 
     int pos = (int)mupGetErrorPos(parser);
     if (pos > len)
         pos = len; /* muparser may point past the end */
+    char shown_buf[EXPR_SHOWN_MAX + 64];
+    const char *shown = expr_shown(expr, pos, shown_buf, sizeof shown_buf);
     if (pos >= 0 && pos < len && expr[pos] == '(' && mupGetErrorCode(parser) == MUP_ERR_UNEXPECTED_PARENS) {
         int end = pos, start;
         while (end > 0 && expr[end - 1] == ' ')
@@ -211,16 +233,16 @@ static int expression_error(const phc_yaml_doc *doc, const phc_yaml_node *node, 
                 return phc_error_set(err, PHC_ERR_INPUT,
                                      "%s:%zu: expression \"%s\": '%s' at character %d is a parameter, not a "
                                      "function (write '*' for a product); known functions: %s",
-                                     doc->path, line, expr, name, start + 1, known);
+                                     doc->path, line, shown, name, start + 1, known);
             const char *near = phc_suggest(name, known_functions, N_KNOWN_FUNCTIONS);
             return phc_error_set(err, PHC_ERR_INPUT,
                                  "%s:%zu: expression \"%s\": unknown function '%s' at character %d;%s%s%s "
                                  "known functions: %s",
-                                 doc->path, line, expr, name, start + 1, near ? " did you mean '" : "",
+                                 doc->path, line, shown, name, start + 1, near ? " did you mean '" : "",
                                  near ? near : "", near ? "'?" : "", known);
         }
     }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)", doc->path, line, expr,
+    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)", doc->path, line, shown,
                          mupGetErrorMsg(parser), pos + 1);
 }
 
@@ -278,6 +300,22 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     }
     mupDefineConst(c->parser, "pi", 3.14159265358979323846);
+    { /* nesting too deep for either parser's stack: refused before muparser sees it */
+        phc_expr *probe = NULL;
+        size_t probe_pos = 0;
+        phc_error probe_err;
+        phc_error_clear(&probe_err);
+        const int probe_rc = phc_expr_compile(expr, &probe, &probe_pos, &probe_err);
+        phc_expr_free(probe);
+        if (probe_rc == PHC_ERR_DOMAIN) {
+            char shown_buf[EXPR_SHOWN_MAX + 64];
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s",
+                               doc->path, phc_key_line(node, "expression"),
+                               expr_shown(expr, (int)probe_pos, shown_buf, sizeof shown_buf),
+                               probe_err.message);
+            goto fail;
+        }
+    }
     mupSetExpr(c->parser, expr);
     int n_vars = mupGetExprVarNum(c->parser);
     if (mupError(c->parser)) {
@@ -285,8 +323,10 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     }
     if (n_vars <= 0) {
+        char shown_buf[EXPR_SHOWN_MAX + 64];
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
-                           doc->path, phc_key_line(node, "expression"), expr);
+                           doc->path, phc_key_line(node, "expression"),
+                           expr_shown(expr, -1, shown_buf, sizeof shown_buf));
         goto fail;
     }
 
@@ -357,8 +397,10 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     if (rc)
         goto fail;
     if (n_slots == 0) {
+        char shown_buf[EXPR_SHOWN_MAX + 64];
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
-                           doc->path, phc_key_line(node, "expression"), expr);
+                           doc->path, phc_key_line(node, "expression"),
+                           expr_shown(expr, -1, shown_buf, sizeof shown_buf));
         goto fail;
     }
 

@@ -49,7 +49,12 @@ typedef struct parser {
     phc_error *err;
     size_t err_pos;
     int failed;
+    int depth;  /* nesting of parse_unary: parentheses, function calls, signs, powers */
 } parser;
+
+/* Deeper nesting is refused: the recursive descent would otherwise run out
+ * of stack (about 6,000 nested parentheses under a 2 MiB stack). */
+#define PHC_EXPR_MAX_DEPTH 200
 
 static const struct {
     const char *name;
@@ -224,7 +229,7 @@ static long parse_power(parser *p)
     return base;
 }
 
-static long parse_unary(parser *p)
+static long parse_unary_nested(parser *p)
 {
     skip_space(p);
     const char c = p->s[p->pos];
@@ -237,6 +242,21 @@ static long parse_unary(parser *p)
         return parse_unary(p);
     }
     return parse_power(p);
+}
+
+static long parse_unary(parser *p)
+{
+    if (p->depth >= PHC_EXPR_MAX_DEPTH) {
+        fail_at(p, p->pos, "nested more than 200 levels deep (parentheses, function calls, "
+                           "signs and powers together); split it or simplify it");
+        if (p->err)
+            p->err->status = PHC_ERR_DOMAIN; /* a limit, not a syntax error (expression.h) */
+        return -1;
+    }
+    p->depth++;
+    const long r = parse_unary_nested(p);
+    p->depth--;
+    return r;
 }
 
 static long parse_term(parser *p)
@@ -291,7 +311,7 @@ int phc_expr_compile(const char *text, phc_expr **out, size_t *pos, phc_error *e
     phc_expr *e = calloc(1, sizeof *e);
     if (!e)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    parser p = {text, 0, e, err, 0, 0};
+    parser p = {text, 0, e, err, 0, 0, 0};
     long root = parse_expr(&p);
     skip_space(&p);
     if (root >= 0 && text[p.pos] != '\0')

@@ -27,7 +27,10 @@
 typedef struct phc_expr phc_expr;
 
 /* Compiles text.  On a syntax error or an unsupported construct returns
- * PHC_ERR_INPUT with a message and the 0-based character position in *pos. */
+ * PHC_ERR_INPUT with a message and the 0-based character position in *pos;
+ * PHC_ERR_DOMAIN when the expression is nested more than 200 levels deep
+ * (parentheses, function calls, signs and powers together), which the
+ * recursive descent refuses instead of overflowing the stack. */
 int phc_expr_compile(const char *text, phc_expr **out, size_t *pos,
                      phc_error *err);
 void phc_expr_free(phc_expr *e); /* accepts NULL */

@@ -358,6 +358,19 @@ write_config "$C/expr_syntax.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x +
 # the second '*' is character 7 of the expression
 fit_case "expression: syntax error (position)" "$C/expr_syntax.yaml" "expr_syntax.yaml:10" "character 7"
 
+# 9,970 nested parentheses (a fuzzing find: it overflowed the stack), under a
+# 2 MiB stack as a small embedding program would have: refused with a message
+DEEP=$(printf '%.0s(' $(seq 9970))a*x$(printf '%.0s)' $(seq 9970))
+write_config "$C/expr_deep.yaml" "$PARAMS_OK" "$(dataset_block data.csv "$DEEP + b")"
+RUN_SAVED=("${RUN[@]}")
+if command -v prlimit >/dev/null 2>&1; then RUN=(prlimit --stack=2097152 "${RUN_SAVED[@]}"); fi
+fit_case "expression: 9970 nested parentheses" "$C/expr_deep.yaml" "expr_deep.yaml:10" "nested more than 200 levels deep" "(19947 characters)"
+RUN=("${RUN_SAVED[@]}")
+# a long expression with an error at its end: the message keeps the reason
+LONG="$(printf 'a*x + %.0s' $(seq 400))b + * 2"
+write_config "$C/expr_long.yaml" "$PARAMS_OK" "$(dataset_block data.csv "$LONG")"
+fit_case "expression: long, error at the end" "$C/expr_long.yaml" "expr_long.yaml:10" "(2407 characters)" "character 2405"
+
 write_config "$C/expr_paren.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*(x + b")"
 fit_case "expression: unbalanced parenthesis" "$C/expr_paren.yaml" "expr_paren.yaml:10" "character "
 

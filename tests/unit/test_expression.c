@@ -742,6 +742,43 @@ static void test_nist_models(void)
     printf("NIST models: worst gradient relative error %.3g\n", worst);
 }
 
+/* Nesting deeper than 200 levels is refused with PHC_ERR_DOMAIN instead of
+ * overflowing the stack (issue 15: 9,970 nested parentheses crashed). */
+static void test_depth_limit(void)
+{
+    const size_t deep[] = {150, 250, 9970, 100000};
+    for (size_t k = 0; k < sizeof deep / sizeof deep[0]; ++k) {
+        for (int form = 0; form < 3; ++form) { /* parentheses, minus signs, function calls */
+            const size_t n = deep[k];
+            char *text = malloc(6 * n + 8);
+            size_t len = 0;
+            for (size_t i = 0; i < n; ++i) {
+                const char *open = form == 0 ? "(" : form == 1 ? "-" : "exp(";
+                memcpy(text + len, open, strlen(open));
+                len += strlen(open);
+            }
+            text[len++] = 'a';
+            for (size_t i = 0; form != 1 && i < n; ++i)
+                text[len++] = ')';
+            text[len] = '\0';
+            phc_expr *e = NULL;
+            size_t pos = 0;
+            phc_error err;
+            phc_error_clear(&err);
+            const int rc = phc_expr_compile(text, &e, &pos, &err);
+            if (n <= 150) {
+                CHECK(rc == PHC_OK);
+            } else {
+                CHECK(rc == PHC_ERR_DOMAIN);
+                CHECK_STR_CONTAINS(err.message, "nested more than 200 levels deep");
+                CHECK(pos == (form == 2 ? 800u : form == 1 ? 200u : 200u));
+            }
+            phc_expr_free(e);
+            free(text);
+        }
+    }
+}
+
 int main(void)
 {
     test_values_and_gradients();
@@ -750,6 +787,7 @@ int main(void)
     test_constants();
     test_names_and_binding();
     test_errors();
+    test_depth_limit();
     test_power_fast_paths();
     test_nist_models();
     return check_finish("test_expression");

@@ -599,12 +599,33 @@ static void test_locale(void)
     setlocale(LC_NUMERIC, "C");
 }
 
+/* A document with no plant is written without undefined behaviour (issue 15:
+ * UBSan found an offset applied to a null pointer) and reads back empty. */
+static void test_empty_document(void)
+{
+    phc_error err;
+    phc_rsml *r = phc_rsml_new(NULL, 3), *back = NULL;
+    const char *path = tmp_path("empty.rsml");
+    CHECK(r != NULL);
+    if (!r)
+        return;
+    const int rc = phc_rsml_write(r, path, &err);
+    CHECK(rc == 0);
+    if (rc == 0 && phc_rsml_read(path, &back, &err) == 0) {
+        CHECK(back->n_plants == 0 && back->n_roots == 0);
+        phc_rsml_free(back);
+    }
+    phc_rsml_free(r);
+    remove(path);
+}
+
 int main(void)
 {
     if (!mkdtemp(tmp_dir)) {
         perror("mkdtemp");
         return 1;
     }
+    test_empty_document();
     test_roundtrip();
     test_reordered();
     test_lengths_and_order();
