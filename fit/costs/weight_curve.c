@@ -1127,7 +1127,7 @@ fail:
 }
 
 /* Report rows of the drivers: the night's loss, the covariates' law, the pot. */
-static void driver_rows(const wc_impl *w, const double *p, double abar, char *buf, size_t size)
+static void driver_rows(const wc_impl *w, const double *p, char *buf, size_t size)
 {
     const phc_weight_drivers *d = &w->drv;
     size_t used = strlen(buf);
@@ -1154,7 +1154,6 @@ static void driver_rows(const wc_impl *w, const double *p, double abar, char *bu
         const double C = isnan(d->capacity) ? p[s++] : d->capacity;
         const double k = isnan(d->conductance) ? p[s++] : d->conductance;
         double vsum = phc_plant_graph_volume(w->graph) * 1e6;
-        (void)abar;
         used += (size_t)snprintf(buf + used, size - used,
                                  "| pot | capacity %.4g g (%s), root–soil conductance %.4g g/s (%s); "
                                  "soil holds %.1f%% of the water at each start; the plant refills "
@@ -1226,7 +1225,7 @@ static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, 
              w0, start * u_end, 100 * u_end, abar,
              delta > 0 && abar > 0 ? log(2.0) / (delta * abar) / 3600.0 : INFINITY);
     logger_rows(w, buf, 4096);
-    driver_rows(w, p, abar, buf, 4096);
+    driver_rows(w, p, buf, 4096);
     *markdown = buf;
     return PHC_OK;
 }
