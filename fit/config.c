@@ -17,44 +17,79 @@
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/weight_curve.h"
 #include "fit/costs/source_file.h"
+#include "fit/config/kinds.h"
+#include "fit/config/yaml_keys.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
-/* The data-set kinds this build knows: name, summary, keys and their help
- * (phc_config_kind_at), and the loader. */
-typedef int (*kind_loader)(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                           const char *base_dir, phc_is_parameter_fn is_parameter,
-                           void *user_data, phc_dataset **out, phc_error *err);
-typedef struct kind_entry {
-    phc_config_section info;
-    kind_loader load;
-} kind_entry;
+/* The data-set kinds this build knows, alphabetical: each descriptor
+ * (fit/config/kind.h) holds the name, summary, keys and their help, the
+ * operations and the YAML translation. */
+static const phc_kind elasticity_curve_kind = {
+    .config = {.name = "elasticity_curve",
+               .summary = "bulk moduli against water content -> the logistic elasticity " "kappa, chi0, e_min, e_max (wilting eq. 9)",
+               .keys = phc_elasticity_curve_keys,
+               .help = phc_elasticity_curve_help},
+    .load_yaml = phc_elasticity_curve_load,
+};
 
-static const kind_entry kinds[] = {
-    {{"curve", "any expression of columns and parameters (muparser) fitted to a column; "
-               "the NIST StRD problems, enzyme kinetics",
-      phc_curve_keys, phc_curve_help}, phc_curve_load},
-    {{"elasticity_curve", "bulk moduli against water content -> the logistic elasticity "
-                          "kappa, chi0, e_min, e_max (wilting eq. 9)",
-      phc_elasticity_curve_keys, phc_elasticity_curve_help}, phc_elasticity_curve_load},
-    {{"infiltration", "the depth reached by a fraction of the applied rain over time -> soil "
-                      "permeability p and capacity c (Rhizomorph §6, Fig. 7)",
-      phc_infiltration_keys, phc_infiltration_help}, phc_infiltration_load},
-    {{"leaf_photos", "photos of an aging leaf -> vein, stomata, inflow and time scales and the "
-                     "colour transfer of the leaf colour aging model (Silva et al. §3)",
-      phc_leaf_photos_keys, phc_leaf_photos_help}, phc_leaf_photos_load},
-    {{"pv_curve", "pressure-volume data (water potential and mass along a bench dry-down) -> "
-                  "PV traits per leaf and the logistic elasticity (wilting eq. 9)",
-      phc_pv_curve_keys, phc_pv_curve_help}, phc_pv_curve_load},
-    {{"root_shoot", "harvested plants' root:shoot against basal diameter -> growth parameters "
-                    "(phi_rg, ...) and soil p, c (Rhizomorph §5-6)",
-      phc_root_shoot_keys, phc_root_shoot_help}, phc_root_shoot_load},
-    {{"soil_probe", "soil-moisture probe readings over time -> soil permeability p and "
-                    "capacity c, globally or per layer (Rhizomorph §6)",
-      phc_soil_probe_keys, phc_soil_probe_help}, phc_soil_probe_load},
-    {{"weight_curve", "a plant or detached leaf weighed on a balance while it dries -> "
-                      "water-loss rate delta, initial water, dry mass (wilting §3-4)",
-      phc_weight_curve_keys, phc_weight_curve_help}, phc_weight_curve_load},
+static const phc_kind infiltration_kind = {
+    .config = {.name = "infiltration",
+               .summary = "the depth reached by a fraction of the applied rain over time -> soil " "permeability p and capacity c (Rhizomorph §6, Fig. 7)",
+               .keys = phc_infiltration_keys,
+               .help = phc_infiltration_help},
+    .load_yaml = phc_infiltration_load,
+};
+
+static const phc_kind leaf_photos_kind = {
+    .config = {.name = "leaf_photos",
+               .summary = "photos of an aging leaf -> vein, stomata, inflow and time scales and the " "colour transfer of the leaf colour aging model (Silva et al. §3)",
+               .keys = phc_leaf_photos_keys,
+               .help = phc_leaf_photos_help},
+    .load_yaml = phc_leaf_photos_load,
+};
+
+static const phc_kind pv_curve_kind = {
+    .config = {.name = "pv_curve",
+               .summary = "pressure-volume data (water potential and mass along a bench dry-down) -> " "PV traits per leaf and the logistic elasticity (wilting eq. 9)",
+               .keys = phc_pv_curve_keys,
+               .help = phc_pv_curve_help},
+    .load_yaml = phc_pv_curve_load,
+};
+
+static const phc_kind root_shoot_kind = {
+    .config = {.name = "root_shoot",
+               .summary = "harvested plants' root:shoot against basal diameter -> growth parameters " "(phi_rg, ...) and soil p, c (Rhizomorph §5-6)",
+               .keys = phc_root_shoot_keys,
+               .help = phc_root_shoot_help},
+    .load_yaml = phc_root_shoot_load,
+};
+
+static const phc_kind soil_probe_kind = {
+    .config = {.name = "soil_probe",
+               .summary = "soil-moisture probe readings over time -> soil permeability p and " "capacity c, globally or per layer (Rhizomorph §6)",
+               .keys = phc_soil_probe_keys,
+               .help = phc_soil_probe_help},
+    .load_yaml = phc_soil_probe_load,
+};
+
+static const phc_kind weight_curve_kind = {
+    .config = {.name = "weight_curve",
+               .summary = "a plant or detached leaf weighed on a balance while it dries -> " "water-loss rate delta, initial water, dry mass (wilting §3-4)",
+               .keys = phc_weight_curve_keys,
+               .help = phc_weight_curve_help},
+    .load_yaml = phc_weight_curve_load,
+};
+
+static const phc_kind *const kinds[] = {
+    &phc_curve_kind,
+    &elasticity_curve_kind,
+    &infiltration_kind,
+    &leaf_photos_kind,
+    &pv_curve_kind,
+    &root_shoot_kind,
+    &soil_probe_kind,
+    &weight_curve_kind,
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])
 
@@ -173,14 +208,14 @@ size_t phc_config_kind_count(void)
 
 const phc_config_section *phc_config_kind_at(size_t i)
 {
-    return i < N_KINDS ? &kinds[i].info : NULL;
+    return i < N_KINDS ? &kinds[i]->config : NULL;
 }
 
 const phc_config_section *phc_config_kind_find(const char *name)
 {
     for (size_t i = 0; name && i < N_KINDS; ++i)
-        if (strcmp(kinds[i].info.name, name) == 0)
-            return &kinds[i].info;
+        if (strcmp(kinds[i]->config.name, name) == 0)
+            return &kinds[i]->config;
     return NULL;
 }
 
@@ -486,12 +521,12 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     if ((rc = phc_yaml_map_string(doc, node, "kind", 1, ctx, &kind, err)) ||
         (rc = phc_yaml_map_string(doc, node, "name", 0, ctx, &name, err)))
         return rc;
-    const kind_entry *entry = NULL;
+    const phc_kind *entry = NULL;
     const char *kind_names[N_KINDS];
     for (size_t i = 0; i < N_KINDS; ++i) {
-        kind_names[i] = kinds[i].info.name;
-        if (strcmp(kinds[i].info.name, kind) == 0)
-            entry = &kinds[i];
+        kind_names[i] = kinds[i]->config.name;
+        if (strcmp(kinds[i]->config.name, kind) == 0)
+            entry = kinds[i];
     }
     if (!entry) {
         const char *near = phc_suggest(kind, kind_names, N_KINDS);
@@ -509,8 +544,8 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     size_t na = 0;
     for (size_t i = 0; common_dataset_keys[i] && na < 63; ++i)
         allowed[na++] = common_dataset_keys[i];
-    for (size_t i = 0; entry->info.keys[i] && na < 63; ++i)
-        allowed[na++] = entry->info.keys[i];
+    for (size_t i = 0; entry->config.keys[i] && na < 63; ++i)
+        allowed[na++] = entry->config.keys[i];
     allowed[na] = NULL;
     if ((rc = phc_yaml_check_keys(doc, node, allowed, ctx, err)))
         return rc;
@@ -520,7 +555,7 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
 
     binding_ctx bctx = {pb, binding};
     phc_dataset *ds = NULL;
-    if ((rc = entry->load(doc, node, base_dir, is_parameter, &bctx, &ds, err)))
+    if ((rc = entry->load_yaml(doc, node, base_dir, is_parameter, &bctx, &ds, err)))
         return rc;
     char fallback[64];
     snprintf(fallback, sizeof fallback, "%s-%zu", kind, index + 1);

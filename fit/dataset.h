@@ -14,6 +14,10 @@
 #include "model/status.h"
 
 typedef struct phc_dataset phc_dataset;
+
+/* Decides whether a name a data set's options use (an expression name, a
+ * model slot) is bound to a parameter of the problem (1) or not (0). */
+typedef int (*phc_is_parameter_fn)(const char *name, void *user_data);
 struct phc_problem;
 
 typedef struct phc_dataset_ops {

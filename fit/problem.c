@@ -109,6 +109,19 @@ int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err)
     return PHC_OK;
 }
 
+int phc_problem_bind_by_name(const phc_problem *pb, phc_dataset *ds, phc_error *err)
+{
+    for (size_t j = 0; j < ds->k; ++j)
+        if (phc_problem_find_parameter(pb, ds->slot_names[j]) < 0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "data set '%s' (%s): slot '%s' has no parameter of that name; "
+                                 "add it with phc_problem_add_parameter first",
+                                 ds->name ? ds->name : "?", ds->ops->kind, ds->slot_names[j]);
+    for (size_t j = 0; j < ds->k; ++j)
+        ds->param_index[j] = (size_t)phc_problem_find_parameter(pb, ds->slot_names[j]);
+    return PHC_OK;
+}
+
 double phc_problem_scale(const phc_problem *pb, size_t i)
 {
     const phc_parameter *p = &pb->params[i];

@@ -69,6 +69,13 @@ long phc_problem_find_parameter(const phc_problem *pb, const char *name);
  * (phc_dataset_describe_series). */
 int phc_problem_add_dataset(phc_problem *pb, phc_dataset *ds, phc_error *err);
 
+/* For data sets built in C (phc_<kind>_new): binds each slot of ds to the
+ * problem's parameter of the same name, so that data sets sharing a slot
+ * name share the parameter (as a config does without a `parameters:`
+ * binding).  A slot without a parameter of its name is PHC_ERR_INPUT naming
+ * both; add the parameters first.  Leaves ds unchanged on failure. */
+int phc_problem_bind_by_name(const phc_problem *pb, phc_dataset *ds, phc_error *err);
+
 /* Checks the whole problem before a fit: starts, finite bounds and ranges
  * within +-PHC_PARAMETER_MAX, bounds are intervals, starts inside them,
  * every parameter used by some data set, at least as many observations as

@@ -611,3 +611,63 @@ fail:
     free(v);
     return rc;
 }
+
+/* Appends text to a growing buffer; 0 when out of memory. */
+static int append(char **buf, size_t *len, size_t *cap, const char *text, size_t n)
+{
+    if (*len + n + 1 > *cap) {
+        size_t grown = *cap ? *cap : 256;
+        while (*len + n + 1 > grown)
+            grown *= 2;
+        char *b = realloc(*buf, grown);
+        if (!b)
+            return 0;
+        *buf = b;
+        *cap = grown;
+    }
+    memcpy(*buf + *len, text, n);
+    *len += n;
+    (*buf)[*len] = '\0';
+    return 1;
+}
+
+int phc_table_from_columns(const char *name, size_t n_columns, const char *const *names,
+                           const double *const *columns, size_t n_rows, phc_table **out,
+                           phc_error *err)
+{
+    *out = NULL;
+    if (!name)
+        name = "table";
+    if (n_columns == 0 || !names || (n_rows > 0 && !columns))
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: a table needs at least one named column", name);
+    for (size_t j = 0; j < n_columns; ++j)
+        if (!names[j] || !names[j][0] || (n_rows > 0 && !columns[j]))
+            return phc_error_set(err, PHC_ERR_INVALID, "%s: column %zu has no %s", name, j + 1,
+                                 !names[j] || !names[j][0] ? "name" : "values");
+    /* Written as CSV text and parsed, so that a table built here behaves
+     * exactly as one read from a file (names quoted, "" for a quote). */
+    char *text = NULL;
+    size_t len = 0, cap = 0;
+    int ok = 1;
+    for (size_t j = 0; j < n_columns && ok; ++j) {
+        ok = append(&text, &len, &cap, j ? ",\"" : "\"", j ? 2 : 1);
+        for (const char *c = names[j]; *c && ok; ++c)
+            ok = append(&text, &len, &cap, *c == '"' ? "\"\"" : c, *c == '"' ? 2 : 1);
+        ok = ok && append(&text, &len, &cap, "\"", 1);
+    }
+    ok = ok && append(&text, &len, &cap, "\n", 1);
+    for (size_t i = 0; i < n_rows && ok; ++i)
+        for (size_t j = 0; j < n_columns && ok; ++j) {
+            char cell[40];
+            const int n = snprintf(cell, sizeof cell, "%s%.17g%s", j ? "," : "", columns[j][i],
+                                   j + 1 == n_columns ? "\n" : "");
+            ok = append(&text, &len, &cap, cell, (size_t)n);
+        }
+    if (!ok) {
+        free(text);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    const int rc = phc_table_parse(text, len, name, out, err);
+    free(text);
+    return rc;
+}

@@ -38,6 +38,15 @@ int phc_table_read(const char *path, phc_table **out, phc_error *err);
 int phc_table_parse(const char *text, size_t length, const char *name,
                     phc_table **out, phc_error *err);
 
+/* A table from C arrays, for programs that build data sets without a file:
+ * n_columns columns named names[j] holding columns[j][0..n_rows-1].  Values
+ * are kept with 17 significant digits (they convert back exactly); a NaN or
+ * infinity is kept and refused when a data set converts that column.  Row i
+ * is reported as line i + 2 of `name` (the header being line 1). */
+int phc_table_from_columns(const char *name, size_t n_columns, const char *const *names,
+                           const double *const *columns, size_t n_rows, phc_table **out,
+                           phc_error *err);
+
 void phc_table_free(phc_table *t); /* accepts NULL */
 
 const char *phc_table_source(const phc_table *t);   /* path or name given */

@@ -17,24 +17,6 @@
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 
-const char *const phc_curve_keys[] = {"file", "x", "y", "expression", "sigma",
-                                      "x_label", "y_label", NULL};
-const phc_key_help phc_curve_help[] = {
-    {"file", "CSV table of the observations (header line, then rows), relative to the config "
-             "file. Required."},
-    {"x", "Column used as abscissa in plots and to order the residuals. Required."},
-    {"y", "Column of observed values. Required."},
-    {"expression", "The model, in muparser syntax: numbers, parameter and column names, "
-                   "+ - * / ^, parentheses, exp log sqrt sin cos tan atan abs (and muparser's "
-                   "other functions), pi. A name is a parameter slot when it is a global "
-                   "parameter or a key of the data set's `parameters:` binding, otherwise a "
-                   "column of the file (both is an error). Required."},
-    {"sigma", "A positive number (one sigma for every point, in y units) or the name of a "
-              "column of per-point sigmas. Default: unweighted."},
-    {"x_label", "Axis label of x in plots. Default: the x column's name."},
-    {"y_label", "Axis label of y in plots. Default: the y column's name."},
-    {NULL, NULL}};
-
 typedef struct curve_impl {
     muParserHandle_t parser;
     phc_expr *tape;       /* exact derivatives; NULL = muparser + numerical */
@@ -117,7 +99,8 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     return 0;
 }
 
-static const phc_dataset_ops curve_ops = {"curve", curve_predict, curve_predict_at, curve_free, NULL, NULL, NULL, NULL};
+const phc_dataset_ops phc_curve_ops = {.kind = "curve", .predict = curve_predict,
+                                       .predict_at = curve_predict_at, .free_impl = curve_free};
 
 /* Compiles the derivative tape and binds its names to the slots and to the
  * columns muparser registered (same names, same order as c->cols). */
@@ -204,11 +187,10 @@ static const char *expr_shown(const char *expr, int pos, char *buf, size_t size)
  * line of `expression:` and the character in the expression.  A name
  * followed by "(" that is not a function is reported as such, with the
  * functions there are (muparser itself says only "Unexpected parenthesis"). */
-static int expression_error(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *expr,
+static int expression_error(const char *where, const char *expr,
                             muParserHandle_t parser, phc_is_parameter_fn is_parameter, void *user_data,
                             phc_error *err)
 {
-    const size_t line = phc_key_line(node, "expression");
     const int len = (int)strlen(expr);
     int pos = (int)mupGetErrorPos(parser);
     if (pos > len)
@@ -229,20 +211,20 @@ static int expression_error(const phc_yaml_doc *doc, const phc_yaml_node *node, 
                 const size_t used = strlen(known);
                 snprintf(known + used, sizeof known - used, "%s%s", i ? " " : "", known_functions[i]);
             }
-            if (is_parameter(name, user_data))
+            if (is_parameter && is_parameter(name, user_data))
                 return phc_error_set(err, PHC_ERR_INPUT,
-                                     "%s:%zu: expression \"%s\": '%s' at character %d is a parameter, not a "
+                                     "%s: expression \"%s\": '%s' at character %d is a parameter, not a "
                                      "function (write '*' for a product); known functions: %s",
-                                     doc->path, line, shown, name, start + 1, known);
+                                     where, shown, name, start + 1, known);
             const char *near = phc_suggest(name, known_functions, N_KNOWN_FUNCTIONS);
             return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: expression \"%s\": unknown function '%s' at character %d;%s%s%s "
+                                 "%s: expression \"%s\": unknown function '%s' at character %d;%s%s%s "
                                  "known functions: %s",
-                                 doc->path, line, shown, name, start + 1, near ? " did you mean '" : "",
+                                 where, shown, name, start + 1, near ? " did you mean '" : "",
                                  near ? near : "", near ? "'?" : "", known);
         }
     }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s (character %d)", doc->path, line, shown,
+    return phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\": %s (character %d)", where, shown,
                          mupGetErrorMsg(parser), pos + 1);
 }
 
@@ -251,42 +233,48 @@ static char *label_or(const char *given, const char *fallback)
     return strdup(given ? given : fallback);
 }
 
-int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                   const char *base_dir, phc_is_parameter_fn is_parameter,
-                   void *user_data, phc_dataset **out, phc_error *err)
+phc_curve_options phc_curve_options_default(void)
 {
-    const char *file = NULL, *xname = NULL, *yname = NULL, *expr = NULL;
-    const char *x_label = NULL, *y_label = NULL;
-    const char *ctx = "curve data set";
-    phc_table *table = NULL;
+    phc_curve_options o = {0};
+    return o;
+}
+
+/* Is an expression name a parameter slot?  The options' rule, or every name
+ * that is not a column. */
+static int names_parameter(const phc_curve_options *o, const phc_table *table, const char *name)
+{
+    return o->is_parameter ? o->is_parameter(name, o->user_data) : phc_table_find(table, name) < 0;
+}
+
+#define WHERE(key) phc_origin_key(opt->origin, "curve", key).text
+
+int phc_curve_new(const phc_table *table, const phc_curve_options *opt,
+                  phc_dataset **out, phc_error *err)
+{
+    const char *xname = opt->x, *yname = opt->y, *expr = opt->expression;
+    const char *path = phc_table_source(table);
     phc_dataset *ds = NULL;
     curve_impl *c = NULL;
-    char *path = NULL;
     char **slot_names = NULL;
     size_t n_slots = 0;
     int rc;
 
     *out = NULL;
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x", 1, ctx, &xname, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y", 1, ctx, &yname, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "expression", 1, ctx, &expr, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
-        return rc;
-
-    path = phc_join_path(base_dir, file);
-    if (!path)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
+    {   /* the required options (a config has checked them already) */
+        static const char *const names[] = {"x", "y", "expression"};
+        const char *const given[] = {xname, yname, expr};
+        for (int i = 0; i < 3; ++i)
+            if (!given[i] || !given[i][0])
+                return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s' is required", WHERE(NULL), names[i]);
     }
-    if (phc_table_rows(table) == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
-        goto fail;
-    }
+    if (phc_table_rows(table) == 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
+    if (opt->sigma_column && opt->sigma != 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': give a number or a column, not both",
+                             WHERE("sigma"));
+    if (!opt->sigma_column && !(opt->sigma >= 0 && isfinite(opt->sigma)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': must be positive, found %g",
+                             WHERE("sigma"), opt->sigma);
 
     c = calloc(1, sizeof *c);
     if (!c) {
@@ -309,8 +297,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         phc_expr_free(probe);
         if (probe_rc == PHC_ERR_DOMAIN) {
             char shown_buf[EXPR_SHOWN_MAX + 64];
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\": %s",
-                               doc->path, phc_key_line(node, "expression"),
+            rc = phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\": %s", WHERE("expression"),
                                expr_shown(expr, (int)probe_pos, shown_buf, sizeof shown_buf),
                                probe_err.message);
             goto fail;
@@ -319,13 +306,12 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     mupSetExpr(c->parser, expr);
     int n_vars = mupGetExprVarNum(c->parser);
     if (mupError(c->parser)) {
-        rc = expression_error(doc, node, expr, c->parser, is_parameter, user_data, err);
+        rc = expression_error(WHERE("expression"), expr, c->parser, opt->is_parameter, opt->user_data, err);
         goto fail;
     }
     if (n_vars <= 0) {
         char shown_buf[EXPR_SHOWN_MAX + 64];
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
-                           doc->path, phc_key_line(node, "expression"),
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\" uses no parameters", WHERE("expression"),
                            expr_shown(expr, -1, shown_buf, sizeof shown_buf));
         goto fail;
     }
@@ -354,14 +340,13 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     rc = PHC_OK;
     for (int v = 0; v < n_vars && !rc; ++v) {
         const char *name = var_names[v];
-        const int is_param = is_parameter(name, user_data);
+        const int is_param = names_parameter(opt, table, name);
         const long col = phc_table_find(table, name);
-        const size_t line = phc_key_line(node, "expression");
         if (is_param && col >= 0) {
             rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: expression name '%s' (character %d) is both a parameter and a column of %s; "
+                               "%s: expression name '%s' (character %d) is both a parameter and a column of %s; "
                                "rename one",
-                               doc->path, line, name, name_column(expr, name), path);
+                               WHERE("expression"), name, name_column(expr, name), path);
         } else if (is_param) {
             slot_names[n_slots] = strdup(name);
             if (!slot_names[n_slots])
@@ -385,7 +370,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         } else {
             char what[64];
             snprintf(what, sizeof what, "expression (character %d): name", name_column(expr, name));
-            rc = phc_unknown_column(doc, line, what, name, table, err);
+            rc = phc_unknown_column_at(WHERE("expression"), what, name, table, err);
             if (rc == PHC_ERR_INPUT)
                 strncat(err->message, " (not a parameter either)",
                         sizeof err->message - strlen(err->message) - 1);
@@ -398,8 +383,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
         goto fail;
     if (n_slots == 0) {
         char shown_buf[EXPR_SHOWN_MAX + 64];
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expression \"%s\" uses no parameters",
-                           doc->path, phc_key_line(node, "expression"),
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\" uses no parameters", WHERE("expression"),
                            expr_shown(expr, -1, shown_buf, sizeof shown_buf));
         goto fail;
     }
@@ -408,7 +392,7 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
      * grammar; otherwise muparser with numerical derivatives. */
     if ((rc = bind_tape(c, expr, (const char *const *)slot_names, n_slots, err)))
         goto fail;
-    ds = phc_dataset_new(&curve_ops, n_slots);
+    ds = phc_dataset_new(&phc_curve_ops, n_slots);
     if (!ds) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
@@ -420,68 +404,56 @@ int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     ds->n = phc_table_rows(table);
     if (phc_table_find(table, xname) < 0) {
-        rc = phc_unknown_column(doc, phc_key_line(node, "x"), "x", xname, table, err);
+        rc = phc_unknown_column_at(WHERE("x"), "x", xname, table, err);
         goto fail;
     }
     if (phc_table_find(table, yname) < 0) {
-        rc = phc_unknown_column(doc, phc_key_line(node, "y"), "y", yname, table, err);
+        rc = phc_unknown_column_at(WHERE("y"), "y", yname, table, err);
         goto fail;
     }
     if ((rc = phc_table_column_numbers(table, xname, &ds->x, err)) ||
         (rc = phc_table_column_numbers(table, yname, &ds->y, err)))
         goto fail;
 
-    const phc_yaml_node *sig = phc_yaml_get(node, "sigma");
-    if (sig) {
-        double s = 0;
-        if (sig->kind == PHC_YAML_SCALAR && phc_table_find(table, sig->scalar) >= 0) {
-            if ((rc = phc_table_column_numbers(table, sig->scalar, &ds->sigma, err)))
-                goto fail;
-            for (size_t i = 0; i < ds->n; ++i)
-                if (!(ds->sigma[i] > 0)) {
-                    rc = phc_error_set(err, PHC_ERR_INPUT,
-                                       "%s:%zu: column '%s': sigma must be positive, found %g",
-                                       path, phc_table_row_line(table, i), sig->scalar, ds->sigma[i]);
-                    goto fail;
-                }
-        } else {
-            if ((rc = phc_yaml_number(doc, sig, "sigma", &s, err))) {
-                snprintf(err->message, sizeof err->message,
-                         "%s:%zu: key 'sigma': expected a positive number or a column of %s, found '%s'",
-                         doc->path, sig->line, path, sig->kind == PHC_YAML_SCALAR ? sig->scalar : "(not a scalar)");
-                goto fail;
-            }
-            if (!(s > 0)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': must be positive, found %g",
-                                   doc->path, sig->line, s);
-                goto fail;
-            }
-            ds->sigma = malloc(ds->n * sizeof *ds->sigma);
-            if (!ds->sigma) {
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
-            for (size_t i = 0; i < ds->n; ++i)
-                ds->sigma[i] = s;
+    if (opt->sigma_column) {
+        if (phc_table_find(table, opt->sigma_column) < 0) {
+            rc = phc_unknown_column_at(WHERE("sigma"), "sigma", opt->sigma_column, table, err);
+            goto fail;
         }
+        if ((rc = phc_table_column_numbers(table, opt->sigma_column, &ds->sigma, err)))
+            goto fail;
+        for (size_t i = 0; i < ds->n; ++i)
+            if (!(ds->sigma[i] > 0)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
+                                   path, phc_table_row_line(table, i), opt->sigma_column, ds->sigma[i]);
+                goto fail;
+            }
+    } else if (opt->sigma > 0) {
+        ds->sigma = malloc(ds->n * sizeof *ds->sigma);
+        if (!ds->sigma) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        for (size_t i = 0; i < ds->n; ++i)
+            ds->sigma[i] = opt->sigma;
     }
     ds->data_file = strdup(path);
     ds->data_lines = malloc(ds->n * sizeof *ds->data_lines);
-    if (!ds->data_file || !ds->data_lines || phc_dataset_add_input(ds, path)) {
+    if (!ds->data_file || !ds->data_lines) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
     for (size_t i = 0; i < ds->n; ++i)
         ds->data_lines[i] = phc_table_row_line(table, i);
-    ds->x_label = label_or(x_label, xname);
-    ds->y_label = label_or(y_label, yname);
+    ds->x_label = label_or(opt->x_label, xname);
+    ds->y_label = label_or(opt->y_label, yname);
     if (!ds->x_label || !ds->y_label) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
     ds->impl = c;
     c = NULL;
-    ds->config_line = node->line;
+    ds->config_line = phc_origin_line(opt->origin, NULL);
     *out = ds;
     ds = NULL;
     rc = PHC_OK;
@@ -492,7 +464,5 @@ fail:
     free(slot_names);
     phc_dataset_free(ds);
     curve_free(c);
-    phc_table_free(table);
-    free(path);
     return rc;
 }

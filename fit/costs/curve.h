@@ -1,41 +1,49 @@
-/* `curve` data sets: y = f(columns; parameters) for a user expression.
+/* `curve` data sets: y = f(columns; parameters) for a user expression, the
+ * NIST StRD problems and any closed-form model of a table.
  *
- * Config keys (besides the common data-set keys of config.h):
- *   file:       CSV file, relative to the config file
- *   x:          column used as abscissa for plots and for ordering residuals
- *   y:          observed column
- *   expression: the model, muparser syntax: numbers, parameter and column
- *               names, + - * / ^, parentheses, exp log sqrt sin cos tan atan
- *               abs (and muparser's other functions), pi
- *   sigma:      a positive number (one sigma for all points, in y units) or
- *               the name of a column of per-point sigmas; absent = unweighted
- *   x_label, y_label: axis labels with units (default: the column names)
+ * Built in C with phc_curve_new from a table (measurements/table.h: read
+ * from a CSV file, or phc_table_from_columns for arrays) and options; the
+ * config's `kind: curve` mapping is translated into the same options by
+ * fit/config/curve_yaml.c.
  *
- * A name in the expression is a parameter slot when it is a global parameter
- * or a key of the data set's `parameters:` binding; otherwise it must be a
- * column of the file.  A name that is both is an error (ambiguous). */
+ * A name in the expression is a parameter slot when options.is_parameter
+ * says so (NULL: every name that is not a column); otherwise it must be a
+ * column of the table.  A name that is both is an error (ambiguous). */
 #ifndef PHC_COSTS_CURVE_H
 #define PHC_COSTS_CURVE_H
 
-#include "fit/config_help.h"
+#include "fit/costs/origin.h"
 #include "fit/dataset.h"
-#include "measurements/yaml_doc.h"
+#include "measurements/table.h"
 #include "model/status.h"
 
-/* Keys specific to `curve` (NULL-terminated). */
-extern const char *const phc_curve_keys[];
-/* Help on each of those keys (fit/config_help.h). */
-extern const phc_key_help phc_curve_help[];
+typedef struct phc_curve_options {
+    const char *x;          /* column used as abscissa for plots and ordering (required) */
+    const char *y;          /* observed column (required) */
+    const char *expression; /* the model, muparser syntax: numbers, parameter and column
+                               names, + - * / ^, parentheses, exp log sqrt sin cos tan atan
+                               abs (and muparser's other functions), pi (required) */
+    double sigma;           /* > 0: one standard deviation for every point, in y units */
+    const char *sigma_column; /* or a column of per-point standard deviations; neither =
+                                 unweighted */
+    const char *x_label, *y_label; /* axis labels with units; NULL = the column names */
+    phc_is_parameter_fn is_parameter; /* NULL: every name that is not a column */
+    void *user_data;                  /* passed to is_parameter */
+    const phc_origin *origin;         /* where the options came from, for messages; NULL */
+} phc_curve_options;
 
-/* Decides whether an expression name is a parameter slot. */
-typedef int (*phc_is_parameter_fn)(const char *name, void *user_data);
+/* Everything unset: no sigma, no labels, no origin. */
+phc_curve_options phc_curve_options_default(void);
 
-/* Builds a curve data set from its config mapping.  base_dir is the config
- * file's directory.  Slot names are filled; parameter indices are left to
- * the caller (binding).  Errors name the config file and line or the CSV
- * file, line and column, or the expression position. */
-int phc_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                   const char *base_dir, phc_is_parameter_fn is_parameter,
-                   void *user_data, phc_dataset **out, phc_error *err);
+/* Builds a curve data set over the rows of `table` (copied; the table may
+ * be freed afterwards).  Slot names are the expression's parameters (in
+ * the order muparser lists them); parameter indices are left to phc_problem binding.
+ * Errors name the option (and the config line when options.origin is set),
+ * the table's source, line and column, or the expression position. */
+int phc_curve_new(const phc_table *table, const phc_curve_options *options,
+                  phc_dataset **out, phc_error *err);
+
+/* The operations of curve data sets (ops->kind is "curve"). */
+extern const phc_dataset_ops phc_curve_ops;
 
 #endif /* PHC_COSTS_CURVE_H */

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"

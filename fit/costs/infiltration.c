@@ -9,6 +9,7 @@
 #include "fit/costs/soil_fields.h"
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "measurements/c_number.h"
 #include "measurements/table.h"
 #include "measurements/units.h"

@@ -10,6 +10,7 @@
 #include "fit/leaf_images.h"
 #include "fit/costs/leaf_setup.h"
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "fit/costs/unique_times.h"
 #include "fit/problem.h"
 #include "measurements/photo.h"

@@ -2,6 +2,7 @@
 #include "fit/costs/pv_curve.h"
 
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 
 #include <math.h>
 #include <stdio.h>

@@ -9,6 +9,7 @@
 
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "fit/growth_outputs.h"
 #include "measurements/baad.h"
 #include "measurements/table.h"

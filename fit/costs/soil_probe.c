@@ -9,6 +9,7 @@
 #include "fit/costs/soil_fields.h"
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "fit/costs/unique_times.h"
 #include "measurements/soil_probes.h"
 #include "measurements/units.h"

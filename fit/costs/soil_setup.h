@@ -40,6 +40,7 @@
 #include "fit/config_help.h"
 #include "fit/costs/curve.h"
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until the soil kinds are YAML-free */
 #include "fit/dataset.h"
 #include "measurements/geo.h"
 #include "measurements/yaml_doc.h"

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "fit/costs/weight_drivers.h"
 #include "fit/costs/unique_times.h"
 #include "measurements/c_number.h"

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "fit/costs/source_file.h"
+#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "measurements/c_number.h"
 #include "measurements/logger_time.h"
 

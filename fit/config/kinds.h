@@ -1,0 +1,10 @@
+/* The descriptors of the data-set kinds this build knows (fit/config/kind.h),
+ * one per kind, each defined in its fit/config/<kind>_yaml.c. */
+#ifndef PHC_CONFIG_KINDS_H
+#define PHC_CONFIG_KINDS_H
+
+#include "fit/config/kind.h"
+
+extern const phc_kind phc_curve_kind;
+
+#endif /* PHC_CONFIG_KINDS_H */
