@@ -18,6 +18,7 @@
 #include "fit/costs/weight_curve.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/kinds.h"
+#include "fit/parameter_units.h"
 #include "fit/config/yaml_keys.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
@@ -133,7 +134,10 @@ static const phc_key_help parameter_help[] = {
     {"lower", "Lower bound; not above upper. Default: none (-inf)."},
     {"upper", "Upper bound. Default: none (+inf)."},
     {"fixed", "true: the parameter keeps its start value and is not fitted. Default: false."},
-    {"unit", "Unit text for tables and plots (a label, not converted). Default: none."},
+    {"unit", "The unit of value, lower, upper, range and scale (UDUNITS-2 syntax, e.g. g h-1). "
+             "When the model slot it is bound to declares a unit, the parameter is converted into "
+             "it for the fit and reported back in this unit (a unit of another dimension is an "
+             "error); otherwise it is a label for tables and plots. Default: the slot's unit."},
     {"scale", "Typical magnitude, > 0: the solver works on value/scale. Default: |value|, or 1 "
               "when value is 0."},
     {"range", "[low, high], low < high: the box in which multi-start draws start points "
@@ -706,6 +710,9 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
     for (size_t i = 0; i < datasets->count; ++i)
         if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, err)))
             goto fail;
+    /* parameters' `unit:` into the units their slots declare */
+    if ((rc = phc_problem_convert_units(pb, err)))
+        goto fail;
     /* A model computed to a relative accuracy tol (an ODE solver) cannot
      * resolve cost changes below it: stopping tolerances the user did not
      * set are raised to it instead of iterating on round-off. */

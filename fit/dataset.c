@@ -37,8 +37,9 @@ phc_dataset *phc_dataset_new(const phc_dataset_ops *ops, size_t k)
     ds->loss_scale = 1.0;
     if (k > 0) {
         ds->slot_names = calloc(k, sizeof *ds->slot_names);
+        ds->slot_units = calloc(k, sizeof *ds->slot_units);
         ds->param_index = calloc(k, sizeof *ds->param_index);
-        if (!ds->slot_names || !ds->param_index) {
+        if (!ds->slot_names || !ds->slot_units || !ds->param_index) {
             phc_dataset_free(ds);
             return NULL;
         }
@@ -56,6 +57,10 @@ void phc_dataset_free(phc_dataset *ds)
         for (size_t j = 0; j < ds->k; ++j)
             free(ds->slot_names[j]);
     free(ds->slot_names);
+    if (ds->slot_units)
+        for (size_t j = 0; j < ds->k; ++j)
+            free(ds->slot_units[j]);
+    free(ds->slot_units);
     free_series_names(ds);
     free(ds->series);
     free(ds->param_index);
@@ -72,6 +77,20 @@ void phc_dataset_free(phc_dataset *ds)
         free(ds->inputs[i]);
     free(ds->inputs);
     free(ds);
+}
+
+int phc_dataset_declare_unit(phc_dataset *ds, const char *slot, const char *unit)
+{
+    for (size_t j = 0; j < ds->k; ++j)
+        if (ds->slot_names[j] && strcmp(ds->slot_names[j], slot) == 0) {
+            char *copy = strdup(unit);
+            if (!copy)
+                return PHC_ERR_NOMEM;
+            free(ds->slot_units[j]);
+            ds->slot_units[j] = copy;
+            return PHC_OK;
+        }
+    return PHC_ERR_INVALID;
 }
 
 int phc_dataset_add_input(phc_dataset *ds, const char *path)

@@ -61,6 +61,10 @@ struct phc_dataset {
     size_t n;                    /* observations = residuals */
     size_t k;                    /* parameter slots */
     char **slot_names;           /* k names as the model calls them */
+    char **slot_units;           /* k units the model works in (UDUNITS-2 syntax, e.g.
+                                    "g s-1"), or NULL entries where a slot declares none;
+                                    a parameter's `unit:` is converted into it
+                                    (fit/parameter_units.h) */
     size_t *param_index;         /* k global parameter indices */
     double *x;                   /* n abscissae for plots and ordering (time, x) */
     double *y;                   /* n observations */
@@ -104,6 +108,10 @@ void phc_dataset_free(phc_dataset *ds); /* accepts NULL; frees impl via ops */
 
 /* Records that the loader read file `path` (kept once; provenance hashes
  * it).  PHC_OK or PHC_ERR_NOMEM. */
+/* Declares the unit slot `slot` works in (copied); PHC_ERR_INVALID for an
+ * unknown slot, PHC_ERR_NOMEM. */
+int phc_dataset_declare_unit(phc_dataset *ds, const char *slot, const char *unit);
+
 int phc_dataset_add_input(phc_dataset *ds, const char *path);
 
 /* Writes the name of series g into buf (size bytes, NUL-terminated). */

@@ -1,5 +1,6 @@
 /* Running a calibration: see fit.h. */
 #include "fit/fit.h"
+#include "fit/parameter_units.h"
 #include "fit/provenance.h"
 
 #include <gsl/gsl_cdf.h>
@@ -864,20 +865,23 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        pr->start = p->value;
-        pr->value = best[i];
+        /* reported in the user's unit (parameter_units.h) */
+        pr->start = phc_parameter_to_user(p, p->value);
+        pr->value = phc_parameter_to_user(p, best[i]);
+        pr->unit_scale = p->unit_scale;
+        pr->unit_offset = p->unit_offset;
         pr->fixed = p->fixed;
         pr->stderr_ = pr->ci_lo = pr->ci_hi = pr->sens_l1 = pr->sens_l2 = NAN;
         if (p->fixed)
             continue;
-        pr->stderr_ = res->dof > 0 ? cov.stderr_[f] : NAN;
+        pr->stderr_ = res->dof > 0 ? cov.stderr_[f] / fabs(p->unit_scale) : NAN;
         pr->ci_lo = pr->value - t * pr->stderr_;
         pr->ci_hi = pr->value + t * pr->stderr_;
         const double tol = 1e-10 * phc_problem_scale(pb, i);
-        if (isfinite(p->lower) && pr->value - p->lower <= tol)
-            pr->at_bound = -1;
-        else if (isfinite(p->upper) && p->upper - pr->value <= tol)
-            pr->at_bound = 1;
+        if (isfinite(p->lower) && best[i] - p->lower <= tol)
+            pr->at_bound = p->unit_scale > 0 ? -1 : 1;
+        else if (isfinite(p->upper) && p->upper - best[i] <= tol)
+            pr->at_bound = p->unit_scale > 0 ? 1 : -1;
         ++f;
     }
 

@@ -80,7 +80,9 @@ typedef struct phc_dataset_result {
 
 typedef struct phc_param_result {
     char *name, *unit;
-    double start, value;
+    double start, value;         /* in the user's unit */
+    double unit_scale, unit_offset; /* user -> the model slots' unit: slot = unit_scale *
+                                       value + unit_offset (parameter_units.h) */
     double stderr_;              /* NAN when not determined or dof = 0 */
     double ci_lo, ci_hi;         /* t-based 95% interval */
     int fixed;

@@ -45,6 +45,7 @@ void phc_problem_free(phc_problem *pb)
     for (size_t i = 0; i < pb->n_params; ++i) {
         free(pb->params[i].name);
         free(pb->params[i].unit);
+        free(pb->params[i].slot_unit);
     }
     free(pb->params);
     for (size_t i = 0; i < pb->n_datasets; ++i)
@@ -84,6 +85,7 @@ int phc_problem_add_parameter(phc_problem *pb, const char *name, double value,
     p->lower = -INFINITY;
     p->upper = INFINITY;
     p->range_lo = p->range_hi = NAN;
+    p->unit_scale = 1.0;
     if (index)
         *index = pb->n_params;
     pb->n_params++;

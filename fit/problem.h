@@ -15,7 +15,13 @@ typedef struct phc_parameter {
     double value;        /* start value (physical units) */
     double lower, upper; /* bounds; -INFINITY / INFINITY when open */
     int fixed;
-    char *unit;          /* free text for reports, e.g. "g s-1 cm-1"; may be NULL */
+    char *unit;          /* the user's unit (reports show values in it), e.g. "g h-1"; may
+                            be NULL.  When a bound slot declares its unit (slot_unit),
+                            phc_problem_convert_units converts value, bounds, range and
+                            scale into slot_unit; otherwise it is a label */
+    char *slot_unit;     /* the unit of the slots it is bound to, or NULL */
+    double unit_scale, unit_offset; /* unit -> slot_unit: slot = unit_scale * user + unit_offset
+                                       (1 and 0 when there is nothing to convert) */
     double scale;        /* typical magnitude; 0 = automatic (|value| or 1) */
     double range_lo, range_hi; /* multi-start box; NAN = automatic */
     size_t config_line;  /* line of its key in the config (problem->source), 0 when

@@ -124,6 +124,10 @@ static json_t *result_json(const phc_fit_result *res)
                                       p->at_bound != 0, "bound_side", p->at_bound, "unit",
                                       p->unit ? json_string(p->unit) : json_null(), "start", num(p->start),
                                       "sensitivity_l1", num(p->sens_l1), "sensitivity_l2", num(p->sens_l2)));
+        if (p->unit_scale != 1.0 || p->unit_offset != 0.0) /* value is in the user's unit */
+            json_object_set_new(json_object_get(params, p->name), "to_model_unit",
+                                json_pack("{s:o, s:o}", "scale", num(p->unit_scale), "offset",
+                                          num(p->unit_offset)));
     }
     json_object_set_new(root, "parameters", params);
     json_t *names = json_array(), *matrix = json_array();
@@ -450,6 +454,16 @@ int phc_result_read_json(const char *path, phc_fit_result **out, phc_error *err)
         p->fixed = json_is_true(json_object_get(pv, "fixed"));
         json_t *side = json_object_get(pv, "bound_side");
         p->at_bound = json_is_integer(side) ? (int)json_integer_value(side) : 0;
+        p->unit_scale = 1.0; /* model unit = value's unit, unless stored */
+        p->unit_offset = 0.0;
+        json_t *to_model = json_object_get(pv, "to_model_unit");
+        if (json_is_object(to_model)) {
+            json_t *sc = json_object_get(to_model, "scale"), *of = json_object_get(to_model, "offset");
+            if (json_is_number(sc) && json_is_number(of) && json_number_value(sc) != 0) {
+                p->unit_scale = json_number_value(sc);
+                p->unit_offset = json_number_value(of);
+            }
+        }
         json_t *unit = json_object_get(pv, "unit");
         if (json_is_string(unit) && !(p->unit = strdup(json_string_value(unit)))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");

@@ -486,7 +486,10 @@ static int write_kind_outputs(const phc_fit_result *res, const phc_problem *pb, 
         if (!p)
             return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         for (size_t j = 0; j < ds->k; ++j)
-            p[j] = res->params[ds->param_index[j]].value;
+        { /* the model's unit */
+            const phc_param_result *pr = &res->params[ds->param_index[j]];
+            p[j] = pr->unit_scale * pr->value + pr->unit_offset;
+        }
         char base[256];
         phc_run_dir_safe_name(ds->name, base, sizeof base);
         const int rc = ds->ops->fit_outputs(ds, p, tmpdir, base, err);
