@@ -27,11 +27,8 @@
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
 #include "fit/simulate.h"
+#include "fit/version.h"
 #include "phc_git_commit.h"
-
-#ifndef PHC_VERSION
-#define PHC_VERSION "dev"
-#endif
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2, EXIT_FIT = 3, EXIT_INTERNAL = 4 };
 
@@ -113,7 +110,7 @@ static void usage(FILE *out)
 static void print_overview(FILE *out)
 {
     fprintf(out, "phytocal %s: calibrate and validate plant-physiology models against measurements.\n\n",
-            PHC_VERSION);
+            phc_version());
     usage(out);
     fprintf(out, "\n%s\n", exit_codes);
     fprintf(out, "data-set kinds (phytocal help KIND for the keys of one):\n");
@@ -340,7 +337,7 @@ static int load_for_run(const char *cmd, int full_argc, char **full_argv, int ar
     for (size_t n = strlen(dir); n > 1 && dir[n - 1] == '/'; --n)
         dir[n - 1] = '\0';
     if (phc_run_dir_check(dir, o->force, *pb, &err) ||
-        phc_provenance_begin(*pb, full_argc, full_argv, PHC_VERSION, PHC_GIT_COMMIT, pv, &err)) {
+        phc_provenance_begin(*pb, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, pv, &err)) {
         phc_problem_free(*pb);
         *pb = NULL;
         *exit_code = fail(&err);
@@ -487,7 +484,7 @@ static int cmd_report(int argc, char **argv)
 
 static int cmd_version(void)
 {
-    printf("phytocal %s%s%s (Ceres Solver %s)\n", PHC_VERSION, PHC_GIT_COMMIT[0] ? ", git " : "", PHC_GIT_COMMIT,
+    printf("phytocal %s%s%s (Ceres Solver %s)\n", phc_version(), PHC_GIT_COMMIT[0] ? ", git " : "", PHC_GIT_COMMIT,
            phc_nls_version());
     return EXIT_OK;
 }

@@ -1,0 +1,251 @@
+#!/usr/bin/env bash
+# phytocal as a C library (issue 15): the build installs into a prefix, and
+# a program outside the tree (examples/embed) builds against the installed
+# copy and fits what it should.
+#
+#   bash test_install.sh PATH/TO/phytocal [SHARED_DATA_DIR]
+#
+# PATH/TO/phytocal is the command in the build directory (the build
+# directory is its folder, or else the working directory).  The shared data
+# folder is not used.  Steps:
+#   1. cmake --install BUILD --prefix TMP/prefix
+#   2. the files: library with its SONAME symlink, headers with their
+#      folders, the umbrella header, phytocal.pc, the CMake package
+#   3. readelf: SONAME libphytocal.so.0; only phc_* symbols exported
+#   4. every installed header compiles alone as strict C11 and includes no
+#      C++ or third-party header a consumer might lack (known exceptions
+#      listed below, with the reason)
+#   5. examples/embed configured with find_package(phytocal) and built; the
+#      fitted delta's 95% interval holds the truth
+#   6. embed.c compiled with `cc $(pkg-config --cflags --libs phytocal)` and
+#      run with LD_LIBRARY_PATH; same check
+#   7. a C++ program includes the umbrella header and links
+#   8. the installed phytocal command runs (RUNPATH $ORIGIN/../lib)
+# Prints "ok - <step>" / "not ok - <step>: <why>", then "N passed, M failed";
+# exits 1 if any step failed, 77 (skip) in a sanitizer build (a program
+# built without -fsanitize cannot load a sanitized library).
+
+set -u
+PHC=${1:-}
+if [ -z "$PHC" ]; then
+    echo "usage: bash test_install.sh PATH/TO/phytocal [SHARED_DATA_DIR]" >&2
+    exit 2
+fi
+case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
+# The checkout this script belongs to (physical path: the README checker
+# runs it through a symlinked tests/).
+SRC=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd -P)
+BUILD=$(cd "$(dirname "$PHC")" 2>/dev/null && pwd -P)
+if [ ! -f "$BUILD/CMakeCache.txt" ]; then
+    BUILD=$(pwd -P)
+fi
+if [ ! -f "$BUILD/CMakeCache.txt" ]; then
+    echo "not ok - setup: no CMakeCache.txt next to $PHC nor in $PWD: run this from the build directory"
+    echo "0 passed, 1 failed"
+    exit 1
+fi
+if grep -q '^PHC_SANITIZE:BOOL=ON' "$BUILD/CMakeCache.txt"; then
+    echo "skip: $BUILD is a sanitizer build (PHC_SANITIZE=ON): programs built without -fsanitize cannot load its library"
+    exit 77
+fi
+for tool in cmake cc c++ pkg-config readelf nm; do
+    if ! command -v "$tool" >/dev/null 2>&1; then
+        echo "not ok - setup: '$tool' is not on PATH"
+        echo "0 passed, 1 failed"
+        exit 1
+    fi
+done
+
+T=$(mktemp -d "${TMPDIR:-/tmp}/phc_install.XXXXXX") || exit 1
+trap 'rm -rf "$T"' EXIT
+P="$T/prefix"
+
+PASSED=0
+FAILED=0
+WHY=""
+why() { WHY="${WHY:+$WHY; }$1"; }
+finish() {
+    if [ -z "$WHY" ]; then
+        PASSED=$((PASSED + 1))
+        echo "ok - $1"
+    else
+        FAILED=$((FAILED + 1))
+        echo "not ok - $1: $WHY"
+    fi
+    WHY=""
+}
+# The last lines of a log file, on one line, for a message.
+tail_of() { tail -n "${2:-6}" "$1" 2>/dev/null | tr '\n' '|' | cut -c1-900; }
+
+# Checks embed's output (file $1): converged, and the line
+# "delta = V UNIT, 95% interval [LO, HI], truth X: inside" holds X in [LO, HI].
+check_embed() {
+    local out=$1 line
+    line=$(grep '^delta = ' "$out")
+    if [ -z "$line" ]; then
+        why "no 'delta = ...' line in its output [$(tail_of "$out")]"
+        return
+    fi
+    if ! awk -v l="$line" 'BEGIN {
+            if (match(l, /interval \[[^,]+, [^]]+\], truth [^:]+/) == 0) exit 1;
+            s = substr(l, RSTART + 10, RLENGTH - 10); gsub(/[],[]/, " ", s);
+            split(s, f, " ");   # f[1] lo, f[2] hi, f[3] "truth", f[4] x
+            exit !(f[1] + 0 <= f[4] + 0 && f[4] + 0 <= f[2] + 0 && f[1] + 0 < f[2] + 0) }'; then
+        why "the truth is not inside the fitted 95% interval: $line"
+    fi
+    grep -q 'converged after' "$out" || why "the fit did not converge [$(tail_of "$out")]"
+}
+
+# 1. install
+if cmake --install "$BUILD" --prefix "$P" >"$T/install.log" 2>&1; then
+    :
+else
+    why "cmake --install $BUILD failed (is it built?) [$(tail_of "$T/install.log")]"
+fi
+finish "cmake --install into a temporary prefix"
+
+# 2. what was installed; LIBDIR as GNUInstallDirs chose it
+SO=$(find "$P" -name 'libphytocal.so.0' 2>/dev/null | head -n 1)
+LIBDIR=$(dirname "${SO:-$P/lib/none}")
+[ -n "$SO" ] || why "no libphytocal.so.0 under $P"
+[ -L "$LIBDIR/libphytocal.so" ] || why "no libphytocal.so symlink (for -lphytocal) in $LIBDIR"
+[ -L "$SO" ] || why "libphytocal.so.0 is not a symlink to the versioned file"
+ls "$LIBDIR"/libphytocal.so.0.* >/dev/null 2>&1 || why "no versioned libphytocal.so.0.x.y in $LIBDIR"
+for h in phytocal.h fit/version.h fit/problem.h fit/dataset.h fit/fit.h fit/config.h fit/report.h \
+         fit/result_json.h model/water.h model/plant_graph.h model/status.h measurements/plant_io.h; do
+    [ -f "$P/include/phytocal/$h" ] || why "missing header include/phytocal/$h"
+done
+[ ! -e "$P/include/phytocal/fit/cli" ] || why "fit/cli was installed"
+[ -z "$(find "$P/include" -name '*_internal.h')" ] || why "an *_internal.h header was installed"
+PC="$LIBDIR/pkgconfig/phytocal.pc"
+[ -f "$PC" ] || why "no $PC"
+[ -f "$LIBDIR/cmake/phytocal/phytocalConfig.cmake" ] || why "no $LIBDIR/cmake/phytocal/phytocalConfig.cmake"
+[ -f "$LIBDIR/cmake/phytocal/phytocalConfigVersion.cmake" ] || why "no phytocalConfigVersion.cmake"
+finish "installed files: library and symlinks, headers in their folders, phytocal.pc, CMake package"
+
+# 3. the shared library itself
+if [ -n "$SO" ]; then
+    soname=$(readelf -d "$SO" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')
+    [ "$soname" = "libphytocal.so.0" ] || why "SONAME is '$soname', expected libphytocal.so.0"
+    others=$(nm -D --defined-only "$SO" | awk '$3 !~ /^phc_/ {print $3}' | head -n 5 | tr '\n' ' ')
+    [ -z "$others" ] || why "exports symbols other than phc_*: $others..."
+    nm -D --defined-only "$SO" | grep -q ' phc_version$' || why "phc_version is not exported"
+fi
+finish "readelf: SONAME libphytocal.so.0, only phc_* exported"
+
+# 4. installed headers include only C standard headers (and each other)
+STD='assert|complex|ctype|errno|float|inttypes|limits|locale|math|setjmp|signal|stdarg|stdbool|stddef|stdint|stdio|stdlib|string|time|wchar'
+# Known exceptions: header -> what it includes, and why that is acceptable.
+#   fit/provenance.h <jansson.h>: a run's provenance as a jansson object; it
+#   is not in phytocal.h (only run_dir.h and simulate.h include it), and a
+#   program that includes it needs libjansson-dev.
+KNOWN='fit/provenance.h:jansson.h'
+bad=""
+while IFS= read -r hit; do
+    file=${hit%%:*}
+    file=${file#"$P/include/phytocal/"}
+    inc=$(printf '%s\n' "$hit" | sed -n 's/.*#[[:space:]]*include[[:space:]]*<\([^>]*\)>.*/\1/p')
+    [ -n "$inc" ] || continue
+    if printf '%s\n' "$inc" | grep -Eq "^($STD)\.h$"; then continue; fi
+    case " $KNOWN " in *" $file:$inc "*) continue ;; esac
+    bad="$bad $file:<$inc>"
+done < <(grep -rHE '^[[:space:]]*#[[:space:]]*include[[:space:]]*<' "$P/include/phytocal" --include='*.h')
+[ -z "$bad" ] || why "headers include non-standard headers consumers may lack:$bad"
+# each one compiles alone as strict C11, with only the prefix's include
+# folders (one translation unit per header, one compiler run for all)
+mkdir -p "$T/headers"
+n_headers=0
+while IFS= read -r h; do
+    n_headers=$((n_headers + 1))
+    printf '#include <%s>\n' "${h#"$P/include/"}" >"$T/headers/h$n_headers.c"
+done < <(find "$P/include/phytocal" -name '*.h' | sort)
+if [ "$n_headers" -eq 0 ]; then
+    why "no headers installed"
+elif ! cc -std=c11 -pedantic -Wall -Wextra -Werror -fsyntax-only -I"$P/include" -I"$P/include/phytocal" \
+        "$T/headers"/h*.c >"$T/headers.log" 2>&1; then
+    why "headers do not compile alone with -std=c11 -pedantic: $(grep -m 3 -E 'error|warning' "$T/headers.log" |
+        sed "s|$P/include/||g" | tr '\n' '|')"
+fi
+finish "installed headers ($n_headers) compile alone as C11 and include no C++ or third-party headers (except $KNOWN)"
+
+# 5. examples/embed through find_package(phytocal)
+E="$T/embed-cmake"
+if ! cmake -S "$SRC/examples/embed" -B "$E" -DCMAKE_PREFIX_PATH="$P" -DCMAKE_BUILD_TYPE=Release \
+        >"$T/embed-configure.log" 2>&1; then
+    why "configuring examples/embed failed [$(tail_of "$T/embed-configure.log")]"
+elif ! grep -q "^phytocal_DIR:PATH=$LIBDIR/cmake/phytocal$" "$E/CMakeCache.txt"; then
+    why "find_package(phytocal) found $(grep '^phytocal_DIR' "$E/CMakeCache.txt"), not the temporary prefix"
+elif ! cmake --build "$E" -j1 >"$E/build.log" 2>&1; then
+    why "building examples/embed failed [$(tail_of "$E/build.log")]"
+elif ! "$E/embed" >"$T/embed-cmake.out" 2>&1; then
+    why "embed exited $? [$(tail_of "$T/embed-cmake.out")]"
+else
+    check_embed "$T/embed-cmake.out"
+fi
+finish "examples/embed built with find_package(phytocal) fits delta (truth inside its 95% interval)"
+
+# 6. embed.c through pkg-config
+export PKG_CONFIG_PATH="$LIBDIR/pkgconfig"
+flags=$(pkg-config --cflags --libs phytocal 2>"$T/pc.err")
+if [ -z "$flags" ]; then
+    why "pkg-config --cflags --libs phytocal failed [$(tail_of "$T/pc.err")]"
+else
+    case "$flags" in *"-I$P/include "*"-I$P/include/phytocal"*) ;;
+        *) why "pkg-config --cflags lacks -I$P/include and -I$P/include/phytocal: $flags" ;; esac
+    # shellcheck disable=SC2086
+    if ! cc -std=c11 -Wall -Wextra -Werror -pedantic "$SRC/examples/embed/embed.c" $flags -lm \
+            -o "$T/embed-pc" >"$T/pc-build.log" 2>&1; then
+        why "cc embed.c \$(pkg-config ...) failed [$(tail_of "$T/pc-build.log")]"
+    elif ! LD_LIBRARY_PATH="$LIBDIR" "$T/embed-pc" >"$T/embed-pc.out" 2>&1; then
+        why "embed (pkg-config build) exited non-zero [$(tail_of "$T/embed-pc.out")]"
+    else
+        check_embed "$T/embed-pc.out"
+        v=$(pkg-config --modversion phytocal)
+        grep -q "^phytocal $v: " "$T/embed-pc.out" ||
+            why "phc_version() does not print pkg-config's version $v: $(head -n 1 "$T/embed-pc.out")"
+    fi
+fi
+finish "embed.c built with pkg-config (-std=c11 -Werror -pedantic) fits delta; phc_version() = pkg-config version"
+
+# 7. C++ consumers: the umbrella header wraps the modules in extern "C"
+cat >"$T/consumer.cc" <<'EOF'
+#include <phytocal/phytocal.h>
+#include <cstdio>
+#include <cstring>
+int main()
+{
+    phc_plant_graph *g = phc_plant_graph_new(1); /* one segment, 1 mm x 1 cm */
+    phc_error err;
+    phc_error_clear(&err);
+    if (g)
+        g->radius[0] = 1e-3, g->length[0] = 1e-2;
+    int rc = g ? phc_plant_graph_finish(g, "cxx", &err) : 1;
+    phc_plant_graph_free(g);
+    std::printf("%s %s\n", phc_version(), phc_strerror(rc));
+    return std::strcmp(phc_version(), PHC_VERSION_STRING) != 0 || rc != PHC_OK;
+}
+EOF
+# shellcheck disable=SC2086
+if ! c++ -std=c++17 -Wall -Wextra "$T/consumer.cc" $flags -o "$T/consumer" >"$T/cxx.log" 2>&1; then
+    why "a C++ program including phytocal.h does not build [$(tail_of "$T/cxx.log")]"
+elif ! LD_LIBRARY_PATH="$LIBDIR" "$T/consumer" >"$T/cxx.out" 2>&1; then
+    why "the C++ program failed: $(tail_of "$T/cxx.out")"
+fi
+finish "a C++ program includes phytocal.h and links"
+
+# 8. the installed command, without LD_LIBRARY_PATH
+if [ ! -x "$P/bin/phytocal" ]; then
+    why "no $P/bin/phytocal"
+elif ! env -u LD_LIBRARY_PATH "$P/bin/phytocal" --version >"$T/version.out" 2>&1; then
+    why "installed phytocal --version failed [$(tail_of "$T/version.out")]"
+elif [ "$(head -n 1 "$T/version.out")" != "$("$PHC" --version | head -n 1)" ]; then
+    why "installed '$(head -n 1 "$T/version.out")' differs from the build's"
+else
+    loaded=$(env -u LD_LIBRARY_PATH ldd "$P/bin/phytocal" | sed -n 's/.*libphytocal\.so\.0 => \([^ ]*\).*/\1/p')
+    [ -n "$loaded" ] && [ "$(readlink -f "$loaded")" = "$(readlink -f "$SO")" ] ||
+        why "the installed command loads '$loaded', not $SO"
+fi
+finish "installed phytocal --version runs with the installed library"
+
+echo "$PASSED passed, $FAILED failed"
+[ "$FAILED" -eq 0 ]
