@@ -151,8 +151,9 @@ int main(void)
     printf("balance: %d weighings over 48 h, %.4f g -> %.4f g, noise sd %g g (seed 42)\n\n", N_OBS,
            mass[0], mass[N_OBS - 1], NOISE_SD);
 
-    /* 2. The problem, by hand: two global parameters, one data set whose
-     *    slots {delta, initial_water} are bound to them. */
+    /* 2. The problem, by hand: two global parameters, and the data set's
+     *    slots {delta, initial_water} (with the units the model works in)
+     *    bound to them by name. */
     ds->name = strdup("balance");
     ds->x_label = strdup("time (h)");
     ds->y_label = strdup("mass (g)");
@@ -164,8 +165,11 @@ int main(void)
     pb = phc_problem_new("embed");
     size_t i_delta, i_water;
     if (!pb || !ds->name || !ds->x_label || !ds->y_label || !ds->slot_names[0] || !ds->slot_names[1] ||
+        phc_dataset_declare_unit(ds, "delta", "s-1 cm-2") ||
+        phc_dataset_declare_unit(ds, "initial_water", "g") ||
         phc_problem_add_parameter(pb, "delta", 1e-3, &i_delta, &err) ||
-        phc_problem_add_parameter(pb, "initial_water", 1.0, &i_water, &err)) {
+        phc_problem_add_parameter(pb, "initial_water", 1.0, &i_water, &err) ||
+        phc_problem_bind_by_name(pb, ds, &err)) {
         phc_dataset_free(ds);
         if (!err.status)
             phc_error_set(&err, PHC_ERR_NOMEM, "out of memory");
@@ -173,11 +177,8 @@ int main(void)
     }
     pb->params[i_delta].lower = 0;          /* a loss rate is not negative */
     pb->params[i_water].lower = 0;
-    pb->params[i_delta].unit = strdup("s-1 cm-2");
-    pb->params[i_water].unit = strdup("g");
-    ds->param_index[0] = i_delta;
-    ds->param_index[1] = i_water;
-    if (phc_problem_add_dataset(pb, ds, &err)) /* takes ds, also on failure */
+    if (phc_problem_add_dataset(pb, ds, &err) || /* takes ds, also on failure */
+        phc_problem_convert_units(pb, &err))     /* parameters take the slots' units */
         goto fail;
 
     /* 3. Fit: solve, covariance, intervals, residual checks. */
@@ -185,10 +186,11 @@ int main(void)
         goto fail;
     phc_report_print_summary(res, stdout);
     putchar('\n');
-    for (size_t i = 0; i < 2; ++i) {
+    for (size_t i = 0; i < 2; ++i) { /* results in the order the parameters were added */
         const phc_param_result *r = &res->params[i];
-        printf("%s = %.6g %s, 95%% interval [%.6g, %.6g], truth %g: %s\n", r->name, r->value, r->unit,
-               r->ci_lo, r->ci_hi, truth[i], r->ci_lo <= truth[i] && truth[i] <= r->ci_hi ? "inside" : "OUTSIDE");
+        const int inside = r->ci_lo <= truth[i] && truth[i] <= r->ci_hi;
+        printf("%s = %.6g %s, 95%% interval [%.6g, %.6g], truth %g: %s\n", r->name, r->value,
+               r->unit ? r->unit : "", r->ci_lo, r->ci_hi, truth[i], inside ? "inside" : "OUTSIDE");
     }
     rc = res->summary.outcome == PHC_NLS_CONVERGED ? 0 : 3;
 fail:

@@ -64,15 +64,21 @@ PASSED=0
 FAILED=0
 WHY=""
 why() { WHY="${WHY:+$WHY; }$1"; }
+now() { date +%s.%N; }
+STEP_START=$(now)
+# Ends a step: "ok - <step> (seconds)" or "not ok - <step>: <why>".
 finish() {
+    local took
+    took=$(awk -v a="$STEP_START" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }')
     if [ -z "$WHY" ]; then
         PASSED=$((PASSED + 1))
-        echo "ok - $1"
+        echo "ok - $1 ($took s)"
     else
         FAILED=$((FAILED + 1))
-        echo "not ok - $1: $WHY"
+        echo "not ok - $1: $WHY ($took s)"
     fi
     WHY=""
+    STEP_START=$(now)
 }
 # The last lines of a log file, on one line, for a message.
 tail_of() { tail -n "${2:-6}" "$1" 2>/dev/null | tr '\n' '|' | cut -c1-900; }
@@ -140,16 +146,14 @@ STD='assert|complex|ctype|errno|float|inttypes|limits|locale|math|setjmp|signal|
 #   is not in phytocal.h (only run_dir.h and simulate.h include it), and a
 #   program that includes it needs libjansson-dev.
 KNOWN='fit/provenance.h:jansson.h'
-bad=""
-while IFS= read -r hit; do
-    file=${hit%%:*}
-    file=${file#"$P/include/phytocal/"}
-    inc=$(printf '%s\n' "$hit" | sed -n 's/.*#[[:space:]]*include[[:space:]]*<\([^>]*\)>.*/\1/p')
-    [ -n "$inc" ] || continue
-    if printf '%s\n' "$inc" | grep -Eq "^($STD)\.h$"; then continue; fi
-    case " $KNOWN " in *" $file:$inc "*) continue ;; esac
-    bad="$bad $file:<$inc>"
-done < <(grep -rHE '^[[:space:]]*#[[:space:]]*include[[:space:]]*<' "$P/include/phytocal" --include='*.h')
+bad=$(find "$P/include/phytocal" -name '*.h' -exec awk -v std="$STD" -v known=" $KNOWN " \
+        -v root="$P/include/phytocal/" '
+    /^[ \t]*#[ \t]*include[ \t]*</ {
+        inc = $0; sub(/^[^<]*</, "", inc); sub(/>.*/, "", inc)
+        file = substr(FILENAME, length(root) + 1)
+        if (inc ~ ("^(" std ")\\.h$") || index(known, " " file ":" inc " ")) next
+        printf " %s:<%s>", file, inc
+    }' {} +)
 [ -z "$bad" ] || why "headers include non-standard headers consumers may lack:$bad"
 # each one compiles alone as strict C11, with only the prefix's include
 # folders (one translation unit per header, one compiler run for all)
