@@ -69,6 +69,7 @@
 #include <string.h>
 #include <strings.h>
 
+#include "measurements/atomic_file.h"
 #include "measurements/c_number.h"
 #include "measurements/table.h"
 #include "measurements/text_file.h"
@@ -1375,48 +1376,28 @@ done:
 
 typedef int (*body_writer)(FILE *f, const phc_plant_graph *g);
 
-/* Writes through body() to PATH.tmp, then renames it into place; the
- * temporary file is removed on any failure. */
+/* Writes through body() to a temporary file next to PATH, renamed into
+ * place (atomic_file.h); the temporary file is removed on any failure. */
 static int write_atomically(const char *path, const phc_plant_graph *g, body_writer body,
                             phc_error *err)
 {
-    size_t plen = strlen(path);
-    char *tmp = malloc(plen + 5);
-    FILE *f;
+    phc_atomic_file *af = NULL;
     phc_c_numeric scope = {(locale_t)0, (locale_t)0};
-    int failed, saved;
-    if (!tmp)
-        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-    memcpy(tmp, path, plen);
-    memcpy(tmp + plen, ".tmp", 5);
-    f = fopen(tmp, "wb");
-    if (!f) {
-        int rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot open for writing: %s", tmp,
-                               strerror(errno));
-        free(tmp);
+    int rc = phc_atomic_file_open(path, &af, err);
+    if (rc)
         return rc;
-    }
     phc_c_numeric_begin(&scope); /* '.' decimal points whatever the locale */
     errno = 0;
-    failed = body(f, g) < 0;
+    const int failed = body(phc_atomic_file_stream(af), g) < 0;
+    const int saved = errno;
     phc_c_numeric_end(&scope);
-    failed |= fflush(f) != 0 || ferror(f);
-    saved = errno;
-    failed |= fclose(f) != 0;
-    if (!failed && rename(tmp, path) != 0) {
-        saved = errno;
-        failed = 1;
-    } else if (failed && !saved) {
-        saved = errno;
-    }
     if (failed) {
-        int rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write: %s", path,
-                               strerror(saved ? saved : EIO));
-        remove(tmp);
-        free(tmp);
-        return rc;
+        phc_atomic_file_abort(af);
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write: %s", path,
+                             strerror(saved ? saved : EIO));
     }
-    free(tmp);
+    if ((rc = phc_atomic_file_commit(af, err)))
+        return rc;
     phc_error_clear(err);
     return PHC_OK;
 }
