@@ -1,4 +1,4 @@
-/* Unit tests for measurements/plant_io.c: the four formats, their error
+/* Unit tests for measurements/plant_io*.c: the four formats, their error
  * messages (file, line, problem), the writers and round trips. */
 #include <glob.h>
 #include <stdio.h>
