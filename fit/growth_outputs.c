@@ -1,13 +1,11 @@
 /* Files describing a grown plant: see growth_outputs.h. */
 #include "fit/growth_outputs.h"
 
-#include <errno.h>
 #include <math.h>
 #include <plplot.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "fit/plot_file.h"
 #include "measurements/plant_io.h"
@@ -103,20 +101,19 @@ int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
                        : phc_error_set(err, PHC_ERR_INTERNAL,
                                        "%s: PLplot has no 'pngcairo' device (install "
                                        "plplot-driver-cairo)", path);
-    char *tmp = NULL;
-    int status = phc_plot_temp_file(path, &tmp, err);
+    phc_atomic_file *af = NULL;
+    int status = phc_atomic_file_open(path, &af, err);
     if (status) return status;
     PLINT old_stream, strm = -1;
     plgstrm(&old_stream);
     plmkstrm(&strm);
     if (strm < 0) {
         plsstrm(old_stream);
-        unlink(tmp);
-        free(tmp);
+        phc_atomic_file_abort(af);
         return phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
     }
     plsdev("pngcairo");
-    plsfnam(tmp);
+    plsfnam(phc_atomic_file_temp_path(af));
     plspage(0.0, 0.0, (PLINT)(520 * n + 180), 760, 0, 0);
     plsfam(0, 0, 0);
     plscmap0n(COL_COUNT);
@@ -176,13 +173,5 @@ int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
     plsstrm(strm);
     plend1();
     plsstrm(old_stream);
-    if (!phc_plot_png_complete(tmp))
-        status = phc_error_set(err, PHC_ERR_IO, "%s: PLplot did not write a complete PNG file "
-                               "(disk full?)", path);
-    else if (rename(tmp, path) != 0)
-        status = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename the temporary plot file "
-                               "into place: %s", path, strerror(errno));
-    if (status) unlink(tmp);
-    free(tmp);
-    return status;
+    return phc_plot_file_finish(af, status, err);
 }

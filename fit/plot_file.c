@@ -1,13 +1,10 @@
 /* The file side of a PLplot figure: see plot_file.h. */
 #include "fit/plot_file.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <plplot.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 /* Copy of s with PLplot's escape character doubled; "" for NULL. */
 char *phc_plot_escape(const char *s)
@@ -49,32 +46,6 @@ int phc_plot_device_available(const char *name)
     return found;
 }
 
-/* Creates the temporary output file next to `path` (O_EXCL). */
-int phc_plot_temp_file(const char *path, char **out, phc_error *err)
-{
-    size_t len = strlen(path) + 64;
-    char *tmp = malloc(len);
-    *out = NULL;
-    if (!tmp)
-        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-    int saved = 0;
-    for (int i = 0; i < 100; ++i) {
-        snprintf(tmp, len, "%s.%ld.%d.tmp", path, (long)getpid(), i);
-        int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd >= 0) {
-            close(fd);
-            *out = tmp;
-            return PHC_OK;
-        }
-        saved = errno;
-        if (saved != EEXIST)
-            break;
-    }
-    free(tmp);
-    return phc_error_set(err, PHC_ERR_IO, "%s: cannot create the plot file: "
-                         "%s", path, strerror(saved));
-}
-
 /* Checks the PNG signature and the final IEND chunk (cairo reports no
  * write errors through PLplot: a full disk shows as a truncated file). */
 int phc_plot_png_complete(const char *file)
@@ -95,4 +66,18 @@ int phc_plot_png_complete(const char *file)
         fclose(f);
     }
     return ok;
+}
+
+int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err)
+{
+    if (!af)
+        return status;
+    if (status == PHC_OK && !phc_plot_png_complete(phc_atomic_file_temp_path(af)))
+        status = phc_error_set(err, PHC_ERR_IO, "%s: PLplot did not write a complete PNG file (disk full?)",
+                               phc_atomic_file_path(af));
+    if (status != PHC_OK) {
+        phc_atomic_file_abort(af);
+        return status;
+    }
+    return phc_atomic_file_commit(af, err);
 }

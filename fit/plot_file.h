@@ -1,10 +1,11 @@
-/* The file side of a PLplot figure, shared by fit/plots.c and
- * fit/soil_plots.c: text escaping, the pngcairo device check, a temporary
- * output file next to the final path, and the check that cairo wrote a
- * complete PNG. */
+/* The file side of a PLplot figure, shared by fit/plots.c,
+ * fit/soil_plots.c and fit/growth_outputs.c: text escaping, the pngcairo
+ * device check, the check that cairo wrote a complete PNG, and committing
+ * the temporary output file (measurements/atomic_file.h). */
 #ifndef PHC_PLOT_FILE_H
 #define PHC_PLOT_FILE_H
 
+#include "measurements/atomic_file.h"
 #include "model/status.h"
 
 /* s with PLplot's escape character '#' doubled (malloc'd; NULL when out of
@@ -12,9 +13,13 @@
 char *phc_plot_escape(const char *s);
 /* 1 when PLplot has the device `name`, 0 when not, -1 when it cannot tell. */
 int phc_plot_device_available(const char *name);
-/* Creates path.<pid>.<i>.tmp with O_EXCL (mode 0666 less the umask) and
- * stores its malloc'd name in *out; PHC_ERR_IO names path and the reason. */
-int phc_plot_temp_file(const char *path, char **out, phc_error *err);
+/* The PNG goes to the temporary file of a phc_atomic_file (PLplot writes it
+ * by name: plsfnam(phc_atomic_file_temp_path(af))).  Finishing it: when
+ * status is PHC_OK and the file is a complete PNG, commits it to its path;
+ * otherwise removes it (af may be NULL).  Returns the final status;
+ * PHC_ERR_IO "PATH: PLplot did not write a complete PNG file (disk full?)"
+ * or the commit's message. */
+int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err);
 /* 1 when file starts with the PNG signature and ends with the IEND chunk
  * (cairo reports no write errors through PLplot: a full disk shows as a
  * truncated file). */

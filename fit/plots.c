@@ -14,8 +14,9 @@
  *   new name on stdout), every axis range is finite and non-empty (plwind
  *   and plbox reject empty windows).
  * - The PNG is written to a temporary file next to `path` (created by us
- *   with O_EXCL, so the directory is known to be writable), checked for the
- *   PNG signature and renamed into place (DESIGN.md §3).
+ *   first, measurements/atomic_file.h, so the directory is known to be
+ *   writable), checked for the PNG signature and IEND chunk and renamed
+ *   into place (DESIGN.md §3).
  *
  * Caller text is plain text: PLplot's escape character '#' is doubled so a
  * label such as "run #3" prints as written; UTF-8 (±, σ, µ, °) renders
@@ -23,14 +24,11 @@
 #include "fit/plots.h"
 #include "fit/plot_file.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #include <gsl/gsl_cdf.h>
 #include <plplot.h>
@@ -246,7 +244,7 @@ static void legend_score_point(legend_boxes *lb, const plot_window *w,
 typedef struct plot_ctx {
     PLINT old_stream;
     PLINT stream;        /* -1 when none was made */
-    char *tmp_path;      /* temporary output file, NULL when none */
+    phc_atomic_file *af; /* the output file until committed, NULL when none */
     double page_fx, page_fy; /* one character height as a page fraction */
     double ch_fx, ch_fy;     /* ... and as a viewport fraction */
     double ylab_disp;        /* y label distance from the frame (chars) */
@@ -285,7 +283,7 @@ static void set_group_colours(size_t count, const double *lut)
 static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error *err)
 {
     ctx->stream = -1;
-    ctx->tmp_path = NULL;
+    ctx->af = NULL;
     ctx->groups = groups;
     ctx->key_w = 0.0;
     plgstrm(&ctx->old_stream);
@@ -305,7 +303,7 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
                              "%s: PLplot has no 'pngcairo' device "
                              "(install plplot-driver-cairo)", path);
 
-    int status = phc_plot_temp_file(path, &ctx->tmp_path, err);
+    int status = phc_atomic_file_open(path, &ctx->af, err);
     if (status)
         return status;
 
@@ -313,16 +311,15 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
     plmkstrm(&strm);
     if (strm < 0) {
         plsstrm(ctx->old_stream);
-        unlink(ctx->tmp_path);
-        free(ctx->tmp_path);
-        ctx->tmp_path = NULL;
+        phc_atomic_file_abort(ctx->af);
+        ctx->af = NULL;
         return phc_error_set(err, PHC_ERR_INTERNAL,
                              "%s: no free PLplot stream", path);
     }
     ctx->stream = strm;
 
     plsdev("pngcairo");
-    plsfnam(ctx->tmp_path);
+    plsfnam(phc_atomic_file_temp_path(ctx->af));
     plspage(0.0, 0.0, PAGE_W, PAGE_H, 0, 0);
     plsfam(0, 0, 0);
 
@@ -355,10 +352,9 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
     return PHC_OK;
 }
 
-/* Ends the stream, checks the file and renames it to `path` when status is
+/* Ends the stream, checks the file and commits it to its path when status is
  * PHC_OK; removes the temporary file otherwise.  Returns the final status. */
-static int plot_end(plot_ctx *ctx, const char *path, int status,
-                    phc_error *err)
+static int plot_end(plot_ctx *ctx, int status, phc_error *err)
 {
     if (ctx->stream >= 0) {
         plsstrm(ctx->stream);
@@ -366,23 +362,8 @@ static int plot_end(plot_ctx *ctx, const char *path, int status,
         plsstrm(ctx->old_stream);
         ctx->stream = -1;
     }
-    if (!ctx->tmp_path)
-        return status;
-    if (status == PHC_OK) {
-        int ok = phc_plot_png_complete(ctx->tmp_path);
-        if (!ok)
-            status = phc_error_set(err, PHC_ERR_IO,
-                                   "%s: PLplot did not write a complete PNG "
-                                   "file (disk full?)", path);
-        else if (rename(ctx->tmp_path, path) != 0)
-            status = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename "
-                                   "the temporary plot file into place: %s",
-                                   path, strerror(errno));
-    }
-    if (status != PHC_OK)
-        unlink(ctx->tmp_path);
-    free(ctx->tmp_path);
-    ctx->tmp_path = NULL;
+    status = phc_plot_file_finish(ctx->af, status, err);
+    ctx->af = NULL;
     return status;
 }
 
@@ -1150,7 +1131,7 @@ int phc_plot_layers(const char *path, const phc_plot_labels *labels, const phc_p
         draw_legend(&lg, pos);
     if (groups)
         draw_key(&ctx, &kp, layers, n_layers, text, count, text + n_layers, text[n_layers + count]);
-    status = plot_end(&ctx, path, PHC_OK, err);
+    status = plot_end(&ctx, PHC_OK, err);
 done:
     for (size_t i = 0; text && i < n_layers + count + 1; ++i)
         free(text[i]);
@@ -1502,7 +1483,7 @@ int phc_plot_qq(const char *path, const phc_plot_labels *labels,
     draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
     draw_legend(&lg, pos);
 
-    status = plot_end(&ctx, path, PHC_OK, err);
+    status = plot_end(&ctx, PHC_OK, err);
     text_free(&t);
     free(z);
     free(q);
@@ -1626,7 +1607,7 @@ static int acf_plot(const char *path, const phc_plot_labels *labels, const doubl
     draw_frame_axes(&ctx, &ax, t.title, t.x, t.y);
     draw_legend(&lg, pos);
 
-    status = plot_end(&ctx, path, PHC_OK, err);
+    status = plot_end(&ctx, PHC_OK, err);
     text_free(&t);
     return status;
 }

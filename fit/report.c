@@ -1,11 +1,11 @@
 /* The residual report: see report.h. */
 #include "fit/report.h"
 #include "fit/provenance.h"
+#include "measurements/atomic_file.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 int phc_report_all_passed(const phc_fit_result *res)
 {
@@ -97,11 +97,11 @@ static void print_goodness_md(const phc_dataset_result *d, FILE *f)
 int phc_report_write_markdown(const phc_fit_result *res, const char *path, const char *const *plots,
                               phc_error *err)
 {
-    char tmp[4096];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f)
-        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write", tmp);
+    phc_atomic_file *af = NULL;
+    int rc = phc_atomic_file_open(path, &af, err);
+    if (rc)
+        return rc;
+    FILE *f = phc_atomic_file_stream(af);
     char a[32], b[32];
     fprintf(f, "# Fit report: %s\n\n", res->name);
     fprintf(f, "## Verdict\n\n");
@@ -226,23 +226,13 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
         char *md = NULL;
         int prc = phc_provenance_markdown(res->provenance, &md, err);
         if (prc) {
-            fclose(f);
-            unlink(tmp);
+            phc_atomic_file_abort(af);
             return prc;
         }
         fprintf(f, "\n%s", md);
         free(md);
     }
-    int bad = ferror(f);
-    if (fclose(f) != 0 || bad) {
-        unlink(tmp);
-        return phc_error_set(err, PHC_ERR_IO, "%s: write failed", tmp);
-    }
-    if (rename(tmp, path) != 0) {
-        unlink(tmp);
-        return phc_error_set(err, PHC_ERR_IO, "%s: cannot rename into place", path);
-    }
-    return PHC_OK;
+    return phc_atomic_file_commit(af, err);
 }
 
 void phc_report_print_summary(const phc_fit_result *res, FILE *out)

@@ -16,6 +16,7 @@
 #include "fit/fit_plots.h"
 #include "fit/report.h"
 #include "fit/result_json.h"
+#include "measurements/atomic_file.h"
 
 #define MAX_PLOTS 512
 
@@ -391,8 +392,16 @@ static int write_manifest(const char *tmpdir, const phc_provenance *pv, phc_erro
         json_object_set_new(root, "provenance", phc_provenance_to_json(pv));
     char path[8192];
     snprintf(path, sizeof path, "%s/%s", tmpdir, PHC_RUN_MANIFEST);
-    if (json_dump_file(root, path, JSON_INDENT(2)) != 0)
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+    phc_atomic_file *af = NULL;
+    if ((rc = phc_atomic_file_open(path, &af, err)))
+        goto done;
+    errno = 0;
+    if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2)) != 0) {
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write: %s", path, strerror(errno ? errno : EIO));
+        phc_atomic_file_abort(af);
+    } else {
+        rc = phc_atomic_file_commit(af, err);
+    }
 done:
     json_decref(root);
     entries_free(&l);

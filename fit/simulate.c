@@ -6,6 +6,7 @@
 
 #include "fit/plots.h"
 #include "fit/run_dir.h"
+#include "measurements/atomic_file.h"
 
 static int simulate_dataset(const phc_problem *pb, phc_dataset *ds, const char *tmpdir, phc_error *err)
 {
@@ -31,18 +32,15 @@ static int simulate_dataset(const phc_problem *pb, phc_dataset *ds, const char *
     }
     phc_run_dir_safe_name(ds->name, base, sizeof base);
     snprintf(path, sizeof path, "%s/%s_simulated.csv", tmpdir, base);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+    phc_atomic_file *af = NULL;
+    if ((rc = phc_atomic_file_open(path, &af, err)))
         goto done;
-    }
+    FILE *f = phc_atomic_file_stream(af);
     fprintf(f, "x,observed,model\n");
     for (size_t i = 0; i < ds->n; ++i)
         fprintf(f, "%.17g,%.17g,%.17g\n", ds->x[i], ds->y[i], yhat[i]);
-    if (ferror(f) | (fclose(f) != 0)) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: write failed", path);
+    if ((rc = phc_atomic_file_commit(af, err)))
         goto done;
-    }
     snprintf(title, sizeof title, "%s: model at the start values", ds->name);
     phc_plot_labels lab = {title, ds->x_label, ds->y_label, "model at start values"};
     snprintf(path, sizeof path, "%s/%s_simulated.png", tmpdir, base);

@@ -9,14 +9,11 @@
 #include "fit/soil_plots.h"
 #include "fit/plot_file.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include <plplot.h>
 
@@ -185,7 +182,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
     }
 
     int status = PHC_OK;
-    char *tmp = NULL;
+    phc_atomic_file *af = NULL;
     PLINT old_stream, strm = -1;
     plgstrm(&old_stream);
     int dev = phc_plot_device_available("pngcairo");
@@ -198,7 +195,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
                                          "plplot-driver-cairo)", path);
         goto done;
     }
-    status = phc_plot_temp_file(path, &tmp, err);
+    status = phc_atomic_file_open(path, &af, err);
     if (status)
         goto done;
     plmkstrm(&strm);
@@ -210,7 +207,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
     }
 
     plsdev("pngcairo");
-    plsfnam(tmp);
+    plsfnam(phc_atomic_file_temp_path(af));
     plspage(0.0, 0.0, PAGE_W, PAGE_H, 0, 0);
     plsfam(0, 0, 0);
     plscmap0n(16);
@@ -311,22 +308,7 @@ done:
         plend1();
         plsstrm(old_stream);
     }
-    if (tmp) {
-        if (status == PHC_OK) {
-            if (!phc_plot_png_complete(tmp))
-                status = phc_error_set(err, PHC_ERR_IO,
-                                       "%s: PLplot did not write a complete "
-                                       "PNG file (disk full?)", path);
-            else if (rename(tmp, path) != 0)
-                status = phc_error_set(err, PHC_ERR_IO,
-                                       "%s: cannot rename the temporary "
-                                       "plot file into place: %s", path,
-                                       strerror(errno));
-        }
-        if (status != PHC_OK)
-            unlink(tmp);
-        free(tmp);
-    }
+    status = phc_plot_file_finish(af, status, err);
     free(img[0]);
     free(img);
     free(t_title);

@@ -16,10 +16,11 @@
  *   PHC_PLANT_FORMAT_SWC      SWC skeletons (`id type x y z radius parent`,
  *                             parent -1 = root; a segment runs from the parent
  *                             sample to the sample; micrometres by default).
- *   PHC_PLANT_FORMAT_NATIVE   phytocal's documented CSV (see plant_io.c and the
- *                             README): header `id,parent,radius,length,x_head,
- *                             y_head,z_head,x_tail,y_tail,z_tail,leaf,fixed`,
- *                             optional first line `# unit: m` (or cm, mm, um).
+ *   PHC_PLANT_FORMAT_NATIVE   phytocal's documented CSV (see plant_io_native.c
+ *                             and the README): header `id,parent,radius,length,
+ *                             x_head,y_head,z_head,x_tail,y_tail,z_tail,leaf,
+ *                             fixed`, optional first line `# unit: m` (or cm,
+ *                             mm, um).
  *   PHC_PLANT_FORMAT_AUTO     by extension: .swc SWC, .csv native, a file whose
  *                             first line starts with `verts` paper, otherwise
  *                             TreeQSM when it has 15 or 16 tab-separated

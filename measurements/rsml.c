@@ -7,13 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <libxml/parser.h>
 #include <libxml/tree.h>
 #include <libxml/xmlerror.h>
 #include <libxml/xmlwriter.h>
 
+#include "measurements/atomic_file.h"
 #include "measurements/c_number.h"
 
 /* ---- the in-memory document ---------------------------------------------- */
@@ -1005,8 +1005,8 @@ int phc_rsml_write(const phc_rsml *r, const char *path, phc_error *err)
 {
     size_t *links = NULL, *plant_first, *plant_last, *child_first, *child_last, *next, *cursor;
     size_t i, n_links;
-    char *tmp = NULL;
-    FILE *f = NULL;
+    phc_atomic_file *af = NULL;
+    FILE *f;
     xmlTextWriterPtr w = NULL;
     xmlOutputBufferPtr out;
     phc_c_numeric numeric;
@@ -1045,18 +1045,9 @@ int phc_rsml_write(const phc_rsml *r, const char *path, phc_error *err)
         *last = i;
     }
 
-    tmp = malloc(strlen(path) + 5);
-    if (!tmp) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+    if ((rc = phc_atomic_file_open(path, &af, err)))
         goto fail;
-    }
-    strcpy(tmp, path);
-    strcat(tmp, ".tmp");
-    f = fopen(tmp, "wb");
-    if (!f) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot create: %s", tmp, strerror(errno));
-        goto fail;
-    }
+    f = phc_atomic_file_stream(af);
     xmlInitParser();
     out = xmlOutputBufferCreateFile(f, NULL); /* flushes f on close, does not fclose it */
     if (!out || !(w = xmlNewTextWriter(out))) {
@@ -1072,33 +1063,21 @@ int phc_rsml_write(const phc_rsml *r, const char *path, phc_error *err)
         phc_c_numeric_end(&numeric);
     xmlFreeTextWriter(w); /* flushes and closes the output buffer */
     w = NULL;
-    if (body < 0 || fflush(f) != 0 || ferror(f) || fsync(fileno(f)) != 0) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: write failed: %s", tmp,
+    if (body < 0) {
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: write failed: %s", path,
                            errno ? strerror(errno) : "libxml2 writer error");
         goto fail;
     }
-    if (fclose(f) != 0) {
-        f = NULL;
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: write failed: %s", tmp, strerror(errno));
+    rc = phc_atomic_file_commit(af, err); /* stream errors, fsync, rename */
+    af = NULL;
+    if (rc)
         goto fail;
-    }
-    f = NULL;
-    if (rename(tmp, path) != 0) {
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot rename %s into place: %s", path, tmp,
-                           strerror(errno));
-        goto fail;
-    }
-    free(tmp);
     free(links);
     return PHC_OK;
 fail:
     if (w)
         xmlFreeTextWriter(w);
-    if (f)
-        fclose(f);
-    if (tmp)
-        remove(tmp);
-    free(tmp);
+    phc_atomic_file_abort(af);
     free(links);
     return rc;
 }

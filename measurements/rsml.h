@@ -121,7 +121,8 @@ int phc_rsml_read_with(const char *path, const phc_rsml_read_options *options, p
  * UTC ISO 8601 time, software "phytocal"; one <plant> per plant; laterals
  * nested in their parent; numbers as the shortest decimal that reads back
  * to the same double; a diameter function when diameter != NULL).  Writes
- * PATH.tmp, then renames it to PATH: never leaves a partial file at PATH.
+ * a temporary file next to PATH, then renames it to PATH (atomic_file.h):
+ * never leaves a partial file at PATH.
  * PHC_ERR_INVALID for an inconsistent document (parent not earlier or on
  * another plant, plant out of range, dimension not 2 or 3, resolution not
  * finite and positive), PHC_ERR_IO when writing fails. */

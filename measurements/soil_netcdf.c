@@ -6,17 +6,16 @@
 #include "measurements/soil_netcdf.h"
 
 #include <ctype.h>
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <netcdf.h>
+
+#include "measurements/atomic_file.h"
 
 /* Largest chunk of a time-dependent variable (bytes).  One frame per chunk
  * when it fits: appending then writes whole chunks, and readers that take
@@ -30,7 +29,7 @@
 struct phc_soil_nc {
     int ncid;          /* -1 once closed */
     char *path;        /* final name */
-    char *tmp_path;    /* name written until close */
+    phc_atomic_file *af; /* the file until close (atomic_file.h) */
     size_t nx, ny, nz;
     int with_nutrient;
     int var_time, var_water, var_nutrient;
@@ -326,42 +325,27 @@ int phc_soil_nc_create(const char *path, const phc_soil_nc_grid *g,
     nc->with_nutrient = g->with_nutrient != 0;
     nc->var_nutrient = -1;
     nc->path = dup_string(path);
-    size_t tlen = strlen(path) + 48;
-    nc->tmp_path = malloc(tlen);
     char *units = malloc((start_iso ? strlen(start_iso) : 0) + 64);
-    if (!nc->path || !nc->tmp_path || !units) {
+    if (!nc->path || !units) {
         status = phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
         goto fail;
     }
-    /* The temporary name is claimed with O_EXCL first: that gives the
-     * system's own reason when the directory is missing or not writable
-     * (HDF5's failure maps to a misleading "Permission denied"), and never
-     * overwrites a file that is not ours.  nc_create then replaces our empty
-     * file. */
+    /* The temporary file is created first (atomic_file.h, with O_EXCL):
+     * that gives the system's own reason when the directory is missing or
+     * not writable (HDF5's failure maps to a misleading "Permission
+     * denied"), and never overwrites a file that is not ours.  nc_create
+     * then replaces our empty file. */
+    if ((status = phc_atomic_file_open(path, &nc->af, err)))
+        goto fail;
     {
-        int saved = 0, fd = -1;
-        for (int i = 0; i < 100 && fd < 0; ++i) {
-            snprintf(nc->tmp_path, tlen, "%s.%ld.%d.tmp", path,
-                     (long)getpid(), i);
-            fd = open(nc->tmp_path, O_WRONLY | O_CREAT | O_EXCL, 0666);
-            saved = errno;
-            if (fd < 0 && saved != EEXIST)
-                break;
-        }
-        if (fd < 0) {
-            status = phc_error_set(err, PHC_ERR_IO, "%s: cannot create the "
-                                   "NetCDF file: %s", path, strerror(saved));
-            goto fail;
-        }
-        close(fd);
-        int rc = nc_create(nc->tmp_path, NC_NETCDF4 | NC_CLOBBER, &nc->ncid);
+        const char *tmp = phc_atomic_file_temp_path(nc->af);
+        int rc = nc_create(tmp, NC_NETCDF4 | NC_CLOBBER, &nc->ncid);
         if (rc != NC_NOERR) {
             nc->ncid = -1;
-            unlink(nc->tmp_path);
             status = phc_error_set(err, PHC_ERR_IO,
                                    "%s: cannot create the NetCDF file "
                                    "(temporary name %s): %s", path,
-                                   nc->tmp_path, nc_strerror(rc));
+                                   tmp, nc_strerror(rc));
             goto fail;
         }
     }
@@ -499,12 +483,10 @@ int phc_soil_nc_create(const char *path, const phc_soil_nc_grid *g,
 
 fail:
     free(units);
-    if (nc->ncid >= 0) {
+    if (nc->ncid >= 0)
         nc_close(nc->ncid);
-        unlink(nc->tmp_path);
-    }
+    phc_atomic_file_abort(nc->af);
     free(nc->path);
-    free(nc->tmp_path);
     free(nc);
     return status;
 }
@@ -579,19 +561,20 @@ int phc_soil_nc_close(phc_soil_nc *nc, phc_error *err)
     if (nc->ncid >= 0) {
         int rc = nc_close(nc->ncid);
         nc->ncid = -1;
-        if (rc != NC_NOERR)
+        if (rc != NC_NOERR) {
             status = phc_error_set(err, PHC_ERR_IO,
                                    "%s: NetCDF: closing the temporary file "
                                    "%s (left in place): %s", path,
-                                   nc->tmp_path, nc_strerror(rc));
-        else if (rename(nc->tmp_path, path) != 0)
-            status = phc_error_set(err, PHC_ERR_IO,
-                                   "%s: cannot rename the temporary file %s "
-                                   "into place (left in place): %s", path,
-                                   nc->tmp_path, strerror(errno));
+                                   phc_atomic_file_temp_path(nc->af),
+                                   nc_strerror(rc));
+            phc_atomic_file_leave(nc->af);
+        } else {
+            status = phc_atomic_file_commit(nc->af, err);
+        }
+    } else {
+        phc_atomic_file_abort(nc->af);
     }
     free(nc->path);
-    free(nc->tmp_path);
     free(nc);
     return status;
 }

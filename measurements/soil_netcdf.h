@@ -27,7 +27,8 @@
  * departs from height above the ellipsoid by x^2/(2 R) ~ 8 mm at 300 m).
  *
  * The file is written under a temporary name next to `path`
- * (path.<pid>.<n>.tmp, claimed with O_EXCL) and renamed to `path` by phc_soil_nc_close (DESIGN §3):
+ * (path.tmp-XXXXXX, claimed with O_EXCL: measurements/atomic_file.h) and
+ * renamed to `path` by phc_soil_nc_close (DESIGN §3):
  * a run that dies leaves no half-written file under the final name.
  * An existing file at `path` is replaced at close.
  *
@@ -94,8 +95,10 @@ int phc_soil_nc_append(phc_soil_nc *nc, double t_hours, const double *water,
 size_t phc_soil_nc_frames(const phc_soil_nc *nc);
 
 /* Closes the file, renames it to its final path and frees the writer, also
- * when it fails (then the temporary file is left in place for inspection
- * and the message names it).  Accepts NULL. */
+ * when it fails.  When netCDF cannot close the file, the temporary file is
+ * left in place for inspection and the message names it; when the finished
+ * file cannot be flushed or renamed into place, it is removed and an earlier
+ * file at `path` stays.  Accepts NULL. */
 int phc_soil_nc_close(phc_soil_nc *nc, phc_error *err);
 
 #ifdef __cplusplus

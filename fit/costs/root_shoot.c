@@ -11,6 +11,7 @@
 #include "fit/costs/source_file.h"
 #include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "fit/growth_outputs.h"
+#include "measurements/atomic_file.h"
 #include "measurements/baad.h"
 #include "measurements/table.h"
 #include "measurements/units.h"
@@ -340,18 +341,13 @@ static int rs_outputs(phc_dataset *ds, const double *p, const char *dir, const c
     }
     snprintf(path, cap, "%s/%s_trajectory.csv", dir, base);
     {
-        char tmp[4200];
-        snprintf(tmp, sizeof tmp, "%s.tmp", path);
-        FILE *f = fopen(tmp, "w");
-        if (!f) { rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", tmp); goto done; }
+        phc_atomic_file *af = NULL;
+        if ((rc = phc_atomic_file_open(path, &af, err))) goto done;
+        FILE *f = phc_atomic_file_stream(af);
         fprintf(f, "age_d,basal_diameter_mm,ln_root_shoot\n");
         for (size_t i = 0; i < tr.m; ++i)
             fprintf(f, "%.6g,%.6g,%.6g\n", tr.t[i], tr.d[i] * 1e3, tr.lrs[i]);
-        if (ferror(f) | (fclose(f) != 0) || rename(tmp, path) != 0) {
-            remove(tmp);
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
-            goto done;
-        }
+        if ((rc = phc_atomic_file_commit(af, err))) goto done;
     }
 done:
     free(path);

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "fit/soil_plots.h"
+#include "measurements/atomic_file.h"
 #include "measurements/soil_netcdf.h"
 
 typedef struct fields_ctx {
@@ -100,15 +101,12 @@ int phc_soil_write_fields(const phc_soil_setup *su, const double *p, double t_en
     if (!rc) {
         char *md = phc_soil_setup_markdown(su, p, s);
         snprintf(path, sizeof path, "%s/%s_budget.md", dir, base);
-        FILE *f = md ? fopen(path, "w") : NULL;
+        phc_atomic_file *af = NULL;
         if (!md)
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        else if (!f)
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
-        else {
-            fprintf(f, "# %s: soil set-up and water budget\n\n%s", name, md);
-            if (ferror(f) | (fclose(f) != 0))
-                rc = phc_error_set(err, PHC_ERR_IO, "%s: write failed", path);
+        else if (!(rc = phc_atomic_file_open(path, &af, err))) {
+            fprintf(phc_atomic_file_stream(af), "# %s: soil set-up and water budget\n\n%s", name, md);
+            rc = phc_atomic_file_commit(af, err);
         }
         free(md);
     }

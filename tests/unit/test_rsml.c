@@ -1,6 +1,7 @@
 /* Unit tests for measurements/rsml.c: building, writing and reading RSML,
  * lengths and orders, and the messages of malformed files. */
 #include <fcntl.h>
+#include <glob.h>
 #include <locale.h>
 #include <math.h>
 #include <stdint.h>
@@ -55,6 +56,18 @@ static int file_exists(const char *path)
 {
     struct stat st;
     return stat(path, &st) == 0;
+}
+
+/* 1 when a writer left a temporary file for path (PATH.tmp-XXXXXX). */
+static int temp_left(const char *path)
+{
+    char pattern[600];
+    glob_t gl;
+    int found;
+    snprintf(pattern, sizeof pattern, "%s.tmp*", path);
+    found = glob(pattern, 0, NULL, &gl) == 0 && gl.gl_pathc > 0;
+    globfree(&gl);
+    return found;
 }
 
 static int same_bits(const double *a, const double *b, size_t n)
@@ -140,7 +153,6 @@ static void test_roundtrip(void)
     phc_error err;
     phc_rsml *r = build_document(), *back = NULL;
     const char *path = tmp_path("two_plants.rsml");
-    char tmp[300];
     int rc;
     CHECK(r != NULL);
     if (!r)
@@ -149,8 +161,7 @@ static void test_roundtrip(void)
     CHECK(rc == 0);
     if (rc)
         fprintf(stderr, "%s\n", err.message);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    CHECK(!file_exists(tmp));
+    CHECK(!temp_left(path));
     rc = phc_rsml_read(path, &back, &err);
     CHECK(rc == 0);
     if (rc)
@@ -307,7 +318,7 @@ static void test_bad_arguments(void)
         CHECK(!strcmp(buf, "previous content\n"));
         /* A directory that does not exist: an I/O error, nothing left. */
         CHECK(phc_rsml_write(r2, "/nonexistent_dir_phc/x.rsml", &err) == PHC_ERR_IO);
-        CHECK_STR_CONTAINS(err.message, "/nonexistent_dir_phc/x.rsml.tmp");
+        CHECK_STR_CONTAINS(err.message, "/nonexistent_dir_phc/x.rsml: cannot open for writing");
     }
     phc_rsml_free(r2);
 }
