@@ -8,10 +8,8 @@
 #include <string.h>
 
 #include "fit/costs/curve.h"
-#include "fit/costs/elasticity_curve.h"
 #include "fit/costs/infiltration.h"
 #include "fit/costs/leaf_photos.h"
-#include "fit/costs/pv_curve.h"
 #include "fit/costs/root_shoot.h"
 #include "fit/costs/soil_probe.h"
 #include "fit/costs/soil_setup.h"
@@ -26,14 +24,6 @@
 /* The data-set kinds this build knows, alphabetical: each descriptor
  * (fit/config/kind.h) holds the name, summary, keys and their help, the
  * operations and the YAML translation. */
-static const phc_kind elasticity_curve_kind = {
-    .config = {.name = "elasticity_curve",
-               .summary = "bulk moduli against water content -> the logistic elasticity " "kappa, chi0, e_min, e_max (wilting eq. 9)",
-               .keys = phc_elasticity_curve_keys,
-               .help = phc_elasticity_curve_help},
-    .load_yaml = phc_elasticity_curve_load,
-};
-
 static const phc_kind infiltration_kind = {
     .config = {.name = "infiltration",
                .summary = "the depth reached by a fraction of the applied rain over time -> soil " "permeability p and capacity c (Rhizomorph §6, Fig. 7)",
@@ -48,14 +38,6 @@ static const phc_kind leaf_photos_kind = {
                .keys = phc_leaf_photos_keys,
                .help = phc_leaf_photos_help},
     .load_yaml = phc_leaf_photos_load,
-};
-
-static const phc_kind pv_curve_kind = {
-    .config = {.name = "pv_curve",
-               .summary = "pressure-volume data (water potential and mass along a bench dry-down) -> " "PV traits per leaf and the logistic elasticity (wilting eq. 9)",
-               .keys = phc_pv_curve_keys,
-               .help = phc_pv_curve_help},
-    .load_yaml = phc_pv_curve_load,
 };
 
 static const phc_kind root_shoot_kind = {
@@ -84,10 +66,10 @@ static const phc_kind weight_curve_kind = {
 
 static const phc_kind *const kinds[] = {
     &phc_curve_kind,
-    &elasticity_curve_kind,
+    &phc_elasticity_curve_kind,
     &infiltration_kind,
     &leaf_photos_kind,
-    &pv_curve_kind,
+    &phc_pv_curve_kind,
     &root_shoot_kind,
     &soil_probe_kind,
     &weight_curve_kind,

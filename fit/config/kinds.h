@@ -6,5 +6,7 @@
 #include "fit/config/kind.h"
 
 extern const phc_kind phc_curve_kind;
+extern const phc_kind phc_elasticity_curve_kind;
+extern const phc_kind phc_pv_curve_kind;
 
 #endif /* PHC_CONFIG_KINDS_H */

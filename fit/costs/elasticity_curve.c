@@ -7,27 +7,8 @@
 #include <string.h>
 
 #include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
-#include "measurements/suggest.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"
-
-const char *const phc_elasticity_curve_keys[] = {"file", "water", "water_content", "modulus", "sigma",
-                                                 "x_label", "y_label", NULL};
-const phc_key_help phc_elasticity_curve_help[] = {
-    {"file", "CSV table of the measurements, relative to the config file. Required."},
-    {"water", "Column of water contents. Required."},
-    {"water_content", "What the water column holds: rwc (relative water content as a fraction "
-                      "0 to 1; values above 1.5 are refused as probably percent) or absolute "
-                      "(water in any unit, >= 0; chi0 then has that unit and kappa its "
-                      "inverse). Required."},
-    {"modulus", "Column of bulk moduli of elasticity, MPa. Required."},
-    {"sigma", "A positive number (MPa) or the name of a column of per-point sigmas. "
-              "Default: unweighted."},
-    {"x_label", "Axis label of the water content. Default: \"relative water content (RWC)\" "
-                "or \"water content (COLUMN)\"."},
-    {"y_label", "Axis label of the modulus. Default: \"bulk modulus of elasticity (MPa)\"."},
-    {NULL, NULL}};
 
 static const char *const slot_base[PHC_ELASTICITY_NPARAMS] = {"kappa", "chi0", "e_min", "e_max"};
 
@@ -107,127 +88,145 @@ nomem:
     return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
 }
 
-static const phc_dataset_ops elasticity_ops = {"elasticity_curve", phc_elasticity_predict,
-                                               phc_elasticity_predict_at, phc_elasticity_impl_free, NULL, NULL, NULL,
-                                               NULL};
+const phc_dataset_ops phc_elasticity_curve_ops = {.kind = "elasticity_curve",
+                                                  .predict = phc_elasticity_predict,
+                                                  .predict_at = phc_elasticity_predict_at,
+                                                  .free_impl = phc_elasticity_impl_free};
 
-
-int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                              const char *base_dir, phc_is_parameter_fn is_parameter,
-                              void *user_data, phc_dataset **out, phc_error *err)
+phc_elasticity_curve_options phc_elasticity_curve_options_default(void)
 {
-    (void)is_parameter;
-    (void)user_data;
-    const char *ctx = "elasticity_curve data set";
-    const char *file = NULL, *water = NULL, *content = NULL, *modulus = NULL;
-    const char *x_label = NULL, *y_label = NULL;
-    phc_table *table = NULL;
+    phc_elasticity_curve_options o = {0};
+    return o;
+}
+
+#define WHERE(key) phc_origin_key(opt->origin, "elasticity_curve", key).text
+
+/* The options alone, before any data: what is required, and sigma. */
+static int check_options(const phc_elasticity_curve_options *opt, phc_error *err)
+{
+    static const char *const names[] = {"water", "modulus"};
+    const char *const given[] = {opt->water, opt->modulus};
+    for (int i = 0; i < 2; ++i)
+        if (!given[i] || !given[i][0])
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s' is required", WHERE(NULL), names[i]);
+    if (opt->water_content != PHC_WATER_CONTENT_RWC && opt->water_content != PHC_WATER_CONTENT_ABSOLUTE)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'water_content': expected rwc or absolute%s",
+                             WHERE("water_content"), opt->water_content ? "" : " (it is required)");
+    if (opt->sigma_column && opt->sigma != 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': give a number or a column, not both",
+                             WHERE("sigma"));
+    if (!opt->sigma_column && !(opt->sigma >= 0 && isfinite(opt->sigma)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': expected a positive number (MPa), found %g",
+                             WHERE("sigma"), opt->sigma);
+    return PHC_OK;
+}
+
+/* A column named by option `key` that the table lacks. */
+static int need_column(const phc_elasticity_curve_options *opt, const char *key, const char *name,
+                       const phc_table *t, phc_error *err)
+{
+    if (phc_table_find(t, name) >= 0)
+        return PHC_OK;
+    char what[64];
+    snprintf(what, sizeof what, "key '%s':", key);
+    return phc_unknown_column_at(WHERE(key), what, name, t, err);
+}
+
+/* The water and modulus columns as numbers, the water contents checked
+ * against what they are said to be; *wx and *my are malloc'd. */
+static int read_columns(const phc_table *table, const phc_elasticity_curve_options *opt, double **wx,
+                        double **my, phc_error *err)
+{
+    const char *path = phc_table_source(table), *water = opt->water;
+    const int is_rwc = opt->water_content == PHC_WATER_CONTENT_RWC;
+    int rc;
+    if ((rc = need_column(opt, "water", water, table, err)) ||
+        (rc = need_column(opt, "modulus", opt->modulus, table, err)) ||
+        (rc = phc_table_column_numbers(table, water, wx, err)) ||
+        (rc = phc_table_column_numbers(table, opt->modulus, my, err)))
+        return rc;
+    const double *w = *wx;
+    for (size_t i = 0; i < phc_table_rows(table); ++i) {
+        if (is_rwc && !(w[i] >= 0 && w[i] <= 1.5))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: column '%s': relative water content must be a fraction in [0, 1.5], found %g%s",
+                                 path, phc_table_row_line(table, i), water, w[i],
+                                 w[i] > 1.5 ? " (percent? divide by 100)" : "");
+        if (!is_rwc && !(w[i] >= 0))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': water content must not be negative, found %g",
+                                 path, phc_table_row_line(table, i), water, w[i]);
+    }
+    return PHC_OK;
+}
+
+/* ds->sigma from the options: a column (every value > 0), one number, or
+ * none (unweighted). */
+static int set_sigma(phc_dataset *ds, const phc_table *table, const phc_elasticity_curve_options *opt,
+                     phc_error *err)
+{
+    const char *col = opt->sigma_column;
+    int rc;
+    if (col) {
+        if (phc_table_find(table, col) < 0)
+            return phc_unknown_column_at(WHERE("sigma"), "sigma", col, table, err);
+        if ((rc = phc_table_column_numbers(table, col, &ds->sigma, err)))
+            return rc;
+        for (size_t i = 0; i < ds->n; ++i)
+            if (!(ds->sigma[i] > 0))
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
+                                     phc_table_source(table), phc_table_row_line(table, i), col, ds->sigma[i]);
+    } else if (opt->sigma > 0) {
+        if (!(ds->sigma = malloc(ds->n * sizeof *ds->sigma)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t i = 0; i < ds->n; ++i)
+            ds->sigma[i] = opt->sigma;
+    }
+    return PHC_OK;
+}
+
+int phc_elasticity_curve_new(const phc_table *table, const phc_elasticity_curve_options *opt,
+                             phc_dataset **out, phc_error *err)
+{
     phc_dataset *ds = NULL;
     double *wx = NULL, *my = NULL;
-    char *path = NULL;
     int rc;
     *out = NULL;
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "water", 1, ctx, &water, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "water_content", 1, ctx, &content, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "modulus", 1, ctx, &modulus, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
+    if (!table || !opt)
+        return phc_error_set(err, PHC_ERR_INVALID, "elasticity_curve: a table and options are required");
+    if ((rc = check_options(opt, err)))
         return rc;
-    int is_rwc;
-    if (strcmp(content, "rwc") == 0)
-        is_rwc = 1;
-    else if (strcmp(content, "absolute") == 0)
-        is_rwc = 0;
-    else
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'water_content': expected rwc or absolute, found '%s'",
-                             doc->path, phc_key_line(node, "water_content"), content);
-    if (!(path = phc_join_path(base_dir, file)))
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
-    }
+    const char *path = phc_table_source(table);
     const size_t n = phc_table_rows(table);
-    if (n == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
-        goto fail;
-    }
-    if ((rc = phc_need_column(doc, node, "water", water, table, err)) ||
-        (rc = phc_need_column(doc, node, "modulus", modulus, table, err)) ||
-        (rc = phc_table_column_numbers(table, water, &wx, err)) ||
-        (rc = phc_table_column_numbers(table, modulus, &my, err)))
-        goto fail;
-    for (size_t i = 0; i < n; ++i) {
-        if (is_rwc && !(wx[i] >= 0 && wx[i] <= 1.5)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: column '%s': relative water content must be a fraction in [0, 1.5], found %g%s",
-                               path, phc_table_row_line(table, i), water, wx[i],
-                               wx[i] > 1.5 ? " (percent? divide by 100)" : "");
-            goto fail;
-        }
-        if (!is_rwc && !(wx[i] >= 0)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': water content must not be negative, found %g",
-                               path, phc_table_row_line(table, i), water, wx[i]);
-            goto fail;
-        }
-    }
-    if ((rc = phc_elasticity_dataset_new(&elasticity_ops, n, 1, NULL, &ds, err)))
+    if (n == 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
+    if ((rc = read_columns(table, opt, &wx, &my, err)) ||
+        (rc = phc_elasticity_dataset_new(&phc_elasticity_curve_ops, n, 1, NULL, &ds, err)))
         goto fail;
     memcpy(ds->x, wx, n * sizeof *wx);
     memcpy(ds->y, my, n * sizeof *my);
     for (size_t i = 0; i < n; ++i)
         ds->data_lines[i] = phc_table_row_line(table, i);
-    const phc_yaml_node *sig = phc_yaml_get(node, "sigma");
-    if (sig) {
-        if (sig->kind == PHC_YAML_SCALAR && phc_table_find(table, sig->scalar) >= 0) {
-            if ((rc = phc_table_column_numbers(table, sig->scalar, &ds->sigma, err)))
-                goto fail;
-            for (size_t i = 0; i < n; ++i)
-                if (!(ds->sigma[i] > 0)) {
-                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
-                                       path, phc_table_row_line(table, i), sig->scalar, ds->sigma[i]);
-                    goto fail;
-                }
-        } else {
-            double s = 0;
-            if ((rc = phc_yaml_number(doc, sig, "sigma", &s, err)) || !(s > 0)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT,
-                                   "%s:%zu: key 'sigma': expected a positive number (MPa) or a column of %s, found '%s'",
-                                   doc->path, sig->line, path,
-                                   sig->kind == PHC_YAML_SCALAR ? sig->scalar : "(not a scalar)");
-                goto fail;
-            }
-            if (!(ds->sigma = malloc(n * sizeof *ds->sigma))) {
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
-            for (size_t i = 0; i < n; ++i)
-                ds->sigma[i] = s;
-        }
-    }
+    if ((rc = set_sigma(ds, table, opt, err)))
+        goto fail;
     char xl[256];
-    if (is_rwc)
+    if (opt->water_content == PHC_WATER_CONTENT_RWC)
         snprintf(xl, sizeof xl, "relative water content (RWC)");
     else
-        snprintf(xl, sizeof xl, "water content (%s)", water);
-    ds->x_label = strdup(x_label ? x_label : xl);
-    ds->y_label = strdup(y_label ? y_label : "bulk modulus of elasticity (MPa)");
+        snprintf(xl, sizeof xl, "water content (%s)", opt->water);
+    ds->x_label = strdup(opt->x_label ? opt->x_label : xl);
+    ds->y_label = strdup(opt->y_label ? opt->y_label : "bulk modulus of elasticity (MPa)");
     ds->data_file = strdup(path);
-    if (!ds->x_label || !ds->y_label || !ds->data_file || phc_dataset_add_input(ds, path)) {
+    if (!ds->x_label || !ds->y_label || !ds->data_file) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    ds->config_line = node->line;
+    ds->config_line = phc_origin_line(opt->origin, NULL);
     *out = ds;
     ds = NULL;
     rc = PHC_OK;
 fail:
     phc_dataset_free(ds);
-    phc_table_free(table);
     free(wx);
     free(my);
-    free(path);
     return rc;
 }

@@ -2,17 +2,10 @@
  * (eq. 9, model/elasticity.h) fitted to bulk moduli measured against water
  * content:  E(θ) = e_min + e_max · σ(kappa · (θ − chi0)).
  *
- * Config keys (besides the common data-set keys of fit/config.h):
- *   file:          CSV file, relative to the config file
- *   water:         column of water contents θ
- *   water_content: rwc | absolute — what the water column holds: relative
- *                  water content as a fraction (0..1; values above 1.5 are
- *                  refused as probably percent) or absolute water (any unit,
- *                  ≥ 0; chi0 then has that unit and kappa its inverse)
- *   modulus:       column of bulk moduli, MPa
- *   sigma:         a positive number (MPa) or a column of per-point sigmas;
- *                  absent = unweighted
- *   x_label, y_label: axis labels (defaults name the quantity and unit)
+ * Built in C with phc_elasticity_curve_new from a table (measurements/
+ * table.h: read from a CSV file, or phc_table_from_columns for arrays) and
+ * options; the config's `kind: elasticity_curve` mapping is translated into
+ * the same options by fit/config/elasticity_curve_yaml.c.
  *
  * Parameter slots: kappa, chi0, e_min, e_max, bound by default to the global
  * parameters of the same names.  Derivatives are analytic.
@@ -22,19 +15,51 @@
 #ifndef PHC_COSTS_ELASTICITY_CURVE_H
 #define PHC_COSTS_ELASTICITY_CURVE_H
 
-#include "fit/config_help.h"
-#include "fit/costs/curve.h"
+#include "fit/costs/origin.h"
 #include "fit/dataset.h"
-#include "measurements/yaml_doc.h"
+#include "measurements/table.h"
 #include "model/status.h"
 
-extern const char *const phc_elasticity_curve_keys[];
-/* Help on each of those keys (fit/config_help.h). */
-extern const phc_key_help phc_elasticity_curve_help[];
+/* What the water column holds. */
+typedef enum phc_water_content {
+    PHC_WATER_CONTENT_UNSET = 0, /* not given: an error (the two read very differently) */
+    PHC_WATER_CONTENT_RWC,       /* relative water content, a fraction 0..1 (values
+                                    above 1.5 are refused as probably percent) */
+    PHC_WATER_CONTENT_ABSOLUTE   /* absolute water in any unit, >= 0; chi0 then has
+                                    that unit and kappa its inverse */
+} phc_water_content;
 
-int phc_elasticity_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                              const char *base_dir, phc_is_parameter_fn is_parameter,
-                              void *user_data, phc_dataset **out, phc_error *err);
+typedef struct phc_elasticity_curve_options {
+    const char *water;               /* column of water contents θ (required) */
+    phc_water_content water_content; /* what that column holds (required) */
+    const char *modulus;             /* column of bulk moduli, MPa (required) */
+    double sigma;                    /* > 0: one standard deviation for every point, MPa */
+    const char *sigma_column;        /* or a column of per-point standard deviations, MPa;
+                                        neither = unweighted */
+    const char *x_label;             /* NULL: "relative water content (RWC)" or
+                                        "water content (<water>)" */
+    const char *y_label;             /* NULL: "bulk modulus of elasticity (MPa)" */
+    const phc_origin *origin;        /* where the options came from, for messages; NULL */
+} phc_elasticity_curve_options;
+
+/* Everything unset: water_content PHC_WATER_CONTENT_UNSET, no sigma, no
+ * labels, no origin. */
+phc_elasticity_curve_options phc_elasticity_curve_options_default(void);
+
+/* Builds an elasticity_curve data set over the rows of `table` (copied; the
+ * table may be freed afterwards): x the water contents, y the moduli, slots
+ * kappa, chi0, e_min, e_max; parameter indices are left to phc_problem
+ * binding (phc_problem_bind_by_name).  Errors name the option (and the
+ * config line when options.origin is set), or the table's source, line and
+ * column: PHC_ERR_INPUT for a missing option, an unknown column, a value that
+ * is not a number, a relative water content outside [0, 1.5], a negative
+ * absolute water content or a sigma that is not positive. */
+int phc_elasticity_curve_new(const phc_table *table, const phc_elasticity_curve_options *options,
+                             phc_dataset **out, phc_error *err);
+
+/* The operations of elasticity_curve data sets (ops->kind is
+ * "elasticity_curve"). */
+extern const phc_dataset_ops phc_elasticity_curve_ops;
 
 /* Shared with pv_curve: the implementation behind a logistic-elasticity data
  * set.  Observations belong to blocks of 4 slots (kappa, chi0, e_min, e_max

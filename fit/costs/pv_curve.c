@@ -1,9 +1,6 @@
 /* `pv_curve` data sets: see pv_curve.h. */
 #include "fit/costs/pv_curve.h"
 
-#include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
-
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,36 +8,11 @@
 #include <strings.h>
 
 #include "fit/costs/elasticity_curve.h"
+#include "fit/costs/source_file.h"
 #include "fit/pv_plots.h"
 #include "measurements/suggest.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"
-
-const char *const phc_pv_curve_keys[] = {"file", "psi", "psi_unit", "fresh_mass", "bag_mass", "dry_mass",
-                                         "saturated_mass", "group", "leaf", "breakpoint", "sigma", NULL};
-const phc_key_help phc_pv_curve_help[] = {
-    {"file", "CSV table of the pressure-volume points, at least 6 per leaf, relative to the "
-             "config file. Required."},
-    {"psi", "Column of water potentials, every value < 0 (enter pressure-chamber balance "
-            "pressures with a minus sign). Required."},
-    {"psi_unit", "Unit of psi: MPa, bar or kPa (case ignored). Default: MPa."},
-    {"fresh_mass", "Column of weighed masses, g: the leaf, or the leaf in its bag when bag_mass "
-                   "is given. Required."},
-    {"bag_mass", "A column or a number, g, subtracted from fresh_mass (the bagged-leaf "
-                 "protocol). Default: none."},
-    {"dry_mass", "A column or a number, g, below every leaf mass. Required."},
-    {"saturated_mass", "The turgid leaf mass, g: a column or a number; or extrapolate (the "
-                       "saturated water from psi against leaf water at psi = 0 over the wettest "
-                       "3 to 5 points). Required."},
-    {"group", "Column of leaf ids, for a table of several leaves. Default: one leaf."},
-    {"leaf", "With group: one leaf id, each (one logistic per leaf: slots kappa_<id>, "
-             "chi0_<id>, e_min_<id>, e_max_<id>) or pooled (one logistic for all leaves). "
-             "Required when the group column holds more than one id."},
-    {"breakpoint", "How the linear (osmotic) region is chosen: min_rss, max_r2, or a whole "
-                   "number >= 3 of driest points. Default: min_rss."},
-    {"sigma", "Standard deviation of the moduli, a positive number, MPa. "
-              "Default: unweighted."},
-    {NULL, NULL}};
 
 typedef struct pv_extra {
     size_t count;
@@ -72,13 +44,17 @@ static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, 
 static int pv_fit_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err);
 static int pv_name_series(phc_dataset *ds, phc_error *err);
 
-static const phc_dataset_ops pv_ops = {"pv_curve", phc_elasticity_predict, phc_elasticity_predict_at,
-                                       phc_elasticity_impl_free, pv_report_section, NULL, pv_fit_outputs,
-                                       pv_name_series};
+const phc_dataset_ops phc_pv_curve_ops = {.kind = "pv_curve",
+                                          .predict = phc_elasticity_predict,
+                                          .predict_at = phc_elasticity_predict_at,
+                                          .free_impl = phc_elasticity_impl_free,
+                                          .report_section = pv_report_section,
+                                          .fit_outputs = pv_fit_outputs,
+                                          .name_series = pv_name_series};
 
 static pv_extra *extra_of(const phc_dataset *ds)
 {
-    if (!ds || ds->ops != &pv_ops || !ds->impl)
+    if (!ds || ds->ops != &phc_pv_curve_ops || !ds->impl)
         return NULL;
     return ((const phc_elasticity_impl *)ds->impl)->extra;
 }
@@ -190,344 +166,379 @@ int phc_pv_curve_markdown(const phc_dataset *ds, char **out, phc_error *err)
     return PHC_OK;
 }
 
-/* ---- loading ------------------------------------------------------------- */
+/* ---- building a data set ------------------------------------------------- */
 
-
-/* A mass given as a column name or a number (g): n values in *values.
- * *extrapolate is set instead when allowed and the value is `extrapolate`. */
-static int mass_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, int required,
-                     const phc_table *t, int *extrapolate, double **values, phc_error *err)
+phc_pv_curve_options phc_pv_curve_options_default(void)
 {
-    const phc_yaml_node *v = phc_yaml_get(node, key);
-    const size_t n = phc_table_rows(t);
-    *values = NULL;
-    if (!v) {
-        if (!required)
-            return PHC_OK;
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: pv_curve data set: missing key '%s' (a column of %s or a number in g%s)",
-                             doc->path, node->line, key, phc_table_source(t),
-                             extrapolate ? ", or 'extrapolate'" : "");
-    }
-    if (v->kind != PHC_YAML_SCALAR || !v->scalar[0])
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': expected a column name or a number (g)",
-                             doc->path, v->line, key);
-    if (extrapolate && strcmp(v->scalar, "extrapolate") == 0) {
-        *extrapolate = 1;
-        return PHC_OK;
-    }
-    if (phc_table_find(t, v->scalar) >= 0)
-        return phc_table_column_numbers(t, v->scalar, values, err);
-    phc_error tmp;
-    double x;
-    phc_error_clear(&tmp);
-    if (phc_yaml_number(doc, v, key, &x, &tmp) != PHC_OK) {
-        int rc = phc_need_column(doc, node, key, v->scalar, t, err);
-        if (rc == PHC_ERR_INPUT)
-            strncat(err->message, " (nor a number)", sizeof err->message - strlen(err->message) - 1);
-        return rc;
-    }
-    if (!(x >= 0))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': a mass must not be negative, found %g", doc->path,
-                             v->line, key, x);
-    if (!(*values = malloc((n ? n : 1) * sizeof **values)))
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    for (size_t i = 0; i < n; ++i)
-        (*values)[i] = x;
+    const phc_pv_mass none = {NULL, NAN};
+    phc_pv_curve_options o = {0};
+    o.bag_mass = o.dry_mass = o.saturated_mass = none;
+    o.analysis = phc_pv_options_default();
+    return o;
+}
+
+#define WHERE(key) phc_origin_key(b->opt->origin, "pv_curve", key).text
+
+/* What phc_pv_curve_new works on, freed in one place (pv_build_free). */
+typedef struct pv_build {
+    const phc_table *t;
+    const phc_pv_curve_options *opt;
+    const char *path;  /* the table's source */
+    const char *unit;  /* of psi, as given */
+    double to_mpa;     /* psi in that unit -> MPa */
+    size_t n;          /* rows */
+    double *psi, *fresh, *bag, *dry, *sat; /* per row: MPa (after check_rows), g; bag, sat may be NULL */
+    size_t *gid;       /* per row: its leaf, an index into gname */
+    const char **gname; /* the n_groups leaf ids, in order of appearance */
+    size_t n_groups;
+    int each;          /* one logistic per leaf */
+    size_t only;       /* the one leaf chosen, or (size_t)-1: all */
+    size_t n_leaves;   /* analysed */
+    size_t *rows;      /* scratch: the rows of one leaf */
+    double *lpsi, *lrwc, *lwater; /* scratch: one leaf's points */
+    pv_extra *x;       /* the analyses, handed to the data set */
+} pv_build;
+
+static void pv_build_free(pv_build *b)
+{
+    pv_extra_free(b->x);
+    free(b->psi);
+    free(b->fresh);
+    free(b->bag);
+    free(b->dry);
+    free(b->sat);
+    free(b->gid);
+    free(b->gname);
+    free(b->rows);
+    free(b->lpsi);
+    free(b->lrwc);
+    free(b->lwater);
+}
+
+static int mass_given(const phc_pv_mass *m)
+{
+    return m->column || !isnan(m->value);
+}
+
+/* The options alone, before any data: what is required, psi_unit, the
+ * breakpoint rule, leaf without group, the masses given, sigma. */
+static int check_options(pv_build *b, phc_error *err)
+{
+    const phc_pv_curve_options *o = b->opt;
+    if (!o->psi || !o->psi[0])
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'psi' is required", WHERE(NULL));
+    if (!o->fresh_mass || !o->fresh_mass[0])
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'fresh_mass' is required", WHERE(NULL));
+    b->unit = o->psi_unit ? o->psi_unit : "MPa";
+    if (strcasecmp(b->unit, "MPa") == 0)
+        b->to_mpa = 1.0;
+    else if (strcasecmp(b->unit, "bar") == 0)
+        b->to_mpa = 0.1;
+    else if (strcasecmp(b->unit, "kPa") == 0)
+        b->to_mpa = 1e-3;
+    else
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'psi_unit': expected MPa, bar or kPa, found '%s'",
+                             WHERE("psi_unit"), b->unit);
+    if (o->analysis.min_points < 3)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: analysis.min_points must be at least 3, found %zu",
+                             WHERE(NULL), o->analysis.min_points);
+    if (o->analysis.rule == PHC_PV_BREAK_FIXED && o->analysis.n_osmotic < o->analysis.min_points)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'breakpoint': expected a whole number of points >= %zu, "
+                             "found %zu", WHERE("breakpoint"), o->analysis.min_points, o->analysis.n_osmotic);
+    if (o->leaf && !o->group)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'leaf' needs key 'group' (the column of leaf ids)",
+                             WHERE("leaf"));
+    if (!mass_given(&o->dry_mass))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'dry_mass' is required (a column or a number in g)",
+                             WHERE(NULL));
+    if (!mass_given(&o->saturated_mass) && !o->extrapolate_saturation)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'saturated_mass' is required (a column or a number in g, "
+                             "or extrapolate_saturation)", WHERE(NULL));
+    if (mass_given(&o->saturated_mass) && o->extrapolate_saturation)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'saturated_mass': give a mass or extrapolate, not both",
+                             WHERE("saturated_mass"));
+    if (!(o->sigma >= 0 && isfinite(o->sigma)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': expected a positive number (MPa), found %g",
+                             WHERE("sigma"), o->sigma);
     return PHC_OK;
 }
 
-int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                      phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
+/* A column named by option `key` that the table lacks. */
+static int need_column(const pv_build *b, const char *key, const char *name, phc_error *err)
 {
-    (void)is_parameter;
-    (void)user_data;
-    const char *ctx = "pv_curve data set";
-    const char *file = NULL, *psi_col = NULL, *unit = "MPa", *fresh_col = NULL, *group_col = NULL, *leaf = NULL;
-    const char *bp = NULL;
-    phc_table *t = NULL;
-    phc_dataset *ds = NULL;
-    pv_extra *x = NULL;
-    char *path = NULL;
-    double *psi = NULL, *fresh = NULL, *bag = NULL, *dry = NULL, *sat = NULL;
-    size_t *gid = NULL, n_groups = 0, *rows = NULL;
-    const char **gname = NULL;
-    double *lpsi = NULL, *lrwc = NULL, *lwater = NULL;
-    int extrapolate = 0, rc;
-    *out = NULL;
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "psi", 1, ctx, &psi_col, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "psi_unit", 0, ctx, &unit, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "fresh_mass", 1, ctx, &fresh_col, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "group", 0, ctx, &group_col, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "leaf", 0, ctx, &leaf, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "breakpoint", 0, ctx, &bp, err)))
-        return rc;
-    double to_mpa;
-    if (strcasecmp(unit, "MPa") == 0)
-        to_mpa = 1.0;
-    else if (strcasecmp(unit, "bar") == 0)
-        to_mpa = 0.1;
-    else if (strcasecmp(unit, "kPa") == 0)
-        to_mpa = 1e-3;
-    else
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'psi_unit': expected MPa, bar or kPa, found '%s'",
-                             doc->path, phc_key_line(node, "psi_unit"), unit);
-    phc_pv_options opt = phc_pv_options_default();
-    if (bp) {
-        char *end = NULL;
-        long m = strtol(bp, &end, 10);
-        if (strcmp(bp, "min_rss") == 0)
-            opt.rule = PHC_PV_BREAK_MIN_RSS;
-        else if (strcmp(bp, "max_r2") == 0)
-            opt.rule = PHC_PV_BREAK_MAX_R2;
-        else if (end != bp && *end == '\0' && m >= 3) {
-            opt.rule = PHC_PV_BREAK_FIXED;
-            opt.n_osmotic = (size_t)m;
-        } else
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: key 'breakpoint': expected min_rss, max_r2 or a whole number of points >= 3, "
-                                 "found '%s'", doc->path, phc_key_line(node, "breakpoint"), bp);
-    }
-    if (leaf && !group_col)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'leaf' needs key 'group' (the column of leaf ids)",
-                             doc->path, phc_key_line(node, "leaf"));
+    if (phc_table_find(b->t, name) >= 0)
+        return PHC_OK;
+    char what[64];
+    snprintf(what, sizeof what, "key '%s':", key);
+    return phc_unknown_column_at(WHERE(key), what, name, b->t, err);
+}
 
-    if (!(path = phc_join_path(base_dir, file)))
+/* A mass option as n values in *values (NULL when not given). */
+static int mass_values(const pv_build *b, const char *key, const phc_pv_mass *m, double **values, phc_error *err)
+{
+    int rc;
+    *values = NULL;
+    if (m->column) {
+        if ((rc = need_column(b, key, m->column, err)))
+            return rc;
+        return phc_table_column_numbers(b->t, m->column, values, err);
+    }
+    if (isnan(m->value))
+        return PHC_OK;
+    if (!(m->value >= 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s': a mass must not be negative, found %g", WHERE(key),
+                             key, m->value);
+    if (!isfinite(m->value))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s': a mass must be finite, found %g", WHERE(key), key,
+                             m->value);
+    if (!(*values = malloc((b->n ? b->n : 1) * sizeof **values)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &t, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
-    }
-    const size_t n = phc_table_rows(t);
-    if (n == 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
-        goto fail;
-    }
-    if ((rc = phc_need_column(doc, node, "psi", psi_col, t, err)) ||
-        (rc = phc_need_column(doc, node, "fresh_mass", fresh_col, t, err)) ||
-        (group_col && (rc = phc_need_column(doc, node, "group", group_col, t, err))) ||
-        (rc = phc_table_column_numbers(t, psi_col, &psi, err)) ||
-        (rc = phc_table_column_numbers(t, fresh_col, &fresh, err)) ||
-        (rc = mass_spec(doc, node, "bag_mass", 0, t, NULL, &bag, err)) ||
-        (rc = mass_spec(doc, node, "dry_mass", 1, t, NULL, &dry, err)) ||
-        (rc = mass_spec(doc, node, "saturated_mass", 1, t, &extrapolate, &sat, err)))
-        goto fail;
+    for (size_t i = 0; i < b->n; ++i)
+        (*values)[i] = m->value;
+    return PHC_OK;
+}
 
-    /* Row checks, with file and line. */
-    for (size_t i = 0; i < n; ++i) {
-        const size_t line = phc_table_row_line(t, i);
-        if (psi[i] > 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: column '%s': water potential must be negative, found %g %s "
-                               "(enter pressure-chamber balance pressures with a minus sign)",
-                               path, line, psi_col, psi[i], unit);
-            goto fail;
-        }
-        if (psi[i] == 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: column '%s': water potential 0 leaves 1/psi undefined; "
-                               "a pressure-volume point needs a negative potential", path, line, psi_col);
-            goto fail;
-        }
-        psi[i] *= to_mpa;
-        const double leafm = fresh[i] - (bag ? bag[i] : 0);
-        if (!(leafm > dry[i])) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: leaf mass %g g (fresh%s) is not above the dry mass %g g", path, line, leafm,
-                               bag ? " minus bag" : "", dry[i]);
-            goto fail;
-        }
-        if (sat && !(sat[i] > dry[i])) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: saturated mass %g g is not above the dry mass %g g", path,
-                               line, sat[i], dry[i]);
-            goto fail;
-        }
-    }
+/* The columns the options name, as numbers per row. */
+static int read_columns(pv_build *b, phc_error *err)
+{
+    const phc_pv_curve_options *o = b->opt;
+    int rc;
+    if (b->n == 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                             b->path);
+    if ((rc = need_column(b, "psi", o->psi, err)) || (rc = need_column(b, "fresh_mass", o->fresh_mass, err)) ||
+        (o->group && (rc = need_column(b, "group", o->group, err))) ||
+        (rc = phc_table_column_numbers(b->t, o->psi, &b->psi, err)) ||
+        (rc = phc_table_column_numbers(b->t, o->fresh_mass, &b->fresh, err)) ||
+        (rc = mass_values(b, "bag_mass", &o->bag_mass, &b->bag, err)) ||
+        (rc = mass_values(b, "dry_mass", &o->dry_mass, &b->dry, err)) ||
+        (rc = mass_values(b, "saturated_mass", &o->saturated_mass, &b->sat, err)))
+        return rc;
+    return PHC_OK;
+}
 
-    /* Leaves. */
-    if (!(gid = calloc(n, sizeof *gid)) || !(gname = calloc(n, sizeof *gname)) || !(rows = malloc(n * sizeof *rows)) ||
-        !(lpsi = malloc(n * sizeof *lpsi)) || !(lrwc = malloc(n * sizeof *lrwc)) ||
-        !(lwater = malloc(n * sizeof *lwater))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
+/* Row checks, with file and line; psi converted to MPa. */
+static int check_rows(pv_build *b, phc_error *err)
+{
+    for (size_t i = 0; i < b->n; ++i) {
+        const size_t line = phc_table_row_line(b->t, i);
+        if (b->psi[i] > 0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: column '%s': water potential must be negative, found %g %s "
+                                 "(enter pressure-chamber balance pressures with a minus sign)",
+                                 b->path, line, b->opt->psi, b->psi[i], b->unit);
+        if (b->psi[i] == 0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: column '%s': water potential 0 leaves 1/psi undefined; "
+                                 "a pressure-volume point needs a negative potential", b->path, line, b->opt->psi);
+        b->psi[i] *= b->to_mpa;
+        const double leafm = b->fresh[i] - (b->bag ? b->bag[i] : 0);
+        if (!(leafm > b->dry[i]))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: leaf mass %g g (fresh%s) is not above the dry mass %g g",
+                                 b->path, line, leafm, b->bag ? " minus bag" : "", b->dry[i]);
+        if (b->sat && !(b->sat[i] > b->dry[i]))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: saturated mass %g g is not above the dry mass %g g",
+                                 b->path, line, b->sat[i], b->dry[i]);
     }
-    const long gcol = group_col ? phc_table_find(t, group_col) : -1;
+    return PHC_OK;
+}
+
+/* The leaf `leaf` names among the group column's ids: b->only, or PHC_ERR_INPUT
+ * listing the ids. */
+static int choose_leaf(pv_build *b, const char *leaf, phc_error *err)
+{
+    for (size_t k = 0; k < b->n_groups; ++k)
+        if (strcmp(b->gname[k], leaf) == 0)
+            b->only = k;
+    if (b->only != (size_t)-1)
+        return PHC_OK;
+    char list[400] = "";
+    for (size_t k = 0; k < b->n_groups && k < 20; ++k) {
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s'%s'", k ? ", " : "", b->gname[k]);
+    }
+    const char *near = phc_suggest(leaf, b->gname, b->n_groups);
+    return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'leaf': '%s' is not a value of column '%s' in %s "
+                         "(values: %s%s)%s%s%s",
+                         WHERE("leaf"), leaf, b->opt->group, b->path, list, b->n_groups > 20 ? ", ..." : "",
+                         near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "");
+}
+
+/* The leaves: the group column's ids (one leaf "all" without one), and which
+ * of them the options choose; the scratch arrays and the analyses' home. */
+static int find_leaves(pv_build *b, phc_error *err)
+{
+    const size_t n = b->n;
+    const char *leaf = b->opt->leaf;
+    int rc;
+    if (!(b->gid = calloc(n, sizeof *b->gid)) || !(b->gname = calloc(n, sizeof *b->gname)) ||
+        !(b->rows = malloc(n * sizeof *b->rows)) || !(b->lpsi = malloc(n * sizeof *b->lpsi)) ||
+        !(b->lrwc = malloc(n * sizeof *b->lrwc)) || !(b->lwater = malloc(n * sizeof *b->lwater)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    const long gcol = b->opt->group ? phc_table_find(b->t, b->opt->group) : -1;
     for (size_t i = 0; i < n; ++i) {
-        const char *g = gcol >= 0 ? phc_table_cell(t, i, (size_t)gcol) : "all";
+        const char *g = gcol >= 0 ? phc_table_cell(b->t, i, (size_t)gcol) : "all";
         size_t k = 0;
-        while (k < n_groups && strcmp(gname[k], g) != 0)
+        while (k < b->n_groups && strcmp(b->gname[k], g) != 0)
             ++k;
-        if (k == n_groups)
-            gname[n_groups++] = g;
-        gid[i] = k;
+        if (k == b->n_groups)
+            b->gname[b->n_groups++] = g;
+        b->gid[i] = k;
     }
-    int each = 0;
-    size_t only = (size_t)-1; /* selected leaf, or all */
+    b->only = (size_t)-1;
     if (gcol >= 0) {
-        if (!leaf && n_groups > 1) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: column '%s' of %s holds %zu leaves ('%s', '%s', ...); choose one with "
-                               "'leaf: <id>', or 'leaf: each' or 'leaf: pooled'",
-                               doc->path, phc_key_line(node, "group"), group_col, path, n_groups, gname[0], gname[1]);
-            goto fail;
-        }
+        if (!leaf && b->n_groups > 1)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s: column '%s' of %s holds %zu leaves ('%s', '%s', ...); choose one with "
+                                 "'leaf: <id>', or 'leaf: each' or 'leaf: pooled'",
+                                 WHERE("group"), b->opt->group, b->path, b->n_groups, b->gname[0], b->gname[1]);
         if (leaf && strcmp(leaf, "each") == 0)
-            each = 1;
-        else if (leaf && strcmp(leaf, "pooled") != 0) {
-            for (size_t k = 0; k < n_groups; ++k)
-                if (strcmp(gname[k], leaf) == 0)
-                    only = k;
-            if (only == (size_t)-1) {
-                char list[400] = "";
-                for (size_t k = 0; k < n_groups && k < 20; ++k) {
-                    size_t used = strlen(list);
-                    snprintf(list + used, sizeof list - used, "%s'%s'", k ? ", " : "", gname[k]);
-                }
-                const char *near = phc_suggest(leaf, gname, n_groups);
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'leaf': '%s' is not a value of column '%s' in %s "
-                                   "(values: %s%s)%s%s%s",
-                                   doc->path, phc_key_line(node, "leaf"), leaf, group_col, path, list,
-                                   n_groups > 20 ? ", ..." : "", near ? "; did you mean '" : "", near ? near : "",
-                                   near ? "'?" : "");
-                goto fail;
-            }
-        }
+            b->each = 1;
+        else if (leaf && strcmp(leaf, "pooled") != 0 && (rc = choose_leaf(b, leaf, err)))
+            return rc;
     }
-    const size_t n_leaves = only == (size_t)-1 ? n_groups : 1;
-    if (!(x = calloc(1, sizeof *x)) || !(x->labels = calloc(n_leaves, sizeof *x->labels)) ||
-        !(x->res = calloc(n_leaves, sizeof *x->res)) || !(x->swc = malloc(n_leaves * sizeof *x->swc)) ||
-        !(x->swc_se = malloc(n_leaves * sizeof *x->swc_se)) || !(x->swc_k = calloc(n_leaves, sizeof *x->swc_k))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    x->extrapolated = extrapolate;
-    size_t n_obs = 0;
-    for (size_t L = 0; L < n_leaves; ++L) {
-        const size_t g = only == (size_t)-1 ? L : only;
-        size_t m = 0;
-        for (size_t i = 0; i < n; ++i)
-            if (gid[i] == g)
-                rows[m++] = i;
-        x->count = L + 1;
-        if (!(x->labels[L] = strdup(gname[g]))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        const size_t first = phc_table_row_line(t, rows[0]);
-        const size_t need = 2 * opt.min_points;
-        if (m < need) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: leaf '%s' has %zu point%s; a pressure-volume analysis needs at least %zu "
-                               "(%zu on each side of the turgor loss point)",
-                               path, first, gname[g], m, m == 1 ? "" : "s", need, opt.min_points);
-            goto fail;
-        }
-        if (opt.rule == PHC_PV_BREAK_FIXED && (opt.n_osmotic > m - opt.min_points)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'breakpoint': %zu linear points leave fewer than %zu "
-                               "above the turgor loss point in leaf '%s' (%zu points)",
-                               doc->path, phc_key_line(node, "breakpoint"), opt.n_osmotic, opt.min_points, gname[g], m);
-            goto fail;
-        }
-        for (size_t j = 0; j < m; ++j) {
-            const size_t i = rows[j];
-            lpsi[j] = psi[i];
-            lwater[j] = fresh[i] - (bag ? bag[i] : 0) - dry[i];
-        }
-        x->swc[L] = x->swc_se[L] = NAN;
-        if (extrapolate) {
-            if ((rc = phc_pv_extrapolate_saturation(lpsi, lwater, m, &x->swc[L], &x->swc_se[L], &x->swc_k[L], err))) {
-                rc = phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", path, first, gname[g]);
-                goto fail;
-            }
-            for (size_t j = 0; j < m; ++j)
-                lrwc[j] = lwater[j] / x->swc[L];
-        } else {
-            for (size_t j = 0; j < m; ++j)
-                lrwc[j] = lwater[j] / (sat[rows[j]] - dry[rows[j]]);
-        }
-        for (size_t j = 0; j < m; ++j)
-            for (size_t q = 0; q < j; ++q)
-                if (lrwc[q] == lrwc[j]) {
-                    rc = phc_error_set(err, PHC_ERR_INPUT,
-                                       "%s:%zu: leaf '%s': same relative water content (%g) as line %zu; masses "
-                                       "must differ between points", path, phc_table_row_line(t, rows[j]), gname[g],
-                                       lrwc[j], phc_table_row_line(t, rows[q]));
-                    goto fail;
-                }
-        if ((rc = phc_pv_analyse(lpsi, lrwc, m, &opt, &x->res[L], err))) {
-            rc = phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", path, first, gname[g]);
-            goto fail;
-        }
-        n_obs += x->res[L]->n_modulus;
-    }
+    const size_t nl = b->n_leaves = b->only == (size_t)-1 ? b->n_groups : 1;
+    pv_extra *x = b->x = calloc(1, sizeof *x);
+    if (!x || !(x->labels = calloc(nl, sizeof *x->labels)) || !(x->res = calloc(nl, sizeof *x->res)) ||
+        !(x->swc = malloc(nl * sizeof *x->swc)) || !(x->swc_se = malloc(nl * sizeof *x->swc_se)) ||
+        !(x->swc_k = calloc(nl, sizeof *x->swc_k)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    x->extrapolated = b->opt->extrapolate_saturation;
+    return PHC_OK;
+}
 
-    /* The elasticity data set over all moduli. */
-    if ((rc = phc_elasticity_dataset_new(&pv_ops, n_obs, each ? n_leaves : 1,
-                                         each ? (const char *const *)x->labels : NULL, &ds, err)))
-        goto fail;
+/* The rows of analysed leaf L in b->rows; returns their count. */
+static size_t leaf_rows(pv_build *b, size_t L)
+{
+    const size_t g = b->only == (size_t)-1 ? L : b->only;
+    size_t m = 0;
+    for (size_t i = 0; i < b->n; ++i)
+        if (b->gid[i] == g)
+            b->rows[m++] = i;
+    return m;
+}
+
+/* The pressure-volume analysis of leaf L (model/pressure_volume.h) into
+ * b->x, with its saturated water extrapolated when asked. */
+static int analyse_leaf(pv_build *b, size_t L, phc_error *err)
+{
+    const phc_pv_options *opt = &b->opt->analysis;
+    const size_t g = b->only == (size_t)-1 ? L : b->only, m = leaf_rows(b, L);
+    const size_t *rows = b->rows;
+    const char *id = b->gname[g];
+    pv_extra *x = b->x;
+    int rc;
+    x->count = L + 1;
+    if (!(x->labels[L] = strdup(id)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    const size_t first = phc_table_row_line(b->t, rows[0]);
+    const size_t need = 2 * opt->min_points;
+    if (m < need)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s:%zu: leaf '%s' has %zu point%s; a pressure-volume analysis needs at least %zu "
+                             "(%zu on each side of the turgor loss point)",
+                             b->path, first, id, m, m == 1 ? "" : "s", need, opt->min_points);
+    if (opt->rule == PHC_PV_BREAK_FIXED && (opt->n_osmotic > m - opt->min_points))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'breakpoint': %zu linear points leave fewer than %zu "
+                             "above the turgor loss point in leaf '%s' (%zu points)",
+                             WHERE("breakpoint"), opt->n_osmotic, opt->min_points, id, m);
+    for (size_t j = 0; j < m; ++j) {
+        const size_t i = rows[j];
+        b->lpsi[j] = b->psi[i];
+        b->lwater[j] = b->fresh[i] - (b->bag ? b->bag[i] : 0) - b->dry[i];
+    }
+    x->swc[L] = x->swc_se[L] = NAN;
+    if (x->extrapolated) {
+        if ((rc = phc_pv_extrapolate_saturation(b->lpsi, b->lwater, m, &x->swc[L], &x->swc_se[L], &x->swc_k[L], err)))
+            return phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", b->path, first, id);
+        for (size_t j = 0; j < m; ++j)
+            b->lrwc[j] = b->lwater[j] / x->swc[L];
+    } else {
+        for (size_t j = 0; j < m; ++j)
+            b->lrwc[j] = b->lwater[j] / (b->sat[rows[j]] - b->dry[rows[j]]);
+    }
+    for (size_t j = 0; j < m; ++j)
+        for (size_t q = 0; q < j; ++q)
+            if (b->lrwc[q] == b->lrwc[j])
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s:%zu: leaf '%s': same relative water content (%g) as line %zu; masses "
+                                     "must differ between points", b->path, phc_table_row_line(b->t, rows[j]), id,
+                                     b->lrwc[j], phc_table_row_line(b->t, rows[q]));
+    if ((rc = phc_pv_analyse(b->lpsi, b->lrwc, m, opt, &x->res[L], err)))
+        return phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", b->path, first, id);
+    return PHC_OK;
+}
+
+/* The elasticity data set over every analysed leaf's moduli; takes b->x. */
+static int moduli_dataset(pv_build *b, phc_dataset **out, phc_error *err)
+{
+    pv_extra *x = b->x;
+    size_t n_obs = 0;
+    int rc;
+    for (size_t L = 0; L < b->n_leaves; ++L)
+        n_obs += x->res[L]->n_modulus;
+    if ((rc = phc_elasticity_dataset_new(&phc_pv_curve_ops, n_obs, b->each ? b->n_leaves : 1,
+                                         b->each ? (const char *const *)x->labels : NULL, out, err)))
+        return rc;
+    phc_dataset *ds = *out;
     phc_elasticity_impl *impl = ds->impl;
     size_t o = 0;
-    for (size_t L = 0; L < n_leaves; ++L) {
-        const size_t g = only == (size_t)-1 ? L : only;
-        size_t m = 0;
-        for (size_t i = 0; i < n; ++i)
-            if (gid[i] == g)
-                rows[m++] = i;
+    for (size_t L = 0; L < b->n_leaves; ++L) {
+        leaf_rows(b, L);
         const phc_pv_result *r = x->res[L];
         for (size_t j = 0; j < r->n_modulus; ++j, ++o) {
             ds->x[o] = r->modulus_rwc[j];
             ds->y[o] = r->modulus[j];
-            ds->data_lines[o] = phc_table_row_line(t, rows[r->order[j]]);
-            impl->block[o] = each ? L : 0;
+            ds->data_lines[o] = phc_table_row_line(b->t, b->rows[r->order[j]]);
+            impl->block[o] = b->each ? L : 0;
         }
     }
     impl->extra = x;
     impl->free_extra = pv_extra_free;
-    x = NULL;
-    const phc_yaml_node *sig = phc_yaml_get(node, "sigma");
-    if (sig) {
-        double s = 0;
-        if ((rc = phc_yaml_number(doc, sig, "sigma", &s, err)) || !(s > 0)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': expected a positive number (MPa), found '%s'",
-                               doc->path, sig->line, sig->kind == PHC_YAML_SCALAR ? sig->scalar : "(not a scalar)");
+    b->x = NULL;
+    return PHC_OK;
+}
+
+int phc_pv_curve_new(const phc_table *table, const phc_pv_curve_options *options, phc_dataset **out,
+                     phc_error *err)
+{
+    *out = NULL;
+    if (!table || !options)
+        return phc_error_set(err, PHC_ERR_INVALID, "pv_curve: a table and options are required");
+    pv_build build = {.t = table, .opt = options, .path = phc_table_source(table), .n = phc_table_rows(table)};
+    pv_build *b = &build;
+    phc_dataset *ds = NULL;
+    int rc;
+    if ((rc = check_options(b, err)) || (rc = read_columns(b, err)) || (rc = check_rows(b, err)) ||
+        (rc = find_leaves(b, err)))
+        goto fail;
+    for (size_t L = 0; L < b->n_leaves; ++L)
+        if ((rc = analyse_leaf(b, L, err)))
             goto fail;
-        }
-        if (!(ds->sigma = malloc(n_obs * sizeof *ds->sigma))) {
+    if ((rc = moduli_dataset(b, &ds, err)))
+        goto fail;
+    if (options->sigma > 0) {
+        if (!(ds->sigma = malloc((ds->n ? ds->n : 1) * sizeof *ds->sigma))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             goto fail;
         }
-        for (size_t i = 0; i < n_obs; ++i)
-            ds->sigma[i] = s;
+        for (size_t i = 0; i < ds->n; ++i)
+            ds->sigma[i] = options->sigma;
     }
     ds->x_label = strdup("relative water content (RWC)");
     ds->y_label = strdup("bulk modulus dP/dRWC (MPa)");
-    ds->data_file = strdup(path);
-    if (!ds->x_label || !ds->y_label || !ds->data_file || phc_dataset_add_input(ds, path)) {
+    ds->data_file = strdup(b->path);
+    if (!ds->x_label || !ds->y_label || !ds->data_file) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    ds->config_line = node->line;
+    ds->config_line = phc_origin_line(options->origin, NULL);
     *out = ds;
     ds = NULL;
     rc = PHC_OK;
 fail:
     phc_dataset_free(ds);
-    pv_extra_free(x);
-    phc_table_free(t);
-    free(path);
-    free(psi);
-    free(fresh);
-    free(bag);
-    free(dry);
-    free(sat);
-    free(gid);
-    free(gname);
-    free(rows);
-    free(lpsi);
-    free(lrwc);
-    free(lwater);
+    pv_build_free(b);
     return rc;
 }
 

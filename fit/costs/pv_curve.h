@@ -4,31 +4,13 @@
  * slots kappa, chi0, e_min, e_max) fitted to the pointwise bulk modulus
  * against relative water content.
  *
- * Config keys (besides the common data-set keys of fit/config.h):
- *   file:           CSV file, relative to the config file
- *   psi:            column of water potentials (balance pressure with a minus
- *                   sign); every value must be < 0 — a positive value is an
- *                   error naming file and line (enter chamber pressures as
- *                   negative potentials)
- *   psi_unit:       MPa (default) | bar (× 0.1) | kPa (× 0.001)
- *   fresh_mass:     column of weighed masses, g (the leaf, or the leaf in its
- *                   bag when bag_mass is given)
- *   bag_mass:       optional: column or number, g, subtracted from fresh_mass
- *                   (the bagged-leaf protocol of the R package photosynthesis)
- *   dry_mass:       column or number, g (required)
- *   saturated_mass: column or number, g: the turgid leaf mass (required); or
- *                   `extrapolate`: the saturated water mass is found by
- *                   extrapolating ψ against leaf water to ψ = 0 over the
- *                   wettest 3–5 points (photosynthesis::fit_PV_curve's rule)
- *   group:          optional column of leaf ids
- *   leaf:           with group: one id (fit that leaf), `each` (one logistic
- *                   per leaf; slots kappa_<id>, chi0_<id>, e_min_<id>,
- *                   e_max_<id>) or `pooled` (one logistic for all leaves'
- *                   moduli; every leaf still gets its own PV analysis).
- *                   Required when the group column holds more than one id.
- *   breakpoint:     min_rss (default) | max_r2 | a whole number of driest
- *                   points in the linear region (see pressure_volume.h)
- *   sigma:          optional positive number, MPa (modulus units)
+ * Built in C with phc_pv_curve_new from a table (measurements/table.h: read
+ * from a CSV file, or phc_table_from_columns for arrays) and options; the
+ * config's `kind: pv_curve` mapping is translated into the same options by
+ * fit/config/pv_curve_yaml.c.
+ *
+ * Slots: kappa, chi0, e_min, e_max (one logistic for the leaves), or
+ * kappa_<id>, chi0_<id>, e_min_<id>, e_max_<id> per leaf with leaf "each".
  *
  * Observations are the moduli ΔP/ΔRWC between consecutive points (n − 1 per
  * leaf); each is attributed to the CSV line of the wetter point of its pair.
@@ -36,20 +18,66 @@
 #ifndef PHC_COSTS_PV_CURVE_H
 #define PHC_COSTS_PV_CURVE_H
 
-#include "fit/config_help.h"
-#include "fit/costs/curve.h"
+#include <stddef.h>
+
+#include "fit/costs/origin.h"
 #include "fit/dataset.h"
-#include "measurements/yaml_doc.h"
+#include "measurements/table.h"
 #include "model/pressure_volume.h"
 #include "model/status.h"
 
-extern const char *const phc_pv_curve_keys[];
-/* Help on each of those keys (fit/config_help.h). */
-extern const phc_key_help phc_pv_curve_help[];
+/* A mass: a column of the table, or one number for every row.  Neither
+ * (column NULL and value NaN) is "not given". */
+typedef struct phc_pv_mass {
+    const char *column; /* column of masses, g, or NULL */
+    double value;       /* without a column: the mass, g (>= 0); NaN = not given */
+} phc_pv_mass;
 
-int phc_pv_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                      phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out,
-                      phc_error *err);
+typedef struct phc_pv_curve_options {
+    const char *psi;        /* column of water potentials (required); every value must be
+                               < 0 (pressure-chamber balance pressures with a minus sign) */
+    const char *psi_unit;   /* "MPa" (NULL means MPa), "bar" (x 0.1) or "kPa" (x 0.001);
+                               case ignored */
+    const char *fresh_mass; /* column of weighed masses, g (required): the leaf, or the
+                               leaf in its bag when bag_mass is given */
+    phc_pv_mass bag_mass;   /* optional: subtracted from fresh_mass (the bagged-leaf
+                               protocol of the R package photosynthesis) */
+    phc_pv_mass dry_mass;   /* required, g, below every leaf mass */
+    phc_pv_mass saturated_mass; /* the turgid leaf mass, g: required unless
+                                   extrapolate_saturation */
+    int extrapolate_saturation; /* 1: the saturated water mass is extrapolated from psi
+                                   against leaf water to psi = 0 over the wettest 3-5 points
+                                   (photosynthesis::fit_PV_curve's rule); saturated_mass
+                                   must then be unset */
+    const char *group;      /* column of leaf ids, or NULL: the table is one leaf */
+    const char *leaf;       /* with group: one id (that leaf), "each" (one logistic per leaf)
+                               or "pooled" (one logistic for all leaves' moduli; every leaf
+                               still gets its own PV analysis); NULL only when the group
+                               column holds one id */
+    phc_pv_options analysis; /* the breakpoint rule (model/pressure_volume.h); default
+                                min_rss */
+    double sigma;           /* > 0: standard deviation of the moduli, MPa; 0 = unweighted */
+    const phc_origin *origin; /* where the options came from, for messages; NULL */
+} phc_pv_curve_options;
+
+/* Nothing given but the defaults: psi in MPa, no masses (value NaN), one
+ * leaf, phc_pv_options_default(), unweighted, no origin. */
+phc_pv_curve_options phc_pv_curve_options_default(void);
+
+/* Analyses every leaf of `table` (at least 2 x analysis.min_points rows per
+ * leaf) and builds the elasticity data set over their moduli; the table may
+ * be freed afterwards.  Parameter indices are left to phc_problem binding
+ * (phc_problem_bind_by_name).  Errors name the option (and the config line
+ * when options.origin is set), or the table's source, line and column:
+ * PHC_ERR_INPUT for a missing option, an unknown column or leaf id, a value
+ * that is not a number, a water potential that is not negative, a leaf mass
+ * not above the dry mass, too few points in a leaf, two points of one leaf
+ * with the same relative water content, or an analysis that fails. */
+int phc_pv_curve_new(const phc_table *table, const phc_pv_curve_options *options, phc_dataset **out,
+                     phc_error *err);
+
+/* The operations of pv_curve data sets (ops->kind is "pv_curve"). */
+extern const phc_dataset_ops phc_pv_curve_ops;
 
 /* The per-leaf PV analyses of a pv_curve data set (NULL / 0 for other kinds). */
 size_t phc_pv_curve_leaf_count(const phc_dataset *ds);
