@@ -481,6 +481,12 @@ static int moduli_dataset(pv_build *b, phc_dataset **out, phc_error *err)
                                          b->each ? (const char *const *)x->labels : NULL, out, err)))
         return rc;
     phc_dataset *ds = *out;
+    /* the moduli are in MPa (psi_unit converts the potentials), so are the
+     * logistic's bounds (parameter_units.h converts a user's bar or kPa) */
+    for (size_t j = 0; j < ds->k; ++j)
+        if ((strncmp(ds->slot_names[j], "e_min", 5) == 0 || strncmp(ds->slot_names[j], "e_max", 5) == 0) &&
+            phc_dataset_declare_unit(ds, ds->slot_names[j], "MPa"))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     phc_elasticity_impl *impl = ds->impl;
     size_t o = 0;
     for (size_t L = 0; L < b->n_leaves; ++L) {
