@@ -13,7 +13,6 @@
 #include "fit/costs/root_shoot.h"
 #include "fit/costs/soil_probe.h"
 #include "fit/costs/soil_setup.h"
-#include "fit/costs/weight_curve.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/kinds.h"
 #include "fit/parameter_units.h"
@@ -56,14 +55,6 @@ static const phc_kind soil_probe_kind = {
     .load_yaml = phc_soil_probe_load,
 };
 
-static const phc_kind weight_curve_kind = {
-    .config = {.name = "weight_curve",
-               .summary = "a plant or detached leaf weighed on a balance while it dries -> " "water-loss rate delta, initial water, dry mass (wilting §3-4)",
-               .keys = phc_weight_curve_keys,
-               .help = phc_weight_curve_help},
-    .load_yaml = phc_weight_curve_load,
-};
-
 static const phc_kind *const kinds[] = {
     &phc_curve_kind,
     &phc_elasticity_curve_kind,
@@ -72,7 +63,7 @@ static const phc_kind *const kinds[] = {
     &phc_pv_curve_kind,
     &root_shoot_kind,
     &soil_probe_kind,
-    &weight_curve_kind,
+    &phc_weight_curve_kind,
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])
 

@@ -6,15 +6,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
-#include "fit/costs/weight_drivers.h"
 #include "fit/costs/unique_times.h"
-#include "measurements/c_number.h"
+#include "fit/costs/weight_drivers.h"
 #include "measurements/logger_time.h"
-#include "measurements/plant_io.h"
-#include "measurements/table.h"
-#include "measurements/units.h"
 #include "model/plant_graph.h"
 #include "model/water.h"
 #include "model/water_balance.h"
@@ -22,89 +16,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-const char *const phc_weight_curve_keys[] = {
-    "file", "time", "mass", "select", "plant", "plant_format", "plant_unit", "leaf_area",
-    "chain_segments", "vein_radius", "dry_mass", "sigma", "exclude", "jumps", "jump_threshold",
-    "tare", "max_gap", "day", "covariates", "pot", "conductance", "method", "step", "viscosity", "x_label", "y_label", NULL};
-const phc_key_help phc_weight_curve_help[] = {
-    {"file", "CSV table of weighings, in time order, relative to the config file. Required."},
-    {"time", "{column: NAME, unit: UNIT} or a column name: the time of each weighing as a "
-             "number; any UDUNITS-2 time unit (also \"seconds since 1970-01-01\" for POSIX "
-             "times), default s. Or logger timestamps: {columns: [DATE, TIME], format: F, "
-             "timezone: Z} (two columns joined by a space) or {column: STAMP, format: F, "
-             "timezone: Z}; a `columns`, `format` or `timezone` key (without `unit`) makes the "
-             "time a timestamp. F: a strptime format such as \"%d/%m/%Y %H:%M:%S\" (a fraction "
-             "after %S is accepted), default ISO 8601 (2024-10-24T13:05:00, optional fraction, "
-             "Z or +02:00). Z: the logger clock's IANA zone (Europe/Berlin) so daylight-saving "
-             "steps are handled (a time in the repeated hour takes the instant that keeps the "
-             "series in order); without it times are taken as written (UTC) and a step back is "
-             "an error. With timestamps the time unit is h since the first weighing (exclude, "
-             "step, max_gap). With a numeric absolute unit, timezone only sets the local "
-             "clock. Required."},
-    {"mass", "{column: NAME, unit: UNIT} or a column name: the masses, > 0; any mass unit, "
-             "default g. Required."},
-    {"select", "{COLUMN: VALUE, ...}: keep only the rows matching every pair (one plant of a "
-               "long table; \"1\" matches \"1.0\"; a logger's stable readings: "
-               "{Status: ST}). Default: every row."},
-    {"plant", "A plant-graph file (paper, TreeQSM, SWC or native CSV), relative to the config "
-              "file. Give exactly one of plant and leaf_area."},
-    {"plant_format", "Format of the plant file: auto (by extension and content), paper, "
-                     "treeqsm, swc or native. Default: auto."},
-    {"plant_unit", "Length unit of the plant file (UDUNITS-2, e.g. mm). Default: the format's "
-                   "(paper, TreeQSM: m; SWC: um; native: its `# unit:` line, else m)."},
-    {"leaf_area", "A detached leaf instead of plant, modelled as a venation chain: its area, a "
-                  "number or {value: A | column: NAME, unit: UNIT} (a column is read at the "
-                  "first selected row); default unit cm2. Give exactly one of plant and "
-                  "leaf_area."},
-    {"chain_segments", "With leaf_area: segments of the venation chain, 2 to 100000. "
-                       "Default: 20."},
-    {"vein_radius", "With leaf_area: radius of the chain's segments, a number or {value | "
-                    "column, unit}; default unit mm. Default: 0.5 mm."},
-    {"dry_mass", "Measured dry mass, a number or {value | column, unit} (default: the mass "
-                 "unit), below every mass: fixes the dry_mass slot. Default: dry_mass is a "
-                 "fitted slot."},
-    {"sigma", "Balance standard deviation, > 0: a number in the mass unit or the name of a "
-              "column of per-point sigmas. Default: unweighted."},
-    {"exclude", "[[from, to], ...], from < to: time windows to drop, in the time unit, counted "
-                "from the first selected row. Default: none."},
-    {"jumps", "What a rise of the mass above jump_threshold (an irrigation) does: error (stop "
-              "and name the line), split (the curve restarts; piece k = 2, 3, ... gets its "
-              "own slot initial_water_<k>) or keep. Default: error."},
-    {"jump_threshold", "The rise between weighings that counts as a jump, > 0, in the mass "
-                       "unit. Default: max(5 sigma, 0.5% of the largest mass)."},
-    {"tare", "auto: drop the readings at the start of the selected rows that are below 50% of "
-             "the median of the next 10 (the empty balance, a pot without its plant) and list "
-             "them in the report; keep: use every row. Default: auto."},
-    {"max_gap", "Longest expected pause between weighings, a number in the time unit or "
-                "{value: V, unit: U}; longer gaps (logger off) are listed in the report. "
-                "Default: 6 h, or 3 times the median step when weighings are sparser."},
-    {"day", "{start: \"07:00\", end: \"23:00\", night_factor: F, clock: \"HH:MM\"}: a light "
-            "schedule, local clock times, start before end; leaves lose night_factor times the "
-            "day's rate by night (left out: a fitted slot night_factor). With logger timestamps "
-            "the hours follow the time zone (daylight saving included); with a plain numeric time "
-            "give clock, the local time of the first weighing. Default: one rate all day."},
-    {"covariates", "{columns: [PAR, VPD, ...], law: linear}: the loss rate follows columns "
-                   "read at every weighing, g = 1 + sum loss_<column> x column (one fitted slot "
-                   "per column; each interval between weighings takes the mean of its two "
-                   "readings; a reading missing is an error). Not with day. Default: none."},
-    {"pot", "{capacity: C, conductance: k}: the pot's soil as a water store joined to the "
-            "plant's root segment; C (g) is the soil water at which its pressure equals that "
-            "of a full plant segment, k (g/s) the exchange per unit difference of relative "
-            "fill; a key left out is a fitted slot (pot_capacity, pot_conductance); plant and "
-            "soil start in equilibrium, sharing initial_water. Default: no pot."},
-    {"conductance", "Edge weights of the water model: poiseuille, mean, paper, reference or "
-                    "reference_2024 (model/water.h). Default: poiseuille."},
-    {"method", "Evaluator: auto (exact up to 400 segments when not stiff, else BDF6), exact "
-               "or bdf6. Default: auto."},
-    {"step", "BDF6 time step in the time unit, >= 0; 0 = a thousandth of the time span. "
-             "Default: 0."},
-    {"viscosity", "Sap viscosity, mPa s, > 0, when no parameter named viscosity makes it a "
-                  "fitted slot. Default: 0.89 (water at 25 °C); 0.9 with the reference "
-                  "conductances."},
-    {"x_label", "Axis label of time. Default: \"time since the first weighing (<time unit>)\"."},
-    {"y_label", "Axis label of mass. Default: \"mass (g)\"."},
-    {NULL, NULL}};
 
 /* A stretch of the curve between irrigations.  Piece 0 starts from the
  * `initial_water` slot, piece k > 0 from its own slot `initial_water_<k+1>`. */
@@ -346,273 +257,407 @@ done:
 
 static int wc_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
 
-static const phc_dataset_ops weight_curve_ops = {"weight_curve", wc_predict, wc_predict_at,
-                                                 wc_free, wc_report_section, NULL, NULL, NULL};
+const phc_dataset_ops phc_weight_curve_ops = {.kind = "weight_curve", .predict = wc_predict,
+                                              .predict_at = wc_predict_at, .free_impl = wc_free,
+                                              .report_section = wc_report_section};
 
-/* ---- loading ------------------------------------------------------------- */
+/* ---- building ------------------------------------------------------------- */
 
-/* A quantity given as a number, or {value: X | column: NAME, unit: UNIT};
- * a column is read at the first selected row.  Converted to `model_unit`. */
-static int quantity(const phc_yaml_doc *doc, const phc_yaml_node *v, const char *key,
-                    const char *default_unit, const char *model_unit, phc_units *units,
-                    const phc_table *t, size_t row, double *out, phc_error *err)
+#define WHERE(key) phc_origin_key(opt->origin, "weight_curve", key).text
+
+phc_weighings phc_weighings_default(void)
 {
-    static const char *const q_keys[] = {"value", "column", "unit", NULL};
-    char ctx[64];
-    const char *unit = default_unit, *column = NULL;
-    double value = NAN;
-    int rc;
-    snprintf(ctx, sizeof ctx, "key '%s'", key);
-    if (v->kind == PHC_YAML_SCALAR) {
-        if ((rc = phc_yaml_number(doc, v, key, &value, err)))
-            return rc;
-    } else {
-        if ((rc = phc_yaml_check_keys(doc, v, q_keys, ctx, err)) ||
-            (rc = phc_yaml_map_number(doc, v, "value", 0, ctx, &value, err)) ||
-            (rc = phc_yaml_map_string(doc, v, "column", 0, ctx, &column, err)) ||
-            (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, &unit, err)))
-            return rc;
-        if ((column != NULL) == !isnan(value))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': give either value or column",
-                                 doc->path, v->line, key);
-        if (column) {
-            long c = phc_table_find(t, column);
-            if (c < 0)
-                return phc_unknown_column(doc, v->line, key, column, t, err);
-            const char *cell = phc_table_cell(t, row, (size_t)c);
-            char *end = NULL;
-            value = phc_strtod_c(cell, &end);
-            if (!end || end == cell || *end || !isfinite(value))
-                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': expected a number, found '%s'",
-                                     phc_table_source(t), phc_table_row_line(t, row), column, cell);
-        }
-    }
-    char where[160];
-    snprintf(where, sizeof where, "%s:%zu: %s unit", doc->path, v->line, key);
-    phc_unit_conversion conv;
-    if ((rc = phc_units_conversion(units, unit, model_unit, where, &conv, err)))
-        return rc;
-    *out = phc_unit_apply(conv, value);
-    if (!(*out > 0))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': must be positive, found %g",
-                             doc->path, v->line, key, value);
+    phc_weighings w = {0};
+    return w;
+}
+
+phc_weight_curve_options phc_weight_curve_options_default(void)
+{
+    phc_weight_curve_options o = {0};
+    o.conductance = PHC_WATER_POISEUILLE;
+    o.method = PHC_WATER_AUTO;
+    o.viscosity = o.dry_mass = o.sigma = o.jump_threshold = NAN;
+    o.day.night_factor = o.day.clock = NAN;
+    o.pot.capacity = o.pot.conductance = NAN;
+    return o;
+}
+
+/* The weighings' defaults filled in: units, names, source. */
+typedef struct series_info {
+    double spx, gpu;          /* s per time unit, g per mass unit */
+    const char *source, *time_name, *mass_name, *time_unit, *mass_unit;
+} series_info;
+
+static series_info info_of(const phc_weighings *w)
+{
+    series_info s = {w->seconds_per_unit > 0 ? w->seconds_per_unit : 1.0,
+                     w->grams_per_unit > 0 ? w->grams_per_unit : 1.0,
+                     w->source ? w->source : "weighings", w->time_name ? w->time_name : "time",
+                     w->mass_name ? w->mass_name : "mass", w->time_unit ? w->time_unit : "s",
+                     w->mass_unit ? w->mass_unit : "g"};
+    return s;
+}
+
+static size_t line_of(const phc_weighings *w, size_t i)
+{
+    return w->lines ? w->lines[i] : i + 1;
+}
+
+static int skipped(const phc_weighings *w, size_t i)
+{
+    return w->skip && w->skip[i];
+}
+
+/* The options' values and the plant: what the model can take. */
+static int check_options(const phc_plant_graph *plant, const phc_weighings *w,
+                         const phc_weight_curve_options *opt, phc_error *err)
+{
+    if (!w || !w->t || !w->mass)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: the weighings need times and masses", WHERE(NULL));
+    if (w->seconds_per_unit < 0 || w->grams_per_unit < 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: seconds_per_unit and grams_per_unit must be positive "
+                             "(0 = s, g)", WHERE(NULL));
+    if (w->n_covariates && !w->covariates)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: %zu covariates without readings", WHERE("covariates"),
+                             w->n_covariates);
+    if (opt->step < 0 || !isfinite(opt->step) || !(isnan(opt->viscosity) || opt->viscosity > 0) ||
+        !(isnan(opt->jump_threshold) || opt->jump_threshold > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: weight_curve data set: step must be >= 0, viscosity and jump_threshold positive",
+                             WHERE(NULL));
+    if (w->sigma && !isnan(opt->sigma))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': give a number or per-weighing sigmas, not both",
+                             WHERE("sigma"));
+    if (!isnan(opt->sigma) && !(opt->sigma > 0 && isfinite(opt->sigma)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': must be positive, found %g", WHERE("sigma"),
+                             opt->sigma);
+    if (!isnan(opt->dry_mass) && !(opt->dry_mass > 0 && isfinite(opt->dry_mass)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'dry_mass': must be positive, found %g",
+                             WHERE("dry_mass"), opt->dry_mass);
+    if (!plant || !plant->order)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: %s", WHERE("plant"),
+                             plant ? "the plant graph is not finished (phc_plant_graph_finish)"
+                                   : "a plant graph is required");
+    if (phc_plant_graph_leaf_count(plant) == 0)
+        return opt->plant_name
+                   ? phc_error_set(err, PHC_ERR_INPUT, "%s: plant '%s' has no leaf segments, so it cannot lose water",
+                                   WHERE("plant"), opt->plant_name)
+                   : phc_error_set(err, PHC_ERR_INPUT, "%s: the plant graph has no leaf segments, so it cannot lose water",
+                                   WHERE("plant"));
     return PHC_OK;
 }
 
-/* Does row r match every `select` pair?  Text equality, or numeric equality
- * when both sides are numbers ("1" matches "1.0"). */
-static int row_selected(const phc_table *t, size_t r, const phc_yaml_node *sel, const long *cols)
+/* Every weighing: times in order, positive masses above the measured dry
+ * mass (excluded windows too), positive sigmas; the covariates of the
+ * weighings kept. */
+static int check_weighings(const phc_weighings *w, const phc_weight_curve_options *opt, phc_error *err)
 {
-    for (size_t i = 0; sel && i < sel->count; ++i) {
-        const char *cell = phc_table_cell(t, r, (size_t)cols[i]);
-        const char *want = sel->values[i]->scalar;
-        if (strcmp(cell, want) == 0)
-            continue;
-        char *e1 = NULL, *e2 = NULL;
-        double a = phc_strtod_c(cell, &e1), b = phc_strtod_c(want, &e2);
-        if (e1 && e2 && e1 != cell && e2 != want && !*e1 && !*e2 && a == b)
-            continue;
-        return 0;
+    const series_info s = info_of(w);
+    for (size_t i = 0; i < w->n; ++i) {
+        const size_t line = line_of(w, i);
+        if (!isfinite(w->t[i]))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': time must be a finite number, found %g",
+                                 s.source, line, s.time_name, w->t[i]);
+        if (i > 0 && !(w->t[i] > w->t[i - 1]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: column '%s': time %g is not after the previous weighing's %g (line %zu); weighings must be in time order",
+                                 s.source, line, s.time_name, w->t[i], w->t[i - 1], line_of(w, i - 1));
+        if (!(w->mass[i] > 0 && isfinite(w->mass[i])))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': a mass must be positive, found %g",
+                                 s.source, line, s.mass_name, w->mass[i]);
     }
-    return 1;
-}
-
-static int parse_choice(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
-                        const char *const *names, int *out, phc_error *err)
-{
-    const char *s = NULL;
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, node, key, 0, "weight_curve data set", &s, err)) || !s)
-        return rc;
-    char list[160] = "";
-    for (int i = 0; names[i]; ++i) {
-        if (strcmp(names[i], s) == 0) {
-            *out = i;
-            return PHC_OK;
-        }
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", names[i]);
-    }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not one of %s", doc->path,
-                         phc_yaml_get(node, key)->line, key, s, list);
-}
-
-/* The `time` key: a numeric column ({column, unit} or a bare name), or logger
- * timestamps ({column: STAMP | columns: [DATE, TIME], format, timezone}); a
- * `columns` or `format` key, or `timezone` without `unit`, makes timestamps. */
-typedef struct time_spec {
-    const char *col[2], *unit, *format, *tz; /* col[1]: NULL or the second column */
-    int stamp;
-    size_t line;
-} time_spec;
-
-static int time_spec_read(const phc_yaml_doc *doc, const phc_yaml_node *node, time_spec *ts,
-                          phc_error *err)
-{
-    static const char *const keys[] = {"column", "columns", "unit", "format", "timezone", NULL};
-    const phc_yaml_node *v = phc_yaml_get(node, "time"), *cols = phc_yaml_get(v, "columns");
-    const char *ctx = "key 'time'";
-    int rc;
-    memset(ts, 0, sizeof *ts);
-    if (!v || v->kind != PHC_YAML_MAPPING || (!cols && !phc_yaml_get(v, "format") && !phc_yaml_get(v, "timezone")))
-        return phc_column_spec(doc, node, "time", "weight_curve data set", "s", &ts->col[0], &ts->unit, err);
-    ts->line = v->line;
-    if ((rc = phc_yaml_check_keys(doc, v, keys, ctx, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "column", !cols, ctx, &ts->col[0], err)) ||
-        (rc = phc_yaml_map_string(doc, v, "unit", 0, ctx, &ts->unit, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "format", 0, ctx, &ts->format, err)) ||
-        (rc = phc_yaml_map_string(doc, v, "timezone", 0, ctx, &ts->tz, err)))
-        return rc;
-    ts->stamp = cols || ts->format || !ts->unit;
-    if (cols && (ts->col[0] || cols->kind != PHC_YAML_SEQUENCE || cols->count < 1 || cols->count > 2 ||
-                 cols->items[0]->kind != PHC_YAML_SCALAR || cols->items[cols->count - 1]->kind != PHC_YAML_SCALAR))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'time': give either column: STAMP or columns: [DATE, TIME] (one or two column names)",
-                             doc->path, phc_key_line(v, "columns"));
-    for (size_t i = 0; cols && i < cols->count; ++i)
-        ts->col[i] = cols->items[i]->scalar;
-    if (ts->stamp && ts->unit)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'time': 'unit' is for numeric times; timestamps (format, columns) become hours since the first weighing",
-                             doc->path, phc_key_line(v, "unit"));
-    if ((rc = phc_time_zone_check(ts->tz, err)))
-        return phc_error_prefix(err, rc, "%s:%zu: key 'timezone'", doc->path, phc_key_line(v, "timezone"));
-    if (!ts->stamp && !strstr(ts->unit, "since"))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'timezone': needs timestamps (format or columns) or an absolute time unit such as \"seconds since 1970-01-01\"",
-                             doc->path, phc_key_line(v, "timezone"));
+    for (size_t i = 0; w->sigma && i < w->n; ++i)
+        if (!(w->sigma[i] > 0 && isfinite(w->sigma[i])))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column 'sigma': sigma must be positive, found %g",
+                                 s.source, line_of(w, i), w->sigma[i]);
+    for (size_t i = 0; !isnan(opt->dry_mass) && i < w->n; ++i)
+        if (w->mass[i] * s.gpu < opt->dry_mass)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: column '%s': mass %g is below the measured dry mass %g %s",
+                                 s.source, line_of(w, i), s.mass_name, w->mass[i], opt->dry_mass / s.gpu,
+                                 s.mass_unit);
+    for (size_t i = 0; i < w->n; ++i)
+        for (size_t j = 0; j < w->n_covariates && !skipped(w, i); ++j)
+            if (!isfinite(w->covariates[i * w->n_covariates + j]))
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s:%zu: covariate '%s': a covariate needs a number at every kept "
+                                     "weighing, found %g", s.source, line_of(w, i),
+                                     w->covariate_names && w->covariate_names[j] ? w->covariate_names[j] : "?",
+                                     w->covariates[i * w->n_covariates + j]);
     return PHC_OK;
 }
 
-/* The times of the selected rows: numbers in the time unit, or for
- * timestamps hours since the first selected row.  *origin is the POSIX time
- * at tv = 0 (NAN when unknown); w->timezone is set. */
-static int time_values(const phc_yaml_doc *doc, const time_spec *ts, const phc_table *t,
-                       const size_t *keep, size_t n, phc_units *units, wc_impl *w, double **tv,
-                       double *origin, phc_error *err)
+/* The weighings kept (not skipped), their masses in g, and where the curve
+ * restarts: an irrigation (a rise above the threshold) starts a new piece
+ * with jumps = split and is an error with jumps = error. */
+typedef struct kept {
+    size_t n, *at;          /* indices of the weighings kept */
+    double *mass;           /* n, g */
+    double jump;            /* the rise that counts as a jump, g */
+    size_t n_pieces;
+} kept;
+
+static int keep_weighings(const phc_weighings *w, const phc_weight_curve_options *opt, kept *k, phc_error *err)
 {
-    int rc = PHC_OK;
-    *origin = NAN;
-    if (ts->tz && !(w->timezone = strdup(ts->tz)))
+    const series_info s = info_of(w);
+    k->at = malloc((w->n ? w->n : 1) * sizeof *k->at);
+    k->mass = malloc((w->n ? w->n : 1) * sizeof *k->mass);
+    if (!k->at || !k->mass)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if (!ts->stamp) {
-        phc_unit_conversion ac;
-        phc_error ignore;
-        if ((rc = phc_table_column_numbers_rows(t, ts->col[0], keep, n, tv, err))) {
-            const char *found = err ? strstr(err->message, "found '") : NULL;
-            if (found && strpbrk(found + 8, ":/")) /* a date or a clock time */
-                snprintf(err->message + strlen(err->message), sizeof err->message - strlen(err->message),
-                         "; for date and time text give time: {column: NAME, format: ..., timezone: ...}");
-            return rc;
+    for (size_t i = 0; i < w->n; ++i)
+        if (!skipped(w, i)) {
+            k->mass[k->n] = w->mass[i] * s.gpu;
+            k->at[k->n++] = i;
         }
-        if (strstr(ts->unit, "since") && !phc_units_conversion(units, ts->unit, "seconds since 1970-01-01 00:00:00 UTC", "", &ac, &ignore))
-            *origin = ac.offset;
-        return PHC_OK;
+    if (k->n < 2)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: %zu weighing%s left after select and exclude; a weight curve needs at least 2",
+                             s.source, k->n, k->n == 1 ? "" : "s");
+    if (isnan(opt->jump_threshold)) {
+        double mmax = 0;
+        for (size_t i = 0; i < k->n; ++i)
+            mmax = fmax(mmax, k->mass[i]);
+        k->jump = fmax(isnan(opt->sigma) ? 0 : 5 * opt->sigma * s.gpu, 0.005 * mmax);
+    } else {
+        k->jump = opt->jump_threshold * s.gpu;
     }
-    long c[2] = {phc_table_find(t, ts->col[0]), ts->col[1] ? phc_table_find(t, ts->col[1]) : -1};
-    if (ts->col[1] && c[1] < 0)
-        return phc_unknown_column(doc, ts->line, "time column", ts->col[1], t, err);
-    char what[160];
-    if (ts->col[1])
-        snprintf(what, sizeof what, "columns '%s' and '%s'", ts->col[0], ts->col[1]);
-    else
-        snprintf(what, sizeof what, "column '%s'", ts->col[0]);
-    char **text = calloc(n ? n : 1, sizeof *text);
-    size_t *lines = malloc((n ? n : 1) * sizeof *lines);
-    *tv = malloc((n ? n : 1) * sizeof **tv);
-    if (!text || !lines || !*tv)
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    for (size_t i = 0; i < n && !rc; ++i) {
-        const char *a = phc_table_cell(t, keep[i], (size_t)c[0]);
-        const char *b = ts->col[1] ? phc_table_cell(t, keep[i], (size_t)c[1]) : NULL;
-        lines[i] = phc_table_row_line(t, keep[i]);
-        if (!(text[i] = malloc(strlen(a) + (b ? strlen(b) + 2 : 1))))
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    k->n_pieces = 1;
+    for (size_t i = 1; i < k->n; ++i)
+        if (k->mass[i] - k->mass[i - 1] > k->jump) {
+            if (opt->jumps == PHC_WEIGHT_JUMPS_ERROR)
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s:%zu: the mass rises by %g g since line %zu (an irrigation?); set `jumps: split` or `exclude` the window",
+                                     s.source, line_of(w, k->at[i]), k->mass[i] - k->mass[i - 1],
+                                     line_of(w, k->at[i - 1]));
+            if (opt->jumps == PHC_WEIGHT_JUMPS_SPLIT)
+                ++k->n_pieces;
+        }
+    return PHC_OK;
+}
+
+/* The model's part of the data set: graph, edge weights, evaluator, the
+ * clock and what reading the logger found (for the report). */
+static int impl_new(const phc_plant_graph *plant, const phc_weighings *w, const phc_weight_curve_options *opt,
+                    wc_impl **out, phc_error *err)
+{
+    wc_impl *m = calloc(1, sizeof *m);
+    *out = m;
+    if (!m)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (int q = 0; q < N_SLOT_KINDS; ++q)
+        m->slot[q] = -1;
+    m->params = phc_water_params_default();
+    m->params.weights = opt->conductance;
+    m->method = opt->method;
+    m->viscosity = !isnan(opt->viscosity) ? opt->viscosity
+                   : opt->conductance >= PHC_WATER_REFERENCE ? 0.9 /* the authors' code */
+                                                             : 0.89; /* mPa·s, water at 25 °C */
+    m->dry_measured = opt->dry_mass;
+    m->step = opt->step;
+    m->seconds_per_x = info_of(w).spx;
+    m->tare_n = w->tare_n;
+    m->tare_line[0] = w->tare_line[0];
+    m->tare_line[1] = w->tare_line[1];
+    m->max_gap = w->max_gap;
+    m->n_gaps = w->gap_s && w->gap_line ? w->n_gaps : 0;
+    m->graph = phc_plant_graph_copy(plant);
+    if (!m->graph || (w->timezone && !(m->timezone = strdup(w->timezone))))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (m->n_gaps) {
+        m->gap_s = malloc(m->n_gaps * sizeof *m->gap_s);
+        m->gap_line = malloc(m->n_gaps * sizeof *m->gap_line);
+        if (!m->gap_s || !m->gap_line)
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        memcpy(m->gap_s, w->gap_s, m->n_gaps * sizeof *m->gap_s);
+        memcpy(m->gap_line, w->gap_line, m->n_gaps * sizeof *m->gap_line);
+    }
+    return PHC_OK;
+}
+
+/* Day and night, covariates, a pot (weight_drivers.h), over the kept
+ * weighings' times since the first (s). */
+static int drivers(wc_impl *m, const phc_weighings *w, const kept *k, const phc_weight_curve_options *opt,
+                   phc_error *err)
+{
+    const size_t J = w->n_covariates;
+    double *cov = J ? malloc(k->n * J * sizeof *cov) : NULL;
+    m->t_abs = malloc(k->n * sizeof *m->t_abs);
+    if (!m->t_abs || (J && !cov)) {
+        free(cov);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    const double t0 = w->t[k->at[0]];
+    for (size_t i = 0; i < k->n; ++i) {
+        m->t_abs[i] = (w->t[k->at[i]] - t0) * m->seconds_per_x;
+        for (size_t j = 0; j < J; ++j)
+            cov[i * J + j] = w->covariates[k->at[i] * J + j];
+    }
+    const double first_posix = w->calendar ? w->t0_posix + t0 * m->seconds_per_x : NAN;
+    int rc = phc_weight_drivers_init(&opt->day, &opt->pot, cov, w->covariate_names, J, m->t_abs, k->n,
+                                     first_posix, m->timezone, opt->origin, &m->drv, err);
+    free(cov);
+    if (rc)
+        return rc;
+    m->n_coef = phc_weight_drivers_coef_count(&m->drv);
+    return PHC_OK;
+}
+
+/* Slots: delta, one initial water per piece (initial_water, then
+ * initial_water_2, ...), dry_mass unless measured, viscosity when the user
+ * made it a parameter, then the drivers' (night_factor, loss_<col>,
+ * pot_capacity, pot_conductance). */
+static int name_slots(phc_dataset **out, wc_impl *m, size_t n_pieces, int viscosity_slot, phc_error *err)
+{
+    const size_t n_drv = phc_weight_drivers_slot_count(&m->drv);
+    const size_t k_slots = 1 + n_pieces + isnan(m->dry_measured) + (viscosity_slot != 0) + n_drv;
+    phc_dataset *ds = phc_dataset_new(&phc_weight_curve_ops, k_slots);
+    *out = ds;
+    m->pieces = calloc(n_pieces, sizeof *m->pieces);
+    if (!m->pieces || !ds)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    size_t js = 0;
+    char slot_name[48];
+    m->slot[SLOT_DELTA] = (int)js;
+    ds->slot_names[js++] = strdup("delta");
+    for (size_t q = 0; q < n_pieces; ++q) {
+        if (q == 0)
+            snprintf(slot_name, sizeof slot_name, "initial_water");
         else
-            sprintf(text[i], b ? "%s %s" : "%s", a, b);
+            snprintf(slot_name, sizeof slot_name, "initial_water_%zu", q + 1);
+        m->pieces[q].slot = (int)js;
+        ds->slot_names[js++] = strdup(slot_name);
     }
-    phc_logger_clock clock = {ts->format, ts->tz, phc_table_source(t), what};
-    if (!rc && !(rc = phc_logger_times(&clock, (const char *const *)text, lines, n, *tv, err)) && n) {
-        *origin = (*tv)[0];
-        for (size_t i = n; i-- > 0;)
-            (*tv)[i] = ((*tv)[i] - *origin) / 3600.0;
+    if (isnan(m->dry_measured)) {
+        m->slot[SLOT_DRY] = (int)js;
+        ds->slot_names[js++] = strdup("dry_mass");
     }
-    for (size_t i = 0; text && i < n; ++i)
-        free(text[i]);
-    free(text);
-    free(lines);
+    if (viscosity_slot) {
+        m->slot[SLOT_MU] = (int)js;
+        ds->slot_names[js++] = strdup("viscosity");
+    }
+    m->drv_slot = n_drv ? (int)js : -1;
+    if (n_drv && phc_weight_drivers_slot_names(&m->drv, ds->slot_names + js))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t j = 0; j < k_slots; ++j)
+        if (!ds->slot_names[j])
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
+/* The observations (x: time unit since the first weighing kept, y: g), their
+ * sigmas and lines, and each one's time since the start of its piece (s). */
+static int fill_series(phc_dataset *ds, wc_impl *m, const phc_weighings *w, const kept *k,
+                       const phc_weight_curve_options *opt, phc_error *err)
+{
+    const series_info s = info_of(w);
+    const size_t n = k->n;
+    const int weighted = w->sigma || !isnan(opt->sigma);
+    m->t_model = malloc(n * sizeof *m->t_model);
+    ds->n = n;
+    ds->x = malloc(n * sizeof *ds->x);
+    ds->y = malloc(n * sizeof *ds->y);
+    ds->sigma = weighted ? malloc(n * sizeof *ds->sigma) : NULL;
+    ds->data_lines = malloc(n * sizeof *ds->data_lines);
+    ds->data_file = strdup(s.source);
+    if (!m->t_model || !ds->x || !ds->y || !ds->data_lines || !ds->data_file || (weighted && !ds->sigma))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    const double t0 = w->t[k->at[0]];
+    double piece_t0 = t0;
+    size_t q = 0;
+    m->pieces[0].start_x = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const double tv = w->t[k->at[i]];
+        if (i > 0 && opt->jumps == PHC_WEIGHT_JUMPS_SPLIT && k->mass[i] - k->mass[i - 1] > k->jump) {
+            m->pieces[q].count = i - m->pieces[q].first;
+            ++q;
+            m->pieces[q].first = i;
+            m->pieces[q].start_x = tv - t0;
+            piece_t0 = tv;
+        }
+        ds->x[i] = tv - t0;
+        ds->y[i] = k->mass[i];
+        m->t_model[i] = (tv - piece_t0) * s.spx;
+        if (ds->sigma)
+            ds->sigma[i] = w->sigma ? w->sigma[k->at[i]] * s.gpu : opt->sigma * s.gpu;
+        ds->data_lines[i] = line_of(w, k->at[i]);
+    }
+    m->pieces[q].count = n - m->pieces[q].first;
+    m->n_pieces = k->n_pieces;
+    return PHC_OK;
+}
+
+/* x_seconds, t0_posix and the local clock of every weighing kept. */
+static int set_clock(phc_dataset *ds, wc_impl *w, double origin, double first, phc_error *err)
+{
+    ds->x_seconds = w->seconds_per_x;
+    w->t0_posix = origin + first * w->seconds_per_x;
+    if (isnan(w->t0_posix))
+        return PHC_OK;
+    if (!(ds->time_of_day = malloc(ds->n * sizeof *ds->time_of_day)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < ds->n; ++i)
+        ds->time_of_day[i] = w->t0_posix + ds->x[i] * w->seconds_per_x;
+    int rc = phc_local_clocks(w->timezone, ds->time_of_day, ds->n, ds->time_of_day, err);
+    for (size_t i = 0; i < ds->n && !rc; ++i)
+        ds->time_of_day[i] /= 3600.0;
     return rc;
 }
 
-static int cmp_double(const void *a, const void *b)
+/* The distinct model times, the workspace, the clock and the labels. */
+static int finish(phc_dataset *ds, wc_impl *m, const phc_weighings *w, const kept *k,
+                  const phc_weight_curve_options *opt, phc_error *err)
 {
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* `tare` and `max_gap`: drops the tare readings at the start of the selected
- * rows (each below 50% of the median of the 10 readings after it; at least 2
- * rows stay) and lists the pauses longer than max_gap (default 6 h, or 3
- * median steps, so that daily weighings are not all gaps). */
-static int tare_and_gaps(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_units *units,
-                         const phc_table *t, size_t *keep, double *tv, double *mv, size_t *n_sel,
-                         wc_impl *w, phc_error *err)
-{
-    static const char *const tare_names[] = {"auto", "keep", NULL};
-    int tare = 0, rc;
-    const phc_yaml_node *mg = phc_yaml_get(node, "max_gap");
-    w->max_gap = 6 * 3600.0;
-    if ((rc = parse_choice(doc, node, "tare", tare_names, &tare, err)))
+    const series_info s = info_of(w);
+    int rc;
+    if ((rc = phc_unique_times(m->t_model, ds->n, &m->t_unique, &m->m_unique, &m->t_at, err)))
         return rc;
-    if (mg && mg->kind == PHC_YAML_SCALAR) {
-        if ((rc = phc_yaml_number(doc, mg, "max_gap", &w->max_gap, err)))
-            return rc;
-        w->max_gap *= w->seconds_per_x;
-    } else if (mg && (rc = quantity(doc, mg, "max_gap", "h", "s", units, t, keep[0], &w->max_gap, err))) {
+    const size_t rows = m->m_unique > ds->n ? m->m_unique : ds->n;
+    m->u = malloc(rows * sizeof *m->u);
+    m->du = malloc(rows * (PHC_WB_COEF + m->n_coef) * sizeof *m->du);
+    if ((rc = set_clock(ds, m, w->calendar ? w->t0_posix : NAN, w->t[k->at[0]], err)))
         return rc;
-    }
-    if (!(w->max_gap > 0))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'max_gap': must be positive", doc->path, mg->line);
-    size_t k = 0, n = *n_sel;
-    while (tare == 0 && k + 2 < n) {
-        double next[10];
-        size_t m = 0;
-        for (size_t j = k + 1; j < n && m < 10; ++j)
-            next[m++] = mv[j];
-        qsort(next, m, sizeof *next, cmp_double);
-        const double median = m % 2 ? next[m / 2] : 0.5 * (next[m / 2 - 1] + next[m / 2]);
-        if (!(mv[k] < 0.5 * median))
-            break;
-        ++k;
-    }
-    if (k > 0) {
-        w->tare_n = k;
-        w->tare_line[0] = phc_table_row_line(t, keep[0]);
-        w->tare_line[1] = phc_table_row_line(t, keep[k - 1]);
-        memmove(keep, keep + k, (n - k) * sizeof *keep);
-        memmove(tv, tv + k, (n - k) * sizeof *tv);
-        memmove(mv, mv + k, (n - k) * sizeof *mv);
-        *n_sel = n -= k;
-    }
-    double *step = mg || n < 2 ? NULL : malloc((n - 1) * sizeof *step);
-    if (step) { /* default: 6 h, or 3 times the median step of sparse weighings */
-        for (size_t i = 1; i < n; ++i)
-            step[i - 1] = tv[i] - tv[i - 1];
-        qsort(step, n - 1, sizeof *step, cmp_double);
-        w->max_gap = fmax(w->max_gap, 3 * step[(n - 1) / 2] * w->seconds_per_x);
-        free(step);
-    }
-    for (size_t i = 1; i < n; ++i)
-        if ((tv[i] - tv[i - 1]) * w->seconds_per_x > w->max_gap) {
-            double *g = realloc(w->gap_s, (w->n_gaps + 1) * sizeof *g);
-            size_t *l = g ? realloc(w->gap_line, (w->n_gaps + 1) * sizeof *l) : NULL;
-            if (g)
-                w->gap_s = g;
-            if (!l)
-                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            w->gap_line = l;
-            w->gap_s[w->n_gaps] = (tv[i] - tv[i - 1]) * w->seconds_per_x;
-            w->gap_line[w->n_gaps++] = phc_table_row_line(t, keep[i - 1]);
-        }
+    if (!m->u || !m->du)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    ds->derivatives = PHC_DERIV_ANALYTIC;
+    /* BDF6 with its extrapolated start reaches ~1e-10 relative (model/water.h) */
+    ds->model_tolerance = 1e-10;
+    char label[160];
+    snprintf(label, sizeof label, "time since the first weighing (%s)", s.time_unit);
+    ds->x_label = strdup(opt->x_label ? opt->x_label : label);
+    ds->y_label = strdup(opt->y_label ? opt->y_label : "mass (g)");
+    if (!ds->x_label || !ds->y_label)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    ds->config_line = phc_origin_line(opt->origin, NULL);
     return PHC_OK;
 }
+
+int phc_weight_curve_new(const phc_plant_graph *plant, const phc_weighings *w,
+                         const phc_weight_curve_options *opt, phc_dataset **out, phc_error *err)
+{
+    phc_dataset *ds = NULL;
+    wc_impl *m = NULL;
+    kept k = {0};
+    int rc;
+
+    *out = NULL;
+    const int viscosity_slot = opt->is_parameter && opt->is_parameter("viscosity", opt->user_data);
+    if ((rc = check_options(plant, w, opt, err)) || (rc = check_weighings(w, opt, err)) ||
+        (rc = keep_weighings(w, opt, &k, err)) || (rc = impl_new(plant, w, opt, &m, err)) ||
+        (rc = drivers(m, w, &k, opt, err)) || (rc = name_slots(&ds, m, k.n_pieces, viscosity_slot, err)) ||
+        (rc = fill_series(ds, m, w, &k, opt, err)) || (rc = finish(ds, m, w, &k, opt, err)))
+        goto fail;
+    ds->impl = m;
+    m = NULL;
+    *out = ds;
+    ds = NULL;
+fail:
+    phc_dataset_free(ds);
+    wc_free(m);
+    free(k.at);
+    free(k.mass);
+    return rc;
+}
+
+/* ---- the report -------------------------------------------------------------- */
 
 /* The report rows of a logger file: the clock, tare readings, long gaps. */
 static void logger_rows(const wc_impl *w, char *buf, size_t size)
@@ -636,495 +681,6 @@ static void logger_rows(const wc_impl *w, char *buf, size_t size)
         if (used < size)
             snprintf(buf + used, size - used, "%s |\n", w->n_gaps > 10 ? ", ..." : "");
     }
-}
-
-/* x_seconds, t0_posix and the local clock of every weighing kept. */
-static int set_clock(phc_dataset *ds, wc_impl *w, double origin, double first, phc_error *err)
-{
-    ds->x_seconds = w->seconds_per_x;
-    w->t0_posix = origin + first * w->seconds_per_x;
-    if (isnan(w->t0_posix))
-        return PHC_OK;
-    if (!(ds->time_of_day = malloc(ds->n * sizeof *ds->time_of_day)))
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    for (size_t i = 0; i < ds->n; ++i)
-        ds->time_of_day[i] = w->t0_posix + ds->x[i] * w->seconds_per_x;
-    int rc = phc_local_clocks(w->timezone, ds->time_of_day, ds->n, ds->time_of_day, err);
-    for (size_t i = 0; i < ds->n && !rc; ++i)
-        ds->time_of_day[i] /= 3600.0;
-    return rc;
-}
-
-enum { JUMPS_ERROR, JUMPS_SPLIT, JUMPS_KEEP };
-
-int phc_weight_curve_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                          const char *base_dir, phc_is_parameter_fn is_parameter,
-                          void *user_data, phc_dataset **out, phc_error *err)
-{
-    const char *ctx = "weight_curve data set";
-    const char *file = NULL, *tcol = NULL, *tunit = NULL, *mcol = NULL, *munit = NULL;
-    const char *x_label = NULL, *y_label = NULL;
-    phc_units *units = NULL;
-    phc_table *table = NULL;
-    phc_dataset *ds = NULL;
-    wc_impl *w = NULL;
-    char *path = NULL, *gpath = NULL; /* the data file; the plant-graph file (or NULL) */
-    double *tv = NULL, *mv = NULL, *sv = NULL;
-    size_t *keep = NULL;
-    long *sel_cols = NULL;
-    int rc;
-    time_spec ts;
-    double t_origin = NAN; /* POSIX time at tv = 0, NAN when unknown */
-
-    *out = NULL;
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = time_spec_read(doc, node, &ts, err)) ||
-        (rc = phc_column_spec(doc, node, "mass", "weight_curve data set", "g", &mcol, &munit, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
-        return rc;
-    tcol = ts.col[0];
-    tunit = ts.stamp ? "h" : ts.unit; /* timestamps: hours since the first weighing */
-    if (!(units = phc_units_new(err)))
-        return err->status;
-    w = calloc(1, sizeof *w);
-    if (!w) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    w->params = phc_water_params_default();
-    w->method = PHC_WATER_AUTO;
-    w->viscosity = 0.89; /* mPa·s, water at 25 °C (model/water.h) */
-    w->dry_measured = NAN;
-
-    /* Units: time to s, mass to g. */
-    phc_unit_conversion tconv, mconv;
-    char where[160];
-    snprintf(where, sizeof where, "%s:%zu: time unit", doc->path, phc_yaml_get(node, "time")->line);
-    if ((rc = phc_units_conversion(units, tunit, "s", where, &tconv, err)))
-        goto fail;
-    snprintf(where, sizeof where, "%s:%zu: mass unit", doc->path, phc_yaml_get(node, "mass")->line);
-    if ((rc = phc_units_conversion(units, munit, "g", where, &mconv, err)))
-        goto fail;
-    w->seconds_per_x = tconv.scale;
-
-    if (!(path = phc_join_path(base_dir, file))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = phc_table_read(path, &table, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
-    }
-    const size_t rows = phc_table_rows(table);
-    if (phc_table_find(table, tcol) < 0) {
-        rc = phc_unknown_column(doc, phc_yaml_get(node, "time")->line, "time column", tcol, table, err);
-        goto fail;
-    }
-    if (phc_table_find(table, mcol) < 0) {
-        rc = phc_unknown_column(doc, phc_yaml_get(node, "mass")->line, "mass column", mcol, table, err);
-        goto fail;
-    }
-
-    /* Rows of this plant. */
-    const phc_yaml_node *sel = phc_yaml_get(node, "select");
-    if (sel) {
-        if (sel->kind != PHC_YAML_MAPPING) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'select': expected a mapping {COLUMN: VALUE}",
-                               doc->path, sel->line);
-            goto fail;
-        }
-        sel_cols = malloc((sel->count ? sel->count : 1) * sizeof *sel_cols);
-        if (!sel_cols) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (size_t i = 0; i < sel->count; ++i) {
-            sel_cols[i] = phc_table_find(table, sel->keys[i]);
-            if (sel_cols[i] < 0) {
-                rc = phc_unknown_column(doc, sel->key_lines[i], "select column", sel->keys[i], table, err);
-                goto fail;
-            }
-            if (sel->values[i]->kind != PHC_YAML_SCALAR) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: select '%s': expected a value",
-                                   doc->path, sel->key_lines[i], sel->keys[i]);
-                goto fail;
-            }
-        }
-    }
-    keep = malloc((rows ? rows : 1) * sizeof *keep);
-    if (!keep) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    size_t n_sel = 0;
-    for (size_t r = 0; r < rows; ++r)
-        if (row_selected(table, r, sel, sel_cols))
-            keep[n_sel++] = r;
-    if (n_sel == 0) {
-        rc = sel ? phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'select': no row of %s matches", doc->path,
-                                 phc_key_line(node, "select"), path)
-                 : phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
-                                 path);
-        goto fail;
-    }
-    if ((rc = time_values(doc, &ts, table, keep, n_sel, units, w, &tv, &t_origin, err)) ||
-        (rc = phc_table_column_numbers_rows(table, mcol, keep, n_sel, &mv, err)) ||
-        (rc = tare_and_gaps(doc, node, units, table, keep, tv, mv, &n_sel, w, err)))
-        goto fail;
-    for (size_t i = 0; i < n_sel; ++i) {
-        if (i > 0 && !(tv[i] > tv[i - 1])) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: column '%s': time %g is not after the previous weighing's %g (line %zu); weighings must be in time order",
-                               path, phc_table_row_line(table, keep[i]), tcol, tv[i], tv[i - 1],
-                               phc_table_row_line(table, keep[i - 1]));
-            goto fail;
-        }
-        if (!(mv[i] > 0)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': a mass must be positive, found %g",
-                               path, phc_table_row_line(table, keep[i]), mcol, mv[i]);
-            goto fail;
-        }
-    }
-
-    /* Per-point sigma (mass unit -> g). */
-    const phc_yaml_node *sig = phc_yaml_get(node, "sigma");
-    double sigma_scalar = NAN;
-    if (sig) {
-        if (sig->kind == PHC_YAML_SCALAR && phc_table_find(table, sig->scalar) >= 0) {
-            if ((rc = phc_table_column_numbers_rows(table, sig->scalar, keep, n_sel, &sv, err)))
-                goto fail;
-            for (size_t i = 0; i < n_sel; ++i)
-                if (!(sv[i] > 0)) {
-                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
-                                       path, phc_table_row_line(table, keep[i]), sig->scalar, sv[i]);
-                    goto fail;
-                }
-        } else {
-            if ((rc = phc_yaml_number(doc, sig, "sigma", &sigma_scalar, err)))
-                goto fail;
-            if (!(sigma_scalar > 0)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': must be positive, found %g",
-                                   doc->path, sig->line, sigma_scalar);
-                goto fail;
-            }
-        }
-    }
-
-    /* Measured dry mass: fixes the slot and bounds the masses. */
-    const phc_yaml_node *dry = phc_yaml_get(node, "dry_mass");
-    if (dry) {
-        if ((rc = quantity(doc, dry, "dry_mass", munit, "g", units, table, keep[0], &w->dry_measured, err)))
-            goto fail;
-        for (size_t i = 0; i < n_sel; ++i)
-            if (phc_unit_apply(mconv, mv[i]) < w->dry_measured) {
-                rc = phc_error_set(err, PHC_ERR_INPUT,
-                                   "%s:%zu: column '%s': mass %g is below the measured dry mass %g %s",
-                                   path, phc_table_row_line(table, keep[i]), mcol, mv[i],
-                                   (w->dry_measured - mconv.offset) / mconv.scale, munit);
-                goto fail;
-            }
-    }
-
-    /* The plant: a graph file or a leaf's venation chain. */
-    const phc_yaml_node *plant = phc_yaml_get(node, "plant");
-    const phc_yaml_node *area = phc_yaml_get(node, "leaf_area");
-    if ((plant != NULL) == (area != NULL)) {
-        rc = phc_error_set(err, PHC_ERR_INPUT,
-                           "%s:%zu: weight_curve data set: give either 'plant' (a plant-graph file) or 'leaf_area' (a detached leaf)",
-                           doc->path, node->line);
-        goto fail;
-    }
-    if (plant) {
-        const char *pfile = NULL, *fmt_name = "auto", *punit = NULL;
-        if ((rc = phc_yaml_string(doc, plant, "plant", &pfile, err)) ||
-            (rc = phc_yaml_map_string(doc, node, "plant_format", 0, ctx, &fmt_name, err)) ||
-            (rc = phc_yaml_map_string(doc, node, "plant_unit", 0, ctx, &punit, err)))
-            goto fail;
-        int fmt = phc_plant_format_from_name(fmt_name);
-        if (fmt < 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: key 'plant_format': '%s' is not one of auto, paper, treeqsm, swc, native",
-                               doc->path, phc_yaml_get(node, "plant_format")->line, fmt_name);
-            goto fail;
-        }
-        double to_m = 0;
-        if (punit) {
-            phc_unit_conversion lc;
-            snprintf(where, sizeof where, "%s:%zu: plant_unit", doc->path, phc_yaml_get(node, "plant_unit")->line);
-            if ((rc = phc_units_conversion(units, punit, "m", where, &lc, err)))
-                goto fail;
-            to_m = lc.scale;
-        }
-        if (!(gpath = phc_join_path(base_dir, pfile))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        if ((rc = phc_plant_io_read(gpath, (phc_plant_format)fmt, to_m, &w->graph, err))) {
-            if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-                phc_error_prefix(err, rc, "%s:%zu: key 'plant'", doc->path, phc_key_line(node, "plant"));
-            goto fail;
-        }
-        if (phc_plant_graph_leaf_count(w->graph) == 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: plant '%s' has no leaf segments, so it cannot lose water",
-                               doc->path, plant->line, pfile);
-            goto fail;
-        }
-    } else {
-        double area_m2 = 0, radius_m = 0.5e-3;
-        long segments = 20;
-        if ((rc = quantity(doc, area, "leaf_area", "cm2", "m2", units, table, keep[0], &area_m2, err)) ||
-            (rc = phc_yaml_map_integer(doc, node, "chain_segments", 0, ctx, &segments, err)))
-            goto fail;
-        const phc_yaml_node *vr = phc_yaml_get(node, "vein_radius");
-        if (vr && (rc = quantity(doc, vr, "vein_radius", "mm", "m", units, table, keep[0], &radius_m, err)))
-            goto fail;
-        if (segments < 2 || segments > 100000) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'chain_segments': expected 2 to 100000, found %ld",
-                               doc->path, phc_yaml_get(node, "chain_segments")->line, segments);
-            goto fail;
-        }
-        w->graph = phc_plant_graph_leaf_chain(area_m2, (size_t)segments, radius_m);
-        if (!w->graph) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: cannot build a leaf of area %g m2 and vein radius %g m",
-                               doc->path, area->line, area_m2, radius_m);
-            goto fail;
-        }
-    }
-
-    /* Model options. */
-    static const char *const cond_names[] = {"poiseuille", "mean", "paper", "reference",
-                                             "reference_2024", NULL};
-    static const char *const method_names[] = {"auto", "exact", "bdf6", NULL};
-    static const char *const jump_names[] = {"error", "split", "keep", NULL};
-    int cond = 0, method = 0, jumps = JUMPS_ERROR;
-    double step = 0, jump_threshold = NAN;
-    if ((rc = parse_choice(doc, node, "conductance", cond_names, &cond, err)) ||
-        (rc = parse_choice(doc, node, "method", method_names, &method, err)) ||
-        (rc = parse_choice(doc, node, "jumps", jump_names, &jumps, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "step", 0, ctx, &step, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "jump_threshold", 0, ctx, &jump_threshold, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "viscosity", 0, ctx, &w->viscosity, err)))
-        goto fail;
-    static const phc_water_weights cond_values[] = {PHC_WATER_POISEUILLE, PHC_WATER_MEAN_CONDUCTANCE,
-                                                    PHC_WATER_PAPER, PHC_WATER_REFERENCE,
-                                                    PHC_WATER_REFERENCE_2024};
-    static const phc_water_method method_values[] = {PHC_WATER_AUTO, PHC_WATER_EXACT, PHC_WATER_BDF6};
-    w->params.weights = cond_values[cond];
-    w->method = method_values[method];
-    if (!phc_yaml_get(node, "viscosity") && cond >= 3)
-        w->viscosity = 0.9; /* the authors' code */
-    if (step < 0 || !(w->viscosity > 0) || (!isnan(jump_threshold) && !(jump_threshold > 0))) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: weight_curve data set: step must be >= 0, viscosity and jump_threshold positive",
-                           doc->path, node->line);
-        goto fail;
-    }
-    w->step = step * tconv.scale;
-
-    /* Exclusion windows, then irrigation jumps, over the selected rows. */
-    const phc_yaml_node *excl = phc_yaml_get(node, "exclude");
-    if (excl && excl->kind != PHC_YAML_SEQUENCE) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'exclude': expected a list of [from, to] windows",
-                           doc->path, excl->line);
-        goto fail;
-    }
-    size_t n_kept = 0;
-    const double t_first = tv[0]; /* the loop below overwrites tv[0] once a row is dropped */
-    for (size_t i = 0; i < n_sel; ++i) {
-        const double rel = tv[i] - t_first;
-        int drop = 0;
-        for (size_t e = 0; excl && e < excl->count && !drop; ++e) {
-            const phc_yaml_node *win = excl->items[e];
-            double lo, hi;
-            if (win->kind != PHC_YAML_SEQUENCE || win->count != 2 ||
-                phc_yaml_number(doc, win->items[0], "exclude", &lo, err) ||
-                phc_yaml_number(doc, win->items[1], "exclude", &hi, err) || !(lo < hi)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT,
-                                   "%s:%zu: key 'exclude': each window is [from, to] with from < to (time unit, from the first row)",
-                                   doc->path, win->line);
-                goto fail;
-            }
-            drop = rel >= lo && rel <= hi;
-        }
-        if (drop)
-            continue;
-        tv[n_kept] = tv[i];
-        mv[n_kept] = phc_unit_apply(mconv, mv[i]);
-        if (sv)
-            sv[n_kept] = sv[i] * mconv.scale;
-        keep[n_kept++] = keep[i];
-    }
-    if (n_kept < 2) {
-        rc = phc_error_set(err, PHC_ERR_INPUT,
-                           "%s: %zu weighing%s left after select and exclude; a weight curve needs at least 2",
-                           path, n_kept, n_kept == 1 ? "" : "s");
-        goto fail;
-    }
-    if (isnan(jump_threshold)) {
-        double mmax = 0;
-        for (size_t i = 0; i < n_kept; ++i)
-            mmax = fmax(mmax, mv[i]);
-        jump_threshold = fmax(isnan(sigma_scalar) ? 0 : 5 * sigma_scalar * mconv.scale, 0.005 * mmax);
-    } else {
-        jump_threshold *= mconv.scale;
-    }
-
-    /* Pieces: an irrigation (a rise above the threshold) starts a new one. */
-    size_t n_pieces = 1;
-    for (size_t i = 1; i < n_kept; ++i)
-        if (mv[i] - mv[i - 1] > jump_threshold) {
-            if (jumps == JUMPS_ERROR) {
-                rc = phc_error_set(err, PHC_ERR_INPUT,
-                                   "%s:%zu: the mass rises by %g g since line %zu (an irrigation?); set `jumps: split` or `exclude` the window",
-                                   path, phc_table_row_line(table, keep[i]), mv[i] - mv[i - 1],
-                                   phc_table_row_line(table, keep[i - 1]));
-                goto fail;
-            }
-            if (jumps == JUMPS_SPLIT)
-                ++n_pieces;
-        }
-
-    /* Day and night, covariates, a pot (weight_drivers.h), over the kept
-     * weighings' times since the first (s). */
-    w->t_abs = malloc(n_kept * sizeof *w->t_abs);
-    if (!w->t_abs) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t i = 0; i < n_kept; ++i)
-        w->t_abs[i] = (tv[i] - tv[0]) * w->seconds_per_x;
-    if ((rc = phc_weight_drivers_load(doc, node, table, keep, w->t_abs, n_kept,
-                                      t_origin + tv[0] * w->seconds_per_x, w->timezone, &w->drv, err)))
-        goto fail;
-    w->n_coef = phc_weight_drivers_coef_count(&w->drv);
-    const size_t n_drv = phc_weight_drivers_slot_count(&w->drv);
-
-    /* Slots: delta, one initial water per piece (initial_water, then
-     * initial_water_2, ...), dry_mass unless measured, viscosity when the
-     * user made it a parameter, then the drivers' (night_factor, loss_<col>,
-     * pot_capacity, pot_conductance). */
-    const size_t k_slots =
-        1 + n_pieces + isnan(w->dry_measured) + is_parameter("viscosity", user_data) + n_drv;
-    for (int q = 0; q < N_SLOT_KINDS; ++q)
-        w->slot[q] = -1;
-    w->pieces = calloc(n_pieces, sizeof *w->pieces);
-    ds = phc_dataset_new(&weight_curve_ops, k_slots);
-    if (!w->pieces || !ds) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    size_t js = 0;
-    char slot_name[48];
-    w->slot[SLOT_DELTA] = (int)js;
-    ds->slot_names[js++] = strdup("delta");
-    for (size_t q = 0; q < n_pieces; ++q) {
-        if (q == 0)
-            snprintf(slot_name, sizeof slot_name, "initial_water");
-        else
-            snprintf(slot_name, sizeof slot_name, "initial_water_%zu", q + 1);
-        w->pieces[q].slot = (int)js;
-        ds->slot_names[js++] = strdup(slot_name);
-    }
-    if (isnan(w->dry_measured)) {
-        w->slot[SLOT_DRY] = (int)js;
-        ds->slot_names[js++] = strdup("dry_mass");
-    }
-    if (js + n_drv < k_slots) {
-        w->slot[SLOT_MU] = (int)js;
-        ds->slot_names[js++] = strdup("viscosity");
-    }
-    w->drv_slot = n_drv ? (int)js : -1;
-    if (n_drv && phc_weight_drivers_slot_names(&w->drv, ds->slot_names + js)) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    js += n_drv;
-    for (size_t j = 0; j < k_slots; ++j)
-        if (!ds->slot_names[j]) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-
-    const size_t n = n_kept;
-    w->t_model = malloc(n * sizeof *w->t_model);
-    ds->n = n;
-    ds->x = malloc(n * sizeof *ds->x);
-    ds->y = malloc(n * sizeof *ds->y);
-    ds->sigma = (sv || !isnan(sigma_scalar)) ? malloc(n * sizeof *ds->sigma) : NULL;
-    ds->data_lines = malloc(n * sizeof *ds->data_lines);
-    ds->data_file = strdup(path);
-    if (!w->t_model || !ds->x || !ds->y || !ds->data_lines || !ds->data_file ||
-        ((sv || !isnan(sigma_scalar)) && !ds->sigma) || phc_dataset_add_input(ds, path) ||
-        (gpath && phc_dataset_add_input(ds, gpath))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    size_t k = 0;
-    double piece_t0 = tv[0];
-    w->pieces[0].start_x = 0;
-    for (size_t i = 0; i < n_kept; ++i) {
-        if (i > 0 && jumps == JUMPS_SPLIT && mv[i] - mv[i - 1] > jump_threshold) {
-            w->pieces[k].count = i - w->pieces[k].first;
-            ++k;
-            w->pieces[k].first = i;
-            w->pieces[k].start_x = tv[i] - tv[0];
-            piece_t0 = tv[i];
-        }
-        ds->x[i] = tv[i] - tv[0];
-        ds->y[i] = mv[i];
-        w->t_model[i] = (tv[i] - piece_t0) * tconv.scale;
-        if (ds->sigma)
-            ds->sigma[i] = sv ? sv[i] : sigma_scalar * mconv.scale;
-        ds->data_lines[i] = phc_table_row_line(table, keep[i]);
-    }
-    w->pieces[k].count = n_kept - w->pieces[k].first;
-    w->n_pieces = n_pieces;
-    if ((rc = phc_unique_times(w->t_model, n, &w->t_unique, &w->m_unique, &w->t_at, err)))
-        goto fail;
-    {
-        const size_t rows = w->m_unique > n ? w->m_unique : n;
-        w->u = malloc(rows * sizeof *w->u);
-        w->du = malloc(rows * (PHC_WB_COEF + w->n_coef) * sizeof *w->du);
-    }
-    if ((rc = set_clock(ds, w, t_origin, tv[0], err)))
-        goto fail;
-    if (!w->u || !w->du) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-
-    ds->derivatives = PHC_DERIV_ANALYTIC;
-    /* BDF6 with its extrapolated start reaches ~1e-10 relative (model/water.h) */
-    ds->model_tolerance = 1e-10;
-    char label[160];
-    snprintf(label, sizeof label, "time since the first weighing (%s)", tunit);
-    ds->x_label = strdup(x_label ? x_label : label);
-    ds->y_label = strdup(y_label ? y_label : "mass (g)");
-    if (!ds->x_label || !ds->y_label) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    ds->config_line = node->line;
-    ds->impl = w;
-    w = NULL;
-    *out = ds;
-    ds = NULL;
-    rc = PHC_OK;
-fail:
-    phc_dataset_free(ds);
-    wc_free(w);
-    phc_table_free(table);
-    phc_units_free(units);
-    free(path);
-    free(gpath);
-    free(tv);
-    free(mv);
-    free(sv);
-    free(keep);
-    free(sel_cols);
-    return rc;
 }
 
 /* Report rows of the drivers: the night's loss, the covariates' law, the pot. */

@@ -7,12 +7,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
-#include "measurements/c_number.h"
 #include "measurements/logger_time.h"
 
 #define DAY_S 86400.0
+
+/* The place of a message about option `key` (fit/costs/origin.h). */
+#define WHERE(key) phc_origin_key(origin, "weight_curve", key).text
 
 void phc_weight_drivers_free(phc_weight_drivers *d)
 {
@@ -29,38 +29,6 @@ void phc_weight_drivers_free(phc_weight_drivers *d)
     memset(d, 0, sizeof *d);
 }
 
-/* "HH:MM" or "HH:MM:SS" -> s since midnight, or -1. */
-static double clock_seconds(const char *s)
-{
-    int h = -1, m = -1, sec = 0, used = 0;
-    if (sscanf(s, "%2d:%2d%n", &h, &m, &used) != 2)
-        return -1;
-    if (s[used] == ':') {
-        int more = 0;
-        if (sscanf(s + used + 1, "%2d%n", &sec, &more) != 1)
-            return -1;
-        used += 1 + more;
-    }
-    if (s[used] || h < 0 || h > 24 || m < 0 || m > 59 || sec < 0 || sec > 59 || (h == 24 && (m || sec)))
-        return -1;
-    return h * 3600.0 + m * 60.0 + sec;
-}
-
-static int clock_key(const phc_yaml_doc *doc, const phc_yaml_node *map, const char *key, int required,
-                     double *out, phc_error *err)
-{
-    const char *s = NULL;
-    int rc = phc_yaml_map_string(doc, map, key, required, "key 'day'", &s, err);
-    if (rc || !s)
-        return rc;
-    *out = clock_seconds(s);
-    if (*out < 0)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: day: %s '%s' is not a clock time; expected \"HH:MM\" (24 h)",
-                             doc->path, phc_yaml_get(map, key)->line, key, s);
-    return PHC_OK;
-}
-
 static int grow(phc_weight_drivers *d, size_t cap)
 {
     double *s = realloc(d->start, cap * sizeof *s);
@@ -74,74 +42,87 @@ static int grow(phc_weight_drivers *d, size_t cap)
     return PHC_OK;
 }
 
+/* The day's starts and ends (s since the first weighing) from a day start
+ * at or before 0 to beyond t_max: through the time zone on a calendar, else
+ * from the clock time of the first weighing.  *starts, *ends malloc'd. */
+static int day_changes(const phc_weight_day *day, double t_max, double t0_posix, const char *timezone,
+                       double **starts, size_t *ns, double **ends, size_t *ne, phc_error *err)
+{
+    int rc;
+    *starts = *ends = NULL;
+    if (!isnan(t0_posix)) {
+        const double lo = t0_posix, hi = t0_posix + t_max;
+        if ((rc = phc_local_daily_times(timezone, lo, hi, day->start, starts, ns, err)) ||
+            (rc = phc_local_daily_times(timezone, lo, hi, day->end, ends, ne, err))) {
+            free(*starts);
+            *starts = NULL;
+            return rc;
+        }
+        for (size_t i = 0; i < *ns; ++i)
+            (*starts)[i] -= t0_posix;
+        for (size_t i = 0; i < *ne; ++i)
+            (*ends)[i] -= t0_posix;
+        return PHC_OK;
+    }
+    const size_t days = (size_t)ceil(t_max / DAY_S) + 3;
+    *starts = malloc(days * sizeof **starts);
+    *ends = malloc(days * sizeof **ends);
+    if (!*starts || !*ends)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t k = 0; k < days; ++k) {
+        (*starts)[k] = ((double)k - 1) * DAY_S + day->start - day->clock;
+        (*ends)[k] = ((double)k - 1) * DAY_S + day->end - day->clock;
+    }
+    *ns = *ne = days;
+    return PHC_OK;
+}
+
+/* The schedule's values: start before end, a night factor >= 0, and the
+ * clock of the first weighing exactly when there is no calendar. */
+static int check_day(const phc_weight_day *day, int stamped, const phc_origin *origin, phc_error *err)
+{
+    if (!(day->start >= 0 && day->end <= DAY_S) || !(isnan(day->clock) || (day->clock >= 0 && day->clock <= DAY_S)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: day: start, end and clock must be clock times, 0 to "
+                             "86400 s since midnight, found %g, %g and %g", WHERE("day"), day->start,
+                             day->end, day->clock);
+    if (!(day->start < day->end))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: day: start (%02d:%02d) must be before end (%02d:%02d) on the "
+                             "same day", WHERE("day.start"),
+                             (int)(day->start / 3600), (int)fmod(day->start / 60, 60),
+                             (int)(day->end / 3600), (int)fmod(day->end / 60, 60));
+    if (!isnan(day->night_factor) && !(day->night_factor >= 0 && isfinite(day->night_factor)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: day: night_factor must be >= 0, found %g",
+                             WHERE("day.night_factor"), day->night_factor);
+    if (stamped == !isnan(day->clock))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             stamped ? "%s: day: the weighings have dates and times, so 'clock' is "
+                                       "not needed; remove it"
+                                     : "%s: day: the time column is a plain number, so give "
+                                       "`clock: \"HH:MM\"`, the local time of the first weighing",
+                             WHERE(stamped ? "day.clock" : "day"));
+    return PHC_OK;
+}
+
 /* Light schedule: intervals alternating day / night over the curve, from a
  * day start at or before 0 to beyond t_max.  The starts and ends are local
  * clock times: with a time zone they are placed day by day through it. */
-static int load_schedule(const phc_yaml_doc *doc, const phc_yaml_node *day, double t_max,
-                         double t0_posix, const char *timezone, phc_weight_drivers *d,
-                         phc_error *err)
+static int load_schedule(const phc_weight_day *day, double t_max, double t0_posix, const char *timezone,
+                         const phc_origin *origin, phc_weight_drivers *d, phc_error *err)
 {
-    static const char *const keys[] = {"start", "end", "night_factor", "clock", NULL};
     int rc;
-    if (day->kind != PHC_YAML_MAPPING)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: key 'day': expected {start: \"HH:MM\", end: \"HH:MM\", "
-                             "night_factor: F}", doc->path, day->line);
-    double clock0 = NAN;
-    d->night_factor = NAN;
-    if ((rc = phc_yaml_check_keys(doc, day, keys, "key 'day'", err)) ||
-        (rc = clock_key(doc, day, "start", 1, &d->day_start, err)) ||
-        (rc = clock_key(doc, day, "end", 1, &d->day_end, err)) ||
-        (rc = clock_key(doc, day, "clock", 0, &clock0, err)) ||
-        (rc = phc_yaml_map_number(doc, day, "night_factor", 0, "key 'day'", &d->night_factor, err)))
+    if ((rc = check_day(day, !isnan(t0_posix), origin, err)))
         return rc;
-    if (!(d->day_start < d->day_end))
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: day: start (%02d:%02d) must be before end (%02d:%02d) on the "
-                             "same day", doc->path, phc_yaml_get(day, "start")->line,
-                             (int)(d->day_start / 3600), (int)fmod(d->day_start / 60, 60),
-                             (int)(d->day_end / 3600), (int)fmod(d->day_end / 60, 60));
-    const phc_yaml_node *nf = phc_yaml_get(day, "night_factor");
-    if (nf && !(d->night_factor >= 0))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: day: night_factor must be >= 0, found %g",
-                             doc->path, nf->line, d->night_factor);
-    const int stamped = !isnan(t0_posix);
-    if (stamped == !isnan(clock0))
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             stamped ? "%s:%zu: day: the weighings have dates and times, so 'clock' is "
-                                       "not needed; remove it"
-                                     : "%s:%zu: day: the time column is a plain number, so give "
-                                       "`clock: \"HH:MM\"`, the local time of the first weighing",
-                             doc->path, stamped ? phc_yaml_get(day, "clock")->line : day->line);
+    d->day_start = day->start;
+    d->day_end = day->end;
+    d->night_factor = day->night_factor;
     d->schedule = 1;
-    /* day starts and ends (s since the first weighing) */
     double *starts = NULL, *ends = NULL;
     size_t ns = 0, ne = 0;
-    if (stamped) {
-        const double lo = t0_posix, hi = t0_posix + t_max;
-        if ((rc = phc_local_daily_times(timezone, lo, hi, d->day_start, &starts, &ns, err)) ||
-            (rc = phc_local_daily_times(timezone, lo, hi, d->day_end, &ends, &ne, err))) {
-            free(starts);
-            return rc;
-        }
-        for (size_t i = 0; i < ns; ++i)
-            starts[i] -= t0_posix;
-        for (size_t i = 0; i < ne; ++i)
-            ends[i] -= t0_posix;
-    } else {
-        const size_t days = (size_t)ceil(t_max / DAY_S) + 3;
-        starts = malloc(days * sizeof *starts);
-        ends = malloc(days * sizeof *ends);
-        if (!starts || !ends) {
-            free(starts);
-            free(ends);
-            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        }
-        for (size_t k = 0; k < days; ++k) {
-            starts[k] = ((double)k - 1) * DAY_S + d->day_start - clock0;
-            ends[k] = ((double)k - 1) * DAY_S + d->day_end - clock0;
-        }
-        ns = ne = days;
+    if ((rc = day_changes(day, t_max, t0_posix, timezone, &starts, &ns, &ends, &ne, err))) {
+        free(starts);
+        free(ends);
+        return rc;
     }
     /* merge: a start opens a day, an end a night; keep from the last change
      * at or before 0 */
@@ -166,129 +147,71 @@ static int load_schedule(const phc_yaml_doc *doc, const phc_yaml_node *day, doub
     free(starts);
     free(ends);
     if (d->n == 0 || d->start[0] > 0)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: day: the schedule does not cover the first "
-                             "weighing", doc->path, day->line);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: day: the schedule does not cover the first "
+                             "weighing", WHERE("day"));
     return PHC_OK;
 }
 
-static int load_covariates(const phc_yaml_doc *doc, const phc_yaml_node *cov, const phc_table *table,
-                           const size_t *rows, const double *t, size_t n_rows, phc_weight_drivers *d,
-                           phc_error *err)
+/* Covariates: interval i = [t_i, t_{i+1}) takes the mean of its two
+ * readings of each column (the last interval its own reading). */
+static int load_covariates(const double *x, const char *const *names, size_t J, const double *t,
+                           size_t n_rows, phc_weight_drivers *d, phc_error *err)
 {
-    static const char *const keys[] = {"columns", "law", NULL};
-    const char *law = "linear";
-    int rc;
-    if (cov->kind != PHC_YAML_MAPPING)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: key 'covariates': expected {columns: [NAME, ...], law: linear}",
-                             doc->path, cov->line);
-    if ((rc = phc_yaml_check_keys(doc, cov, keys, "key 'covariates'", err)) ||
-        (rc = phc_yaml_map_string(doc, cov, "law", 0, "key 'covariates'", &law, err)))
-        return rc;
-    if (strcmp(law, "linear") != 0)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: covariates: law '%s' is not known; the one law is linear "
-                             "(g = 1 + sum of loss_<column> x column)",
-                             doc->path, phc_yaml_get(cov, "law")->line, law);
-    const phc_yaml_node *cols = phc_yaml_get(cov, "columns");
-    if (!cols || cols->kind != PHC_YAML_SEQUENCE || cols->count == 0)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: covariates: 'columns' must be a non-empty list of column names",
-                             doc->path, cols ? cols->line : cov->line);
-    const size_t J = cols->count;
-    d->n_cov = J;
-    d->cov_names = calloc(J, sizeof *d->cov_names);
-    d->cov_x = malloc(n_rows * J * sizeof *d->cov_x);
-    double *v = malloc(n_rows * sizeof *v);
-    if (!d->cov_names || !d->cov_x || !v || grow(d, n_rows)) {
-        free(v);
+    if (!(d->cov_names = calloc(J, sizeof *d->cov_names)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    }
+    d->n_cov = J;
+    d->cov_x = malloc((n_rows ? n_rows : 1) * J * sizeof *d->cov_x);
+    if (!d->cov_x || grow(d, n_rows ? n_rows : 1))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     for (size_t j = 0; j < J; ++j) {
-        const phc_yaml_node *c = cols->items[j];
-        if (c->kind != PHC_YAML_SCALAR) {
-            free(v);
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: covariates: expected a column name",
-                                 doc->path, c->line);
-        }
-        long col = phc_table_find(table, c->scalar);
-        if (col < 0) {
-            free(v);
-            return phc_unknown_column(doc, c->line, "covariate column", c->scalar, table, err);
-        }
-        if (!(d->cov_names[j] = strdup(c->scalar))) {
-            free(v);
+        if (!(d->cov_names[j] = strdup(names && names[j] ? names[j] : "covariate")))
             return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        }
-        for (size_t i = 0; i < n_rows; ++i) {
-            const char *cell = phc_table_cell(table, rows[i], (size_t)col);
-            char *end = NULL;
-            v[i] = phc_strtod_c(cell, &end);
-            if (!end || end == cell || *end || !isfinite(v[i])) {
-                rc = phc_error_set(err, PHC_ERR_INPUT,
-                                   "%s:%zu: column '%s': a covariate needs a number at every kept "
-                                   "weighing, found '%s'", phc_table_source(table),
-                                   phc_table_row_line(table, rows[i]), c->scalar, cell);
-                free(v);
-                return rc;
-            }
-        }
-        /* interval i = [t_i, t_{i+1}): the mean of its two readings */
         for (size_t i = 0; i < n_rows; ++i)
-            d->cov_x[i * J + j] = i + 1 < n_rows ? 0.5 * (v[i] + v[i + 1]) : v[i];
+            d->cov_x[i * J + j] = i + 1 < n_rows ? 0.5 * (x[i * J + j] + x[(i + 1) * J + j]) : x[i * J + j];
     }
-    free(v);
     d->n = n_rows;
     for (size_t i = 0; i < n_rows; ++i)
         d->start[i] = t[i];
     return PHC_OK;
 }
 
-static int load_pot(const phc_yaml_doc *doc, const phc_yaml_node *pot, phc_weight_drivers *d,
+static int load_pot(const phc_weight_pot *pot, const phc_origin *origin, phc_weight_drivers *d,
                     phc_error *err)
 {
-    static const char *const keys[] = {"capacity", "conductance", NULL};
-    int rc;
-    if (pot->kind != PHC_YAML_MAPPING)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: key 'pot': expected {capacity: GRAMS, conductance: G_PER_S} "
-                             "(either may be left out to fit it)", doc->path, pot->line);
+    if (!isnan(pot->capacity) && !(pot->capacity > 0 && isfinite(pot->capacity)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: pot: capacity must be > 0 g, found %g",
+                             WHERE("pot.capacity"), pot->capacity);
+    if (!isnan(pot->conductance) && !(pot->conductance >= 0 && isfinite(pot->conductance)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: pot: conductance must be >= 0 g/s, found %g",
+                             WHERE("pot.conductance"), pot->conductance);
     d->pot = 1;
-    d->capacity = d->conductance = NAN;
-    if ((rc = phc_yaml_check_keys(doc, pot, keys, "key 'pot'", err)) ||
-        (rc = phc_yaml_map_number(doc, pot, "capacity", 0, "key 'pot'", &d->capacity, err)) ||
-        (rc = phc_yaml_map_number(doc, pot, "conductance", 0, "key 'pot'", &d->conductance, err)))
-        return rc;
-    const phc_yaml_node *c = phc_yaml_get(pot, "capacity"), *k = phc_yaml_get(pot, "conductance");
-    if (c && !(d->capacity > 0 && isfinite(d->capacity)))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: pot: capacity must be > 0 g, found %g",
-                             doc->path, c->line, d->capacity);
-    if (k && !(d->conductance >= 0 && isfinite(d->conductance)))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: pot: conductance must be >= 0 g/s, found %g",
-                             doc->path, k->line, d->conductance);
+    d->capacity = pot->capacity;
+    d->conductance = pot->conductance;
     return PHC_OK;
 }
 
-int phc_weight_drivers_load(const phc_yaml_doc *doc, const phc_yaml_node *node,
-                            const phc_table *table, const size_t *rows, const double *t,
-                            size_t n_rows, double t0_posix, const char *timezone,
-                            phc_weight_drivers *d, phc_error *err)
+int phc_weight_drivers_init(const phc_weight_day *day, const phc_weight_pot *pot,
+                            const double *covariates, const char *const *names, size_t n_cov,
+                            const double *t, size_t n_rows, double t0_posix, const char *timezone,
+                            const phc_origin *origin, phc_weight_drivers *d, phc_error *err)
 {
     memset(d, 0, sizeof *d);
     d->night_factor = d->capacity = d->conductance = NAN;
-    const phc_yaml_node *day = phc_yaml_get(node, "day"), *cov = phc_yaml_get(node, "covariates"),
-                        *pot = phc_yaml_get(node, "pot");
+    const int schedule = day && day->on;
     int rc = PHC_OK;
-    if (day && cov)
+    if (schedule && n_cov)
         return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s:%zu: give either 'day' (a light schedule) or 'covariates', not both",
-                             doc->path, cov->line);
-    if (day)
-        rc = load_schedule(doc, day, n_rows ? t[n_rows - 1] : 0, t0_posix, timezone, d, err);
-    else if (cov)
-        rc = load_covariates(doc, cov, table, rows, t, n_rows, d, err);
-    if (!rc && pot)
-        rc = load_pot(doc, pot, d, err);
+                             "%s: give either 'day' (a light schedule) or 'covariates', not both",
+                             WHERE("covariates"));
+    if (n_cov && !covariates)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: %zu covariates without readings",
+                             WHERE("covariates"), n_cov);
+    if (schedule)
+        rc = load_schedule(day, n_rows ? t[n_rows - 1] : 0, t0_posix, timezone, origin, d, err);
+    else if (n_cov)
+        rc = load_covariates(covariates, names, n_cov, t, n_rows, d, err);
+    if (!rc && pot && pot->on)
+        rc = load_pot(pot, origin, d, err);
     const size_t nc = phc_weight_drivers_coef_count(d);
     if (!rc && d->n) {
         d->g = malloc(d->n * sizeof *d->g);
