@@ -10,6 +10,7 @@
  *   photo_register_bridge.cc  ECC registration, correlation, warping
  *   photo_veins_bridge.cc     ridge (vein) maps and their scores
  *   photo_draw_bridge.cc      text and the viridis colour map
+ * Colour arithmetic (sRGB transfer function, CIELAB, ΔE) is model/colour.h's.
  *
  * Every extern "C" function catches every exception (PHOTO_CATCH below) and
  * turns it into a status and a one-line message; sizes are validated before

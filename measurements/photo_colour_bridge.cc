@@ -1,6 +1,7 @@
 /* measurements/photo_colour_bridge.cc: colour correction of photos, gray
  * world and ColorChecker (measurements/photo.h; OpenCV core and contrib's
- * mcc).  What the photo bridge files share is in photo_bridge.h. */
+ * mcc).  The sRGB transfer function, CIELAB and ΔE00 are model/colour.h's.
+ * What the photo bridge files share is in photo_bridge.h. */
 #include "measurements/photo_bridge.h"
 
 #include "model/colour.h"
@@ -10,7 +11,6 @@
 #include <opencv2/mcc/ccm.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -18,45 +18,13 @@
 
 using namespace phc_photo;
 
-/* ---- sRGB transfer function (IEC 61966-2-1) and CIELAB (D65) ------------------ */
-
-static double srgb_decode(double v)
-{
-    return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
-
-static double srgb_encode(double v)
-{
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
-}
-
-/* Linear sRGB -> CIELAB (D65, 2°): IEC 61966-2-1 matrix, CIE 15 Lab.  Kept
- * on linear values (not phc_colour_srgb_to_lab) because the ColorChecker's
- * cyan patch lies slightly outside the sRGB gamut (negative linear red),
- * which the gamma encoding cannot represent. */
-static void linear_to_lab(const double rgb[3], double lab[3])
-{
-    const double X = 0.4124564 * rgb[0] + 0.3575761 * rgb[1] + 0.1804375 * rgb[2];
-    const double Y = 0.2126729 * rgb[0] + 0.7151522 * rgb[1] + 0.0721750 * rgb[2];
-    const double Z = 0.0193339 * rgb[0] + 0.1191920 * rgb[1] + 0.9503041 * rgb[2];
-    const double wx = 0.95047, wy = 1.0, wz = 1.08883;
-    auto f = [](double t) {
-        const double d = 6.0 / 29.0;
-        return t > d * d * d ? std::cbrt(t) : t / (3 * d * d) + 4.0 / 29.0;
-    };
-    const double fx = f(X / wx), fy = f(Y / wy), fz = f(Z / wz);
-    lab[0] = 116 * fy - 16;
-    lab[1] = 500 * (fx - fy);
-    lab[2] = 200 * (fy - fz);
-}
-
 /* Linear-light copy (IEC 61966-2-1 decoding) of a phc_image, CV_64FC3. */
 static cv::Mat linear_copy(const phc_image *img)
 {
     cv::Mat lin = mat_of(img).clone();
     lin.forEach<cv::Vec3d>([](cv::Vec3d &p, const int *) {
         for (int c = 0; c < 3; ++c)
-            p[c] = srgb_decode(std::max(0.0, p[c]));
+            p[c] = phc_colour_srgb_decode(std::max(0.0, p[c]));
     });
     return lin;
 }
@@ -76,7 +44,7 @@ static double store_linear(const cv::Mat &lin, phc_image *img)
                 clip = true;
                 v = std::min(1.0, std::max(0.0, v));
             }
-            img->data[3 * i + c] = srgb_encode(v);
+            img->data[3 * i + c] = phc_colour_srgb_encode(v);
         }
         clipped += clip;
     }
@@ -174,6 +142,17 @@ static bool find_checker(const phc_image *img, double meas[24][3], std::string &
     return true;
 }
 
+/* CIELAB of a linear-light colour: encoded without clipping, then
+ * phc_colour_srgb_to_lab.  The ColorChecker's cyan patch lies slightly
+ * outside the sRGB gamut (negative linear red); the transfer function's
+ * linear segment carries such values through exactly (colour.h). */
+static void linear_to_lab(const double lin[3], double lab[3])
+{
+    const double rgb[3] = {phc_colour_srgb_encode(lin[0]), phc_colour_srgb_encode(lin[1]),
+                           phc_colour_srgb_encode(lin[2])};
+    phc_colour_srgb_to_lab(rgb, lab);
+}
+
 /* Least-squares 3x3 matrix, linear RGB, measured -> reference, over the
  * patches with no clipped component (a clipped patch's mean is not its
  * colour).  ΔE00 (Sharma et al. 2005, phc_colour_de2000) before and after,
@@ -197,7 +176,7 @@ static int checker_fit(const double meas[24][3], const double ref[24][3],
     cv::Mat A(n, 3, CV_64F), B(n, 3, CV_64F), X;
     for (int k = 0; k < n; ++k)
         for (int c = 0; c < 3; ++c) {
-            A.at<double>(k, c) = srgb_decode(meas[use[k]][c]);
+            A.at<double>(k, c) = phc_colour_srgb_decode(meas[use[k]][c]);
             B.at<double>(k, c) = ref[use[k]][c];
         }
     if (!cv::solve(A, B, X, cv::DECOMP_SVD)) { /* B ≈ A X, so M = X^T */
@@ -217,7 +196,7 @@ static int checker_fit(const double meas[24][3], const double ref[24][3],
                              rep->matrix[3 * r + 2] * lin[2];
             cor[r] = std::min(1.0, std::max(0.0, v)); /* as the image will hold it */
         }
-        linear_to_lab(lin, lab_m);
+        phc_colour_srgb_to_lab(meas[use[k]], lab_m); /* as measured (encoded) */
         linear_to_lab(cor, lab_c);
         linear_to_lab(ref[use[k]], lab_r);
         const double before = phc_colour_de2000(lab_m, lab_r), after = phc_colour_de2000(lab_c, lab_r);

@@ -1,7 +1,10 @@
 /* measurements/photo_segment_bridge.cc: leaf segmentation and cropping
- * (measurements/photo.h; OpenCV imgproc).  What the photo bridge files share
- * is in photo_bridge.h. */
+ * (measurements/photo.h; OpenCV imgproc).  The leaf feature is computed in
+ * CIELAB with model/colour.h.  What the photo bridge files share is in
+ * photo_bridge.h. */
 #include "measurements/photo_bridge.h"
+
+#include "model/colour.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -54,26 +57,27 @@ static cv::Vec3f background_colour(const cv::Mat &rgb)
 }
 
 /* Leaf feature: CIELAB chroma relative to the background colour, counted
- * only on the yellow side (b* above the background's), in ΔE*ab units.
+ * only on the yellow side (b* above the background's), in ΔE*ab units
+ * (phc_colour_de76 of the a*, b* components; L* is left out).
  * Chlorophylls, carotenoids and the brown products of senescence all absorb
  * blue light, so green, yellow and brown lamina lie at b* above white paper,
- * while grey rules, shadows and blue-black ink do not. */
+ * while grey rules, shadows and blue-black ink do not.  CIELAB is
+ * model/colour.h's (exact IEC 61966-2-1 and CIE 15 formulas, in double). */
 static cv::Mat leaf_feature(const cv::Mat &rgb, const cv::Vec3f &bg)
 {
-    cv::Mat lab, bglab;
-    cv::cvtColor(rgb, lab, cv::COLOR_RGB2Lab); /* sRGB-encoded float input, D65 */
-    cv::Mat bgm(1, 1, CV_32FC3, cv::Scalar(bg[0], bg[1], bg[2]));
-    cv::cvtColor(bgm, bglab, cv::COLOR_RGB2Lab);
-    const cv::Vec3f ref = bglab.at<cv::Vec3f>(0, 0);
+    const double bg_rgb[3] = {bg[0], bg[1], bg[2]};
+    double ref[3];
+    phc_colour_srgb_to_lab(bg_rgb, ref);
+    ref[0] = 0;
     cv::Mat f(rgb.size(), CV_32F);
-    for (int y = 0; y < rgb.rows; ++y) {
-        const cv::Vec3f *l = lab.ptr<cv::Vec3f>(y);
-        float *o = f.ptr<float>(y);
-        for (int x = 0; x < rgb.cols; ++x) {
-            const float da = l[x][1] - ref[1], db = l[x][2] - ref[2];
-            o[x] = db > 0 ? std::sqrt(da * da + db * db) : 0.0f;
-        }
-    }
+    f.forEach<float>([&](float &o, const int *pos) {
+        const cv::Vec3f &p = rgb.at<cv::Vec3f>(pos[0], pos[1]);
+        const double c[3] = {p[0], p[1], p[2]};
+        double lab[3];
+        phc_colour_srgb_to_lab(c, lab);
+        lab[0] = 0;
+        o = lab[2] > ref[2] ? (float)phc_colour_de76(lab, ref) : 0.0f;
+    });
     return f;
 }
 
