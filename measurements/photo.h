@@ -2,8 +2,9 @@
  * and venation maps, turning real photos into the inputs of the leaf colour
  * aging model (model/leaf.h, model/colour.h; Silva et al. §3).
  *
- * A plain C interface to OpenCV 4.6 (+ contrib: mcc, ximgproc).  Only
- * measurements/photo_bridge.cc touches OpenCV; no C++ type appears here.
+ * A plain C interface to OpenCV 4.6 (+ contrib: mcc, ximgproc).  Only the
+ * measurements/photo_*_bridge.cc files touch OpenCV (photo_bridge.h lists
+ * them); no C++ type appears here.
  * Every function returns PHC_OK (0) or a positive enum phc_status and fills
  * `err` (may be NULL) with a message naming the file (when there is one) and
  * the reason.  Nothing keeps global state.

@@ -35,7 +35,7 @@ static const double xyz_to_srgb_m[3][3] = {
 
 /* IEC 61966-2-1 sRGB decoding (electro-optical transfer): gamma-encoded
  * component -> linear. */
-static double srgb_decode(double c)
+double phc_colour_srgb_decode(double c)
 {
     if (c <= 0.04045)
         return c / 12.92;
@@ -48,10 +48,11 @@ static double srgb_decode(double c)
  * 0.0031308050 (linear branch) to 0.0031308073 (power branch), and the
  * stated encoding threshold 0.0031308 lies below that gap, so colours just
  * under 0.04045 would come back ~3e-8 off.  We switch branch in the middle
- * of the gap instead, so that encoding inverts srgb_decode to rounding on
- * the whole line, even after the 1e-16 perturbations of the XYZ matrices
- * (the two branches differ by < 3e-8 between 0.0031308 and this value). */
-static double srgb_encode(double v)
+ * of the gap instead, so that encoding inverts phc_colour_srgb_decode to
+ * rounding on the whole line, even after the 1e-16 perturbations of the XYZ
+ * matrices (the two branches differ by < 3e-8 between 0.0031308 and this
+ * value). */
+double phc_colour_srgb_encode(double v)
 {
     if (v <= 0.003130806118314028)
         return 12.92 * v;
@@ -80,7 +81,7 @@ void phc_colour_srgb_to_lab(const double rgb[3], double lab[3])
 {
     double lin[3], xyz[3];
     for (int k = 0; k < 3; ++k)
-        lin[k] = srgb_decode(rgb[k]);
+        lin[k] = phc_colour_srgb_decode(rgb[k]);
     for (int r = 0; r < 3; ++r)
         xyz[r] = srgb_to_xyz_m[r][0] * lin[0] + srgb_to_xyz_m[r][1] * lin[1] +
                  srgb_to_xyz_m[r][2] * lin[2];
@@ -101,7 +102,7 @@ void phc_colour_lab_to_srgb(const double lab[3], double rgb[3])
     for (int r = 0; r < 3; ++r) {
         const double lin = xyz_to_srgb_m[r][0] * xyz[0] + xyz_to_srgb_m[r][1] * xyz[1] +
                            xyz_to_srgb_m[r][2] * xyz[2];
-        rgb[r] = srgb_encode(lin);
+        rgb[r] = phc_colour_srgb_encode(lin);
     }
 }
 

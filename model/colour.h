@@ -50,6 +50,15 @@ extern "C" {
 
 typedef enum phc_colour_space { PHC_COLOUR_RGB = 0, PHC_COLOUR_LAB = 1 } phc_colour_space;
 
+/* The IEC 61966-2-1 sRGB transfer function of one component: decode takes
+ * a gamma-encoded value to linear light, encode takes it back.  Neither
+ * clips: the linear segment near 0 extends to negative values (an
+ * out-of-gamut colour such as the ColorChecker's cyan has a negative linear
+ * red), and encode inverts decode to rounding on the whole line (the
+ * standard's two thresholds disagree by ~1e-8; see colour.c). */
+double phc_colour_srgb_decode(double c);
+double phc_colour_srgb_encode(double v);
+
 /* sRGB (gamma-encoded, [0,1]) <-> CIELAB (D65).  lab_to_srgb does not
  * clip: out-of-gamut colours give components outside [0, 1]. */
 void phc_colour_srgb_to_lab(const double rgb[3], double lab[3]);

@@ -975,7 +975,7 @@ inf_config inf_nofile.yaml inf_none.csv "$RAIN_OK"
 fit_case "infiltration: missing data file" "$C/inf_nofile.yaml" "inf_nofile.yaml:7" "key 'file'" "inf_none.csv"
 # ---- end soil ----------------------------------------------------------------
 
-# ---- leaf photos (leaf_photos data sets, measurements/photo_bridge.cc) --------
+# ---- leaf photos (leaf_photos data sets, measurements/photo_*_bridge.cc) ------
 # leaf_png FILE W H [LEAVES] [COLOUR]: green elliptical leaves with a darker
 # midrib on white paper, written with the Python standard library only.
 leaf_png() {

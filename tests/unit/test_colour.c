@@ -116,6 +116,21 @@ static void test_lab(void)
     CHECK_NEAR(lab[0], 32.30, 0.01, 0);
     CHECK_NEAR(lab[1], 79.19, 0.01, 0);
     CHECK_NEAR(lab[2], -107.86, 0.01, 0);
+    /* the transfer function alone: IEC 61966-2-1 values, and encode inverts
+     * decode on the whole line, negative (out-of-gamut) values included */
+    CHECK_NEAR(phc_colour_srgb_decode(0.5), pow(0.555 / 1.055, 2.4), 1e-15, 0);
+    CHECK_NEAR(phc_colour_srgb_decode(0.04), 0.04 / 12.92, 1e-17, 0);
+    CHECK_NEAR(phc_colour_srgb_encode(1.0), 1.0, 1e-15, 0);
+    CHECK_NEAR(phc_colour_srgb_encode(0.002), 12.92 * 0.002, 1e-17, 0);
+    double max_tf = 0.0;
+    for (int i = -200; i <= 1200; ++i) {
+        const double v = i / 1000.0;
+        max_tf = fmax(max_tf, fabs(phc_colour_srgb_encode(phc_colour_srgb_decode(v)) - v));
+    }
+    for (int i = 0; i < ne; ++i)
+        max_tf = fmax(max_tf, fabs(phc_colour_srgb_encode(phc_colour_srgb_decode(edge[i])) - edge[i]));
+    printf("sRGB decode -> encode on [-0.2, 1.2]: max |error| = %.3g\n", max_tf);
+    CHECK(max_tf <= 1e-14);
     /* mid grey: L* of Y = srgb_decode(0.5) = 0.21404 */
     const double grey[3] = {0.5, 0.5, 0.5};
     phc_colour_srgb_to_lab(grey, lab);
