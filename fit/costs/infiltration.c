@@ -10,6 +10,7 @@
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
+#include "fit/config/soil_setup_yaml.h" /* until this kind is YAML-free */
 #include "measurements/c_number.h"
 #include "measurements/table.h"
 #include "measurements/units.h"
@@ -172,6 +173,18 @@ static const phc_dataset_ops infiltration_ops = {"infiltration", inf_predict, in
                                                  inf_report_section, inf_simulate_outputs, NULL, NULL};
 
 
+/* The soil: block (until this kind is YAML-free). */
+static int soil_from_yaml(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc_is_parameter_fn is_parameter,
+                          void *user_data, phc_soil_setup **out, phc_error *err)
+{
+    phc_soil_setup_yaml sy;
+    int rc = phc_soil_setup_yaml_read(doc, soil, &sy, err);
+    if (!rc)
+        rc = phc_soil_setup_new(&sy.options, "infiltration", is_parameter, user_data, out, err);
+    phc_soil_setup_yaml_free(&sy);
+    return rc;
+}
+
 int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                           phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
 {
@@ -207,7 +220,7 @@ int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, co
                            node->line);
         goto fail;
     }
-    if ((rc = phc_soil_setup_parse(doc, soil, is_parameter, user_data, &im->su, err)))
+    if ((rc = soil_from_yaml(doc, soil, is_parameter, user_data, &im->su, err)))
         goto fail;
     if (!im->su->n_rain && !im->su->n_sources) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: infiltration data set: the soil has no rain or source, so "

@@ -10,6 +10,7 @@
 #include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
+#include "fit/config/soil_setup_yaml.h" /* until this kind is YAML-free */
 #include "fit/growth_outputs.h"
 #include "measurements/baad.h"
 #include "measurements/table.h"
@@ -685,6 +686,18 @@ static int load_baad(const phc_yaml_doc *doc, const phc_yaml_node *node, const c
     return rc;
 }
 
+/* The soil: block (until this kind is YAML-free). */
+static int soil_from_yaml(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc_is_parameter_fn is_parameter,
+                          void *user_data, phc_soil_setup **out, phc_error *err)
+{
+    phc_soil_setup_yaml sy;
+    int rc = phc_soil_setup_yaml_read(doc, soil, &sy, err);
+    if (!rc)
+        rc = phc_soil_setup_new(&sy.options, "root_shoot", is_parameter, user_data, out, err);
+    phc_soil_setup_yaml_free(&sy);
+    return rc;
+}
+
 int phc_root_shoot_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                         phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out,
                         phc_error *err)
@@ -785,7 +798,7 @@ int phc_root_shoot_load(const phc_yaml_doc *doc, const phc_yaml_node *node, cons
     }
     /* the soil and the plant's position in it */
     const phc_yaml_node *soil = phc_yaml_get(node, "soil");
-    if (soil && (rc = phc_soil_setup_parse(doc, soil, is_parameter, user_data, &im->su, err)))
+    if (soil && (rc = soil_from_yaml(doc, soil, is_parameter, user_data, &im->su, err)))
         goto fail;
     im->k_soil = im->su ? im->su->k : 0;
     {
