@@ -13,7 +13,6 @@
 #include "fit/costs/leaf_photos.h"
 #include "fit/costs/pv_curve.h"
 #include "fit/costs/root_shoot.h"
-#include "fit/costs/soil_probe.h"
 #include "fit/costs/weight_curve.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/kinds.h"
@@ -65,14 +64,6 @@ static const phc_kind root_shoot_kind = {
     .load_yaml = phc_root_shoot_load,
 };
 
-static const phc_kind soil_probe_kind = {
-    .config = {.name = "soil_probe",
-               .summary = "soil-moisture probe readings over time -> soil permeability p and " "capacity c, globally or per layer (Rhizomorph §6)",
-               .keys = phc_soil_probe_keys,
-               .help = phc_soil_probe_help},
-    .load_yaml = phc_soil_probe_load,
-};
-
 static const phc_kind weight_curve_kind = {
     .config = {.name = "weight_curve",
                .summary = "a plant or detached leaf weighed on a balance while it dries -> " "water-loss rate delta, initial water, dry mass (wilting §3-4)",
@@ -88,7 +79,7 @@ static const phc_kind *const kinds[] = {
     &leaf_photos_kind,
     &pv_curve_kind,
     &root_shoot_kind,
-    &soil_probe_kind,
+    &phc_soil_probe_kind,
     &weight_curve_kind,
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])
