@@ -9,7 +9,6 @@
 
 #include "fit/costs/curve.h"
 #include "fit/costs/elasticity_curve.h"
-#include "fit/costs/infiltration.h"
 #include "fit/costs/leaf_photos.h"
 #include "fit/costs/pv_curve.h"
 #include "fit/costs/root_shoot.h"
@@ -30,14 +29,6 @@ static const phc_kind elasticity_curve_kind = {
                .keys = phc_elasticity_curve_keys,
                .help = phc_elasticity_curve_help},
     .load_yaml = phc_elasticity_curve_load,
-};
-
-static const phc_kind infiltration_kind = {
-    .config = {.name = "infiltration",
-               .summary = "the depth reached by a fraction of the applied rain over time -> soil " "permeability p and capacity c (Rhizomorph §6, Fig. 7)",
-               .keys = phc_infiltration_keys,
-               .help = phc_infiltration_help},
-    .load_yaml = phc_infiltration_load,
 };
 
 static const phc_kind leaf_photos_kind = {
@@ -75,7 +66,7 @@ static const phc_kind weight_curve_kind = {
 static const phc_kind *const kinds[] = {
     &phc_curve_kind,
     &elasticity_curve_kind,
-    &infiltration_kind,
+    &phc_infiltration_kind,
     &leaf_photos_kind,
     &pv_curve_kind,
     &root_shoot_kind,

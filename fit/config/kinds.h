@@ -6,6 +6,7 @@
 #include "fit/config/kind.h"
 
 extern const phc_kind phc_curve_kind;
+extern const phc_kind phc_infiltration_kind;
 extern const phc_kind phc_soil_probe_kind;
 
 #endif /* PHC_CONFIG_KINDS_H */
