@@ -11,7 +11,6 @@
 #include "fit/costs/elasticity_curve.h"
 #include "fit/costs/leaf_photos.h"
 #include "fit/costs/pv_curve.h"
-#include "fit/costs/root_shoot.h"
 #include "fit/costs/weight_curve.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/kinds.h"
@@ -47,14 +46,6 @@ static const phc_kind pv_curve_kind = {
     .load_yaml = phc_pv_curve_load,
 };
 
-static const phc_kind root_shoot_kind = {
-    .config = {.name = "root_shoot",
-               .summary = "harvested plants' root:shoot against basal diameter -> growth parameters " "(phi_rg, ...) and soil p, c (Rhizomorph §5-6)",
-               .keys = phc_root_shoot_keys,
-               .help = phc_root_shoot_help},
-    .load_yaml = phc_root_shoot_load,
-};
-
 static const phc_kind weight_curve_kind = {
     .config = {.name = "weight_curve",
                .summary = "a plant or detached leaf weighed on a balance while it dries -> " "water-loss rate delta, initial water, dry mass (wilting §3-4)",
@@ -69,7 +60,7 @@ static const phc_kind *const kinds[] = {
     &phc_infiltration_kind,
     &leaf_photos_kind,
     &pv_curve_kind,
-    &root_shoot_kind,
+    &phc_root_shoot_kind,
     &phc_soil_probe_kind,
     &weight_curve_kind,
 };

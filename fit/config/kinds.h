@@ -7,6 +7,7 @@
 
 extern const phc_kind phc_curve_kind;
 extern const phc_kind phc_infiltration_kind;
+extern const phc_kind phc_root_shoot_kind;
 extern const phc_kind phc_soil_probe_kind;
 
 #endif /* PHC_CONFIG_KINDS_H */
