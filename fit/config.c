@@ -7,14 +7,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/costs/curve.h"
-#include "fit/costs/infiltration.h"
 #include "fit/costs/leaf_photos.h"
-#include "fit/costs/root_shoot.h"
-#include "fit/costs/soil_probe.h"
-#include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
 #include "fit/config/kinds.h"
+#include "fit/config/soil_setup_yaml.h"
 #include "fit/parameter_units.h"
 #include "fit/config/yaml_keys.h"
 #include "measurements/suggest.h"
@@ -23,14 +19,6 @@
 /* The data-set kinds this build knows, alphabetical: each descriptor
  * (fit/config/kind.h) holds the name, summary, keys and their help, the
  * operations and the YAML translation. */
-static const phc_kind infiltration_kind = {
-    .config = {.name = "infiltration",
-               .summary = "the depth reached by a fraction of the applied rain over time -> soil " "permeability p and capacity c (Rhizomorph §6, Fig. 7)",
-               .keys = phc_infiltration_keys,
-               .help = phc_infiltration_help},
-    .load_yaml = phc_infiltration_load,
-};
-
 static const phc_kind leaf_photos_kind = {
     .config = {.name = "leaf_photos",
                .summary = "photos of an aging leaf -> vein, stomata, inflow and time scales and the " "colour transfer of the leaf colour aging model (Silva et al. §3)",
@@ -39,30 +27,14 @@ static const phc_kind leaf_photos_kind = {
     .load_yaml = phc_leaf_photos_load,
 };
 
-static const phc_kind root_shoot_kind = {
-    .config = {.name = "root_shoot",
-               .summary = "harvested plants' root:shoot against basal diameter -> growth parameters " "(phi_rg, ...) and soil p, c (Rhizomorph §5-6)",
-               .keys = phc_root_shoot_keys,
-               .help = phc_root_shoot_help},
-    .load_yaml = phc_root_shoot_load,
-};
-
-static const phc_kind soil_probe_kind = {
-    .config = {.name = "soil_probe",
-               .summary = "soil-moisture probe readings over time -> soil permeability p and " "capacity c, globally or per layer (Rhizomorph §6)",
-               .keys = phc_soil_probe_keys,
-               .help = phc_soil_probe_help},
-    .load_yaml = phc_soil_probe_load,
-};
-
 static const phc_kind *const kinds[] = {
     &phc_curve_kind,
     &phc_elasticity_curve_kind,
-    &infiltration_kind,
+    &phc_infiltration_kind,
     &leaf_photos_kind,
     &phc_pv_curve_kind,
-    &root_shoot_kind,
-    &soil_probe_kind,
+    &phc_root_shoot_kind,
+    &phc_soil_probe_kind,
     &phc_weight_curve_kind,
 };
 #define N_KINDS (sizeof kinds / sizeof kinds[0])

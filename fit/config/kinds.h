@@ -7,7 +7,10 @@
 
 extern const phc_kind phc_curve_kind;
 extern const phc_kind phc_elasticity_curve_kind;
+extern const phc_kind phc_infiltration_kind;
 extern const phc_kind phc_pv_curve_kind;
+extern const phc_kind phc_root_shoot_kind;
+extern const phc_kind phc_soil_probe_kind;
 extern const phc_kind phc_weight_curve_kind;
 
 #endif /* PHC_CONFIG_KINDS_H */

@@ -7,31 +7,8 @@
 #include <string.h>
 
 #include "fit/costs/soil_fields.h"
-#include "fit/costs/soil_setup.h"
 #include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
-#include "measurements/c_number.h"
-#include "measurements/table.h"
 #include "measurements/units.h"
-
-const char *const phc_infiltration_keys[] = {"file", "time", "depth", "fraction", "sigma", "soil",
-                                             "x_label", "y_label", NULL};
-const phc_key_help phc_infiltration_help[] = {
-    {"file", "CSV table of the infiltration front, relative to the config file. Required."},
-    {"time", "{column: NAME, unit: UNIT} or a column name: time since the start of the run, "
-             "> 0 and increasing; any UDUNITS-2 time unit, default h. Required."},
-    {"depth", "{column: NAME, unit: UNIT} or a column name: the depth above which `fraction` "
-              "of the water applied so far lies, >= 0; any length unit, default m. Required."},
-    {"fraction", "The fraction of the applied water above the depth, in (0, 1]. "
-                 "Default: 0.8 (Rhizomorph Fig. 7)."},
-    {"sigma", "Standard deviation of the depth, > 0: a number or the name of a column, both in "
-              "the depth column's unit. Required."},
-    {"soil", "The soil set-up (the soil: keys below); it must have rain or a source. "
-             "Required."},
-    {"x_label", "Axis label of time. Default: \"time since the start (h)\"."},
-    {"y_label", "Axis label of depth. Default: \"depth of 80% of the applied water (m)\" "
-                "(with the fraction given)."},
-    {NULL, NULL}};
 
 typedef struct inf_impl {
     phc_soil_setup *su;
@@ -168,148 +145,150 @@ static int inf_simulate_outputs(phc_dataset *ds, const double *p, const char *di
     return phc_soil_write_fields(im->su, p, im->t[ds->n - 1], 24, dir, base, ds->name, err);
 }
 
-static const phc_dataset_ops infiltration_ops = {"infiltration", inf_predict, inf_predict_at, inf_free,
-                                                 inf_report_section, inf_simulate_outputs, NULL, NULL};
+const phc_dataset_ops phc_infiltration_ops = {
+    .kind = "infiltration",
+    .predict = inf_predict,
+    .predict_at = inf_predict_at,
+    .free_impl = inf_free,
+    .report_section = inf_report_section,
+    .simulate_outputs = inf_simulate_outputs,
+};
 
-
-int phc_infiltration_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                          phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
+phc_infiltration_options phc_infiltration_options_default(void)
 {
-    const char *ctx = "infiltration data set";
-    const char *file = NULL, *tcol = NULL, *tunit = NULL, *dcol = NULL, *dunit = NULL;
-    const char *x_label = NULL, *y_label = NULL;
-    phc_units *units = NULL;
-    phc_table *table = NULL;
-    phc_dataset *ds = NULL;
-    double *tv = NULL, *dv = NULL, *sv = NULL;
-    char *path = NULL;
+    phc_infiltration_options o = {.time_unit = "h", .depth_unit = "m", .fraction = 0.8, .sigma = NAN};
+    return o;
+}
+
+#define WHERE(key) phc_origin_key(o->origin, "infiltration", key).text
+
+/* The fraction, and a soil that gets water. */
+static int setup_soil(inf_impl *im, const phc_infiltration_options *o, phc_error *err)
+{
     int rc;
-    *out = NULL;
-    inf_impl *im = calloc(1, sizeof *im);
-    if (!im)
+    im->fraction = o->fraction;
+    if (!(im->fraction > 0 && im->fraction <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'fraction': must be in (0, 1], found %g", WHERE("fraction"),
+                             im->fraction);
+    if (!o->soil)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: infiltration data set: missing key 'soil'", WHERE(NULL));
+    if ((rc = phc_soil_setup_new(o->soil, "infiltration", o->is_parameter, o->user_data, &im->su, err)))
+        return rc;
+    if (!im->su->n_rain && !im->su->n_sources)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: infiltration data set: the soil has no rain or source, so "
+                             "nothing infiltrates", phc_origin_key(o->soil->origin, "infiltration", NULL).text);
+    return PHC_OK;
+}
+
+/* The time, depth and sigma columns as numbers (sv NULL for one sigma),
+ * and the conversions of their units to h and m. */
+static int read_columns(const phc_table *table, const phc_infiltration_options *o, double **tv, double **dv,
+                        double **sv, phc_unit_conversion *tconv, phc_unit_conversion *dconv, phc_error *err)
+{
+    const char *tcol = o->time, *dcol = o->depth;
+    phc_units *units = NULL;
+    char where[4300];
+    int rc;
+    if (!tcol || !dcol)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s' is required", WHERE(NULL), tcol ? "depth" : "time");
+    if (!(units = phc_units_new(err)))
+        return err->status;
+    snprintf(where, sizeof where, "%s: time unit", WHERE("time"));
+    rc = phc_units_conversion(units, o->time_unit ? o->time_unit : "h", "h", where, tconv, err);
+    snprintf(where, sizeof where, "%s: depth unit", WHERE("depth"));
+    if (!rc)
+        rc = phc_units_conversion(units, o->depth_unit ? o->depth_unit : "m", "m", where, dconv, err);
+    phc_units_free(units);
+    if (rc)
+        return rc;
+    if (phc_table_find(table, tcol) < 0)
+        return phc_unknown_column_at(WHERE("time"), "key 'time':", tcol, table, err);
+    if (phc_table_find(table, dcol) < 0)
+        return phc_unknown_column_at(WHERE("depth"), "key 'depth':", dcol, table, err);
+    if ((rc = phc_table_column_numbers(table, tcol, tv, err)) || (rc = phc_table_column_numbers(table, dcol, dv, err)))
+        return rc;
+    if (phc_table_rows(table) < 1)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                             phc_table_source(table));
+    if (!o->sigma_column && isnan(o->sigma))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: infiltration data set: missing key 'sigma' (the depth's "
+                             "standard deviation, or a column)", WHERE(NULL));
+    if (o->sigma_column && !isnan(o->sigma))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': give a number or a column, not both",
+                             WHERE("sigma"));
+    if (o->sigma_column && phc_table_find(table, o->sigma_column) < 0)
+        return phc_unknown_column_at(WHERE("sigma"), "key 'sigma':", o->sigma_column, table, err);
+    if (o->sigma_column)
+        return phc_table_column_numbers(table, o->sigma_column, sv, err);
+    return PHC_OK;
+}
+
+/* The observations in h and m; times > 0 and increasing, depths >= 0. */
+static int fill_rows(phc_dataset *ds, inf_impl *im, const phc_table *table, const phc_infiltration_options *o,
+                     const double *tv, const double *dv, const double *sv, phc_unit_conversion tconv,
+                     phc_unit_conversion dconv, phc_error *err)
+{
+    const char *path = phc_table_source(table);
+    if (!(im->t = malloc(ds->n * sizeof *im->t)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    im->fraction = 0.8;
-    const phc_yaml_node *soil = phc_yaml_get(node, "soil");
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_column_spec(doc, node, "time", "infiltration data set", "h", &tcol, &tunit, err)) ||
-        (rc = phc_column_spec(doc, node, "depth", "infiltration data set", "m", &dcol, &dunit, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "fraction", 0, ctx, &im->fraction, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
-        goto fail;
-    if (!(im->fraction > 0 && im->fraction <= 1)) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'fraction': must be in (0, 1], found %g", doc->path,
-                           phc_key_line(node, "fraction"), im->fraction);
-        goto fail;
-    }
-    if (!soil) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: infiltration data set: missing key 'soil'", doc->path,
-                           node->line);
-        goto fail;
-    }
-    if ((rc = phc_soil_setup_parse(doc, soil, is_parameter, user_data, &im->su, err)))
-        goto fail;
-    if (!im->su->n_rain && !im->su->n_sources) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: infiltration data set: the soil has no rain or source, so "
-                           "nothing infiltrates", doc->path, soil->line);
-        goto fail;
-    }
-    if (!(units = phc_units_new(err))) {
-        rc = err->status;
-        goto fail;
-    }
-    phc_unit_conversion tconv, dconv;
-    char where[256];
-    snprintf(where, sizeof where, "%s:%zu: time unit", doc->path, phc_key_line(node, "time"));
-    if ((rc = phc_units_conversion(units, tunit, "h", where, &tconv, err)))
-        goto fail;
-    snprintf(where, sizeof where, "%s:%zu: depth unit", doc->path, phc_key_line(node, "depth"));
-    if ((rc = phc_units_conversion(units, dunit, "m", where, &dconv, err)))
-        goto fail;
-    if (!(path = phc_join_path(base_dir, file))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = phc_table_read(path, &table, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
-    }
-    if ((rc = phc_need_column(doc, node, "time", tcol, table, err)) ||
-        (rc = phc_need_column(doc, node, "depth", dcol, table, err)) ||
-        (rc = phc_table_column_numbers(table, tcol, &tv, err)) ||
-        (rc = phc_table_column_numbers(table, dcol, &dv, err)))
-        goto fail;
-    const size_t n = phc_table_rows(table);
-    if (n < 1) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
-        goto fail;
-    }
-    const phc_yaml_node *sg = phc_yaml_get(node, "sigma");
-    double sigma = NAN;
-    if (!sg) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: infiltration data set: missing key 'sigma' (the depth's "
-                           "standard deviation, or a column)", doc->path, node->line);
-        goto fail;
-    }
-    if (sg->kind == PHC_YAML_SCALAR && phc_table_find(table, sg->scalar) >= 0) {
-        if ((rc = phc_table_column_numbers(table, sg->scalar, &sv, err)))
-            goto fail;
-    } else if ((rc = phc_yaml_number(doc, sg, "sigma", &sigma, err))) {
-        goto fail;
-    }
-    ds = phc_soil_setup_dataset(im->su, &infiltration_ops, n, path);
-    if (!ds || phc_dataset_add_input(ds, path)) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    im->t = malloc(n * sizeof *im->t);
-    if (!im->t) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t r = 0; r < n; ++r) {
+    for (size_t r = 0; r < ds->n; ++r) {
         const size_t line = phc_table_row_line(table, r);
         double t = phc_unit_apply(tconv, tv[r]), d = phc_unit_apply(dconv, dv[r]);
-        double s = sv ? sv[r] * dconv.scale : sigma * dconv.scale;
-        if (!(t > 0) || (r > 0 && !(t > im->t[r - 1]))) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': times must be > 0 (after the start of the "
-                               "run) and increasing, found %g", path, line, tcol, tv[r]);
-            goto fail;
-        }
-        if (!(d >= 0) || !(s > 0)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: a depth must be >= 0 and its sigma > 0 (found %g, %g)",
-                               path, line, dv[r], s / dconv.scale);
-            goto fail;
-        }
+        double s = sv ? sv[r] * dconv.scale : o->sigma * dconv.scale;
+        if (!(t > 0) || (r > 0 && !(t > im->t[r - 1])))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': times must be > 0 (after the start of the "
+                                 "run) and increasing, found %g", path, line, o->time, tv[r]);
+        if (!(d >= 0) || !(s > 0))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: a depth must be >= 0 and its sigma > 0 (found %g, %g)",
+                                 path, line, dv[r], s / dconv.scale);
         im->t[r] = t;
         ds->x[r] = t;
         ds->y[r] = d;
         ds->sigma[r] = s;
         ds->data_lines[r] = line;
     }
+    return PHC_OK;
+}
+
+int phc_infiltration_new(const phc_table *table, const phc_infiltration_options *o, phc_dataset **out,
+                         phc_error *err)
+{
+    phc_dataset *ds = NULL;
+    double *tv = NULL, *dv = NULL, *sv = NULL;
+    phc_unit_conversion tconv, dconv;
+    int rc;
+    *out = NULL;
+    inf_impl *im = calloc(1, sizeof *im);
+    if (!im)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if ((rc = setup_soil(im, o, err)) || (rc = read_columns(table, o, &tv, &dv, &sv, &tconv, &dconv, err)))
+        goto fail;
+    ds = phc_soil_setup_dataset(im->su, &phc_infiltration_ops, phc_table_rows(table), phc_table_source(table));
+    if (!ds) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((rc = fill_rows(ds, im, table, o, tv, dv, sv, tconv, dconv, err)))
+        goto fail;
     char ylab[96];
     snprintf(ylab, sizeof ylab, "depth of %.0f%% of the applied water (m)", 100 * im->fraction);
-    ds->x_label = strdup(x_label ? x_label : "time since the start (h)");
-    ds->y_label = strdup(y_label ? y_label : ylab);
+    ds->x_label = strdup(o->x_label ? o->x_label : "time since the start (h)");
+    ds->y_label = strdup(o->y_label ? o->y_label : ylab);
     if (!ds->x_label || !ds->y_label) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
     ds->derivatives = PHC_DERIV_ANALYTIC;
-    ds->config_line = node->line;
+    ds->config_line = phc_origin_line(o->origin, NULL);
     ds->impl = im;
     im = NULL;
     *out = ds;
     ds = NULL;
     rc = PHC_OK;
 fail:
-    phc_units_free(units);
-    phc_table_free(table);
     free(tv);
     free(dv);
     free(sv);
-    free(path);
     inf_free(im);
     if (ds)
         ds->impl = NULL;

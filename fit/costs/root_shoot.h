@@ -4,6 +4,11 @@
  * fit soil permeability and capacity jointly with growth parameters such
  * as phi_rg.
  *
+ * Built in C with phc_root_shoot_new from the harvested plants
+ * (fit/costs/harvest.h: from arrays, a table or a BAAD study folder) and
+ * options; the config's `kind: root_shoot` mapping is translated into the
+ * same by fit/config/root_shoot_yaml.c:
+ *
  *   - kind: root_shoot
  *     file: harvest.csv             # a table ...
  *     diameter: {column: d, unit: mm}
@@ -42,17 +47,54 @@
 #ifndef PHC_COSTS_ROOT_SHOOT_H
 #define PHC_COSTS_ROOT_SHOOT_H
 
-#include "fit/config_help.h"
-#include "fit/costs/curve.h"
+#include <stdint.h>
+
+#include "fit/costs/harvest.h"
+#include "fit/costs/origin.h"
+#include "fit/costs/soil_setup.h"
 #include "fit/dataset.h"
-#include "measurements/yaml_doc.h"
+#include "model/growth.h"
+#include "model/status.h"
 
-extern const char *const phc_root_shoot_keys[];
-/* Help on each of those keys (fit/config_help.h). */
-extern const phc_key_help phc_root_shoot_help[];
+typedef struct phc_root_shoot_options {
+    double sigma;            /* standard deviation of ln(root mass / shoot mass), > 0
+                                (required; NAN until set) */
+    const char *preset;      /* growth preset: oak (default), cherry, apple, poplar, maple */
+    const phc_growth_params *growth; /* the growth parameters (model/growth.h); NULL: the
+                                        preset's */
+    phc_growth_mode mode;    /* PHC_GROWTH_EXPECTED (default, smooth) or PHC_GROWTH_STOCHASTIC */
+    uint64_t seed;           /* stochastic mode's seed; default 1 */
+    phc_growth_uptake uptake; /* root water uptake: physical (default) or none (the authors'
+                                 code) */
+    double days;             /* longest simulated age, d, > 0; default 365 */
+    double step;             /* growth step, d, 0 < step <= days; default 1 */
+    double plant_x, plant_y; /* where the seed is planted, m in the soil grid; NAN (default):
+                                the centre of the surface */
+    double plant_depth;      /* m below the surface; default 0 */
+    const phc_soil_setup_options *soil; /* the soil (a pot); NULL: none (the roots see the
+                                           growth parameter soil_fill as fill level) */
+    const char *x_label, *y_label; /* NULL: "basal diameter (mm)", "ln(root mass / shoot mass)" */
+    phc_is_parameter_fn is_parameter; /* which soil slots and growth parameters are fitted;
+                                         NULL: p and c (with a soil) and phi_rg */
+    void *user_data;                  /* passed to is_parameter */
+    const phc_origin *origin;         /* where the options came from, for messages; NULL */
+} phc_root_shoot_options;
 
-int phc_root_shoot_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                        phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out,
-                        phc_error *err);
+/* sigma NAN (to be given), preset oak, expected mode, seed 1, physical
+ * uptake, 365 days in steps of 1 d, the plant at the centre of the
+ * surface, no soil. */
+phc_root_shoot_options phc_root_shoot_options_default(void);
+
+/* Builds a root_shoot data set over the harvested plants (copied; they may
+ * be freed afterwards; their input files are recorded as the data set's).
+ * Slots: the soil's (phc_soil_setup_new) first, then the growth parameters
+ * is_parameter accepts, in model/growth.h's order; parameter indices are
+ * left to the caller.  Errors (PHC_ERR_INPUT) name the option (and the
+ * config line when options.origin is set) or the plants' file and line. */
+int phc_root_shoot_new(const phc_harvest *plants, const phc_root_shoot_options *options, phc_dataset **out,
+                       phc_error *err);
+
+/* The operations of root_shoot data sets (ops->kind is "root_shoot"). */
+extern const phc_dataset_ops phc_root_shoot_ops;
 
 #endif /* PHC_COSTS_ROOT_SHOOT_H */

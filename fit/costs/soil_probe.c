@@ -7,39 +7,7 @@
 #include <string.h>
 
 #include "fit/costs/soil_fields.h"
-#include "fit/costs/soil_setup.h"
-#include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
 #include "fit/costs/unique_times.h"
-#include "measurements/soil_probes.h"
-#include "measurements/units.h"
-
-const char *const phc_soil_probe_keys[] = {"file", "time", "probe", "value", "quantity", "start", "probes",
-                                           "sigma", "soil", "x_label", "y_label", NULL};
-const phc_key_help phc_soil_probe_help[] = {
-    {"file", "CSV table of readings (time, probe, value; in time order), relative to the "
-             "config file. Required."},
-    {"time", "{column: NAME, unit: UNIT} or a column name: reading times; any UDUNITS-2 time "
-             "unit, or a timestamp unit such as \"hours since 2024-05-01\" (then start is "
-             "required); default h. Required."},
-    {"probe", "Column of probe ids, each in the probe table. Required."},
-    {"value", "Column of readings, in the quantity's unit. Required."},
-    {"quantity", "What the readings are: water (w, m³/m³) or fill (w/c). Default: water."},
-    {"start", "The reading time of the model's t = 0, in the time unit; no reading may be "
-              "earlier. Default: 0; required with a timestamp unit."},
-    {"probes", "The probe table, one row per probe: {file, id, x, y, depth, sigma}, its CSV "
-               "file (required, relative to the config file) and the names of its columns "
-               "(defaults id, x, y, depth; sigma optional: per-probe standard deviations); lat "
-               "and lon instead of x and y place probes by latitude and longitude (needs the "
-               "soil's geo_origin). x, y in m from the grid's west-south corner, depth in m "
-               "below the surface. Required."},
-    {"sigma", "Standard deviation of a reading, > 0, in the readings' unit, for probes without "
-              "a sigma column. Required unless every probe has one."},
-    {"soil", "The soil set-up (the soil: keys below). Required."},
-    {"x_label", "Axis label of time. Default: \"time since start (h)\"."},
-    {"y_label", "Axis label of the readings. Default: \"water content w (m³/m³)\" or "
-                "\"fill level w/c\"."},
-    {NULL, NULL}};
 
 typedef struct sp_impl {
     phc_soil_setup *su;
@@ -192,200 +160,165 @@ static int sp_name_series(phc_dataset *ds, phc_error *err)
     return phc_dataset_name_series(ds, "probe", im->probes->n, sp_series_name, err);
 }
 
-static const phc_dataset_ops soil_probe_ops = {"soil_probe", sp_predict, NULL, sp_free, sp_report_section,
-                                               sp_simulate_outputs, NULL, sp_name_series};
+const phc_dataset_ops phc_soil_probe_ops = {
+    .kind = "soil_probe",
+    .predict = sp_predict,
+    .free_impl = sp_free,
+    .report_section = sp_report_section,
+    .simulate_outputs = sp_simulate_outputs,
+    .name_series = sp_name_series,
+};
 
-
-
-int phc_soil_probe_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                        phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
+phc_soil_probe_options phc_soil_probe_options_default(void)
 {
-    static const char *const probe_keys[] = {"file", "id", "x", "y", "lat", "lon", "depth", "sigma", NULL};
-    const char *ctx = "soil_probe data set";
-    const char *file = NULL, *tcol = NULL, *tunit = NULL, *pcol = NULL, *vcol = NULL, *quantity = "water";
-    const char *x_label = NULL, *y_label = NULL;
-    phc_units *units = NULL;
-    phc_probe_series *ser = NULL;
-    phc_dataset *ds = NULL;
-    char *path = NULL, *ppath = NULL;
-    int rc;
-    *out = NULL;
-    sp_impl *im = calloc(1, sizeof *im);
-    if (!im)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    const phc_yaml_node *soil = phc_yaml_get(node, "soil"), *pn = phc_yaml_get(node, "probes");
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_column_spec(doc, node, "time", "soil_probe data set", "h", &tcol, &tunit, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "probe", 1, ctx, &pcol, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "value", 1, ctx, &vcol, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "quantity", 0, ctx, &quantity, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)))
-        goto fail;
-    if (strcmp(quantity, "water") && strcmp(quantity, "fill")) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'quantity': '%s' is not one of water, fill", doc->path,
-                           phc_key_line(node, "quantity"), quantity);
-        goto fail;
-    }
-    im->fill = !strcmp(quantity, "fill");
-    if (!soil || !pn) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil_probe data set: missing key '%s'", doc->path, node->line,
-                           soil ? "probes" : "soil");
-        goto fail;
-    }
-    if ((rc = phc_soil_setup_parse(doc, soil, is_parameter, user_data, &im->su, err)))
-        goto fail;
+    phc_soil_probe_options o = {.quantity = PHC_SOIL_PROBE_WATER, .start = NAN, .sigma = NAN};
+    return o;
+}
 
-    /* Probe table. */
-    phc_probe_columns pc = {0};
-    const char *pfile = NULL;
-    if (pn->kind != PHC_YAML_MAPPING) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'probes': expected {file, id, x, y | lat, lon, depth}",
-                           doc->path, pn->line);
-        goto fail;
+#define WHERE(key) phc_origin_key(o->origin, "soil_probe", key).text
+
+/* What a program may hand over that a file reader never would. */
+static int check_inputs(const phc_probe_table *probes, const phc_probe_series *ser,
+                        const phc_soil_probe_options *o, phc_error *err)
+{
+    if (!probes || !probes->n || !probes->probes)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: the probe table has no probes", WHERE("probes"));
+    if (!ser || !ser->n || !ser->t || !ser->probe || !ser->value)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: no readings", WHERE("file"));
+    for (size_t i = 0; i < probes->n; ++i)
+        if (!probes->probes[i].id)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: probe %zu has no id", WHERE("probes"), i + 1);
+    for (size_t r = 0; r < ser->n; ++r)
+        if (ser->probe[r] >= probes->n || !isfinite(ser->t[r]) || !isfinite(ser->value[r]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s: reading %zu: probe %zu of %zu, time %g h, value %g: expected a probe "
+                                 "of the table and finite numbers",
+                                 WHERE("file"), r + 1, ser->probe[r] + 1, probes->n, ser->t[r], ser->value[r]);
+    if (!o->soil)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: soil_probe data set: missing key 'soil'", WHERE(NULL));
+    return PHC_OK;
+}
+
+/* A copy of the probe table the data set keeps (freed by
+ * phc_probe_table_free); NULL when out of memory. */
+static phc_probe_table *copy_probes(const phc_probe_table *t)
+{
+    phc_probe_table *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    c->path = strdup(t->path ? t->path : "probes");
+    c->probes = calloc(t->n, sizeof *c->probes);
+    if (!c->path || !c->probes) {
+        phc_probe_table_free(c);
+        return NULL;
     }
-    pc.id = "id";
-    pc.depth = "depth";
-    if ((rc = phc_yaml_check_keys(doc, pn, probe_keys, "probes", err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "file", 1, "probes", &pfile, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "id", 0, "probes", &pc.id, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "x", 0, "probes", &pc.x, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "y", 0, "probes", &pc.y, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "lat", 0, "probes", &pc.lat, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "lon", 0, "probes", &pc.lon, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "depth", 0, "probes", &pc.depth, err)) ||
-        (rc = phc_yaml_map_string(doc, pn, "sigma", 0, "probes", &pc.sigma, err)))
-        goto fail;
-    if (!pc.lat && !pc.lon && !pc.x && !pc.y) {
-        pc.x = "x";
-        pc.y = "y";
+    for (size_t i = 0; i < t->n; ++i) {
+        c->probes[i] = t->probes[i];
+        if (!(c->probes[i].id = strdup(t->probes[i].id))) {
+            phc_probe_table_free(c);
+            return NULL;
+        }
+        c->n = i + 1;
     }
-    if (!(ppath = phc_join_path(base_dir, pfile)) || !(path = phc_join_path(base_dir, file))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = phc_probe_table_read(ppath, &pc, im->su->has_geo ? &im->su->geo : NULL, &im->probes, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: probes: key 'file'", doc->path, phc_key_line(pn, "file"));
-        goto fail;
-    }
-    const double top = im->su->nz * im->su->dx, ex = im->su->nx * im->su->dx, ey = im->su->ny * im->su->dx;
-    if (!(im->pz = malloc(im->probes->n * sizeof *im->pz))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
+    return c;
+}
+
+/* The probes' heights in the grid frame; a probe outside the grid is an
+ * error naming its line in the probe table. */
+static int place_probes(sp_impl *im, phc_error *err)
+{
+    const phc_soil_setup *su = im->su;
+    const double top = su->nz * su->dx, ex = su->nx * su->dx, ey = su->ny * su->dx;
+    if (!(im->pz = malloc(im->probes->n * sizeof *im->pz)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < im->probes->n; ++i) {
         const phc_probe *pr = &im->probes->probes[i];
         if (!(pr->x >= 0 && pr->x <= ex && pr->y >= 0 && pr->y <= ey && pr->depth <= top)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: probe '%s' at x = %.3f m, y = %.3f m, depth %.3f m%s is outside the soil grid "
-                               "(x 0..%g m, y 0..%g m, depth 0..%g m; config line %zu)",
-                               ppath, pr->line, pr->id, pr->x, pr->y, pr->depth,
-                               pr->geographic ? " (east, north of geo_origin)" : "", ex, ey, top, im->su->line);
-            goto fail;
+            char config_line[48] = "";
+            if (su->line)
+                snprintf(config_line, sizeof config_line, "; config line %zu", su->line);
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: probe '%s' at x = %.3f m, y = %.3f m, depth %.3f m%s is outside the soil grid "
+                                 "(x 0..%g m, y 0..%g m, depth 0..%g m%s)",
+                                 im->probes->path, pr->line, pr->id, pr->x, pr->y, pr->depth,
+                                 pr->geographic ? " (east, north of geo_origin)" : "", ex, ey, top, config_line);
         }
         im->pz[i] = top - pr->depth;
     }
+    return PHC_OK;
+}
 
-    /* Readings. */
-    if (!(units = phc_units_new(err))) {
-        rc = err->status;
-        goto fail;
-    }
-    phc_unit_conversion tconv;
-    char where[256];
-    snprintf(where, sizeof where, "%s:%zu: time unit", doc->path, phc_key_line(node, "time"));
-    if ((rc = phc_units_conversion(units, tunit, "h", where, &tconv, err)))
-        goto fail;
-    if ((rc = phc_probe_series_read(path, tcol, tconv, pcol, vcol, im->probes, &ser, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
-    }
-    double start = phc_unit_apply(tconv, 0.0);
-    if (strstr(tunit, "since") && !phc_yaml_get(node, "start")) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the time unit '%s' is a timestamp: give `start:` (the "
-                           "reading time of the model's t = 0, in that unit)", doc->path, phc_key_line(node, "time"),
-                           tunit);
-        goto fail;
-    }
-    if (phc_yaml_get(node, "start")) {
-        double st;
-        if ((rc = phc_yaml_map_number(doc, node, "start", 0, ctx, &st, err)))
-            goto fail;
-        start = phc_unit_apply(tconv, st);
-        if (ser->t[0] < start) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the first reading is before `start` (the model's t = 0)",
-                               path, ser->line[0]);
-            goto fail;
-        }
-    }
-
-    /* Sigma: per probe, or a scalar. */
-    double sigma = NAN;
-    const phc_yaml_node *sg = phc_yaml_get(node, "sigma");
-    if (sg) {
-        if ((rc = phc_yaml_number(doc, sg, "sigma", &sigma, err)))
-            goto fail;
-        if (!(sigma > 0)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'sigma': must be > 0", doc->path, sg->line);
-            goto fail;
-        }
-    }
-
-    const size_t n = ser->n;
-    ds = phc_soil_setup_dataset(im->su, &soil_probe_ops, n, path);
-    if (!ds || phc_dataset_add_input(ds, path) || phc_dataset_add_input(ds, ppath)) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    im->probe_of = malloc(n * sizeof *im->probe_of);
-    if (!im->probe_of) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t r = 0; r < n; ++r) {
+/* The observations: model times since start, readings, their sigmas. */
+static int fill_readings(phc_dataset *ds, sp_impl *im, const phc_probe_series *ser, const phc_soil_probe_options *o,
+                         phc_error *err)
+{
+    const char *path = ds->data_file;
+    const double start = isnan(o->start) ? 0 : o->start;
+    for (size_t r = 0; !isnan(o->start) && r < ser->n; ++r)
+        if (ser->t[r] < start)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the first reading is before `start` (the model's t = 0)",
+                                 path, ser->line ? ser->line[r] : r + 2);
+    if (!isnan(o->sigma) && !(o->sigma > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': must be > 0", WHERE("sigma"));
+    if (!(im->probe_of = malloc(ser->n * sizeof *im->probe_of)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t r = 0; r < ser->n; ++r) {
         const phc_probe *pr = &im->probes->probes[ser->probe[r]];
-        double s = isnan(pr->sigma) ? sigma : pr->sigma;
-        if (isnan(s)) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil_probe data set: give `sigma:` or a sigma column in "
-                               "the probe table (probe '%s' has none)", doc->path, node->line, pr->id);
-            goto fail;
-        }
+        double s = isnan(pr->sigma) ? o->sigma : pr->sigma;
+        if (isnan(s))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: soil_probe data set: give `sigma:` or a sigma column in "
+                                 "the probe table (probe '%s' has none)", WHERE(NULL), pr->id);
         ds->x[r] = ser->t[r] - start;
         ds->y[r] = ser->value[r];
         ds->sigma[r] = s;
-        ds->data_lines[r] = ser->line[r];
+        ds->data_lines[r] = ser->line ? ser->line[r] : r + 2;
         im->probe_of[r] = ser->probe[r];
     }
-    if ((rc = phc_unique_times(ds->x, n, &im->t_unique, &im->m_unique, &im->t_at, err)))
+    return PHC_OK;
+}
+
+int phc_soil_probe_new(const phc_probe_table *probes, const phc_probe_series *ser,
+                       const phc_soil_probe_options *o, phc_dataset **out, phc_error *err)
+{
+    phc_dataset *ds = NULL;
+    int rc;
+    *out = NULL;
+    if ((rc = check_inputs(probes, ser, o, err)))
+        return rc;
+    sp_impl *im = calloc(1, sizeof *im);
+    if (!im)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    im->fill = o->quantity == PHC_SOIL_PROBE_FILL;
+    if ((rc = phc_soil_setup_new(o->soil, "soil_probe", o->is_parameter, o->user_data, &im->su, err)))
         goto fail;
-    ds->x_label = strdup(x_label ? x_label : "time since start (h)");
-    ds->y_label = strdup(y_label ? y_label : im->fill ? "fill level w/c" : "water content w (m³/m³)");
-    if (!ds->x_label || !ds->y_label) {
+    if (!(im->probes = copy_probes(probes))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if (!(ds->series = malloc(n * sizeof *ds->series))) {
+    if ((rc = place_probes(im, err)))
+        goto fail;
+    const size_t n = ser->n;
+    ds = phc_soil_setup_dataset(im->su, &phc_soil_probe_ops, n, ser->path ? ser->path : "readings");
+    if (!ds) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((rc = fill_readings(ds, im, ser, o, err)) ||
+        (rc = phc_unique_times(ds->x, n, &im->t_unique, &im->m_unique, &im->t_at, err)))
+        goto fail;
+    ds->x_label = strdup(o->x_label ? o->x_label : "time since start (h)");
+    ds->y_label = strdup(o->y_label ? o->y_label : im->fill ? "fill level w/c" : "water content w (m³/m³)");
+    if (!ds->x_label || !ds->y_label || !(ds->series = malloc(n * sizeof *ds->series))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
     memcpy(ds->series, im->probe_of, n * sizeof *ds->series);
     ds->derivatives = PHC_DERIV_ANALYTIC;
-    ds->config_line = node->line;
+    ds->config_line = phc_origin_line(o->origin, NULL);
     ds->impl = im;
-    im = NULL;
-    phc_units_free(units);
-    phc_probe_series_free(ser);
-    free(path);
-    free(ppath);
     *out = ds;
     return PHC_OK;
 fail:
-    phc_units_free(units);
-    phc_probe_series_free(ser);
-    free(path);
-    free(ppath);
     sp_free(im);
     if (ds)
         ds->impl = NULL;

@@ -1,53 +1,32 @@
-/* The `soil:` block of the soil data sets: see soil_setup.h. */
+/* The soil shared by the soil data sets: see soil_setup.h. */
 #include "fit/costs/soil_setup.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-const char *const phc_soil_setup_keys[] = {"grid", "dt", "substep", "max_substeps", "f_diff", "f_grav", "f_nutrient",
-                                           "boundaries", "absorb", "layers", "rocks", "nutrient_pockets",
-                                           "rain", "sources", "geo_origin", NULL};
-const phc_key_help phc_soil_setup_help[] = {
-    {"grid", "{nx, ny, nz, dx}: voxels along x (east), y (north) (default 1 each) and z "
-             "(required), and the voxel side dx in m (required); at most 5e8 voxels. "
-             "Required."},
-    {"dt", "Time step, h, > 0 (sub-stepped over the stability limit unless substep is false). "
-           "Default: 0.01."},
-    {"substep", "true: sub-step a dt over the explicit step's stability limit; false: refuse "
-                "such a dt. Default: true."},
-    {"max_substeps", "Most sub-steps per dt (a fit's trial point needing more is refused); 0 = "
-                     "no limit. Default: 100."},
-    {"f_diff", "Diffusion force, m, >= 0 (fitted when there is a parameter f_diff). "
-               "Default: 1."},
-    {"f_grav", "Gravity force, >= 0 (fitted when there is a parameter f_grav). Default: 1."},
-    {"f_nutrient", "Nutrient transport factor, >= 0. Default: 1."},
-    {"boundaries", "{sides, x_min, x_max, y_min, y_max, bottom, top}: each block, absorb or "
-                   "periodic; sides sets the four vertical faces, periodic faces come in "
-                   "pairs. Default: block everywhere."},
-    {"absorb", "{form, width}: the damping of absorbing faces, form code (the authors' code) or "
-               "paper (eq. 31), over width voxel layers, 1 to 1000. Default: code, 5."},
-    {"layers", "List of layers from the surface down, each {soil: PRESET or c and p (m/h), "
-               "thickness (m; not for the last, which reaches the bottom), fill (w/c) or water "
-               "(m³/m³) (default water 0), d (default 1), nutrient (default 0)}. Presets: clay, "
-               "clay_loam, sandy_clay_loam, sandy_loam, silt_loam, silt. Required."},
-    {"rocks", "{seed, scale, fraction}: random rocks (p = 0), scale the noise's length in m "
-              "(> 0), fraction the share of the soil they fill (0 <= fraction < 1), seed a "
-              "whole number (default 1). Default: none."},
-    {"nutrient_pockets", "{seed, scale, fraction, amount}: random nutrient pockets as for rocks, "
-                         "with amount >= 0 (required). Default: none."},
-    {"rain", "List of {start, end, rate, nutrient, x0, x1, y0, y1}: rain of rate m/h from start "
-             "to end h carrying nutrient units/m³ (default 0), on the rectangle x0..x1, y0..y1 "
-             "m (default the whole surface). Default: none."},
-    {"sources", "List of {x, y, depth, radius, water_rate, nutrient_rate, start, end}: point "
-                "sources (negative rates: sinks) at x, y, depth m (required), spread over "
-                "radius m (default 0), water_rate m³/h, nutrient_rate units/h, from start "
-                "(default 0) to end (default never) h. Default: none."},
-    {"geo_origin", "{lat, lon, height}: where the grid's west-south corner at the surface is, "
-                   "e.g. lat: \"43.6481 N\", lon: \"79.3832 W\" (height default 0); needed for "
-                   "probes placed by latitude and longitude. Default: none."},
-    {NULL, NULL}};
+phc_soil_setup_layer phc_soil_setup_layer_default(void)
+{
+    phc_soil_setup_layer l = {.c = NAN, .p = NAN, .d = 1, .fill = NAN, .water = NAN};
+    return l;
+}
+
+phc_soil_setup_source phc_soil_setup_source_default(void)
+{
+    phc_soil_setup_source s = {.end = INFINITY};
+    return s;
+}
+
+phc_soil_setup_options phc_soil_setup_options_default(void)
+{
+    phc_soil_setup_options o = {.nx = 1, .ny = 1, .dx = NAN};
+    o.params = phc_soil_params_default();
+    o.params.dt = 0.01;
+    o.params.max_substeps = 100; /* a fit's trial point 100x too fast for dt is refused, not run */
+    return o;
+}
 
 void phc_soil_setup_free(phc_soil_setup *su)
 {
@@ -70,35 +49,23 @@ void phc_soil_setup_free(phc_soil_setup *su)
     free(su);
 }
 
-static int expect_map(const phc_yaml_doc *doc, const phc_yaml_node *n, const char *what, phc_error *err)
-{
-    if (n && n->kind == PHC_YAML_MAPPING)
-        return PHC_OK;
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: expected a mapping", doc->path, n ? n->line : 1, what);
-}
+/* The place of a message about `key` of the options (a printf format:
+ * "layers[2]"): "cfg.yaml:12" from a config, else the kind's name. */
+typedef struct place {
+    const phc_origin *origin;
+    const char *kind;
+} place;
 
-static int expect_seq(const phc_yaml_doc *doc, const phc_yaml_node *n, const char *what, phc_error *err)
+static phc_where at(const place *pl, const char *key_fmt, ...)
 {
-    if (n && n->kind == PHC_YAML_SEQUENCE)
-        return PHC_OK;
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: expected a list", doc->path, n ? n->line : 1, what);
-}
-
-static int parse_boundary(const phc_yaml_doc *doc, const phc_yaml_node *map, const char *key,
-                          phc_soil_boundary *out, phc_error *err)
-{
-    const char *s = NULL;
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, map, key, 0, "soil boundaries", &s, err)) || !s)
-        return rc;
-    static const char *names[] = {"block", "absorb", "periodic"};
-    for (int i = 0; i < 3; ++i)
-        if (!strcmp(s, names[i])) {
-            *out = (phc_soil_boundary)i;
-            return PHC_OK;
-        }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil boundary '%s': '%s' is not one of block, absorb, periodic",
-                         doc->path, phc_yaml_get(map, key)->line, key, s);
+    char key[96];
+    if (key_fmt) {
+        va_list ap;
+        va_start(ap, key_fmt);
+        vsnprintf(key, sizeof key, key_fmt, ap);
+        va_end(ap);
+    }
+    return phc_origin_key(pl->origin, pl->kind, key_fmt ? key : NULL);
 }
 
 static int add_slot(phc_soil_setup *su, const char *name, int *slot)
@@ -118,93 +85,136 @@ static int add_slot(phc_soil_setup *su, const char *name, int *slot)
     return PHC_OK;
 }
 
-static int parse_layers(const phc_yaml_doc *doc, const phc_yaml_node *seq, phc_soil_setup *su, phc_error *err)
+/* The grid, the step and the forces. */
+static int setup_grid(phc_soil_setup *su, const phc_soil_setup_options *o, const place *pl, phc_error *err)
 {
-    static const char *const keys[] = {"soil", "c", "p", "d", "thickness", "fill", "water", "nutrient", NULL};
-    int rc;
-    if ((rc = expect_seq(doc, seq, "soil layers", err)))
-        return rc;
-    if (!seq->count)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil layers: give at least one layer", doc->path, seq->line);
-    su->n_layers = seq->count;
-    su->layers = calloc(seq->count, sizeof *su->layers);
-    su->layer_names = calloc(seq->count, sizeof *su->layer_names);
-    if (!su->layers || !su->layer_names)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    for (size_t L = 0; L < seq->count; ++L) {
-        const phc_yaml_node *n = seq->items[L];
-        char ctx[48];
-        snprintf(ctx, sizeof ctx, "soil layer %zu", L + 1);
-        if ((rc = expect_map(doc, n, ctx, err)) || (rc = phc_yaml_check_keys(doc, n, keys, ctx, err)))
-            return rc;
-        phc_soil_layer *l = &su->layers[L];
-        l->c = NAN;
-        l->p = NAN;
-        l->d = 1;
-        l->fill = -1;
-        l->water = -1;
-        const char *preset = NULL;
-        if ((rc = phc_yaml_map_string(doc, n, "soil", 0, ctx, &preset, err)))
-            return rc;
-        if (preset && phc_soil_preset(preset, &l->c, &l->p)) {
-            char list[256] = "";
-            for (size_t i = 0; phc_soil_preset_name(i); ++i) {
-                size_t used = strlen(list);
-                snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", phc_soil_preset_name(i));
-            }
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: unknown soil '%s' (known: %s)", doc->path,
-                                 phc_key_line(n, "soil"), ctx, preset, list);
-        }
-        if ((rc = phc_yaml_map_number(doc, n, "c", 0, ctx, &l->c, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "p", 0, ctx, &l->p, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "d", 0, ctx, &l->d, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "thickness", L + 1 < seq->count, ctx, &l->thickness, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "fill", 0, ctx, &l->fill, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "water", 0, ctx, &l->water, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "nutrient", 0, ctx, &l->nutrient, err)))
-            return rc;
-        if (isnan(l->c) || isnan(l->p))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: give `soil: NAME` or both c and p", doc->path,
-                                 n->line, ctx);
-        if (phc_yaml_get(n, "fill") && phc_yaml_get(n, "water"))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: give the initial water as fill or water, not both",
-                                 doc->path, n->line, ctx);
-        if (!phc_yaml_get(n, "fill") && !phc_yaml_get(n, "water"))
-            l->water = 0;
-        if ((phc_yaml_get(n, "fill") && !(l->fill >= 0)) || (phc_yaml_get(n, "water") && !(l->water >= 0)))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: the initial water must be >= 0", doc->path,
-                                 n->line, ctx);
-        if (L + 1 < seq->count && !(l->thickness > 0))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: thickness must be > 0 m, found %g", doc->path,
-                                 phc_key_line(n, "thickness"), ctx, l->thickness);
-        phc_error model_err;
-        if (phc_soil_layer_check(l, L + 1, L + 1 == seq->count, &model_err)) /* the model's checks, with the line */
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s", doc->path, n->line, model_err.message);
-        if (!(su->layer_names[L] = strdup(preset ? preset : "custom")))
-            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (o->nx < 1 || o->ny < 1 || o->nz < 1 || !(o->dx > 0) || (double)o->nx * o->ny * o->nz > 5e8)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: soil grid: needs nx, ny, nz >= 1 (at most 5e8 voxels) and "
+                             "dx > 0 m", at(pl, "grid").text);
+    su->nx = o->nx;
+    su->ny = o->ny;
+    su->nz = o->nz;
+    su->dx = o->dx;
+    const phc_soil_params *pr = &o->params;
+    if (!(pr->dt > 0) || !(pr->f_diff >= 0) || !(pr->f_grav >= 0) || !(pr->f_nutrient >= 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: soil: needs dt > 0 h and f_diff, f_grav, f_nutrient >= 0",
+                             at(pl, NULL).text);
+    su->params = *pr;
+    return PHC_OK;
+}
+
+/* Absorbing faces fit into the grid; periodic faces come in pairs. */
+static int setup_boundaries(const phc_soil_setup *su, const place *pl, phc_error *err)
+{
+    const phc_soil_params *pr = &su->params;
+    if (pr->absorb_width < 1 || pr->absorb_width > 1000)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: soil absorb width must be 1..1000 voxels",
+                             at(pl, "absorb").text);
+    size_t dims[3] = {su->nx, su->ny, su->nz};
+    static const char *face[] = {"x_min", "x_max", "y_min", "y_max", "bottom", "top"};
+    for (int f = 0; f < PHC_SOIL_FACES; ++f) {
+        if ((unsigned)pr->boundary[f] > PHC_SOIL_PERIODIC)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: soil boundary %s: %d is not one of block, absorb, "
+                                 "periodic", at(pl, "boundaries").text, face[f], (int)pr->boundary[f]);
+        if (pr->boundary[f] == PHC_SOIL_ABSORB && (size_t)pr->absorb_width > dims[f / 2])
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: soil boundary %s absorbs over %d layers but the grid "
+                                 "has %zu voxels along that axis", at(pl, "boundaries").text, face[f],
+                                 pr->absorb_width, dims[f / 2]);
+        if ((pr->boundary[f] == PHC_SOIL_PERIODIC) != (pr->boundary[f ^ 1] == PHC_SOIL_PERIODIC))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: soil boundaries: %s is periodic but %s is not; "
+                                 "periodic faces come in pairs", at(pl, "boundaries").text, face[f & ~1],
+                                 face[f | 1]);
     }
     return PHC_OK;
 }
 
-/* A noise block {seed, scale, fraction[, amount]} into a per-voxel mask or amount. */
-static int parse_noise(const phc_yaml_doc *doc, const phc_yaml_node *n, const char *what, phc_soil_setup *su,
-                       int rocks, phc_error *err)
+/* One layer's numbers: a preset's c and p unless given, the initial water. */
+static int setup_layer(phc_soil_setup *su, size_t L, const phc_soil_setup_layer *in, const place *pl,
+                       phc_error *err)
 {
-    static const char *const rock_keys[] = {"seed", "scale", "fraction", NULL};
-    static const char *const pocket_keys[] = {"seed", "scale", "fraction", "amount", NULL};
-    long seed = 1;
-    double scale = NAN, fraction = NAN, amount = 1;
+    const size_t count = su->n_layers;
+    char ctx[48];
+    snprintf(ctx, sizeof ctx, "soil layer %zu", L + 1);
+    phc_soil_layer *l = &su->layers[L];
+    l->c = NAN;
+    l->p = NAN;
+    if (in->soil && phc_soil_preset(in->soil, &l->c, &l->p)) {
+        char list[256] = "";
+        for (size_t i = 0; phc_soil_preset_name(i); ++i) {
+            size_t used = strlen(list);
+            snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", phc_soil_preset_name(i));
+        }
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: unknown soil '%s' (known: %s)",
+                             at(pl, "layers[%zu].soil", L).text, ctx, in->soil, list);
+    }
+    if (!isnan(in->c))
+        l->c = in->c;
+    if (!isnan(in->p))
+        l->p = in->p;
+    l->d = in->d;
+    l->thickness = in->thickness;
+    l->nutrient = in->nutrient;
+    l->fill = -1;
+    l->water = -1;
+    if (isnan(l->c) || isnan(l->p))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: give `soil: NAME` or both c and p",
+                             at(pl, "layers[%zu]", L).text, ctx);
+    const int has_fill = !isnan(in->fill), has_water = !isnan(in->water);
+    if (has_fill && has_water)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: give the initial water as fill or water, not both",
+                             at(pl, "layers[%zu]", L).text, ctx);
+    if (has_fill)
+        l->fill = in->fill;
+    if (has_water)
+        l->water = in->water;
+    if (!has_fill && !has_water)
+        l->water = 0;
+    if ((has_fill && !(l->fill >= 0)) || (has_water && !(l->water >= 0)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: the initial water must be >= 0",
+                             at(pl, "layers[%zu]", L).text, ctx);
+    if (L + 1 < count && !(l->thickness > 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: thickness must be > 0 m, found %g",
+                             at(pl, "layers[%zu].thickness", L).text, ctx, l->thickness);
+    phc_error model_err;
+    if (phc_soil_layer_check(l, L + 1, L + 1 == count, &model_err)) /* the model's checks, with the line */
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s", at(pl, "layers[%zu]", L).text, model_err.message);
+    if (!(su->layer_names[L] = strdup(in->soil ? in->soil : "custom")))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
+/* The layers and the layer of each z-plane. */
+static int setup_layers(phc_soil_setup *su, const phc_soil_setup_options *o, const place *pl, phc_error *err)
+{
     int rc;
-    if ((rc = expect_map(doc, n, what, err)) ||
-        (rc = phc_yaml_check_keys(doc, n, rocks ? rock_keys : pocket_keys, what, err)) ||
-        (rc = phc_yaml_map_integer(doc, n, "seed", 0, what, &seed, err)) ||
-        (rc = phc_yaml_map_number(doc, n, "scale", 1, what, &scale, err)) ||
-        (rc = phc_yaml_map_number(doc, n, "fraction", 1, what, &fraction, err)) ||
-        (!rocks && (rc = phc_yaml_map_number(doc, n, "amount", 1, what, &amount, err))))
-        return rc;
-    if (!(scale > 0) || !(fraction >= 0 && fraction < 1) || !(amount >= 0))
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: needs scale > 0 m, 0 <= fraction < 1%s", doc->path,
-                             n->line, what, rocks ? "" : " and amount >= 0");
+    if (!o->n_layers || !o->layers)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: soil layers: give at least one layer",
+                             at(pl, "layers").text);
+    su->n_layers = o->n_layers;
+    su->layers = calloc(o->n_layers, sizeof *su->layers);
+    su->layer_names = calloc(o->n_layers, sizeof *su->layer_names);
+    if (!su->layers || !su->layer_names)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t L = 0; L < o->n_layers; ++L)
+        if ((rc = setup_layer(su, L, &o->layers[L], pl, err)))
+            return rc;
+    if (!(su->layer_of_k = malloc(su->nz * sizeof *su->layer_of_k)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    phc_soil tmp = {.nx = su->nx, .ny = su->ny, .nz = su->nz, .dx = su->dx};
+    phc_soil_layer_of_planes(&tmp, su->layers, su->n_layers, su->layer_of_k);
+    return PHC_OK;
+}
+
+/* A noise block into a per-voxel mask (rocks) or amount (pockets). */
+static int setup_noise(phc_soil_setup *su, const phc_soil_setup_noise *nz, int rocks, const place *pl,
+                       phc_error *err)
+{
+    const char *what = rocks ? "soil rocks" : "soil nutrient_pockets";
+    const double amount = rocks ? 1 : nz->amount;
+    if (!(nz->scale > 0) || !(nz->fraction >= 0 && nz->fraction < 1) || !(amount >= 0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: needs scale > 0 m, 0 <= fraction < 1%s",
+                             at(pl, rocks ? "rocks" : "nutrient_pockets").text, what,
+                             rocks ? "" : " and amount >= 0");
     phc_soil *tmp = phc_soil_new(su->nx, su->ny, su->nz, su->dx);
     if (!tmp)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -212,13 +222,13 @@ static int parse_noise(const phc_yaml_doc *doc, const phc_yaml_node *n, const ch
     if (rocks) {
         for (size_t i = 0; i < nvox; ++i)
             tmp->p[i] = 1;
-        phc_soil_add_rocks(tmp, (uint64_t)seed, scale, fraction);
+        phc_soil_add_rocks(tmp, nz->seed, nz->scale, nz->fraction);
         su->rock = malloc(nvox);
         if (su->rock)
             for (size_t i = 0; i < nvox; ++i)
                 su->rock[i] = tmp->p[i] == 0;
     } else {
-        phc_soil_add_nutrient_pockets(tmp, (uint64_t)seed, scale, fraction, amount);
+        phc_soil_add_nutrient_pockets(tmp, nz->seed, nz->scale, nz->fraction, amount);
         su->pocket = malloc(nvox * sizeof *su->pocket);
         if (su->pocket)
             memcpy(su->pocket, tmp->v, nvox * sizeof *su->pocket);
@@ -229,275 +239,89 @@ static int parse_noise(const phc_yaml_doc *doc, const phc_yaml_node *n, const ch
     return PHC_OK;
 }
 
-static int parse_rain(const phc_yaml_doc *doc, const phc_yaml_node *seq, phc_soil_setup *su, phc_error *err)
+static int setup_rain(phc_soil_setup *su, const phc_soil_setup_options *o, const place *pl, phc_error *err)
 {
-    static const char *const keys[] = {"start", "end", "rate", "nutrient", "x0", "x1", "y0", "y1", NULL};
-    int rc;
-    if ((rc = expect_seq(doc, seq, "soil rain", err)))
-        return rc;
-    su->rain = calloc(seq->count ? seq->count : 1, sizeof *su->rain);
+    su->rain = calloc(o->n_rain ? o->n_rain : 1, sizeof *su->rain);
     if (!su->rain)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    su->n_rain = seq->count;
-    for (size_t r = 0; r < seq->count; ++r) {
-        const phc_yaml_node *n = seq->items[r];
-        phc_soil_rain *rn = &su->rain[r];
-        char ctx[48];
-        snprintf(ctx, sizeof ctx, "rain %zu", r + 1);
-        if ((rc = expect_map(doc, n, ctx, err)) || (rc = phc_yaml_check_keys(doc, n, keys, ctx, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "start", 1, ctx, &rn->start, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "end", 1, ctx, &rn->end, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "rate", 1, ctx, &rn->rate, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "nutrient", 0, ctx, &rn->nutrient, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "x0", 0, ctx, &rn->x0, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "x1", 0, ctx, &rn->x1, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "y0", 0, ctx, &rn->y0, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "y1", 0, ctx, &rn->y1, err)))
-            return rc;
+    su->n_rain = o->n_rain;
+    for (size_t r = 0; r < o->n_rain; ++r) {
+        const phc_soil_rain *rn = &o->rain[r];
         if (!(rn->rate >= 0) || !(rn->end >= rn->start) || !(rn->nutrient >= 0))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: needs rate >= 0 m/h, nutrient >= 0 and start <= end",
-                                 doc->path, n->line, ctx);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: rain %zu: needs rate >= 0 m/h, nutrient >= 0 and start <= end",
+                                 at(pl, "rain[%zu]", r).text, r + 1);
+        su->rain[r] = *rn;
     }
     return PHC_OK;
 }
 
-static int parse_sources(const phc_yaml_doc *doc, const phc_yaml_node *seq, phc_soil_setup *su, phc_error *err)
+static int setup_sources(phc_soil_setup *su, const phc_soil_setup_options *o, const place *pl, phc_error *err)
 {
-    static const char *const keys[] = {"x", "y", "depth", "radius", "water_rate", "nutrient_rate", "start", "end",
-                                       NULL};
-    int rc;
-    if ((rc = expect_seq(doc, seq, "soil sources", err)))
-        return rc;
-    su->sources = calloc(seq->count ? seq->count : 1, sizeof *su->sources);
+    su->sources = calloc(o->n_sources ? o->n_sources : 1, sizeof *su->sources);
     if (!su->sources)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    su->n_sources = seq->count;
+    su->n_sources = o->n_sources;
     const double top = su->nz * su->dx;
-    for (size_t q = 0; q < seq->count; ++q) {
-        const phc_yaml_node *n = seq->items[q];
+    for (size_t q = 0; q < o->n_sources; ++q) {
+        const phc_soil_setup_source *in = &o->sources[q];
         phc_soil_source *src = &su->sources[q];
-        double depth = NAN;
-        char ctx[48];
-        snprintf(ctx, sizeof ctx, "source %zu", q + 1);
-        src->end = INFINITY;
-        if ((rc = expect_map(doc, n, ctx, err)) || (rc = phc_yaml_check_keys(doc, n, keys, ctx, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "x", 1, ctx, &src->x, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "y", 1, ctx, &src->y, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "depth", 1, ctx, &depth, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "radius", 0, ctx, &src->radius, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "water_rate", 0, ctx, &src->water_rate, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "nutrient_rate", 0, ctx, &src->nutrient_rate, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "start", 0, ctx, &src->start, err)) ||
-            (rc = phc_yaml_map_number(doc, n, "end", 0, ctx, &src->end, err)))
-            return rc;
-        src->z = top - depth;
-        if (!(src->x >= 0 && src->x < su->nx * su->dx && src->y >= 0 && src->y < su->ny * su->dx && depth >= 0 &&
-              depth < top))
+        *src = (phc_soil_source){.x = in->x, .y = in->y, .z = top - in->depth, .radius = in->radius,
+                                 .water_rate = in->water_rate, .nutrient_rate = in->nutrient_rate,
+                                 .start = in->start, .end = in->end};
+        if (!(src->x >= 0 && src->x < su->nx * su->dx && src->y >= 0 && src->y < su->ny * su->dx &&
+              in->depth >= 0 && in->depth < top))
             return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: %s: (x %g m, y %g m, depth %g m) is outside the soil grid (%g x %g m, "
-                                 "%g m deep)", doc->path, n->line, ctx, src->x, src->y, depth, su->nx * su->dx,
-                                 su->ny * su->dx, top);
+                                 "%s: source %zu: (x %g m, y %g m, depth %g m) is outside the soil grid (%g x %g m, "
+                                 "%g m deep)", at(pl, "sources[%zu]", q).text, q + 1, src->x, src->y, in->depth,
+                                 su->nx * su->dx, su->ny * su->dx, top);
         if (!(src->radius >= 0) || !(src->end >= src->start))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: needs radius >= 0 and start <= end", doc->path,
-                                 n->line, ctx);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: source %zu: needs radius >= 0 and start <= end",
+                                 at(pl, "sources[%zu]", q).text, q + 1);
     }
     return PHC_OK;
 }
 
-static int parse_geo(const phc_yaml_doc *doc, const phc_yaml_node *n, phc_soil_setup *su, phc_error *err)
+/* Without sub-stepping, a step over the stability limit at the given soil
+ * is refused here, with the limit (trial points of a fit that cross it are
+ * rejected as outside the model's domain). */
+static int setup_stability(const phc_soil_setup *su, const place *pl, phc_error *err)
 {
-    static const char *const keys[] = {"lat", "lon", "height", NULL};
-    const char *lat = NULL, *lon = NULL;
-    int rc;
-    if ((rc = expect_map(doc, n, "geo_origin", err)) || (rc = phc_yaml_check_keys(doc, n, keys, "geo_origin", err)) ||
-        (rc = phc_yaml_map_string(doc, n, "lat", 1, "geo_origin", &lat, err)) ||
-        (rc = phc_yaml_map_string(doc, n, "lon", 1, "geo_origin", &lon, err)) ||
-        (rc = phc_yaml_map_number(doc, n, "height", 0, "geo_origin", &su->geo.h0, err)))
+    const phc_soil_params *pr = &su->params;
+    if (pr->substep)
+        return PHC_OK;
+    phc_soil *tmp = NULL;
+    int rc = phc_soil_setup_build(su, NULL, &tmp, err);
+    if (rc)
         return rc;
-    char where[512];
-    snprintf(where, sizeof where, "%s:%zu: geo_origin lat", doc->path, phc_key_line(n, "lat"));
-    if ((rc = phc_geo_parse_angle(lat, PHC_GEO_LATITUDE, where, &su->geo.lat0, err)))
-        return rc;
-    snprintf(where, sizeof where, "%s:%zu: geo_origin lon", doc->path, phc_key_line(n, "lon"));
-    if ((rc = phc_geo_parse_angle(lon, PHC_GEO_LONGITUDE, where, &su->geo.lon0, err)))
-        return rc;
-    su->has_geo = 1;
-    return PHC_OK;
+    size_t at_voxel = 0;
+    double lim = phc_soil_stable_dt(tmp, &at_voxel);
+    if (pr->dt > lim) {
+        size_t i = at_voxel % su->nx, j = (at_voxel / su->nx) % su->ny, k = at_voxel / (su->nx * su->ny);
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s: soil: dt = %g h exceeds the stability limit %g h of the explicit step "
+                           "(set by voxel (%zu, %zu, %zu), p = %g m/h, c = %g) and substep is false; lower "
+                           "dt or allow sub-stepping", at(pl, "dt").text, pr->dt, lim, i, j, k,
+                           tmp->p[at_voxel], tmp->c[at_voxel]);
+    }
+    phc_soil_free(tmp);
+    return rc;
 }
 
-int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc_is_parameter_fn is_parameter,
-                         void *user_data, phc_soil_setup **out, phc_error *err)
+static int default_is_parameter(const char *name, void *user_data)
 {
-    static const char *const grid_keys[] = {"nx", "ny", "nz", "dx", NULL};
-    static const char *const bnd_keys[] = {"x_min", "x_max", "y_min", "y_max", "bottom", "top", "sides", NULL};
-    static const char *const abs_keys[] = {"form", "width", NULL};
-    const char *ctx = "soil";
-    int rc;
-    *out = NULL;
-    if ((rc = expect_map(doc, soil, "key 'soil'", err)) || (rc = phc_yaml_check_keys(doc, soil, phc_soil_setup_keys, ctx, err)))
-        return rc;
-    phc_soil_setup *su = calloc(1, sizeof *su);
-    if (!su)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    su->line = soil->line;
-    su->params = phc_soil_params_default();
-    su->params.dt = 0.01;
-    su->params.max_substeps = 100; /* a fit's trial point 100x too fast for dt is refused, not run */
-    su->slot_fd = su->slot_fg = -1;
-    const phc_yaml_node *grid = phc_yaml_get(soil, "grid");
-    long nx = 1, ny = 1, nz = 0;
-    double dx = NAN;
-    if (!grid) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil: missing key 'grid' ({nx, ny, nz, dx})", doc->path,
-                           soil->line);
-        goto fail;
-    }
-    if ((rc = expect_map(doc, grid, "soil grid", err)) ||
-        (rc = phc_yaml_check_keys(doc, grid, grid_keys, "soil grid", err)) ||
-        (rc = phc_yaml_map_integer(doc, grid, "nx", 0, "soil grid", &nx, err)) ||
-        (rc = phc_yaml_map_integer(doc, grid, "ny", 0, "soil grid", &ny, err)) ||
-        (rc = phc_yaml_map_integer(doc, grid, "nz", 1, "soil grid", &nz, err)) ||
-        (rc = phc_yaml_map_number(doc, grid, "dx", 1, "soil grid", &dx, err)))
-        goto fail;
-    if (nx < 1 || ny < 1 || nz < 1 || !(dx > 0) || (double)nx * ny * nz > 5e8) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil grid: needs nx, ny, nz >= 1 (at most 5e8 voxels) and "
-                           "dx > 0 m", doc->path, grid->line);
-        goto fail;
-    }
-    su->nx = (size_t)nx;
-    su->ny = (size_t)ny;
-    su->nz = (size_t)nz;
-    su->dx = dx;
-    phc_soil_params *pr = &su->params;
-    long max_sub = (long)pr->max_substeps;
-    if ((rc = phc_yaml_map_number(doc, soil, "dt", 0, ctx, &pr->dt, err)) ||
-        (rc = phc_yaml_map_integer(doc, soil, "max_substeps", 0, ctx, &max_sub, err)) ||
-        (rc = phc_yaml_map_boolean(doc, soil, "substep", 0, ctx, &pr->substep, err)) ||
-        (rc = phc_yaml_map_number(doc, soil, "f_diff", 0, ctx, &pr->f_diff, err)) ||
-        (rc = phc_yaml_map_number(doc, soil, "f_grav", 0, ctx, &pr->f_grav, err)) ||
-        (rc = phc_yaml_map_number(doc, soil, "f_nutrient", 0, ctx, &pr->f_nutrient, err)))
-        goto fail;
-    if (max_sub < 0) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil: max_substeps must be >= 0 (0 = no limit)", doc->path,
-                           phc_key_line(soil, "max_substeps"));
-        goto fail;
-    }
-    pr->max_substeps = (size_t)max_sub;
-    if (!(pr->dt > 0) || !(pr->f_diff >= 0) || !(pr->f_grav >= 0) || !(pr->f_nutrient >= 0)) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil: needs dt > 0 h and f_diff, f_grav, f_nutrient >= 0",
-                           doc->path, soil->line);
-        goto fail;
-    }
-    const phc_yaml_node *bnd = phc_yaml_get(soil, "boundaries");
-    if (bnd) {
-        phc_soil_boundary sides = PHC_SOIL_BLOCK;
-        if ((rc = expect_map(doc, bnd, "soil boundaries", err)) ||
-            (rc = phc_yaml_check_keys(doc, bnd, bnd_keys, "soil boundaries", err)) ||
-            (rc = parse_boundary(doc, bnd, "sides", &sides, err)))
-            goto fail;
-        for (int f = 0; f < 4; ++f)
-            pr->boundary[f] = sides;
-        static const char *face_keys[] = {"x_min", "x_max", "y_min", "y_max", "bottom", "top"};
-        for (int f = 0; f < PHC_SOIL_FACES; ++f)
-            if ((rc = parse_boundary(doc, bnd, face_keys[f], &pr->boundary[f], err)))
-                goto fail;
-    }
-    const phc_yaml_node *ab = phc_yaml_get(soil, "absorb");
-    if (ab) {
-        const char *form = NULL;
-        long width = pr->absorb_width;
-        if ((rc = expect_map(doc, ab, "soil absorb", err)) ||
-            (rc = phc_yaml_check_keys(doc, ab, abs_keys, "soil absorb", err)) ||
-            (rc = phc_yaml_map_string(doc, ab, "form", 0, "soil absorb", &form, err)) ||
-            (rc = phc_yaml_map_integer(doc, ab, "width", 0, "soil absorb", &width, err)))
-            goto fail;
-        if (form && strcmp(form, "code") && strcmp(form, "paper")) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil absorb form '%s': expected code or paper", doc->path,
-                               phc_key_line(ab, "form"), form);
-            goto fail;
-        }
-        pr->absorb_form = form && !strcmp(form, "paper") ? PHC_SOIL_ABSORB_PAPER : PHC_SOIL_ABSORB_CODE;
-        if (width < 1 || width > 1000) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil absorb width must be 1..1000 voxels", doc->path,
-                               ab->line);
-            goto fail;
-        }
-        pr->absorb_width = (int)width;
-    }
-    {
-        size_t dims[3] = {su->nx, su->ny, su->nz};
-        static const char *face[] = {"x_min", "x_max", "y_min", "y_max", "bottom", "top"};
-        for (int f = 0; f < PHC_SOIL_FACES; ++f) {
-            if (pr->boundary[f] == PHC_SOIL_ABSORB && (size_t)pr->absorb_width > dims[f / 2]) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil boundary %s absorbs over %d layers but the grid "
-                                   "has %zu voxels along that axis", doc->path, bnd ? bnd->line : soil->line, face[f],
-                                   pr->absorb_width, dims[f / 2]);
-                goto fail;
-            }
-            if ((pr->boundary[f] == PHC_SOIL_PERIODIC) != (pr->boundary[f ^ 1] == PHC_SOIL_PERIODIC)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil boundaries: %s is periodic but %s is not; "
-                                   "periodic faces come in pairs", doc->path, bnd ? bnd->line : soil->line,
-                                   face[f & ~1], face[f | 1]);
-                goto fail;
-            }
-        }
-    }
-    const phc_yaml_node *layers = phc_yaml_get(soil, "layers");
-    if (!layers) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: soil: missing key 'layers'", doc->path, soil->line);
-        goto fail;
-    }
-    if ((rc = parse_layers(doc, layers, su, err)))
-        goto fail;
-    if (!(su->layer_of_k = malloc(su->nz * sizeof *su->layer_of_k))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    {
-        phc_soil tmp = {.nx = su->nx, .ny = su->ny, .nz = su->nz, .dx = su->dx};
-        phc_soil_layer_of_planes(&tmp, su->layers, su->n_layers, su->layer_of_k);
-    }
-    const phc_yaml_node *n;
-    if ((n = phc_yaml_get(soil, "rocks")) && (rc = parse_noise(doc, n, "soil rocks", su, 1, err)))
-        goto fail;
-    if ((n = phc_yaml_get(soil, "nutrient_pockets")) && (rc = parse_noise(doc, n, "soil nutrient_pockets", su, 0, err)))
-        goto fail;
-    if ((n = phc_yaml_get(soil, "rain")) && (rc = parse_rain(doc, n, su, err)))
-        goto fail;
-    if ((n = phc_yaml_get(soil, "sources")) && (rc = parse_sources(doc, n, su, err)))
-        goto fail;
-    if ((n = phc_yaml_get(soil, "geo_origin")) && (rc = parse_geo(doc, n, su, err)))
-        goto fail;
+    (void)user_data;
+    return !strcmp(name, "p") || !strcmp(name, "c");
+}
 
-    /* Without sub-stepping, a step over the stability limit at the configured
-       soil is refused here, with the limit (trial points of a fit that cross
-       it are rejected as outside the model's domain). */
-    if (!pr->substep) {
-        phc_soil *tmp = NULL;
-        if ((rc = phc_soil_setup_build(su, NULL, &tmp, err)))
-            goto fail;
-        size_t at = 0;
-        double lim = phc_soil_stable_dt(tmp, &at);
-        if (pr->dt > lim) {
-            size_t i = at % su->nx, j = (at / su->nx) % su->ny, k = at / (su->nx * su->ny);
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s:%zu: soil: dt = %g h exceeds the stability limit %g h of the explicit step "
-                               "(set by voxel (%zu, %zu, %zu), p = %g m/h, c = %g) and substep is false; lower "
-                               "dt or allow sub-stepping", doc->path, phc_key_line(soil, "dt"), pr->dt, lim, i, j, k,
-                               tmp->p[at], tmp->c[at]);
-        }
-        phc_soil_free(tmp);
-        if (rc)
-            goto fail;
-    }
-
-    /* Slots. */
+/* The fitted numbers: per-layer slots before the global p and c. */
+static int setup_slots(phc_soil_setup *su, phc_is_parameter_fn is_parameter, void *user_data, phc_error *err)
+{
+    if (!is_parameter)
+        is_parameter = default_is_parameter;
     su->slot_p = malloc(su->n_layers * sizeof *su->slot_p);
     su->slot_c = malloc(su->n_layers * sizeof *su->slot_c);
-    if (!su->slot_p || !su->slot_c) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
+    if (!su->slot_p || !su->slot_c)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     for (size_t L = 0; L < su->n_layers; ++L) {
         char name[32];
         su->slot_p[L] = su->slot_c[L] = -1;
@@ -506,17 +330,39 @@ int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil, phc
             const char *base = which ? "c" : "p";
             snprintf(name, sizeof name, "%s_%zu", base, L + 1);
             const char *use = is_parameter(name, user_data) ? name : is_parameter(base, user_data) ? base : NULL;
-            if (use && add_slot(su, use, slot)) {
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
+            if (use && add_slot(su, use, slot))
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         }
     }
     if ((is_parameter("f_diff", user_data) && add_slot(su, "f_diff", &su->slot_fd)) ||
-        (is_parameter("f_grav", user_data) && add_slot(su, "f_grav", &su->slot_fg))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        (is_parameter("f_grav", user_data) && add_slot(su, "f_grav", &su->slot_fg)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
+int phc_soil_setup_new(const phc_soil_setup_options *o, const char *kind, phc_is_parameter_fn is_parameter,
+                       void *user_data, phc_soil_setup **out, phc_error *err)
+{
+    const place pl = {o->origin, kind ? kind : "soil"};
+    int rc;
+    *out = NULL;
+    phc_soil_setup *su = calloc(1, sizeof *su);
+    if (!su)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    su->line = phc_origin_line(o->origin, NULL);
+    su->slot_fd = su->slot_fg = -1;
+    if ((rc = setup_grid(su, o, &pl, err)) || (rc = setup_boundaries(su, &pl, err)) ||
+        (rc = setup_layers(su, o, &pl, err)) ||
+        (o->rocks && (rc = setup_noise(su, o->rocks, 1, &pl, err))) ||
+        (o->nutrient_pockets && (rc = setup_noise(su, o->nutrient_pockets, 0, &pl, err))) ||
+        (rc = setup_rain(su, o, &pl, err)) || (rc = setup_sources(su, o, &pl, err)))
         goto fail;
+    if (o->geo_origin) {
+        su->geo = *o->geo_origin;
+        su->has_geo = 1;
     }
+    if ((rc = setup_stability(su, &pl, err)) || (rc = setup_slots(su, is_parameter, user_data, err)))
+        goto fail;
     *out = su;
     return PHC_OK;
 fail:

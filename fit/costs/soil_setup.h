@@ -1,7 +1,11 @@
-/* The `soil:` block shared by the soil data sets (soil_probe, infiltration):
- * the grid, layers, boundaries, rain and sources of a Rhizomorph soil
- * (model/soil.h), which of its numbers are fitted, and building the soil
- * and its tangent directions at given parameter values.
+/* The soil shared by the soil data sets (soil_probe, infiltration,
+ * root_shoot): the grid, layers, boundaries, rain and sources of a
+ * Rhizomorph soil (model/soil.h), which of its numbers are fitted, and
+ * building the soil and its tangent directions at given parameter values.
+ *
+ * Built in C with phc_soil_setup_new from phc_soil_setup_options; a data
+ * set's `soil:` block in a config is translated into the same options by
+ * fit/config/soil_setup_yaml.c (`phytocal help soil` lists its keys):
  *
  *   soil:
  *     grid: {nx: 1, ny: 1, nz: 60, dx: 0.02}     # voxels, m
@@ -26,30 +30,95 @@
  *
  * A layer's initial water is `fill` (w/c) or `water` (w, m^3/m^3).
  *
- * Fitted numbers are the parameter slots below, present when the problem
- * has a parameter of that name (or the data set binds the slot):
+ * Fitted numbers are the parameter slots below, present when is_parameter
+ * says so (in a config: the problem has a parameter of that name, or the
+ * data set binds the slot):
  *   p_<L>, c_<L>   permeability (m/h) and capacity of layer L (1-based)
  *   p, c           the same for every layer without its own slot
  *   f_diff, f_grav the diffusion and gravity forces
- * Otherwise the values in the config are used. */
+ * Otherwise the values of the options are used. */
 #ifndef PHC_COSTS_SOIL_SETUP_H
 #define PHC_COSTS_SOIL_SETUP_H
 
 #include <stddef.h>
+#include <stdint.h>
 
-#include "fit/config_help.h"
-#include "fit/costs/curve.h"
-#include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until the soil kinds are YAML-free */
+#include "fit/costs/origin.h"
 #include "fit/dataset.h"
 #include "measurements/geo.h"
-#include "measurements/yaml_doc.h"
 #include "model/soil.h"
 #include "model/status.h"
 
-extern const char *const phc_soil_setup_keys[];
-/* Help on each of those keys (fit/config_help.h). */
-extern const phc_key_help phc_soil_setup_help[];
+/* One layer, from the surface down. */
+typedef struct phc_soil_setup_layer {
+    const char *soil;      /* a preset (clay, clay_loam, sandy_clay_loam, sandy_loam, silt_loam,
+                              silt: phc_soil_preset) giving c and p, or NULL */
+    double c, p;           /* capacity (dimensionless) and permeability (m/h); NAN: the preset's */
+    double d;              /* growth resistance, >= 0; default 1 */
+    double thickness;      /* m, > 0; not used for the last layer, which reaches the bottom */
+    double fill;           /* initial fill level w/c, >= 0; NAN: not given */
+    double water;          /* initial water w, m^3/m^3, >= 0; NAN: not given (neither: 0) */
+    double nutrient;       /* initial nutrients, units/m^3, >= 0; default 0 */
+} phc_soil_setup_layer;
+
+/* NAN c, p, fill and water, d = 1, the rest 0. */
+phc_soil_setup_layer phc_soil_setup_layer_default(void);
+
+/* Seeded 3-D noise: rocks (p = 0) or nutrient pockets (phc_soil_add_rocks,
+ * phc_soil_add_nutrient_pockets). */
+typedef struct phc_soil_setup_noise {
+    uint64_t seed;         /* the noise's seed (a config's default: 1) */
+    double scale;          /* the noise's length, m, > 0 */
+    double fraction;       /* the share of the soil they fill, 0 <= fraction < 1 */
+    double amount;         /* pockets only: extra nutrients, units/m^3, >= 0 */
+} phc_soil_setup_noise;
+
+/* A point source (negative rates: a sink), placed by depth below the
+ * surface (model/soil.h's phc_soil_source has the height instead). */
+typedef struct phc_soil_setup_source {
+    double x, y;           /* m from the grid's west-south corner, inside the grid */
+    double depth;          /* m below the surface, 0 <= depth < nz dx */
+    double radius;         /* m, >= 0: the spread (0: one voxel) */
+    double water_rate;     /* m^3/h */
+    double nutrient_rate;  /* units/h */
+    double start, end;     /* h, start <= end; INFINITY = never ends */
+} phc_soil_setup_source;
+
+/* x, y, depth and rates 0, start 0, end INFINITY. */
+phc_soil_setup_source phc_soil_setup_source_default(void);
+
+/* Everything a `soil:` block can say. */
+typedef struct phc_soil_setup_options {
+    size_t nx, ny, nz;     /* voxels along x (east), y (north) (default 1 each) and z
+                              (required); at most 5e8 voxels */
+    double dx;             /* voxel side, m, > 0 (required; NAN until set) */
+    phc_soil_params params; /* dt (h, > 0; default 0.01), substep (default 1),
+                              max_substeps (default 100; 0 = no limit), f_diff (m), f_grav,
+                              f_nutrient (>= 0, default 1), boundary[] per face (block, absorb
+                              or periodic in pairs; default block), absorb_form, absorb_width
+                              (1..1000 voxel layers, default 5): model/soil.h */
+    const phc_soil_setup_layer *layers; /* n_layers >= 1, surface first */
+    size_t n_layers;
+    const phc_soil_setup_noise *rocks;            /* NULL: none */
+    const phc_soil_setup_noise *nutrient_pockets; /* NULL: none */
+    const phc_soil_rain *rain; /* n_rain spells (model/soil.h): rate >= 0 m/h, nutrient >= 0,
+                                  start <= end h; may be NULL when n_rain is 0 */
+    size_t n_rain;
+    const phc_soil_setup_source *sources; /* n_sources; may be NULL when 0 */
+    size_t n_sources;
+    const phc_geo_frame *geo_origin; /* the grid's west-south corner at the surface (degrees,
+                                        m); NULL: not georeferenced */
+    /* Where the options came from, for messages; NULL from C.  Besides its
+     * keys (dt, grid, absorb, ...) the kind asks for the places of list
+     * items as "layers[0]", "layers[0].soil", "rain[2]", "sources[1]"
+     * (0-based). */
+    const phc_origin *origin;
+} phc_soil_setup_options;
+
+/* nx = ny = 1, nz = 0, dx NAN (both to be set), the model's parameters with
+ * dt = 0.01 h and max_substeps = 100, no layers, rain, sources, noise or
+ * geographic origin. */
+phc_soil_setup_options phc_soil_setup_options_default(void);
 
 typedef struct phc_soil_setup {
     size_t nx, ny, nz;
@@ -72,13 +141,18 @@ typedef struct phc_soil_setup {
     int slot_fd, slot_fg;
     size_t k;
     char **slot_names;           /* k names */
-    size_t line;                 /* config line of the soil block */
+    size_t line;                 /* config line of the soil block (0 without an origin) */
 } phc_soil_setup;
 
-/* Reads the `soil:` mapping.  Errors name the config file and line. */
-int phc_soil_setup_parse(const phc_yaml_doc *doc, const phc_yaml_node *soil,
-                         phc_is_parameter_fn is_parameter, void *user_data, phc_soil_setup **out,
-                         phc_error *err);
+/* Builds a set-up from the options (copied: they may be freed afterwards).
+ * The slots are the names is_parameter accepts (NULL: p and c).  `kind`
+ * names the data set's kind in messages when the options have no origin
+ * (NULL: "soil"): "soil_probe: soil layer 1: unknown soil 'peat' (known:
+ * ...)"; with an origin they name the config file and line.  Errors:
+ * PHC_ERR_INPUT for values outside their ranges, PHC_ERR_NOMEM. */
+int phc_soil_setup_new(const phc_soil_setup_options *options, const char *kind,
+                       phc_is_parameter_fn is_parameter, void *user_data, phc_soil_setup **out,
+                       phc_error *err);
 void phc_soil_setup_free(phc_soil_setup *su);
 
 /* A new soil with the set-up's fields at slot values p (k values, from
