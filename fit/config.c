@@ -10,7 +10,6 @@
 #include "fit/costs/curve.h"
 #include "fit/costs/elasticity_curve.h"
 #include "fit/costs/infiltration.h"
-#include "fit/costs/leaf_photos.h"
 #include "fit/costs/pv_curve.h"
 #include "fit/costs/root_shoot.h"
 #include "fit/costs/soil_probe.h"
@@ -39,14 +38,6 @@ static const phc_kind infiltration_kind = {
                .keys = phc_infiltration_keys,
                .help = phc_infiltration_help},
     .load_yaml = phc_infiltration_load,
-};
-
-static const phc_kind leaf_photos_kind = {
-    .config = {.name = "leaf_photos",
-               .summary = "photos of an aging leaf -> vein, stomata, inflow and time scales and the " "colour transfer of the leaf colour aging model (Silva et al. §3)",
-               .keys = phc_leaf_photos_keys,
-               .help = phc_leaf_photos_help},
-    .load_yaml = phc_leaf_photos_load,
 };
 
 static const phc_kind pv_curve_kind = {
@@ -85,7 +76,7 @@ static const phc_kind *const kinds[] = {
     &phc_curve_kind,
     &elasticity_curve_kind,
     &infiltration_kind,
-    &leaf_photos_kind,
+    &phc_leaf_photos_kind,
     &pv_curve_kind,
     &root_shoot_kind,
     &soil_probe_kind,

@@ -6,5 +6,6 @@
 #include "fit/config/kind.h"
 
 extern const phc_kind phc_curve_kind;
+extern const phc_kind phc_leaf_photos_kind;
 
 #endif /* PHC_CONFIG_KINDS_H */
