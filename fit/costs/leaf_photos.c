@@ -11,7 +11,7 @@
 #include "fit/costs/leaf_setup.h"
 #include "fit/costs/origin.h"
 #include "fit/costs/unique_times.h"
-#include "fit/problem.h"
+#include "fit/cross_validation.h"
 #include "measurements/photo.h"
 
 #define KIND "leaf_photos"
@@ -60,9 +60,7 @@ typedef struct lp_impl {
     size_t m_unique, *t_at;            /* per data row index (into rows) */
     double *lab;                       /* 3 w h scratch */
     double *scratch;                   /* w h */
-    int cross_validate;
-    double *mask_row_zero;             /* during cross-validation: residuals of this row zeroed */
-    size_t left_out;                   /* row left out (n_rows = none) */
+    int cross_validate;                /* the engine's leave-one-out (lp_cross_validation) */
 } lp_impl;
 
 static void lp_free(void *p)
@@ -251,10 +249,6 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
     char *out = NULL;
     size_t len = 0;
     double *yhat = malloc(ds->n * sizeof *yhat);
-    double *cv_stage = NULL, *cv_model = NULL, *cv_base = NULL;
-    char **cv_ids = NULL;
-    size_t cv_n = 0;
-    double rmse[2] = {NAN, NAN};
     int rc = PHC_OK;
     if (!yhat)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -262,11 +256,6 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
         free(yhat);
         return phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the leaf model cannot be evaluated at the optimum",
                              ds->name);
-    }
-    if (im->cross_validate &&
-        (rc = phc_leaf_photos_cross_validate(ds, p, &cv_n, &cv_ids, &cv_stage, &cv_model, &cv_base, rmse, err))) {
-        free(yhat);
-        return rc;
     }
     FILE *f = open_memstream(&out, &len);
     if (!f) {
@@ -307,17 +296,6 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
             fprintf(f, " %.4f |", row->correlation);
         fputc('\n', f);
     }
-    if (im->cross_validate) {
-        fprintf(f, "\n**Leave-one-out prediction of %s** (each row left out in turn; the free parameters refitted "
-                   "on the others; the stage read off the model time whose colours match the photo best).  "
-                   "Baseline: a straight line in the mean chromatic greenness G/(R+G+B), fitted on the same rows.\n\n"
-                   "| row | measured | model | baseline |\n|---|---|---|---|\n", im->stage_name);
-        for (size_t r = 0; r < cv_n; ++r)
-            if (!isnan(cv_model[r]))
-                fprintf(f, "| %s | %g | %.2f | %.2f |\n", cv_ids[r], cv_stage[r], cv_model[r], cv_base[r]);
-        fprintf(f, "\nRMSE of the prediction (%s units): model **%.3g**, baseline **%.3g**.\n", im->stage_name,
-                rmse[0], rmse[1]);
-    }
     if (ferror(f) | (fclose(f) != 0)) {
         free(out);
         out = NULL;
@@ -325,70 +303,11 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
     }
 done:
     free(yhat);
-    for (size_t r = 0; cv_ids && r < cv_n; ++r)
-        free(cv_ids[r]);
-    free(cv_ids);
-    free(cv_stage);
-    free(cv_model);
-    free(cv_base);
     *markdown = out;
     return rc;
 }
 
-/* ---- cross-validation -------------------------------------------------------------- */
-
-static int loo_residuals(const double *p, double *r, double *jac, void *user)
-{
-    phc_dataset *ds = user;
-    lp_impl *im = ds->impl;
-    const int rc = phc_dataset_residuals(p, r, jac, ds);
-    if (rc == 0 && im->left_out < im->n_rows) {
-        const lp_row *row = &im->rows[im->left_out];
-        for (size_t i = row->first; i < row->first + row->count; ++i)
-            r[i] = 0;
-    }
-    return rc;
-}
-
-/* Refits the data set's free slots with row `left_out` excluded, from p;
- * the result overwrites p. */
-static int refit_without(phc_dataset *ds, double *p, size_t fold, size_t folds, phc_error *err)
-{
-    const phc_problem *pb = ds->problem;
-    phc_nls *nls = phc_nls_new(ds->k);
-    size_t *idx = malloc(ds->k * sizeof *idx);
-    int rc = PHC_OK;
-    if (!nls || !idx) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    for (size_t q = 0; q < ds->k; ++q) {
-        const phc_parameter *par = &pb->params[ds->param_index[q]];
-        idx[q] = q;
-        double lo = par->lower, hi = par->upper;
-        if (p[q] < lo || p[q] > hi)
-            p[q] = fmin(fmax(p[q], lo), hi);
-        if ((rc = phc_nls_set_parameter(nls, q, lo, hi, par->fixed, phc_problem_scale(pb, ds->param_index[q]), err)))
-            goto done;
-    }
-    if ((rc = phc_nls_add_block(nls, ds->n, idx, ds->k, loo_residuals, PHC_DERIV_CENTRAL, PHC_LOSS_NONE, 1.0, ds,
-                                err)))
-        goto done;
-    phc_nls_options opt = pb->options.nls;
-    phc_progress_relay relay = {ds->progress, ds->progress_data, "leave-one-out", ds->name, fold, folds, 0};
-    if (ds->progress) {
-        opt.on_iteration = phc_progress_relay_iteration;
-        opt.on_iteration_data = &relay;
-    }
-    phc_nls_summary sum;
-    rc = phc_nls_solve(nls, &opt, p, &sum, err);
-    if (rc == PHC_OK && relay.cancelled)
-        rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-done:
-    phc_nls_free(nls);
-    free(idx);
-    return rc;
-}
+/* ---- cross-validation (by the engine: fit/cross_validation.h) -------------------------- */
 
 /* The stage of row r read off the model: the model time whose colours are
  * closest (weighted squared residuals) to the row's photo, searched over
@@ -442,33 +361,128 @@ static int predict_stage(phc_dataset *ds, const double *p, const lp_row *row, do
     return 0;
 }
 
+/* The row of the g-th data row (the groups of the cross-validation). */
+static size_t data_row(const lp_impl *im, size_t g)
+{
+    for (size_t r = 0, k = 0; r < im->n_rows; ++r)
+        if (im->rows[r].role == 0 && k++ == g)
+            return r;
+    return im->n_rows;
+}
+
+/* The greenness baseline for row j: the least-squares line stage = a + b g
+ * in the mean chromatic greenness g over every other row (the fresh and
+ * reference leaves included), at row j's greenness. */
+static double greenness_baseline(const lp_impl *im, size_t j)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    size_t c = 0;
+    for (size_t i = 0; i < im->n_rows; ++i) {
+        if (i == j)
+            continue;
+        const double g = im->rows[i].greenness, y = im->rows[i].stage;
+        sx += g;
+        sy += y;
+        sxx += g * g;
+        sxy += g * y;
+        ++c;
+    }
+    const double den = (double)c * sxx - sx * sx;
+    const double b = den != 0 ? ((double)c * sxy - sx * sy) / den : 0, a = (sy - b * sx) / (double)c;
+    return a + b * im->rows[j].greenness;
+}
+
+/* Group g (a data row) left out: its stage read off the model at the
+ * refitted slot values p (NAN outside the model's domain), and the
+ * greenness baseline. */
+static int lp_cv_predict(phc_dataset *ds, const double *p, size_t g, double *values, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    const size_t j = data_row(im, g);
+    if (j == im->n_rows)
+        return phc_error_set(err, PHC_ERR_INVALID, "data set '%s': no data row %zu", ds->name, g);
+    values[0] = NAN;
+    if (predict_stage(ds, p, &im->rows[j], &values[0]) < 0)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    values[1] = greenness_baseline(im, j);
+    return PHC_OK;
+}
+
+/* The plan of the leave-one-out prediction of each row's stage: a group per
+ * data row (the residuals of its photo); the fresh and reference leaves
+ * are never left out. */
+static int lp_plan(phc_dataset *ds, phc_cv_plan *plan, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    size_t ng = 0;
+    for (size_t r = 0; r < im->n_rows; ++r)
+        ng += im->rows[r].role == 0;
+    memset(plan, 0, sizeof *plan);
+    plan->group = malloc((ds->n ? ds->n : 1) * sizeof *plan->group);
+    plan->names = calloc(ng ? ng : 1, sizeof *plan->names);
+    plan->observed = malloc((ng ? ng : 1) * sizeof *plan->observed);
+    plan->n_groups = ng;
+    if (!plan->group || !plan->names || !plan->observed)
+        goto nomem;
+    for (size_t i = 0; i < ds->n; ++i)
+        plan->group[i] = PHC_CV_NO_GROUP;
+    for (size_t r = 0, g = 0; r < im->n_rows; ++r) {
+        const lp_row *row = &im->rows[r];
+        if (row->role)
+            continue;
+        for (size_t i = row->first; i < row->first + row->count; ++i)
+            plan->group[i] = g;
+        if (!(plan->names[g] = strdup(row->id)))
+            goto nomem;
+        plan->observed[g++] = row->stage;
+    }
+    plan->n_predictions = 2;
+    plan->labels[0] = "model";
+    plan->labels[1] = "baseline";
+    plan->quantity = im->stage_name;
+    plan->group_title = "row";
+    plan->how = "the stage read off the model time whose colours match the photo best";
+    plan->note = "Baseline: a straight line in the mean chromatic greenness G/(R+G+B), fitted on the same rows.";
+    plan->predict = lp_cv_predict;
+    return PHC_OK;
+nomem:
+    phc_cv_plan_clear(plan);
+    return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+}
+
+/* The op: a plan when the data set asks for cross-validation. */
+static int lp_cross_validation(phc_dataset *ds, phc_cv_plan *plan, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    return im->cross_validate ? lp_plan(ds, plan, err) : PHC_OK;
+}
+
 int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_rows, char ***ids,
                                    double **stage, double **model, double **baseline, double rmse[2],
                                    phc_error *err)
 {
-    lp_impl *im = ds->impl;
+    const lp_impl *im = ds->impl;
     const size_t n = im->n_rows;
-    double *pj = malloc((ds->k ? ds->k : 1) * sizeof *pj);
+    phc_cv_plan plan;
+    phc_cv_result *res = NULL;
     *ids = calloc(n, sizeof **ids);
     *stage = malloc(n * sizeof **stage);
     *model = malloc(n * sizeof **model);
     *baseline = malloc(n * sizeof **baseline);
     *n_rows = n;
+    rmse[0] = rmse[1] = NAN;
     int rc = PHC_OK;
-    if (!pj || !*ids || !*stage || !*model || !*baseline) {
+    if (!*ids || !*stage || !*model || !*baseline) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    if (!ds->problem) {
-        rc = phc_error_set(err, PHC_ERR_INVALID, "data set '%s': cross-validation needs the data set's problem",
-                           ds->name);
+    if ((rc = lp_plan(ds, &plan, err)))
         goto done;
-    }
-    double s2[2] = {0, 0};
-    size_t m = 0, folds = 0, fold = 0;
-    for (size_t j = 0; j < n; ++j)
-        folds += im->rows[j].role == 0;
-    for (size_t j = 0; j < n; ++j) {
+    rc = phc_cross_validate_plan(ds->problem, ds, &plan, p, ds->progress, ds->progress_data, &res, err);
+    phc_cv_plan_clear(&plan);
+    if (rc)
+        goto done;
+    for (size_t j = 0, g = 0; j < n; ++j) {
         const lp_row *row = &im->rows[j];
         if (!((*ids)[j] = strdup(row->id))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -476,58 +490,18 @@ int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_r
         }
         (*stage)[j] = row->stage;
         (*model)[j] = (*baseline)[j] = NAN;
-        if (row->role)
-            continue;
-        /* model: refit without row j, then read its stage off the model */
-        memcpy(pj, p, ds->k * sizeof *pj);
-        im->left_out = j;
-        ++fold;
-        if (phc_progress_report(ds->progress, ds->progress_data, "leave-one-out", fold, folds, -1, NAN,
-                                ds->name)) {
-            im->left_out = n;
-            rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-            goto done;
-        }
-        rc = refit_without(ds, pj, fold, folds, err);
-        im->left_out = n;
-        if (rc)
-            goto done;
-        const int pr = predict_stage(ds, pj, row, &(*model)[j]);
-        if (pr < 0) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto done;
-        }
-        /* baseline: least-squares line stage = a + b g over the other rows */
-        double sx = 0, sy = 0, sxx = 0, sxy = 0;
-        size_t c = 0;
-        for (size_t i = 0; i < n; ++i) {
-            if (i == j)
-                continue;
-            const double g = im->rows[i].greenness, y = im->rows[i].stage;
-            sx += g;
-            sy += y;
-            sxx += g * g;
-            sxy += g * y;
-            ++c;
-        }
-        const double den = (double)c * sxx - sx * sx;
-        const double b = den != 0 ? ((double)c * sxy - sx * sy) / den : 0, a = (sy - b * sx) / (double)c;
-        (*baseline)[j] = a + b * row->greenness;
-        if (!isnan((*model)[j])) {
-            s2[0] += pow((*model)[j] - row->stage, 2);
-            s2[1] += pow((*baseline)[j] - row->stage, 2);
-            ++m;
+        if (row->role == 0 && res && g < res->n_groups) {
+            (*model)[j] = res->predicted[2 * g];
+            (*baseline)[j] = res->predicted[2 * g + 1];
+            ++g;
         }
     }
-    rmse[0] = m ? sqrt(s2[0] / (double)m) : NAN;
-    rmse[1] = m ? sqrt(s2[1] / (double)m) : NAN;
-    /* leave the model at the fitted values */
-    double *yh = malloc(ds->n * sizeof *yh);
-    if (yh)
-        lp_predict(ds, p, yh, NULL);
-    free(yh);
+    if (res) {
+        rmse[0] = res->rmse[0];
+        rmse[1] = res->rmse[1];
+    }
 done:
-    free(pj);
+    phc_cv_result_free(res);
     if (rc) {
         for (size_t j = 0; *ids && j < n; ++j)
             free((*ids)[j]);
@@ -766,7 +740,8 @@ const phc_dataset_ops phc_leaf_photos_ops = {.kind = KIND,
                                             .report_section = lp_report_section,
                                             .simulate_outputs = lp_simulate_outputs,
                                             .fit_outputs = lp_fit_outputs,
-                                            .name_series = lp_name_series};
+                                            .name_series = lp_name_series,
+                                            .cross_validation = lp_cross_validation};
 
 /* ---- building ------------------------------------------------------------------------------ */
 
@@ -1425,7 +1400,6 @@ int phc_leaf_photos_new(const phc_leaf_photos_row *rows, size_t n_rows, const ph
         (rc = load_row_photos(&b, err)) || (rc = check_stages(&b, err)) || (rc = build_model(&b, err)) ||
         (rc = collect_observations(&b, err)) || (rc = model_times(&b, err)))
         goto fail;
-    im->left_out = im->n_rows;
     if ((rc = choose_slots(&b, err)))
         goto fail;
     if (!(ds = phc_dataset_new(&phc_leaf_photos_ops, b.k_slots)) ||
