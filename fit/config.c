@@ -7,31 +7,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/costs/leaf_photos.h"
-#include "fit/costs/source_file.h"
 #include "fit/config/kinds.h"
 #include "fit/config/soil_setup_yaml.h"
-#include "fit/parameter_units.h"
 #include "fit/config/yaml_keys.h"
+#include "fit/costs/source_file.h"
+#include "fit/parameter_units.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
 /* The data-set kinds this build knows, alphabetical: each descriptor
  * (fit/config/kind.h) holds the name, summary, keys and their help, the
  * operations and the YAML translation. */
-static const phc_kind leaf_photos_kind = {
-    .config = {.name = "leaf_photos",
-               .summary = "photos of an aging leaf -> vein, stomata, inflow and time scales and the " "colour transfer of the leaf colour aging model (Silva et al. §3)",
-               .keys = phc_leaf_photos_keys,
-               .help = phc_leaf_photos_help},
-    .load_yaml = phc_leaf_photos_load,
-};
 
 static const phc_kind *const kinds[] = {
     &phc_curve_kind,
     &phc_elasticity_curve_kind,
     &phc_infiltration_kind,
-    &leaf_photos_kind,
+    &phc_leaf_photos_kind,
     &phc_pv_curve_kind,
     &phc_root_shoot_kind,
     &phc_soil_probe_kind,

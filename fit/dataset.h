@@ -14,6 +14,7 @@
 #include "model/status.h"
 
 typedef struct phc_dataset phc_dataset;
+struct phc_cv_plan; /* fit/cross_validation.h */
 
 /* Decides whether a name a data set's options use (an expression name, a
  * model slot) is bound to a parameter of the problem (1) or not (0). */
@@ -52,6 +53,13 @@ typedef struct phc_dataset_ops {
      * key.  Sets ds->series when the loader did not, then calls
      * phc_dataset_name_series.  phc_problem_add_dataset calls it once. */
     int (*name_series)(phc_dataset *ds, phc_error *err);
+    /* Optional (NULL = none): cross-validation by the engine
+     * (fit/cross_validation.h).  Fills *plan (zeroed by the caller): the
+     * groups of observations left out in turn, what is measured of each and
+     * how to predict it from the data set refitted without it; leaves
+     * plan->n_groups 0 when the data set asks for none.  The engine runs
+     * the refits after the fit and adds the predictions to the report. */
+    int (*cross_validation)(phc_dataset *ds, struct phc_cv_plan *plan, phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/cross_validation.h"
 #include "fit/multistart.h"
 #include "fit/residual_checks.h"
 #include "fit/uncertainty.h"
@@ -661,6 +662,37 @@ done:
     return rc;
 }
 
+/* The data set's cross-validation (fit/cross_validation.h), when its kind
+ * has the op and the data set asks for it: run at the fitted values x and
+ * added to the data set's report section. */
+static int add_cross_validation(const phc_problem *pb, phc_dataset *ds, const double *x, phc_progress_fn progress,
+                                void *user_data, phc_dataset_result *d, phc_error *err)
+{
+    if (!ds->ops->cross_validation)
+        return PHC_OK;
+    double *p = calloc(ds->k ? ds->k : 1, sizeof *p);
+    phc_cv_result *cv = NULL;
+    char *md = NULL;
+    int rc;
+    if (!p)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    slot_values(ds, x, p);
+    if (!(rc = phc_cross_validate(pb, ds, p, progress, user_data, &cv, err)) && cv &&
+        !(rc = phc_cv_result_markdown(cv, &md, err))) {
+        const size_t a = d->extra_markdown ? strlen(d->extra_markdown) : 0, b = strlen(md);
+        char *joined = realloc(d->extra_markdown, a + b + 1);
+        if (joined) {
+            memcpy(joined + a, md, b + 1);
+            d->extra_markdown = joined;
+        } else
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    free(md);
+    phc_cv_result_free(cv);
+    free(p);
+    return rc;
+}
+
 int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
                 phc_fit_result **out, phc_error *err)
 {
@@ -673,8 +705,8 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     *out = NULL;
     if ((rc = phc_problem_validate(pb, err)))
         return rc;
-    /* kinds that refit themselves (cross-validation in their report
-     * section) report progress through their data set while the fit runs */
+    /* long work of the kinds while the fit runs reports progress through
+     * their data set */
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         pb->datasets[d]->progress = progress;
         pb->datasets[d]->progress_data = user_data;
@@ -910,11 +942,12 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         res->params[res->free_index[f]].sens_l2 = res->sensitivity.l2[f];
     }
 
-    /* Per data set: goodness, checks, curves. */
+    /* Per data set: goodness, checks, curves, cross-validation. */
     for (size_t d = 0, row = 0; d < pb->n_datasets; ++d) {
         phc_dataset *ds = pb->datasets[d];
         if ((rc = fill_dataset_result(ds, best, r + row, J + row * np, np, res->free_index, nf,
-                                      opt->absolute_sigma ? 1.0 : s_noise, opt->level, &res->datasets[d], err)))
+                                      opt->absolute_sigma ? 1.0 : s_noise, opt->level, &res->datasets[d], err)) ||
+            (rc = add_cross_validation(pb, ds, best, progress, user_data, &res->datasets[d], err)))
             goto fail;
         for (size_t i = 0; i < ds->n; ++i)
             res->rss += res->datasets[d].residual[i] * res->datasets[d].residual[i];

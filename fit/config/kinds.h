@@ -8,6 +8,7 @@
 extern const phc_kind phc_curve_kind;
 extern const phc_kind phc_elasticity_curve_kind;
 extern const phc_kind phc_infiltration_kind;
+extern const phc_kind phc_leaf_photos_kind;
 extern const phc_kind phc_pv_curve_kind;
 extern const phc_kind phc_root_shoot_kind;
 extern const phc_kind phc_soil_probe_kind;

@@ -9,63 +9,15 @@
 
 #include "fit/leaf_images.h"
 #include "fit/costs/leaf_setup.h"
-#include "fit/costs/source_file.h"
-#include "fit/config/yaml_keys.h" /* until this kind is YAML-free */
+#include "fit/costs/origin.h"
 #include "fit/costs/unique_times.h"
-#include "fit/problem.h"
+#include "fit/cross_validation.h"
 #include "measurements/photo.h"
-#include "measurements/table.h"
 
-const char *const phc_leaf_photos_keys[] = {
-    "file", "image", "leaf", "id", "stage", "initial", "reference", "residual", "difference", "grid",
-    "quantiles", "sigma", "colour_space", "colour_correction", "register", "model_size", "dt", "veins",
-    "vein_floor", "stomata", "inflow", "cross_validate", "x_label", "y_label", NULL};
-const phc_key_help phc_leaf_photos_help[] = {
-    {"file", "CSV table with one row per photographed leaf, relative to the config file: the "
-             "fresh leaf and at least one more. Required."},
-    {"image", "The photo of every row (a file relative to the config file), or {column: NAME}: "
-              "a column naming each row's photo. Required."},
-    {"leaf", "Column: the leaf's number in its photo, a whole number >= 1 in reading order. "
-             "Default: 1 for every row."},
-    {"id", "Column naming the rows (for initial and reference). Default: the leaf column, "
-           "else the row's line number."},
-    {"stage", "{column: NAME, direction: increasing | decreasing} or a column name: each "
-              "photo's stage, a time (increasing, the default) or a measured stage such as "
-              "SPAD chlorophyll (decreasing); with residual pixels the rows are in stage order. "
-              "Required."},
-    {"initial", "Id of the row of the fresh leaf the model ages. Default: the row with the "
-                "earliest stage."},
-    {"reference", "The senescent reference leaf (eq. 8): a row id (not the initial one), or "
-                  "{image: FILE, leaf: N} (N default 1). Required."},
-    {"residual", "pixels (CIELAB means over grid cells of the photo and the simulated leaf) or "
-                 "histogram (quantiles of L*, a*, b* over the leaf; for photos of different "
-                 "leaves or that cannot be registered). Default: pixels."},
-    {"difference", "pixels: de76 (3 residuals per cell, dL*, da*, db*) or ciede2000 (one per "
-                   "cell). Default: de76."},
-    {"grid", "pixels: grid cells on the long side of the leaf, 2 to 512. Default: 24."},
-    {"quantiles", "histogram: quantiles per CIELAB channel, 2 to 256. Default: 16."},
-    {"sigma", "Standard deviation of each residual, delta-E units, > 0. Default: 2."},
-    {"colour_space", "Space in which the fresh leaf's colours are matched to the reference's: "
-                     "rgb (the paper's) or lab. Default: rgb."},
-    {"colour_correction", "Colour correction of every photo: none, gray_world or colorchecker "
-                          "(a 24-patch ColorChecker Classic in the frame). Default: none."},
-    {"register", "pixels: align each photo to the fresh leaf's (ECC on the silhouettes). "
-                 "Default: true."},
-    {"model_size", "Simulation grid, px on the long side of the leaf, 16 to 4096. "
-                   "Default: 128."},
-    {"dt", "Model step, in model time units, > 0. Default: 0.1."},
-    {"veins", "Venation map: auto (ridge map of the fresh photo), uniform, or an image file the "
-              "size of the fresh leaf's photo. Default: auto."},
-    {"vein_floor", "Venation value on the lamina between veins, 0 to 1. Default: 0.05."},
-    {"stomata", "Stomata map: uniform or an image file. Default: uniform."},
-    {"inflow", "Inflow map: veins (the venation map), uniform, none or an image file. "
-               "Default: veins."},
-    {"cross_validate", "After the fit, predict each row's stage with that row left out, beside "
-                       "a greenness baseline, in the report. Default: false."},
-    {"x_label", "Axis label of the stage. Default: the stage column's name."},
-    {"y_label", "Axis label of the residuals. Default: names the residual (e.g. \"CIELAB cell "
-                "mean (L*, a*, b*)\")."},
-    {NULL, NULL}};
+#define KIND "leaf_photos"
+/* The place of a message about option `key`: "cfg.yaml:12" from a config,
+ * else the kind's name (fit/costs/origin.h). */
+#define WHERE(key) phc_origin_key(opt->origin, KIND, key).text
 
 /* Parameter slots and their defaults when no parameter of that name exists. */
 enum { SL_BETA, SL_STOMATA, SL_INFLOW, SL_TIME, SL_YLO, SL_YHI, N_SLOTS };
@@ -108,9 +60,7 @@ typedef struct lp_impl {
     size_t m_unique, *t_at;            /* per data row index (into rows) */
     double *lab;                       /* 3 w h scratch */
     double *scratch;                   /* w h */
-    int cross_validate;
-    double *mask_row_zero;             /* during cross-validation: residuals of this row zeroed */
-    size_t left_out;                   /* row left out (n_rows = none) */
+    int cross_validate;                /* the engine's leave-one-out (lp_cross_validation) */
 } lp_impl;
 
 static void lp_free(void *p)
@@ -299,10 +249,6 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
     char *out = NULL;
     size_t len = 0;
     double *yhat = malloc(ds->n * sizeof *yhat);
-    double *cv_stage = NULL, *cv_model = NULL, *cv_base = NULL;
-    char **cv_ids = NULL;
-    size_t cv_n = 0;
-    double rmse[2] = {NAN, NAN};
     int rc = PHC_OK;
     if (!yhat)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -310,11 +256,6 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
         free(yhat);
         return phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the leaf model cannot be evaluated at the optimum",
                              ds->name);
-    }
-    if (im->cross_validate &&
-        (rc = phc_leaf_photos_cross_validate(ds, p, &cv_n, &cv_ids, &cv_stage, &cv_model, &cv_base, rmse, err))) {
-        free(yhat);
-        return rc;
     }
     FILE *f = open_memstream(&out, &len);
     if (!f) {
@@ -355,17 +296,6 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
             fprintf(f, " %.4f |", row->correlation);
         fputc('\n', f);
     }
-    if (im->cross_validate) {
-        fprintf(f, "\n**Leave-one-out prediction of %s** (each row left out in turn; the free parameters refitted "
-                   "on the others; the stage read off the model time whose colours match the photo best).  "
-                   "Baseline: a straight line in the mean chromatic greenness G/(R+G+B), fitted on the same rows.\n\n"
-                   "| row | measured | model | baseline |\n|---|---|---|---|\n", im->stage_name);
-        for (size_t r = 0; r < cv_n; ++r)
-            if (!isnan(cv_model[r]))
-                fprintf(f, "| %s | %g | %.2f | %.2f |\n", cv_ids[r], cv_stage[r], cv_model[r], cv_base[r]);
-        fprintf(f, "\nRMSE of the prediction (%s units): model **%.3g**, baseline **%.3g**.\n", im->stage_name,
-                rmse[0], rmse[1]);
-    }
     if (ferror(f) | (fclose(f) != 0)) {
         free(out);
         out = NULL;
@@ -373,70 +303,11 @@ static int lp_report_section(phc_dataset *ds, const double *p, char **markdown, 
     }
 done:
     free(yhat);
-    for (size_t r = 0; cv_ids && r < cv_n; ++r)
-        free(cv_ids[r]);
-    free(cv_ids);
-    free(cv_stage);
-    free(cv_model);
-    free(cv_base);
     *markdown = out;
     return rc;
 }
 
-/* ---- cross-validation -------------------------------------------------------------- */
-
-static int loo_residuals(const double *p, double *r, double *jac, void *user)
-{
-    phc_dataset *ds = user;
-    lp_impl *im = ds->impl;
-    const int rc = phc_dataset_residuals(p, r, jac, ds);
-    if (rc == 0 && im->left_out < im->n_rows) {
-        const lp_row *row = &im->rows[im->left_out];
-        for (size_t i = row->first; i < row->first + row->count; ++i)
-            r[i] = 0;
-    }
-    return rc;
-}
-
-/* Refits the data set's free slots with row `left_out` excluded, from p;
- * the result overwrites p. */
-static int refit_without(phc_dataset *ds, double *p, size_t fold, size_t folds, phc_error *err)
-{
-    const phc_problem *pb = ds->problem;
-    phc_nls *nls = phc_nls_new(ds->k);
-    size_t *idx = malloc(ds->k * sizeof *idx);
-    int rc = PHC_OK;
-    if (!nls || !idx) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    for (size_t q = 0; q < ds->k; ++q) {
-        const phc_parameter *par = &pb->params[ds->param_index[q]];
-        idx[q] = q;
-        double lo = par->lower, hi = par->upper;
-        if (p[q] < lo || p[q] > hi)
-            p[q] = fmin(fmax(p[q], lo), hi);
-        if ((rc = phc_nls_set_parameter(nls, q, lo, hi, par->fixed, phc_problem_scale(pb, ds->param_index[q]), err)))
-            goto done;
-    }
-    if ((rc = phc_nls_add_block(nls, ds->n, idx, ds->k, loo_residuals, PHC_DERIV_CENTRAL, PHC_LOSS_NONE, 1.0, ds,
-                                err)))
-        goto done;
-    phc_nls_options opt = pb->options.nls;
-    phc_progress_relay relay = {ds->progress, ds->progress_data, "leave-one-out", ds->name, fold, folds, 0};
-    if (ds->progress) {
-        opt.on_iteration = phc_progress_relay_iteration;
-        opt.on_iteration_data = &relay;
-    }
-    phc_nls_summary sum;
-    rc = phc_nls_solve(nls, &opt, p, &sum, err);
-    if (rc == PHC_OK && relay.cancelled)
-        rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-done:
-    phc_nls_free(nls);
-    free(idx);
-    return rc;
-}
+/* ---- cross-validation (by the engine: fit/cross_validation.h) -------------------------- */
 
 /* The stage of row r read off the model: the model time whose colours are
  * closest (weighted squared residuals) to the row's photo, searched over
@@ -490,33 +361,128 @@ static int predict_stage(phc_dataset *ds, const double *p, const lp_row *row, do
     return 0;
 }
 
+/* The row of the g-th data row (the groups of the cross-validation). */
+static size_t data_row(const lp_impl *im, size_t g)
+{
+    for (size_t r = 0, k = 0; r < im->n_rows; ++r)
+        if (im->rows[r].role == 0 && k++ == g)
+            return r;
+    return im->n_rows;
+}
+
+/* The greenness baseline for row j: the least-squares line stage = a + b g
+ * in the mean chromatic greenness g over every other row (the fresh and
+ * reference leaves included), at row j's greenness. */
+static double greenness_baseline(const lp_impl *im, size_t j)
+{
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    size_t c = 0;
+    for (size_t i = 0; i < im->n_rows; ++i) {
+        if (i == j)
+            continue;
+        const double g = im->rows[i].greenness, y = im->rows[i].stage;
+        sx += g;
+        sy += y;
+        sxx += g * g;
+        sxy += g * y;
+        ++c;
+    }
+    const double den = (double)c * sxx - sx * sx;
+    const double b = den != 0 ? ((double)c * sxy - sx * sy) / den : 0, a = (sy - b * sx) / (double)c;
+    return a + b * im->rows[j].greenness;
+}
+
+/* Group g (a data row) left out: its stage read off the model at the
+ * refitted slot values p (NAN outside the model's domain), and the
+ * greenness baseline. */
+static int lp_cv_predict(phc_dataset *ds, const double *p, size_t g, double *values, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    const size_t j = data_row(im, g);
+    if (j == im->n_rows)
+        return phc_error_set(err, PHC_ERR_INVALID, "data set '%s': no data row %zu", ds->name, g);
+    values[0] = NAN;
+    if (predict_stage(ds, p, &im->rows[j], &values[0]) < 0)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    values[1] = greenness_baseline(im, j);
+    return PHC_OK;
+}
+
+/* The plan of the leave-one-out prediction of each row's stage: a group per
+ * data row (the residuals of its photo); the fresh and reference leaves
+ * are never left out. */
+static int lp_plan(phc_dataset *ds, phc_cv_plan *plan, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    size_t ng = 0;
+    for (size_t r = 0; r < im->n_rows; ++r)
+        ng += im->rows[r].role == 0;
+    memset(plan, 0, sizeof *plan);
+    plan->group = malloc((ds->n ? ds->n : 1) * sizeof *plan->group);
+    plan->names = calloc(ng ? ng : 1, sizeof *plan->names);
+    plan->observed = malloc((ng ? ng : 1) * sizeof *plan->observed);
+    plan->n_groups = ng;
+    if (!plan->group || !plan->names || !plan->observed)
+        goto nomem;
+    for (size_t i = 0; i < ds->n; ++i)
+        plan->group[i] = PHC_CV_NO_GROUP;
+    for (size_t r = 0, g = 0; r < im->n_rows; ++r) {
+        const lp_row *row = &im->rows[r];
+        if (row->role)
+            continue;
+        for (size_t i = row->first; i < row->first + row->count; ++i)
+            plan->group[i] = g;
+        if (!(plan->names[g] = strdup(row->id)))
+            goto nomem;
+        plan->observed[g++] = row->stage;
+    }
+    plan->n_predictions = 2;
+    plan->labels[0] = "model";
+    plan->labels[1] = "baseline";
+    plan->quantity = im->stage_name;
+    plan->group_title = "row";
+    plan->how = "the stage read off the model time whose colours match the photo best";
+    plan->note = "Baseline: a straight line in the mean chromatic greenness G/(R+G+B), fitted on the same rows.";
+    plan->predict = lp_cv_predict;
+    return PHC_OK;
+nomem:
+    phc_cv_plan_clear(plan);
+    return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+}
+
+/* The op: a plan when the data set asks for cross-validation. */
+static int lp_cross_validation(phc_dataset *ds, phc_cv_plan *plan, phc_error *err)
+{
+    const lp_impl *im = ds->impl;
+    return im->cross_validate ? lp_plan(ds, plan, err) : PHC_OK;
+}
+
 int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_rows, char ***ids,
                                    double **stage, double **model, double **baseline, double rmse[2],
                                    phc_error *err)
 {
-    lp_impl *im = ds->impl;
+    const lp_impl *im = ds->impl;
     const size_t n = im->n_rows;
-    double *pj = malloc((ds->k ? ds->k : 1) * sizeof *pj);
+    phc_cv_plan plan;
+    phc_cv_result *res = NULL;
     *ids = calloc(n, sizeof **ids);
     *stage = malloc(n * sizeof **stage);
     *model = malloc(n * sizeof **model);
     *baseline = malloc(n * sizeof **baseline);
     *n_rows = n;
+    rmse[0] = rmse[1] = NAN;
     int rc = PHC_OK;
-    if (!pj || !*ids || !*stage || !*model || !*baseline) {
+    if (!*ids || !*stage || !*model || !*baseline) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    if (!ds->problem) {
-        rc = phc_error_set(err, PHC_ERR_INVALID, "data set '%s': cross-validation needs the data set's problem",
-                           ds->name);
+    if ((rc = lp_plan(ds, &plan, err)))
         goto done;
-    }
-    double s2[2] = {0, 0};
-    size_t m = 0, folds = 0, fold = 0;
-    for (size_t j = 0; j < n; ++j)
-        folds += im->rows[j].role == 0;
-    for (size_t j = 0; j < n; ++j) {
+    rc = phc_cross_validate_plan(ds->problem, ds, &plan, p, ds->progress, ds->progress_data, &res, err);
+    phc_cv_plan_clear(&plan);
+    if (rc)
+        goto done;
+    for (size_t j = 0, g = 0; j < n; ++j) {
         const lp_row *row = &im->rows[j];
         if (!((*ids)[j] = strdup(row->id))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -524,58 +490,18 @@ int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_r
         }
         (*stage)[j] = row->stage;
         (*model)[j] = (*baseline)[j] = NAN;
-        if (row->role)
-            continue;
-        /* model: refit without row j, then read its stage off the model */
-        memcpy(pj, p, ds->k * sizeof *pj);
-        im->left_out = j;
-        ++fold;
-        if (phc_progress_report(ds->progress, ds->progress_data, "leave-one-out", fold, folds, -1, NAN,
-                                ds->name)) {
-            im->left_out = n;
-            rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-            goto done;
-        }
-        rc = refit_without(ds, pj, fold, folds, err);
-        im->left_out = n;
-        if (rc)
-            goto done;
-        const int pr = predict_stage(ds, pj, row, &(*model)[j]);
-        if (pr < 0) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto done;
-        }
-        /* baseline: least-squares line stage = a + b g over the other rows */
-        double sx = 0, sy = 0, sxx = 0, sxy = 0;
-        size_t c = 0;
-        for (size_t i = 0; i < n; ++i) {
-            if (i == j)
-                continue;
-            const double g = im->rows[i].greenness, y = im->rows[i].stage;
-            sx += g;
-            sy += y;
-            sxx += g * g;
-            sxy += g * y;
-            ++c;
-        }
-        const double den = (double)c * sxx - sx * sx;
-        const double b = den != 0 ? ((double)c * sxy - sx * sy) / den : 0, a = (sy - b * sx) / (double)c;
-        (*baseline)[j] = a + b * row->greenness;
-        if (!isnan((*model)[j])) {
-            s2[0] += pow((*model)[j] - row->stage, 2);
-            s2[1] += pow((*baseline)[j] - row->stage, 2);
-            ++m;
+        if (row->role == 0 && res && g < res->n_groups) {
+            (*model)[j] = res->predicted[2 * g];
+            (*baseline)[j] = res->predicted[2 * g + 1];
+            ++g;
         }
     }
-    rmse[0] = m ? sqrt(s2[0] / (double)m) : NAN;
-    rmse[1] = m ? sqrt(s2[1] / (double)m) : NAN;
-    /* leave the model at the fitted values */
-    double *yh = malloc(ds->n * sizeof *yh);
-    if (yh)
-        lp_predict(ds, p, yh, NULL);
-    free(yh);
+    if (res) {
+        rmse[0] = res->rmse[0];
+        rmse[1] = res->rmse[1];
+    }
 done:
-    free(pj);
+    phc_cv_result_free(res);
     if (rc) {
         for (size_t j = 0; *ids && j < n; ++j)
             free((*ids)[j]);
@@ -808,64 +734,27 @@ static int lp_name_series(phc_dataset *ds, phc_error *err)
     return phc_dataset_name_series(ds, "quantile", 3 * im->nq, lp_series_name, err);
 }
 
-static const phc_dataset_ops leaf_photos_ops = {"leaf_photos", lp_predict, NULL, lp_free, lp_report_section,
-                                                lp_simulate_outputs, lp_fit_outputs, lp_name_series};
+const phc_dataset_ops phc_leaf_photos_ops = {.kind = KIND,
+                                            .predict = lp_predict,
+                                            .free_impl = lp_free,
+                                            .report_section = lp_report_section,
+                                            .simulate_outputs = lp_simulate_outputs,
+                                            .fit_outputs = lp_fit_outputs,
+                                            .name_series = lp_name_series,
+                                            .cross_validation = lp_cross_validation};
 
-/* ---- loading ------------------------------------------------------------------------------ */
+/* ---- building ------------------------------------------------------------------------------ */
 
-/* One of `names` (NULL-terminated) for key `key`; *choice its index. */
-static int choose(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *const *names,
-                  int *choice, phc_error *err)
-{
-    const char *v = NULL;
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, node, key, 0, "leaf_photos data set", &v, err)) || !v)
-        return rc;
-    for (int i = 0; names[i]; ++i)
-        if (!strcmp(v, names[i])) {
-            *choice = i;
-            return PHC_OK;
-        }
-    char list[256] = "";
-    for (int i = 0; names[i]; ++i) {
-        strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-        strncat(list, names[i], sizeof list - strlen(list) - 1);
-    }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not one of %s", doc->path,
-                         phc_key_line(node, key), key, v, list);
-}
-
-/* A map key: the keywords in `names` (their index in *source), or a file. */
-static int map_key(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *base_dir,
-                   const char *const *names, const phc_leaf_map_source *sources, phc_leaf_map_source *source,
-                   char **file, phc_error *err)
-{
-    const char *v = NULL;
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, node, key, 0, "leaf_photos data set", &v, err)) || !v)
-        return rc;
-    for (int i = 0; names[i]; ++i)
-        if (!strcmp(v, names[i])) {
-            *source = sources[i];
-            return PHC_OK;
-        }
-    *source = PHC_LEAF_MAP_FILE;
-    if (!(*file = phc_join_path(base_dir, v)))
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    return PHC_OK;
-}
-
-/* The row whose id is `id`, or PHC_ERR_INPUT naming the key. */
-static int find_row(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const lp_impl *im,
-                    const char *id, size_t *row, phc_error *err)
+/* The row whose id is `id`, or PHC_ERR_INPUT naming the option `key`. */
+static int find_row(const phc_leaf_photos_options *opt, const char *key, const lp_impl *im, const char *id,
+                    size_t *row, phc_error *err)
 {
     for (size_t r = 0; r < im->n_rows; ++r)
         if (!strcmp(im->rows[r].id, id)) {
             *row = r;
             return PHC_OK;
         }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': no row has id '%s'", doc->path, phc_key_line(node, key),
-                         key, id);
+    return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s': no row has id '%s'", WHERE(key), key, id);
 }
 
 /* Mean chromatic greenness G/(R+G+B) of an image's leaf pixels. */
@@ -884,44 +773,86 @@ static double mean_greenness(const phc_image *img, const unsigned char *mask)
     return n ? s / (double)n : NAN;
 }
 
-/* The observations of data row r: pixels mode registers the photo to the
- * fresh leaf and averages cells; histogram mode takes quantiles. */
-static int row_observations(lp_impl *im, lp_row *row, int do_register, phc_error *err)
+/* Histogram observations of a data row: the quantiles of L*, a*, b* over
+ * the leaf in its photo on a grid the size of the model's. */
+static int histogram_observations(lp_impl *im, lp_row *row, phc_error *err)
+{
+    const phc_leaf_setup *su = im->su;
+    unsigned char *m = NULL;
+    double *lab = NULL, *scr = NULL;
+    int rc;
+    if ((rc = phc_leaf_photo_grid(&row->photo, su->w > su->h ? su->w : su->h, &row->grid, &m, err)))
+        return rc;
+    const size_t np = row->grid.width * row->grid.height;
+    lab = malloc(3 * np * sizeof *lab);
+    row->obs = malloc(3 * im->nq * sizeof *row->obs);
+    scr = malloc(2 * 3 * np * sizeof *scr);
+    if (!lab || !row->obs || !scr) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    phc_colour_convert(np, row->grid.data, PHC_COLOUR_RGB, PHC_COLOUR_LAB, lab);
+    double *keep = im->scratch;
+    im->scratch = scr;
+    lab_quantiles(im, lab, m, np, row->obs);
+    im->scratch = keep;
+    row->greenness = mean_greenness(&row->grid, m);
+    row->count = 3 * im->nq;
+    row->mask = m;
+    m = NULL;
+    rc = PHC_OK;
+done:
+    free(scr);
+    free(m);
+    free(lab);
+    return rc;
+}
+
+/* Aligns a data row's photo `raw` and its mask `rm` (on the model grid) to
+ * the fresh leaf by its outline: ECC on the two silhouettes (mask images),
+ * because aging changes exactly the colours that ECC on the photos would
+ * compare.  The warp then moves photo and mask; row->correlation is ECC's. */
+static int register_row(const phc_leaf_setup *su, lp_row *row, phc_image *raw, unsigned char *rm, phc_error *err)
+{
+    const size_t n = su->w * su->h;
+    double warp[6];
+    phc_image sf = {0}, sr = {0}, aligned = {0}, warped = {0}, mw = {0};
+    int rc;
+    if ((rc = phc_image_alloc(&sf, su->w, su->h, err)) || (rc = phc_image_alloc(&sr, su->w, su->h, err)))
+        goto done;
+    for (size_t i = 0; i < n; ++i) {
+        sf.data[3 * i] = sf.data[3 * i + 1] = sf.data[3 * i + 2] = su->mask[i];
+        sr.data[3 * i] = sr.data[3 * i + 1] = sr.data[3 * i + 2] = rm[i];
+    }
+    if ((rc = phc_photo_register(&sf, &sr, NULL, NULL, &aligned, warp, &row->correlation, err)) ||
+        (rc = phc_photo_warp(raw, warp, su->w, su->h, &warped, err)) ||
+        (rc = phc_photo_warp(&sr, warp, su->w, su->h, &mw, err)))
+        goto done;
+    for (size_t i = 0; i < n; ++i)
+        rm[i] = mw.data[3 * i] >= 0.5;
+    phc_image_free(raw);
+    *raw = warped;
+    warped.data = NULL;
+done:
+    phc_image_free(&sf);
+    phc_image_free(&sr);
+    phc_image_free(&aligned);
+    phc_image_free(&warped);
+    phc_image_free(&mw);
+    return rc;
+}
+
+/* Pixels observations of a data row: its photo on the fresh leaf's grid,
+ * registered to it when asked, averaged over the cells that are at least
+ * half leaf in both. */
+static int pixels_observations(lp_impl *im, lp_row *row, int do_register, phc_error *err)
 {
     const phc_leaf_setup *su = im->su;
     const size_t n = su->w * su->h;
-    unsigned char *m = NULL;
     double *lab = NULL;
-    int rc;
-    row->correlation = NAN;
-    if (im->histogram) {
-        if ((rc = phc_leaf_photo_grid(&row->photo, su->w > su->h ? su->w : su->h, &row->grid, &m, err)))
-            return rc;
-        const size_t np = row->grid.width * row->grid.height;
-        lab = malloc(3 * np * sizeof *lab);
-        row->obs = malloc(3 * im->nq * sizeof *row->obs);
-        double *scr = malloc(2 * 3 * np * sizeof *scr);
-        if (!lab || !row->obs || !scr) {
-            free(scr);
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto done;
-        }
-        phc_colour_convert(np, row->grid.data, PHC_COLOUR_RGB, PHC_COLOUR_LAB, lab);
-        double *keep = im->scratch;
-        im->scratch = scr;
-        lab_quantiles(im, lab, m, np, row->obs);
-        im->scratch = keep;
-        free(scr);
-        row->greenness = mean_greenness(&row->grid, m);
-        row->count = 3 * im->nq;
-        row->mask = m;
-        m = NULL;
-        rc = PHC_OK;
-        goto done;
-    }
-    /* pixels: the photo on the fresh leaf's grid, registered to it */
-    phc_image raw = {0}, full = {0};
+    phc_image raw = {0};
     unsigned char *rm = NULL;
+    int rc;
     if ((rc = phc_photo_resize(&row->photo.crop, su->w, su->h, &raw, err)) ||
         (rc = phc_photo_resize_mask(row->photo.mask, row->photo.crop.width, row->photo.crop.height, su->w, su->h, &rm,
                                     err))) {
@@ -932,40 +863,12 @@ static int row_observations(lp_impl *im, lp_row *row, int do_register, phc_error
     for (size_t i = 0; i < n; ++i)
         if (!rm[i])
             raw.data[3 * i] = raw.data[3 * i + 1] = raw.data[3 * i + 2] = 0;
-    if (do_register) {
-        /* Aligned by the leaf's outline: ECC on the two silhouettes (mask
-         * images), because aging changes exactly the colours that ECC on
-         * the photos would compare.  The warp then moves photo and mask. */
-        double warp[6];
-        phc_image sf = {0}, sr = {0}, aligned = {0}, warped = {0}, mw = {0};
-        if ((rc = phc_image_alloc(&sf, su->w, su->h, err)) || (rc = phc_image_alloc(&sr, su->w, su->h, err)))
-            goto reg_done;
-        for (size_t i = 0; i < n; ++i) {
-            sf.data[3 * i] = sf.data[3 * i + 1] = sf.data[3 * i + 2] = su->mask[i];
-            sr.data[3 * i] = sr.data[3 * i + 1] = sr.data[3 * i + 2] = rm[i];
-        }
-        if ((rc = phc_photo_register(&sf, &sr, NULL, NULL, &aligned, warp, &row->correlation, err)) ||
-            (rc = phc_photo_warp(&raw, warp, su->w, su->h, &warped, err)) ||
-            (rc = phc_photo_warp(&sr, warp, su->w, su->h, &mw, err)))
-            goto reg_done;
-        for (size_t i = 0; i < n; ++i)
-            rm[i] = mw.data[3 * i] >= 0.5;
+    if (do_register && (rc = register_row(su, row, &raw, rm, err))) {
         phc_image_free(&raw);
-        raw = warped;
-        warped.data = NULL;
-    reg_done:
-        phc_image_free(&sf);
-        phc_image_free(&sr);
-        phc_image_free(&aligned);
-        phc_image_free(&warped);
-        phc_image_free(&mw);
-        if (rc) {
-            phc_image_free(&raw);
-            free(rm);
-            return rc;
-        }
+        free(rm);
+        return rc;
     }
-    full = raw;
+    phc_image full = raw;
     row->mask = rm;
     row->grid = full;
     for (size_t i = 0; i < n; ++i)
@@ -976,8 +879,8 @@ static int row_observations(lp_impl *im, lp_row *row, int do_register, phc_error
     row->cell_ok = calloc(im->cw * im->ch, 1);
     row->obs = malloc(3 * im->cw * im->ch * sizeof *row->obs);
     if (!lab || !row->cell_ok || !row->obs) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
+        free(lab);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     phc_colour_convert(n, full.data, PHC_COLOUR_RGB, PHC_COLOUR_LAB, lab);
     size_t k = 0;
@@ -992,425 +895,454 @@ static int row_observations(lp_impl *im, lp_row *row, int do_register, phc_error
             ++k;
         }
     row->count = im->de2000 ? k : 3 * k;
-    rc = PHC_OK;
-done:
-    free(m);
     free(lab);
-    return rc;
+    return PHC_OK;
 }
 
-int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                         phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
+/* The observations of a data row: pixels mode registers the photo to the
+ * fresh leaf and averages cells; histogram mode takes quantiles. */
+static int row_observations(lp_impl *im, lp_row *row, int do_register, phc_error *err)
 {
-    static const char *const residual_names[] = {"pixels", "histogram", NULL};
-    static const char *const difference_names[] = {"de76", "ciede2000", NULL};
-    static const char *const space_names[] = {"rgb", "lab", NULL};
-    static const char *const correction_names[] = {"none", "gray_world", "colorchecker", NULL};
-    static const char *const direction_names[] = {"increasing", "decreasing", NULL};
-    static const char *const vein_names[] = {"auto", "uniform", NULL};
-    static const phc_leaf_map_source vein_sources[] = {PHC_LEAF_MAP_AUTO, PHC_LEAF_MAP_UNIFORM};
-    static const char *const stomata_names[] = {"uniform", NULL};
-    static const phc_leaf_map_source stomata_sources[] = {PHC_LEAF_MAP_UNIFORM};
-    static const char *const inflow_names[] = {"veins", "uniform", "none", NULL};
-    static const phc_leaf_map_source inflow_sources[] = {PHC_LEAF_MAP_AUTO, PHC_LEAF_MAP_UNIFORM, PHC_LEAF_MAP_NONE};
-    static const char *const stage_keys[] = {"column", "direction", NULL};
-    static const char *const ref_keys[] = {"image", "leaf", NULL};
-    const char *ctx = "leaf_photos data set";
-    const char *file = NULL, *leaf_col = NULL, *id_col = NULL, *stage_col = NULL, *image_name = NULL,
-               *image_col = NULL, *x_label = NULL, *y_label = NULL;
-    char *path = NULL, *veins_file = NULL, *stomata_file = NULL, *inflow_file = NULL, *img_path = NULL;
-    phc_table *t = NULL;
-    phc_dataset *ds = NULL;
-    double *stage = NULL, *leafno = NULL, *dst = NULL;
-    size_t *data_rows = NULL;
-    char where[512];
-    int rc;
-    *out = NULL;
-    lp_impl *im = calloc(1, sizeof *im);
-    if (!im || !(im->cache = phc_photo_cache_new())) {
-        free(im);
+    row->correlation = NAN;
+    return im->histogram ? histogram_observations(im, row, err) : pixels_observations(im, row, do_register, err);
+}
+
+phc_leaf_photos_options phc_leaf_photos_options_default(void)
+{
+    phc_leaf_photos_options o;
+    memset(&o, 0, sizeof o);
+    o.direction = 1;
+    o.residual = PHC_LEAF_RESIDUAL_PIXELS;
+    o.difference = PHC_LEAF_DE76;
+    o.grid = 24;
+    o.quantiles = 16;
+    o.sigma = 2;
+    o.colour_correction = PHC_CC_NONE;
+    o.register_photos = 1;
+    o.setup = phc_leaf_setup_options_default();
+    return o;
+}
+
+/* What a leaf_photos data set is built from, while it is built. */
+typedef struct lp_build {
+    const phc_leaf_photos_options *opt;
+    const phc_leaf_photos_row *rows;
+    lp_impl *im;
+    size_t n_obs, n_data, k_slots; /* residuals, data rows, slots */
+} lp_build;
+
+/* Where the options placed a message: "cfg.yaml:12: key 'grid'" (the config
+ * line of the key) or, built in C, "leaf_photos: key 'grid'". */
+static void key_where(const phc_leaf_photos_options *opt, const char *key, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s: key '%s'", WHERE(key), key);
+}
+
+/* The data set as a whole: "cfg.yaml:5: leaf_photos data set" or "leaf_photos". */
+static void set_where(const phc_leaf_photos_options *opt, char *buf, size_t size)
+{
+    if (opt->origin && opt->origin->path)
+        snprintf(buf, size, "%s: leaf_photos data set", WHERE(NULL));
+    else
+        snprintf(buf, size, "%s", KIND);
+}
+
+/* Where row r's value came from: its table line and `column` when the rows
+ * came from a table ("leaves.csv:3: column 'leaf'", or "leaves.csv:3"
+ * without a column), else the row and the field ("leaf_photos: rows[2]
+ * (leaf)", or "leaf_photos: rows[2]" without a field). */
+static void row_where(const lp_build *b, size_t r, const char *column, const char *field, char *buf, size_t size)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    if (opt->rows_source && b->rows[r].line) {
+        if (column)
+            snprintf(buf, size, "%s:%zu: column '%s'", opt->rows_source, b->rows[r].line, column);
+        else
+            snprintf(buf, size, "%s:%zu", opt->rows_source, b->rows[r].line);
+    } else if (field)
+        snprintf(buf, size, "%s: rows[%zu] (%s)", KIND, r, field);
+    else
+        snprintf(buf, size, "%s: rows[%zu]", KIND, r);
+}
+
+/* Where row r's photo was named: the table's image column, the config's
+ * `image:` key (one photo for every row), or the row. */
+static void image_where(const lp_build *b, size_t r, char *buf, size_t size)
+{
+    if (b->opt->image_column || !b->opt->origin)
+        row_where(b, r, b->opt->image_column, "image", buf, size);
+    else
+        key_where(b->opt, "image", buf, size);
+}
+
+static const char *stage_name(const phc_leaf_photos_options *opt)
+{
+    return opt->stage_name ? opt->stage_name : "stage";
+}
+
+/* The options' values within their ranges, the reference given once, at
+ * least two rows. */
+static int check_options(const phc_leaf_photos_options *opt, size_t n_rows, phc_error *err)
+{
+    const phc_leaf_setup_options *so = &opt->setup;
+    const struct {
+        const char *key;
+        int ok;
+        const char *what;
+    } checks[] = {{"grid", opt->grid >= 2 && opt->grid <= 512, "an integer from 2 to 512"},
+                  {"quantiles", opt->quantiles >= 2 && opt->quantiles <= 256, "an integer from 2 to 256"},
+                  {"model_size", so->model_size >= 16 && so->model_size <= 4096, "an integer from 16 to 4096"},
+                  {"sigma", opt->sigma > 0, "> 0"},
+                  {"dt", so->dt > 0, "> 0"},
+                  {"vein_floor", so->vein_floor >= 0 && so->vein_floor <= 1, "between 0 and 1"},
+                  {"residual", opt->residual == PHC_LEAF_RESIDUAL_PIXELS || opt->residual == PHC_LEAF_RESIDUAL_HISTOGRAM,
+                   "pixels or histogram"},
+                  {"difference", opt->difference == PHC_LEAF_DE76 || opt->difference == PHC_LEAF_CIEDE2000,
+                   "de76 or ciede2000"},
+                  {"colour_space", so->space == PHC_COLOUR_RGB || so->space == PHC_COLOUR_LAB, "rgb or lab"},
+                  {"colour_correction", opt->colour_correction == PHC_CC_NONE ||
+                                            opt->colour_correction == PHC_CC_GRAY_WORLD ||
+                                            opt->colour_correction == PHC_CC_COLORCHECKER,
+                   "none, gray_world or colorchecker"},
+                  {"veins", so->veins != PHC_LEAF_MAP_FILE || so->veins_file, "a file when the map is a file"},
+                  {"stomata", so->stomata != PHC_LEAF_MAP_FILE || so->stomata_file, "a file when the map is a file"},
+                  {"inflow", so->inflow != PHC_LEAF_MAP_FILE || so->inflow_file, "a file when the map is a file"}};
+    char where[4400];
+    for (size_t i = 0; i < sizeof checks / sizeof checks[0]; ++i)
+        if (!checks[i].ok) {
+            key_where(opt, checks[i].key, where, sizeof where);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: must be %s", where, checks[i].what);
+        }
+    if (!opt->reference && !opt->reference_image && !opt->reference_pixels) {
+        set_where(opt, where, sizeof where);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: missing key 'reference' (the id of the senescent leaf's row, or "
+                             "{image: FILE, leaf: N})", where);
+    }
+    if (opt->reference && (opt->reference_image || opt->reference_pixels)) {
+        key_where(opt, "reference", where, sizeof where);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: a row id or an image, not both", where);
+    }
+    if (n_rows < 2) {
+        if (opt->rows_source)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:1: %zu data row%s below the header: a leaf_photos data set "
+                                 "needs a fresh leaf and at least one more photo", opt->rows_source, n_rows,
+                                 n_rows == 1 ? "" : "s");
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: %zu row%s: a leaf_photos data set needs a fresh leaf and at "
+                             "least one more photo", KIND, n_rows, n_rows == 1 ? "" : "s");
+    }
+    return PHC_OK;
+}
+
+/* The rows' ids, lines and stages; an id used twice and a stage that is
+ * not a number are errors naming the row. */
+static int copy_rows(lp_build *b, size_t n_rows, phc_error *err)
+{
+    lp_impl *im = b->im;
+    char where[4400];
+    if (!(im->rows = calloc(n_rows, sizeof *im->rows)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    }
-    phc_leaf_setup_options so = phc_leaf_setup_options_default();
-    int residual = 0, difference = 0, space = 0, correction = 0, direction = 0, do_register = 1;
-    long grid = 24, nq = 16, model_size = 128;
-    double sigma = 2;
-    im->cross_validate = 0;
-    if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, &file, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "leaf", 0, ctx, &leaf_col, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "id", 0, ctx, &id_col, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &x_label, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &y_label, err)) ||
-        (rc = choose(doc, node, "residual", residual_names, &residual, err)) ||
-        (rc = choose(doc, node, "difference", difference_names, &difference, err)) ||
-        (rc = choose(doc, node, "colour_space", space_names, &space, err)) ||
-        (rc = choose(doc, node, "colour_correction", correction_names, &correction, err)) ||
-        (rc = phc_yaml_map_boolean(doc, node, "register", 0, ctx, &do_register, err)) ||
-        (rc = phc_yaml_map_boolean(doc, node, "cross_validate", 0, ctx, &im->cross_validate, err)) ||
-        (rc = phc_yaml_map_integer(doc, node, "grid", 0, ctx, &grid, err)) ||
-        (rc = phc_yaml_map_integer(doc, node, "quantiles", 0, ctx, &nq, err)) ||
-        (rc = phc_yaml_map_integer(doc, node, "model_size", 0, ctx, &model_size, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "sigma", 0, ctx, &sigma, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "dt", 0, ctx, &so.dt, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "vein_floor", 0, ctx, &so.vein_floor, err)) ||
-        (rc = map_key(doc, node, "veins", base_dir, vein_names, vein_sources, &so.veins, &veins_file, err)) ||
-        (rc = map_key(doc, node, "stomata", base_dir, stomata_names, stomata_sources, &so.stomata, &stomata_file,
-                      err)) ||
-        (rc = map_key(doc, node, "inflow", base_dir, inflow_names, inflow_sources, &so.inflow, &inflow_file, err)))
-        goto fail;
-    /* ranges */
-    {
-        const struct {
-            const char *key;
-            int ok;
-            const char *what;
-        } checks[] = {{"grid", grid >= 2 && grid <= 512, "an integer from 2 to 512"},
-                      {"quantiles", nq >= 2 && nq <= 256, "an integer from 2 to 256"},
-                      {"model_size", model_size >= 16 && model_size <= 4096, "an integer from 16 to 4096"},
-                      {"sigma", sigma > 0, "> 0"},
-                      {"dt", so.dt > 0, "> 0"},
-                      {"vein_floor", so.vein_floor >= 0 && so.vein_floor <= 1, "between 0 and 1"}};
-        for (size_t i = 0; i < sizeof checks / sizeof checks[0]; ++i)
-            if (!checks[i].ok) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': must be %s", doc->path,
-                                   phc_key_line(node, checks[i].key), checks[i].key, checks[i].what);
-                goto fail;
-            }
-    }
-    im->histogram = residual == 1;
-    im->de2000 = difference == 1;
-    im->nq = (size_t)nq;
-    im->sigma = sigma;
-    so.space = space ? PHC_COLOUR_LAB : PHC_COLOUR_RGB;
-    so.model_size = (size_t)model_size;
-    so.veins_file = veins_file;
-    so.stomata_file = stomata_file;
-    so.inflow_file = inflow_file;
-    const phc_colour_correction_method cc_method = correction == 2   ? PHC_CC_COLORCHECKER
-                                                   : correction == 1 ? PHC_CC_GRAY_WORLD
-                                                                     : PHC_CC_NONE;
-
-    /* stage: {column, direction} or a bare column name */
-    const phc_yaml_node *sn = phc_yaml_get(node, "stage");
-    if (!sn) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: missing key 'stage' ({column: NAME, direction: "
-                           "increasing | decreasing})", doc->path, node->line, ctx);
-        goto fail;
-    }
-    if (sn->kind == PHC_YAML_MAPPING) {
-        if ((rc = phc_yaml_check_keys(doc, sn, stage_keys, "stage", err)) ||
-            (rc = phc_yaml_map_string(doc, sn, "column", 1, "stage", &stage_col, err)) ||
-            (rc = choose(doc, sn, "direction", direction_names, &direction, err)))
-            goto fail;
-    } else if ((rc = phc_yaml_string(doc, sn, "stage", &stage_col, err)))
-        goto fail;
-    im->direction = direction ? -1 : 1;
-    if (!(im->stage_name = strdup(stage_col))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    /* image: a file for every row, or {column: NAME} */
-    const phc_yaml_node *in = phc_yaml_get(node, "image");
-    if (!in) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: missing key 'image' (a photo file, or {column: NAME})",
-                           doc->path, node->line, ctx);
-        goto fail;
-    }
-    if (in->kind == PHC_YAML_MAPPING) {
-        static const char *const image_keys[] = {"column", NULL};
-        if ((rc = phc_yaml_check_keys(doc, in, image_keys, "image", err)) ||
-            (rc = phc_yaml_map_string(doc, in, "column", 1, "image", &image_col, err)))
-            goto fail;
-    } else if ((rc = phc_yaml_string(doc, in, "image", &image_name, err)))
-        goto fail;
-
-    /* the rows */
-    if (!(path = phc_join_path(base_dir, file))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = phc_table_read(path, &t, err))) {
-        if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
-            phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
-        goto fail;
-    }
-    const size_t nr = phc_table_rows(t);
-    if (nr < 2) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: %zu data row%s below the header: a leaf_photos data set needs a "
-                           "fresh leaf and at least one more photo", path, nr, nr == 1 ? "" : "s");
-        goto fail;
-    }
-    if ((rc = phc_need_column(doc, sn->kind == PHC_YAML_MAPPING ? sn : node, sn->kind == PHC_YAML_MAPPING ? "column" : "stage",
-                              stage_col, t, err)) ||
-        (leaf_col && (rc = phc_need_column(doc, node, "leaf", leaf_col, t, err))) ||
-        (id_col && (rc = phc_need_column(doc, node, "id", id_col, t, err))) ||
-        (image_col && (rc = phc_need_column(doc, in, "column", image_col, t, err))) ||
-        (rc = phc_table_column_numbers(t, stage_col, &stage, err)) ||
-        (leaf_col && (rc = phc_table_column_numbers(t, leaf_col, &leafno, err))))
-        goto fail;
-    if (!(im->rows = calloc(nr, sizeof *im->rows))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    im->n_rows = nr;
-    const long idc = phc_table_find(t, id_col ? id_col : leaf_col ? leaf_col : "");
-    for (size_t r = 0; r < nr; ++r) {
+    im->n_rows = n_rows;
+    for (size_t r = 0; r < n_rows; ++r) {
+        const phc_leaf_photos_row *in = &b->rows[r];
         lp_row *row = &im->rows[r];
-        row->line = phc_table_row_line(t, r);
-        row->stage = stage[r];
+        row->line = in->line;
+        row->stage = in->stage;
         char buf[32];
-        snprintf(buf, sizeof buf, "%zu", row->line);
-        if (!(row->id = strdup(idc >= 0 ? phc_table_cell(t, r, (size_t)idc) : buf))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
+        snprintf(buf, sizeof buf, "%zu", in->line ? in->line : r + 1);
+        if (!(row->id = strdup(in->id ? in->id : buf)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (!isfinite(row->stage)) {
+            row_where(b, r, stage_name(b->opt), "stage", where, sizeof where);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: the stage must be a finite number, found %g", where,
+                                 row->stage);
         }
         for (size_t q = 0; q < r; ++q)
             if (!strcmp(im->rows[q].id, row->id)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: id '%s' is used twice (also on line %zu)", path,
-                                   row->line, row->id, im->rows[q].line);
-                goto fail;
+                if (b->opt->rows_source && row->line && im->rows[q].line)
+                    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: id '%s' is used twice (also on line %zu)",
+                                         b->opt->rows_source, row->line, row->id, im->rows[q].line);
+                return phc_error_set(err, PHC_ERR_INPUT, "%s: rows[%zu]: id '%s' is used twice (also rows[%zu])",
+                                     KIND, r, row->id, q);
             }
-        if (leafno && !(leafno[r] >= 1 && leafno[r] == floor(leafno[r]))) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': the leaf number must be a whole number >= 1, "
-                               "found %g", path, row->line, leaf_col, leafno[r]);
-            goto fail;
-        }
     }
-    /* the fresh leaf */
-    const phc_yaml_node *ini = phc_yaml_get(node, "initial");
-    if (ini) {
-        const char *id;
-        if ((rc = phc_yaml_string(doc, ini, "initial", &id, err)) ||
-            (rc = find_row(doc, node, "initial", im, id, &im->initial, err)))
-            goto fail;
+    return PHC_OK;
+}
+
+/* The fresh leaf: the row named by `initial`, else the earliest stage. */
+static int choose_initial(lp_build *b, phc_error *err)
+{
+    lp_impl *im = b->im;
+    int rc;
+    if (b->opt->initial) {
+        if ((rc = find_row(b->opt, "initial", im, b->opt->initial, &im->initial, err)))
+            return rc;
     } else {
         im->initial = 0;
-        for (size_t r = 1; r < nr; ++r)
-            if (im->direction * (stage[r] - stage[im->initial]) < 0)
+        for (size_t r = 1; r < im->n_rows; ++r)
+            if (im->direction * (im->rows[r].stage - im->rows[im->initial].stage) < 0)
                 im->initial = r;
     }
     im->rows[im->initial].role = 1;
-    /* the reference: a row id or {image, leaf} */
-    const phc_yaml_node *rf = phc_yaml_get(node, "reference");
-    if (!rf) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: missing key 'reference' (the id of the senescent leaf's "
-                           "row, or {image: FILE, leaf: N})", doc->path, node->line, ctx);
-        goto fail;
-    }
-    im->reference = nr;
-    if (rf->kind == PHC_YAML_MAPPING) {
-        const char *rimg;
-        long rleaf = 1;
-        if ((rc = phc_yaml_check_keys(doc, rf, ref_keys, "reference", err)) ||
-            (rc = phc_yaml_map_string(doc, rf, "image", 1, "reference", &rimg, err)) ||
-            (rc = phc_yaml_map_integer(doc, rf, "leaf", 0, "reference", &rleaf, err)))
-            goto fail;
-        if (rleaf < 1) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: reference: leaf must be >= 1", doc->path, rf->line);
-            goto fail;
-        }
-        if (!(img_path = phc_join_path(base_dir, rimg))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        /* the file's errors at `image:`, a leaf number beyond its leaves at `leaf:` */
-        snprintf(where, sizeof where, "%s:%zu: reference: key 'image'", doc->path, phc_key_line(rf, "image"));
-        if ((rc = phc_photo_cache_read(im->cache, img_path, cc_method, where, err)))
-            goto fail;
-        if (phc_yaml_get(rf, "leaf"))
-            snprintf(where, sizeof where, "%s:%zu: reference: key 'leaf'", doc->path, phc_key_line(rf, "leaf"));
-        if ((rc = phc_leaf_photo_load(im->cache, img_path, (size_t)rleaf, cc_method, where, &im->ref_photo, err)))
-            goto fail;
-        free(img_path);
-        img_path = NULL;
-    } else {
-        const char *id;
-        if ((rc = phc_yaml_string(doc, rf, "reference", &id, err)) ||
-            (rc = find_row(doc, node, "reference", im, id, &im->reference, err)))
-            goto fail;
+    return PHC_OK;
+}
+
+/* Reads (or takes from memory) a photo into the cache under `name`,
+ * errors placed at `where`. */
+static int cache_photo(lp_impl *im, const char *name, const phc_image *pixels, phc_colour_correction_method cc,
+                       const char *where, phc_error *err)
+{
+    return pixels ? phc_photo_cache_add(im->cache, name, pixels, cc, where, err)
+                  : phc_photo_cache_read(im->cache, name, cc, where, err);
+}
+
+/* The senescent reference: a row (not the fresh leaf's) or its own photo,
+ * whose errors are placed at `reference: {image: ...}` and its `leaf:`. */
+static int choose_reference(lp_build *b, phc_error *err)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    lp_impl *im = b->im;
+    char where[4400];
+    int rc;
+    im->reference = im->n_rows;
+    if (opt->reference) {
+        if ((rc = find_row(opt, "reference", im, opt->reference, &im->reference, err)))
+            return rc;
         if (im->reference == im->initial) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'reference': row '%s' is also the fresh leaf (initial)",
-                               doc->path, phc_key_line(node, "reference"), id);
-            goto fail;
+            key_where(opt, "reference", where, sizeof where);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: row '%s' is also the fresh leaf (initial)", where,
+                                 opt->reference);
         }
         im->rows[im->reference].role = 2;
+        return PHC_OK;
     }
-    /* every row's photo */
-    for (size_t r = 0; r < nr; ++r) {
-        lp_row *row = &im->rows[r];
-        const char *name = image_col ? phc_table_cell(t, r, (size_t)phc_table_find(t, image_col)) : image_name;
-        if (!name || !*name) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': no image file given", path, row->line,
-                               image_col);
-            goto fail;
-        }
-        free(img_path);
-        if (!(img_path = phc_join_path(base_dir, name))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        /* The photo's own errors where its name was given: the row's image
-         * column, or the config's `image:`; a leaf number beyond its leaves
-         * at the row's leaf column. */
-        if (image_col)
-            snprintf(where, sizeof where, "%s:%zu: column '%s'", path, row->line, image_col);
-        else
-            snprintf(where, sizeof where, "%s:%zu: key 'image'", doc->path, phc_key_line(node, "image"));
-        if ((rc = phc_photo_cache_read(im->cache, img_path, cc_method, where, err)))
-            goto fail;
-        if (leafno)
-            snprintf(where, sizeof where, "%s:%zu: column '%s'", path, row->line, leaf_col);
-        if ((rc = phc_leaf_photo_load(im->cache, img_path, leafno ? (size_t)leafno[r] : 1, cc_method, where,
-                                      &row->photo, err)))
-            goto fail;
+    const char *name = opt->reference_image ? opt->reference_image : "reference_pixels";
+    snprintf(where, sizeof where, "%s: reference: key 'image'", phc_origin_key(opt->reference_origin, KIND, "image").text);
+    if ((rc = cache_photo(im, name, opt->reference_pixels, opt->colour_correction, where, err)))
+        return rc;
+    if (opt->reference_leaf)
+        snprintf(where, sizeof where, "%s: reference: key 'leaf'",
+                 phc_origin_key(opt->reference_origin, KIND, "leaf").text);
+    return phc_leaf_photo_load(im->cache, name, opt->reference_leaf ? opt->reference_leaf : 1, opt->colour_correction,
+                               where, &im->ref_photo, err);
+}
+
+/* The name of row r's photo in the cache: its file, or the name of its
+ * image in memory (an earlier row's when they share the image). */
+static void photo_name(const lp_build *b, size_t r, char *buf, size_t size)
+{
+    const phc_leaf_photos_row *in = &b->rows[r];
+    if (in->image || !in->pixels) {
+        snprintf(buf, size, "%s", in->image ? in->image : "");
+        return;
     }
-    /* stages: every data row after the fresh leaf; a series in order */
+    size_t first = r;
+    for (size_t q = 0; q < r; ++q)
+        if (b->rows[q].pixels == in->pixels && !b->rows[q].image) {
+            first = q;
+            break;
+        }
+    snprintf(buf, size, "rows[%zu].pixels", first);
+}
+
+/* Every row's photo, read once per file and segmented; the row's leaf cut
+ * out of it.  A photo's errors are placed where it was named, a leaf
+ * number beyond its leaves at the row's leaf. */
+static int load_row_photos(lp_build *b, phc_error *err)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    lp_impl *im = b->im;
+    char where[4400], name[4200];
+    int rc;
+    for (size_t r = 0; r < im->n_rows; ++r) {
+        const phc_leaf_photos_row *in = &b->rows[r];
+        photo_name(b, r, name, sizeof name);
+        image_where(b, r, where, sizeof where);
+        if (!name[0])
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: no image file given", where);
+        if ((rc = cache_photo(im, name, in->pixels, opt->colour_correction, where, err)))
+            return rc;
+        if (in->leaf)
+            row_where(b, r, opt->leaf_column, "leaf", where, sizeof where);
+        if ((rc = phc_leaf_photo_load(im->cache, name, in->leaf ? in->leaf : 1, opt->colour_correction, where,
+                                      &im->rows[r].photo, err)))
+            return rc;
+    }
+    return PHC_OK;
+}
+
+/* Stages: every data row after the fresh leaf; a series (pixels) in order. */
+static int check_stages(lp_build *b, phc_error *err)
+{
+    lp_impl *im = b->im;
     const double s0 = im->rows[im->initial].stage;
-    for (size_t r = 0; r < nr; ++r) {
+    char where[4400];
+    for (size_t r = 0; r < im->n_rows; ++r) {
         lp_row *row = &im->rows[r];
         row->dstage = im->direction * (row->stage - s0);
-        if (row->role == 0 && row->dstage < 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': stage %g comes before the fresh leaf's (%g, "
-                               "row '%s'; direction %s)", path, row->line, stage_col, row->stage, s0,
-                               im->rows[im->initial].id, im->direction > 0 ? "increasing" : "decreasing");
-            goto fail;
-        }
-        if (!im->histogram && r > 0 && im->direction * (row->stage - im->rows[r - 1].stage) < 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': stages out of order (%g after %g): the photos "
-                               "of one leaf must be listed in time order", path, row->line, stage_col, row->stage,
-                               im->rows[r - 1].stage);
-            goto fail;
-        }
+        row_where(b, r, stage_name(b->opt), "stage", where, sizeof where);
+        if (row->role == 0 && row->dstage < 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: stage %g comes before the fresh leaf's (%g, row '%s'; "
+                                 "direction %s)", where, row->stage, s0, im->rows[im->initial].id,
+                                 im->direction > 0 ? "increasing" : "decreasing");
+        if (!im->histogram && r > 0 && im->direction * (row->stage - im->rows[r - 1].stage) < 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: stages out of order (%g after %g): the photos of one leaf "
+                                 "must be listed in time order", where, row->stage, im->rows[r - 1].stage);
     }
-    /* the model; errors about a map file at its key, the others at the data set */
-    char map_where[3][256];
-    snprintf(map_where[0], sizeof map_where[0], "%s:%zu: key 'veins'", doc->path, phc_key_line(node, "veins"));
-    snprintf(map_where[1], sizeof map_where[1], "%s:%zu: key 'stomata'", doc->path, phc_key_line(node, "stomata"));
-    snprintf(map_where[2], sizeof map_where[2], "%s:%zu: key 'inflow'", doc->path, phc_key_line(node, "inflow"));
-    so.veins_where = map_where[0];
-    so.stomata_where = map_where[1];
-    so.inflow_where = map_where[2];
+    return PHC_OK;
+}
+
+/* The model set-up from the fresh and reference leaves (errors about a map
+ * file at its key, the others at the data set), its grid cells and
+ * scratch space. */
+static int build_model(lp_build *b, phc_error *err)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    lp_impl *im = b->im;
+    phc_leaf_setup_options so = opt->setup;
+    char map_where[3][4400];
+    int rc;
+    key_where(opt, "veins", map_where[0], sizeof map_where[0]);
+    key_where(opt, "stomata", map_where[1], sizeof map_where[1]);
+    key_where(opt, "inflow", map_where[2], sizeof map_where[2]);
+    if (!so.veins_where)
+        so.veins_where = map_where[0];
+    if (!so.stomata_where)
+        so.stomata_where = map_where[1];
+    if (!so.inflow_where)
+        so.inflow_where = map_where[2];
     if ((rc = phc_leaf_setup_new(&im->rows[im->initial].photo,
-                                 im->reference < nr ? &im->rows[im->reference].photo : &im->ref_photo, &so, &im->su,
-                                 err))) {
-        if (strncmp(err->message, doc->path, strlen(doc->path)) != 0) /* not placed yet */
-            phc_error_prefix(err, rc, "%s:%zu", doc->path, node->line);
-        goto fail;
+                                 im->reference < im->n_rows ? &im->rows[im->reference].photo : &im->ref_photo, &so,
+                                 &im->su, err))) {
+        const char *placed = opt->origin && opt->origin->path ? opt->origin->path : KIND;
+        if (strncmp(err->message, placed, strlen(placed)) != 0) /* not placed yet */
+            phc_error_prefix(err, rc, "%s", WHERE(NULL));
+        return rc;
     }
     const phc_leaf_setup *su = im->su;
-    im->cell = ((su->w > su->h ? su->w : su->h) + (size_t)grid - 1) / (size_t)grid;
+    im->cell = ((su->w > su->h ? su->w : su->h) + opt->grid - 1) / opt->grid;
     im->cw = (su->w + im->cell - 1) / im->cell;
     im->ch = (su->h + im->cell - 1) / im->cell;
     const size_t np = su->w * su->h;
     im->lab = malloc(3 * np * sizeof *im->lab);
     im->scratch = malloc(2 * 3 * np * sizeof *im->scratch);
-    if (!im->lab || !im->scratch) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    size_t n = 0, m_data = 0;
-    for (size_t r = 0; r < nr; ++r) {
+    if (!im->lab || !im->scratch)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
+/* Every data row's observations (the fresh and reference leaves give the
+ * greenness baseline only); b->n_obs residuals over b->n_data rows. */
+static int collect_observations(lp_build *b, phc_error *err)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    lp_impl *im = b->im;
+    char where[4400];
+    int rc;
+    b->n_obs = b->n_data = 0;
+    for (size_t r = 0; r < im->n_rows; ++r) {
         lp_row *row = &im->rows[r];
         if (row->role) {
             /* the greenness baseline uses the fresh and reference leaves too */
             phc_image g = {0};
             unsigned char *gm = NULL;
-            if ((rc = phc_leaf_photo_grid(&row->photo, so.model_size, &g, &gm, err)))
-                goto fail;
+            if ((rc = phc_leaf_photo_grid(&row->photo, opt->setup.model_size, &g, &gm, err)))
+                return rc;
             row->greenness = mean_greenness(&g, gm);
             row->grid = g;
             free(gm);
             continue;
         }
-        if ((rc = row_observations(im, row, do_register, err))) {
-            snprintf(where, sizeof where, "%s:%zu: row '%s'", path, row->line, row->id);
-            phc_error_prefix(err, rc, "%s", where);
-            goto fail;
-        }
-        if (!row->count) {
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: row '%s': no grid cell is leaf in both this photo and the "
-                               "fresh leaf (registration failed, or a different leaf: use residual: histogram)", path,
-                               row->line, row->id);
-            goto fail;
-        }
-        row->first = n;
-        n += row->count;
-        ++m_data;
+        row_where(b, r, NULL, NULL, where, sizeof where);
+        if ((rc = row_observations(im, row, opt->register_photos, err)))
+            return phc_error_prefix(err, rc, "%s: row '%s'", where, row->id);
+        if (!row->count)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: row '%s': no grid cell is leaf in both this photo and the "
+                                 "fresh leaf (registration failed, or a different leaf: use residual: histogram)",
+                                 where, row->id);
+        row->first = b->n_obs;
+        b->n_obs += row->count;
+        ++b->n_data;
     }
-    if (!m_data) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: no row of %s is left to fit besides the fresh leaf "
-                           "(initial) and the reference", doc->path, node->line, ctx, path);
-        goto fail;
+    if (!b->n_data) {
+        set_where(opt, where, sizeof where);
+        if (opt->rows_source)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: no row of %s is left to fit besides the fresh leaf "
+                                 "(initial) and the reference", where, opt->rows_source);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: no row is left to fit besides the fresh leaf (initial) and the "
+                             "reference", where);
     }
-    /* distinct model times over the data rows */
-    data_rows = malloc(m_data * sizeof *data_rows);
-    dst = malloc(m_data * sizeof *dst);
-    im->t_at = calloc(nr, sizeof *im->t_at);
+    return PHC_OK;
+}
+
+/* The distinct model times over the data rows, and each data row's. */
+static int model_times(lp_build *b, phc_error *err)
+{
+    lp_impl *im = b->im;
+    const size_t m_data = b->n_data;
+    size_t *data_rows = malloc(m_data * sizeof *data_rows), *at = NULL;
+    double *dst = malloc(m_data * sizeof *dst);
+    int rc = PHC_OK;
+    im->t_at = calloc(im->n_rows, sizeof *im->t_at);
     if (!data_rows || !dst || !im->t_at) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
+        goto done;
     }
-    for (size_t r = 0, k = 0; r < nr; ++r)
+    for (size_t r = 0, k = 0; r < im->n_rows; ++r)
         if (!im->rows[r].role) {
             data_rows[k] = r;
             dst[k++] = im->rows[r].dstage;
         }
-    size_t *at = NULL;
     if ((rc = phc_unique_times(dst, m_data, &im->t_unique, &im->m_unique, &at, err)))
-        goto fail;
+        goto done;
     for (size_t k = 0; k < m_data; ++k)
         im->t_at[data_rows[k]] = at[k];
+done:
     free(at);
-    im->left_out = nr;
+    free(dst);
+    free(data_rows);
+    return rc;
+}
 
-    /* slots */
-    size_t k_slots = 0;
+/* The slots that are parameters (is_parameter; NULL: all six). */
+static int choose_slots(lp_build *b, phc_error *err)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    lp_impl *im = b->im;
+    b->k_slots = 0;
     for (int q = 0; q < N_SLOTS; ++q)
-        im->slot[q] = is_parameter(slot_names[q], user_data) ? (int)k_slots++ : -1;
-    if (!k_slots) {
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: no parameter to fit: name at least one of beta_scale, "
-                           "stomata_scale, inflow_scale, time_scale, y_lo, y_hi under parameters", doc->path,
-                           node->line, ctx);
-        goto fail;
+        im->slot[q] = !opt->is_parameter || opt->is_parameter(slot_names[q], opt->user_data) ? (int)b->k_slots++ : -1;
+    if (!b->k_slots) {
+        char where[4400];
+        set_where(opt, where, sizeof where);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: no parameter to fit: name at least one of beta_scale, "
+                             "stomata_scale, inflow_scale, time_scale, y_lo, y_hi under parameters", where);
     }
-    if (!(ds = phc_dataset_new(&leaf_photos_ops, k_slots))) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
+    return PHC_OK;
+}
+
+/* The data set's slots, observations, sigmas, lines and labels. */
+static int fill_dataset(const lp_build *b, phc_dataset *ds, phc_error *err)
+{
+    const phc_leaf_photos_options *opt = b->opt;
+    const lp_impl *im = b->im;
+    const size_t n = b->n_obs;
     for (int q = 0; q < N_SLOTS; ++q)
-        if (im->slot[q] >= 0 && !(ds->slot_names[im->slot[q]] = strdup(slot_names[q]))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
+        if (im->slot[q] >= 0 && !(ds->slot_names[im->slot[q]] = strdup(slot_names[q])))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     ds->n = n;
     ds->x = malloc(n * sizeof *ds->x);
     ds->y = malloc(n * sizeof *ds->y);
     ds->sigma = malloc(n * sizeof *ds->sigma);
-    ds->data_lines = malloc(n * sizeof *ds->data_lines);
-    ds->data_file = strdup(path);
-    im->row_of = malloc(n * sizeof *im->row_of);
+    if (opt->rows_source) {
+        ds->data_lines = malloc(n * sizeof *ds->data_lines);
+        ds->data_file = strdup(opt->rows_source);
+    }
     if (im->histogram)
         ds->series = malloc(n * sizeof *ds->series);
-    if (!ds->x || !ds->y || !ds->sigma || !ds->data_lines || !ds->data_file || !im->row_of ||
-        (im->histogram && !ds->series)) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    /* every file read: the table, the photos, the reference photo, map files */
-    rc = phc_dataset_add_input(ds, path);
-    for (size_t r = 0; r < nr && !rc; ++r)
-        rc = phc_dataset_add_input(ds, im->rows[r].photo.path);
-    if (!rc && im->reference == nr)
-        rc = phc_dataset_add_input(ds, im->ref_photo.path);
-    const char *const map_files[] = {veins_file, stomata_file, inflow_file};
-    for (size_t q = 0; q < 3 && !rc; ++q)
-        if (map_files[q])
-            rc = phc_dataset_add_input(ds, map_files[q]);
-    if (rc) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t r = 0; r < nr; ++r) {
+    if (!ds->x || !ds->y || !ds->sigma || (opt->rows_source && (!ds->data_lines || !ds->data_file)) ||
+        (im->histogram && !ds->series))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t r = 0; r < im->n_rows; ++r) {
         const lp_row *row = &im->rows[r];
         if (row->role)
             continue;
@@ -1418,54 +1350,70 @@ int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, con
             const size_t j = row->first + i;
             ds->x[j] = row->stage;
             ds->y[j] = im->de2000 ? 0 : row->obs[i];
-            ds->sigma[j] = sigma;
-            ds->data_lines[j] = row->line;
+            ds->sigma[j] = opt->sigma;
+            if (ds->data_lines)
+                ds->data_lines[j] = row->line;
             im->row_of[j] = r;
             if (ds->series)
                 ds->series[j] = i;
         }
     }
     char xl[160];
-    snprintf(xl, sizeof xl, "%s", stage_col);
-    ds->x_label = strdup(x_label ? x_label : xl);
-    ds->y_label = strdup(y_label ? y_label
+    snprintf(xl, sizeof xl, "%s", stage_name(opt));
+    ds->x_label = strdup(opt->x_label ? opt->x_label : xl);
+    ds->y_label = strdup(opt->y_label ? opt->y_label
                          : im->histogram ? "CIELAB quantile (L*, a*, b*)"
                          : im->de2000    ? "CIEDE2000 to the photo"
                                          : "CIELAB cell mean (L*, a*, b*)");
-    if (!ds->x_label || !ds->y_label) {
+    if (!ds->x_label || !ds->y_label)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    ds->derivatives = PHC_DERIV_CENTRAL;
+    ds->config_line = phc_origin_line(opt->origin, NULL);
+    return PHC_OK;
+}
+
+int phc_leaf_photos_new(const phc_leaf_photos_row *rows, size_t n_rows, const phc_leaf_photos_options *opt,
+                        phc_dataset **out, phc_error *err)
+{
+    lp_build b = {.opt = opt, .rows = rows};
+    phc_dataset *ds = NULL;
+    int rc;
+    *out = NULL;
+    if ((rc = check_options(opt, n_rows, err)))
+        return rc;
+    lp_impl *im = b.im = calloc(1, sizeof *im);
+    if (!im || !(im->cache = phc_photo_cache_new())) {
+        free(im);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    im->histogram = opt->residual == PHC_LEAF_RESIDUAL_HISTOGRAM;
+    im->de2000 = opt->difference == PHC_LEAF_CIEDE2000;
+    im->nq = opt->quantiles;
+    im->sigma = opt->sigma;
+    im->direction = opt->direction < 0 ? -1 : 1;
+    im->cross_validate = opt->cross_validate;
+    if (!(im->stage_name = strdup(stage_name(opt)))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    ds->derivatives = PHC_DERIV_CENTRAL;
-    ds->config_line = node->line;
+    if ((rc = copy_rows(&b, n_rows, err)) || (rc = choose_initial(&b, err)) || (rc = choose_reference(&b, err)) ||
+        (rc = load_row_photos(&b, err)) || (rc = check_stages(&b, err)) || (rc = build_model(&b, err)) ||
+        (rc = collect_observations(&b, err)) || (rc = model_times(&b, err)))
+        goto fail;
+    if ((rc = choose_slots(&b, err)))
+        goto fail;
+    if (!(ds = phc_dataset_new(&phc_leaf_photos_ops, b.k_slots)) ||
+        !(im->row_of = malloc(b.n_obs * sizeof *im->row_of))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    if ((rc = fill_dataset(&b, ds, err)))
+        goto fail;
     ds->impl = im;
-    im = NULL;
-    phc_table_free(t);
-    free(stage);
-    free(leafno);
-    free(dst);
-    free(data_rows);
-    free(path);
-    free(img_path);
-    free(veins_file);
-    free(stomata_file);
-    free(inflow_file);
     *out = ds;
     return PHC_OK;
 fail:
-    phc_table_free(t);
-    free(stage);
-    free(leafno);
-    free(dst);
-    free(data_rows);
-    free(path);
-    free(img_path);
-    free(veins_file);
-    free(stomata_file);
-    free(inflow_file);
     lp_free(im);
-    if (ds)
-        ds->impl = NULL;
     phc_dataset_free(ds);
     return rc;
 }

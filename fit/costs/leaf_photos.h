@@ -3,6 +3,11 @@
  * fit/costs/leaf_setup.h), to fit the scales of the venation, stomata and
  * inflow maps, the time scale and the colour transfer.
  *
+ * Built in C with phc_leaf_photos_new from rows (one per photographed leaf:
+ * its photo, as a file or an image in memory, its number in that photo and
+ * its stage) and options; the config's `kind: leaf_photos` mapping is
+ * translated into the same rows and options by fit/config/leaf_photos_yaml.c:
+ *
  *   - kind: leaf_photos
  *     file: leaves.csv              # one row per photographed leaf
  *     image: scan.jpg               # the photo of every row, or {column: NAME}
@@ -63,17 +68,103 @@
 #ifndef PHC_COSTS_LEAF_PHOTOS_H
 #define PHC_COSTS_LEAF_PHOTOS_H
 
-#include "fit/config_help.h"
-#include "fit/costs/curve.h"
+#include <stddef.h>
+
+#include "fit/costs/leaf_setup.h"
+#include "fit/costs/origin.h"
 #include "fit/dataset.h"
-#include "measurements/yaml_doc.h"
+#include "measurements/photo.h"
+#include "model/colour.h"
+#include "model/status.h"
 
-extern const char *const phc_leaf_photos_keys[];
-/* Help on each of those keys (fit/config_help.h). */
-extern const phc_key_help phc_leaf_photos_help[];
+/* One photographed leaf. */
+typedef struct phc_leaf_photos_row {
+    double stage;            /* its stage: a time, or a measured stage such as SPAD
+                                chlorophyll (options.direction), in stage units */
+    const char *image;       /* its photo: a PNG, JPEG or TIFF file (measurements/photo.h),
+                                or, with `pixels`, the name that stands for it in messages
+                                and the report (NULL: "rows[i].pixels") */
+    const phc_image *pixels; /* the photo already in memory (sRGB in [0, 1]), or NULL to
+                                read `image`; rows may share one (a scan of many leaves):
+                                it is segmented once per name */
+    size_t leaf;             /* the leaf's number in its photo, reading order, >= 1; 0 = 1 */
+    const char *id;          /* names the row (options.initial and .reference, the report);
+                                NULL: its line when given, else its 1-based position */
+    size_t line;             /* its line in options.rows_source, for messages; 0 = none */
+} phc_leaf_photos_row;
 
-int phc_leaf_photos_load(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
-                         phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err);
+typedef enum phc_leaf_residual {
+    PHC_LEAF_RESIDUAL_PIXELS = 0, /* CIELAB means over grid cells of photo and simulation */
+    PHC_LEAF_RESIDUAL_HISTOGRAM   /* quantiles of L*, a*, b* over the leaf */
+} phc_leaf_residual;
+
+typedef enum phc_leaf_difference {
+    PHC_LEAF_DE76 = 0,   /* pixels: 3 residuals per cell, ΔL*, Δa*, Δb* */
+    PHC_LEAF_CIEDE2000   /* pixels: one residual per cell, ΔE00 */
+} phc_leaf_difference;
+
+typedef struct phc_leaf_photos_options {
+    int direction;           /* +1: the stage increases as the leaf ages (a time; the
+                                default), -1: it decreases (SPAD) */
+    const char *stage_name;  /* what the stage is, for the report, the x label and
+                                messages (the stage column's name); NULL = "stage" */
+    const char *initial;     /* id of the row of the fresh leaf the model ages;
+                                NULL = the row with the earliest stage */
+    /* The senescent reference leaf (eq. 8): a row (not the initial one) ... */
+    const char *reference;   /* its id, or NULL for a separate photo: */
+    const char *reference_image;       /* a file, or with reference_pixels its name
+                                          (NULL: "reference_pixels") */
+    const phc_image *reference_pixels; /* or an image in memory (NULL: read the file) */
+    size_t reference_leaf;   /* the leaf's number in that photo; 0 = 1 */
+    phc_leaf_residual residual;        /* PIXELS */
+    phc_leaf_difference difference;    /* DE76 */
+    size_t grid;             /* pixels: cells on the long side of the leaf, 2..512 (24) */
+    size_t quantiles;        /* histogram: quantiles per CIELAB channel, 2..256 (16) */
+    double sigma;            /* of each residual, ΔE units, > 0 (2) */
+    phc_colour_correction_method colour_correction; /* of every photo (PHC_CC_NONE) */
+    int register_photos;     /* pixels: align each photo to the fresh leaf's (1) */
+    phc_leaf_setup_options setup; /* model grid (model_size 16..4096 px, 128), matching
+                                space, dt (> 0, 0.1), vein_floor (0..1, 0.05) and the
+                                venation, stomata and inflow maps (fit/costs/leaf_setup.h);
+                                its *_where fields are filled from `origin` when NULL */
+    int cross_validate;      /* leave-one-out prediction of each row's stage in the
+                                report (0) */
+    const char *x_label;     /* NULL: the stage name */
+    const char *y_label;     /* NULL: names the residual ("CIELAB cell mean (L*, a*, b*)") */
+    phc_is_parameter_fn is_parameter; /* which of the six slots are parameters; NULL:
+                                         all six */
+    void *user_data;                  /* passed to is_parameter */
+    /* Where the rows and options came from, for messages (NULL: the messages
+     * name the kind and rows[i]): */
+    const char *rows_source;  /* the table the rows were read from ("leaves.csv"): a row's
+                                 messages then start "leaves.csv:LINE" */
+    const char *image_column; /* the table's columns named in those messages */
+    const char *leaf_column;
+    const phc_origin *origin; /* the data set's config mapping (fit/costs/origin.h) */
+    const phc_origin *reference_origin; /* the `reference: {image, leaf}` mapping */
+} phc_leaf_photos_options;
+
+/* The defaults above: pixels, de76, grid 24, 16 quantiles, sigma 2, no
+ * colour correction, registration on, phc_leaf_setup_options_default(),
+ * direction +1, no reference (one must be given). */
+phc_leaf_photos_options phc_leaf_photos_options_default(void);
+
+/* Builds a leaf_photos data set over rows[0..n_rows-1] (at least two: the
+ * fresh leaf and one more; copied, so rows and images may be freed
+ * afterwards).  Reads each photo file once (rows may share one), colour
+ * corrects and segments it, cuts each row's leaf out, builds the model
+ * (fit/costs/leaf_setup.h) and the observations.  Slot names are the
+ * slots is_parameter accepts (in the order beta_scale, stomata_scale,
+ * inflow_scale, time_scale, y_lo, y_hi); parameter indices are left to
+ * phc_problem binding.  The files read are not recorded as inputs
+ * (phc_dataset_add_input): the caller knows them.  Errors name the option
+ * (the config line with options.origin), the row (its table line with
+ * options.rows_source) or the photo, and say what was expected. */
+int phc_leaf_photos_new(const phc_leaf_photos_row *rows, size_t n_rows, const phc_leaf_photos_options *options,
+                        phc_dataset **out, phc_error *err);
+
+/* The operations of leaf_photos data sets (ops->kind is "leaf_photos"). */
+extern const phc_dataset_ops phc_leaf_photos_ops;
 
 /* Leave-one-out prediction of each row's stage (see above), at the fitted
  * slot values p, with the free slots and their bounds taken from the data

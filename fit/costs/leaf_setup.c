@@ -39,14 +39,20 @@ void phc_photo_cache_free(phc_photo_cache *c)
     free(c);
 }
 
-static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction_method method,
-                     const char *where, cache_entry **out, phc_error *err)
+static cache_entry *cache_find(phc_photo_cache *c, const char *path, phc_colour_correction_method method)
 {
     for (size_t i = 0; i < c->n; ++i)
-        if (c->e[i].method == method && !strcmp(c->e[i].path, path)) {
-            *out = &c->e[i];
-            return PHC_OK;
-        }
+        if (c->e[i].method == method && !strcmp(c->e[i].path, path))
+            return &c->e[i];
+    return NULL;
+}
+
+/* A new entry for `path`: the image `img` when given (copied), else the
+ * file read; colour corrected and segmented.  Errors name the photo and
+ * are placed after `where`. */
+static int cache_insert(phc_photo_cache *c, const char *path, const phc_image *img,
+                        phc_colour_correction_method method, const char *where, cache_entry **out, phc_error *err)
+{
     cache_entry *grown = realloc(c->e, (c->n + 1) * sizeof *grown);
     if (!grown)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -58,7 +64,14 @@ static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     e->method = method;
     phc_segment_options so = phc_segment_options_default();
-    if ((rc = phc_photo_read(path, &e->img, err)) ||
+    if (img) {
+        if (!(rc = phc_image_alloc(&e->img, img->width, img->height, err))) {
+            memcpy(e->img.data, img->data, 3 * img->width * img->height * sizeof *img->data);
+            e->img.bit_depth = img->bit_depth;
+        }
+    } else
+        rc = phc_photo_read(path, &e->img, err);
+    if (rc ||
         (rc = phc_photo_colour_correct(&e->img, NULL, method, &e->correction, err)) ||
         (rc = phc_photo_segment_leaves(&e->img, &so, &e->seg, err))) {
         if (rc == PHC_ERR_INPUT || rc == PHC_ERR_IO) {
@@ -76,11 +89,31 @@ static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction
     return PHC_OK;
 }
 
+static int cache_get(phc_photo_cache *c, const char *path, phc_colour_correction_method method,
+                     const char *where, cache_entry **out, phc_error *err)
+{
+    if ((*out = cache_find(c, path, method)))
+        return PHC_OK;
+    return cache_insert(c, path, NULL, method, where, out, err);
+}
+
 int phc_photo_cache_read(phc_photo_cache *cache, const char *path, phc_colour_correction_method correction,
                          const char *where, phc_error *err)
 {
     cache_entry *e = NULL;
     return cache_get(cache, path, correction, where, &e, err);
+}
+
+int phc_photo_cache_add(phc_photo_cache *cache, const char *name, const phc_image *img,
+                        phc_colour_correction_method correction, const char *where, phc_error *err)
+{
+    cache_entry *e = NULL;
+    if (!name || !img || !img->data || !img->width || !img->height)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s%sphc_photo_cache_add: a name and a non-empty image are needed",
+                             where ? where : "", where ? ": " : "");
+    if (cache_find(cache, name, correction))
+        return PHC_OK;
+    return cache_insert(cache, name, img, correction, where, &e, err);
 }
 
 int phc_leaf_photo_load(phc_photo_cache *cache, const char *path, size_t number,
@@ -304,13 +337,111 @@ static void pack(const double *c, const unsigned char *mask, size_t n, double *o
         }
 }
 
+/* Eq. 8: the fresh leaf's colours in the matching space (0 off the leaf)
+ * and their histogram match onto the reference's leaf pixels. */
+static int match_colours(phc_leaf_setup *s, phc_image *ref, const unsigned char *ref_mask, phc_error *err)
+{
+    const size_t n = s->w * s->h, n_px_ref = ref->width * ref->height;
+    size_t n_ref = 0;
+    for (size_t i = 0; i < n_px_ref; ++i)
+        n_ref += ref_mask[i] != 0;
+    double *a = malloc(3 * s->cells * sizeof *a), *m = malloc(3 * s->cells * sizeof *m);
+    double *b = malloc(3 * n_ref * sizeof *b);
+    int rc = PHC_OK;
+    if (!a || !m || !b) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    /* Colours in the matching space; eq. 8 on the leaf pixels only. */
+    phc_colour_convert(n, s->fresh.data, PHC_COLOUR_RGB, s->space, s->original);
+    phc_colour_convert(n_px_ref, ref->data, PHC_COLOUR_RGB, s->space, ref->data);
+    for (size_t i = 0; i < n; ++i)
+        if (!s->mask[i])
+            s->original[3 * i] = s->original[3 * i + 1] = s->original[3 * i + 2] = 0;
+    pack(s->original, s->mask, n, a);
+    pack(ref->data, ref_mask, n_px_ref, b);
+    if ((rc = phc_colour_match_histograms(s->cells, a, n_ref, b, m, err)))
+        goto done;
+    for (size_t i = 0, k = 0; i < n; ++i)
+        if (s->mask[i]) {
+            memcpy(s->matched + 3 * i, m + 3 * k, 3 * sizeof *m);
+            ++k;
+        }
+done:
+    free(a);
+    free(b);
+    free(m);
+    return rc;
+}
+
+/* Venation map β = floor + (1 - floor) ridge on the leaf: a file, uniform,
+ * or the fresh crop's ridge map faded out at the edge. */
+static int venation_map(phc_leaf_setup *s, const phc_leaf_photo *fresh, const phc_leaf_setup_options *opt,
+                        phc_error *err)
+{
+    const size_t w = s->w, h = s->h, n = w * h;
+    double *ridge = NULL;
+    int rc = PHC_OK;
+    if (opt->veins == PHC_LEAF_MAP_FILE) {
+        if ((rc = map_from_file(opt->veins_file, "veins", opt->veins_where, fresh, w, h, s->beta, err)))
+            return rc;
+    } else if (opt->veins == PHC_LEAF_MAP_UNIFORM) {
+        for (size_t i = 0; i < n; ++i)
+            s->beta[i] = 1;
+    } else {
+        phc_vein_options vo = phc_vein_options_default();
+        rc = phc_photo_vein_map(&fresh->crop, fresh->mask, &vo, &ridge, err);
+        if (!rc && !(rc = taper_edge(fresh, opt->vein_edge_taper, ridge, err)))
+            rc = map_to_grid(ridge, fresh->crop.width, fresh->crop.height, w, h, s->beta, err);
+        free(ridge);
+        if (rc)
+            return rc;
+    }
+    if (opt->veins != PHC_LEAF_MAP_UNIFORM)
+        for (size_t i = 0; i < n; ++i)
+            s->beta[i] = s->mask[i] ? opt->vein_floor + (1 - opt->vein_floor) * fmin(fmax(s->beta[i], 0), 1) : 0;
+    return PHC_OK;
+}
+
+/* Stomata (uniform unless a file) and inflow (through the veins unless
+ * told otherwise) maps; every map 0 off the leaf. */
+static int stomata_inflow_maps(phc_leaf_setup *s, const phc_leaf_photo *fresh, const phc_leaf_setup_options *opt,
+                               phc_error *err)
+{
+    const size_t w = s->w, h = s->h, n = w * h;
+    int rc;
+    if (opt->stomata == PHC_LEAF_MAP_FILE) {
+        if ((rc = map_from_file(opt->stomata_file, "stomata", opt->stomata_where, fresh, w, h, s->stomata, err)))
+            return rc;
+    } else
+        for (size_t i = 0; i < n; ++i)
+            s->stomata[i] = 1;
+    switch (opt->inflow) {
+    case PHC_LEAF_MAP_FILE:
+        if ((rc = map_from_file(opt->inflow_file, "inflow", opt->inflow_where, fresh, w, h, s->inflow, err)))
+            return rc;
+        break;
+    case PHC_LEAF_MAP_UNIFORM:
+        for (size_t i = 0; i < n; ++i)
+            s->inflow[i] = 1;
+        break;
+    case PHC_LEAF_MAP_NONE:
+        break;
+    default:
+        memcpy(s->inflow, s->beta, n * sizeof *s->inflow);
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (!s->mask[i])
+            s->stomata[i] = s->inflow[i] = s->beta[i] = 0;
+    return PHC_OK;
+}
+
 int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *reference,
                        const phc_leaf_setup_options *opt, phc_leaf_setup **out, phc_error *err)
 {
     phc_leaf_setup *s = calloc(1, sizeof *s);
     phc_image ref = {0};
     unsigned char *ref_mask = NULL;
-    double *a = NULL, *b = NULL, *m = NULL, *ridge = NULL;
     int rc;
     *out = NULL;
     if (!s)
@@ -336,90 +467,24 @@ int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *refere
     s->beta = calloc(n, sizeof *s->beta);
     s->stomata = calloc(n, sizeof *s->stomata);
     s->inflow = calloc(n, sizeof *s->inflow);
-    a = malloc(3 * s->cells * sizeof *a);
-    m = malloc(3 * s->cells * sizeof *m);
-    b = malloc(3 * n_ref * sizeof *b);
-    if (!s->original || !s->matched || !s->blend || !s->beta || !s->stomata || !s->inflow || !a || !m || !b) {
+    if (!s->original || !s->matched || !s->blend || !s->beta || !s->stomata || !s->inflow) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    /* Colours in the matching space; eq. 8 on the leaf pixels only. */
-    phc_colour_convert(n, s->fresh.data, PHC_COLOUR_RGB, s->space, s->original);
-    phc_colour_convert(ref.width * ref.height, ref.data, PHC_COLOUR_RGB, s->space, ref.data);
-    for (size_t i = 0; i < n; ++i)
-        if (!s->mask[i])
-            s->original[3 * i] = s->original[3 * i + 1] = s->original[3 * i + 2] = 0;
-    pack(s->original, s->mask, n, a);
-    pack(ref.data, ref_mask, ref.width * ref.height, b);
-    if ((rc = phc_colour_match_histograms(s->cells, a, n_ref, b, m, err)))
+    if ((rc = match_colours(s, &ref, ref_mask, err)) || (rc = venation_map(s, fresh, opt, err)) ||
+        (rc = stomata_inflow_maps(s, fresh, opt, err)))
         goto fail;
-    for (size_t i = 0, k = 0; i < n; ++i)
-        if (s->mask[i]) {
-            memcpy(s->matched + 3 * i, m + 3 * k, 3 * sizeof *m);
-            ++k;
-        }
-
-    /* Venation map β = floor + (1 - floor) ridge on the leaf. */
-    if (opt->veins == PHC_LEAF_MAP_FILE) {
-        if ((rc = map_from_file(opt->veins_file, "veins", opt->veins_where, fresh, w, h, s->beta, err)))
-            goto fail;
-    } else if (opt->veins == PHC_LEAF_MAP_UNIFORM) {
-        for (size_t i = 0; i < n; ++i)
-            s->beta[i] = 1;
-    } else {
-        phc_vein_options vo = phc_vein_options_default();
-        if ((rc = phc_photo_vein_map(&fresh->crop, fresh->mask, &vo, &ridge, err)) ||
-            (rc = taper_edge(fresh, opt->vein_edge_taper, ridge, err)) ||
-            (rc = map_to_grid(ridge, fresh->crop.width, fresh->crop.height, w, h, s->beta, err)))
-            goto fail;
-    }
-    if (opt->veins != PHC_LEAF_MAP_UNIFORM)
-        for (size_t i = 0; i < n; ++i)
-            s->beta[i] = s->mask[i] ? opt->vein_floor + (1 - opt->vein_floor) * fmin(fmax(s->beta[i], 0), 1) : 0;
-    /* Stomata: uniform unless a file. */
-    if (opt->stomata == PHC_LEAF_MAP_FILE) {
-        if ((rc = map_from_file(opt->stomata_file, "stomata", opt->stomata_where, fresh, w, h, s->stomata, err)))
-            goto fail;
-    } else
-        for (size_t i = 0; i < n; ++i)
-            s->stomata[i] = 1;
-    /* Inflow: through the veins unless told otherwise. */
-    switch (opt->inflow) {
-    case PHC_LEAF_MAP_FILE:
-        if ((rc = map_from_file(opt->inflow_file, "inflow", opt->inflow_where, fresh, w, h, s->inflow, err)))
-            goto fail;
-        break;
-    case PHC_LEAF_MAP_UNIFORM:
-        for (size_t i = 0; i < n; ++i)
-            s->inflow[i] = 1;
-        break;
-    case PHC_LEAF_MAP_NONE:
-        break;
-    default:
-        memcpy(s->inflow, s->beta, n * sizeof *s->inflow);
-    }
-    for (size_t i = 0; i < n; ++i)
-        if (!s->mask[i])
-            s->stomata[i] = s->inflow[i] = s->beta[i] = 0;
     phc_leaf_params lp = phc_leaf_params_default();
     lp.dt = opt->dt;
     if ((rc = phc_leaf_new(w, h, s->mask, s->beta, s->stomata, s->inflow, lp, &s->leaf, err)))
         goto fail;
     phc_image_free(&ref);
     free(ref_mask);
-    free(a);
-    free(b);
-    free(m);
-    free(ridge);
     *out = s;
     return PHC_OK;
 fail:
     phc_image_free(&ref);
     free(ref_mask);
-    free(a);
-    free(b);
-    free(m);
-    free(ridge);
     phc_leaf_setup_free(s);
     return rc;
 }

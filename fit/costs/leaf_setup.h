@@ -24,7 +24,7 @@
 
 /* One leaf cut out of a photo (after colour correction). */
 typedef struct phc_leaf_photo {
-    char *path;          /* the photo file */
+    char *path;          /* the photo file (or the name of an image given in memory) */
     size_t number;       /* leaf number in the photo (reading order, 1-based) */
     size_t leaves;       /* leaves found in the photo */
     phc_image crop;      /* full-resolution crop around the leaf */
@@ -40,6 +40,16 @@ typedef struct phc_leaf_photo {
 typedef struct phc_photo_cache phc_photo_cache;
 phc_photo_cache *phc_photo_cache_new(void);
 void phc_photo_cache_free(phc_photo_cache *c); /* accepts NULL */
+
+/* Puts an image already in memory (measurements/photo.h: sRGB in [0, 1])
+ * into the cache under `name`, as phc_photo_cache_read does a file: copied,
+ * colour corrected by `correction` and segmented, once (a name already
+ * cached with that correction is kept).  phc_leaf_photo_load(cache, name,
+ * ...) then cuts its leaves out without reading any file; `name` stands for
+ * the image in messages and reports.  Errors as phc_photo_cache_read's
+ * ("no leaf found"); PHC_ERR_INVALID without a name or an image. */
+int phc_photo_cache_add(phc_photo_cache *cache, const char *name, const phc_image *img,
+                        phc_colour_correction_method correction, const char *where, phc_error *err);
 
 /* Cuts leaf `number` (1-based, reading order) out of photo `path`, colour
  * corrected by `correction` (measured over the whole photo for gray world).
