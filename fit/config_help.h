@@ -6,7 +6,7 @@
  *     table phc_<kind>_help with one entry per key;
  *   - the top-level, parameter, common data-set, solver and report keys
  *     have theirs in fit/config.c, the nested `soil:` block in
- *     fit/costs/soil_setup.c;
+ *     fit/config/soil_setup_yaml.c;
  *   - fit/config.h's registry (phc_config_kind_at, phc_config_block) pairs
  *     each key table with its help table and a one-line summary.
  *

@@ -206,12 +206,12 @@ static int setup_layers(phc_soil_setup *su, const phc_soil_setup_options *o, con
 }
 
 /* A noise block into a per-voxel mask (rocks) or amount (pockets). */
-static int setup_noise(phc_soil_setup *su, const phc_soil_setup_noise *nz, int rocks, const place *pl,
+static int setup_noise(phc_soil_setup *su, const phc_soil_setup_noise *noise, int rocks, const place *pl,
                        phc_error *err)
 {
     const char *what = rocks ? "soil rocks" : "soil nutrient_pockets";
-    const double amount = rocks ? 1 : nz->amount;
-    if (!(nz->scale > 0) || !(nz->fraction >= 0 && nz->fraction < 1) || !(amount >= 0))
+    const double amount = rocks ? 1 : noise->amount;
+    if (!(noise->scale > 0) || !(noise->fraction >= 0 && noise->fraction < 1) || !(amount >= 0))
         return phc_error_set(err, PHC_ERR_INPUT, "%s: %s: needs scale > 0 m, 0 <= fraction < 1%s",
                              at(pl, rocks ? "rocks" : "nutrient_pockets").text, what,
                              rocks ? "" : " and amount >= 0");
@@ -222,13 +222,13 @@ static int setup_noise(phc_soil_setup *su, const phc_soil_setup_noise *nz, int r
     if (rocks) {
         for (size_t i = 0; i < nvox; ++i)
             tmp->p[i] = 1;
-        phc_soil_add_rocks(tmp, nz->seed, nz->scale, nz->fraction);
+        phc_soil_add_rocks(tmp, noise->seed, noise->scale, noise->fraction);
         su->rock = malloc(nvox);
         if (su->rock)
             for (size_t i = 0; i < nvox; ++i)
                 su->rock[i] = tmp->p[i] == 0;
     } else {
-        phc_soil_add_nutrient_pockets(tmp, nz->seed, nz->scale, nz->fraction, amount);
+        phc_soil_add_nutrient_pockets(tmp, noise->seed, noise->scale, noise->fraction, amount);
         su->pocket = malloc(nvox * sizeof *su->pocket);
         if (su->pocket)
             memcpy(su->pocket, tmp->v, nvox * sizeof *su->pocket);
