@@ -58,7 +58,8 @@
  * The Jacobian is by central differences (the model's steps make it a
  * piecewise-smooth function of the scales).
  *
- * cross_validate (after the fit, in the report): each row but the initial
+ * cross_validate (after the fit, in the report; run by the engine,
+ * fit/cross_validation.h, from the kind's plan): each row but the initial
  * and the reference is left out in turn, the data set's free slots are
  * refitted on the others, and the row's stage is predicted by finding the
  * model time whose colours are closest to its photo; beside it, a baseline
@@ -167,11 +168,14 @@ int phc_leaf_photos_new(const phc_leaf_photos_row *rows, size_t n_rows, const ph
 extern const phc_dataset_ops phc_leaf_photos_ops;
 
 /* Leave-one-out prediction of each row's stage (see above), at the fitted
- * slot values p, with the free slots and their bounds taken from the data
- * set's problem.  Fills n_rows values each (NAN for the initial and
- * reference rows): observed stage, model prediction, baseline prediction;
- * rmse[0] model, rmse[1] baseline, over the predicted rows.  Arrays are
- * malloc'd.  Used by the report and by tests. */
+ * slot values p, whether or not options.cross_validate asked for it: the
+ * engine's phc_cross_validate_plan (fit/cross_validation.h) on the data
+ * set's plan, with the free slots, their bounds and the solver options of
+ * the data set's problem (ds->problem; progress through ds->progress).
+ * Fills n_rows values each (NAN for the initial and reference rows):
+ * observed stage, model prediction, baseline prediction; rmse[0] model,
+ * rmse[1] baseline, over the predicted rows.  Arrays are malloc'd.  The
+ * report gets the same numbers from phc_fit_run. */
 int phc_leaf_photos_cross_validate(phc_dataset *ds, const double *p, size_t *n_rows, char ***ids,
                                    double **stage, double **model, double **baseline, double rmse[2],
                                    phc_error *err);
