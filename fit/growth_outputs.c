@@ -67,12 +67,6 @@ int phc_growth_write_plant_graph(const phc_growth *g, const char *path, phc_erro
 
 enum { COL_BG = 0, COL_FG, COL_SHOOT, COL_ROOT, COL_SOIL, COL_COUNT };
 
-static double nice_step(double range, double ticks)
-{
-    double raw = range / ticks, mag = pow(10, floor(log10(raw))), f = raw / mag;
-    return (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
-}
-
 int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
                          const char *const *titles, size_t n, double soil_top, double box_x0,
                          double box_x1, phc_error *err)
@@ -149,7 +143,7 @@ int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
         }
         plwidth(1.0);
         plcol0(COL_FG);
-        plbox("bcnst", nice_step(x1 - x0, 4), 0, "bcnstv", nice_step(z1 - z0, 6), 0);
+        plbox("bcnst", phc_plot_nice_step(x1 - x0, 4), 0, "bcnstv", phc_plot_nice_step(z1 - z0, 6), 0);
         plmtex("b", 3.0, 0.5, 0.5, "x (m)");
         plmtex("l", 4.0, 0.5, 0.5, "height z (m)");
         char *t = phc_plot_escape(titles && titles[p] ? titles[p] : "");

@@ -2,6 +2,7 @@
 #include "fit/plot_file.h"
 
 #include <plplot.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -80,4 +81,12 @@ int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err)
         return status;
     }
     return phc_atomic_file_commit(af, err);
+}
+
+double phc_plot_nice_step(double span, double target)
+{
+    const double raw = span / target;
+    const double p = pow(10.0, floor(log10(raw)));
+    const double m = raw / p;
+    return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
 }

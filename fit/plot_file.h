@@ -25,4 +25,8 @@ int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err);
  * truncated file). */
 int phc_plot_png_complete(const char *file);
 
+/* Tick interval 1, 2 or 5 x 10^k giving about `target` intervals over
+ * `span` (both > 0). */
+double phc_plot_nice_step(double span, double target);
+
 #endif /* PHC_PLOT_FILE_H */

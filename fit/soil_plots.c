@@ -36,15 +36,6 @@ static const unsigned char BLUES[9][3] = {
 
 
 
-/* Tick interval of 1, 2 or 5 x 10^k giving about `target` intervals. */
-static double nice_step(double span, double target)
-{
-    double raw = span / target;
-    double p = pow(10.0, floor(log10(raw)));
-    double m = raw / p;
-    return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
-}
-
 /* The slice as PLplot wants it: img[h][r], h along the horizontal axis,
  * r = 0 the top (surface) layer.  Non-finite values become `nodata`, which
  * lies below the plotted z range so plimagefr leaves those cells out (the
@@ -264,7 +255,7 @@ int phc_plot_soil_slice(const char *path, const char *title,
 
     /* about one x tick label per 0.1 of the page, so narrow slices stay readable */
     double xticks = 10.0 * (vx1 - vx0) < 2.0 ? 2.0 : 10.0 * (vx1 - vx0) > 6.0 ? 6.0 : 10.0 * (vx1 - vx0);
-    double xstep = nice_step(width, xticks), ystep = nice_step(depth, 6.0);
+    double xstep = phc_plot_nice_step(width, xticks), ystep = phc_plot_nice_step(depth, 6.0);
     plcol0(COL_FG);
     plwidth(1.2);
     plbox("bcnst", xstep, 0, "bcnstv", ystep, 0);

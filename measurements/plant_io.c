@@ -291,7 +291,8 @@ done:
 /* Writes through body() to a temporary file next to PATH, renamed into
  * place (atomic_file.h); the temporary file is removed on any failure. */
 int phc_plant_io_write_atomically(const char *path, const phc_plant_graph *g,
-                                  phc_plant_io_body_writer body, phc_error *err)
+                                  phc_plant_io_body_writer body, const void *ctx,
+                                  phc_error *err)
 {
     phc_atomic_file *af = NULL;
     phc_c_numeric scope = {(locale_t)0, (locale_t)0};
@@ -300,7 +301,7 @@ int phc_plant_io_write_atomically(const char *path, const phc_plant_graph *g,
         return rc;
     phc_c_numeric_begin(&scope); /* '.' decimal points whatever the locale */
     errno = 0;
-    const int failed = body(phc_atomic_file_stream(af), g) < 0;
+    const int failed = body(phc_atomic_file_stream(af), g, ctx) < 0;
     const int saved = errno;
     phc_c_numeric_end(&scope);
     if (failed) {

@@ -63,6 +63,22 @@ int phc_plant_io_read(const char *path, phc_plant_format format, double unit_to_
 int phc_plant_io_write_native(const char *path, const phc_plant_graph *g, phc_error *err);
 int phc_plant_io_write_paper(const char *path, const phc_plant_graph *g, phc_error *err);
 
+/* One value per segment, written beside the shape (e.g. "relative_water",
+ * "young_modulus_Pa"); name: letters, digits and '_' only. */
+typedef struct phc_plant_field {
+    const char *name;
+    const double *value; /* g->n values */
+} phc_plant_field;
+
+/* The graph's current shape (head and tail of every segment, m) as legacy
+ * VTK polydata for ParaView or Blender: one line per segment, the radius as
+ * point data (for a Tube filter), segment_id, leaf, fixed and the fields as
+ * cell data (measurements/plant_io_vtk.c gives the layout).  title: the
+ * file's title line (NULL: "phytocal plant shape").  Write-only: VTK is an
+ * output format here, not read back. */
+int phc_plant_io_write_vtk(const char *path, const phc_plant_graph *g, const char *title,
+                           const phc_plant_field *fields, size_t count, phc_error *err);
+
 #ifdef __cplusplus
 }
 #endif

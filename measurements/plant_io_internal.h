@@ -49,13 +49,15 @@ int phc_plant_io_build_id_map(const char *path, const long *ids, const size_t *l
 size_t phc_plant_io_find_id(const phc_plant_io_id_entry *map, size_t n, long id);
 
 /* ---- writers (plant_io.c) ------------------------------------------------ */
-/* Writes the body of a file; < 0 on a stream error. */
-typedef int (*phc_plant_io_body_writer)(FILE *f, const phc_plant_graph *g);
+/* Writes the body of a file (ctx: the writer's own extra data, may be
+ * NULL); < 0 on a stream error. */
+typedef int (*phc_plant_io_body_writer)(FILE *f, const phc_plant_graph *g, const void *ctx);
 
-/* Writes through body() (numbers in the C locale) to a temporary file
- * renamed to path on success (measurements/atomic_file.h). */
+/* Writes through body(f, g, ctx) (numbers in the C locale) to a temporary
+ * file renamed to path on success (measurements/atomic_file.h). */
 int phc_plant_io_write_atomically(const char *path, const phc_plant_graph *g,
-                                  phc_plant_io_body_writer body, phc_error *err);
+                                  phc_plant_io_body_writer body, const void *ctx,
+                                  phc_error *err);
 /* PHC_ERR_INVALID naming `who` unless path and a finished graph are given. */
 int phc_plant_io_check_writable(const char *who, const char *path, const phc_plant_graph *g,
                                 phc_error *err);

@@ -315,13 +315,15 @@ static int native_body_ids(FILE *f, const phc_plant_graph *g, int keep_ids)
     return 0;
 }
 
-static int native_body_keep(FILE *f, const phc_plant_graph *g)
+static int native_body_keep(FILE *f, const phc_plant_graph *g, const void *ctx)
 {
+    (void)ctx;
     return native_body_ids(f, g, 1);
 }
 
-static int native_body_index(FILE *f, const phc_plant_graph *g)
+static int native_body_index(FILE *f, const phc_plant_graph *g, const void *ctx)
 {
+    (void)ctx;
     return native_body_ids(f, g, 0);
 }
 
@@ -333,5 +335,6 @@ int phc_plant_io_write_native(const char *path, const phc_plant_graph *g, phc_er
     keep = source_ids_usable(g);
     if (keep < 0)
         return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
-    return phc_plant_io_write_atomically(path, g, keep ? native_body_keep : native_body_index, err);
+    return phc_plant_io_write_atomically(path, g, keep ? native_body_keep : native_body_index, NULL,
+                                         err);
 }

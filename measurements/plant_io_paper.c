@@ -341,8 +341,9 @@ int phc_plant_io_read_paper(const char *path, char *text, size_t length, double 
 
 /* ---- writer ------------------------------------------------------------- */
 
-static int paper_body(FILE *f, const phc_plant_graph *g)
+static int paper_body(FILE *f, const phc_plant_graph *g, const void *ctx)
 {
+    (void)ctx;
     size_t i;
     if (fprintf(f, "verts %zu\n", g->n) < 0)
         return -1;
@@ -386,5 +387,5 @@ int phc_plant_io_write_paper(const char *path, const phc_plant_graph *g, phc_err
                                  "root's tail is nearest the origin",
                                  path, g->source_id[i], g->source_id[g->root]);
     }
-    return phc_plant_io_write_atomically(path, g, paper_body, err);
+    return phc_plant_io_write_atomically(path, g, paper_body, NULL, err);
 }
