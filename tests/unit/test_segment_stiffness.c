@@ -77,7 +77,7 @@ static void check_derivatives(const phc_plant_graph *g, phc_segment_stiffness_pa
             *slot[k] = v;
             const double fd = (ep - em) / (2 * h);
             CHECK_NEAR(dp[4 * i + k], fd, 1e-9 * fabs(E[i]), 1e-6);
-            if (fabs(fd) > 0)
+            if (fabs(fd) * h > 1e-8 * fabs(E[i])) /* not drowned in rounding */
                 maxrel = fmax(maxrel, fabs(dp[4 * i + k] - fd) / fabs(fd));
         }
     }
@@ -90,7 +90,7 @@ static void check_derivatives(const phc_plant_graph *g, phc_segment_stiffness_pa
         theta[i] = t0;
         const double fd = (ep - em) / (2 * h);
         CHECK_NEAR(dth[i], fd, 1e-9 * fabs(E[i]) / (fabs(t0) + 1e-6), 1e-6);
-        if (fabs(fd) > 0)
+        if (fabs(fd) * h > 1e-8 * fabs(E[i]))
             maxrel = fmax(maxrel, fabs(dth[i] - fd) / fabs(fd));
         /* E_i depends on theta_i only: moving theta_j leaves E_i unchanged */
         for (size_t j = 0; j < n; ++j)
@@ -100,8 +100,9 @@ static void check_derivatives(const phc_plant_graph *g, phc_segment_stiffness_pa
                 theta[j] -= 0.1;
             }
     }
-    printf("  %s content: largest relative difference analytic vs central difference: %.2e\n",
-           p.content == PHC_STIFFNESS_RELATIVE ? "relative" : "absolute", maxrel);
+    printf("  %s content, kappa %g: largest relative difference analytic vs central "
+           "difference: %.2e\n",
+           p.content == PHC_STIFFNESS_RELATIVE ? "relative" : "absolute", p.logistic.kappa, maxrel);
 }
 
 int main(void)
