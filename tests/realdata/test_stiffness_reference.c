@@ -9,7 +9,9 @@
  * joints stiffer than Emin + Emax / 2, and the joint moduli; once, the
  * joint "radius" of their code against the length-weighted mean radius it
  * evidently means, and the build-time against the per-frame masses.
- * Checks (each can fail): W(1e3 s) and W(1e4 s) equal their matrix's values
+ * Also printed: the relative water content theta / V that the physical
+ * default maps (uniform at t = 0, since theta(0) = W0 V / sum V).
+ * Checks (each can fail): segment volumes equal the water model's; W(1e3 s) and W(1e4 s) equal their matrix's values
  * (W_THEIRS of tests/realdata/test_water_reference.c) to 1e-9; every output finite, non-root moduli within
  * [Emin, Emin + Emax]; per-frame masses sum to (sum V rho + W(t) - root's
  * share) * 1e-3 with W(t) the water model's own total; at t = 0 a stem
@@ -115,6 +117,26 @@ int main(void)
                sm[0], sm[1], sm[2], pow(sm[1], 4));
     }
 
+    /* the volumes behind relative water content are the water model's own */
+    double *rwc = malloc(n * sizeof *rwc);
+    if (!rwc) {
+        CHECK(0);
+        return check_finish("test_stiffness_reference");
+    }
+    {
+        double worst = 0, vsum = 0;
+        phc_water_system_volume(s, rwc);
+        for (size_t i = 0; i < n; ++i) {
+            worst = fmax(worst, fabs(phc_segment_volume_cm3(g, i) - rwc[i]) / rwc[i]);
+            vsum += rwc[i];
+        }
+        CHECK(worst < 1e-14);
+        printf("segment volumes vs the water model's: largest relative difference %.2g; total "
+               "volume %.6g cm^3, so theta(0) = W0 V / sum V is a uniform relative content "
+               "%.6g\n",
+               worst, vsum, 8.0 / vsum);
+    }
+
     const double times[4] = {0, 1e3, 1e4, 3e4};
     for (int q = 0; q < 4; ++q) {
         if (times[q] == 0) {
@@ -148,6 +170,11 @@ int main(void)
             ++k;
         }
         CHECK(bad == 0);
+        /* relative water content theta / V, what the physical default maps */
+        for (size_t i = 0; i < n; ++i)
+            rwc[i] = theta[i] / phc_segment_volume_cm3(g, i);
+        double sr[3];
+        summary(rwc, n, sr);
         CHECK_NEAR(mass, want, 0, 1e-13);
         /* W_THEIRS of test_water_reference.c: their matrix evaluated accurately */
         if (times[q] == 1e3)
@@ -159,8 +186,12 @@ int main(void)
         summary(je, k, se);
         printf("t = %g s: W = %.10g g; joint water min %.3g, median %.3g, max %.3g g; "
                "stiffer than Emin + Emax/2: %zu of %zu joints; E min %.3g, median %.3g, max %.3g; "
-               "frame mass %.6g\n",
-               times[q], total, sw[0], sw[1], sw[2], stiff, k, se[0], se[1], se[2], mass);
+               "frame mass %.6g; relative content theta/V median %.4g, (max - min) / median "
+               "%.2g\n",
+               times[q], total, sw[0], sw[1], sw[2], stiff, k, se[0], se[1], se[2], mass, sr[1],
+               (sr[2] - sr[0]) / sr[1]);
+        if (times[q] == 0)
+            CHECK(sr[2] - sr[0] <= 1e-12 * sr[1]);
         if (times[q] == 0) {
             /* build-time masses: exactly 1000 x the frame's for stem segments (quirk 7) */
             CHECK(phc_stiffness_reference_masses(g, &rp, theta, 1, mb, &err) == PHC_OK);
@@ -183,6 +214,6 @@ int main(void)
     phc_water_system_free(s);
     phc_plant_graph_free(g);
     free(theta), free(E), free(W), free(R), free(L), free(m), free(mb), free(jw), free(je),
-        free(ratio);
+        free(ratio), free(rwc);
     return check_finish("test_stiffness_reference");
 }
