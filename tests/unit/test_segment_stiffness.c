@@ -352,5 +352,27 @@ int main(void)
             phc_plant_graph_free(g3);
         }
     }
+    /* ---- a single segment: no joints; the root weighs 0 and has E_base */
+    {
+        const size_t par1[1] = {PHC_PLANT_NO_PARENT};
+        const double r1[1] = {0.003}, l1[1] = {0.05};
+        phc_plant_graph *g1 = make_graph(1, par1, r1, l1, NULL);
+        CHECK(g1 != NULL);
+        if (g1) {
+            const phc_stiffness_reference_params rp = phc_stiffness_reference_default();
+            const double th[1] = {0.5};
+            double Y[1] = {-1}, m[1] = {-1}, e[1] = {-1};
+            CHECK(phc_stiffness_reference_joints(g1, &rp, th, Y, NULL, NULL, NULL, NULL, NULL,
+                                                 NULL, &err) == PHC_OK);
+            CHECK(Y[0] == 0);
+            CHECK(phc_stiffness_reference_masses(g1, &rp, th, 0, m, &err) == PHC_OK);
+            CHECK(m[0] == 0);
+            CHECK(phc_segment_stiffness_depth(g1, 2e9, e, NULL, &err) == PHC_OK && e[0] == 2e9);
+            CHECK(phc_segment_stiffness_radius(g1, 2e9, e, NULL, &err) == PHC_OK && e[0] == 2e9);
+            phc_plant_graph_free(g1);
+        }
+        const phc_segment_stiffness_params d = phc_segment_stiffness_params_default();
+        CHECK(phc_segment_stiffness_check(&d, &err) == PHC_OK);
+    }
     return check_finish("test_segment_stiffness");
 }
