@@ -74,7 +74,8 @@ static int is_one_of(const char *s, const char *const *names)
 }
 
 static const char *const pixel_names[] = {"px", "pixel", "pixels", NULL};
-static const char *const degree_names[] = {"deg", "degree", "degrees", NULL};
+static const char *const degree_names[] = {"deg",    "degree", "degrees",
+                                           "arc_degree", "arcdeg", "\xc2\xb0", NULL};
 static const char *const radian_names[] = {"rad", "radian", "radians", NULL};
 
 /* Checks the spec before any file is read. */
@@ -189,8 +190,12 @@ static int series_conversion(const phc_shape_series_spec *s, const char *where, 
         c->offset = 0;
         return PHC_OK;
     }
-    snprintf(w, sizeof w, "%s%sseries '%s': angle unit", wp ? wp : "", wp ? ": " : "", s->id);
-    return phc_units_conversion(units, s->angle_unit, "radian", w, c, err);
+    /* Not through UDUNITS-2: there the radian is dimensionless, so "percent"
+     * or "1" would convert to radians without complaint. */
+    return phc_error_set(err, PHC_ERR_INPUT,
+                         "%s%sseries '%s': angle unit '%s' is not one phytocal reads (use deg "
+                         "or rad; also degree(s), arc_degree, arcdeg, radian(s))",
+                         wp ? wp : "", wp ? ": " : "", s->id, s->angle_unit);
 }
 
 static int build(const phc_table *t, const phc_shape_spec *spec, phc_units *units,

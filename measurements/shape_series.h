@@ -14,9 +14,10 @@
  *      ("mm", "cm", "m") or in pixels ("px", "pixel", "pixels") with a scale
  *      in m/px; with y_down (image rows: y grows downwards) y is negated so
  *      that the output's y points up; output in metres;
- *    * an angle: one column in "deg" ("degree", "degrees") or "rad"
- *      ("radian", "radians"), or any angle UDUNITS-2 converts to radians;
- *      output in radians, unwrapped: each sample is moved by a multiple of
+ *    * an angle: one column in "deg" ("degree", "degrees", "arc_degree",
+ *      "arcdeg", "°") or "rad" ("radian", "radians"); not through UDUNITS-2,
+ *      where the radian is dimensionless and "percent" would pass as an
+ *      angle; output in radians, unwrapped: each sample is moved by a multiple of
  *      2 pi so that it differs from the previous one by at most pi, so a
  *      track that passes 360 deg -> 0 deg continues to 361, 362 ...; with
  *      y_down (an angle measured in image axes, clockwise on screen) the
@@ -55,7 +56,7 @@ typedef struct phc_shape_series_spec {
     const char *length_unit;      /* POINT: UDUNITS-2 length unit, or "px"/"pixel"/"pixels" */
     double metres_per_pixel;      /* POINT in pixels: scale, m/px, > 0 */
     const char *angle;            /* ANGLE: column name */
-    const char *angle_unit;       /* ANGLE: "deg", "rad" or a UDUNITS-2 angle unit */
+    const char *angle_unit;       /* ANGLE: "deg" or "rad" (aliases above) */
     int y_down;                   /* 1: image axes (y down): y (or the angle) is negated */
     int keep_wrapped;             /* ANGLE: 1 keeps the angle as read (no unwrapping) */
     const char *where;            /* for messages about this spec, e.g. "cfg.yaml:14"; may be NULL */

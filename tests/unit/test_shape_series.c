@@ -1,6 +1,6 @@
 /* Tracked motion reader (measurements/shape_series.h) on small files written
  * to a temporary directory: units (time, length, pixels with a scale and
- * y down, degrees and radians, a UDUNITS-2 angle), angle unwrapping across
+ * y down, degrees and radians), angle unwrapping across
  * 360 -> 0 both ways, CRLF, and every refusal with its file:line or spec
  * location. */
 #include <math.h>
@@ -129,7 +129,7 @@ int main(void)
         }
     }
 
-    /* ---- radians, time in minutes, a UDUNITS-2 angle unit (arc_degree) */
+    /* ---- radians, time in minutes, the UDUNITS-2 name arc_degree */
     {
         phc_shape_series *s = NULL;
         const char *text = "Time (s),A\n0.5,3.0\n1.0,-3.0\n1.5,3.1\n";
@@ -264,11 +264,14 @@ int main(void)
         CHECK_STR_CONTAINS(err.message, "cannot be converted to 's'");
         CHECK(read_angle(u, "ok.csv", "Time (s),A\n10,1\n", "s", "A", "degs", &s, &err) ==
               PHC_ERR_INPUT);
-        CHECK_STR_CONTAINS(err.message, "cfg.yaml:7: series 'flower': angle unit");
+        CHECK_STR_CONTAINS(err.message, "cfg.yaml:7: series 'flower': angle unit 'degs' is not");
         printf("unknown angle unit: %s\n", err.message);
         CHECK(read_angle(u, "ok.csv", "Time (s),A\n10,1\n", "s", "A", "kg", &s, &err) ==
               PHC_ERR_INPUT);
-        CHECK_STR_CONTAINS(err.message, "cannot be converted");
+        /* dimensionless units are not angles, though UDUNITS-2 converts them to radians */
+        CHECK(read_angle(u, "ok.csv", "Time (s),A\n10,1\n", "s", "A", "percent", &s, &err) ==
+              PHC_ERR_INPUT);
+        CHECK_STR_CONTAINS(err.message, "angle unit 'percent' is not one phytocal reads");
         CHECK(read_angle(u, "ok.csv", "Time (s),A\n10,1\n", "s", "A", "", &s, &err) ==
               PHC_ERR_INPUT);
         CHECK_STR_CONTAINS(err.message, "no angle unit");
