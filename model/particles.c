@@ -210,7 +210,7 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
         for (int k = 0; k < 3; ++k)
             om[k] *= sc;
         const double wn = sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
-        if (wn < 1e-15) {
+        if (wn < 1e-14) {
             converged = 1;
             break;
         }
@@ -223,23 +223,26 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     if (converged) {
         /* Certificate: at a maximum of tr(Rᵀa) over rotations, S = Rᵀa is
          * symmetric and nᵀSn <= tr S for all unit n (second variation
-         * along a rotation about n).  Gershgorin bounds λ_max(S). */
+         * along a rotation about n). */
         phc_particles_quat_to_matrix(q, R);
         double S[9];
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
                 S[3 * i + j] = R[i] * a[j] + R[3 + i] * a[3 + j] + R[6 + i] * a[6 + j];
+        /* T = tr(S) I - sym(S) must be positive semidefinite: all its
+         * principal minors >= 0 (|a|_F = 1 sets the tolerance's scale). */
         const double tr = S[0] + S[4] + S[8];
-        double bound = -INFINITY;
-        for (int i = 0; i < 3; ++i) {
-            double b = S[4 * i];
+        double T[9];
+        for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
-                if (j != i)
-                    b += fabs(0.5 * (S[3 * i + j] + S[3 * j + i]));
-            if (b > bound)
-                bound = b;
-        }
-        if (bound <= tr + 1e-12)
+                T[3 * i + j] = (i == j ? tr : 0) - 0.5 * (S[3 * i + j] + S[3 * j + i]);
+        const double tol = -1e-12;
+        const double m01 = T[0] * T[4] - T[1] * T[3], m02 = T[0] * T[8] - T[2] * T[6],
+                     m12 = T[4] * T[8] - T[5] * T[7];
+        const double det = T[0] * m12 - T[1] * (T[3] * T[8] - T[5] * T[6]) +
+                           T[2] * (T[3] * T[7] - T[4] * T[6]);
+        if (T[0] >= tol && T[4] >= tol && T[8] >= tol && m01 >= tol && m02 >= tol && m12 >= tol &&
+            det >= tol)
             return 0;
     }
     if (polar_svd(a, R) != 0)
@@ -524,6 +527,26 @@ int phc_particles_set_position(phc_particles *p, size_t i, const double x[3], ph
         p->x[3 * i + k] = p->xp[3 * i + k] = x[k];
         p->v[3 * i + k] = 0;
     }
+    return PHC_OK;
+}
+
+int phc_particles_set_orientation(phc_particles *p, size_t i, const double q[4],
+                                  phc_error *err)
+{
+    if (check_index(p, i, "orientation", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (!q)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: particle %zu: orientation: NULL", i);
+    const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!isfinite(r) || !(r > 0))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): orientation quaternion must "
+                             "be finite and non-zero, found (%g, %g, %g, %g)",
+                             i, p->source_id[i], q[0], q[1], q[2], q[3]);
+    for (int k = 0; k < 4; ++k)
+        p->q[4 * i + k] = p->qp[4 * i + k] = q[k] / r;
+    for (int k = 0; k < 3; ++k)
+        p->w[3 * i + k] = 0;
     return PHC_OK;
 }
 

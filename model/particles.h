@@ -124,6 +124,10 @@ int phc_particles_set_age(phc_particles *p, size_t i, double age /* s, >= 0 */,
 /* Moves a particle (m; finite) and zeroes its velocity. */
 int phc_particles_set_position(phc_particles *p, size_t i, const double x[3],
                                phc_error *err);
+/* Turns a particle to the unit quaternion q (w,x,y,z; finite, not zero;
+ * normalised here) and zeroes its angular velocity. */
+int phc_particles_set_orientation(phc_particles *p, size_t i, const double q[4],
+                                  phc_error *err);
 /* External force on particle i, N (finite), held until changed. */
 int phc_particles_set_force(phc_particles *p, size_t i, const double f[3],
                             phc_error *err);
@@ -180,7 +184,8 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
  * the start on entry (e.g. the last step's rotation) and the result on
  * return.  Müller et al. 2016 ("A robust method to extract the rotational
  * part of deformations") iteration; its stationary point is certified a
- * maximum (λ_max(RᵀA) <= tr(RᵀA) by a Gershgorin bound), otherwise LAPACK
+ * maximum (tr(S)·I − S positive semidefinite, S = RᵀA, checked by its
+ * principal minors), otherwise LAPACK
  * dgesvd gives R = U diag(1, 1, det(UVᵀ)) Vᵀ.  Returns 0 with the
  * iteration, 1 with the SVD fallback, -1 when A is not finite or zero. */
 int phc_particles_polar_rotation(const double A[9], double q[4]);
