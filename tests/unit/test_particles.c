@@ -14,7 +14,9 @@
  *     sag qL⁴/(8EI) for E = 1 GPa.  Asserts the measured qualitative facts.
  *  6. Breaking: a tip force growing every step breaks the most stressed link
  *     at the first step whose stress exceeds the threshold, never before.
- *  7. Bad input: messages name the particle. */
+ *  7. Anchors (eq. 5) and the attachment rule, age-dependent stiffness,
+ *     free fall of the centre of mass: exact one-step answers.
+ *  8. Bad input: messages name the particle. */
 #include "model/particles.h"
 #include "model/plant_graph.h"
 
@@ -576,6 +578,122 @@ static void test_breaking(void)
     phc_plant_graph_free(g);
 }
 
+/* Anchors (eq. 5), the attachment rule, age-dependent stiffness and free
+ * fall: exact one-step answers. */
+static void test_anchor_age_fall(void)
+{
+    const double o[3] = {0, 0, 0}, dz[3] = {0, 0, 1};
+    phc_error err;
+    /* one free particle, no gravity, 1 iteration: its group is rigid, so
+     * a step moves it exactly x + k (a - x) */
+    phc_plant_graph *g1 = chain(1, o, dz, 0.04, 0.003, 0);
+    phc_particles_options opt = phc_particles_options_default();
+    opt.gravity[2] = 0;
+    opt.iterations = 1;
+    opt.damping = 0;
+    phc_particles *p = phc_particles_new(g1, &opt, &err);
+    CHECK(p != NULL);
+    if (p) {
+        const double a[3] = {0.1, 0.2, -0.05};
+        double x0[3], x1[3], want[3];
+        phc_particles_position(p, 0, x0);
+        CHECK(phc_particles_anchor(p, 0, a, 0.25, 0, &err) == PHC_OK);
+        CHECK(phc_particles_step(p, 0.01, NULL, &err) == PHC_OK);
+        phc_particles_position(p, 0, x1);
+        for (int d = 0; d < 3; ++d)
+            want[d] = x0[d] + 0.25 * (a[d] - x0[d]);
+        const double e = maxdiff(x1, want, 3);
+        printf("anchor (eq. 5): one step with k = 0.25 moves the particle to x + k (a - x) within "
+               "%.3g m\n",
+               e);
+        CHECK(e < 1e-15);
+        CHECK(phc_particles_anchor(p, 0, a, 1.5, 0, &err) == PHC_ERR_INPUT);
+        CHECK_STR_CONTAINS(err.message, "particle 0 (segment 100): anchor strength must be in (0, 1]");
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g1);
+
+    /* attachment rule: particles whose closest support point is within d */
+    phc_plant_graph *g = chain(10, o, dz, 0.05, 0.003, 1);
+    opt = phc_particles_options_default();
+    opt.maturity_age = 2.0;
+    p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (p) {
+        /* a wall at x = 0.02: support points beside the centres of 3..5 */
+        double pts[9];
+        for (int j = 0; j < 3; ++j) {
+            pts[3 * j] = 0.02;
+            pts[3 * j + 1] = 0;
+            pts[3 * j + 2] = 0.05 * (3 + j) + 0.025;
+        }
+        size_t att = 0;
+        CHECK(phc_particles_attach(p, pts, 3, 0.021, 1.0, &att, &err) == PHC_OK);
+        size_t att_far = 0;
+        CHECK(phc_particles_attach(p, pts, 3, 0.019, 1.0, &att_far, &err) == PHC_OK);
+        printf("attach: support points 2 cm beside particles 3..5: within 2.1 cm %zu attached, "
+               "then within 1.9 cm %zu more\n",
+               att, att_far);
+        CHECK(att == 3);
+        CHECK(att_far == 0);
+        CHECK(phc_particles_attach(p, pts, 3, -1, 1.0, &att, &err) == PHC_ERR_INPUT);
+        /* age-dependent stiffness s = min(1, t_l / t_m), t_m = 2 s */
+        const double s0 = phc_particles_stiffness(p, 7);
+        for (int k = 0; k < 100; ++k)
+            phc_particles_step(p, 0.01, NULL, &err);
+        const double s1 = phc_particles_stiffness(p, 7);
+        phc_particles_set_age(p, 7, 5.0, &err);
+        const double s2 = phc_particles_stiffness(p, 7);
+        printf("age stiffness, t_m = 2 s: s = %.6g at age 0, %.6g after 100 steps of 0.01 s, "
+               "%.6g at age 5 s (clamped)\n",
+               s0, s1, s2);
+        CHECK(s0 == 0);
+        CHECK_NEAR(s1, 0.5, 1e-12, 0);
+        CHECK(s2 == 1);
+        double x[3];
+        phc_particles_position(p, 4, x);
+        printf("attach: particle 4 after 1 s held at x = %.6g m (its support point x = 0.02)\n",
+               x[0]);
+        CHECK_NEAR(x[0], 0.02, 1e-15, 0);
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g);
+
+    /* free fall of an unanchored plant: the centre of mass follows the
+     * symplectic Euler of PBD, z_n = z_0 - g dt^2 n(n+1)/2, for any s */
+    g = phc_plant_graph_random(30, 11);
+    opt = phc_particles_options_default();
+    opt.stiffness = 0.4;
+    opt.damping = 0;
+    p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (p) {
+        const size_t n = phc_particles_count(p);
+        double M = 0, z0 = 0, z = 0;
+        for (size_t i = 0; i < n; ++i) {
+            double xx[3];
+            phc_particles_position(p, i, xx);
+            M += phc_particles_mass(p, i);
+            z0 += phc_particles_mass(p, i) * xx[2];
+        }
+        const int steps = 50;
+        const double dt = 0.01;
+        for (int k = 0; k < steps; ++k)
+            CHECK(phc_particles_step(p, dt, NULL, &err) == PHC_OK);
+        for (size_t i = 0; i < n; ++i) {
+            double xx[3];
+            phc_particles_position(p, i, xx);
+            z += phc_particles_mass(p, i) * xx[2];
+        }
+        const double drop = (z0 - z) / M, want = 9.81 * dt * dt * steps * (steps + 1) / 2;
+        printf("free fall: centre of mass dropped %.15g m in %d steps, symplectic Euler %.15g m\n",
+               drop, steps, want);
+        CHECK_NEAR(drop, want, 1e-13, 0);
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g);
+}
+
 static void test_bad_input(void)
 {
     const double o[3] = {0, 0, 0}, dx[3] = {1, 0, 0};
@@ -666,6 +784,7 @@ int main(void)
     test_momentum();
     test_cantilever();
     test_breaking();
+    test_anchor_age_fall();
     test_bad_input();
     return check_finish("test_particles");
 }
