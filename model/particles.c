@@ -39,6 +39,7 @@ struct phc_particles {
     size_t cap;
     size_t *mem;
     double *mu, *goal;
+    size_t polar_total, polar_fallbacks; /* counters of the current step */
 };
 
 phc_particles_options phc_particles_options_default(void)
@@ -718,8 +719,11 @@ static long match_group(phc_particles *p, size_t k, const double *X, const doubl
             }
     }
     double *gq = p->gq + 4 * k;
-    if (phc_particles_polar_rotation(A, gq) < 0)
+    const int how = phc_particles_polar_rotation(A, gq);
+    if (how < 0)
         return -1;
+    ++p->polar_total;
+    p->polar_fallbacks += how == 1;
     phc_particles_quat_to_matrix(gq, R);
     double num = 0, den = 0;
     for (size_t a = 0; a < n; ++a) {
@@ -824,6 +828,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         report->broken = 0;
         report->broken_particle = PHC_PARTICLES_NONE;
         report->broken_stress = 0;
+        report->polar_total = 0;
+        report->polar_fallbacks = 0;
     }
     if (!p)
         return phc_error_set(err, PHC_ERR_INVALID, "particles: step: no particle system");
@@ -832,6 +838,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
                              "particles: step: time step must be positive and finite, found %g s",
                              dt);
     const size_t n = p->n;
+    p->polar_total = p->polar_fallbacks = 0;
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d)
             if (!isfinite(p->x[3 * i + d]))
@@ -907,6 +914,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (bk != PHC_PARTICLES_NONE)
         p->linked[bk] = 0;
     if (report) {
+        report->polar_total = p->polar_total;
+        report->polar_fallbacks = p->polar_fallbacks;
         report->max_stress = smax;
         report->max_stress_group = gmax;
         if (bk != PHC_PARTICLES_NONE) {

@@ -150,6 +150,8 @@ typedef struct phc_particles_report {
     size_t broken;          /* links broken this step: 0 or 1 */
     size_t broken_particle; /* the child whose parent link broke, else NONE */
     double broken_stress;   /* its stress (1) */
+    size_t polar_total;     /* polar decompositions done in the step */
+    size_t polar_fallbacks; /* of which the SVD fallback finished */
 } phc_particles_report;
 
 /* One time step of dt seconds (> 0, finite).  report may be NULL.  A state

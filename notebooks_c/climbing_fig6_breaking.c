@@ -145,6 +145,7 @@ int main(int argc, char **argv)
     }
     /* 1. settle under gravity */
     double settled_max = 0;
+    size_t polar_total = 0, polar_fallbacks = 0;
     for (int s = 0; s < SETTLE_STEPS; ++s) {
         phc_particles_report rep;
         if (phc_particles_step(p, DT, &rep, &err) != PHC_OK) {
@@ -156,6 +157,8 @@ int main(int argc, char **argv)
             return 1;
         }
         settled_max = rep.max_stress;
+        polar_total += rep.polar_total;
+        polar_fallbacks += rep.polar_fallbacks;
     }
     double tip0[3], target[3];
     {
@@ -186,6 +189,8 @@ int main(int argc, char **argv)
             return 1;
         }
         const double lm = linked_max(p, rep.broken_particle);
+        polar_total += rep.polar_total;
+        polar_fallbacks += rep.polar_fallbacks;
         if (rep.broken) {
             ++breaks;
             if (breaks == 1) {
@@ -281,6 +286,8 @@ int main(int argc, char **argv)
            break_step, (double)break_step * DT, g->source_id[broken],
            g->source_id[g->parent[broken]], at_break, before_break, max_before);
     printf("the tip fell %.4f m in the %.2f s after the break\n", fell, AFTER_STEPS * DT);
+    printf("polar decompositions: %zu, finished by the SVD fallback: %zu\n", polar_total,
+           polar_fallbacks);
     printf("check: broke exactly once: %s (%zu)\n", ok_once ? "pass" : "FAIL", breaks);
     printf("check: no linked stress above the threshold before: %s\n", ok_before ? "pass" : "FAIL");
     printf("check: breaking stress within one step's growth of the threshold (%.6f - %.6f <= "
