@@ -176,7 +176,8 @@ void phc_particles_momentum(const phc_particles *p, double P[3]);
 /* Goals of group k from the current positions and orientations: members
  * (up to cap) and their goal positions (3·cap), the rotation R (row-major
  * 3x3) and the stress.  Returns the member count (0 when k is out of range
- * or cap is too small). */
+ * or cap is too small).  Uses the system's scratch space: do not call it
+ * concurrently with other calls on the same system. */
 size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
                                  size_t *member, double *goal, double R[9],
                                  double *stress);
