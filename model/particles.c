@@ -1,0 +1,975 @@
+/* Oriented particles with generalized shape matching (climbing plants §4.1,
+ * §4.3; Müller & Chentanez 2011).  See particles.h for the model, the
+ * choices made where the paper is terse, and the units. */
+#include "model/particles.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* pi to double precision (M_PI is not ISO C). */
+static const double PI = 3.14159265358979323846;
+
+struct phc_particles {
+    size_t n;
+    phc_particles_options o;
+    double *x, *v, *xp;      /* 3n: position, velocity, predicted position (m, m/s) */
+    double *x0;              /* 3n: rest position (m) */
+    double *q, *qp, *q0;     /* 4n: orientation, predicted, rest */
+    double *w;               /* 3n: angular velocity (rad/s) */
+    double *m;               /* n: kg */
+    double *ax;              /* 3n: ellipsoid radii (r, r, L/2), m */
+    double *age;             /* n: s */
+    double *s;               /* n: own stiffness (used when maturity_age == 0) */
+    double *f;               /* 3n: external force, N */
+    unsigned char *anchored, *hold_q;
+    double *anchor_at;       /* 3n */
+    double *anchor_k;        /* n */
+    double *anchor_q;        /* 4n */
+    size_t *parent;          /* n: parent from the graph */
+    unsigned char *linked;   /* n: 1 while i is linked to its parent */
+    size_t *child_start, *child; /* children from the graph */
+    double *gq;              /* 4n: last rotation of each group (warm start) */
+    double *gsum;            /* 3n: goal accumulator */
+    double *stress;          /* n: group stress after the last step */
+    long *source_id;         /* n: segment ids for messages */
+    /* scratch for one group */
+    size_t cap;
+    size_t *mem;
+    double *mu, *goal;
+    size_t polar_total, polar_fallbacks; /* counters of the current step */
+};
+
+phc_particles_options phc_particles_options_default(void)
+{
+    phc_particles_options o;
+    o.density = 1000.0;
+    o.gravity[0] = 0.0;
+    o.gravity[1] = 0.0;
+    o.gravity[2] = -9.81;
+    o.stiffness = 1.0;
+    o.maturity_age = 0.0;
+    o.parent_weight = 2.0;
+    o.iterations = 4;
+    o.damping = 0.01;
+    o.break_threshold = 0.0;
+    return o;
+}
+
+/* ---- small linear algebra (row-major 3x3) -------------------------------- */
+
+void phc_particles_quat_to_matrix(const double q[4], double R[9])
+{
+    const double w = q[0], x = q[1], y = q[2], z = q[3];
+    R[0] = 1 - 2 * (y * y + z * z);
+    R[1] = 2 * (x * y - w * z);
+    R[2] = 2 * (x * z + w * y);
+    R[3] = 2 * (x * y + w * z);
+    R[4] = 1 - 2 * (x * x + z * z);
+    R[5] = 2 * (y * z - w * x);
+    R[6] = 2 * (x * z - w * y);
+    R[7] = 2 * (y * z + w * x);
+    R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* Shepperd's method: the largest of w², x², y², z² is taken from the
+ * diagonal, the others from off-diagonal sums (no cancellation). */
+void phc_particles_matrix_to_quat(const double R[9], double q[4])
+{
+    const double t = R[0] + R[4] + R[8];
+    if (t >= R[0] && t >= R[4] && t >= R[8]) {
+        const double r = sqrt(1 + t), h = 0.5 / r;
+        q[0] = 0.5 * r;
+        q[1] = (R[7] - R[5]) * h;
+        q[2] = (R[2] - R[6]) * h;
+        q[3] = (R[3] - R[1]) * h;
+    } else if (R[0] >= R[4] && R[0] >= R[8]) {
+        const double r = sqrt(1 + R[0] - R[4] - R[8]), h = 0.5 / r;
+        q[0] = (R[7] - R[5]) * h;
+        q[1] = 0.5 * r;
+        q[2] = (R[1] + R[3]) * h;
+        q[3] = (R[2] + R[6]) * h;
+    } else if (R[4] >= R[8]) {
+        const double r = sqrt(1 - R[0] + R[4] - R[8]), h = 0.5 / r;
+        q[0] = (R[2] - R[6]) * h;
+        q[1] = (R[1] + R[3]) * h;
+        q[2] = 0.5 * r;
+        q[3] = (R[5] + R[7]) * h;
+    } else {
+        const double r = sqrt(1 - R[0] - R[4] + R[8]), h = 0.5 / r;
+        q[0] = (R[3] - R[1]) * h;
+        q[1] = (R[2] + R[6]) * h;
+        q[2] = (R[5] + R[7]) * h;
+        q[3] = 0.5 * r;
+    }
+    if (q[0] < 0)
+        for (int k = 0; k < 4; ++k)
+            q[k] = -q[k];
+}
+
+static void quat_mul(const double a[4], const double b[4], double c[4])
+{
+    const double w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
+    const double x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
+    const double y = a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1];
+    const double z = a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0];
+    c[0] = w;
+    c[1] = x;
+    c[2] = y;
+    c[3] = z;
+}
+
+static void quat_normalize(double q[4])
+{
+    const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int k = 0; k < 4; ++k)
+        q[k] /= r;
+}
+
+/* Unit quaternion of the rotation vector phi (rad): exp(phi/2). */
+static void quat_exp(const double phi[3], double q[4])
+{
+    const double a = sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]);
+    if (a < 1e-300) {
+        q[0] = 1;
+        q[1] = q[2] = q[3] = 0;
+        return;
+    }
+    const double sh = sin(0.5 * a) / a;
+    q[0] = cos(0.5 * a);
+    q[1] = phi[0] * sh;
+    q[2] = phi[1] * sh;
+    q[3] = phi[2] * sh;
+}
+
+static void mat_vec(const double R[9], const double a[3], double b[3])
+{
+    b[0] = R[0] * a[0] + R[1] * a[1] + R[2] * a[2];
+    b[1] = R[3] * a[0] + R[4] * a[1] + R[5] * a[2];
+    b[2] = R[6] * a[0] + R[7] * a[1] + R[8] * a[2];
+}
+
+/* R = U diag(1, 1, det(U Vt)) Vt from LAPACK's SVD of A (row-major). */
+static int polar_svd(const double A[9], double R[9])
+{
+    double a[9], s[3], u[9], vt[9], superb[2];
+    memcpy(a, A, sizeof a);
+    if (LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', 3, 3, a, 3, s, u, 3, vt, 3, superb) != 0)
+        return -1;
+    double uv[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            uv[3 * i + j] = u[3 * i] * vt[j] + u[3 * i + 1] * vt[3 + j] + u[3 * i + 2] * vt[6 + j];
+    const double det = uv[0] * (uv[4] * uv[8] - uv[5] * uv[7]) -
+                       uv[1] * (uv[3] * uv[8] - uv[5] * uv[6]) +
+                       uv[2] * (uv[3] * uv[7] - uv[4] * uv[6]);
+    const double d[3] = {1, 1, det < 0 ? -1 : 1};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            R[3 * i + j] = u[3 * i] * d[0] * vt[j] + u[3 * i + 1] * d[1] * vt[3 + j] +
+                           u[3 * i + 2] * d[2] * vt[6 + j];
+    return 0;
+}
+
+int phc_particles_polar_rotation(const double A[9], double q[4])
+{
+    double a[9], norm = 0;
+    for (int k = 0; k < 9; ++k) {
+        if (!isfinite(A[k]))
+            return -1;
+        norm += A[k] * A[k];
+    }
+    norm = sqrt(norm);
+    if (!(norm > 0))
+        return -1;
+    for (int k = 0; k < 9; ++k)
+        a[k] = A[k] / norm; /* scale-free: |a|_F = 1 */
+    if (!(fabs(q[0]) + fabs(q[1]) + fabs(q[2]) + fabs(q[3]) > 0) ||
+        !isfinite(q[0] + q[1] + q[2] + q[3])) {
+        q[0] = 1;
+        q[1] = q[2] = q[3] = 0;
+    }
+    quat_normalize(q);
+    /* Müller et al. 2016, eq. 7: ω = Σ_c r_c × a_c / (|Σ_c r_c · a_c| + ε)
+     * over the columns c of R and A; q ← exp(ω) q until |ω| is negligible. */
+    double R[9];
+    int converged = 0;
+    for (int it = 0; it < 100; ++it) {
+        phc_particles_quat_to_matrix(q, R);
+        double om[3] = {0, 0, 0}, dot = 0;
+        for (int c = 0; c < 3; ++c) {
+            const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
+            const double a0 = a[c], a1 = a[3 + c], a2 = a[6 + c];
+            om[0] += r1 * a2 - r2 * a1;
+            om[1] += r2 * a0 - r0 * a2;
+            om[2] += r0 * a1 - r1 * a0;
+            dot += r0 * a0 + r1 * a1 + r2 * a2;
+        }
+        const double sc = 1.0 / (fabs(dot) + 1e-12);
+        for (int k = 0; k < 3; ++k)
+            om[k] *= sc;
+        const double wn = sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
+        if (wn < 1e-14) {
+            converged = 1;
+            break;
+        }
+        double dq[4], t[4];
+        quat_exp(om, dq);
+        quat_mul(dq, q, t);
+        memcpy(q, t, sizeof t);
+        quat_normalize(q);
+    }
+    if (converged) {
+        /* Certificate: at a maximum of tr(Rᵀa) over rotations, S = Rᵀa is
+         * symmetric and nᵀSn <= tr S for all unit n (second variation
+         * along a rotation about n). */
+        phc_particles_quat_to_matrix(q, R);
+        double S[9];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                S[3 * i + j] = R[i] * a[j] + R[3 + i] * a[3 + j] + R[6 + i] * a[6 + j];
+        /* T = tr(S) I - sym(S) must be positive semidefinite: all its
+         * principal minors >= 0 (|a|_F = 1 sets the tolerance's scale). */
+        const double tr = S[0] + S[4] + S[8];
+        double T[9];
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                T[3 * i + j] = (i == j ? tr : 0) - 0.5 * (S[3 * i + j] + S[3 * j + i]);
+        const double tol = -1e-12;
+        const double m01 = T[0] * T[4] - T[1] * T[3], m02 = T[0] * T[8] - T[2] * T[6],
+                     m12 = T[4] * T[8] - T[5] * T[7];
+        const double det = T[0] * m12 - T[1] * (T[3] * T[8] - T[5] * T[6]) +
+                           T[2] * (T[3] * T[7] - T[4] * T[6]);
+        if (T[0] >= tol && T[4] >= tol && T[8] >= tol && m01 >= tol && m02 >= tol && m12 >= tol &&
+            det >= tol)
+            return 0;
+    }
+    if (polar_svd(a, R) != 0)
+        return -1;
+    phc_particles_matrix_to_quat(R, q);
+    return 1;
+}
+
+/* ---- construction ------------------------------------------------------- */
+
+static const char *opt_problem(const phc_particles_options *o, char *buf, size_t size)
+{
+    if (!(o->density > 0) || !isfinite(o->density))
+        snprintf(buf, size, "density must be positive and finite, found %g kg m-3", o->density);
+    else if (!(o->stiffness >= 0 && o->stiffness <= 1))
+        snprintf(buf, size, "stiffness s must be in [0, 1], found %g", o->stiffness);
+    else if (!(o->maturity_age >= 0) || !isfinite(o->maturity_age))
+        snprintf(buf, size, "maturity age must be >= 0 and finite, found %g s", o->maturity_age);
+    else if (!(o->parent_weight >= 1) || !isfinite(o->parent_weight))
+        snprintf(buf, size, "parent weight must be >= 1 and finite, found %g", o->parent_weight);
+    else if (o->iterations < 1)
+        snprintf(buf, size, "iterations must be >= 1, found %zu", o->iterations);
+    else if (!(o->damping >= 0 && o->damping < 1))
+        snprintf(buf, size, "damping must be in [0, 1), found %g", o->damping);
+    else if (!isfinite(o->break_threshold))
+        snprintf(buf, size, "break threshold must be finite, found %g", o->break_threshold);
+    else if (!isfinite(o->gravity[0]) || !isfinite(o->gravity[1]) || !isfinite(o->gravity[2]))
+        snprintf(buf, size, "gravity must be finite");
+    else
+        return NULL;
+    return buf;
+}
+
+void phc_particles_free(phc_particles *p)
+{
+    if (!p)
+        return;
+    free(p->x);
+    free(p->v);
+    free(p->xp);
+    free(p->x0);
+    free(p->q);
+    free(p->qp);
+    free(p->q0);
+    free(p->w);
+    free(p->m);
+    free(p->ax);
+    free(p->age);
+    free(p->s);
+    free(p->f);
+    free(p->anchored);
+    free(p->hold_q);
+    free(p->anchor_at);
+    free(p->anchor_k);
+    free(p->anchor_q);
+    free(p->parent);
+    free(p->linked);
+    free(p->child_start);
+    free(p->child);
+    free(p->gq);
+    free(p->gsum);
+    free(p->stress);
+    free(p->source_id);
+    free(p->mem);
+    free(p->mu);
+    free(p->goal);
+    free(p);
+}
+
+/* Rest orientation: the shortest-arc rotation taking the local z axis to
+ * the unit direction d. */
+static void quat_from_z(const double d[3], double q[4])
+{
+    if (d[2] < -1 + 1e-12) {
+        q[0] = 0;
+        q[1] = 1;
+        q[2] = q[3] = 0;
+        return;
+    }
+    q[0] = 1 + d[2];
+    q[1] = -d[1];
+    q[2] = d[0];
+    q[3] = 0;
+    quat_normalize(q);
+}
+
+phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_options *options,
+                                 phc_error *err)
+{
+    char buf[256];
+    const phc_particles_options o = options ? *options : phc_particles_options_default();
+    if (!g || g->n == 0 || !g->child_start) {
+        phc_error_set(err, PHC_ERR_INVALID, "particles: the plant graph is empty or not finished");
+        return NULL;
+    }
+    if (opt_problem(&o, buf, sizeof buf)) {
+        phc_error_set(err, PHC_ERR_INVALID, "particles: options: %s", buf);
+        return NULL;
+    }
+    const size_t n = g->n;
+    size_t maxdeg = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const size_t deg = g->child_start[i + 1] - g->child_start[i] + 2;
+        if (deg > maxdeg)
+            maxdeg = deg;
+    }
+    phc_particles *p = calloc(1, sizeof *p);
+    if (!p)
+        goto nomem;
+    p->n = n;
+    p->o = o;
+    p->cap = maxdeg;
+#define ALLOC(field, count) \
+    if (!(p->field = calloc((count), sizeof *p->field))) goto nomem
+    ALLOC(x, 3 * n);
+    ALLOC(v, 3 * n);
+    ALLOC(xp, 3 * n);
+    ALLOC(x0, 3 * n);
+    ALLOC(q, 4 * n);
+    ALLOC(qp, 4 * n);
+    ALLOC(q0, 4 * n);
+    ALLOC(w, 3 * n);
+    ALLOC(m, n);
+    ALLOC(ax, 3 * n);
+    ALLOC(age, n);
+    ALLOC(s, n);
+    ALLOC(f, 3 * n);
+    ALLOC(anchored, n);
+    ALLOC(hold_q, n);
+    ALLOC(anchor_at, 3 * n);
+    ALLOC(anchor_k, n);
+    ALLOC(anchor_q, 4 * n);
+    ALLOC(parent, n);
+    ALLOC(linked, n);
+    ALLOC(child_start, n + 1);
+    ALLOC(child, n > 1 ? n - 1 : 1);
+    ALLOC(gq, 4 * n);
+    ALLOC(gsum, 3 * n);
+    ALLOC(stress, n);
+    ALLOC(source_id, n);
+    ALLOC(mem, maxdeg);
+    ALLOC(mu, maxdeg);
+    ALLOC(goal, 3 * maxdeg);
+#undef ALLOC
+    memcpy(p->child_start, g->child_start, (n + 1) * sizeof *p->child_start);
+    if (n > 1)
+        memcpy(p->child, g->child, (n - 1) * sizeof *p->child);
+    for (size_t i = 0; i < n; ++i) {
+        const long id = g->source_id ? g->source_id[i] : (long)i;
+        p->source_id[i] = id;
+        const double r = g->radius[i], L = g->length[i];
+        if (!(r > 0) || !isfinite(r) || !(L > 0) || !isfinite(L)) {
+            phc_error_set(err, PHC_ERR_INPUT,
+                          "particles: particle %zu (segment %ld): radius and length must be "
+                          "positive and finite, found r = %g m, L = %g m",
+                          i, id, r, L);
+            goto fail;
+        }
+        double d[3], len = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double h = g->head[3 * i + k], t = g->tail[3 * i + k];
+            if (!isfinite(h) || !isfinite(t)) {
+                phc_error_set(err, PHC_ERR_INPUT,
+                              "particles: particle %zu (segment %ld): coordinate %c is not finite",
+                              i, id, "xyz"[k]);
+                goto fail;
+            }
+            p->x0[3 * i + k] = p->x[3 * i + k] = 0.5 * (h + t);
+            d[k] = t - h;
+            len += d[k] * d[k];
+        }
+        len = sqrt(len);
+        if (!(len > 0)) {
+            phc_error_set(err, PHC_ERR_INPUT,
+                          "particles: particle %zu (segment %ld): head and tail coincide", i, id);
+            goto fail;
+        }
+        for (int k = 0; k < 3; ++k)
+            d[k] /= len;
+        quat_from_z(d, p->q0 + 4 * i);
+        memcpy(p->q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
+        p->gq[4 * i] = 1;
+        p->m[i] = o.density * PI * r * r * L;
+        p->ax[3 * i] = p->ax[3 * i + 1] = r;
+        p->ax[3 * i + 2] = 0.5 * L;
+        p->s[i] = o.stiffness;
+        p->parent[i] = g->parent[i];
+        p->linked[i] = g->parent[i] != PHC_PLANT_NO_PARENT;
+        if (g->fixed && g->fixed[i]) {
+            p->anchored[i] = 1;
+            p->hold_q[i] = 1;
+            p->anchor_k[i] = 1;
+            memcpy(p->anchor_at + 3 * i, p->x0 + 3 * i, 3 * sizeof(double));
+            memcpy(p->anchor_q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
+        }
+    }
+    memcpy(p->xp, p->x, 3 * n * sizeof(double));
+    memcpy(p->qp, p->q, 4 * n * sizeof(double));
+    return p;
+nomem:
+    phc_error_set(err, PHC_ERR_NOMEM, "particles: out of memory for %zu particles", g->n);
+fail:
+    phc_particles_free(p);
+    return NULL;
+}
+
+size_t phc_particles_count(const phc_particles *p) { return p ? p->n : 0; }
+
+/* ---- setters ------------------------------------------------------------ */
+
+static int check_index(const phc_particles *p, size_t i, const char *what, phc_error *err)
+{
+    if (!p)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: %s: no particle system", what);
+    if (i >= p->n)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: %s: particle %zu does not exist (%zu particles)", what, i,
+                             p->n);
+    return PHC_OK;
+}
+
+int phc_particles_set_mass(phc_particles *p, size_t i, double mass, phc_error *err)
+{
+    if (check_index(p, i, "mass", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (!(mass > 0) || !isfinite(mass))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): mass must be positive and "
+                             "finite, found %g kg",
+                             i, p->source_id[i], mass);
+    p->m[i] = mass;
+    return PHC_OK;
+}
+
+int phc_particles_set_stiffness(phc_particles *p, size_t i, double s, phc_error *err)
+{
+    if (check_index(p, i, "stiffness", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (!(s >= 0 && s <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): stiffness s must be in "
+                             "[0, 1], found %g",
+                             i, p->source_id[i], s);
+    p->s[i] = s;
+    return PHC_OK;
+}
+
+int phc_particles_set_age(phc_particles *p, size_t i, double age, phc_error *err)
+{
+    if (check_index(p, i, "age", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (!(age >= 0) || !isfinite(age))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): age must be >= 0 and "
+                             "finite, found %g s",
+                             i, p->source_id[i], age);
+    p->age[i] = age;
+    return PHC_OK;
+}
+
+static int check_vec(const phc_particles *p, size_t i, const double a[3], const char *what,
+                     const char *unit, phc_error *err)
+{
+    if (!a)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: particle %zu: %s: NULL", i, what);
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(a[k]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "particles: particle %zu (segment %ld): %s %c must be finite, "
+                                 "found %g %s",
+                                 i, p->source_id[i], what, "xyz"[k], a[k], unit);
+    return PHC_OK;
+}
+
+int phc_particles_set_position(phc_particles *p, size_t i, const double x[3], phc_error *err)
+{
+    if (check_index(p, i, "position", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (check_vec(p, i, x, "position", "m", err))
+        return err ? err->status : PHC_ERR_INPUT;
+    for (int k = 0; k < 3; ++k) {
+        p->x[3 * i + k] = p->xp[3 * i + k] = x[k];
+        p->v[3 * i + k] = 0;
+    }
+    return PHC_OK;
+}
+
+int phc_particles_set_orientation(phc_particles *p, size_t i, const double q[4],
+                                  phc_error *err)
+{
+    if (check_index(p, i, "orientation", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (!q)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: particle %zu: orientation: NULL", i);
+    const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!isfinite(r) || !(r > 0))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): orientation quaternion must "
+                             "be finite and non-zero, found (%g, %g, %g, %g)",
+                             i, p->source_id[i], q[0], q[1], q[2], q[3]);
+    for (int k = 0; k < 4; ++k)
+        p->q[4 * i + k] = p->qp[4 * i + k] = q[k] / r;
+    for (int k = 0; k < 3; ++k)
+        p->w[3 * i + k] = 0;
+    return PHC_OK;
+}
+
+int phc_particles_set_force(phc_particles *p, size_t i, const double f[3], phc_error *err)
+{
+    if (check_index(p, i, "force", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (check_vec(p, i, f, "force", "N", err))
+        return err ? err->status : PHC_ERR_INPUT;
+    memcpy(p->f + 3 * i, f, 3 * sizeof(double));
+    return PHC_OK;
+}
+
+int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
+                         int hold_orientation, phc_error *err)
+{
+    if (check_index(p, i, "anchor", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (check_vec(p, i, a, "anchor point", "m", err))
+        return err ? err->status : PHC_ERR_INPUT;
+    if (!(k > 0 && k <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): anchor strength must be in "
+                             "(0, 1], found %g",
+                             i, p->source_id[i], k);
+    p->anchored[i] = 1;
+    p->anchor_k[i] = k;
+    memcpy(p->anchor_at + 3 * i, a, 3 * sizeof(double));
+    if (hold_orientation && !p->hold_q[i])
+        memcpy(p->anchor_q + 4 * i, p->q + 4 * i, 4 * sizeof(double));
+    p->hold_q[i] = hold_orientation != 0;
+    return PHC_OK;
+}
+
+int phc_particles_release(phc_particles *p, size_t i, phc_error *err)
+{
+    if (check_index(p, i, "release", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    p->anchored[i] = 0;
+    p->hold_q[i] = 0;
+    return PHC_OK;
+}
+
+int phc_particles_attach(phc_particles *p, const double *points, size_t count, double distance,
+                         double k, size_t *attached, phc_error *err)
+{
+    if (attached)
+        *attached = 0;
+    if (!p || (!points && count))
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: attach: NULL argument");
+    if (!(distance > 0) || !isfinite(distance))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: attach: distance must be positive and finite, found %g m",
+                             distance);
+    if (!(k > 0 && k <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: attach: strength must be in (0, 1], found %g", k);
+    for (size_t j = 0; j < 3 * count; ++j)
+        if (!isfinite(points[j]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "particles: attach: support point %zu coordinate %c is not finite",
+                                 j / 3, "xyz"[j % 3]);
+    for (size_t i = 0; i < p->n; ++i) {
+        if (p->anchored[i])
+            continue;
+        double best = INFINITY;
+        size_t bj = 0;
+        for (size_t j = 0; j < count; ++j) {
+            double d2 = 0;
+            for (int c = 0; c < 3; ++c) {
+                const double d = points[3 * j + c] - p->x[3 * i + c];
+                d2 += d * d;
+            }
+            if (d2 < best) {
+                best = d2;
+                bj = j;
+            }
+        }
+        if (count && sqrt(best) <= distance) {
+            p->anchored[i] = 1;
+            p->hold_q[i] = 0;
+            p->anchor_k[i] = k;
+            memcpy(p->anchor_at + 3 * i, points + 3 * bj, 3 * sizeof(double));
+            if (attached)
+                ++*attached;
+        }
+    }
+    return PHC_OK;
+}
+
+/* ---- groups ------------------------------------------------------------- */
+
+/* Normaliser of particle i's blend weights: 1 (own group) + w_p (parent's
+ * group, if linked) + 1 per linked child. */
+static double weight_sum(const phc_particles *p, size_t i)
+{
+    double W = 1;
+    if (p->linked[i])
+        W += p->o.parent_weight;
+    for (size_t c = p->child_start[i]; c < p->child_start[i + 1]; ++c)
+        if (p->linked[p->child[c]])
+            W += 1;
+    return W;
+}
+
+/* Members of group k and their blend weights ω_jk (in p->mu, still to be
+ * multiplied by the masses). */
+static size_t group_members(const phc_particles *p, size_t k)
+{
+    size_t n = 0;
+    p->mem[n] = k;
+    p->mu[n++] = 1.0 / weight_sum(p, k);
+    if (p->linked[k]) {
+        const size_t pa = p->parent[k];
+        p->mem[n] = pa;
+        p->mu[n++] = 1.0 / weight_sum(p, pa);
+    }
+    for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c) {
+        const size_t ch = p->child[c];
+        if (p->linked[ch]) {
+            p->mem[n] = ch;
+            p->mu[n++] = p->o.parent_weight / weight_sum(p, ch);
+        }
+    }
+    return n;
+}
+
+/* Shape matching of group k against positions X (3n) and orientations Q
+ * (4n): fills p->mem, p->mu (= μ_jk), p->goal and R (row-major), returns
+ * the member count; *stress gets σ_k.  Negative on a numerical failure. */
+static long match_group(phc_particles *p, size_t k, const double *X, const double *Q,
+                        double R[9], double *stress)
+{
+    const size_t n = group_members(p, k);
+    double M = 0, c[3] = {0, 0, 0}, c0[3] = {0, 0, 0};
+    for (size_t a = 0; a < n; ++a) {
+        const size_t j = p->mem[a];
+        p->mu[a] *= p->m[j];
+        M += p->mu[a];
+        for (int d = 0; d < 3; ++d) {
+            c[d] += p->mu[a] * X[3 * j + d];
+            c0[d] += p->mu[a] * p->x0[3 * j + d];
+        }
+    }
+    for (int d = 0; d < 3; ++d) {
+        c[d] /= M;
+        c0[d] /= M;
+    }
+    /* A = Σ μ (x − c)(x̄ − c̄)ᵀ + Σ (μ/5) R_j D_j R̄_jᵀ (Müller & Chentanez
+     * eq. 9 with the ellipsoid moment of eq. 10). */
+    double A[9] = {0};
+    for (size_t a = 0; a < n; ++a) {
+        const size_t j = p->mem[a];
+        double dx[3], d0[3], Rj[9], R0[9];
+        for (int d = 0; d < 3; ++d) {
+            dx[d] = X[3 * j + d] - c[d];
+            d0[d] = p->x0[3 * j + d] - c0[d];
+        }
+        phc_particles_quat_to_matrix(Q + 4 * j, Rj);
+        phc_particles_quat_to_matrix(p->q0 + 4 * j, R0);
+        const double *e = p->ax + 3 * j;
+        const double D[3] = {e[0] * e[0], e[1] * e[1], e[2] * e[2]};
+        for (int r = 0; r < 3; ++r)
+            for (int s = 0; s < 3; ++s) {
+                double ell = 0;
+                for (int t = 0; t < 3; ++t)
+                    ell += Rj[3 * r + t] * D[t] * R0[3 * s + t];
+                A[3 * r + s] += p->mu[a] * (dx[r] * d0[s] + 0.2 * ell);
+            }
+    }
+    double *gq = p->gq + 4 * k;
+    const int how = phc_particles_polar_rotation(A, gq);
+    if (how < 0)
+        return -1;
+    ++p->polar_total;
+    p->polar_fallbacks += how == 1;
+    phc_particles_quat_to_matrix(gq, R);
+    double num = 0, den = 0;
+    for (size_t a = 0; a < n; ++a) {
+        const size_t j = p->mem[a];
+        double d0[3], rd[3];
+        for (int d = 0; d < 3; ++d)
+            d0[d] = p->x0[3 * j + d] - c0[d];
+        mat_vec(R, d0, rd);
+        for (int d = 0; d < 3; ++d) {
+            p->goal[3 * a + d] = rd[d] + c[d];
+            const double e = X[3 * j + d] - p->goal[3 * a + d];
+            num += p->mu[a] * e * e;
+            den += p->mu[a] * d0[d] * d0[d];
+        }
+    }
+    if (stress)
+        *stress = den > 0 ? sqrt(num / den) : 0.0;
+    return (long)n;
+}
+
+size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, size_t *member,
+                                 double *goal, double R[9], double *stress)
+{
+    if (!p || k >= p->n)
+        return 0;
+    phc_particles *pm = (phc_particles *)p; /* scratch only; state unchanged */
+    double gq_keep[4];
+    memcpy(gq_keep, pm->gq + 4 * k, sizeof gq_keep);
+    double Rl[9], st;
+    const long n = match_group(pm, k, p->x, p->q, Rl, &st);
+    memcpy(pm->gq + 4 * k, gq_keep, sizeof gq_keep);
+    if (n < 0 || (size_t)n > cap)
+        return 0;
+    for (long a = 0; a < n; ++a) {
+        if (member)
+            member[a] = p->mem[a];
+        if (goal)
+            memcpy(goal + 3 * a, p->goal + 3 * a, 3 * sizeof(double));
+    }
+    if (R)
+        memcpy(R, Rl, sizeof Rl);
+    if (stress)
+        *stress = st;
+    return (size_t)n;
+}
+
+double phc_particles_stiffness(const phc_particles *p, size_t i)
+{
+    if (!p || i >= p->n)
+        return NAN;
+    if (p->o.maturity_age > 0) {
+        const double s = p->age[i] / p->o.maturity_age; /* t_l / t_m */
+        return s < 1 ? s : 1;
+    }
+    return p->s[i];
+}
+
+/* ---- the time step ------------------------------------------------------ */
+
+static int project(phc_particles *p, phc_error *err)
+{
+    const size_t n = p->n;
+    memset(p->gsum, 0, 3 * n * sizeof(double));
+    for (size_t k = 0; k < n; ++k) {
+        double R[9];
+        const long m = match_group(p, k, p->xp, p->qp, R, NULL);
+        if (m < 0)
+            return phc_error_set(err, PHC_ERR_NUMERIC,
+                                 "particles: particle %zu (segment %ld): the moment matrix of its "
+                                 "group is not finite",
+                                 k, p->source_id[k]);
+        for (long a = 0; a < m; ++a) {
+            const size_t j = p->mem[a];
+            const double omega = p->mu[a] / p->m[j]; /* ω_jk */
+            for (int d = 0; d < 3; ++d)
+                p->gsum[3 * j + d] += omega * p->goal[3 * a + d];
+        }
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double s = phc_particles_stiffness(p, i);
+        for (int d = 0; d < 3; ++d) /* x' = x_p + s (x_g − x_p) */
+            p->xp[3 * i + d] += s * (p->gsum[3 * i + d] - p->xp[3 * i + d]);
+        /* q_i = R_i q̄_i: own group's rotation applied to the rest pose. */
+        quat_mul(p->gq + 4 * i, p->q0 + 4 * i, p->qp + 4 * i);
+        quat_normalize(p->qp + 4 * i);
+        if (p->anchored[i]) { /* eq. 5 */
+            const double ka = p->anchor_k[i];
+            for (int d = 0; d < 3; ++d)
+                p->xp[3 * i + d] += ka * (p->anchor_at[3 * i + d] - p->xp[3 * i + d]);
+            if (p->hold_q[i])
+                memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
+        }
+    }
+    return PHC_OK;
+}
+
+int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report, phc_error *err)
+{
+    if (report) {
+        report->max_stress = 0;
+        report->max_stress_group = PHC_PARTICLES_NONE;
+        report->broken = 0;
+        report->broken_particle = PHC_PARTICLES_NONE;
+        report->broken_stress = 0;
+        report->polar_total = 0;
+        report->polar_fallbacks = 0;
+    }
+    if (!p)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: step: no particle system");
+    if (!(dt > 0) || !isfinite(dt))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: step: time step must be positive and finite, found %g s",
+                             dt);
+    const size_t n = p->n;
+    p->polar_total = p->polar_fallbacks = 0;
+    for (size_t i = 0; i < n; ++i)
+        for (int d = 0; d < 3; ++d)
+            if (!isfinite(p->x[3 * i + d]))
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "particles: particle %zu (segment %ld): position %c is not "
+                                     "finite (%g m)",
+                                     i, p->source_id[i], "xyz"[d], p->x[3 * i + d]);
+    /* Predict (symplectic Euler). */
+    for (size_t i = 0; i < n; ++i) {
+        for (int d = 0; d < 3; ++d) {
+            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
+            p->xp[3 * i + d] = p->x[3 * i + d] + dt * (p->v[3 * i + d] + dt * a);
+        }
+        double phi[3], dq[4];
+        for (int d = 0; d < 3; ++d)
+            phi[d] = p->w[3 * i + d] * dt;
+        quat_exp(phi, dq);
+        quat_mul(dq, p->q + 4 * i, p->qp + 4 * i);
+        quat_normalize(p->qp + 4 * i);
+    }
+    for (size_t it = 0; it < p->o.iterations; ++it) {
+        const int rc = project(p, err);
+        if (rc)
+            return rc;
+    }
+    for (size_t i = 0; i < n; ++i)
+        for (int d = 0; d < 3; ++d)
+            if (!isfinite(p->xp[3 * i + d]) || !isfinite(p->qp[4 * i + d]))
+                return phc_error_set(err, PHC_ERR_NUMERIC,
+                                     "particles: particle %zu (segment %ld): the step of %g s gave "
+                                     "a non-finite state; nothing was changed",
+                                     i, p->source_id[i], dt);
+    /* Velocities from the positions (PBD), then damping. */
+    const double keep = 1 - p->o.damping;
+    for (size_t i = 0; i < n; ++i) {
+        for (int d = 0; d < 3; ++d) {
+            p->v[3 * i + d] = keep * (p->xp[3 * i + d] - p->x[3 * i + d]) / dt;
+            p->x[3 * i + d] = p->xp[3 * i + d];
+        }
+        double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
+        double dq[4];
+        quat_mul(p->qp + 4 * i, inv, dq);
+        if (dq[0] < 0)
+            for (int d = 0; d < 4; ++d)
+                dq[d] = -dq[d];
+        const double sn = sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3]);
+        const double ang = 2 * atan2(sn, dq[0]);
+        for (int d = 0; d < 3; ++d)
+            p->w[3 * i + d] = sn > 0 ? keep * dq[1 + d] / sn * ang / dt : 0.0;
+        memcpy(p->q + 4 * i, p->qp + 4 * i, 4 * sizeof(double));
+        p->age[i] += dt;
+    }
+    /* Stress of every group on the new state (§4.3), and breaking. */
+    double smax = 0, bmax = -1;
+    size_t gmax = PHC_PARTICLES_NONE, bk = PHC_PARTICLES_NONE;
+    for (size_t k = 0; k < n; ++k) {
+        double R[9], st;
+        if (match_group(p, k, p->x, p->q, R, &st) < 0)
+            return phc_error_set(err, PHC_ERR_NUMERIC,
+                                 "particles: particle %zu (segment %ld): the moment matrix of its "
+                                 "group is not finite",
+                                 k, p->source_id[k]);
+        p->stress[k] = st;
+        if (st > smax || gmax == PHC_PARTICLES_NONE) {
+            smax = st;
+            gmax = k;
+        }
+        if (p->o.break_threshold > 0 && p->linked[k] && st > p->o.break_threshold && st > bmax) {
+            bmax = st;
+            bk = k;
+        }
+    }
+    if (bk != PHC_PARTICLES_NONE)
+        p->linked[bk] = 0;
+    if (report) {
+        report->polar_total = p->polar_total;
+        report->polar_fallbacks = p->polar_fallbacks;
+        report->max_stress = smax;
+        report->max_stress_group = gmax;
+        if (bk != PHC_PARTICLES_NONE) {
+            report->broken = 1;
+            report->broken_particle = bk;
+            report->broken_stress = bmax;
+        }
+    }
+    return PHC_OK;
+}
+
+/* ---- accessors ---------------------------------------------------------- */
+
+void phc_particles_position(const phc_particles *p, size_t i, double x[3])
+{
+    memcpy(x, p->x + 3 * i, 3 * sizeof(double));
+}
+
+void phc_particles_velocity(const phc_particles *p, size_t i, double v[3])
+{
+    memcpy(v, p->v + 3 * i, 3 * sizeof(double));
+}
+
+void phc_particles_orientation(const phc_particles *p, size_t i, double q[4])
+{
+    memcpy(q, p->q + 4 * i, 4 * sizeof(double));
+}
+
+double phc_particles_mass(const phc_particles *p, size_t i) { return p->m[i]; }
+
+double phc_particles_stress(const phc_particles *p, size_t i) { return p->stress[i]; }
+
+size_t phc_particles_parent(const phc_particles *p, size_t i)
+{
+    return p->linked[i] ? p->parent[i] : PHC_PARTICLES_NONE;
+}
+
+void phc_particles_segment_ends(const phc_particles *p, double *head, double *tail)
+{
+    for (size_t i = 0; i < p->n; ++i) {
+        double R[9], e[3] = {0, 0, p->ax[3 * i + 2]}, r[3];
+        phc_particles_quat_to_matrix(p->q + 4 * i, R);
+        mat_vec(R, e, r);
+        for (int d = 0; d < 3; ++d) {
+            head[3 * i + d] = p->x[3 * i + d] - r[d];
+            tail[3 * i + d] = p->x[3 * i + d] + r[d];
+        }
+    }
+}
+
+void phc_particles_momentum(const phc_particles *p, double P[3])
+{
+    P[0] = P[1] = P[2] = 0;
+    for (size_t i = 0; i < p->n; ++i)
+        for (int d = 0; d < 3; ++d)
+            P[d] += p->m[i] * p->v[3 * i + d];
+}

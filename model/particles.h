@@ -1,0 +1,204 @@
+/* Oriented particles with generalized shape matching on a plant graph
+ * (climbing plants: Hädrich, Benes, Deussen, Pirk, "Interactive Modeling
+ * and Authoring of Climbing Plants", CGF 36(2) 2017, §4.1 and §4.3; the
+ * particle model of Müller & Chentanez, "Solid simulation with oriented
+ * particles", SIGGRAPH 2011).
+ *
+ * Representation (decided here, see README "Oriented particles"):
+ *   one particle per SEGMENT of a phc_plant_graph, at the segment's centre
+ *   (head + tail)/2.  Its ellipsoid has radii (r, r, L/2) along the
+ *   particle's local x, y, z, and the local z axis points from head to tail
+ *   in the rest pose, so a particle IS its segment: the segment's ends are
+ *   centre -/+ R(q)·(0, 0, L/2) (phc_particles_segment_ends draws them).
+ *   Mass m = density·π r² L (the segment's cylinder; the ellipsoid only
+ *   supplies the second-moment term below).
+ *
+ * Groups (climbing §4.1): every particle k owns the group
+ *   G_k = {k} ∪ {parent(k), if linked} ∪ {linked children of k}.
+ * A particle i belongs to its own group, to its parent's group and to each
+ * child's group.  Blending weights (this module's reading of the paper's
+ * parent-weighted blend): raw weight w_p (parent_weight, >= 1) for the group
+ * owned by i's parent, 1 for every other group of i; normalised,
+ * ω_ik = w_ik / Σ_k' w_ik'.  The goal of i is x_g,i = Σ_k ω_ik g_i^k.
+ * Each group matches with the member masses μ_ik = ω_ik m_i (the share of
+ * i's mass lent to group k, as Rivers & James's lattice shape matching
+ * divides a particle's mass among its regions), so that Σ_k μ_ik = m_i and
+ * the blended projection conserves total linear momentum exactly when the
+ * stiffness s is the same for all particles.
+ *
+ * Moment matrix of group k (Müller & Chentanez eq. 9, centred form):
+ *   A_k = Σ_j μ_jk (x_j − c_k)(x̄_j − c̄_k)ᵀ + Σ_j (μ_jk/5) R_j D_j R̄_jᵀ,
+ *   D_j = diag(r², r², (L/2)²) (kg m²), R_j current, R̄_j rest orientation.
+ * With R̄ = I this is the paper's Σ m x x̄ᵀ − M c c̄ᵀ + Σ (1/5) m R diag(a²,b²,c²).
+ * The ellipsoid term makes A_k of full rank for a single particle or a
+ * straight chain, so the rotation is defined.  R_k = rotational factor of
+ * the polar decomposition A_k = R_k S_k (Müller, Bender, Chentanez, Macklin
+ * 2016 iteration, warm-started, certified, LAPACK SVD fallback).  Goals
+ * g_j^k = R_k (x̄_j − c̄_k) + c_k.
+ *
+ * Stiffness blend (climbing §4.1): x ← x_p + s_i (x_g − x_p).  s_i is the
+ * particle's own stiffness (phc_particles_set_stiffness) or, when
+ * maturity_age t_m > 0, the age-dependent s_i = min(1, t_l / t_m) with t_l
+ * the particle's age (young shoots are soft, mature ones stiff; the clamp
+ * at 1 is ours: a particle older than t_m is as stiff as the model allows).
+ * Orientation: q_i ← quat(R_i) ⊗ q̄_i, the rotation of i's own group
+ * applied to its rest orientation (Müller & Chentanez §4.2).
+ *
+ * Anchors (climbing eq. 5): an anchored particle is pulled to its anchor
+ * point a after every projection, x ← x + k_a (a − x), 0 < k_a <= 1
+ * (k_a = 1 pins it); optionally its orientation is held too (a clamp).
+ * phc_particles_attach applies the paper's rule: a free particle attaches
+ * to its closest support point when that point is within the attach
+ * distance.
+ *
+ * Time step (position-based dynamics): predict v += Δt (g + f/m),
+ * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
+ * from the current x_p (Jacobi), blend, stiffness, anchors}; update
+ * v = (x_p − x)/Δt, ω from q_p q⁻¹, both times (1 − damping); age += Δt.
+ *
+ * Breaking (climbing §4.3; our definition of the stress): after the step,
+ * each group's stress is its relative RMS misfit to the best rigid motion,
+ *   σ_k = sqrt( Σ_j μ_jk |x_j − g_j^k|² / Σ_j μ_jk |x̄_j − c̄_k|² )
+ * (dimensionless, 0 for any rigid motion; 0 for a group of one particle).
+ * If the largest σ_k over groups with a linked parent exceeds the break
+ * threshold, the link k–parent(k) is removed: the subtree rooted at k
+ * becomes free.  At most one link breaks per step (the most stressed); the
+ * others are judged again at the next step with the new topology.
+ *
+ * Units: SI.  Positions m, time s, mass kg, density kg m⁻³, force N,
+ * gravity m s⁻², angular velocity rad s⁻¹, stiffness and stress
+ * dimensionless.  Quaternions (w, x, y, z), unit norm. */
+#ifndef PHC_PARTICLES_H
+#define PHC_PARTICLES_H
+
+#include <stddef.h>
+
+#include "model/plant_graph.h"
+#include "model/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PHC_PARTICLES_NONE ((size_t)-1)
+
+typedef struct phc_particles_options {
+    double density;        /* kg m^-3, > 0; default 1000 (fresh green stem) */
+    double gravity[3];     /* m s^-2; default (0, 0, -9.81) (plant graphs have z up) */
+    double stiffness;      /* s in [0, 1] for every particle (used when
+                              maturity_age == 0); default 1 */
+    double maturity_age;   /* t_m, s, >= 0; > 0: s_i = min(1, age_i / t_m) */
+    double parent_weight;  /* w_p >= 1: weight of the parent's group in a
+                              particle's goal blend; default 2; 1 = plain mean */
+    size_t iterations;     /* projection iterations per step, >= 1; default 4 */
+    double damping;        /* fraction of velocity removed per step, [0, 1); default 0.01 */
+    double break_threshold;/* group stress above which the parent link breaks;
+                              <= 0: no breaking (default 0) */
+} phc_particles_options;
+
+phc_particles_options phc_particles_options_default(void);
+
+typedef struct phc_particles phc_particles;
+
+/* One particle per segment of a finished graph, at rest (positions from the
+ * graph, zero velocity, age 0).  Segments with g->fixed[i] set are anchored
+ * (k_a = 1, orientation held) at their rest centre.  Errors (NULL returned,
+ * err filled): bad options (density, stiffness outside [0,1], parent
+ * weight < 1, iterations 0, damping outside [0,1)), a radius or length not
+ * positive and finite, a non-finite coordinate ("particle 3 (segment 17):
+ * ..."), out of memory. */
+phc_particles *phc_particles_new(const phc_plant_graph *g,
+                                 const phc_particles_options *options,
+                                 phc_error *err);
+void phc_particles_free(phc_particles *p); /* accepts NULL */
+
+size_t phc_particles_count(const phc_particles *p);
+
+/* Setters; each validates and names the particle in its message. */
+int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
+                           phc_error *err);
+int phc_particles_set_stiffness(phc_particles *p, size_t i, double s /* [0,1] */,
+                                phc_error *err);
+int phc_particles_set_age(phc_particles *p, size_t i, double age /* s, >= 0 */,
+                          phc_error *err);
+/* Moves a particle (m; finite) and zeroes its velocity. */
+int phc_particles_set_position(phc_particles *p, size_t i, const double x[3],
+                               phc_error *err);
+/* Turns a particle to the unit quaternion q (w,x,y,z; finite, not zero;
+ * normalised here) and zeroes its angular velocity. */
+int phc_particles_set_orientation(phc_particles *p, size_t i, const double q[4],
+                                  phc_error *err);
+/* External force on particle i, N (finite), held until changed. */
+int phc_particles_set_force(phc_particles *p, size_t i, const double f[3],
+                            phc_error *err);
+/* Anchor (eq. 5) particle i at point a (m) with strength k in (0, 1];
+ * hold_orientation != 0 also holds its current orientation.  A moving
+ * anchor (a target point that drags the particle) is set again each step. */
+int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
+                         int hold_orientation, phc_error *err);
+int phc_particles_release(phc_particles *p, size_t i, phc_error *err);
+/* The paper's attachment rule: every particle without an anchor whose
+ * closest support point (points: 3·count, m) lies within `distance` (m, > 0)
+ * is anchored there with strength k.  *attached (may be NULL) counts them. */
+int phc_particles_attach(phc_particles *p, const double *points, size_t count,
+                         double distance, double k, size_t *attached,
+                         phc_error *err);
+
+typedef struct phc_particles_report {
+    double max_stress;      /* largest group stress after the step (1) */
+    size_t max_stress_group;/* its owner particle */
+    size_t broken;          /* links broken this step: 0 or 1 */
+    size_t broken_particle; /* the child whose parent link broke, else NONE */
+    double broken_stress;   /* its stress (1) */
+    size_t polar_total;     /* polar decompositions done in the step */
+    size_t polar_fallbacks; /* of which the SVD fallback finished */
+} phc_particles_report;
+
+/* One time step of dt seconds (> 0, finite).  report may be NULL.  A state
+ * that becomes non-finite is refused with PHC_ERR_NUMERIC naming the
+ * particle (the step is then not applied: positions are kept). */
+int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report,
+                       phc_error *err);
+
+/* Accessors. */
+void phc_particles_position(const phc_particles *p, size_t i, double x[3]);        /* m */
+void phc_particles_velocity(const phc_particles *p, size_t i, double v[3]);        /* m s^-1 */
+void phc_particles_orientation(const phc_particles *p, size_t i, double q[4]);
+double phc_particles_mass(const phc_particles *p, size_t i);                      /* kg */
+double phc_particles_stiffness(const phc_particles *p, size_t i);  /* s_i in effect */
+double phc_particles_stress(const phc_particles *p, size_t i); /* group i, last step */
+size_t phc_particles_parent(const phc_particles *p, size_t i); /* linked parent or NONE */
+/* Segment ends for drawing (fit/shape_plots.h): head/tail 3n each, m. */
+void phc_particles_segment_ends(const phc_particles *p, double *head, double *tail);
+/* Total linear momentum Σ m v, kg m s^-1. */
+void phc_particles_momentum(const phc_particles *p, double P[3]);
+
+/* Goals of group k from the current positions and orientations: members
+ * (up to cap) and their goal positions (3·cap), the rotation R (row-major
+ * 3x3) and the stress.  Returns the member count (0 when k is out of range
+ * or cap is too small).  Uses the system's scratch space: do not call it
+ * concurrently with other calls on the same system. */
+size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
+                                 size_t *member, double *goal, double R[9],
+                                 double *stress);
+
+/* Rotational factor of the polar decomposition of a 3x3 matrix A
+ * (row-major): the proper rotation R maximising tr(Rᵀ A).  q (w,x,y,z) is
+ * the start on entry (e.g. the last step's rotation) and the result on
+ * return.  Müller et al. 2016 ("A robust method to extract the rotational
+ * part of deformations") iteration; its stationary point is certified a
+ * maximum (tr(S)·I − S positive semidefinite, S = RᵀA, checked by its
+ * principal minors), otherwise LAPACK
+ * dgesvd gives R = U diag(1, 1, det(UVᵀ)) Vᵀ.  Returns 0 with the
+ * iteration, 1 with the SVD fallback, -1 when A is not finite or zero. */
+int phc_particles_polar_rotation(const double A[9], double q[4]);
+
+/* Quaternion (w,x,y,z) to row-major rotation matrix and back. */
+void phc_particles_quat_to_matrix(const double q[4], double R[9]);
+void phc_particles_matrix_to_quat(const double R[9], double q[4]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PHC_PARTICLES_H */

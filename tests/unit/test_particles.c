@@ -1,0 +1,815 @@
+/* Unit test of the oriented particles (model/particles.h; climbing plants
+ * §4.1, §4.3; Müller & Chentanez 2011).  Every checked number is printed.
+ *
+ *  1. Polar decomposition: A = Q S (Q an exact rotation, S symmetric
+ *     positive definite) gives Q; random matrices (some with det < 0)
+ *     against LAPACK's SVD, R = U diag(1,1,det(UVᵀ)) Vᵀ; bad starts.
+ *  2. The ellipsoid term: a single particle's group (point term zero) and a
+ *     straight two-particle group (point term rank 1) get the exact rotation.
+ *  3. Rigid limit: a rotated and translated rest shape is its own goal
+ *     (1e-12), and a step with s = 1 and no gravity leaves it in place.
+ *  4. Momentum: without gravity and anchors the projection conserves Σ m v.
+ *  5. A horizontal cantilever under gravity, root clamped: tip sag against
+ *     s, iteration count and time step (table), next to the Euler–Bernoulli
+ *     sag qL⁴/(8EI) for E = 1 GPa.  Asserts the measured qualitative facts.
+ *  6. Breaking: a tip force growing every step breaks the most stressed link
+ *     at the first step whose stress exceeds the threshold, never before.
+ *  7. Anchors (eq. 5) and the attachment rule, age-dependent stiffness,
+ *     free fall of the centre of mass: exact one-step answers.
+ *  8. Bad input: messages name the particle. */
+#include "model/particles.h"
+#include "model/plant_graph.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+
+static const double PI = 3.14159265358979323846;
+
+/* Deterministic uniform numbers in [-1, 1) (xorshift64*). */
+static unsigned long long rng_state = 88172645463325252ULL;
+static double urand(void)
+{
+    rng_state ^= rng_state >> 12;
+    rng_state ^= rng_state << 25;
+    rng_state ^= rng_state >> 27;
+    const unsigned long long r = rng_state * 2685821657736338717ULL;
+    return (double)(r >> 11) / 9007199254740992.0 * 2 - 1;
+}
+
+static void random_quat(double q[4])
+{
+    double r = 0;
+    do {
+        r = 0;
+        for (int k = 0; k < 4; ++k) {
+            q[k] = urand();
+            r += q[k] * q[k];
+        }
+    } while (r > 1 || r < 1e-4);
+    r = sqrt(r);
+    for (int k = 0; k < 4; ++k)
+        q[k] /= r;
+}
+
+static void matmul(const double *a, const double *b, double *c) /* 3x3 row-major */
+{
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            c[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
+}
+
+static double maxdiff(const double *a, const double *b, size_t n)
+{
+    double m = 0;
+    for (size_t i = 0; i < n; ++i)
+        if (fabs(a[i] - b[i]) > m)
+            m = fabs(a[i] - b[i]);
+    return m;
+}
+
+/* Reference: R = U diag(1,1,det(UVᵀ)) Vᵀ, computed here independently. */
+static void svd_rotation(const double A[9], double R[9])
+{
+    double a[9], s[3], u[9], vt[9], sup[2], uv[9];
+    memcpy(a, A, sizeof a);
+    LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'A', 'A', 3, 3, a, 3, s, u, 3, vt, 3, sup);
+    matmul(u, vt, uv);
+    const double det = uv[0] * (uv[4] * uv[8] - uv[5] * uv[7]) -
+                       uv[1] * (uv[3] * uv[8] - uv[5] * uv[6]) +
+                       uv[2] * (uv[3] * uv[7] - uv[4] * uv[6]);
+    for (int c = 0; c < 3; ++c)
+        if (det < 0)
+            u[3 * c + 2] = -u[3 * c + 2];
+    matmul(u, vt, R);
+}
+
+static void test_polar(void)
+{
+    double worst_exact = 0, worst_svd = 0, worst_bad = 0;
+    int fallbacks = 0, negdet = 0;
+    for (int t = 0; t < 2000; ++t) {
+        /* exact: A = Q S, S = V diag(λ) Vᵀ with λ in [1e-3, 1] */
+        double q[4], Q[9], v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9], A[9];
+        random_quat(q);
+        random_quat(v);
+        phc_particles_quat_to_matrix(q, Q);
+        phc_particles_quat_to_matrix(v, V);
+        for (int i = 0; i < 3; ++i) {
+            L[4 * i] = 1e-3 + fabs(urand());
+            for (int j = 0; j < 3; ++j)
+                Vt[3 * i + j] = V[3 * j + i];
+        }
+        matmul(V, L, T);
+        matmul(T, Vt, S);
+        matmul(Q, S, A);
+        double start[4] = {1, 0, 0, 0}, R[9];
+        fallbacks += phc_particles_polar_rotation(A, start) == 1;
+        phc_particles_quat_to_matrix(start, R);
+        const double e = maxdiff(R, Q, 9);
+        if (e > worst_exact)
+            worst_exact = e;
+        /* random matrix against SVD */
+        double B[9], Rs[9], Rp[9], qb[4] = {1, 0, 0, 0};
+        for (int k = 0; k < 9; ++k)
+            B[k] = urand();
+        const double det = B[0] * (B[4] * B[8] - B[5] * B[7]) - B[1] * (B[3] * B[8] - B[5] * B[6]) +
+                           B[2] * (B[3] * B[7] - B[4] * B[6]);
+        negdet += det < 0;
+        svd_rotation(B, Rs);
+        fallbacks += phc_particles_polar_rotation(B, qb) == 1;
+        phc_particles_quat_to_matrix(qb, Rp);
+        const double es = maxdiff(Rp, Rs, 9);
+        if (es > worst_svd)
+            worst_svd = es;
+        /* a bad start: the solution turned by pi about a random axis */
+        double flip[4] = {0, 0, 0, 0}, qs[4], qn[4];
+        phc_particles_matrix_to_quat(Rs, qs);
+        random_quat(flip);
+        flip[0] = 0;
+        {
+            double r = sqrt(flip[1] * flip[1] + flip[2] * flip[2] + flip[3] * flip[3]);
+            for (int k = 1; k < 4; ++k)
+                flip[k] /= r;
+        }
+        /* qn = flip ⊗ qs */
+        qn[0] = flip[0] * qs[0] - flip[1] * qs[1] - flip[2] * qs[2] - flip[3] * qs[3];
+        qn[1] = flip[0] * qs[1] + flip[1] * qs[0] + flip[2] * qs[3] - flip[3] * qs[2];
+        qn[2] = flip[0] * qs[2] - flip[1] * qs[3] + flip[2] * qs[0] + flip[3] * qs[1];
+        qn[3] = flip[0] * qs[3] + flip[1] * qs[2] - flip[2] * qs[1] + flip[3] * qs[0];
+        phc_particles_polar_rotation(B, qn);
+        phc_particles_quat_to_matrix(qn, Rp);
+        const double eb = maxdiff(Rp, Rs, 9);
+        if (eb > worst_bad)
+            worst_bad = eb;
+    }
+    printf("polar: 2000 exact A = Q S: max |R - Q| = %.3g\n", worst_exact);
+    printf("polar: 2000 random A (%d with det < 0) vs LAPACK SVD: max |R - R_svd| = %.3g\n", negdet,
+           worst_svd);
+    printf("polar: same, started a half turn away: max |R - R_svd| = %.3g\n", worst_bad);
+    printf("polar: SVD fallbacks taken in the first two sets: %d of 4000\n", fallbacks);
+    CHECK(worst_exact < 1e-12);
+    CHECK(worst_svd < 1e-10);
+    CHECK(worst_bad < 1e-10);
+    CHECK(negdet > 500);
+    double Z[9] = {0}, qz[4] = {1, 0, 0, 0}, Nn[9] = {0, 0, NAN, 0, 0, 0, 0, 0, 0};
+    CHECK(phc_particles_polar_rotation(Z, qz) == -1);
+    CHECK(phc_particles_polar_rotation(Nn, qz) == -1);
+    /* quaternion <-> matrix round trip */
+    double worst_rt = 0;
+    for (int t = 0; t < 1000; ++t) {
+        double q[4], R[9], q2[4];
+        random_quat(q);
+        if (q[0] < 0)
+            for (int k = 0; k < 4; ++k)
+                q[k] = -q[k];
+        phc_particles_quat_to_matrix(q, R);
+        phc_particles_matrix_to_quat(R, q2);
+        const double e = maxdiff(q, q2, 4);
+        if (e > worst_rt)
+            worst_rt = e;
+    }
+    printf("quaternion -> matrix -> quaternion: max error %.3g\n", worst_rt);
+    CHECK(worst_rt < 1e-14);
+}
+
+/* A straight chain of n segments from `origin` along unit direction dir,
+ * each of length h and radius r; segment 0 fixed when clamp != 0. */
+static phc_plant_graph *chain(size_t n, const double origin[3], const double dir[3], double h,
+                              double r, int clamp)
+{
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    if (!g)
+        return NULL;
+    for (size_t i = 0; i < n; ++i) {
+        for (int d = 0; d < 3; ++d) {
+            g->head[3 * i + d] = origin[d] + dir[d] * h * (double)i;
+            g->tail[3 * i + d] = origin[d] + dir[d] * h * (double)(i + 1);
+        }
+        g->radius[i] = r;
+        g->length[i] = h;
+        g->parent[i] = i == 0 ? PHC_PLANT_NO_PARENT : i - 1;
+        g->source_id[i] = 100 + (long)i;
+    }
+    g->fixed[0] = clamp != 0;
+    if (phc_plant_graph_finish(g, "chain", NULL)) {
+        phc_plant_graph_free(g);
+        return NULL;
+    }
+    return g;
+}
+
+static void test_ellipsoid_term(void)
+{
+    const double o[3] = {0.1, -0.2, 0.3}, dx[3] = {1, 0, 0};
+    phc_error err;
+    for (size_t n = 1; n <= 2; ++n) {
+        phc_plant_graph *g = chain(n, o, dx, 0.05, 0.004, 0);
+        phc_particles_options opt = phc_particles_options_default();
+        phc_particles *p = phc_particles_new(g, &opt, &err);
+        CHECK(p != NULL);
+        if (!p) {
+            phc_plant_graph_free(g);
+            return;
+        }
+        /* Turn the whole group rigidly by Q about its centre of mass. */
+        double Qq[4], Q[9], c[3] = {0, 0, 0}, M = 0;
+        random_quat(Qq);
+        phc_particles_quat_to_matrix(Qq, Q);
+        for (size_t i = 0; i < n; ++i) {
+            double x[3];
+            phc_particles_position(p, i, x);
+            for (int d = 0; d < 3; ++d)
+                c[d] += phc_particles_mass(p, i) * x[d];
+            M += phc_particles_mass(p, i);
+        }
+        for (int d = 0; d < 3; ++d)
+            c[d] /= M;
+        for (size_t i = 0; i < n; ++i) {
+            double x[3], y[3], q0[4], q1[4];
+            phc_particles_position(p, i, x);
+            phc_particles_orientation(p, i, q0);
+            for (int r = 0; r < 3; ++r)
+                y[r] = c[r] + Q[3 * r] * (x[0] - c[0]) + Q[3 * r + 1] * (x[1] - c[1]) +
+                       Q[3 * r + 2] * (x[2] - c[2]);
+            q1[0] = Qq[0] * q0[0] - Qq[1] * q0[1] - Qq[2] * q0[2] - Qq[3] * q0[3];
+            q1[1] = Qq[0] * q0[1] + Qq[1] * q0[0] + Qq[2] * q0[3] - Qq[3] * q0[2];
+            q1[2] = Qq[0] * q0[2] - Qq[1] * q0[3] + Qq[2] * q0[0] + Qq[3] * q0[1];
+            q1[3] = Qq[0] * q0[3] + Qq[1] * q0[2] - Qq[2] * q0[1] + Qq[3] * q0[0];
+            CHECK(phc_particles_set_position(p, i, y, &err) == PHC_OK);
+            CHECK(phc_particles_set_orientation(p, i, q1, &err) == PHC_OK);
+        }
+        size_t mem[4];
+        double goal[12], R[9], st;
+        const size_t m = phc_particles_group_goals(p, 0, 4, mem, goal, R, &st);
+        CHECK(m == n);
+        const double e = maxdiff(R, Q, 9);
+        /* the point term alone: Σ m (x - c)(x̄ - c̄)ᵀ, its singular values */
+        double A[9] = {0}, c0[3] = {0, 0, 0};
+        for (size_t i = 0; i < n; ++i)
+            for (int d = 0; d < 3; ++d)
+                c0[d] += phc_particles_mass(p, i) * (o[d] + dx[d] * 0.05 * (i + 0.5)) / M;
+        for (size_t i = 0; i < n; ++i) {
+            double x[3];
+            phc_particles_position(p, i, x);
+            for (int r = 0; r < 3; ++r)
+                for (int s = 0; s < 3; ++s)
+                    A[3 * r + s] += phc_particles_mass(p, i) * (x[r] - c[r]) *
+                                    (o[s] + dx[s] * 0.05 * (i + 0.5) - c0[s]);
+        }
+        double sv[3], u[9], vt[9], sup[2];
+        LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'N', 3, 3, A, 3, sv, u, 3, vt, 3, sup);
+        printf("ellipsoid term: group of %zu particle(s): point-term singular values "
+               "(%.3g, %.3g, %.3g) kg m2 (rank %d), with the ellipsoid term |R - Q| = %.3g, "
+               "stress %.3g\n",
+               n, sv[0], sv[1], sv[2], (sv[0] > 1e-15) + (sv[1] > 1e-15) + (sv[2] > 1e-15), e,
+               st);
+        CHECK(sv[1] < 1e-15); /* the point term alone leaves the rotation undefined */
+        CHECK(e < 1e-12);
+        CHECK(st < 1e-12);
+        phc_particles_free(p);
+        phc_plant_graph_free(g);
+    }
+}
+
+static void rotate_rigidly(phc_particles *p, const double Qq[4], const double t[3])
+{
+    double Q[9];
+    phc_particles_quat_to_matrix(Qq, Q);
+    phc_error err;
+    for (size_t i = 0; i < phc_particles_count(p); ++i) {
+        double x[3], y[3], q0[4], q1[4];
+        phc_particles_position(p, i, x);
+        phc_particles_orientation(p, i, q0);
+        for (int r = 0; r < 3; ++r)
+            y[r] = t[r] + Q[3 * r] * x[0] + Q[3 * r + 1] * x[1] + Q[3 * r + 2] * x[2];
+        q1[0] = Qq[0] * q0[0] - Qq[1] * q0[1] - Qq[2] * q0[2] - Qq[3] * q0[3];
+        q1[1] = Qq[0] * q0[1] + Qq[1] * q0[0] + Qq[2] * q0[3] - Qq[3] * q0[2];
+        q1[2] = Qq[0] * q0[2] - Qq[1] * q0[3] + Qq[2] * q0[0] + Qq[3] * q0[1];
+        q1[3] = Qq[0] * q0[3] + Qq[1] * q0[2] - Qq[2] * q0[1] + Qq[3] * q0[0];
+        phc_particles_set_position(p, i, y, &err);
+        phc_particles_set_orientation(p, i, q1, &err);
+    }
+}
+
+static void test_rigid_limit(void)
+{
+    phc_plant_graph *g = phc_plant_graph_random(60, 7);
+    phc_error err;
+    phc_particles_options opt = phc_particles_options_default();
+    opt.gravity[2] = 0;
+    opt.damping = 0;
+    opt.stiffness = 1;
+    phc_particles *p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (!p) {
+        phc_plant_graph_free(g);
+        return;
+    }
+    double Qq[4], t[3] = {0.3, -1.2, 0.7};
+    random_quat(Qq);
+    rotate_rigidly(p, Qq, t);
+    double worst = 0, worst_stress = 0;
+    for (size_t k = 0; k < phc_particles_count(p); ++k) {
+        size_t mem[64];
+        double goal[192], st;
+        const size_t m = phc_particles_group_goals(p, k, 64, mem, goal, NULL, &st);
+        CHECK(m >= 1);
+        for (size_t a = 0; a < m; ++a) {
+            double x[3];
+            phc_particles_position(p, mem[a], x);
+            const double e = maxdiff(goal + 3 * a, x, 3);
+            if (e > worst)
+                worst = e;
+        }
+        if (st > worst_stress)
+            worst_stress = st;
+    }
+    double before[180];
+    for (size_t i = 0; i < 60; ++i)
+        phc_particles_position(p, i, before + 3 * i);
+    for (int s = 0; s < 5; ++s)
+        CHECK(phc_particles_step(p, 0.01, NULL, &err) == PHC_OK);
+    double moved = 0;
+    for (size_t i = 0; i < 60; ++i) {
+        double x[3];
+        phc_particles_position(p, i, x);
+        const double e = maxdiff(x, before + 3 * i, 3);
+        if (e > moved)
+            moved = e;
+    }
+    printf("rigid limit: 60-segment random plant turned and moved: max |goal - x| = %.3g m, "
+           "max stress %.3g; after 5 steps with s = 1, no gravity: max displacement %.3g m\n",
+           worst, worst_stress, moved);
+    CHECK(worst < 1e-12);
+    CHECK(worst_stress < 1e-12);
+    CHECK(moved < 1e-12);
+    phc_particles_free(p);
+    phc_plant_graph_free(g);
+}
+
+static void test_momentum(void)
+{
+    phc_plant_graph *g = phc_plant_graph_random(40, 3);
+    phc_error err;
+    for (int aged = 0; aged <= 1; ++aged) {
+        phc_particles_options opt = phc_particles_options_default();
+        opt.gravity[2] = 0;
+        opt.damping = 0;
+        opt.stiffness = 0.7;
+        opt.iterations = 5;
+        if (aged)
+            opt.maturity_age = 1.0; /* s_i = age_i / t_m differs between particles */
+        phc_particles *p = phc_particles_new(g, &opt, &err);
+        CHECK(p != NULL);
+        if (!p)
+            break;
+        const size_t n = phc_particles_count(p);
+        for (size_t i = 0; i < n; ++i) {
+            double x[3];
+            phc_particles_position(p, i, x);
+            for (int d = 0; d < 3; ++d)
+                x[d] += 0.01 * urand(); /* a deformed start */
+            phc_particles_set_position(p, i, x, &err);
+            if (aged)
+                phc_particles_set_age(p, i, 0.2 + 0.6 * fabs(urand()), &err);
+        }
+        /* one step with forces gives the system momentum Σ f dt */
+        const double dt = 0.005;
+        double F[3] = {0, 0, 0};
+        for (size_t i = 0; i < n; ++i) {
+            const double f[3] = {urand(), urand(), urand()};
+            phc_particles_set_force(p, i, f, &err);
+            for (int d = 0; d < 3; ++d)
+                F[d] += f[d] * dt;
+        }
+        CHECK(phc_particles_step(p, dt, NULL, &err) == PHC_OK);
+        const double zero[3] = {0, 0, 0};
+        for (size_t i = 0; i < n; ++i)
+            phc_particles_set_force(p, i, zero, &err);
+        double P0[3], P[3], drift = 0, mag = sqrt(F[0] * F[0] + F[1] * F[1] + F[2] * F[2]);
+        phc_particles_momentum(p, P0);
+        for (int s = 0; s < 200; ++s) {
+            CHECK(phc_particles_step(p, dt, NULL, &err) == PHC_OK);
+            phc_particles_momentum(p, P);
+            const double e = maxdiff(P, P0, 3);
+            if (e > drift)
+                drift = e;
+        }
+        const double e0 = maxdiff(P0, F, 3);
+        printf("momentum (%s): after the kick |P - Σ f dt| = %.3g, over 200 steps max |P - P0| = "
+               "%.3g kg m/s (|P0| = %.3g)\n",
+               aged ? "age-dependent s, differs per particle" : "uniform s = 0.7", e0, drift, mag);
+        if (!aged) {
+            CHECK(e0 < 1e-13 * (1 + mag));
+            CHECK(drift < 1e-13 * (1 + mag));
+        } else {
+            CHECK(drift > 1e-9 * mag); /* measured: non-uniform s does not conserve it */
+        }
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g);
+}
+
+/* Tip sag of a clamped horizontal chain at rest under gravity. */
+static double cantilever_sag(size_t nseg, double s, size_t iters, double dt, size_t *steps_out,
+                             double *qout, double *Lc, double *stretch)
+{
+    const double o[3] = {0, 0, 0}, dx[3] = {1, 0, 0}, Lt = 0.5, r = 0.005;
+    phc_plant_graph *g = chain(nseg, o, dx, Lt / (double)nseg, r, 1);
+    phc_particles_options opt = phc_particles_options_default();
+    opt.stiffness = s;
+    opt.iterations = iters;
+    opt.damping = 0.02;
+    phc_error err;
+    phc_particles *p = phc_particles_new(g, &opt, &err);
+    double sag = NAN;
+    size_t steps = 0;
+    if (p) {
+        double *head = malloc(3 * nseg * sizeof *head), *tail = malloc(3 * nseg * sizeof *tail);
+        for (steps = 1; steps <= 200000; ++steps) {
+            if (phc_particles_step(p, dt, NULL, &err))
+                break;
+            double vmax = 0;
+            for (size_t i = 0; i < nseg; ++i) {
+                double v[3];
+                phc_particles_velocity(p, i, v);
+                const double sp = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+                if (sp > vmax)
+                    vmax = sp;
+            }
+            if (steps * dt > 1.0 && vmax < 1e-7)
+                break;
+        }
+        phc_particles_segment_ends(p, head, tail);
+        sag = -tail[3 * (nseg - 1) + 2];
+        /* stretch of the chain: root-to-last-centre distance against rest */
+        double a[3], b[3], d2 = 0;
+        phc_particles_position(p, 0, a);
+        phc_particles_position(p, nseg - 1, b);
+        for (int d = 0; d < 3; ++d)
+            d2 += (b[d] - a[d]) * (b[d] - a[d]);
+        *stretch = sqrt(d2) / (Lt * (double)(nseg - 1) / (double)nseg) - 1;
+        free(head);
+        free(tail);
+        *qout = opt.density * 9.81 * PI * r * r;
+        *Lc = Lt - 0.5 * Lt / (double)nseg; /* clamped at the root segment's centre */
+    }
+    *steps_out = steps;
+    phc_particles_free(p);
+    phc_plant_graph_free(g);
+    return sag;
+}
+
+static void test_cantilever(void)
+{
+    const double E = 1e9, r = 0.005, Iz = PI * r * r * r * r / 4;
+    const double svals[] = {0.05, 0.2, 0.5, 1.0};
+    const size_t ivals[] = {1, 4, 16};
+    const double dts[] = {1.0 / 30, 1.0 / 120, 1.0 / 480};
+    double sag[4][3][3];
+    double q = 0, Lc = 0;
+    printf("cantilever: 10 segments, L = 0.5 m, r = 5 mm, density 1000 kg/m3, clamped at the root "
+           "segment; sag of the free end at rest\n");
+    size_t steps;
+    double stretch = 0;
+    cantilever_sag(10, 1, 1, 1.0 / 120, &steps, &q, &Lc, &stretch);
+    const double eb = q * Lc * Lc * Lc * Lc / (8 * E * Iz);
+    printf("cantilever: Euler-Bernoulli q Lc^4/(8 E I) with E = 1 GPa, q = %.4g N/m, Lc = %.4g m: "
+           "%.4g mm\n",
+           q, Lc, 1e3 * eb);
+    printf("  %5s %5s %9s %12s %10s %12s %11s %7s\n", "s", "iters", "dt (s)", "sag (mm)",
+           "sag/EB", "E_eff (Pa)", "stretch (%)", "steps");
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 3; ++b)
+            for (int c = 0; c < 3; ++c) {
+                sag[a][b][c] =
+                    cantilever_sag(10, svals[a], ivals[b], dts[c], &steps, &q, &Lc, &stretch);
+                printf("  %5.2f %5zu %9.5f %12.5g %10.4g %12.4g %11.3g %7zu\n", svals[a], ivals[b],
+                       dts[c], 1e3 * sag[a][b][c], sag[a][b][c] / eb,
+                       q * Lc * Lc * Lc * Lc / (8 * Iz * sag[a][b][c]), 100 * stretch, steps);
+            }
+    /* Measured facts asserted: sag falls as s grows (every iteration count
+     * and step), falls as the iteration count grows (s < 1), and falls as
+     * the time step shrinks: the effective stiffness depends on all three. */
+    int mono_s = 1, mono_it = 1, mono_dt = 1;
+    for (int b = 0; b < 3; ++b)
+        for (int c = 0; c < 3; ++c)
+            for (int a = 1; a < 4; ++a)
+                mono_s &= sag[a][b][c] < sag[a - 1][b][c];
+    for (int a = 0; a < 3; ++a)
+        for (int c = 0; c < 3; ++c)
+            for (int b = 1; b < 3; ++b)
+                mono_it &= sag[a][b][c] < sag[a][b - 1][c];
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 3; ++b)
+            for (int c = 1; c < 3; ++c)
+                mono_dt &= sag[a][b][c] < sag[a][b][c - 1];
+    const double it_ratio = sag[1][0][1] / sag[1][2][1];
+    const double dt_ratio = sag[1][1][0] / sag[1][1][2];
+    printf("cantilever: sag falls with s: %s; with iterations (s < 1): %s; with smaller dt: %s\n",
+           mono_s ? "yes" : "no", mono_it ? "yes" : "no", mono_dt ? "yes" : "no");
+    printf("cantilever: s = 0.2, dt = 1/120 s: sag(1 iteration)/sag(16 iterations) = %.4g; "
+           "4 iterations: sag(dt = 1/30)/sag(dt = 1/480) = %.4g\n",
+           it_ratio, dt_ratio);
+    CHECK(mono_s);
+    CHECK(mono_it);
+    CHECK(mono_dt);
+    CHECK(it_ratio > 1.2);
+    /* N Jacobi projections with blend s act like one with 1 - (1 - s)^N:
+     * (s, N) = (0.05, 16) and (0.2, 4) give 0.56 and 0.59, (0.05, 4) and
+     * (0.2, 1) give 0.185 and 0.2; the sags agree to the measured 0.2%. */
+    double worst_pair = 0;
+    for (int c = 0; c < 3; ++c) {
+        const double r1 = fabs(sag[0][2][c] / sag[1][1][c] - 1);
+        const double r2 = fabs(sag[0][1][c] / sag[1][0][c] - 1);
+        if (r1 > worst_pair)
+            worst_pair = r1;
+        if (r2 > worst_pair)
+            worst_pair = r2;
+    }
+    printf("cantilever: (s, N) = (0.05, 16) vs (0.2, 4) and (0.05, 4) vs (0.2, 1): sags differ by at "
+           "most %.3g%% (1 - (1 - s)^N = 0.560 vs 0.590, 0.185 vs 0.200)\n",
+           100 * worst_pair);
+    CHECK(worst_pair < 0.02);
+    CHECK(dt_ratio > 1.5);
+}
+
+static void test_breaking(void)
+{
+    const double o[3] = {0, 0, 0}, dx[3] = {1, 0, 0};
+    phc_plant_graph *g = chain(8, o, dx, 0.05, 0.004, 1);
+    phc_particles_options opt = phc_particles_options_default();
+    opt.gravity[2] = 0;
+    opt.stiffness = 0.3;
+    opt.iterations = 4;
+    opt.damping = 0.05;
+    opt.break_threshold = 0.05;
+    phc_error err;
+    phc_particles *p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (!p) {
+        phc_plant_graph_free(g);
+        return;
+    }
+    const double dt = 1.0 / 120, rate = 0.002; /* N per step */
+    size_t breaks = 0, break_step = 0, broken = PHC_PARTICLES_NONE;
+    double prev_linked = 0, at_break = 0, before_break = 0, max_before = 0;
+    for (size_t step = 1; step <= 4000; ++step) {
+        /* the pull grows until the branch breaks, then it lets go (Fig. 6) */
+        const double F[3] = {0, 0, breaks ? 0.0 : rate * (double)step};
+        phc_particles_set_force(p, 7, F, &err);
+        phc_particles_report rep;
+        CHECK(phc_particles_step(p, dt, &rep, &err) == PHC_OK);
+        double linked_max = 0;
+        for (size_t k = 0; k < 8; ++k)
+            if (phc_particles_parent(p, k) != PHC_PARTICLES_NONE || k == rep.broken_particle)
+                if (phc_particles_stress(p, k) > linked_max)
+                    linked_max = phc_particles_stress(p, k);
+        if (rep.broken) {
+            ++breaks;
+            if (breaks == 1) {
+                break_step = step;
+                broken = rep.broken_particle;
+                at_break = rep.broken_stress;
+                before_break = prev_linked;
+                CHECK(at_break == linked_max);
+            }
+        } else if (!breaks && linked_max > max_before) {
+            max_before = linked_max;
+        }
+        if (breaks && step > break_step + 300)
+            break;
+        prev_linked = linked_max;
+    }
+    printf("breaking: 8-segment branch, tip force growing %.3g N per step of %.4g s, threshold "
+           "%.3g: broke at step %zu (force %.4g N), link of particle %zu to its parent, stress "
+           "%.5g; largest stress of any linked group before: %.5g (previous step %.5g); breaks in "
+           "the run: %zu\n",
+           rate, dt, opt.break_threshold, break_step, rate * (double)break_step, broken, at_break,
+           max_before, before_break, breaks);
+    CHECK(breaks == 1);
+    CHECK(break_step > 1);
+    CHECK(max_before <= opt.break_threshold);
+    CHECK(at_break > opt.break_threshold);
+    /* within one step of the threshold: the stress crossed it during this step */
+    CHECK(at_break - opt.break_threshold <= at_break - before_break);
+    CHECK(broken != PHC_PARTICLES_NONE && phc_particles_parent(p, broken) == PHC_PARTICLES_NONE);
+    phc_particles_free(p);
+    phc_plant_graph_free(g);
+}
+
+/* Anchors (eq. 5), the attachment rule, age-dependent stiffness and free
+ * fall: exact one-step answers. */
+static void test_anchor_age_fall(void)
+{
+    const double o[3] = {0, 0, 0}, dz[3] = {0, 0, 1};
+    phc_error err;
+    /* one free particle, no gravity, 1 iteration: its group is rigid, so
+     * a step moves it exactly x + k (a - x) */
+    phc_plant_graph *g1 = chain(1, o, dz, 0.04, 0.003, 0);
+    phc_particles_options opt = phc_particles_options_default();
+    opt.gravity[2] = 0;
+    opt.iterations = 1;
+    opt.damping = 0;
+    phc_particles *p = phc_particles_new(g1, &opt, &err);
+    CHECK(p != NULL);
+    if (p) {
+        const double a[3] = {0.1, 0.2, -0.05};
+        double x0[3], x1[3], want[3];
+        phc_particles_position(p, 0, x0);
+        CHECK(phc_particles_anchor(p, 0, a, 0.25, 0, &err) == PHC_OK);
+        CHECK(phc_particles_step(p, 0.01, NULL, &err) == PHC_OK);
+        phc_particles_position(p, 0, x1);
+        for (int d = 0; d < 3; ++d)
+            want[d] = x0[d] + 0.25 * (a[d] - x0[d]);
+        const double e = maxdiff(x1, want, 3);
+        printf("anchor (eq. 5): one step with k = 0.25 moves the particle to x + k (a - x) within "
+               "%.3g m\n",
+               e);
+        CHECK(e < 1e-15);
+        CHECK(phc_particles_anchor(p, 0, a, 1.5, 0, &err) == PHC_ERR_INPUT);
+        CHECK_STR_CONTAINS(err.message, "particle 0 (segment 100): anchor strength must be in (0, 1]");
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g1);
+
+    /* attachment rule: particles whose closest support point is within d */
+    phc_plant_graph *g = chain(10, o, dz, 0.05, 0.003, 1);
+    opt = phc_particles_options_default();
+    opt.maturity_age = 2.0;
+    p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (p) {
+        /* a wall at x = 0.02: support points beside the centres of 3..5 */
+        double pts[9];
+        for (int j = 0; j < 3; ++j) {
+            pts[3 * j] = 0.02;
+            pts[3 * j + 1] = 0;
+            pts[3 * j + 2] = 0.05 * (3 + j) + 0.025;
+        }
+        size_t att = 0;
+        CHECK(phc_particles_attach(p, pts, 3, 0.021, 1.0, &att, &err) == PHC_OK);
+        size_t att_far = 0;
+        CHECK(phc_particles_attach(p, pts, 3, 0.019, 1.0, &att_far, &err) == PHC_OK);
+        printf("attach: support points 2 cm beside particles 3..5: within 2.1 cm %zu attached, "
+               "then within 1.9 cm %zu more\n",
+               att, att_far);
+        CHECK(att == 3);
+        CHECK(att_far == 0);
+        CHECK(phc_particles_attach(p, pts, 3, -1, 1.0, &att, &err) == PHC_ERR_INPUT);
+        /* age-dependent stiffness s = min(1, t_l / t_m), t_m = 2 s */
+        const double s0 = phc_particles_stiffness(p, 7);
+        for (int k = 0; k < 100; ++k)
+            phc_particles_step(p, 0.01, NULL, &err);
+        const double s1 = phc_particles_stiffness(p, 7);
+        phc_particles_set_age(p, 7, 5.0, &err);
+        const double s2 = phc_particles_stiffness(p, 7);
+        printf("age stiffness, t_m = 2 s: s = %.6g at age 0, %.6g after 100 steps of 0.01 s, "
+               "%.6g at age 5 s (clamped)\n",
+               s0, s1, s2);
+        CHECK(s0 == 0);
+        CHECK_NEAR(s1, 0.5, 1e-12, 0);
+        CHECK(s2 == 1);
+        double x[3];
+        phc_particles_position(p, 4, x);
+        printf("attach: particle 4 after 1 s held at x = %.6g m (its support point x = 0.02)\n",
+               x[0]);
+        CHECK_NEAR(x[0], 0.02, 1e-15, 0);
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g);
+
+    /* free fall of an unanchored plant: the centre of mass follows the
+     * symplectic Euler of PBD, z_n = z_0 - g dt^2 n(n+1)/2, for any s */
+    g = phc_plant_graph_random(30, 11);
+    opt = phc_particles_options_default();
+    opt.stiffness = 0.4;
+    opt.damping = 0;
+    p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (p) {
+        const size_t n = phc_particles_count(p);
+        double M = 0, z0 = 0, z = 0;
+        for (size_t i = 0; i < n; ++i) {
+            double xx[3];
+            phc_particles_position(p, i, xx);
+            M += phc_particles_mass(p, i);
+            z0 += phc_particles_mass(p, i) * xx[2];
+        }
+        const int steps = 50;
+        const double dt = 0.01;
+        for (int k = 0; k < steps; ++k)
+            CHECK(phc_particles_step(p, dt, NULL, &err) == PHC_OK);
+        for (size_t i = 0; i < n; ++i) {
+            double xx[3];
+            phc_particles_position(p, i, xx);
+            z += phc_particles_mass(p, i) * xx[2];
+        }
+        const double drop = (z0 - z) / M, want = 9.81 * dt * dt * steps * (steps + 1) / 2;
+        printf("free fall: centre of mass dropped %.15g m in %d steps, symplectic Euler %.15g m\n",
+               drop, steps, want);
+        CHECK_NEAR(drop, want, 1e-13, 0);
+        phc_particles_free(p);
+    }
+    phc_plant_graph_free(g);
+}
+
+static void test_bad_input(void)
+{
+    const double o[3] = {0, 0, 0}, dx[3] = {1, 0, 0};
+    phc_plant_graph *g = chain(4, o, dx, 0.05, 0.004, 1);
+    phc_error err;
+    phc_particles_options opt = phc_particles_options_default();
+    phc_particles *p = phc_particles_new(g, &opt, &err);
+    CHECK(p != NULL);
+    if (!p) {
+        phc_plant_graph_free(g);
+        return;
+    }
+    struct {
+        int rc;
+        const char *needle;
+    } cases[8];
+    int nc = 0;
+    const double nanx[3] = {0, NAN, 0};
+    cases[nc].rc = phc_particles_set_mass(p, 2, -1.0, &err);
+    cases[nc++].needle = "particle 2 (segment 102): mass must be positive";
+    printf("bad input: %s\n", err.message);
+    cases[nc].rc = phc_particles_set_stiffness(p, 1, 1.5, &err);
+    cases[nc++].needle = "particle 1 (segment 101): stiffness s must be in [0, 1], found 1.5";
+    printf("bad input: %s\n", err.message);
+    cases[nc].rc = phc_particles_set_stiffness(p, 3, -0.1, &err);
+    cases[nc++].needle = "particle 3 (segment 103): stiffness";
+    printf("bad input: %s\n", err.message);
+    cases[nc].rc = phc_particles_set_position(p, 3, nanx, &err);
+    cases[nc++].needle = "particle 3 (segment 103): position y must be finite";
+    printf("bad input: %s\n", err.message);
+    cases[nc].rc = phc_particles_step(p, 0.0, NULL, &err);
+    cases[nc++].needle = "time step must be positive";
+    printf("bad input: %s\n", err.message);
+    cases[nc].rc = phc_particles_step(p, -0.01, NULL, &err);
+    cases[nc++].needle = "found -0.01 s";
+    printf("bad input: %s\n", err.message);
+    for (int c = 0; c < nc; ++c) {
+        CHECK(cases[c].rc == PHC_ERR_INPUT);
+        (void)0;
+    }
+    /* messages (re-run each to read its own message) */
+    phc_particles_set_mass(p, 2, -1.0, &err);
+    CHECK_STR_CONTAINS(err.message, cases[0].needle);
+    phc_particles_set_stiffness(p, 1, 1.5, &err);
+    CHECK_STR_CONTAINS(err.message, cases[1].needle);
+    phc_particles_set_stiffness(p, 3, -0.1, &err);
+    CHECK_STR_CONTAINS(err.message, cases[2].needle);
+    phc_particles_set_position(p, 3, nanx, &err);
+    CHECK_STR_CONTAINS(err.message, cases[3].needle);
+    phc_particles_step(p, 0.0, NULL, &err);
+    CHECK_STR_CONTAINS(err.message, cases[4].needle);
+    phc_particles_step(p, -0.01, NULL, &err);
+    CHECK_STR_CONTAINS(err.message, cases[5].needle);
+    CHECK(phc_particles_set_mass(p, 9, 1.0, &err) == PHC_ERR_INVALID);
+    CHECK_STR_CONTAINS(err.message, "particle 9 does not exist");
+    /* a state left unchanged by the refused calls: one step still works */
+    CHECK(phc_particles_step(p, 0.01, NULL, &err) == PHC_OK);
+    phc_particles_free(p);
+
+    /* options and graph problems at construction */
+    opt.stiffness = 1.2;
+    CHECK(phc_particles_new(g, &opt, &err) == NULL);
+    printf("bad input: %s\n", err.message);
+    CHECK_STR_CONTAINS(err.message, "stiffness s must be in [0, 1], found 1.2");
+    opt = phc_particles_options_default();
+    opt.density = 0;
+    CHECK(phc_particles_new(g, &opt, &err) == NULL);
+    printf("bad input: %s\n", err.message);
+    CHECK_STR_CONTAINS(err.message, "density must be positive");
+    opt = phc_particles_options_default();
+    g->radius[2] = -0.001; /* a graph changed after it was finished */
+    CHECK(phc_particles_new(g, &opt, &err) == NULL);
+    printf("bad input: %s\n", err.message);
+    CHECK_STR_CONTAINS(err.message, "particle 2 (segment 102): radius and length must be positive");
+    g->radius[2] = 0.004;
+    g->head[3 * 1 + 2] = NAN;
+    CHECK(phc_particles_new(g, &opt, &err) == NULL);
+    printf("bad input: %s\n", err.message);
+    CHECK_STR_CONTAINS(err.message, "particle 1 (segment 101): coordinate z is not finite");
+    phc_plant_graph_free(g);
+}
+
+int main(void)
+{
+    test_polar();
+    test_ellipsoid_term();
+    test_rigid_limit();
+    test_momentum();
+    test_cantilever();
+    test_breaking();
+    test_anchor_age_fall();
+    test_bad_input();
+    return check_finish("test_particles");
+}
