@@ -75,12 +75,13 @@ typedef struct frame {
     double lo, hi;         /* colour range */
     double r_max;          /* m */
     int any_value;
+    double chr;            /* character scale of the figure */
 } frame;
 
 static frame common_frame(const phc_shape_panel *panels, size_t count,
                           const phc_shape_plot_options *o)
 {
-    frame f = {INFINITY, -INFINITY, INFINITY, -INFINITY, INFINITY, -INFINITY, 0.0, 0};
+    frame f = {INFINITY, -INFINITY, INFINITY, -INFINITY, INFINITY, -INFINITY, 0.0, 0, CHAR_SCALE};
     const int a = o->across_axis, u = o->up_axis;
     for (size_t p = 0; p < count; ++p) {
         const phc_shape_panel *s = panels + p;
@@ -161,21 +162,9 @@ static void draw_panel(const phc_shape_panel *s, const frame *f, const phc_shape
     if (s->title && *s->title) {
         char *t = phc_plot_escape(s->title);
         if (t) {
-            plschr(0.0, 0.9 * CHAR_SCALE);
+            plschr(0.0, 0.9 * f->chr);
             plmtex("t", 1.2, 0.5, 0.5, t);
-            plschr(0.0, CHAR_SCALE);
-        }
-        free(t);
-    }
-    if (s->markers) {
-        char *t = phc_plot_escape(s->marker_label ? s->marker_label : "marker");
-        if (t) {
-            plschr(0.0, 0.75 * CHAR_SCALE);
-            plcol0(COL_MARKER);
-            plmtex("b", 4.4, 1.0, 1.0, "o: ");
-            plcol0(COL_FG);
-            plmtex("b", 4.4, 1.0, 0.0, t);
-            plschr(0.0, CHAR_SCALE);
+            plschr(0.0, f->chr);
         }
         free(t);
     }
@@ -227,7 +216,8 @@ int phc_shape_plot(const char *path, const phc_shape_panel *panels, size_t count
     const size_t rows = (count + cols - 1) / cols;
     const int page_w = o.page_width > 0 ? o.page_width : (int)(560 * cols + 200);
     const int page_h = o.page_height > 0 ? o.page_height : (int)(520 * rows + 120);
-    const frame f = common_frame(panels, count, &o);
+    frame f = common_frame(panels, count, &o);
+    f.chr = cols * rows > 2 ? 0.8 * CHAR_SCALE : CHAR_SCALE; /* smaller letters in grids */
     char *bar_label = phc_plot_escape(o.value_label ? o.value_label : "value");
     char *title = phc_plot_escape(o.title ? o.title : "");
     if (!bar_label || !title) {
@@ -279,26 +269,49 @@ int phc_shape_plot(const char *path, const phc_shape_panel *panels, size_t count
     }
     plinit();
     pladv(0);
-    plschr(0.0, CHAR_SCALE);
+    plschr(0.0, f.chr);
     {
         /* the panels fill [0.0, 0.86] of the page's width (the colour bar
          * and its label take the rest) and [0.02, 0.93] of its height */
         const double gx0 = 0.0, gx1 = f.any_value ? 0.86 : 0.98, gy0 = 0.02, gy1 = 0.93;
         const double cw = (gx1 - gx0) / (double)cols, ch = (gy1 - gy0) / (double)rows;
         const double aspect = (f.u1 - f.u0) / (f.a1 - f.a0);
+        /* margins of each cell in character heights (page fractions): the
+           y tick labels and axis label on the left, the x ones below, the
+           panel title above */
+        PLFLT def, ht, sx0, sx1, sy0, sy1;
+        plgchr(&def, &ht);
+        plgspa(&sx0, &sx1, &sy0, &sy1);
+        const double cfx = ht / (sx1 - sx0), cfy = ht / (sy1 - sy0);
+        const char *marker_label = NULL;
         for (size_t p = 0; p < count; ++p) {
             const size_t r = p / cols, c = p % cols;
             const double x0 = gx0 + c * cw, y1 = gy1 - r * ch;
-            plvpas(x0 + 0.16 * cw, x0 + cw - 0.04 * cw, y1 - ch + 0.16 * ch, y1 - 0.09 * ch,
+            plvpas(x0 + 6.0 * cfx, x0 + cw - 1.0 * cfx, y1 - ch + 4.6 * cfy, y1 - 2.6 * cfy,
                    aspect);
             draw_panel(panels + p, &f, &o);
+            if (panels[p].markers && !marker_label)
+                marker_label = panels[p].marker_label ? panels[p].marker_label : "marker";
+        }
+        if (marker_label) { /* one key for the markers of every panel */
+            char *t = phc_plot_escape(marker_label);
+            char key[200];
+            if (t) {
+                snprintf(key, sizeof key, "o  %s", t);
+                plvpor(0, 1, 0, 1);
+                plwind(0, 1, 0, 1);
+                plcol0(COL_MARKER);
+                plptex(0.01, 0.03, 1, 0, 0.0, key);
+                plcol0(COL_FG);
+            }
+            free(t);
         }
         if (*title) {
             plvpor(0, 1, 0, 1);
             plwind(0, 1, 0, 1);
-            plschr(0.0, 1.25 * CHAR_SCALE);
+            plschr(0.0, 1.25 * f.chr);
             plptex(0.5, 0.965, 1, 0, 0.5, title);
-            plschr(0.0, CHAR_SCALE);
+            plschr(0.0, f.chr);
         }
         if (f.any_value)
             draw_colour_bar(&f, bar_label, gx0, gx1, gy0 + 0.1, gy1 - 0.1);
