@@ -1,7 +1,7 @@
 /* Running a calibration: see fit.h. */
-#include "fit/fit.h"
-#include "fit/parameter_units.h"
-#include "fit/provenance.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/provenance.h"
 
 #include <gsl/gsl_cdf.h>
 #include <lapacke.h>
@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/cross_validation.h"
-#include "fit/multistart.h"
-#include "fit/residual_checks.h"
-#include "fit/uncertainty.h"
+#include "fit/engine/cross_validation.h"
+#include "fit/engine/multistart.h"
+#include "fit/engine/residual_checks.h"
+#include "fit/engine/uncertainty.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -662,7 +662,7 @@ done:
     return rc;
 }
 
-/* The data set's cross-validation (fit/cross_validation.h), when its kind
+/* The data set's cross-validation (fit/engine/cross_validation.h), when its kind
  * has the op and the data set asks for it: run at the fitted values x and
  * added to the data set's report section. */
 static int add_cross_validation(const phc_problem *pb, phc_dataset *ds, const double *x, phc_progress_fn progress,

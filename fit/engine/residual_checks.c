@@ -45,7 +45,7 @@
  * matrices and vectors are views on buffers obtained with malloc, so that an
  * out-of-memory condition is returned as PHC_ERR_NOMEM instead of reaching
  * the GSL error handler. */
-#include "residual_checks.h"
+#include "fit/engine/residual_checks.h"
 
 #include <float.h>
 #include <math.h>
