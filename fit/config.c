@@ -11,7 +11,7 @@
 #include "fit/config/soil_setup_yaml.h"
 #include "fit/config/yaml_keys.h"
 #include "fit/costs/source_file.h"
-#include "fit/parameter_units.h"
+#include "fit/engine/parameter_units.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 

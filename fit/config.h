@@ -28,7 +28,7 @@
 #include <stddef.h>
 
 #include "fit/config_help.h"
-#include "fit/problem.h"
+#include "fit/engine/problem.h"
 #include "model/status.h"
 
 /* Loads and validates (phc_problem_validate) a configuration file. */

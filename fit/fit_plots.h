@@ -14,7 +14,7 @@
 
 #include <stddef.h>
 
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "model/status.h"
 
 /* Writes the plots of every data set of res into directory dir and appends

@@ -1,6 +1,6 @@
 /* The residual report: see report.h. */
 #include "fit/report.h"
-#include "fit/provenance.h"
+#include "fit/engine/provenance.h"
 #include "measurements/atomic_file.h"
 
 #include <math.h>

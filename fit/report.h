@@ -11,7 +11,7 @@
 
 #include <stdio.h>
 
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "model/status.h"
 
 /* Markdown report.  `plots` lists the PNG file names (relative to the

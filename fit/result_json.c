@@ -1,6 +1,6 @@
 /* result.json writer and reader (jansson): see result_json.h. */
 #include "fit/result_json.h"
-#include "fit/provenance.h"
+#include "fit/engine/provenance.h"
 #include "measurements/atomic_file.h"
 
 #include <jansson.h>

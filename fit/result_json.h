@@ -11,7 +11,7 @@
 #ifndef PHC_RESULT_JSON_H
 #define PHC_RESULT_JSON_H
 
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "model/status.h"
 
 /* Writes res to path (through a temporary name renamed into place). */

@@ -18,8 +18,8 @@
 #ifndef PHC_RUN_DIR_H
 #define PHC_RUN_DIR_H
 
-#include "fit/fit.h"
-#include "fit/provenance.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/provenance.h"
 #include "model/status.h"
 
 #define PHC_RUN_MANIFEST "phytocal-run.json"

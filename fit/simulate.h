@@ -6,8 +6,8 @@
 #ifndef PHC_SIMULATE_H
 #define PHC_SIMULATE_H
 
-#include "fit/problem.h"
-#include "fit/provenance.h"
+#include "fit/engine/problem.h"
+#include "fit/engine/provenance.h"
 #include "model/status.h"
 
 /* pv (may be NULL) goes into the directory's manifest (run_dir.h). */

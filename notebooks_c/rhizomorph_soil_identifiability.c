@@ -31,8 +31,8 @@
 #include <time.h>
 
 #include "fit/config.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "model/soil.h"
 
 #include "notebook_plot.h"

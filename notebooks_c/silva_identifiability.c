@@ -39,8 +39,8 @@
 
 #include "fit/config.h"
 #include "fit/costs/leaf_setup.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "measurements/photo.h"
 #include "model/colour.h"
 #include "model/leaf.h"

@@ -28,7 +28,7 @@
 #include <plplot.h>
 
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 
 #include "notebook_plot.h"
 

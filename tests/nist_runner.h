@@ -11,7 +11,7 @@
 #include <time.h>
 
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "nist_problem.h"
 
 typedef struct nist_outcome {

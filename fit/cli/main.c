@@ -18,11 +18,11 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "fit/ceres_bridge.h"
+#include "fit/engine/ceres_bridge.h"
 #include "fit/config.h"
 #include "fit/config_help.h"
-#include "fit/fit.h"
-#include "fit/provenance.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/provenance.h"
 #include "fit/report.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"

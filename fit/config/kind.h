@@ -12,7 +12,7 @@
 
 #include "fit/config.h"
 #include "fit/config_help.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/yaml_doc.h"
 #include "model/status.h"
 

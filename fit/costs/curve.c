@@ -248,152 +248,226 @@ static int names_parameter(const phc_curve_options *o, const phc_table *table, c
 
 #define WHERE(key) phc_origin_key(opt->origin, "curve", key).text
 
-int phc_curve_new(const phc_table *table, const phc_curve_options *opt,
-                  phc_dataset **out, phc_error *err)
+/* The options phc_curve_new needs before it reads anything (a config has
+ * checked them already): x, y and expression given, a table with rows, and
+ * sigma a positive number or a column, not both. */
+static int check_options(const phc_table *table, const phc_curve_options *opt, phc_error *err)
 {
-    const char *xname = opt->x, *yname = opt->y, *expr = opt->expression;
-    const char *path = phc_table_source(table);
-    phc_dataset *ds = NULL;
-    curve_impl *c = NULL;
-    char **slot_names = NULL;
-    size_t n_slots = 0;
-    int rc;
-
-    *out = NULL;
-    {   /* the required options (a config has checked them already) */
-        static const char *const names[] = {"x", "y", "expression"};
-        const char *const given[] = {xname, yname, expr};
-        for (int i = 0; i < 3; ++i)
-            if (!given[i] || !given[i][0])
-                return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s' is required", WHERE(NULL), names[i]);
-    }
+    static const char *const names[] = {"x", "y", "expression"};
+    const char *const given[] = {opt->x, opt->y, opt->expression};
+    for (int i = 0; i < 3; ++i)
+        if (!given[i] || !given[i][0])
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key '%s' is required", WHERE(NULL), names[i]);
     if (phc_table_rows(table) == 0)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one",
+                             phc_table_source(table));
     if (opt->sigma_column && opt->sigma != 0)
         return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': give a number or a column, not both",
                              WHERE("sigma"));
     if (!opt->sigma_column && !(opt->sigma >= 0 && isfinite(opt->sigma)))
         return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': must be positive, found %g",
                              WHERE("sigma"), opt->sigma);
+    return PHC_OK;
+}
 
-    c = calloc(1, sizeof *c);
-    if (!c) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    c->x_col = -1;
+/* The error "expression uses no parameters", at the expression's key. */
+static int no_parameters(const phc_curve_options *opt, phc_error *err)
+{
+    char shown_buf[EXPR_SHOWN_MAX + 64];
+    return phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\" uses no parameters", WHERE("expression"),
+                         expr_shown(opt->expression, -1, shown_buf, sizeof shown_buf));
+}
+
+/* Creates c's muparser parser for opt->expression (with the constant pi)
+ * and sets *n_vars to the number of names it uses.  Nesting too deep for
+ * either parser's stack (phc_expr_compile says PHC_ERR_DOMAIN) is refused
+ * before muparser sees it; a parse error is muparser's message
+ * (expression_error); an expression without names uses no parameters. */
+static int parse_expression(curve_impl *c, const phc_curve_options *opt, int *n_vars, phc_error *err)
+{
+    const char *expr = opt->expression;
     c->parser = mupCreate(muBASETYPE_FLOAT);
-    if (!c->parser) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "cannot create an expression parser");
-        goto fail;
-    }
+    if (!c->parser)
+        return phc_error_set(err, PHC_ERR_NOMEM, "cannot create an expression parser");
     mupDefineConst(c->parser, "pi", 3.14159265358979323846);
-    { /* nesting too deep for either parser's stack: refused before muparser sees it */
-        phc_expr *probe = NULL;
-        size_t probe_pos = 0;
-        phc_error probe_err;
-        phc_error_clear(&probe_err);
-        const int probe_rc = phc_expr_compile(expr, &probe, &probe_pos, &probe_err);
-        phc_expr_free(probe);
-        if (probe_rc == PHC_ERR_DOMAIN) {
-            char shown_buf[EXPR_SHOWN_MAX + 64];
-            rc = phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\": %s", WHERE("expression"),
-                               expr_shown(expr, (int)probe_pos, shown_buf, sizeof shown_buf),
-                               probe_err.message);
-            goto fail;
-        }
+    phc_expr *probe = NULL;
+    size_t probe_pos = 0;
+    phc_error probe_err;
+    phc_error_clear(&probe_err);
+    const int probe_rc = phc_expr_compile(expr, &probe, &probe_pos, &probe_err);
+    phc_expr_free(probe);
+    if (probe_rc == PHC_ERR_DOMAIN) {
+        char shown_buf[EXPR_SHOWN_MAX + 64];
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\": %s", WHERE("expression"),
+                             expr_shown(expr, (int)probe_pos, shown_buf, sizeof shown_buf), probe_err.message);
     }
     mupSetExpr(c->parser, expr);
-    int n_vars = mupGetExprVarNum(c->parser);
-    if (mupError(c->parser)) {
-        rc = expression_error(WHERE("expression"), expr, c->parser, opt->is_parameter, opt->user_data, err);
-        goto fail;
-    }
-    if (n_vars <= 0) {
-        char shown_buf[EXPR_SHOWN_MAX + 64];
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\" uses no parameters", WHERE("expression"),
-                           expr_shown(expr, -1, shown_buf, sizeof shown_buf));
-        goto fail;
-    }
+    *n_vars = mupGetExprVarNum(c->parser);
+    if (mupError(c->parser))
+        return expression_error(WHERE("expression"), expr, c->parser, opt->is_parameter, opt->user_data, err);
+    return *n_vars <= 0 ? no_parameters(opt, err) : PHC_OK;
+}
 
-    /* Split the expression's names into parameter slots and columns. */
-    slot_names = calloc((size_t)n_vars, sizeof *slot_names);
+/* One name of the expression: a parameter becomes slot *n_slots (its name
+ * stored in slot_names, bound to c->slots), a column of the table is read
+ * into c->cols and bound to c->row (the x column noted in c->x_col); a name
+ * that is both, or neither, is an error naming the character it stands at. */
+static int bind_name(curve_impl *c, const phc_table *table, const phc_curve_options *opt, const char *name,
+                     char **slot_names, size_t *n_slots, phc_error *err)
+{
+    const int is_param = names_parameter(opt, table, name);
+    const long col = phc_table_find(table, name);
+    int rc = PHC_OK;
+    if (is_param && col >= 0)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: expression name '%s' (character %d) is both a parameter and a column of %s; "
+                             "rename one",
+                             WHERE("expression"), name, name_column(opt->expression, name),
+                             phc_table_source(table));
+    if (is_param) {
+        if (!(slot_names[*n_slots] = strdup(name)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        mupDefineVar(c->parser, name, &c->slots[(*n_slots)++]);
+        return PHC_OK;
+    }
+    if (col < 0) {
+        char what[64];
+        snprintf(what, sizeof what, "expression (character %d): name", name_column(opt->expression, name));
+        rc = phc_unknown_column_at(WHERE("expression"), what, name, table, err);
+        if (rc == PHC_ERR_INPUT)
+            strncat(err->message, " (not a parameter either)", sizeof err->message - strlen(err->message) - 1);
+        return rc;
+    }
+    if ((rc = phc_table_column_numbers(table, name, &c->cols[c->n_cols], err)))
+        return rc;
+    if (!(c->col_names[c->n_cols] = strdup(name))) {
+        free(c->cols[c->n_cols]);
+        c->cols[c->n_cols] = NULL;
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    if (strcmp(name, opt->x) == 0)
+        c->x_col = (long)c->n_cols;
+    else
+        c->other_cols = 1;
+    mupDefineVar(c->parser, name, &c->row[c->n_cols++]);
+    return PHC_OK;
+}
+
+/* Splits the n_vars names of c's expression into parameter slots (their
+ * names into slot_names, n_vars long; *n_slots counts them) and columns
+ * (bind_name); an expression with no parameter among them is an error. */
+static int bind_names(curve_impl *c, const phc_table *table, const phc_curve_options *opt, int n_vars,
+                      char **slot_names, size_t *n_slots, phc_error *err)
+{
     c->cols = calloc((size_t)n_vars, sizeof *c->cols);
     c->col_names = calloc((size_t)n_vars, sizeof *c->col_names);
     c->row = calloc((size_t)n_vars, sizeof *c->row);
     c->slots = calloc((size_t)n_vars, sizeof *c->slots);
-    if (!slot_names || !c->cols || !c->col_names || !c->row || !c->slots) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
     char **var_names = calloc((size_t)n_vars, sizeof *var_names);
-    if (!var_names) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
+    if (!c->cols || !c->col_names || !c->row || !c->slots || !var_names) {
+        free(var_names);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
+    /* copies of muparser's names, taken before any variable is defined */
     for (int v = 0; v < n_vars; ++v) {
         const char *name = NULL;
         double *ptr = NULL;
         mupGetExprVar(c->parser, (unsigned)v, &name, &ptr);
         var_names[v] = strdup(name ? name : "");
     }
-    rc = PHC_OK;
-    for (int v = 0; v < n_vars && !rc; ++v) {
-        const char *name = var_names[v];
-        const int is_param = names_parameter(opt, table, name);
-        const long col = phc_table_find(table, name);
-        if (is_param && col >= 0) {
-            rc = phc_error_set(err, PHC_ERR_INPUT,
-                               "%s: expression name '%s' (character %d) is both a parameter and a column of %s; "
-                               "rename one",
-                               WHERE("expression"), name, name_column(expr, name), path);
-        } else if (is_param) {
-            slot_names[n_slots] = strdup(name);
-            if (!slot_names[n_slots])
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            else
-                mupDefineVar(c->parser, name, &c->slots[n_slots++]);
-        } else if (col >= 0) {
-            rc = phc_table_column_numbers(table, name, &c->cols[c->n_cols], err);
-            if (!rc && !(c->col_names[c->n_cols] = strdup(name))) {
-                free(c->cols[c->n_cols]);
-                c->cols[c->n_cols] = NULL;
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            }
-            if (!rc) {
-                if (strcmp(name, xname) == 0)
-                    c->x_col = (long)c->n_cols;
-                else
-                    c->other_cols = 1;
-                mupDefineVar(c->parser, name, &c->row[c->n_cols++]);
-            }
-        } else {
-            char what[64];
-            snprintf(what, sizeof what, "expression (character %d): name", name_column(expr, name));
-            rc = phc_unknown_column_at(WHERE("expression"), what, name, table, err);
-            if (rc == PHC_ERR_INPUT)
-                strncat(err->message, " (not a parameter either)",
-                        sizeof err->message - strlen(err->message) - 1);
-        }
-    }
+    int rc = PHC_OK;
+    for (int v = 0; v < n_vars && !rc; ++v)
+        rc = bind_name(c, table, opt, var_names[v], slot_names, n_slots, err);
     for (int v = 0; v < n_vars; ++v)
         free(var_names[v]);
     free(var_names);
-    if (rc)
-        goto fail;
-    if (n_slots == 0) {
-        char shown_buf[EXPR_SHOWN_MAX + 64];
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: expression \"%s\" uses no parameters", WHERE("expression"),
-                           expr_shown(expr, -1, shown_buf, sizeof shown_buf));
+    if (!rc && *n_slots == 0)
+        rc = no_parameters(opt, err);
+    return rc;
+}
+
+/* ds->sigma from the options: a column (every value positive, else an
+ * error at its file line), one number for every row, or none (NULL). */
+static int read_sigma(phc_dataset *ds, const phc_table *table, const phc_curve_options *opt, phc_error *err)
+{
+    int rc;
+    if (opt->sigma_column) {
+        if (phc_table_find(table, opt->sigma_column) < 0)
+            return phc_unknown_column_at(WHERE("sigma"), "sigma", opt->sigma_column, table, err);
+        if ((rc = phc_table_column_numbers(table, opt->sigma_column, &ds->sigma, err)))
+            return rc;
+        for (size_t i = 0; i < ds->n; ++i)
+            if (!(ds->sigma[i] > 0))
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
+                                     phc_table_source(table), phc_table_row_line(table, i), opt->sigma_column,
+                                     ds->sigma[i]);
+    } else if (opt->sigma > 0) {
+        if (!(ds->sigma = malloc(ds->n * sizeof *ds->sigma)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t i = 0; i < ds->n; ++i)
+            ds->sigma[i] = opt->sigma;
+    }
+    return PHC_OK;
+}
+
+/* The data set's observations from the table: n, x and y (the columns the
+ * options name), sigma (read_sigma), each row's file and line, and the axis
+ * labels (the column names unless the options give labels). */
+static int read_observations(phc_dataset *ds, const phc_table *table, const phc_curve_options *opt,
+                             phc_error *err)
+{
+    int rc;
+    ds->n = phc_table_rows(table);
+    if (phc_table_find(table, opt->x) < 0)
+        return phc_unknown_column_at(WHERE("x"), "x", opt->x, table, err);
+    if (phc_table_find(table, opt->y) < 0)
+        return phc_unknown_column_at(WHERE("y"), "y", opt->y, table, err);
+    if ((rc = phc_table_column_numbers(table, opt->x, &ds->x, err)) ||
+        (rc = phc_table_column_numbers(table, opt->y, &ds->y, err)) || (rc = read_sigma(ds, table, opt, err)))
+        return rc;
+    ds->data_file = strdup(phc_table_source(table));
+    ds->data_lines = malloc(ds->n * sizeof *ds->data_lines);
+    if (!ds->data_file || !ds->data_lines)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < ds->n; ++i)
+        ds->data_lines[i] = phc_table_row_line(table, i);
+    ds->x_label = label_or(opt->x_label, opt->x);
+    ds->y_label = label_or(opt->y_label, opt->y);
+    if (!ds->x_label || !ds->y_label)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
+int phc_curve_new(const phc_table *table, const phc_curve_options *opt,
+                  phc_dataset **out, phc_error *err)
+{
+    phc_dataset *ds = NULL;
+    curve_impl *c = NULL;
+    char **slot_names = NULL;
+    size_t n_slots = 0;
+    int n_vars = 0;
+    int rc;
+
+    *out = NULL;
+    if ((rc = check_options(table, opt, err)))
+        return rc;
+    if (!(c = calloc(1, sizeof *c))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-
+    c->x_col = -1;
+    if ((rc = parse_expression(c, opt, &n_vars, err)))
+        goto fail;
+    if (!(slot_names = calloc((size_t)n_vars, sizeof *slot_names))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
     /* Exact derivatives when the expression stays within DESIGN.md's
      * grammar; otherwise muparser with numerical derivatives. */
-    if ((rc = bind_tape(c, expr, (const char *const *)slot_names, n_slots, err)))
+    if ((rc = bind_names(c, table, opt, n_vars, slot_names, &n_slots, err)) ||
+        (rc = bind_tape(c, opt->expression, (const char *const *)slot_names, n_slots, err)))
         goto fail;
-    ds = phc_dataset_new(&phc_curve_ops, n_slots);
-    if (!ds) {
+    if (!(ds = phc_dataset_new(&phc_curve_ops, n_slots))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
@@ -402,61 +476,13 @@ int phc_curve_new(const phc_table *table, const phc_curve_options *opt,
         ds->slot_names[j] = slot_names[j];
         slot_names[j] = NULL;
     }
-    ds->n = phc_table_rows(table);
-    if (phc_table_find(table, xname) < 0) {
-        rc = phc_unknown_column_at(WHERE("x"), "x", xname, table, err);
+    if ((rc = read_observations(ds, table, opt, err)))
         goto fail;
-    }
-    if (phc_table_find(table, yname) < 0) {
-        rc = phc_unknown_column_at(WHERE("y"), "y", yname, table, err);
-        goto fail;
-    }
-    if ((rc = phc_table_column_numbers(table, xname, &ds->x, err)) ||
-        (rc = phc_table_column_numbers(table, yname, &ds->y, err)))
-        goto fail;
-
-    if (opt->sigma_column) {
-        if (phc_table_find(table, opt->sigma_column) < 0) {
-            rc = phc_unknown_column_at(WHERE("sigma"), "sigma", opt->sigma_column, table, err);
-            goto fail;
-        }
-        if ((rc = phc_table_column_numbers(table, opt->sigma_column, &ds->sigma, err)))
-            goto fail;
-        for (size_t i = 0; i < ds->n; ++i)
-            if (!(ds->sigma[i] > 0)) {
-                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': sigma must be positive, found %g",
-                                   path, phc_table_row_line(table, i), opt->sigma_column, ds->sigma[i]);
-                goto fail;
-            }
-    } else if (opt->sigma > 0) {
-        ds->sigma = malloc(ds->n * sizeof *ds->sigma);
-        if (!ds->sigma) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (size_t i = 0; i < ds->n; ++i)
-            ds->sigma[i] = opt->sigma;
-    }
-    ds->data_file = strdup(path);
-    ds->data_lines = malloc(ds->n * sizeof *ds->data_lines);
-    if (!ds->data_file || !ds->data_lines) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t i = 0; i < ds->n; ++i)
-        ds->data_lines[i] = phc_table_row_line(table, i);
-    ds->x_label = label_or(opt->x_label, xname);
-    ds->y_label = label_or(opt->y_label, yname);
-    if (!ds->x_label || !ds->y_label) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
     ds->impl = c;
     c = NULL;
     ds->config_line = phc_origin_line(opt->origin, NULL);
     *out = ds;
     ds = NULL;
-    rc = PHC_OK;
 fail:
     if (slot_names)
         for (size_t j = 0; j < n_slots; ++j)

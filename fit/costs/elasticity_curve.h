@@ -16,7 +16,7 @@
 #define PHC_COSTS_ELASTICITY_CURVE_H
 
 #include "fit/costs/origin.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/table.h"
 #include "model/status.h"
 

@@ -31,7 +31,7 @@
 
 #include "fit/costs/origin.h"
 #include "fit/costs/soil_setup.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/table.h"
 #include "model/status.h"
 

@@ -11,7 +11,7 @@
 #include "fit/costs/leaf_setup.h"
 #include "fit/costs/origin.h"
 #include "fit/costs/unique_times.h"
-#include "fit/cross_validation.h"
+#include "fit/engine/cross_validation.h"
 #include "measurements/photo.h"
 
 #define KIND "leaf_photos"
@@ -307,7 +307,7 @@ done:
     return rc;
 }
 
-/* ---- cross-validation (by the engine: fit/cross_validation.h) -------------------------- */
+/* ---- cross-validation (by the engine: fit/engine/cross_validation.h) -------------------------- */
 
 /* The stage of row r read off the model: the model time whose colours are
  * closest (weighted squared residuals) to the row's photo, searched over

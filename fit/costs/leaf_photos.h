@@ -59,7 +59,7 @@
  * piecewise-smooth function of the scales).
  *
  * cross_validate (after the fit, in the report; run by the engine,
- * fit/cross_validation.h, from the kind's plan): each row but the initial
+ * fit/engine/cross_validation.h, from the kind's plan): each row but the initial
  * and the reference is left out in turn, the data set's free slots are
  * refitted on the others, and the row's stage is predicted by finding the
  * model time whose colours are closest to its photo; beside it, a baseline
@@ -73,7 +73,7 @@
 
 #include "fit/costs/leaf_setup.h"
 #include "fit/costs/origin.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/photo.h"
 #include "model/colour.h"
 #include "model/status.h"
@@ -169,7 +169,7 @@ extern const phc_dataset_ops phc_leaf_photos_ops;
 
 /* Leave-one-out prediction of each row's stage (see above), at the fitted
  * slot values p, whether or not options.cross_validate asked for it: the
- * engine's phc_cross_validate_plan (fit/cross_validation.h) on the data
+ * engine's phc_cross_validate_plan (fit/engine/cross_validation.h) on the data
  * set's plan, with the free slots, their bounds and the solver options of
  * the data set's problem (ds->problem; progress through ds->progress).
  * Fills n_rows values each (NAN for the initial and reference rows):

@@ -21,7 +21,7 @@
 #include <stddef.h>
 
 #include "fit/costs/origin.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/table.h"
 #include "model/pressure_volume.h"
 #include "model/status.h"

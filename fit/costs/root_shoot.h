@@ -52,7 +52,7 @@
 #include "fit/costs/harvest.h"
 #include "fit/costs/origin.h"
 #include "fit/costs/soil_setup.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "model/growth.h"
 #include "model/status.h"
 

@@ -29,7 +29,7 @@
 
 #include "fit/costs/origin.h"
 #include "fit/costs/soil_setup.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/soil_probes.h"
 #include "model/status.h"
 

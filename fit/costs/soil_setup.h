@@ -44,7 +44,7 @@
 #include <stdint.h>
 
 #include "fit/costs/origin.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "measurements/geo.h"
 #include "model/soil.h"
 #include "model/status.h"

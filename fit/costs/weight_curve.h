@@ -44,7 +44,7 @@
 
 #include "fit/costs/origin.h"
 #include "fit/costs/weight_drivers.h"
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 #include "model/plant_graph.h"
 #include "model/status.h"
 #include "model/water.h"

@@ -34,7 +34,7 @@
 #include <unistd.h>
 
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "measurements/plant_io.h"
 #include "model/water.h"
 

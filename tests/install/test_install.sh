@@ -117,8 +117,8 @@ LIBDIR=$(dirname "${SO:-$P/lib/none}")
 [ -L "$LIBDIR/libphytocal.so" ] || why "no libphytocal.so symlink (for -lphytocal) in $LIBDIR"
 [ -L "$SO" ] || why "libphytocal.so.0 is not a symlink to the versioned file"
 ls "$LIBDIR"/libphytocal.so.0.* >/dev/null 2>&1 || why "no versioned libphytocal.so.0.x.y in $LIBDIR"
-for h in phytocal.h fit/version.h fit/problem.h fit/dataset.h fit/fit.h fit/config.h fit/report.h \
-         fit/result_json.h model/water.h model/plant_graph.h model/status.h measurements/plant_io.h; do
+for h in phytocal.h fit/version.h fit/engine/problem.h fit/engine/dataset.h fit/engine/fit.h fit/config.h \
+         fit/report.h fit/result_json.h model/water.h model/plant_graph.h model/status.h measurements/plant_io.h; do
     [ -f "$P/include/phytocal/$h" ] || why "missing header include/phytocal/$h"
 done
 [ ! -e "$P/include/phytocal/fit/cli" ] || why "fit/cli was installed"
@@ -142,10 +142,10 @@ finish "readelf: SONAME libphytocal.so.0, only phc_* exported"
 # 4. installed headers include only C standard headers (and each other)
 STD='assert|complex|ctype|errno|float|inttypes|limits|locale|math|setjmp|signal|stdarg|stdbool|stddef|stdint|stdio|stdlib|string|time|wchar'
 # Known exceptions: header -> what it includes, and why that is acceptable.
-#   fit/provenance.h <jansson.h>: a run's provenance as a jansson object; it
-#   is not in phytocal.h (only run_dir.h and simulate.h include it), and a
-#   program that includes it needs libjansson-dev.
-KNOWN='fit/provenance.h:jansson.h'
+#   fit/engine/provenance.h <jansson.h>: a run's provenance as a jansson
+#   object; it is not in phytocal.h (only run_dir.h and simulate.h include
+#   it), and a program that includes it needs libjansson-dev.
+KNOWN='fit/engine/provenance.h:jansson.h'
 bad=$(find "$P/include/phytocal" -name '*.h' -exec awk -v std="$STD" -v known=" $KNOWN " \
         -v root="$P/include/phytocal/" '
     /^[ \t]*#[ \t]*include[ \t]*</ {

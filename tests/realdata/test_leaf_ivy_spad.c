@@ -17,7 +17,7 @@
 #include "check.h"
 #include "fit/config.h"
 #include "fit/costs/leaf_photos.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 
 int main(void)
 {

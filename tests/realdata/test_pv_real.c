@@ -24,7 +24,7 @@
 #include "check.h"
 #include "fit/config.h"
 #include "fit/costs/pv_curve.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 
 static const char *params_block = "parameters:\n"
                                   "  kappa: {value: 20, lower: 0, upper: 1000}\n"

@@ -29,7 +29,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "fit/growth_outputs.h"
 #include "measurements/rsml.h"
 #include "model/growth.h"

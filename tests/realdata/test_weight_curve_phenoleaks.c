@@ -22,7 +22,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 
 #define EX PHC_SOURCE_DIR "/measurements/examples/phenoleaks/"
 

@@ -11,7 +11,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
 #include "fit/simulate.h"

@@ -24,7 +24,7 @@
 #include "fit/config.h"
 #include "fit/leaf_images.h"
 #include "fit/costs/leaf_setup.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "fit/run_dir.h"
 #include "fit/simulate.h"
 

@@ -1,4 +1,4 @@
-/* Parameter units through a config (fit/parameter_units.h): the bundled
+/* Parameter units through a config (fit/engine/parameter_units.h): the bundled
  * pressure-volume example fitted with e_max given in MPa (the unit pv_curve
  * declares for e_min and e_max) and again in bar (start 50 bar = 5 MPa).
  * The fitted value and its standard error must come back 10x larger in bar,
@@ -11,7 +11,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 
 static char dir[] = "/tmp/phc_units_pv_XXXXXX";
 

@@ -15,7 +15,7 @@
 #include "check.h"
 #include "fit/config.h"
 #include "fit/costs/pv_curve.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "fit/run_dir.h"
 
 static const phc_param_result *param(const phc_fit_result *r, const char *name)

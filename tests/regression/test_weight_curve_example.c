@@ -15,7 +15,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 
 static const phc_param_result *param(const phc_fit_result *r, const char *name)
 {

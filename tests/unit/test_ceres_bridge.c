@@ -1,4 +1,4 @@
-/* Unit tests of fit/ceres_bridge.cc through the phc_nls_* C API with small C
+/* Unit tests of fit/engine/ceres_bridge.cc through the phc_nls_* C API with small C
  * callbacks (no data sets, no configs).
  *
  *  - linear least squares y = a + b x: the exact normal-equations solution,
@@ -21,7 +21,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "fit/ceres_bridge.h"
+#include "fit/engine/ceres_bridge.h"
 
 /* The trust-region solver accepts a step only when the cost decreases; near
  * the optimum a parameter error e changes the cost by O(e^2), below the

@@ -16,8 +16,8 @@
 
 #include "check.h"
 #include "fit/costs/curve.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "measurements/table.h"
 
 static void test_table_from_columns(void)

@@ -21,7 +21,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "fit/fit_plots.h"
 #include "fit/report.h"
 #include "fit/result_json.h"

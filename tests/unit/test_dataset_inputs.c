@@ -1,5 +1,5 @@
 /* Every data-set kind records the files its loader read
- * (phc_dataset_add_input, fit/dataset.h), for provenance.  Checked here with
+ * (phc_dataset_add_input, fit/engine/dataset.h), for provenance.  Checked here with
  * phc_config_load, list against list (in any order, each path as opened:
  * the config's directory joined with the name it gives):
  *

@@ -18,8 +18,8 @@
 
 #include "check.h"
 #include "fit/costs/elasticity_curve.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "measurements/table.h"
 #include "model/elasticity.h"
 

@@ -27,7 +27,7 @@
 
 #include "check.h"
 #include "fit/config.h"
-#include "fit/fit.h"
+#include "fit/engine/fit.h"
 #include "fit/result_json.h"
 
 static char tmp_dir[] = "/tmp/phc_test_fit_engine_XXXXXX";

@@ -1,4 +1,4 @@
-/* Unit tests of fit/goodness.c: a hand-computed example and R's nls
+/* Unit tests of fit/engine/goodness.c: a hand-computed example and R's nls
  * log-likelihood / AIC / BIC.
  *
  * References: hand arithmetic (shown in comments); Python 3.11
@@ -8,7 +8,7 @@
 #include <stddef.h>
 
 #include "check.h"
-#include "fit/goodness.h"
+#include "fit/engine/goodness.h"
 
 static void test_hand_example(void)
 {

@@ -17,8 +17,8 @@
 
 #include "check.h"
 #include "fit/costs/infiltration.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "measurements/table.h"
 
 #define N_OBS 6

@@ -9,7 +9,7 @@
  *    phc_leaf_photos_new over them, bound by name to a hand-built problem,
  *    fits the inflow scale back from 0.15 (within 10 %: the photos went
  *    model grid -> photo size -> model grid, which blurs); the engine's
- *    leave-one-out (fit/cross_validation.h, run by phc_fit_run because the
+ *    leave-one-out (fit/engine/cross_validation.h, run by phc_fit_run because the
  *    data set asks for it) puts its table in the report section, with the
  *    numbers phc_cross_validate gives;
  * 2. histogram residuals over a "scan" of two leaves shared by two rows
@@ -26,9 +26,9 @@
 #include "check.h"
 #include "fit/costs/leaf_photos.h"
 #include "fit/costs/leaf_setup.h"
-#include "fit/cross_validation.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/cross_validation.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 
 #define W 120
 #define H 80

@@ -1,4 +1,4 @@
-/* Parameter units (fit/parameter_units.h): a parameter given in the user's
+/* Parameter units (fit/engine/parameter_units.h): a parameter given in the user's
  * unit is converted into the unit its model slot declares, fitted there,
  * and reported back in the user's unit.
  *
@@ -17,9 +17,9 @@
 
 #include "check.h"
 #include "fit/costs/curve.h"
-#include "fit/fit.h"
-#include "fit/parameter_units.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/problem.h"
 
 /* Mass loss y (g) at times t (s) for a = 2e-3 g s-1, with a small
  * deterministic disturbance so that the standard error is not zero. */

@@ -1,4 +1,4 @@
-/* Provenance (fit/provenance.h): SHA-256 against the FIPS 180-2 test
+/* Provenance (fit/engine/provenance.h): SHA-256 against the FIPS 180-2 test
  * vectors, the JSON round trip, the markdown section, and the state of a
  * recorded file (same, changed, missing). */
 #define _XOPEN_SOURCE 700
@@ -8,8 +8,8 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "fit/problem.h"
-#include "fit/provenance.h"
+#include "fit/engine/problem.h"
+#include "fit/engine/provenance.h"
 
 static char dir[] = "/tmp/phc-provenance-XXXXXX";
 

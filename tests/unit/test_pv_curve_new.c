@@ -27,8 +27,8 @@
 
 #include "check.h"
 #include "fit/costs/pv_curve.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "measurements/table.h"
 
 #define PER_LEAF 31

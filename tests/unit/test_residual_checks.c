@@ -1,4 +1,4 @@
-/* Unit tests of fit/residual_checks.c against independently computed
+/* Unit tests of fit/engine/residual_checks.c against independently computed
  * reference values.
  *
  * Reference tools (Debian 12 packages):
@@ -18,7 +18,7 @@
 #include <stdio.h>
 
 #include "check.h"
-#include "fit/residual_checks.h"
+#include "fit/engine/residual_checks.h"
 
 #define N30 30
 

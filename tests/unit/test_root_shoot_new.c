@@ -24,8 +24,8 @@
 
 #include "check.h"
 #include "fit/costs/root_shoot.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 #include "measurements/table.h"
 
 #define N_PLANTS 5

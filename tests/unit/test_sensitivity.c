@@ -1,4 +1,4 @@
-/* Unit tests of fit/sensitivity.c: FME-style L1/L2 summaries and the
+/* Unit tests of fit/engine/sensitivity.c: FME-style L1/L2 summaries and the
  * collinearity index of Brun et al. (2001).
  *
  * Two columns at angle theta: after scaling to unit length they are u and v
@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "fit/sensitivity.h"
+#include "fit/engine/sensitivity.h"
 
 static const double PI = 3.14159265358979323846;
 

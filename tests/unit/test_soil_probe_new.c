@@ -20,8 +20,8 @@
 
 #include "check.h"
 #include "fit/costs/soil_probe.h"
-#include "fit/fit.h"
-#include "fit/problem.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
 
 #define N_READ 12 /* 2 probes x 6 times */
 

@@ -1,4 +1,4 @@
-/* Unit tests of fit/uncertainty.c: covariance, standard errors, correlation
+/* Unit tests of fit/engine/uncertainty.c: covariance, standard errors, correlation
  * and undetermined directions from a Jacobian.
  *
  * References are computed here independently: s^2 (X'X)^-1 by GSL's
@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "fit/uncertainty.h"
+#include "fit/engine/uncertainty.h"
 
 /* s2 (J'J)^-1 by GSL (Cholesky), n x n row-major into out. */
 static void gsl_cov(const double *J, size_t m, size_t n, double s2, double *out)

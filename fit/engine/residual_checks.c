@@ -45,7 +45,7 @@
  * matrices and vectors are views on buffers obtained with malloc, so that an
  * out-of-memory condition is returned as PHC_ERR_NOMEM instead of reaching
  * the GSL error handler. */
-#include "residual_checks.h"
+#include "fit/engine/residual_checks.h"
 
 #include <float.h>
 #include <math.h>
@@ -92,6 +92,20 @@ static int is_constant(const double *x, size_t n)
         if (x[i] != x[0])
             return 0;
     return 1;
+}
+
+/* sum_i (r_i - rbar)^2 over n > 0 values, with their mean rbar in *mean
+ * (the autocorrelations' c_0 times n). */
+static double centred_sum_of_squares(const double *r, size_t n, double *mean)
+{
+    double m = 0.0, ss = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        m += r[i];
+    m /= (double)n;
+    for (size_t i = 0; i < n; ++i)
+        ss += (r[i] - m) * (r[i] - m);
+    *mean = m;
+    return ss;
 }
 
 static int cmp_double(const void *pa, const void *pb)
@@ -417,13 +431,8 @@ int phc_check_acf(const double *r, size_t n, size_t max_lag, double *acf)
         return PHC_ERR_INVALID;
     }
 
-    double mean = 0.0;
-    for (size_t i = 0; i < n; ++i)
-        mean += r[i];
-    mean /= (double)n;
-    double c0 = 0.0;
-    for (size_t i = 0; i < n; ++i)
-        c0 += (r[i] - mean) * (r[i] - mean);
+    double mean;
+    const double c0 = centred_sum_of_squares(r, n, &mean);
     if (!(c0 > 0.0) || !isfinite(c0)) {
         for (size_t h = 0; h <= max_lag; ++h)
             acf[h] = NAN;
@@ -813,14 +822,8 @@ int phc_check_acf_time(const double *t, const double *r, size_t n,
     if (!t || !r || n < 3 || !(bin_h > 0.0) || !isfinite(bin_h) ||
         !all_finite(t, n) || !all_finite(r, n) || is_constant(r, n))
         return PHC_ERR_INVALID;
-    double mean = 0.0;
-    for (size_t i = 0; i < n; ++i)
-        mean += r[i];
-    mean /= (double)n;
-    double c0 = 0.0;
-    for (size_t i = 0; i < n; ++i)
-        c0 += (r[i] - mean) * (r[i] - mean);
-    c0 /= (double)n;
+    double mean;
+    const double c0 = centred_sum_of_squares(r, n, &mean) / (double)n;
     if (!(c0 > 0.0) || !isfinite(c0))
         return PHC_ERR_INVALID;
     timed_index *o = malloc(n * sizeof *o);

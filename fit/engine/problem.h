@@ -6,8 +6,8 @@
 
 #include <stddef.h>
 
-#include "fit/ceres_bridge.h"
-#include "fit/dataset.h"
+#include "fit/engine/ceres_bridge.h"
+#include "fit/engine/dataset.h"
 #include "model/status.h"
 
 typedef struct phc_parameter {

@@ -1,12 +1,12 @@
 /* Cross-validation by the engine: see cross_validation.h. */
-#include "fit/cross_validation.h"
+#include "fit/engine/cross_validation.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/ceres_bridge.h"
+#include "fit/engine/ceres_bridge.h"
 
 void phc_cv_plan_clear(phc_cv_plan *plan)
 {

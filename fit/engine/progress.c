@@ -1,5 +1,5 @@
 /* Progress reports: see progress.h. */
-#include "fit/progress.h"
+#include "fit/engine/progress.h"
 
 int phc_progress_report(phc_progress_fn fn, void *user_data, const char *stage, size_t step,
                         size_t steps, int iteration, double cost, const char *detail)

@@ -1,5 +1,5 @@
 /* Sensitivities and collinearity indices: see sensitivity.h. */
-#include "fit/sensitivity.h"
+#include "fit/engine/sensitivity.h"
 
 #include <float.h>
 #include <lapacke.h>

@@ -13,7 +13,7 @@
  * The Nash-Sutcliffe efficiency (Nash & Sutcliffe 1970, eq. 1)
  * NSE = 1 - sum (y - yhat)^2 / sum (y - ybar)^2 is the same number as the
  * coefficient of determination defined that way. */
-#include "goodness.h"
+#include "fit/engine/goodness.h"
 
 #include <math.h>
 

@@ -1,5 +1,5 @@
 /* Covariance at the optimum: see uncertainty.h. */
-#include "fit/uncertainty.h"
+#include "fit/engine/uncertainty.h"
 
 #include <lapacke.h>
 #include <math.h>

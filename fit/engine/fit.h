@@ -7,10 +7,10 @@
 
 #include <stddef.h>
 
-#include "fit/ceres_bridge.h"
-#include "fit/goodness.h"
-#include "fit/problem.h"
-#include "fit/sensitivity.h"
+#include "fit/engine/ceres_bridge.h"
+#include "fit/engine/goodness.h"
+#include "fit/engine/problem.h"
+#include "fit/engine/sensitivity.h"
 #include "model/status.h"
 
 /* Residual checks reported per data set, in this order. */

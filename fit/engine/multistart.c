@@ -1,5 +1,5 @@
 /* Sobol starting points: see multistart.h. */
-#include "fit/multistart.h"
+#include "fit/engine/multistart.h"
 
 #include <gsl/gsl_qrng.h>
 #include <math.h>

@@ -2,7 +2,7 @@
  *
  * Why not ceres/c_api.h: it has no bounds, no solver options, no summary and
  * no covariance.  This bridge is the only file that touches Ceres
- * (fit/ceres_bridge.cc); no C++ type appears here.
+ * (fit/engine/ceres_bridge.cc); no C++ type appears here.
  *
  * The problem minimises  1/2 sum_b sum_i rho_b(r_bi(x)^2)  over x in R^n,
  * where each residual block b is a caller callback returning m_b residuals

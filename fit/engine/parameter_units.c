@@ -1,5 +1,5 @@
 /* Parameter units: see parameter_units.h. */
-#include "fit/parameter_units.h"
+#include "fit/engine/parameter_units.h"
 
 #include <math.h>
 #include <stdio.h>

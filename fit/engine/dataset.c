@@ -1,5 +1,5 @@
 /* Data sets: see dataset.h. */
-#include "fit/dataset.h"
+#include "fit/engine/dataset.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,7 +1,7 @@
 /* Running a calibration: see fit.h. */
-#include "fit/fit.h"
-#include "fit/parameter_units.h"
-#include "fit/provenance.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/provenance.h"
 
 #include <gsl/gsl_cdf.h>
 #include <lapacke.h>
@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fit/cross_validation.h"
-#include "fit/multistart.h"
-#include "fit/residual_checks.h"
-#include "fit/uncertainty.h"
+#include "fit/engine/cross_validation.h"
+#include "fit/engine/multistart.h"
+#include "fit/engine/residual_checks.h"
+#include "fit/engine/uncertainty.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -662,7 +662,7 @@ done:
     return rc;
 }
 
-/* The data set's cross-validation (fit/cross_validation.h), when its kind
+/* The data set's cross-validation (fit/engine/cross_validation.h), when its kind
  * has the op and the data set asks for it: run at the fitted values x and
  * added to the data set's report section. */
 static int add_cross_validation(const phc_problem *pb, phc_dataset *ds, const double *x, phc_progress_fn progress,
@@ -693,61 +693,52 @@ static int add_cross_validation(const phc_problem *pb, phc_dataset *ds, const do
     return rc;
 }
 
-int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
-                phc_fit_result **out, phc_error *err)
-{
-    phc_nls *nls = NULL;
-    phc_fit_result *res = NULL;
-    phc_multistart *ms = NULL;
-    double *x = NULL, *best = NULL, *r = NULL, *J = NULL, *Jf = NULL, *S = NULL;
-    phc_covariance cov = {0};
-    int rc;
-    *out = NULL;
-    if ((rc = phc_problem_validate(pb, err)))
-        return rc;
-    /* long work of the kinds while the fit runs reports progress through
-     * their data set */
-    for (size_t d = 0; d < pb->n_datasets; ++d) {
-        pb->datasets[d]->progress = progress;
-        pb->datasets[d]->progress_data = user_data;
-    }
-    const size_t np = pb->n_params;
-    const phc_fit_options *opt = &pb->options;
+/* ---- the solve stage: starts, rescue, polish ---------------------------- */
 
-    nls = phc_nls_new(np);
-    res = calloc(1, sizeof *res);
-    x = calloc(np, sizeof *x);
-    best = calloc(np, sizeof *best);
-    if (!nls || !res || !x || !best) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t i = 0; i < np; ++i) {
+/* Declares pb's parameters (bounds, fixed flags, scales) and one residual
+ * block per data set to nls, and writes the configured start into x (np
+ * values).  Every data set must be able to evaluate its model there
+ * (phc_dataset_check_start).  PHC_OK or an error with a message. */
+static int solve_setup(phc_nls *nls, const phc_problem *pb, double *x, phc_error *err)
+{
+    int rc;
+    for (size_t i = 0; i < pb->n_params; ++i) {
         const phc_parameter *p = &pb->params[i];
         if ((rc = phc_nls_set_parameter(nls, i, p->lower, p->upper, p->fixed, phc_problem_scale(pb, i), err)))
-            goto fail;
+            return rc;
         x[i] = p->value;
     }
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         phc_dataset *ds = pb->datasets[d];
         if ((rc = phc_dataset_check_start(ds, x, err)))
-            goto fail;
+            return rc;
         if ((rc = phc_nls_add_block(nls, ds->n, ds->param_index, ds->k, phc_dataset_residuals,
                                     ds->derivatives, ds->loss, ds->loss_scale, ds, err)))
-            goto fail;
+            return rc;
     }
+    return PHC_OK;
+}
 
-    /* Start 0 is the configured start; the others come from the Sobol box.
-     * With a single configured start, a result that did not converge or that
-     * sits where the model no longer depends on a parameter (a stall on a
-     * plateau, e.g. NIST BoxBOD from Start 1) triggers rescue starts. */
-    double best_cost = INFINITY;
+/* Runs the starts from x (the configured start, overwritten): start 0 is x
+ * itself, the others come from the Sobol box (multistart.h).  With a single
+ * configured start, a start 0 that did not converge or that sits where the
+ * model no longer depends on a parameter (a stall on a plateau, e.g. NIST
+ * BoxBOD from Start 1) adds opt->rescue_starts starts.  On PHC_OK best (np)
+ * holds the lowest-cost point, and res->summary (of that start),
+ * total_time, starts, rescue_starts and starts_at_best are set.  Reports
+ * "start" progress; a cancelled callback is an error. */
+static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progress, void *user_data,
+                      double *x, double *best, phc_fit_result *res, phc_error *err)
+{
+    const phc_fit_options *opt = &pb->options;
+    const size_t np = pb->n_params;
     size_t planned = opt->starts;
+    double best_cost = INFINITY;
     double *costs = calloc(opt->starts + opt->rescue_starts, sizeof *costs);
-    if (!costs) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
+    phc_multistart *ms = NULL;
+    int rc = PHC_OK;
+    if (!costs)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     phc_progress_relay relay = {progress, user_data, "start", NULL, 0, planned, 0};
     phc_nls_options nls_opt = opt->nls;
     if (progress) {
@@ -759,22 +750,22 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         relay.steps = planned;
         if (phc_progress_report(progress, user_data, "start", s + 1, planned, -1, NAN, NULL)) {
             rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-            goto fail_costs;
+            goto done;
         }
         if (s > 0 && !ms && !(ms = phc_multistart_new(pb))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail_costs;
+            goto done;
         }
         if (s > 0 && (rc = phc_multistart_next(ms, x))) {
             phc_error_set(err, rc, "cannot draw start %zu", s + 1);
-            goto fail_costs;
+            goto done;
         }
         phc_nls_summary sum;
         if ((rc = phc_nls_solve(nls, &nls_opt, x, &sum, err)))
-            goto fail_costs;
+            goto done;
         if (relay.cancelled) {
             rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-            goto fail_costs;
+            goto done;
         }
         res->total_time += sum.wall_time;
         costs[s] = sum.outcome == PHC_NLS_FAILED ? INFINITY : sum.final_cost;
@@ -797,41 +788,56 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     for (size_t s = 0; s < planned; ++s)
         if (isfinite(costs[s]) && costs[s] <= best_cost + 1e-8 * fabs(best_cost) + 1e-300)
             res->starts_at_best++;
+done:
+    phc_multistart_free(ms);
     free(costs);
-    costs = NULL;
-    if (phc_progress_report(progress, user_data, "uncertainty", 0, 0, -1, NAN, NULL)) {
-        rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
-        goto fail;
-    }
+    return rc;
+}
 
-    /* Everything else is judged at the best point. */
-    const size_t m = phc_nls_residual_count(nls);
-    if (res->summary.outcome == PHC_NLS_CONVERGED && (rc = polish(nls, pb, best, m, err)))
-        goto fail;
-    r = calloc(m, sizeof *r);
-    J = calloc(m * np, sizeof *J);
-    if (!r || !J) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if ((rc = phc_nls_evaluate(nls, best, r, J, &res->cost, err)))
-        goto fail;
+/* The solve stage: declares pb to nls (solve_setup), runs the starts
+ * (run_starts) and, when the best start converged, polishes it by
+ * Gauss-Newton (polish).  On PHC_OK best (np values) is the solution, at
+ * which the analyse stage judges everything; res holds the solver's
+ * summary and the start counts. */
+static int fit_solve(phc_nls *nls, const phc_problem *pb, phc_progress_fn progress, void *user_data,
+                     double *best, phc_fit_result *res, phc_error *err)
+{
+    double *x = calloc(pb->n_params, sizeof *x);
+    int rc;
+    if (!x)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (!(rc = solve_setup(nls, pb, x, err)) && !(rc = run_starts(nls, pb, progress, user_data, x, best, res, err)) &&
+        res->summary.outcome == PHC_NLS_CONVERGED)
+        rc = polish(nls, pb, best, phc_nls_residual_count(nls), err);
+    free(x);
+    return rc;
+}
+
+/* ---- the analyse stage: covariance, intervals, sensitivities, data sets -- */
+
+/* The result's frame at the solution: its name, the parameter and data-set
+ * arrays (filled later), the free parameters (free_index, n_free), the
+ * observation count m, degrees of freedom, the options it reports, the
+ * weighted residual sum of squares of the m weighted residuals r and the
+ * variance factor s2 (1 with absolute sigmas, else wrss / dof, NAN without
+ * degrees of freedom).  PHC_OK or PHC_ERR_NOMEM with a message. */
+static int result_frame(const phc_problem *pb, const double *r, size_t m, phc_fit_result *res, phc_error *err)
+{
+    const size_t np = pb->n_params;
+    const phc_fit_options *opt = &pb->options;
     res->name = strdup(pb->name);
     res->n_params = np;
     res->params = calloc(np, sizeof *res->params);
     res->free_index = calloc(np, sizeof *res->free_index);
     res->n_datasets = pb->n_datasets;
     res->datasets = calloc(pb->n_datasets, sizeof *res->datasets);
-    if (!res->name || !res->params || !res->free_index || !res->datasets) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
+    if (!res->name || !res->params || !res->free_index || !res->datasets)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     res->n_obs = m;
     for (size_t i = 0; i < np; ++i)
         if (!pb->params[i].fixed)
             res->free_index[res->n_free++] = i;
-    const size_t nf = res->n_free;
-    res->dof = (long)m - (long)nf;
+    res->dof = (long)m - (long)res->n_free;
     res->absolute_sigma = opt->absolute_sigma;
     res->level = opt->level;
     res->collinearity_threshold = opt->collinearity_threshold;
@@ -839,65 +845,24 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     for (size_t i = 0; i < m; ++i)
         res->wrss += r[i] * r[i];
     res->s2 = opt->absolute_sigma ? 1.0 : (res->dof > 0 ? res->wrss / (double)res->dof : NAN);
+    return PHC_OK;
+}
 
-    /* Covariance over the free parameters. */
-    Jf = malloc(m * nf * sizeof *Jf);
-    if (!Jf) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t i = 0; i < m; ++i)
-        for (size_t f = 0; f < nf; ++f)
-            Jf[i * nf + f] = J[i * np + res->free_index[f]];
-    const double s2 = isfinite(res->s2) ? res->s2 : 1.0;
-    double *scales = malloc((nf ? nf : 1) * sizeof *scales);
-    if (!scales) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    for (size_t f = 0; f < nf; ++f) {
-        const size_t gi = res->free_index[f];
-        scales[f] = effect_scale(pb, best, gi);
-    }
-    rc = phc_covariance_compute(Jf, m, nf, s2, NEGLIGIBLE_EFFECT, scales, &cov, err);
-    free(scales);
-    if (rc)
-        goto fail;
-    res->rank = cov.rank;
-    res->condition = cov.condition;
-    res->correlation = dup_array(cov.correlation, nf * nf);
-    if (!res->correlation) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
-    }
-    if (cov.n_null) {
-        const char **names = malloc(nf * sizeof *names);
-        res->undetermined = calloc(cov.n_null, sizeof *res->undetermined);
-        if (!names || !res->undetermined) {
-            free(names);
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        for (size_t f = 0; f < nf; ++f)
-            names[f] = pb->params[res->free_index[f]].name;
-        for (size_t k = 0; k < cov.n_null; ++k) {
-            char buf[512];
-            phc_covariance_describe_null(&cov, k, names, buf, sizeof buf);
-            res->undetermined[res->n_undetermined++] = strdup(buf);
-        }
-        free(names);
-    }
+/* Each parameter's result at the solution best: name, unit, start and value
+ * in the user's unit (parameter_units.h), and for free parameters the
+ * standard error from cov (NAN without degrees of freedom), the t-based 95%
+ * interval and whether it ended on a bound.  PHC_OK or PHC_ERR_NOMEM. */
+static int param_results(const phc_problem *pb, const double *best, const phc_covariance *cov,
+                         phc_fit_result *res, phc_error *err)
+{
     const double t = res->dof > 0 ? gsl_cdf_tdist_Pinv(0.975, (double)res->dof) : NAN;
-    for (size_t i = 0, f = 0; i < np; ++i) {
+    for (size_t i = 0, f = 0; i < pb->n_params; ++i) {
         const phc_parameter *p = &pb->params[i];
         phc_param_result *pr = &res->params[i];
         pr->name = strdup(p->name);
         pr->unit = p->unit ? strdup(p->unit) : NULL;
-        if (!pr->name || (p->unit && !pr->unit)) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
-        }
-        /* reported in the user's unit (parameter_units.h) */
+        if (!pr->name || (p->unit && !pr->unit))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         pr->start = phc_parameter_to_user(p, p->value);
         pr->value = phc_parameter_to_user(p, best[i]);
         pr->unit_scale = p->unit_scale;
@@ -906,7 +871,7 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         pr->stderr_ = pr->ci_lo = pr->ci_hi = pr->sens_l1 = pr->sens_l2 = NAN;
         if (p->fixed)
             continue;
-        pr->stderr_ = res->dof > 0 ? cov.stderr_[f] / fabs(p->unit_scale) : NAN;
+        pr->stderr_ = res->dof > 0 ? cov->stderr_[f] / fabs(p->unit_scale) : NAN;
         pr->ci_lo = pr->value - t * pr->stderr_;
         pr->ci_hi = pr->value + t * pr->stderr_;
         const double tol = 1e-10 * phc_problem_scale(pb, i);
@@ -916,18 +881,91 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             pr->at_bound = p->unit_scale > 0 ? 1 : -1;
         ++f;
     }
+    return PHC_OK;
+}
 
-    /* Normalised sensitivities S_ij = d yhat_i / d p_j * p_j / sigma_i. */
-    S = malloc(m * (nf ? nf : 1) * sizeof *S);
-    if (!S) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
+/* The combinations of free parameters the data cannot determine (cov's null
+ * space, described with the parameters' names) into res->undetermined. */
+static int undetermined_combinations(const phc_problem *pb, const phc_covariance *cov, phc_fit_result *res,
+                                     phc_error *err)
+{
+    const size_t nf = res->n_free;
+    if (!cov->n_null)
+        return PHC_OK;
+    const char **names = malloc(nf * sizeof *names);
+    res->undetermined = calloc(cov->n_null, sizeof *res->undetermined);
+    if (!names || !res->undetermined) {
+        free(names);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
-    const double s_noise = isfinite(res->s2) && res->s2 > 0 ? sqrt(res->s2) : 1.0;
+    for (size_t f = 0; f < nf; ++f)
+        names[f] = pb->params[res->free_index[f]].name;
+    for (size_t k = 0; k < cov->n_null; ++k) {
+        char buf[512];
+        phc_covariance_describe_null(cov, k, names, buf, sizeof buf);
+        res->undetermined[res->n_undetermined++] = strdup(buf);
+    }
+    free(names);
+    return PHC_OK;
+}
+
+/* Covariance over the free parameters from Jf (m x n_free, the Jacobian's
+ * free columns at best), scaled by res->s2 (1 when undefined): rank,
+ * condition, correlations, undetermined combinations and every parameter's
+ * interval (param_results).  PHC_OK or an error with a message. */
+static int analyse_covariance(const phc_problem *pb, const double *best, const double *Jf, size_t m,
+                              phc_fit_result *res, phc_error *err)
+{
+    const size_t nf = res->n_free;
+    const double s2 = isfinite(res->s2) ? res->s2 : 1.0;
+    phc_covariance cov = {0};
+    double *scales = calloc(nf ? nf : 1, sizeof *scales); /* one zero when no parameter is free */
+    if (!scales)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t f = 0; f < nf; ++f)
+        scales[f] = effect_scale(pb, best, res->free_index[f]);
+    int rc = phc_covariance_compute(Jf, m, nf, s2, NEGLIGIBLE_EFFECT, scales, &cov, err);
+    free(scales);
+    if (rc)
+        goto done;
+    res->rank = cov.rank;
+    res->condition = cov.condition;
+    res->correlation = dup_array(cov.correlation, nf * nf);
+    if (!res->correlation) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    if (!(rc = undetermined_combinations(pb, &cov, res, err)))
+        rc = param_results(pb, best, &cov, res, err);
+done:
+    phc_covariance_clear(&cov);
+    return rc;
+}
+
+/* The standard deviation the weighted residuals are measured in: sqrt(s2),
+ * or 1 when s2 is not a positive number. */
+static double noise_scale(const phc_fit_result *res)
+{
+    return isfinite(res->s2) && res->s2 > 0 ? sqrt(res->s2) : 1.0;
+}
+
+/* Normalised sensitivities S_ij = d yhat_i / d p_j * p_j / sigma_i (FME;
+ * Soetaert & Petzoldt 2010) of the free parameters from Jf (m x n_free) at
+ * best, their L1/L2 summaries and collinearity indices into
+ * res->sensitivity and the parameters' sens_l1, sens_l2. */
+static int analyse_sensitivity(const phc_problem *pb, const double *best, const double *Jf, size_t m,
+                               phc_fit_result *res, phc_error *err)
+{
+    const size_t nf = res->n_free;
+    double *S = malloc(m * (nf ? nf : 1) * sizeof *S);
+    int rc = PHC_OK;
+    if (!S)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    const double s_noise = noise_scale(res);
     for (size_t d = 0, row = 0; d < pb->n_datasets; ++d) {
         const phc_dataset *ds = pb->datasets[d];
         /* residuals are already divided by sigma when sigmas are given */
-        const double extra = ds->sigma && opt->absolute_sigma ? 1.0 : s_noise;
+        const double extra = ds->sigma && pb->options.absolute_sigma ? 1.0 : s_noise;
         for (size_t i = 0; i < ds->n; ++i, ++row)
             for (size_t f = 0; f < nf; ++f) {
                 const size_t gi = res->free_index[f];
@@ -936,47 +974,107 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
             }
     }
     if (nf && (rc = phc_sensitivity_compute(S, m, nf, MAX_COLLIN_SETS, &res->sensitivity, err)))
-        goto fail;
+        goto done;
     for (size_t f = 0; f < nf; ++f) {
         res->params[res->free_index[f]].sens_l1 = res->sensitivity.l1[f];
         res->params[res->free_index[f]].sens_l2 = res->sensitivity.l2[f];
     }
+done:
+    free(S);
+    return rc;
+}
 
-    /* Per data set: goodness, checks, curves, cross-validation. */
+/* Per data set at best, from the weighted residuals r (m) and Jacobian J
+ * (m x np): goodness, residual checks, the dense curve, the kind's report
+ * section and cross-validation (fill_dataset_result, add_cross_validation);
+ * res->rss sums the unweighted residuals' squares. */
+static int analyse_datasets(const phc_problem *pb, const double *best, const double *r, const double *J,
+                            phc_progress_fn progress, void *user_data, phc_fit_result *res, phc_error *err)
+{
+    const size_t np = pb->n_params;
+    const double s = pb->options.absolute_sigma ? 1.0 : noise_scale(res);
+    int rc;
     for (size_t d = 0, row = 0; d < pb->n_datasets; ++d) {
         phc_dataset *ds = pb->datasets[d];
-        if ((rc = fill_dataset_result(ds, best, r + row, J + row * np, np, res->free_index, nf,
-                                      opt->absolute_sigma ? 1.0 : s_noise, opt->level, &res->datasets[d], err)) ||
+        if ((rc = fill_dataset_result(ds, best, r + row, J + row * np, np, res->free_index, res->n_free, s,
+                                      pb->options.level, &res->datasets[d], err)) ||
             (rc = add_cross_validation(pb, ds, best, progress, user_data, &res->datasets[d], err)))
-            goto fail;
+            return rc;
         for (size_t i = 0; i < ds->n; ++i)
             res->rss += res->datasets[d].residual[i] * res->datasets[d].residual[i];
         row += ds->n;
     }
-    if (build_verdict(res)) {
+    return PHC_OK;
+}
+
+/* The analyse stage: everything judged at the solution best (from the
+ * solve stage, nls set up by it): residuals and Jacobian, the result's
+ * frame, covariance and intervals, sensitivities, the per-data-set results
+ * and the verdict.  Reports "uncertainty" progress first; a cancelled
+ * callback is an error. */
+static int fit_analyse(phc_nls *nls, phc_problem *pb, const double *best, phc_progress_fn progress,
+                       void *user_data, phc_fit_result *res, phc_error *err)
+{
+    const size_t np = pb->n_params, m = phc_nls_residual_count(nls);
+    if (phc_progress_report(progress, user_data, "uncertainty", 0, 0, -1, NAN, NULL))
+        return phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+    double *r = calloc(m, sizeof *r), *J = calloc(m * np, sizeof *J), *Jf = NULL;
+    int rc;
+    if (!r || !J) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto fail;
+        goto done;
     }
-    *out = res;
-    res = NULL;
-    rc = PHC_OK;
-    goto fail;
-fail_costs:
-    free(costs);
-fail:
+    if ((rc = phc_nls_evaluate(nls, best, r, J, &res->cost, err)) || (rc = result_frame(pb, r, m, res, err)))
+        goto done;
+    const size_t nf = res->n_free;
+    if (!(Jf = malloc(m * nf * sizeof *Jf))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < m; ++i)
+        for (size_t f = 0; f < nf; ++f)
+            Jf[i * nf + f] = J[i * np + res->free_index[f]];
+    if ((rc = analyse_covariance(pb, best, Jf, m, res, err)) || (rc = analyse_sensitivity(pb, best, Jf, m, res, err)) ||
+        (rc = analyse_datasets(pb, best, r, J, progress, user_data, res, err)))
+        goto done;
+    if (build_verdict(res))
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+done:
+    free(r);
+    free(J);
+    free(Jf);
+    return rc;
+}
+
+int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
+                phc_fit_result **out, phc_error *err)
+{
+    int rc;
+    *out = NULL;
+    if ((rc = phc_problem_validate(pb, err)))
+        return rc;
+    /* long work of the kinds while the fit runs reports progress through
+     * their data set */
+    for (size_t d = 0; d < pb->n_datasets; ++d) {
+        pb->datasets[d]->progress = progress;
+        pb->datasets[d]->progress_data = user_data;
+    }
+    phc_nls *nls = phc_nls_new(pb->n_params);
+    phc_fit_result *res = calloc(1, sizeof *res);
+    double *best = calloc(pb->n_params, sizeof *best);
+    if (!nls || !res || !best)
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    else if (!(rc = fit_solve(nls, pb, progress, user_data, best, res, err)) &&
+             !(rc = fit_analyse(nls, pb, best, progress, user_data, res, err))) {
+        *out = res;
+        res = NULL;
+    }
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         pb->datasets[d]->progress = NULL;
         pb->datasets[d]->progress_data = NULL;
     }
-    phc_covariance_clear(&cov);
-    phc_multistart_free(ms);
     phc_nls_free(nls);
     phc_fit_result_free(res);
-    free(x);
     free(best);
-    free(r);
-    free(J);
-    free(Jf);
-    free(S);
     return rc;
 }

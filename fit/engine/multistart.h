@@ -11,7 +11,7 @@
 
 #include <stddef.h>
 
-#include "fit/problem.h"
+#include "fit/engine/problem.h"
 
 /* Fills x (n_params values) with start number `index` (1-based among the
  * extra starts: start 0 is the configured one).  Fixed parameters keep

@@ -1,5 +1,5 @@
 /* Calibration problems: see problem.h. */
-#include "fit/problem.h"
+#include "fit/engine/problem.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -9,12 +9,12 @@
 
 #include <stddef.h>
 
-#include "fit/ceres_bridge.h"
-#include "fit/progress.h"
+#include "fit/engine/ceres_bridge.h"
+#include "fit/engine/progress.h"
 #include "model/status.h"
 
 typedef struct phc_dataset phc_dataset;
-struct phc_cv_plan; /* fit/cross_validation.h */
+struct phc_cv_plan; /* fit/engine/cross_validation.h */
 
 /* Decides whether a name a data set's options use (an expression name, a
  * model slot) is bound to a parameter of the problem (1) or not (0). */
@@ -54,7 +54,7 @@ typedef struct phc_dataset_ops {
      * phc_dataset_name_series.  phc_problem_add_dataset calls it once. */
     int (*name_series)(phc_dataset *ds, phc_error *err);
     /* Optional (NULL = none): cross-validation by the engine
-     * (fit/cross_validation.h).  Fills *plan (zeroed by the caller): the
+     * (fit/engine/cross_validation.h).  Fills *plan (zeroed by the caller): the
      * groups of observations left out in turn, what is measured of each and
      * how to predict it from the data set refitted without it; leaves
      * plan->n_groups 0 when the data set asks for none.  The engine runs
@@ -72,7 +72,7 @@ struct phc_dataset {
     char **slot_units;           /* k units the model works in (UDUNITS-2 syntax, e.g.
                                     "g s-1"), or NULL entries where a slot declares none;
                                     a parameter's `unit:` is converted into it
-                                    (fit/parameter_units.h) */
+                                    (fit/engine/parameter_units.h) */
     size_t *param_index;         /* k global parameter indices */
     double *x;                   /* n abscissae for plots and ordering (time, x) */
     double *y;                   /* n observations */

@@ -15,7 +15,7 @@
 #ifndef PHC_PARAMETER_UNITS_H
 #define PHC_PARAMETER_UNITS_H
 
-#include "fit/problem.h"
+#include "fit/engine/problem.h"
 #include "model/status.h"
 
 /* Converts every parameter of a bound problem as above.  Call once, after

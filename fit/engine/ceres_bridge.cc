@@ -4,7 +4,7 @@
 // code, and every size and index is validated before Ceres sees it (Ceres
 // CHECK failures abort the process).
 
-#include "fit/ceres_bridge.h"
+#include "fit/engine/ceres_bridge.h"
 
 #include <ceres/ceres.h>
 #include <ceres/dynamic_numeric_diff_cost_function.h>

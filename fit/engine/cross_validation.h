@@ -3,12 +3,12 @@
  * in turn, the data set's free slots are refitted on the others, and the
  * kind predicts the left-out group's quantity (a photo's stage, say) from
  * the refitted slots, beside any baselines of its own.  The engine runs the
- * refits (one Ceres solve per group, fit/ceres_bridge.h), reports progress
+ * refits (one Ceres solve per group, fit/engine/ceres_bridge.h), reports progress
  * ("leave-one-out 3/13 (ivy)") and collects the predictions and their RMSE;
  * no kind runs a solve.
  *
  * A kind takes part through its optional op `cross_validation`
- * (fit/dataset.h), which fills a phc_cv_plan: the groups, what is measured
+ * (fit/engine/dataset.h), which fills a phc_cv_plan: the groups, what is measured
  * and how to predict it.  phc_fit_run calls phc_cross_validate for every
  * data set whose kind has the op and adds phc_cv_result_markdown to the
  * data set's report section.
@@ -23,9 +23,9 @@
 
 #include <stddef.h>
 
-#include "fit/dataset.h"
-#include "fit/problem.h"
-#include "fit/progress.h"
+#include "fit/engine/dataset.h"
+#include "fit/engine/problem.h"
+#include "fit/engine/progress.h"
 #include "model/status.h"
 
 /* An observation in no group: never left out. */

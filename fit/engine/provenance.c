@@ -1,6 +1,6 @@
 /* Provenance of a run: see provenance.h.  SHA-256 from nettle. */
 #define _XOPEN_SOURCE 700 /* realpath, gethostname */
-#include "fit/provenance.h"
+#include "fit/engine/provenance.h"
 
 #include <errno.h>
 #include <limits.h>

@@ -15,7 +15,7 @@
 #include <jansson.h>
 #include <stddef.h>
 
-#include "fit/problem.h"
+#include "fit/engine/problem.h"
 #include "model/status.h"
 
 typedef struct phc_provenance_file {
