@@ -211,7 +211,7 @@ static void nb_draw_panel(const nb_panel *p, double vx0, double vx1, double vy0,
 
 /* Draws np panels on a cols x rows grid into a width x height PNG at path
  * (written to path.tmp, then renamed).  Returns 0 or -1. */
-static int nb_plot(const char *path, int width, int height, int cols, int rows,
+__attribute__((unused)) static int nb_plot(const char *path, int width, int height, int cols, int rows,
                    const nb_panel *panels, size_t np)
 {
     char tmp[1040];
