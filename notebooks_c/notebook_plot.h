@@ -277,14 +277,14 @@ static int nb_mkdirs(const char *dir)
 }
 
 /* Opens dir/name for writing through a temporary name; nb_close_md renames it. */
-static FILE *nb_open_md(const char *dir, const char *name, char *final, char *tmp, size_t cap)
+__attribute__((unused)) static FILE *nb_open_md(const char *dir, const char *name, char *final, char *tmp, size_t cap)
 {
     snprintf(final, cap, "%s/%s", dir, name);
     snprintf(tmp, cap, "%s/%s.tmp", dir, name);
     return fopen(tmp, "w");
 }
 
-static int nb_close_md(FILE *f, const char *final, const char *tmp)
+__attribute__((unused)) static int nb_close_md(FILE *f, const char *final, const char *tmp)
 {
     int bad = ferror(f);
     bad |= fclose(f) != 0;
