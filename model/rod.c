@@ -6,6 +6,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <lapacke.h>
+#ifdef ROD_DEBUG
+#include <stdio.h>
+#endif
+
 #include "model/quaternion.h"
 #include "model/rod_joint.h"
 #include "model/rod_tree_solver.h"
@@ -41,6 +46,7 @@ struct phc_rod {
     double *schur;                  /* (6 n_anchors)² */
     int *schur_piv;
     double reach;
+    double load_scale;              /* continuation factor on gravity and loads */
     phc_rod_tree *tree;
 };
 
@@ -52,7 +58,7 @@ void phc_rod_options_default(phc_rod_options *o)
     o->gravity[1] = 0.0;
     o->gravity[2] = -9.81;
     o->tolerance = 1e-10;
-    o->max_iterations = 100;
+    o->max_iterations = 200;
     o->damping = 0.0;
     o->scheme = PHC_ROD_DIRECT;
     o->substeps = 1;
@@ -116,11 +122,11 @@ static void update_stiffness(phc_rod *rod)
             continue;
         const double ell = rod->joint[c].ell;
         const double e = ell / (0.5 * g->length[p] / rod->young[p] + 0.5 * g->length[c] / rod->young[c]);
-        const double r = g->radius[c], I = M_PI * r * r * r * r / 4.0;
+        const double r = g->radius[c], area_moment = M_PI * r * r * r * r / 4.0;
         const double G = e / (2.0 * (1.0 + rod->opt.poisson));
-        rod->stiff[3 * c] = ell * e * I;
-        rod->stiff[3 * c + 1] = ell * e * I;
-        rod->stiff[3 * c + 2] = ell * G * 2.0 * I;
+        rod->stiff[3 * c] = ell * e * area_moment;
+        rod->stiff[3 * c + 1] = ell * e * area_moment;
+        rod->stiff[3 * c + 2] = ell * G * 2.0 * area_moment;
     }
 }
 
@@ -200,6 +206,7 @@ int phc_rod_new(const phc_plant_graph *g, const double *young, const phc_rod_opt
     rod->g = g;
     rod->n = n;
     rod->opt = *options;
+    rod->load_scale = 1.0;
 #define ALLOC(f, count) (rod->f = calloc((count), sizeof *rod->f)) == NULL
     if (ALLOC(young, n) || ALLOC(extra, n) || ALLOC(mass, n) || ALLOC(inertia, 3 * n) ||
         ALLOC(fixed, n) || ALLOC(factor, n) || ALLOC(load, 3 * n) || ALLOC(joint, n) ||
@@ -543,7 +550,8 @@ typedef struct step_params {
 } step_params;
 
 typedef struct residual_norm {
-    double force, torque, stretch, bend, max;
+    double force, torque, stretch, bend, max; /* max norms of the scaled residual */
+    double sq;                                /* its sum of squares (line-search merit) */
 } residual_norm;
 
 static void add_block(double *dst, int stride, const double *src6, double s)
@@ -564,7 +572,7 @@ static double load_total(const phc_rod *rod)
             continue;
         f += rod->mass[i] * gn + sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
     }
-    return f;
+    return f * rod->load_scale;
 }
 
 /* Residual (rod->res) and, when `matrix`, the Newton matrix in rod->tree.
@@ -581,11 +589,13 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
     }
     for (size_t i = 0; i < n; ++i) {
         double *r = rod->res + 12 * i, *D = t->diag + 144 * i;
-        const double m = rod->mass[i], *F = rod->load + 3 * i;
+        const double m = rod->mass[i], ts = rod->load_scale;
+        const double F[3] = {ts * rod->load[3 * i], ts * rod->load[3 * i + 1],
+                             ts * rod->load[3 * i + 2]};
         double u[3];
         tail_offset(rod, i, u);
         for (int k = 0; k < 3; ++k)
-            r[k] = -m * rod->opt.gravity[k] - F[k];
+            r[k] = -m * ts * rod->opt.gravity[k] - F[k];
         /* torque of the tail load: ∇_θ(−F·(x + Ru)) = −u × F */
         r[3] = -(u[1] * F[2] - u[2] * F[1]);
         r[4] = -(u[2] * F[0] - u[0] * F[2]);
@@ -660,11 +670,31 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
             D[(6 + a) * 12 + 6 + a] = -alpha[a];
         }
     }
+    if (!matrix)
+        return;
+    /* The residual's rotation rows are gradients with respect to an increment
+     * at the CURRENT orientation (a moving chart): their exact derivative is
+     * the pullback Hessian above plus −½[r_θ]× (from exp(ε)exp(δ) =
+     * exp(δ + ε + ½ ε×δ + …)), r_θ the body's rotation residual.  It vanishes
+     * at equilibrium; with it the Newton matrix is the exact Jacobian of the
+     * residual map, so Newton converges quadratically from farther away and
+     * the line search on the residual is consistent.  (The block is no longer
+     * symmetric: the tree solver does not assume it is.) */
+    for (size_t i = 0; i < n; ++i) {
+        const double *g = rod->res + 12 * i + 3;
+        double *D = t->diag + 144 * i + 3 * 12 + 3;
+        D[0 * 12 + 1] += 0.5 * g[2];
+        D[0 * 12 + 2] -= 0.5 * g[1];
+        D[1 * 12 + 0] -= 0.5 * g[2];
+        D[1 * 12 + 2] += 0.5 * g[0];
+        D[2 * 12 + 0] += 0.5 * g[1];
+        D[2 * 12 + 1] -= 0.5 * g[0];
+    }
 }
 
 static residual_norm residual_measure(const phc_rod *rod)
 {
-    residual_norm rn = {0, 0, 0, 0, 0};
+    residual_norm rn = {0, 0, 0, 0, 0, 0};
     const double L = rod->reach;
     double F = load_total(rod);
     if (!(F > 0.0))
@@ -673,22 +703,26 @@ static residual_norm residual_measure(const phc_rod *rod)
         const double *r = rod->res + 12 * i;
         if (!rod->fixed[i])
             for (int k = 0; k < 3; ++k) {
-                rn.force = fmax(rn.force, fabs(r[k]) / F);
-                rn.torque = fmax(rn.torque, fabs(r[3 + k]) / (F * L));
+                const double a = fabs(r[k]) / F, b = fabs(r[3 + k]) / (F * L);
+                rn.force = fmax(rn.force, a);
+                rn.torque = fmax(rn.torque, b);
+                rn.sq += a * a + b * b;
             }
         if (rod->tree->dim[i] == 12) {
             const size_t c = rod->ejoint[i];
             for (int k = 0; k < 3; ++k) {
-                rn.stretch = fmax(rn.stretch, fabs(r[6 + k]) / L);
                 /* (C − αλ)·f ℓK: a moment × length, N m² */
-                rn.bend = fmax(rn.bend, fabs(r[9 + k]) * rod->factor[c] * rod->stiff[3 * c + k] /
-                                            (F * L * L));
+                const double a = fabs(r[6 + k]) / L,
+                             b = fabs(r[9 + k]) * rod->factor[c] * rod->stiff[3 * c + k] / (F * L * L);
+                rn.stretch = fmax(rn.stretch, a);
+                rn.bend = fmax(rn.bend, b);
+                rn.sq += a * a + b * b;
             }
         }
     }
     rn.max = fmax(fmax(rn.force, rn.torque), fmax(rn.stretch, rn.bend));
-    if (!isfinite(rn.max))
-        rn.max = INFINITY;
+    if (!isfinite(rn.max) || !isfinite(rn.sq))
+        rn.max = rn.sq = INFINITY;
     return rn;
 }
 
@@ -701,8 +735,9 @@ static size_t newton_direction(phc_rod *rod)
     const size_t bad = phc_rod_tree_factor(t);
     if (bad != PHC_TREE_NONE)
         return bad;
-    for (size_t i = 0; i < 12 * n; ++i)
-        rod->sol[i] = -rod->res[i];
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 12; ++k)
+            rod->sol[12 * i + k] = (k < t->dim[i]) ? -rod->res[12 * i + k] : 0.0;
     if (na == 0) {
         phc_rod_tree_solve(t, rod->sol);
         return PHC_TREE_NONE;
@@ -724,11 +759,51 @@ static size_t newton_direction(phc_rod *rod)
             for (int k = 0; k < 6; ++k)
                 rod->schur[(6 * a + k) * m + col] = rod->rhs[12 * rod->anchors[a] + k];
     }
-    if (phc_dense_lu(rod->schur, (int)m, rod->schur_piv) != 0) {
-        free(mu);
-        return rod->anchors[0];
+    /* S is symmetric and may be singular: an inextensible span between two
+     * supports leaves its axial force undetermined (only the multipliers, not
+     * the positions).  Pseudo-inverse by eigen-decomposition, in units where
+     * rotations are scaled by the reach (every entry m/N), dropping
+     * eigenvalues below 1e-10 of the largest. */
+    {
+        const double L = rod->reach;
+        double *ev = malloc(m * sizeof *ev), *tmp = malloc(m * sizeof *tmp);
+        if (!ev || !tmp) {
+            free(ev);
+            free(tmp);
+            free(mu);
+            return 0;
+        }
+        for (size_t r = 0; r < m; ++r) {
+            const double sr = (r % 6 >= 3) ? L : 1.0;
+            mu[r] *= sr;
+            for (size_t c = 0; c < m; ++c)
+                rod->schur[r * m + c] *= sr * ((c % 6 >= 3) ? L : 1.0);
+        }
+        if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', (lapack_int)m, rod->schur, (lapack_int)m, ev) != 0) {
+            free(ev);
+            free(tmp);
+            free(mu);
+            return rod->anchors[0];
+        }
+        double emax = 0.0;
+        for (size_t k = 0; k < m; ++k)
+            emax = fmax(emax, fabs(ev[k]));
+
+        for (size_t k = 0; k < m; ++k) {
+            double d = 0.0;
+            for (size_t r = 0; r < m; ++r)
+                d += rod->schur[r * m + k] * mu[r];
+            tmp[k] = (fabs(ev[k]) > 1e-10 * emax) ? d / ev[k] : 0.0;
+        }
+        for (size_t r = 0; r < m; ++r) {
+            double d = 0.0;
+            for (size_t k = 0; k < m; ++k)
+                d += rod->schur[r * m + k] * tmp[k];
+            mu[r] = d * ((r % 6 >= 3) ? L : 1.0);
+        }
+        free(ev);
+        free(tmp);
     }
-    phc_dense_lu_solve(rod->schur, (int)m, rod->schur_piv, mu);
     for (size_t a = 0; a < na; ++a)
         for (int k = 0; k < 6; ++k)
             rod->sol[12 * rod->anchors[a] + k] -= mu[6 * a + k];
@@ -781,7 +856,8 @@ static void apply_step(phc_rod *rod, double s)
 
 /* Newton with backtracking on the scaled residual.  0 converged, otherwise
  * PHC_ERR_NOT_CONVERGED / PHC_ERR_NUMERIC with the message set. */
-static int newton(phc_rod *rod, const step_params *sp, phc_rod_report *rep, phc_error *err)
+static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *rep,
+                  phc_error *err)
 {
     const phc_plant_graph *g = rod->g;
     const double tol = rod->opt.tolerance, L = rod->reach;
@@ -789,7 +865,7 @@ static int newton(phc_rod *rod, const step_params *sp, phc_rod_report *rep, phc_
     residual_norm rn = residual_measure(rod);
     rep->iterations = 0;
     rep->residual = rn.max;
-    for (int it = 0; it < rod->opt.max_iterations; ++it) {
+    for (int it = 0; it < cap; ++it) {
         if (rn.max <= tol)
             return PHC_OK;
         const size_t bad = newton_direction(rod);
@@ -811,14 +887,17 @@ static int newton(phc_rod *rod, const step_params *sp, phc_rod_report *rep, phc_
         if (maxrot > 1.0)
             s = 1.0 / maxrot;
         save_state(rod);
-        const double phi0 = rn.max;
+        const double phi0 = rn.sq;
         residual_norm trial = rn;
         int accepted = 0;
         for (int ls = 0; ls < 30; ++ls, s *= 0.5) {
             apply_step(rod, s);
             assemble(rod, sp, 0);
             trial = residual_measure(rod);
-            if (trial.max < phi0 || trial.max <= tol) {
+#ifdef ROD_DEBUG
+            fprintf(stderr, "  ls %d s %g res %g (f %g t %g s %g b %g)\n", ls, s, trial.max, trial.force, trial.torque, trial.stretch, trial.bend);
+#endif
+            if (trial.sq < (1.0 - 1e-4 * s) * phi0 || trial.max <= tol) {
                 accepted = 1;
                 break;
             }
@@ -833,8 +912,11 @@ static int newton(phc_rod *rod, const step_params *sp, phc_rod_report *rep, phc_
             return phc_error_set(err, PHC_ERR_NOT_CONVERGED,
                                  "rod: Newton iteration %d: no step decreases the residual "
                                  "(scaled residual %.3g, tolerance %.3g)",
-                                 it + 1, phi0, tol);
+                                 it + 1, rn.max, tol);
         }
+#ifdef ROD_DEBUG
+        fprintf(stderr, "it %d s %g maxdx %g maxrot %g res %g (f %g t %g s %g b %g)\n", it, s, maxdx, maxrot, trial.max, trial.force, trial.torque, trial.stretch, trial.bend);
+#endif
         assemble(rod, sp, 1);
         rn = trial;
         rep->residual = rn.max;
@@ -846,44 +928,98 @@ static int newton(phc_rod *rod, const step_params *sp, phc_rod_report *rep, phc_
     return phc_error_set(err, PHC_ERR_NOT_CONVERGED,
                          "rod: no convergence in %d Newton iterations (scaled residual %.3g: "
                          "force %.3g, torque %.3g, stretch %.3g, bending %.3g; tolerance %.3g)",
-                         rod->opt.max_iterations, rn.max, rn.force, rn.torque, rn.stretch, rn.bend,
+                         cap, rn.max, rn.force, rn.torque, rn.stretch, rn.bend,
                          tol);
 }
 
+/* Newton at load factor 1 from the current state; when that fails, load
+ * continuation from the rest shape (the equilibrium at load factor 0): the
+ * factor grows by doubling increments, an increment halves when its Newton
+ * solve fails.  Each stage at most STAGE_CAP iterations; all stages share
+ * options.max_iterations. */
+#define STAGE_CAP 40
+
 int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err)
 {
-    phc_rod_report local;
+    phc_rod_report local, stage;
     phc_rod_report *rep = report ? report : &local;
     step_params sp = {0, 0.0, 0.0};
+    const size_t n = rod->n;
     int rc = build_tree(rod, 1, err);
     memset(rep, 0, sizeof *rep);
     if (rc != PHC_OK)
         return rc;
-    /* the start, for restoring on failure (newton overwrites xs/qs/ls) */
-    double *x = malloc(3 * rod->n * sizeof *x), *q = malloc(4 * rod->n * sizeof *q),
-           *l = malloc(6 * rod->n * sizeof *l);
-    if (!x || !q || !l) {
-        free(x);
-        free(q);
-        free(l);
+    /* the start (restored on failure) and the last converged stage */
+    double *keep = malloc(26 * n * sizeof *keep);
+    if (!keep)
         return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory");
+    double *x = keep, *q = keep + 3 * n, *l = keep + 7 * n;
+    double *xg = keep + 13 * n, *qg = keep + 16 * n, *lg = keep + 20 * n;
+    memcpy(x, rod->x, 3 * n * sizeof *x);
+    memcpy(q, rod->q, 4 * n * sizeof *q);
+    memcpy(l, rod->lambda, 6 * n * sizeof *l);
+    const int budget = rod->opt.max_iterations;
+    const int cap = budget < STAGE_CAP ? budget : STAGE_CAP;
+    rod->load_scale = 1.0;
+    rc = newton(rod, &sp, cap, &stage, err);
+    rep->total_iterations = stage.iterations;
+    rep->residual = stage.residual;
+    if (rc != PHC_OK && rc != PHC_ERR_NOMEM) {
+        double t = 0.0, dt = 0.5;
+        phc_rod_reset(rod);
+        memcpy(xg, rod->x, 3 * n * sizeof *x);
+        memcpy(qg, rod->q, 4 * n * sizeof *q);
+        memcpy(lg, rod->lambda, 6 * n * sizeof *l);
+        while (t < 1.0) {
+            if (rep->total_iterations >= budget) {
+                rc = phc_error_set(err, PHC_ERR_NOT_CONVERGED,
+                                   "rod: no static equilibrium within %d Newton iterations "
+                                   "(load continuation reached %.3g of the load; scaled residual "
+                                   "%.3g, tolerance %.3g)",
+                                   budget, t, stage.residual, rod->opt.tolerance);
+                break;
+            }
+            if (dt < 1e-6) {
+                rc = phc_error_set(err, PHC_ERR_NOT_CONVERGED,
+                                   "rod: no static equilibrium: load continuation stalled at %.6g "
+                                   "of the load (%s)",
+                                   t, err ? err->message : "");
+                break;
+            }
+            const double tt = fmin(1.0, t + dt);
+            rod->load_scale = tt;
+            int left = budget - rep->total_iterations;
+            rc = newton(rod, &sp, left < cap ? left : cap, &stage, err);
+            rep->total_iterations += stage.iterations;
+            rep->residual = stage.residual;
+            if (rc == PHC_OK) {
+                t = tt;
+                dt = fmin(2.0 * dt, 1.0);
+                memcpy(xg, rod->x, 3 * n * sizeof *x);
+                memcpy(qg, rod->q, 4 * n * sizeof *q);
+                memcpy(lg, rod->lambda, 6 * n * sizeof *l);
+            } else {
+                dt *= 0.5;
+                memcpy(rod->x, xg, 3 * n * sizeof *x);
+                memcpy(rod->q, qg, 4 * n * sizeof *q);
+                memcpy(rod->lambda, lg, 6 * n * sizeof *l);
+            }
+        }
+        if (t >= 1.0)
+            rc = PHC_OK;
     }
-    memcpy(x, rod->x, 3 * rod->n * sizeof *x);
-    memcpy(q, rod->q, 4 * rod->n * sizeof *q);
-    memcpy(l, rod->lambda, 6 * rod->n * sizeof *l);
-    rc = newton(rod, &sp, rep, err);
-    rep->total_iterations = rep->iterations;
+    rod->load_scale = 1.0;
+    rep->iterations = rep->total_iterations;
     if (rc != PHC_OK) {
-        memcpy(rod->x, x, 3 * rod->n * sizeof *x);
-        memcpy(rod->q, q, 4 * rod->n * sizeof *q);
-        memcpy(rod->lambda, l, 6 * rod->n * sizeof *l);
+        memcpy(rod->x, x, 3 * n * sizeof *x);
+        memcpy(rod->q, q, 4 * n * sizeof *q);
+        memcpy(rod->lambda, l, 6 * n * sizeof *l);
     } else {
-        memset(rod->v, 0, 3 * rod->n * sizeof *rod->v);
-        memset(rod->w, 0, 3 * rod->n * sizeof *rod->w);
+        memset(rod->v, 0, 3 * n * sizeof *rod->v);
+        memset(rod->w, 0, 3 * n * sizeof *rod->w);
+        phc_error_clear(err);
     }
-    free(x);
-    free(q);
-    free(l);
+    free(keep);
     return rc;
 }
 
@@ -945,7 +1081,7 @@ static int substep_direct(phc_rod *rod, double h, phc_rod_report *rep, phc_error
             memcpy(rod->x + 3 * i, rod->xp + 3 * i, 3 * sizeof *rod->x);
             memcpy(rod->q + 4 * i, rod->qp + 4 * i, 4 * sizeof *rod->q);
         }
-    int rc = newton(rod, &sp, rep, err);
+    int rc = newton(rod, &sp, rod->opt.max_iterations, rep, err);
     if (rc != PHC_OK)
         return phc_error_prefix(err, PHC_ERR_DOMAIN,
                                 "rod: the implicit step of %g s did not converge (time step too "

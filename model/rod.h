@@ -70,7 +70,8 @@ typedef struct phc_rod_options {
     double poisson;         /* ν in (−1, 0.5]; default 0.5 */
     double gravity[3];      /* m s⁻²; default (0, 0, −9.81) */
     double tolerance;       /* scaled residual; default 1e-10 */
-    int max_iterations;     /* Newton iterations per solve / sub-step; default 100 */
+    int max_iterations;     /* Newton iterations per static solve (all load
+                               stages) or per sub-step; default 200 */
     double damping;         /* c, s⁻¹ (>= 0); default 0 */
     phc_rod_scheme scheme;  /* for phc_rod_step; default PHC_ROD_DIRECT */
     int substeps;           /* sub-steps per phc_rod_step; default 1 */

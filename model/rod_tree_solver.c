@@ -16,8 +16,9 @@ phc_rod_tree *phc_rod_tree_new(size_t n)
     t->order = calloc(n, sizeof *t->order);
     t->diag = calloc(144 * n, sizeof *t->diag);
     t->coup = calloc(72 * n, sizeof *t->coup);
+    t->y = calloc(72 * n, sizeof *t->y);
     t->piv = calloc(12 * n, sizeof *t->piv);
-    if (!t->parent || !t->dim || !t->order || !t->diag || !t->coup || !t->piv) {
+    if (!t->parent || !t->dim || !t->order || !t->diag || !t->coup || !t->y || !t->piv) {
         phc_rod_tree_free(t);
         return NULL;
     }
@@ -35,6 +36,7 @@ void phc_rod_tree_free(phc_rod_tree *t)
     free(t->order);
     free(t->diag);
     free(t->coup);
+    free(t->y);
     free(t->piv);
     free(t);
 }
@@ -121,6 +123,8 @@ int phc_dense_lu(double *a, int n, int *piv)
 
 void phc_dense_lu_solve(const double *a, int n, const int *piv, double *b)
 {
+    /* rows were swapped whole during the factorisation (the multipliers
+     * too), so apply every swap first, then the unit lower triangle */
     for (int k = 0; k < n; ++k) {
         const int p = piv[k];
         if (p != k) {
@@ -128,9 +132,10 @@ void phc_dense_lu_solve(const double *a, int n, const int *piv, double *b)
             b[k] = b[p];
             b[p] = tmp;
         }
+    }
+    for (int k = 0; k < n; ++k)
         for (int r = k + 1; r < n; ++r)
             b[r] -= a[r * n + k] * b[k];
-    }
     for (int k = n - 1; k >= 0; --k) {
         double s = b[k];
         for (int c = k + 1; c < n; ++c)
@@ -158,8 +163,9 @@ size_t phc_rod_tree_factor(phc_rod_tree *t)
         const size_t p = t->parent[i];
         if (p == PHC_TREE_NONE || t->dim[p] == 0)
             continue;
-        /* Y = D⁻¹ A (d x 6), stored over A; parent body block −= Aᵀ Y */
-        double *A = t->coup + 72 * i, Y[72], col[12];
+        /* Y = D⁻¹ A (d x 6); parent body block −= Aᵀ Y */
+        const double *A = t->coup + 72 * i;
+        double *Y = t->y + 72 * i, col[12];
         for (int c = 0; c < 6; ++c) {
             for (int r = 0; r < d; ++r)
                 col[r] = A[r * 6 + c];
@@ -175,36 +181,31 @@ size_t phc_rod_tree_factor(phc_rod_tree *t)
                     s += A[k * 6 + r] * Y[k * 6 + c];
                 P[r * 12 + c] -= s;
             }
-        memcpy(A, Y, (size_t)(d * 6) * sizeof *A);
     }
     return PHC_TREE_NONE;
 }
 
 void phc_rod_tree_solve(const phc_rod_tree *t, double *rhs)
 {
-    /* forward (leaves first): y_i = D_i⁻¹ r_i;  r_p −= A_iᵀ y_i
-     * (A_iᵀ y_i = A_iᵀ D_i⁻¹ r_i = Y_iᵀ r_i, Y_i = D_i⁻¹ A_i: D is not
-     * symmetric after pivoting, so use A = D Y only through Y:  the update
-     * is A_iᵀ y_i = (D_i Y_i)ᵀ D_i⁻¹ r_i = Y_iᵀ D_iᵀ D_i⁻¹ r_i, which equals
-     * Y_iᵀ r_i because D_i is symmetric.) */
+    /* forward (leaves first): y_i = D_i⁻¹ r_i;  r_p −= A_iᵀ y_i */
     for (size_t o = 0; o < t->n; ++o) {
         const size_t i = t->order[o];
         const int d = t->dim[i];
         if (d == 0)
             continue;
         double *r = rhs + 12 * i;
+        phc_dense_lu_solve(t->diag + 144 * i, d, t->piv + 12 * i, r);
         const size_t p = t->parent[i];
         if (p != PHC_TREE_NONE && t->dim[p] != 0) {
-            const double *Y = t->coup + 72 * i;
+            const double *A = t->coup + 72 * i;
             double *rp = rhs + 12 * p;
             for (int c = 0; c < 6; ++c) {
                 double s = 0.0;
                 for (int k = 0; k < d; ++k)
-                    s += Y[k * 6 + c] * r[k];
+                    s += A[k * 6 + c] * r[k];
                 rp[c] -= s;
             }
         }
-        phc_dense_lu_solve(t->diag + 144 * i, d, t->piv + 12 * i, r);
     }
     /* backward (parents first): u_i = y_i − Y_i u_p */
     for (size_t o = t->n; o-- > 0;) {
@@ -213,7 +214,7 @@ void phc_rod_tree_solve(const phc_rod_tree *t, double *rhs)
         const size_t p = t->parent[i];
         if (d == 0 || p == PHC_TREE_NONE || t->dim[p] == 0)
             continue;
-        const double *Y = t->coup + 72 * i, *up = rhs + 12 * p;
+        const double *Y = t->y + 72 * i, *up = rhs + 12 * p;
         double *u = rhs + 12 * i;
         for (int k = 0; k < d; ++k) {
             double s = 0.0;

@@ -30,7 +30,8 @@ typedef struct phc_rod_tree {
     int *dim;        /* n: 0, 6 or 12 */
     size_t *order;   /* n: children before parents (leaves first) */
     double *diag;    /* 144 n: the node blocks; factorised in place */
-    double *coup;    /* 72 n: A[node, parent body]; replaced by D⁻¹A after factor */
+    double *coup;    /* 72 n: A[node, parent body] (A[parent body, node] = Aᵀ) */
+    double *y;       /* 72 n: D⁻¹A after factor */
     int *piv;        /* 12 n: LU pivots */
 } phc_rod_tree;
 
@@ -43,7 +44,8 @@ void phc_rod_tree_free(phc_rod_tree *t); /* accepts NULL */
  * parent PHC_TREE_NONE).  Returns 0, or -1 when parent[] has a cycle. */
 int phc_rod_tree_set_order(phc_rod_tree *t);
 
-/* Factorises in place.  Returns PHC_TREE_NONE on success, otherwise the node
+/* The node blocks need not be symmetric (the off-diagonal pairs are
+ * transposes of each other).  Factorises in place.  Returns PHC_TREE_NONE on success, otherwise the node
  * whose (updated) block is singular or not finite. */
 size_t phc_rod_tree_factor(phc_rod_tree *t);
 
