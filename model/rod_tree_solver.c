@@ -90,7 +90,7 @@ done:
     return rc;
 }
 
-int phc_dense_lu(double *a, int n, int *piv)
+static inline int lu_inline(double *a, const int n, int *piv)
 {
     for (int k = 0; k < n; ++k) {
         int p = k;
@@ -121,7 +121,7 @@ int phc_dense_lu(double *a, int n, int *piv)
     return 0;
 }
 
-void phc_dense_lu_solve(const double *a, int n, const int *piv, double *b)
+static inline void lu_solve_inline(const double *a, const int n, const int *piv, double *b)
 {
     /* rows were swapped whole during the factorisation (the multipliers
      * too), so apply every swap first, then the unit lower triangle */
@@ -144,6 +144,67 @@ void phc_dense_lu_solve(const double *a, int n, const int *piv, double *b)
     }
 }
 
+int phc_dense_lu(double *a, int n, int *piv) { return lu_inline(a, n, piv); }
+
+void phc_dense_lu_solve(const double *a, int n, const int *piv, double *b)
+{
+    lu_solve_inline(a, n, piv, b);
+}
+
+/* Solves with the LU factors of a (n x n) for the 6 columns of the n x 6
+ * row-major matrix y at once (row operations 6 wide). */
+static inline void lu_solve6_inline(const double *a, const int n, const int *piv, double *y)
+{
+    for (int k = 0; k < n; ++k) {
+        const int p = piv[k];
+        if (p != k)
+            for (int c = 0; c < 6; ++c) {
+                const double tmp = y[k * 6 + c];
+                y[k * 6 + c] = y[p * 6 + c];
+                y[p * 6 + c] = tmp;
+            }
+    }
+    for (int k = 0; k < n; ++k)
+        for (int r = k + 1; r < n; ++r) {
+            const double f = a[r * n + k];
+            for (int c = 0; c < 6; ++c)
+                y[r * 6 + c] -= f * y[k * 6 + c];
+        }
+    for (int k = n - 1; k >= 0; --k) {
+        for (int j = k + 1; j < n; ++j) {
+            const double f = a[k * n + j];
+            for (int c = 0; c < 6; ++c)
+                y[k * 6 + c] -= f * y[j * 6 + c];
+        }
+        const double inv = 1.0 / a[k * n + k];
+        for (int c = 0; c < 6; ++c)
+            y[k * 6 + c] *= inv;
+    }
+}
+
+/* the node sizes: 12 (paired) and 6 (free top of a loose part), as
+ * compile-time constants so the loops unroll */
+static int node_lu(double *a, int d, int *piv)
+{
+    return d == 12 ? lu_inline(a, 12, piv) : lu_inline(a, d, piv);
+}
+
+static void node_solve(const double *a, int d, const int *piv, double *b)
+{
+    if (d == 12)
+        lu_solve_inline(a, 12, piv, b);
+    else
+        lu_solve_inline(a, d, piv, b);
+}
+
+static void node_solve6(const double *a, int d, const int *piv, double *y)
+{
+    if (d == 12)
+        lu_solve6_inline(a, 12, piv, y);
+    else
+        lu_solve6_inline(a, d, piv, y);
+}
+
 /* The node's d x d block lives in diag with stride 12: copy to and from a
  * packed d x d buffer for the LU. */
 size_t phc_rod_tree_factor(phc_rod_tree *t)
@@ -157,7 +218,7 @@ size_t phc_rod_tree_factor(phc_rod_tree *t)
         for (int r = 0; r < d; ++r)
             for (int c = 0; c < d; ++c)
                 packed[r * d + c] = D[r * 12 + c];
-        if (phc_dense_lu(packed, d, t->piv + 12 * i) != 0)
+        if (node_lu(packed, d, t->piv + 12 * i) != 0)
             return i;
         memcpy(D, packed, (size_t)(d * d) * sizeof *D); /* packed d x d from here on */
         const size_t p = t->parent[i];
@@ -165,14 +226,9 @@ size_t phc_rod_tree_factor(phc_rod_tree *t)
             continue;
         /* Y = D⁻¹ A (d x 6); parent body block −= Aᵀ Y */
         const double *A = t->coup + 72 * i;
-        double *Y = t->y + 72 * i, col[12];
-        for (int c = 0; c < 6; ++c) {
-            for (int r = 0; r < d; ++r)
-                col[r] = A[r * 6 + c];
-            phc_dense_lu_solve(D, d, t->piv + 12 * i, col);
-            for (int r = 0; r < d; ++r)
-                Y[r * 6 + c] = col[r];
-        }
+        double *Y = t->y + 72 * i;
+        memcpy(Y, A, (size_t)(d * 6) * sizeof *Y);
+        node_solve6(D, d, t->piv + 12 * i, Y);
         double *P = t->diag + 144 * p;
         for (int r = 0; r < 6; ++r)
             for (int c = 0; c < 6; ++c) {
@@ -194,7 +250,7 @@ void phc_rod_tree_solve(const phc_rod_tree *t, double *rhs)
         if (d == 0)
             continue;
         double *r = rhs + 12 * i;
-        phc_dense_lu_solve(t->diag + 144 * i, d, t->piv + 12 * i, r);
+        node_solve(t->diag + 144 * i, d, t->piv + 12 * i, r);
         const size_t p = t->parent[i];
         if (p != PHC_TREE_NONE && t->dim[p] != 0) {
             const double *A = t->coup + 72 * i;
