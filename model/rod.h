@@ -35,7 +35,9 @@
  *     scaled residual; converged when every scaled residual is ≤ tolerance
  *     (forces / total load, torques / (total load × reach), stretch / reach,
  *     bending / (load × reach²); reach = longest root-to-tip path), or when
- *     the step is ≤ 1e-12·reach.
+ *     the step is ≤ 1e-12·reach with the residual within 1e3 × tolerance
+ *     (rounding).  When Newton from the current state fails: load
+ *     continuation from the rest shape.
  *   phc_rod_step, scheme PHC_ROD_DIRECT (default): the implicit (backward
  *     Euler) step in XPBD's compliant form: multipliers accumulated over the
  *     Newton iterations of each sub-step, each iteration one direct solve,
