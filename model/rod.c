@@ -690,11 +690,24 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
     }
 }
 
-static residual_norm residual_measure(const phc_rod *rod)
+/* The force scale of the scaled residual: the total load, and in dynamics
+ * also the momentum change Σ m |v_old| / h of a sub-step and the largest
+ * joint force |λ_s| (so that a free vibration without gravity or loads has
+ * a scale too). */
+static residual_norm residual_measure(const phc_rod *rod, const step_params *sp)
 {
     residual_norm rn = {0, 0, 0, 0, 0, 0};
     const double L = rod->reach;
-    double F = load_total(rod);
+    double F = load_total(rod), lmax = 0.0;
+    if (sp->dynamic)
+        for (size_t i = 0; i < rod->n; ++i)
+            if (!rod->fixed[i]) {
+                const double *v = rod->v + 3 * i;
+                const double *l = rod->lambda + 6 * i;
+                F += rod->mass[i] * sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / sp->h;
+                lmax = fmax(lmax, sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]));
+            }
+    F += lmax;
     if (!(F > 0.0))
         F = 1e-300;
     for (size_t i = 0; i < rod->n; ++i) {
@@ -867,7 +880,7 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
     const phc_plant_graph *g = rod->g;
     const double tol = rod->opt.tolerance, L = rod->reach;
     assemble(rod, sp, 1);
-    residual_norm rn = residual_measure(rod);
+    residual_norm rn = residual_measure(rod, sp);
     rep->iterations = 0;
     rep->residual = rn.max;
     for (int it = 0; it < cap; ++it) {
@@ -898,7 +911,7 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         for (int ls = 0; ls < 30; ++ls, s *= 0.5) {
             apply_step(rod, s);
             assemble(rod, sp, 0);
-            trial = residual_measure(rod);
+            trial = residual_measure(rod, sp);
             if (trial.sq < (1.0 - 1e-4 * s) * phi0 || trial.max <= tol) {
                 accepted = 1;
                 break;
