@@ -929,12 +929,14 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
                                  "(scaled residual %.3g, tolerance %.3g)",
                                  it + 1, rn.max, tol);
         }
-        assemble(rod, sp, 1);
         rn = trial;
         rep->residual = rn.max;
+        if (rn.max <= tol) /* rod->res is this state's: no matrix needed */
+            return PHC_OK;
         if (maxdx * s <= 1e-12 * L && maxrot * s <= 1e-12 && s == 1.0 &&
             rn.max <= STEP_RESIDUAL * tol)
             return PHC_OK;
+        assemble(rod, sp, 1);
     }
     if (rn.max <= tol)
         return PHC_OK;

@@ -1002,6 +1002,27 @@ static void test_random_tree(void)
            "iteration (assembly, factorisation, solve and line search; not asserted)\n",
            n, rep.iterations, rep.residual, maxd, t1 - t0,
            1e6 * (t1 - t0) / ((double)n * (rep.iterations > 0 ? rep.iterations : 1)));
+    /* dynamics from that equilibrium after gravity tilts by 3 degrees:
+     * implicit steps of 1 ms, each a few Newton iterations */
+    {
+        phc_error err;
+        int its = 0, ok = 1;
+        o.gravity[0] = 9.81 * sin(3.0 * M_PI / 180.0);
+        o.gravity[2] = -9.81 * cos(3.0 * M_PI / 180.0);
+        CHECK(phc_rod_set_options(rod, &o, &err) == PHC_OK);
+        const double t2 = now();
+        for (int s = 0; s < 20 && ok; ++s) {
+            ok = phc_rod_step(rod, 1e-3, &rep, &err) == PHC_OK;
+            if (!ok)
+                fprintf(stderr, "step %d: %s\n", s, err.message);
+            its += rep.total_iterations;
+        }
+        const double t3 = now();
+        CHECK(ok);
+        printf("  20 implicit steps of 1 ms: %d Newton iterations, %.3f us per segment per "
+               "iteration (not asserted)\n",
+               its, 1e6 * (t3 - t2) / ((double)n * (its > 0 ? its : 1)));
+    }
     phc_rod_free(rod);
     phc_plant_graph_free(g);
 }
