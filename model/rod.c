@@ -710,7 +710,9 @@ static residual_norm residual_measure(const phc_rod *rod, const step_params *sp)
 }
 
 /* Solves the Newton system for −res into rod->sol, supports by Schur
- * complement.  Returns PHC_TREE_NONE or the singular node. */
+ * complement.  Returns PHC_TREE_NONE, the singular node, or DIRECTION_NOMEM. */
+#define DIRECTION_NOMEM ((size_t)-2)
+
 static size_t newton_direction(phc_rod *rod)
 {
     phc_rod_tree *t = rod->tree;
@@ -728,7 +730,7 @@ static size_t newton_direction(phc_rod *rod)
     /* u0 = K⁻¹(−r); S = G K⁻¹ Gᵀ; μ = S⁻¹ G u0; u = K⁻¹(−r − Gᵀ μ) */
     double *mu = malloc(m * sizeof *mu);
     if (!mu)
-        return 0;
+        return DIRECTION_NOMEM;
     memcpy(rod->rhs, rod->sol, 12 * n * sizeof *rod->rhs);
     phc_rod_tree_solve(t, rod->rhs);
     for (size_t a = 0; a < na; ++a)
@@ -752,7 +754,8 @@ static size_t newton_direction(phc_rod *rod)
         double *sv = malloc(m * sizeof *sv), *tmp = malloc(m * sizeof *tmp);
         double *U = malloc(m * m * sizeof *U), *VT = malloc(m * m * sizeof *VT);
         double *superb = malloc((m > 1 ? m : 2) * sizeof *superb);
-        int bad = !sv || !tmp || !U || !VT || !superb;
+        const int nomem = !sv || !tmp || !U || !VT || !superb;
+        int bad = nomem;
         if (!bad) {
             for (size_t r = 0; r < m; ++r) {
                 const double sr = (r % 6 >= 3) ? L : 1.0;
@@ -786,7 +789,7 @@ static size_t newton_direction(phc_rod *rod)
         free(superb);
         if (bad) {
             free(mu);
-            return rod->anchors[0];
+            return nomem ? DIRECTION_NOMEM : rod->anchors[0];
         }
     }
     for (size_t a = 0; a < na; ++a)
@@ -859,6 +862,8 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         if (rn.max <= tol)
             return PHC_OK;
         const size_t bad = newton_direction(rod);
+        if (bad == DIRECTION_NOMEM)
+            return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory for the supports' system");
         if (bad != PHC_TREE_NONE)
             return phc_error_set(err, PHC_ERR_NUMERIC,
                                  "rod: segment %ld: the Newton system is singular at iteration %d "
@@ -979,6 +984,8 @@ int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err)
             rc = newton(rod, &sp, left < cap ? left : cap, &stage, err);
             rep->total_iterations += stage.iterations;
             rep->residual = stage.residual;
+            if (rc == PHC_ERR_NOMEM)
+                break;
             if (rc == PHC_OK) {
                 t = tt;
                 dt = fmin(2.0 * dt, 1.0);
