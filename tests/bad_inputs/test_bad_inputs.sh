@@ -32,7 +32,11 @@ SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 EXAMPLE_DIR="$SCRIPT_DIR/../../measurements/examples/enzyme_kinetics"
 
 T=$(mktemp -d "${TMPDIR:-/tmp}/phc_bad_inputs.XXXXXX") || exit 1
-trap 'chmod -R u+rwx "$T" 2>/dev/null; rm -rf "$T"' EXIT
+# PHC_BAD_INPUTS_KEEP=DIR: copy the case files into DIR before they are
+# removed (scripts/fuzz builds its seed corpora from them).
+trap 'chmod -R u+rwx "$T" 2>/dev/null
+      if [ -n "${PHC_BAD_INPUTS_KEEP:-}" ]; then cp -R "$T/cases/." "$PHC_BAD_INPUTS_KEEP/"; fi
+      rm -rf "$T"' EXIT
 cd "$T" || exit 1
 mkdir -p cases
 C="$T/cases"
