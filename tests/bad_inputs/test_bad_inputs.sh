@@ -1250,6 +1250,12 @@ printf 'x,"y\nz"\n1,2.1\n2,3.9\n3,6.2\n4,8.0\n' >"$C/hdr_nl.csv"
 write_config "$C/hdr_nl.yaml" "$PARAMS_OK" "$(dataset_block hdr_nl.csv "a*x + b" | sed 's/    y: y/    y: yz/')"
 fuzz_case "fuzz: column name with a line break" "$C/hdr_nl.yaml" \
     "$C/hdr_nl.yaml:9: y 'yz' is not a column of $C/hdr_nl.csv; did you mean 'y\\nz'?"
+# The same in the one message written without phc_error_set (found by
+# reading the code after the case above, fit/costs/curve.c): sigma text.
+write_config "$C/sigma_nl.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    sigma: "s\nt"
+')"
+fuzz_case "fuzz: sigma text with a line break" "$C/sigma_nl.yaml" \
+    "$C/sigma_nl.yaml:11: key 'sigma': expected a positive number or a column of $C/data.csv, found 's\\nt'"
 # A unit with a line break ("h\n"): UDUNITS-2 printed the line break on
 # stdout and accepted "h"; now it is not a unit (measurements/units.c).
 wc_config wc_unit_nl.yaml wc_ok.csv '    leaf_area: 100
