@@ -14,7 +14,7 @@
 #include "fuzz_common.h"
 
 #include "fit/config.h"
-#include "fit/problem.h"
+#include "fit/engine/problem.h"
 
 static const char data_csv[] = "x,y\n1,2.1\n2,3.9\n3,6.2\n4,8.0\n5,9.9\n6,12.1\n";
 
