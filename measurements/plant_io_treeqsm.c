@@ -130,6 +130,17 @@ int phc_plant_io_read_treeqsm(const char *path, char *text, size_t length, doubl
             g->head[3 * i + k] = v[2 + k] * unit;
             g->tail[3 * i + k] = (v[2 + k] + v[1] * v[5 + k] / axis_norm) * unit;
         }
+        /* A length below the rounding of the start coordinates leaves the
+         * tail on the start: refuse it as the native reader would (same
+         * relative tolerance, 1e-4). */
+        const double geom = phc_plant_io_distance3(g->tail + 3 * i, g->head + 3 * i);
+        if (!(fabs(geom - g->length[i]) <= 1e-4 * g->length[i])) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: segment %ld: length %g is lost in the rounding of its "
+                               "start point: |tail - start| = %g",
+                               path, number, id, v[1], geom / unit);
+            goto fail;
+        }
         g->source_id[i] = id;
     }
     if ((rc = phc_plant_io_check_structure(path, g, lines, err)) ||

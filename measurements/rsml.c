@@ -282,7 +282,10 @@ static void capture_error(void *data, xmlErrorPtr e)
     cap->have = e->level == XML_ERR_FATAL ? 2 : 1;
     cap->line = e->line;
     snprintf(cap->message, sizeof cap->message, "%s", e->message ? e->message : "XML error");
-    n = strlen(cap->message);
+    /* libxml2 adds detail lines ("...indicate encoding !\nBytes: 0x8A ..."):
+     * a message is one line, so keep the first */
+    n = strcspn(cap->message, "\n");
+    cap->message[n] = '\0';
     while (n && (cap->message[n - 1] == '\n' || cap->message[n - 1] == ' '))
         cap->message[--n] = '\0';
 }

@@ -27,7 +27,7 @@ int phc_read_text_file(const char *path, char **text, size_t *length, phc_error 
         }
         size_t got = fread(buf + len, 1, cap - len - 1, f);
         len += got;
-        if (got == 0)
+        if (got == 0 || feof(f)) /* a short read at the end: no second, larger buffer */
             break;
     }
     if (ferror(f)) {

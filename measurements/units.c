@@ -42,6 +42,13 @@ static ut_unit *parse(phc_units *u, const char *text)
 {
     if (!text || !*text)
         return NULL;
+    /* UDUNITS-2's lexer copies characters no rule matches, a line break
+     * ("h\n" from a YAML "\n" or a quoted CSV cell), to stdout and then
+     * accepts the unit before it; the library never prints, and a unit has
+     * no control characters: refuse them (spaces and tabs separate factors). */
+    for (const char *c = text; *c; ++c)
+        if (((unsigned char)*c < 0x20 && *c != '\t') || *c == 0x7f)
+            return NULL;
     return ut_parse(u->system, text, UT_UTF8);
 }
 

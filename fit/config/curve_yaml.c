@@ -59,9 +59,9 @@ static int curve_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
         o.sigma_column = sig->scalar;
     } else if (sig) {
         if ((rc = phc_yaml_number(doc, sig, "sigma", &o.sigma, err))) {
-            snprintf(err->message, sizeof err->message,
-                     "%s:%zu: key 'sigma': expected a positive number or a column of %s, found '%s'",
-                     doc->path, sig->line, path, sig->kind == PHC_YAML_SCALAR ? sig->scalar : "(not a scalar)");
+            phc_error_set(err, rc,
+                          "%s:%zu: key 'sigma': expected a positive number or a column of %s, found '%s'",
+                          doc->path, sig->line, path, sig->kind == PHC_YAML_SCALAR ? sig->scalar : "(not a scalar)");
             goto done;
         }
         if (!(o.sigma > 0)) {

@@ -32,7 +32,11 @@ SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 EXAMPLE_DIR="$SCRIPT_DIR/../../measurements/examples/enzyme_kinetics"
 
 T=$(mktemp -d "${TMPDIR:-/tmp}/phc_bad_inputs.XXXXXX") || exit 1
-trap 'chmod -R u+rwx "$T" 2>/dev/null; rm -rf "$T"' EXIT
+# PHC_BAD_INPUTS_KEEP=DIR: copy the case files into DIR before they are
+# removed (scripts/fuzz builds its seed corpora from them).
+trap 'chmod -R u+rwx "$T" 2>/dev/null
+      if [ -n "${PHC_BAD_INPUTS_KEEP:-}" ]; then cp -R "$T/cases/." "$PHC_BAD_INPUTS_KEEP/"; fi
+      rm -rf "$T"' EXIT
 cd "$T" || exit 1
 mkdir -p cases
 C="$T/cases"
@@ -1218,6 +1222,49 @@ fit_case "root_shoot: select matches no rows" "$C/rs_none.yaml" "rs_ok.csv" "sel
 rs_table_config rs_nofile.yaml rs_none.csv
 fit_case "root_shoot: missing table" "$C/rs_nofile.yaml" "rs_nofile.yaml:6" "key 'file'" "rs_none.csv" "No such file"
 # ---- end root_shoot --------------------------------------------------------
+
+# ---- fuzzing finds (tests/fuzz, scripts/fuzz) --------------------------------
+# Inputs the libFuzzer harnesses found mishandled, each with the exact message
+# (after "phytocal: ") and nothing on stdout.
+# fuzz_case NAME CONFIG MESSAGE: fit_case, then stderr is exactly
+# "phytocal: MESSAGE" and stdout is empty.
+fuzz_case() {
+    local name=$1 config=$2 want=$3
+    local out="$T/out_${name//[^A-Za-z0-9_]/_}"
+    WHY=""
+    run_phc fit "$config" -o "$out"
+    check_error_output 2
+    check_no_output "$out"
+    if [ "$ERR" != "phytocal: $want" ]; then
+        add_why "stderr is not exactly 'phytocal: $want'"
+    fi
+    if [ -s "$T/stdout" ]; then
+        add_why "stdout is not empty ($(head -c 80 "$T/stdout" | od -c | head -2 | tr '\n' ' '))"
+    fi
+    report_case "$name"
+}
+# A quoted CSV header with a line break, named in a "did you mean": the
+# message was two lines; control characters in messages are now escaped
+# (model/status.c).
+printf 'x,"y\nz"\n1,2.1\n2,3.9\n3,6.2\n4,8.0\n' >"$C/hdr_nl.csv"
+write_config "$C/hdr_nl.yaml" "$PARAMS_OK" "$(dataset_block hdr_nl.csv "a*x + b" | sed 's/    y: y/    y: yz/')"
+fuzz_case "fuzz: column name with a line break" "$C/hdr_nl.yaml" \
+    "$C/hdr_nl.yaml:9: y 'yz' is not a column of $C/hdr_nl.csv; did you mean 'y\\nz'?"
+# The same in the one message written without phc_error_set (found by
+# reading the code after the case above, fit/costs/curve.c): sigma text.
+write_config "$C/sigma_nl.yaml" "$PARAMS_OK" "$(dataset_block data.csv "a*x + b" '    sigma: "s\nt"
+')"
+fuzz_case "fuzz: sigma text with a line break" "$C/sigma_nl.yaml" \
+    "$C/sigma_nl.yaml:11: key 'sigma': expected a positive number or a column of $C/data.csv, found 's\\nt'"
+# A unit with a line break ("h\n"): UDUNITS-2 printed the line break on
+# stdout and accepted "h"; now it is not a unit (measurements/units.c).
+wc_config wc_unit_nl.yaml wc_ok.csv '    leaf_area: 100
+' && sed -i 's/unit: h}/unit: "h\\n"}/' "$C/wc_unit_nl.yaml"
+fuzz_case "fuzz: time unit with a line break" "$C/wc_unit_nl.yaml" \
+    "$C/wc_unit_nl.yaml:9: time unit: 'h\\n' is not a unit UDUNITS-2 knows"
+# A TreeQSM cylinder shorter than the rounding of its start point: its tail
+# fell on its start (a zero-length segment); the plant_graphs case list has
+# the file (treeqsm_length_lost_in_rounding.txt, measurements/plant_io.c).
 
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"

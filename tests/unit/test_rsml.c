@@ -342,6 +342,7 @@ static void expect_input_error(const char *name, const char *text, int line, con
     snprintf(where, sizeof where, "%s:%d: ", path, line);
     CHECK(!strncmp(err.message, where, strlen(where)));
     CHECK_STR_CONTAINS(err.message, needle);
+    CHECK(strchr(err.message, '\n') == NULL); /* one line */
     if (rc != PHC_ERR_INPUT || strncmp(err.message, where, strlen(where)) ||
         !strstr(err.message, needle))
         fprintf(stderr, "  %s: got '%s'\n", name, err.message);
@@ -470,6 +471,19 @@ static void test_malformed(void)
                             "</metadata><scene/></rsml>\n",
                        4, "<resolution>: expected a finite number > 0, found '0'", NULL);
     expect_input_error("no_scene.rsml", HEAD META "</rsml>\n", 2, "has no <scene>", NULL);
+    /* a fuzzing find: libxml2's message for a byte that is not UTF-8 has a
+     * second line ("Bytes: 0x8A 0x65 ..."); the message keeps the first */
+    {
+        static const char text[] = HEAD "<metadata><unit>cm</unit>\n<\x8a" "esolution>1</resolution>\n"
+                                        "</metadata><scene/></rsml>\n";
+        const char *path = write_file("not_utf8.rsml", text);
+        phc_rsml *r = NULL;
+        phc_error err;
+        const char *tail = ":4: Input is not proper UTF-8, indicate encoding !";
+        CHECK(path && phc_rsml_read(path, &r, &err) == PHC_ERR_INPUT && r == NULL);
+        CHECK(path && !strncmp(err.message, path, strlen(path)) &&
+              !strcmp(err.message + strlen(path), tail));
+    }
 
     fflush(stderr);
     if (quiet >= 0 && saved_stderr >= 0) {

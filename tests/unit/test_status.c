@@ -27,5 +27,20 @@ int main(void)
     CHECK(strlen(err.message) == PHC_ERROR_MESSAGE_SIZE - 1);
     CHECK(strncmp(err.message, place, strlen(place)) == 0);
     CHECK(strncmp(err.message + strlen(place), ": the", 5) == 0);
+    /* a message is one line: control characters quoted from the input are
+     * escaped (a fuzzing find: a quoted CSV header with a line break) */
+    phc_error_set(&err, PHC_ERR_INPUT, "column '%s'", "y\nz\t\x7f\r");
+    CHECK(strcmp(err.message, "column 'y\\nz\\t\\x7f\\r'") == 0);
+    phc_error_set(&err, PHC_ERR_INPUT, "reason");
+    phc_error_prefix(&err, PHC_ERR_INPUT, "a\nb");
+    CHECK(strcmp(err.message, "a\\nb: reason") == 0);
+    /* escapes that do not fit are dropped whole, never cut */
+    char longer[PHC_ERROR_MESSAGE_SIZE];
+    memset(longer, 'p', PHC_ERROR_MESSAGE_SIZE - 4);
+    longer[PHC_ERROR_MESSAGE_SIZE - 4] = '\x01'; /* its escape needs 4 of the 3 bytes left */
+    longer[PHC_ERROR_MESSAGE_SIZE - 3] = '\0';
+    phc_error_set(&err, PHC_ERR_INPUT, "%s", longer);
+    CHECK(strlen(err.message) == PHC_ERROR_MESSAGE_SIZE - 4);
+    CHECK(strchr(err.message, '\\') == NULL);
     return check_finish("test_status");
 }

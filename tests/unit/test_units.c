@@ -35,6 +35,12 @@ int main(void)
     CHECK(phc_units_conversion(u, "g", "s", "cfg.yaml:8: time unit", &c, &err) == PHC_ERR_INPUT);
     CHECK_STR_CONTAINS(err.message, "'g' cannot be converted to 's'");
     CHECK(phc_units_conversion(u, "", "s", "x", &c, &err) == PHC_ERR_INPUT);
+    /* A line break is not part of a unit (a fuzzing find: UDUNITS-2 echoed
+     * it to stdout and accepted "h"); the message shows it escaped. */
+    CHECK(phc_units_conversion(u, "h\n", "s", "t", &c, &err) == PHC_ERR_INPUT);
+    CHECK(strcmp(err.message, "t: 'h\\n' is not a unit UDUNITS-2 knows") == 0);
+    CHECK(phc_units_convertible(u, "h\r", "s") == 0);
+    CHECK(phc_units_convertible(u, "kg\tm", "kg m") == 1); /* tabs separate factors */
     CHECK(phc_units_convertible(u, "d", "s") == 1);
     CHECK(phc_units_convertible(u, "kg", "s") == 0);
     phc_units_free(u);
