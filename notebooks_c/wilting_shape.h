@@ -54,7 +54,7 @@
 #define WS_KAPPA 20.0        /* per unit of relative water content */
 #define WS_CHI0 0.8          /* relative water content */
 
-static double ws_now(void)
+__attribute__((unused)) static double ws_now(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -62,7 +62,7 @@ static double ws_now(void)
 }
 
 /* Reads the plant (metres); NULL after printing the reason. */
-static phc_plant_graph *ws_read(const char *path)
+__attribute__((unused)) static phc_plant_graph *ws_read(const char *path)
 {
     phc_error err;
     phc_error_clear(&err);
@@ -75,7 +75,7 @@ static phc_plant_graph *ws_read(const char *path)
 }
 
 /* Segment volumes (cm^3) into v (n) and their sum. */
-static double ws_volumes(const phc_plant_graph *g, double *v)
+__attribute__((unused)) static double ws_volumes(const phc_plant_graph *g, double *v)
 {
     double s = 0.0;
     for (size_t i = 0; i < g->n; ++i)
@@ -88,7 +88,7 @@ static double ws_volumes(const phc_plant_graph *g, double *v)
  * loses the fraction 1 - rwc of its water in t seconds:
  * W' = -delta sum_leaf(A_i theta_i) = -delta (sum_leaf A_i V_i / sum V) W,
  * so delta = -ln(rwc) / (t sum_leaf(A_i V_i) / sum V), A_i = r_i h_i (cm^2). */
-static double ws_delta_for(const phc_plant_graph *g, double rwc, double t)
+__attribute__((unused)) static double ws_delta_for(const phc_plant_graph *g, double rwc, double t)
 {
     double av = 0.0, vs = 0.0;
     for (size_t i = 0; i < g->n; ++i) {
@@ -102,7 +102,7 @@ static double ws_delta_for(const phc_plant_graph *g, double rwc, double t)
 
 /* Water theta (g) at m times (s, each 0 or a multiple of WS_H, increasing),
  * row k of theta (m x n) for time t[k]; BDF6 with step WS_H. */
-static int ws_water(const phc_plant_graph *g, const phc_water_params *p, const double *t, size_t m,
+__attribute__((unused)) static int ws_water(const phc_plant_graph *g, const phc_water_params *p, const double *t, size_t m,
                     double *theta, phc_error *err)
 {
     phc_water_system *s = NULL;
@@ -130,7 +130,7 @@ static int ws_water(const phc_plant_graph *g, const phc_water_params *p, const d
 }
 
 /* Our water model parameters: physical default, W0 = the plant's volume. */
-static phc_water_params ws_water_params(const phc_plant_graph *g, double delta)
+__attribute__((unused)) static phc_water_params ws_water_params(const phc_plant_graph *g, double delta)
 {
     phc_water_params p = phc_water_params_default();
     double *v = malloc(g->n * sizeof *v);
@@ -140,7 +140,7 @@ static phc_water_params ws_water_params(const phc_plant_graph *g, double delta)
     return p;
 }
 
-static phc_segment_stiffness_params ws_stiffness(double kappa, double chi0)
+__attribute__((unused)) static phc_segment_stiffness_params ws_stiffness(double kappa, double chi0)
 {
     phc_segment_stiffness_params sp = phc_segment_stiffness_params_default();
     sp.law = PHC_STIFFNESS_WATER;
@@ -153,7 +153,7 @@ static phc_segment_stiffness_params ws_stiffness(double kappa, double chi0)
 }
 
 /* Relative water content theta/V per segment into rwc; min and max. */
-static void ws_rwc(const phc_plant_graph *g, const double *theta, double *rwc, double *lo, double *hi)
+__attribute__((unused)) static void ws_rwc(const phc_plant_graph *g, const double *theta, double *rwc, double *lo, double *hi)
 {
     *lo = INFINITY, *hi = -INFINITY;
     for (size_t i = 0; i < g->n; ++i) {
@@ -162,7 +162,7 @@ static void ws_rwc(const phc_plant_graph *g, const double *theta, double *rwc, d
     }
 }
 
-static phc_rod *ws_rod(const phc_plant_graph *g, const double *E, phc_error *err)
+__attribute__((unused)) static phc_rod *ws_rod(const phc_plant_graph *g, const double *E, phc_error *err)
 {
     phc_rod_options o;
     phc_rod_options_default(&o);
@@ -176,7 +176,7 @@ static phc_rod *ws_rod(const phc_plant_graph *g, const double *E, phc_error *err
 /* One static solve with moduli E (Pa) and water theta (g, or NULL: no water
  * mass) from the rod's current state (fresh: call phc_rod_reset first).
  * Adds the wall time to *secs; returns the status. */
-static int ws_solve(phc_rod *rod, const double *E, const double *theta, double *secs, int *iterations,
+__attribute__((unused)) static int ws_solve(phc_rod *rod, const double *E, const double *theta, double *secs, int *iterations,
                     phc_error *err)
 {
     size_t n = phc_rod_segment_count(rod);
@@ -201,7 +201,7 @@ static int ws_solve(phc_rod *rod, const double *E, const double *theta, double *
 
 /* The rod's current shape: heads and tails (3n each) and the height (max z
  * of the tails, m). */
-static double ws_shape(const phc_rod *rod, double *head, double *tail)
+__attribute__((unused)) static double ws_shape(const phc_rod *rod, double *head, double *tail)
 {
     double h = -INFINITY;
     for (size_t i = 0; i < phc_rod_segment_count(rod); ++i) {
@@ -213,7 +213,7 @@ static double ws_shape(const phc_rod *rod, double *head, double *tail)
 }
 
 /* The segment whose tail is highest in the rest shape (the highest tip). */
-static size_t ws_highest(const phc_plant_graph *g)
+__attribute__((unused)) static size_t ws_highest(const phc_plant_graph *g)
 {
     size_t best = 0;
     for (size_t i = 1; i < g->n; ++i)
@@ -223,7 +223,7 @@ static size_t ws_highest(const phc_plant_graph *g)
 }
 
 /* Mean of tail z minus rest tail z over the segments (m; negative = down). */
-static double ws_mean_dz(const phc_plant_graph *g, const double *tail)
+__attribute__((unused)) static double ws_mean_dz(const phc_plant_graph *g, const double *tail)
 {
     double s = 0.0;
     for (size_t i = 0; i < g->n; ++i)
