@@ -92,7 +92,8 @@ typedef struct phc_rod_report {
     double residual;  /* final scaled residual (max norm) */
 } phc_rod_report;
 
-/* Builds the rods of a finished graph.  young: n Young's moduli in Pa (> 0,
+/* Builds the rods of a finished graph (kept by pointer, not copied: it
+ * must outlive the rod and not change).  young: n Young's moduli in Pa (> 0,
  * finite).  options may be NULL (defaults).  Errors (PHC_ERR_INPUT) name the
  * segment by source_id: zero/negative/NaN radius, length, modulus, density;
  * NaN coordinates; a graph of one segment (every segment fixed). */
