@@ -159,8 +159,8 @@ int main(int argc, char **argv)
         return 1;
 
     printf("plant000: %zu segments, rest height %.4f m; water after %.0f h at delta = %.4e 1/(cm^2 s): %.4f g of "
-           "%.4f g (theta/V %.6f .. %.6f)\n",
-           n, g->tail[3 * top + 2], T_DRY / 3600.0, delta, W, wp.initial_water, lo, hi);
+           "%.4f g (theta/V %.6f .. %.6f, spread (max - min)/min %.1e)\n",
+           n, g->tail[3 * top + 2], T_DRY / 3600.0, delta, W, wp.initial_water, lo, hi, (hi - lo) / lo);
     printf("water law: absolute water, chi0 = median theta = %.4e g, kappa = %g/chi0 = %.4e 1/g\n", chi0, KAPPA_CHI0, KAPPA_CHI0 / chi0);
     printf("deep segments: depth > %.0f (median depth)\n", dmed);
     printf("%-32s %10s %10s %13s %9s %12s %12s %12s %11s %8s %5s\n", "law", "E min (Pa)", "E max (Pa)",
