@@ -10,8 +10,8 @@
  * of 1e10 "Pa" on a radius of cm^2, see model/segment_stiffness.h quirks
  * 1-8; they do not carry over to SI):
  *   plant    plant000 of the authors' code (1964 segments, 24.9 cm tall, z up,
- *            metres); its static equilibrium takes 0.1-0.3 s here, so no smaller
- *            plant is needed.
+ *            metres); one static equilibrium takes 0.02-1.5 s here (measured
+ *            in these notebooks), so no smaller plant is needed.
  *   water    phytocal's physical water model (PHC_WATER_POISEUILLE), initial
  *            water W0 = sum of segment volumes (relative water content
  *            theta/V = 1 everywhere at t = 0), BDF6 with a step of WS_H s.
