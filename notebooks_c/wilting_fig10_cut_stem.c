@@ -363,8 +363,8 @@ int main(int argc, char **argv)
             "  own with the same initial water (BDF6 both): %.1e (bound 1e-10) %s;\n"
             "- the damaged edge lies between intact and cut above the cut at every time %s.\n\n"
             "**How ours differs.** The paper shows the cut on its own plants, with the wilting shapes that\n"
-            "the position-based dynamics draw; phytocal computes the water only, on a plant of the authors'\n"
-            "code.\n",
+            "the position-based dynamics draw; this notebook follows the water only, on a plant of the authors'\n"
+            "code. The shape of a cut plant (water -> stiffness -> rods) is `wilting_fig10_cut_stem_shape`.\n",
             worst_sum, ok_sum ? "(pass)" : "(**FAIL**)", worst_piece, piece_bound, piece_bdf, ok_piece ? "(pass)" : "(**FAIL**)",
             worst_sub, ok_sub ? "(pass)" : "(**FAIL**)", between ? "(pass)" : "(**FAIL**)");
     if (nb_close_md(f, md, mdtmp) != 0) {
