@@ -3,17 +3,16 @@
  * imgproc).  What the photo bridge files share is in photo_bridge.h.
  *
  * Files are read whole and checked for truncation before decoding; every
- * file written here goes through write_atomic (a temporary name renamed into
- * place). */
+ * file written here goes through phc_atomic_file (measurements/atomic_file.h:
+ * a temporary name renamed into place). */
 #include "measurements/photo_bridge.h"
+
+#include "measurements/atomic_file.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <fcntl.h>
 #include <strings.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -163,41 +162,22 @@ static int decode_file(const char *path, cv::Mat &m, phc_error *err)
     return PHC_OK;
 }
 
-/* Writes bytes to path through a temporary name in the same directory,
- * renamed into place (atomic on POSIX); created with mode 0666 & ~umask. */
+/* Writes bytes to path through measurements/atomic_file.h (a temporary
+ * DIR/NAME.tmp-XXXXXX renamed into place once written and synced, like every
+ * other writer); the destination is untouched on any failure. */
 static int write_atomic(const char *path, const std::vector<unsigned char> &buf, phc_error *err)
 {
-    std::string tmp;
-    int fd = -1;
-    for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-        tmp = std::string(path) + ".tmp." + std::to_string((long)getpid()) + "." +
-              std::to_string(attempt);
-        fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0666);
-        if (fd < 0 && errno != EEXIST)
-            break;
-    }
-    if (fd < 0)
-        return phc_error_set(err, PHC_ERR_IO, "%s: cannot create %s: %s", path, tmp.c_str(),
-                             std::strerror(errno));
-    size_t done = 0;
-    while (done < buf.size()) {
-        const ssize_t k = write(fd, buf.data() + done, buf.size() - done);
-        if (k < 0 && errno == EINTR)
-            continue;
-        if (k <= 0) {
-            const int e = errno;
-            close(fd);
-            unlink(tmp.c_str());
-            return phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", path, std::strerror(e));
-        }
-        done += (size_t)k;
-    }
-    if (close(fd) != 0 || std::rename(tmp.c_str(), path) != 0) {
+    phc_atomic_file *af = NULL;
+    int rc = phc_atomic_file_open(path, &af, err);
+    if (rc)
+        return rc;
+    FILE *f = phc_atomic_file_stream(af);
+    if (!buf.empty() && std::fwrite(buf.data(), 1, buf.size(), f) != buf.size()) {
         const int e = errno;
-        unlink(tmp.c_str());
+        phc_atomic_file_abort(af);
         return phc_error_set(err, PHC_ERR_IO, "%s: cannot write: %s", path, std::strerror(e));
     }
-    return PHC_OK;
+    return phc_atomic_file_commit(af, err);
 }
 
 /* The encoder's extension from the path: ".png", ".tif" or ".jpg". */

@@ -6,9 +6,10 @@
  * truth we simulate an infiltration experiment with the C model itself
  * (1 x 1 x nz column, periodic sides, top and bottom BLOCK, initially nearly
  * dry by `fill`, rain 10 mm/h for 2 h from t = 0), sample three designs,
- * add Gaussian noise with a fixed seed, write the CSV files and a YAML
- * config per (soil, design), and fit p and c with the calibration code
- * (phc_config_load -> phc_fit_run):
+ * add Gaussian noise with a fixed seed, write the CSV files, and fit p and
+ * c with the calibration code: each (soil, design) problem is built through
+ * the C API (phc_soil_probe_new or phc_infiltration_new over the files read
+ * back, a problem of its own) and fitted with phc_fit_run:
  *
  *   A  soil_probe, quantity water: w at 4 probe depths, read every dt_obs
  *   B  soil_probe, quantity fill: the same probes as w/c
@@ -30,9 +31,14 @@
 #include <string.h>
 #include <time.h>
 
-#include "fit/config.h"
+#include "fit/costs/infiltration.h"
+#include "fit/costs/soil_probe.h"
+#include "fit/costs/soil_setup.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
 #include "fit/engine/problem.h"
+#include "measurements/soil_probes.h"
+#include "measurements/table.h"
 #include "model/soil.h"
 
 #include "notebook_plot.h"
@@ -253,13 +259,13 @@ static void classify(outcome *o, double p, double c)
         snprintf(o->verdict, sizeof o->verdict, "not identified");
 }
 
-static int fit_one(const char *cfg, const plan *pl, double p, double c, outcome *o, phc_error *err)
+/* Fits pb (taken: freed here; NULL = its build failed, err set) and reads the outcome. */
+static int fit_one(phc_problem *pb, const plan *pl, double p, double c, outcome *o, phc_error *err)
 {
-    phc_problem *pb = NULL;
     phc_fit_result *res = NULL;
-    int rc = phc_config_load(cfg, &pb, err);
-    if (rc)
-        return rc;
+    int rc;
+    if (!pb)
+        return err->status ? err->status : PHC_ERR_INPUT;
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
     rc = phc_fit_run(pb, NULL, NULL, &res, err);
@@ -285,7 +291,7 @@ static int fit_one(const char *cfg, const plan *pl, double p, double c, outcome 
     if (ip < 0 || ic < 0 || fp < 0 || fc < 0) {
         phc_fit_result_free(res);
         phc_problem_free(pb);
-        return phc_error_set(err, PHC_ERR_INTERNAL, "%s: p and c are not both free", cfg);
+        return phc_error_set(err, PHC_ERR_INTERNAL, "%s: p and c are not both free", pb->name);
     }
     o->converged = res->summary.outcome == PHC_NLS_CONVERGED;
     o->iterations = res->summary.iterations;
@@ -318,38 +324,132 @@ static int fit_one(const char *cfg, const plan *pl, double p, double c, outcome 
     return 0;
 }
 
-/* ---- writing the data and the configs ---- */
-static int write_config(const char *path, const char *soil, int des, const plan *pl, double c, double p,
-                        double c0, double p0, double sigma, const char *data_file, const char *probe_file)
+/* ---- the problems, built through the C API ---- */
+
+/* The column's soil (model/soil.h through fit/costs/soil_setup.h): 1 x 1 x
+ * nz voxels of dx m, sides periodic, top and bottom BLOCK, the plan's fixed
+ * step without sub-stepping, one layer of the true c and p starting at fill
+ * W0 / c, rain RAIN_RATE m/h from 0 to RAIN_END h over the whole surface.
+ * layer and rain are the caller's (options point at them). */
+static phc_soil_setup_options column_soil(const plan *pl, double c, double p, phc_soil_setup_layer *layer,
+                                          phc_soil_rain *rain)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
-    fprintf(f, "# Identifiability study, soil %s, design %s (written by the notebook).\n", soil, des_name[des]);
-    fprintf(f, "# Truth: p = %.17g m/h, c = %.17g; start p = %.17g m/h, c = %.17g.\n", p, c, p0, c0);
-    fprintf(f, "name: ident-%s-%c%s\nparameters:\n", soil, des_tag[des], p0 == p && c0 == c ? "-from-truth" : "");
-    fprintf(f, "  p: {value: %.17g, lower: 1.0e-6, upper: %.17g, unit: \"m/h\"}\n", p0, 100.0 * p);
-    fprintf(f, "  c: {value: %.17g, lower: 1.0e-6, upper: %.17g}\n", c0, 100.0 * c);
-    fprintf(f, "datasets:\n");
+    phc_soil_setup_options so = phc_soil_setup_options_default();
+    so.nx = so.ny = 1;
+    so.nz = pl->nz;
+    so.dx = pl->dx;
+    so.params.dt = pl->dt;
+    so.params.substep = 0;
+    so.params.boundary[PHC_SOIL_XMIN] = so.params.boundary[PHC_SOIL_XMAX] = PHC_SOIL_PERIODIC;
+    so.params.boundary[PHC_SOIL_YMIN] = so.params.boundary[PHC_SOIL_YMAX] = PHC_SOIL_PERIODIC;
+    so.params.boundary[PHC_SOIL_ZMIN] = so.params.boundary[PHC_SOIL_ZMAX] = PHC_SOIL_BLOCK;
+    *layer = phc_soil_setup_layer_default();
+    layer->c = c;
+    layer->p = p;
+    layer->fill = W0 / c;
+    so.layers = layer;
+    so.n_layers = 1;
+    memset(rain, 0, sizeof *rain);
+    rain->start = 0;
+    rain->end = RAIN_END;
+    rain->rate = RAIN_RATE;
+    so.rain = rain;
+    so.n_rain = 1;
+    return so;
+}
+
+/* Design des's data set over the files the notebook wrote (data_file; the
+ * probe table probe_file for A and B): soil_probe reading w (A) or w/c (B)
+ * with times in h, or infiltration (C) of the 80% depth in m; sigma the
+ * noise sd.  NULL with err set on failure. */
+static phc_dataset *design_dataset(int des, const phc_soil_setup_options *so, double sigma, const char *data_file,
+                                   const char *probe_file, phc_error *err)
+{
+    phc_dataset *ds = NULL;
     if (des < 2) {
-        fprintf(f, "  - kind: soil_probe\n    name: probes-%s\n    file: %s\n", des == 0 ? "w" : "fill", data_file);
-        fprintf(f, "    time: {column: t, unit: h}\n    probe: probe\n    value: value\n    quantity: %s\n",
-                des == 0 ? "water" : "fill");
-        fprintf(f, "    probes: {file: %s, id: id, x: x, y: y, depth: depth}\n", probe_file);
-        fprintf(f, "    sigma: %.17g\n", sigma);
+        const phc_probe_columns pc = {.id = "id", .x = "x", .y = "y", .depth = "depth"};
+        const phc_unit_conversion hours = {1.0, 0.0}; /* the readings' times are in h */
+        phc_probe_table *probes = NULL;
+        phc_probe_series *ser = NULL;
+        phc_soil_probe_options o = phc_soil_probe_options_default();
+        o.quantity = des == 0 ? PHC_SOIL_PROBE_WATER : PHC_SOIL_PROBE_FILL;
+        o.sigma = sigma;
+        o.soil = so;
+        if (!phc_probe_table_read(probe_file, &pc, NULL, &probes, err) &&
+            !phc_probe_series_read(data_file, "t", hours, "probe", "value", probes, &ser, err))
+            phc_soil_probe_new(probes, ser, &o, &ds, err);
+        phc_probe_series_free(ser);
+        phc_probe_table_free(probes);
     } else {
-        fprintf(f, "  - kind: infiltration\n    name: depth80\n    file: %s\n", data_file);
-        fprintf(f, "    time: {column: t, unit: h}\n    depth: {column: d80, unit: m}\n    fraction: 0.8\n");
-        fprintf(f, "    sigma: %.17g\n", sigma);
+        phc_table *t = NULL;
+        phc_infiltration_options o = phc_infiltration_options_default();
+        o.time = "t";
+        o.time_unit = "h";
+        o.depth = "d80";
+        o.depth_unit = "m";
+        o.fraction = 0.8;
+        o.sigma = sigma;
+        o.soil = so;
+        if (!phc_table_read(data_file, &t, err))
+            phc_infiltration_new(t, &o, &ds, err);
+        phc_table_free(t);
     }
-    fprintf(f, "    soil:\n      grid: {nx: 1, ny: 1, nz: %zu, dx: %.17g}\n      dt: %.17g\n      substep: false\n",
-            pl->nz, pl->dx, pl->dt);
-    fprintf(f, "      boundaries: {sides: periodic, bottom: block, top: block}\n");
-    fprintf(f, "      layers:\n        - {c: %.17g, p: %.17g, fill: %.17g}\n", c, p, W0 / c);
-    fprintf(f, "      rain: [{start: 0, end: %g, rate: %g}]\n", RAIN_END, RAIN_RATE);
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    return bad ? -1 : 0;
+    if (ds && !(ds->name = strdup(des == 0 ? "probes-w" : des == 1 ? "probes-fill" : "depth80"))) {
+        phc_dataset_free(ds);
+        phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    return ds;
+}
+
+/* The fit of p and c for (soil, design) from the start (p0, c0): p in m/h
+ * and c in their boxes [1e-6, 100 x truth], the column of the true soil,
+ * the design's data set bound by name; units converted, stopping
+ * tolerances kept above the model's accuracy and the problem checked, as
+ * phc_config_load does for a config. */
+static phc_problem *build_problem(const char *soil, int des, const plan *pl, double c, double p, double c0,
+                                  double p0, double sigma, const char *data_file, const char *probe_file,
+                                  phc_error *err)
+{
+    char name[128];
+    snprintf(name, sizeof name, "ident-%s-%c%s", soil, des_tag[des], p0 == p && c0 == c ? "-from-truth" : "");
+    phc_problem *pb = phc_problem_new(name);
+    if (!pb) {
+        phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    size_t ip = 0, ic = 0;
+    int rc = phc_problem_add_parameter(pb, "p", p0, &ip, err);
+    if (!rc && !(rc = phc_problem_add_parameter(pb, "c", c0, &ic, err))) {
+        pb->params[ip].lower = pb->params[ic].lower = 1.0e-6;
+        pb->params[ip].upper = 100.0 * p;
+        pb->params[ic].upper = 100.0 * c;
+        if (!(pb->params[ip].unit = strdup("m/h")))
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    phc_soil_setup_layer layer;
+    phc_soil_rain rain;
+    const phc_soil_setup_options so = column_soil(pl, c, p, &layer, &rain);
+    phc_dataset *ds = rc ? NULL : design_dataset(des, &so, sigma, data_file, probe_file, err);
+    if (!rc && !ds)
+        rc = err->status ? err->status : PHC_ERR_INPUT;
+    if (!rc && !(rc = phc_problem_bind_by_name(pb, ds, err))) {
+        rc = phc_problem_add_dataset(pb, ds, err);
+        ds = NULL;
+    }
+    phc_dataset_free(ds);
+    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
+        const double tol = pb->datasets[0]->model_tolerance;
+        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
+        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
+        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
+        rc = phc_problem_validate(pb, err);
+    }
+    if (rc) {
+        phc_problem_free(pb);
+        return NULL;
+    }
+    return pb;
 }
 
 static double range_of(const double (*v)[NPROBE], size_t nt)
@@ -498,7 +598,7 @@ int main(int argc, char **argv)
                 fprintf(stderr, "%s: no 80%% depth at t = %g h\n", name[q], pl[q].dt_obs * (double)(k + 1));
                 return 1;
             }
-        char probes[1100], data[NDES][1100], cfg[NDES][1100], cfgT[NDES][1100], rel[NDES][64];
+        char probes[1100], data[NDES][1100], rel[NDES][64];
         snprintf(probes, sizeof probes, "%s/%s_probes.csv", dir, name[q]);
         sig[q][0] = NOISE_FRAC * range_of((const double(*)[NPROBE])w, pl[q].nt);
         sig[q][1] = NOISE_FRAC * range_of((const double(*)[NPROBE])fl, pl[q].nt);
@@ -506,12 +606,8 @@ int main(int argc, char **argv)
         for (int e = 0; e < NDES; ++e) {
             snprintf(rel[e], sizeof rel[e], "%s_%c.csv", name[q], des_tag[e]);
             snprintf(data[e], sizeof data[e], "%s/%s", dir, rel[e]);
-            snprintf(cfg[e], sizeof cfg[e], "%s/%s_%c.yaml", dir, name[q], des_tag[e]);
-            snprintf(cfgT[e], sizeof cfgT[e], "%s/%s_%c_from_truth.yaml", dir, name[q], des_tag[e]);
         }
         rng_state = 0x5eed0000ULL + (uint64_t)q; /* one fixed stream per soil */
-        char probes_rel[64];
-        snprintf(probes_rel, sizeof probes_rel, "%s_probes.csv", name[q]);
         if (write_probes(probes, &pl[q]) ||
             write_readings(data[0], &pl[q], (const double(*)[NPROBE])w, sig[q][0], "water content w (m3/m3)") ||
             write_readings(data[1], &pl[q], (const double(*)[NPROBE])fl, sig[q][1], "fill level w/c") ||
@@ -520,21 +616,19 @@ int main(int argc, char **argv)
             return 1;
         }
         for (int e = 0; e < NDES; ++e) {
-            if (write_config(cfg[e], name[q], e, &pl[q], cs[q], ps[q], cs[q] / START_FACTOR, ps[q] * START_FACTOR,
-                             sig[q][e], rel[e], probes_rel) ||
-                write_config(cfgT[e], name[q], e, &pl[q], cs[q], ps[q], cs[q], ps[q], sig[q][e], rel[e],
-                             probes_rel)) {
-                fprintf(stderr, "%s: cannot write the configs\n", cfg[e]);
+            phc_error_clear(&err);
+            if (fit_one(build_problem(name[q], e, &pl[q], cs[q], ps[q], cs[q] / START_FACTOR, ps[q] * START_FACTOR,
+                                      sig[q][e], data[e], probes, &err),
+                        &pl[q], ps[q], cs[q], &fit3[q][e], &err)) {
+                fprintf(stderr, "%s, design %c (3x start): the fit failed: %s\n", name[q], des_tag[e], err.message);
                 return 1;
             }
             phc_error_clear(&err);
-            if (fit_one(cfg[e], &pl[q], ps[q], cs[q], &fit3[q][e], &err)) {
-                fprintf(stderr, "%s: the fit failed: %s\n", cfg[e], err.message);
-                return 1;
-            }
-            phc_error_clear(&err);
-            if (fit_one(cfgT[e], &pl[q], ps[q], cs[q], &fitT[q][e], &err)) {
-                fprintf(stderr, "%s: the fit failed: %s\n", cfgT[e], err.message);
+            if (fit_one(build_problem(name[q], e, &pl[q], cs[q], ps[q], cs[q], ps[q], sig[q][e], data[e], probes,
+                                      &err),
+                        &pl[q], ps[q], cs[q], &fitT[q][e], &err)) {
+                fprintf(stderr, "%s, design %c (from the truth): the fit failed: %s\n", name[q], des_tag[e],
+                        err.message);
                 return 1;
             }
             /* the 3x-start fit counts when it got (at least) as low as the fit from the truth */
@@ -786,15 +880,15 @@ int main(int argc, char **argv)
             "- **B** `soil_probe`, `quantity: fill`: the same probes reading w/c;\n"
             "- **C** `infiltration`, `fraction: 0.8`: the depth above which 80%% of the rain applied so far lies.\n\n"
             "Noise: for A and B sd = %g%% of the range of the noiseless readings of the design (so A and B\n"
-            "compare at the same relative noise), for C sd = %g cm. Each (soil, design) has its CSV files and\n"
-            "two YAML configs in `rhizomorph_soil_identifiability/` next to this page (re-run any with\n"
-            "`phytocal fit`): `<soil>_<design>.yaml` starts at p × %g and c / %g (D 9× too large), and\n"
-            "`<soil>_<design>_from_truth.yaml` starts at the truth. Bounds [1e-6, 100 × truth], one start\n"
+            "compare at the same relative noise), for C sd = %g cm. Each (soil, design) has its CSV files in\n"
+            "`rhizomorph_soil_identifiability/` next to this page; its data set is built from them through the\n"
+            "C API (`phc_soil_probe_new`, `phc_infiltration_new`) and fitted twice: from p × %g and c / %g\n"
+            "(D 9× too large), and from the truth. Bounds [1e-6, 100 × truth], one start\n"
             "(plus the fit's rescue starts when a start does not converge), sigma = the noise sd, covariance\n"
             "scaled by the residual variance (`absolute_sigma: false`). When the fit from the 3× start ends at a\n"
             "higher cost than the fit from the truth, it found a worse local optimum; the table then reports the\n"
             "fit from the truth (local identifiability at the truth) and says where the 3× start stopped.\n\n"
-            "**Fixed step, no sub-stepping.** The configs use `substep: false` with dt = half the stability\n"
+            "**Fixed step, no sub-stepping.** The soils use `substep: false` with dt = half the stability\n"
             "limit at the start values (the most restrictive point a fit has to visit). With sub-stepping on,\n"
             "Ceres' bounded line search evaluated the model (with Jacobian) at the lower bounds p = c = 1e-6,\n"
             "where D = p/c is 1 m²/h and the explicit step needs ~10⁶ sub-steps (6 s per evaluation for the\n"

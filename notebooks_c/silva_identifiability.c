@@ -19,9 +19,10 @@
  *      σ = 0.02 in sRGB, seeded), and fitted with `register: true` and
  *      `colour_correction: gray_world`; case "control": no misalignment, no
  *      lighting change, no noise, fitted with `colour_correction: none`.
- * The frames, a CSV (id, day, image) and a YAML config per case and start
- * are written into a temporary directory, loaded with phc_config_load and
- * fitted with phc_fit_run from two starts off the truth.
+ * The frames are written into a temporary directory as PNG photos; each
+ * case's problem is built through the C API (phc_leaf_photos_new over the
+ * rows fresh, d2 ... d10, a problem of its own) and fitted with phc_fit_run
+ * from two starts off the truth.
  *
  * Reported per parameter: true, fitted, standard error, |error| / SE, the
  * correlation matrix and the undetermined combinations of the fit, and a
@@ -37,9 +38,10 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "fit/config.h"
+#include "fit/costs/leaf_photos.h"
 #include "fit/costs/leaf_setup.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
 #include "fit/engine/problem.h"
 #include "measurements/photo.h"
 #include "model/colour.h"
@@ -149,28 +151,89 @@ done:
     return rc;
 }
 
-/* st = NSTART: a run from the truth limited to one iteration, to read the
- * objective at the truth (summary.initial_cost). */
-static int write_config(const char *path, int cs, int st, const char *csv)
+/* The paths of a case's photos in dir: fresh.png, then <case>_dayDD.png. */
+static void frame_path(char *buf, size_t size, const char *dir, int cs, int d)
+{
+    if (d < 0)
+        snprintf(buf, size, "%s/fresh.png", dir);
+    else
+        snprintf(buf, size, "%s/%s_day%02d.png", dir, case_name[cs], (int)days[d]);
+}
+
+static int is_fitted(const char *name, void *user_data)
+{
+    (void)user_data;
+    for (int p = 0; p < NPAR; ++p)
+        if (!strcmp(name, pname[p]))
+            return 1;
+    return 0; /* time_scale: its default, 1 (stage = day) */
+}
+
+/* Case cs's problem from start st, built through the C API: a leaf_photos
+ * data set over the fresh photo (id "fresh", day 0) and the frames (id
+ * "d<day>"), the scan's leaf REF_LEAF as the reference, pixels residuals on
+ * a GRID grid with sigma SIGMA, registration on, gray-world correction in
+ * the perturbed case, none in the control; the five parameters in their
+ * boxes, one start, at most 60 iterations.  st = NSTART: a run from the
+ * truth limited to one iteration, to read the objective at the truth
+ * (summary.initial_cost). */
+static phc_problem *build_problem(const char *dir, int cs, int st, phc_error *err)
 {
     const double *v = st < NSTART ? start[st] : truth;
-    FILE *f = fopen(path, "w");
-    if (!f)
-        return -1;
-    fprintf(f, "# Identifiability of the leaf aging model, case %s, start %d (written by the notebook).\n",
-            case_name[cs], st + 1);
-    fprintf(f, "name: silva-ident-%s-%d\nparameters:\n", case_name[cs], st + 1);
-    for (int p = 0; p < NPAR; ++p)
-        fprintf(f, "  %s: {value: %.17g, lower: %.17g, upper: %.17g}\n", pname[p], v[p], lower[p], upper[p]);
-    fprintf(f, "datasets:\n  - kind: leaf_photos\n    name: frames\n    file: %s\n    image: {column: image}\n"
-               "    id: id\n    stage: {column: day}\n    initial: fresh\n    reference: {image: %s, leaf: %d}\n"
-               "    residual: pixels\n    grid: %d\n    sigma: %g\n    register: true\n    colour_correction: %s\n"
-               "    model_size: %d\n    dt: 0.1\n",
-            csv, SCAN, REF_LEAF, GRID, SIGMA, cs == 0 ? "gray_world" : "none", MODEL_SIZE);
-    fprintf(f, "solver: {max_iterations: %d, starts: 1}\n", st < NSTART ? 60 : 1);
-    int bad = ferror(f);
-    bad |= fclose(f) != 0;
-    return bad ? -1 : 0;
+    char name[64], paths[NDAY + 1][2048], ids[NDAY + 1][16];
+    snprintf(name, sizeof name, "silva-ident-%s-%d", case_name[cs], st + 1);
+    phc_leaf_photos_row rows[NDAY + 1];
+    memset(rows, 0, sizeof rows);
+    for (int r = 0; r <= NDAY; ++r) {
+        frame_path(paths[r], sizeof paths[r], dir, cs, r - 1);
+        snprintf(ids[r], sizeof ids[r], r ? "d%d" : "fresh", r ? (int)days[r - 1] : 0);
+        rows[r].stage = r ? days[r - 1] : 0;
+        rows[r].image = paths[r];
+        rows[r].id = ids[r];
+    }
+    phc_leaf_photos_options lo = phc_leaf_photos_options_default();
+    lo.stage_name = "day";
+    lo.initial = "fresh";
+    lo.reference_image = SCAN;
+    lo.reference_leaf = REF_LEAF;
+    lo.residual = PHC_LEAF_RESIDUAL_PIXELS;
+    lo.grid = GRID;
+    lo.sigma = SIGMA;
+    lo.register_photos = 1;
+    lo.colour_correction = cs == 0 ? PHC_CC_GRAY_WORLD : PHC_CC_NONE;
+    lo.setup.model_size = MODEL_SIZE;
+    lo.setup.dt = 0.1;
+    lo.is_parameter = is_fitted;
+    phc_problem *pb = phc_problem_new(name);
+    phc_dataset *ds = NULL;
+    int rc = pb ? PHC_OK : phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (int p = 0; p < NPAR && !rc; ++p) {
+        size_t i = 0;
+        if (!(rc = phc_problem_add_parameter(pb, pname[p], v[p], &i, err))) {
+            pb->params[i].lower = lower[p];
+            pb->params[i].upper = upper[p];
+        }
+    }
+    if (!rc) {
+        pb->options.nls.max_iterations = st < NSTART ? 60 : 1;
+        pb->options.starts = 1;
+    }
+    if (!rc && !(rc = phc_leaf_photos_new(rows, NDAY + 1, &lo, &ds, err))) {
+        if (!(ds->name = strdup("frames")))
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (!rc && !(rc = phc_problem_bind_by_name(pb, ds, err))) {
+            rc = phc_problem_add_dataset(pb, ds, err);
+            ds = NULL;
+        }
+    }
+    phc_dataset_free(ds);
+    if (!rc && !(rc = phc_problem_convert_units(pb, err)))
+        rc = phc_problem_validate(pb, err);
+    if (rc) {
+        phc_problem_free(pb);
+        return NULL;
+    }
+    return pb;
 }
 
 typedef struct outcome {
@@ -180,14 +243,14 @@ typedef struct outcome {
     char undet[6][160];
 } outcome;
 
-static int run_fit(const char *cfg, outcome *o, phc_error *err)
+static int run_fit(const char *dir, int cs, int st, outcome *o, phc_error *err)
 {
-    phc_problem *pb = NULL;
     phc_fit_result *res = NULL;
     memset(o, 0, sizeof *o);
     struct timespec t0, t1;
     clock_gettime(CLOCK_MONOTONIC, &t0);
-    int rc = phc_config_load(cfg, &pb, err);
+    phc_problem *pb = build_problem(dir, cs, st, err);
+    int rc = pb ? PHC_OK : err->status ? err->status : PHC_ERR_INPUT;
     if (!rc)
         rc = phc_fit_run(pb, NULL, NULL, &res, err);
     clock_gettime(CLOCK_MONOTONIC, &t1);
@@ -325,21 +388,10 @@ int main(int argc, char **argv)
     /* 3. the two cases: frames, CSV, configs, fits */
     rng_state = SEED;
     for (int cs = 0; cs < NCASE; ++cs) {
-        char csv[2048];
-        snprintf(csv, sizeof csv, "%s/%s.csv", dir, case_name[cs]);
-        FILE *f = fopen(csv, "w");
-        if (!f) {
-            phc_error_set(&err, PHC_ERR_IO, "%s: cannot write", csv);
-            goto fail_frames;
-        }
-        REMEMBER(csv);
-        fprintf(f, "id,day,image\nfresh,0,fresh.png\n");
         for (int d = 0; d < NDAY; ++d) {
-            if (compose(&frames[d], su->mask, cs == 0, &frame_img, &err)) {
-                fclose(f);
+            if (compose(&frames[d], su->mask, cs == 0, &frame_img, &err))
                 goto fail_frames;
-            }
-            snprintf(path, sizeof path, "%s/%s_day%02d.png", dir, case_name[cs], (int)days[d]);
+            frame_path(path, sizeof path, dir, cs, d);
             rc = phc_photo_write_png(path, &frame_img, &err);
             if (!rc && cs == 0 && d == NDAY - 1) {
                 char keep[1024];
@@ -347,39 +399,18 @@ int main(int argc, char **argv)
                 rc = phc_photo_write_png(keep, &frame_img, &err);
             }
             phc_image_free(&frame_img);
-            if (rc) {
-                fclose(f);
+            if (rc)
                 goto fail_frames;
-            }
             REMEMBER(path);
-            fprintf(f, "d%d,%g,%s_day%02d.png\n", (int)days[d], days[d], case_name[cs], (int)days[d]);
-        }
-        if (fclose(f) != 0) {
-            phc_error_set(&err, PHC_ERR_IO, "%s: cannot write", csv);
-            goto fail_frames;
         }
         for (int st = 0; st < NSTART; ++st) {
-            char cfg[2048];
-            snprintf(cfg, sizeof cfg, "%s/%s_%d.yaml", dir, case_name[cs], st + 1);
-            if (write_config(cfg, cs, st, csv) != 0) {
-                phc_error_set(&err, PHC_ERR_IO, "%s: cannot write", cfg);
-                goto fail_frames;
-            }
-            REMEMBER(cfg);
-            if (run_fit(cfg, &o[cs][st], &err))
+            if (run_fit(dir, cs, st, &o[cs][st], &err))
                 goto fail_frames;
             printf("fit %s start %d: %s, %.1f s, weighted RSS %.4g over %zu residuals\n", case_name[cs], st + 1,
                    o[cs][st].converged ? "converged" : "not converged", o[cs][st].seconds, o[cs][st].wrss,
                    o[cs][st].n_obs);
         }
-        char cfg[2048];
-        snprintf(cfg, sizeof cfg, "%s/%s_truth.yaml", dir, case_name[cs]);
-        if (write_config(cfg, cs, NSTART, csv) != 0) {
-            phc_error_set(&err, PHC_ERR_IO, "%s: cannot write", cfg);
-            goto fail_frames;
-        }
-        REMEMBER(cfg);
-        if (run_fit(cfg, &at_truth[cs], &err))
+        if (run_fit(dir, cs, NSTART, &at_truth[cs], &err))
             goto fail_frames;
         printf("ident_wrss_at_truth_%s: %.4g\n", case_name[cs], at_truth[cs].initial_wrss);
     }

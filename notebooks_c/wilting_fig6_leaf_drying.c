@@ -5,7 +5,8 @@
  * balance (R package pvldcurve 1.2.6, `leaf_drying_data`, two treatments;
  * ../shared/data/leaf_drying).
  *
- * One joint fit through the same YAML path a user takes (fit/config.h):
+ * One joint fit built through the C API (phc_weight_curve_read_table,
+ * phc_plant_graph_leaf_chain, phc_weight_curve_new, a problem of its own):
  * one loss rate delta shared by the twelve leaves, an initial water per leaf,
  * the measured dry weight as the dry mass; each leaf is a venation chain
  * built from its measured area (weight_curve `leaf_area`).  Plotted: the
@@ -17,18 +18,22 @@
  * weighing, every fitted curve decreases.
  *
  * Usage: notebook_wilting_fig6_leaf_drying OUTPUT_DIR */
-#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <plplot.h>
 
-#include "fit/config.h"
+#include "fit/costs/weight_curve.h"
+#include "fit/costs/weight_table.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/problem.h"
+#include "measurements/c_number.h"
+#include "measurements/table.h"
+#include "measurements/units.h"
+#include "model/plant_graph.h"
 
 #include "notebook_plot.h"
 
@@ -42,6 +47,106 @@ static const phc_param_result *param(const phc_fit_result *r, const char *name)
     return NULL;
 }
 
+/* Leaf `leaf` (the table's `sample`) as a weight_curve data set: times in
+ * s, masses in g, a venation chain of 20 segments (vein radius 0.5 mm) from
+ * its leaf.area (cm2) and its dry.weight (g) as the dry mass, both read at
+ * its first weighing (fit/costs/weight_table.h, weight_curve.h). */
+static phc_dataset *leaf_dataset(const phc_table *t, phc_units *units, int leaf, phc_error *err)
+{
+    char sample[16], name[32];
+    snprintf(sample, sizeof sample, "%d", leaf);
+    snprintf(name, sizeof name, "leaf%d", leaf);
+    const char *sel_col[] = {"sample"}, *sel_val[] = {sample};
+    phc_weight_curve_read_options ro = phc_weight_curve_read_options_default();
+    ro.time_column = "date.and.time";
+    ro.time_unit = "s";
+    ro.mass_column = "fresh.weight";
+    ro.mass_unit = "g";
+    ro.n_select = 1;
+    ro.select_columns = sel_col;
+    ro.select_values = sel_val;
+    ro.units = units;
+    phc_weighings w = phc_weighings_default();
+    if (phc_weight_curve_read_table(t, &ro, &w, err)) {
+        phc_weighings_release(&w);
+        return NULL;
+    }
+    const size_t row = w.rows[0];
+    const long c_area = phc_table_find(t, "leaf.area"), c_dry = phc_table_find(t, "dry.weight");
+    phc_unit_conversion cm2;
+    int rc = phc_units_conversion(units, "cm2", "m2", "leaf_area", &cm2, err);
+    if (!rc && (c_area < 0 || c_dry < 0))
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no column leaf.area or dry.weight", phc_table_source(t));
+    phc_plant_graph *g = NULL;
+    phc_weight_curve_options o = phc_weight_curve_options_default();
+    if (!rc) {
+        g = phc_plant_graph_leaf_chain(phc_unit_apply(cm2, phc_strtod_c(phc_table_cell(t, row, (size_t)c_area), NULL)),
+                                       20, 0.5e-3);
+        o.dry_mass = phc_strtod_c(phc_table_cell(t, row, (size_t)c_dry), NULL);
+    }
+    phc_dataset *ds = NULL;
+    if (g && !phc_weight_curve_new(g, &w, &o, &ds, err) && !(ds->name = strdup(name))) {
+        phc_dataset_free(ds);
+        ds = NULL;
+    }
+    phc_plant_graph_free(g);
+    phc_weighings_release(&w);
+    return ds;
+}
+
+/* delta (1e-3 s-1 cm-2) and w1..w12 (4 g), all >= 0; leaf l's slots bound
+ * by name except initial_water -> w<l>; the units converted and the
+ * stopping tolerances kept above the ODE solver's accuracy, as
+ * phc_config_load does. */
+static phc_problem *joint_problem(const char *csv, phc_error *err)
+{
+    phc_problem *pb = phc_problem_new("wilting-fig6-leaf-drying");
+    phc_units *units = phc_units_new(err);
+    phc_table *t = NULL;
+    int rc = !pb || !units ? PHC_ERR_NOMEM : phc_table_read(csv, &t, err);
+    for (int l = 0; l <= N_LEAVES && !rc; ++l) {
+        char name[16];
+        snprintf(name, sizeof name, l ? "w%d" : "delta", l);
+        size_t i = 0;
+        if (!(rc = phc_problem_add_parameter(pb, name, l ? 4 : 1.0e-3, &i, err))) {
+            pb->params[i].lower = 0;
+            if (!(pb->params[i].unit = strdup(l ? "g" : "s-1 cm-2")))
+                rc = PHC_ERR_NOMEM;
+        }
+    }
+    for (int l = 1; l <= N_LEAVES && !rc; ++l) {
+        phc_dataset *ds = leaf_dataset(t, units, l, err);
+        if (!ds) {
+            rc = PHC_ERR_INPUT;
+            break;
+        }
+        char w[16];
+        snprintf(w, sizeof w, "w%d", l);
+        for (size_t j = 0; j < ds->k; ++j)
+            ds->param_index[j] = (size_t)phc_problem_find_parameter(pb, strcmp(ds->slot_names[j], "initial_water")
+                                                                             ? ds->slot_names[j] : w);
+        rc = phc_problem_add_dataset(pb, ds, err);
+    }
+    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
+        double tol = 0;
+        for (size_t d = 0; d < pb->n_datasets; ++d)
+            tol = fmax(tol, pb->datasets[d]->model_tolerance);
+        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
+        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
+        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
+        rc = phc_problem_validate(pb, err);
+    }
+    phc_table_free(t);
+    phc_units_free(units);
+    if (rc) {
+        if (rc == PHC_ERR_NOMEM && !err->status)
+            phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        phc_problem_free(pb);
+        return NULL;
+    }
+    return pb;
+}
+
 int main(int argc, char **argv)
 {
     const char *csv = PHC_SHARED_DATA "/leaf_drying/pvldcurve_leaf_drying.csv";
@@ -49,43 +154,14 @@ int main(int argc, char **argv)
     int started = nb_begin(argc, argv, csv, &out);
     if (started)
         return started;
-    /* The configuration, kept next to the figure so the fit can be re-run
-     * with `phytocal fit`. */
-    char yaml[1024];
-    snprintf(yaml, sizeof yaml, "%s/wilting_fig6_leaf_drying.yaml", out);
-    FILE *f = fopen(yaml, "w");
-    if (!f) {
-        fprintf(stderr, "%s: cannot write: %s\n", yaml, strerror(errno));
-        return 1;
-    }
-    fprintf(f, "# written by notebook_wilting_fig6_leaf_drying: one delta, twelve initial waters\n"
-               "name: wilting-fig6-leaf-drying\nparameters:\n"
-               "  delta: {value: 1.0e-3, lower: 0, unit: \"s-1 cm-2\"}\n");
-    for (int l = 1; l <= N_LEAVES; ++l)
-        fprintf(f, "  w%d: {value: 4, lower: 0, unit: g}\n", l);
-    fprintf(f, "datasets:\n");
-    for (int l = 1; l <= N_LEAVES; ++l)
-        fprintf(f,
-                "  - kind: weight_curve\n"
-                "    name: leaf%d\n"
-                "    file: %s\n"
-                "    select: {sample: %d}\n"
-                "    time: {column: date.and.time, unit: s}\n"
-                "    mass: {column: fresh.weight, unit: g}\n"
-                "    leaf_area: {column: leaf.area, unit: cm2}\n"
-                "    dry_mass: {column: dry.weight, unit: g}\n"
-                "    parameters: {initial_water: w%d}\n",
-                l, csv, l, l);
-    if (fclose(f) != 0) {
-        fprintf(stderr, "%s: cannot write\n", yaml);
-        return 1;
-    }
-
+    /* The problem, built through the C API: one delta, twelve initial
+     * waters, as a config with `parameters: {initial_water: w<l>}` per leaf
+     * would say. */
     phc_error err;
     phc_error_clear(&err);
-    phc_problem *pb = NULL;
+    phc_problem *pb = joint_problem(csv, &err);
     phc_fit_result *r = NULL;
-    if (phc_config_load(yaml, &pb, &err) != PHC_OK || phc_fit_run(pb, NULL, NULL, &r, &err) != PHC_OK) {
+    if (!pb || phc_fit_run(pb, NULL, NULL, &r, &err) != PHC_OK) {
         fprintf(stderr, "%s\n", err.message);
         phc_problem_free(pb);
         return 1;
@@ -224,7 +300,7 @@ int main(int argc, char **argv)
             "the package labels \"10%%\" and \"40%%\": the plants grew at a soil moisture of 10–30 %% or of\n"
             "40–60 %% during their last 6 days; samples 1, 3, ..., 11 are \"10%%\", 2, 4, ..., 12 \"40%%\". Each leaf is\n"
             "a venation chain of 20 segments built from its measured area; its measured dry weight is the\n"
-            "dry mass. One joint fit (`%s`, the same configuration path a user takes): **one loss rate δ\n"
+            "dry mass. One joint fit (%s): **one loss rate δ\n"
             "for all twelve leaves, one initial water per leaf**.\n\n"
             "- δ = %.4e ± %.2e s⁻¹ cm⁻² (95%% interval [%.4e, %.4e]); %s after %d iterations;\n"
             "- %zu weighings, RMSE %.4f g over all of them.\n\n"
@@ -235,7 +311,8 @@ int main(int argc, char **argv)
             "measured − fitted (dots joined by dotted lines, in time order). Both columns share their y axes.\n\n"
             "| leaf | treatment | first weighing (g) | last (g) | fitted last (g) | dry (g) | fitted W0 (g) | RMSE (g) | residual at first weighing / most negative (at h) / at last weighing (g) | residual checks failed |\n"
             "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
-            "wilting_fig6_leaf_drying.yaml", delta ? delta->value : NAN, delta ? delta->stderr_ : NAN,
+            "built through the C API: `phc_weight_curve_new` per leaf, the same as `kind: weight_curve` with "
+            "`leaf_area` and `dry_mass` columns", delta ? delta->value : NAN, delta ? delta->stderr_ : NAN,
             delta ? delta->ci_lo : NAN, delta ? delta->ci_hi : NAN, phc_fit_status_name(r->summary.outcome),
             (int)r->summary.iterations, r->n_obs, rmse_all);
     for (int l = 0; l < N_LEAVES; ++l)

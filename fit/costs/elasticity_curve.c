@@ -54,8 +54,10 @@ int phc_elasticity_predict_at(phc_dataset *ds, const double *p, const double *x,
 }
 
 int phc_elasticity_dataset_new(const phc_dataset_ops *ops, size_t n, size_t n_blocks,
-                               const char *const *suffixes, phc_dataset **out, phc_error *err)
+                               const char *const *suffixes, int rwc, phc_dataset **out, phc_error *err)
 {
+    /* units of kappa, chi0, e_min, e_max (model/elasticity.h) */
+    const char *const unit[PHC_ELASTICITY_NPARAMS] = {rwc ? "1" : NULL, rwc ? "1" : NULL, "MPa", "MPa"};
     *out = NULL;
     phc_dataset *ds = phc_dataset_new(ops, PHC_ELASTICITY_NPARAMS * n_blocks);
     phc_elasticity_impl *e = calloc(1, sizeof *e);
@@ -76,7 +78,8 @@ int phc_elasticity_dataset_new(const phc_dataset_ops *ops, size_t n, size_t n_bl
                 snprintf(name, sizeof name, "%s_%s", slot_base[j], suffixes[b]);
             else
                 snprintf(name, sizeof name, "%s", slot_base[j]);
-            if (!(ds->slot_names[PHC_ELASTICITY_NPARAMS * b + j] = strdup(name)))
+            if (!(ds->slot_names[PHC_ELASTICITY_NPARAMS * b + j] = strdup(name)) ||
+                (unit[j] && phc_dataset_declare_unit(ds, name, unit[j])))
                 goto nomem;
         }
     *out = ds;
@@ -200,7 +203,8 @@ int phc_elasticity_curve_new(const phc_table *table, const phc_elasticity_curve_
     if (n == 0)
         return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no data rows below the header; expected at least one", path);
     if ((rc = read_columns(table, opt, &wx, &my, err)) ||
-        (rc = phc_elasticity_dataset_new(&phc_elasticity_curve_ops, n, 1, NULL, &ds, err)))
+        (rc = phc_elasticity_dataset_new(&phc_elasticity_curve_ops, n, 1, NULL,
+                                             opt->water_content == PHC_WATER_CONTENT_RWC, &ds, err)))
         goto fail;
     memcpy(ds->x, wx, n * sizeof *wx);
     memcpy(ds->y, my, n * sizeof *my);

@@ -8,7 +8,9 @@
  * the same options by fit/config/elasticity_curve_yaml.c.
  *
  * Parameter slots: kappa, chi0, e_min, e_max, bound by default to the global
- * parameters of the same names.  Derivatives are analytic.
+ * parameters of the same names; e_min and e_max are in MPa, kappa and chi0
+ * dimensionless ("1") on relative water content (declared units: a
+ * parameter's `unit:` such as kPa is converted).  Derivatives are analytic.
  *
  * The pressure–volume kind (pv_curve.h) builds its data sets with the same
  * model through phc_elasticity_dataset_new below. */
@@ -73,11 +75,14 @@ typedef struct phc_elasticity_impl {
 
 /* A data set with n observations (x, y, data_lines allocated, to be filled)
  * and 4·n_blocks slots named kappa, chi0, e_min, e_max — or, when suffixes is
- * not NULL, kappa_<suffix[b]> ... for block b.  ops must use
+ * not NULL, kappa_<suffix[b]> ... for block b.  The slots declare their
+ * units (model/elasticity.h): e_min, e_max MPa; with rwc nonzero (θ a
+ * relative water content) kappa and chi0 are dimensionless, "1"; otherwise
+ * they follow the water column's unit and declare none.  ops must use
  * phc_elasticity_predict and phc_elasticity_predict_at and a free_impl that
  * calls phc_elasticity_impl_free. */
 int phc_elasticity_dataset_new(const phc_dataset_ops *ops, size_t n, size_t n_blocks,
-                               const char *const *suffixes, phc_dataset **out, phc_error *err);
+                               const char *const *suffixes, int rwc, phc_dataset **out, phc_error *err);
 int phc_elasticity_predict(phc_dataset *ds, const double *p, double *yhat, double *jac);
 int phc_elasticity_predict_at(phc_dataset *ds, const double *p, const double *x, size_t m,
                               double *y);

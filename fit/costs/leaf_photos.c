@@ -24,6 +24,12 @@ enum { SL_BETA, SL_STOMATA, SL_INFLOW, SL_TIME, SL_YLO, SL_YHI, N_SLOTS };
 static const char *const slot_names[N_SLOTS] = {"beta_scale", "stomata_scale", "inflow_scale",
                                                 "time_scale", "y_lo", "y_hi"};
 static const double slot_defaults[N_SLOTS] = {50, 0.1, 0.05, 1, 0.2, 0.8};
+/* Their units where UDUNITS-2 can spell them: the transfer levels are fluid
+ * amounts, dimensionless (model/leaf.h: y = 1 is a fresh leaf).  The model's
+ * time unit is whatever dt is counted in and the stage's unit the user's (a
+ * SPAD reading, days ...), so the scales declare none and keep `unit:` as a
+ * label. */
+static const char *const slot_units[N_SLOTS] = {NULL, NULL, NULL, NULL, "1", "1"};
 
 /* Steps beyond which a trial point is refused (a runaway time scale). */
 #define MAX_STEPS 200000
@@ -1327,7 +1333,8 @@ static int fill_dataset(const lp_build *b, phc_dataset *ds, phc_error *err)
     const lp_impl *im = b->im;
     const size_t n = b->n_obs;
     for (int q = 0; q < N_SLOTS; ++q)
-        if (im->slot[q] >= 0 && !(ds->slot_names[im->slot[q]] = strdup(slot_names[q])))
+        if (im->slot[q] >= 0 && (!(ds->slot_names[im->slot[q]] = strdup(slot_names[q])) ||
+                                 (slot_units[q] && phc_dataset_declare_unit(ds, slot_names[q], slot_units[q]))))
             return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     ds->n = n;
     ds->x = malloc(n * sizeof *ds->x);

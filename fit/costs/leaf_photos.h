@@ -44,7 +44,9 @@
  * Parameter slots (each present only when a parameter of that name exists
  * or is bound; otherwise the default in brackets is used):
  *   beta_scale [50] px²/time, stomata_scale [0.1] /time, inflow_scale [0.05]
- *   /time, time_scale [1] model time per stage unit, y_lo [0.2], y_hi [0.8].
+ *   /time, time_scale [1] model time per stage unit, y_lo [0.2], y_hi [0.8]
+ *   (fluid levels, dimensionless: their slots declare the unit "1"; the
+ *   model's time unit is the user's, so the scales declare none).
  * A row's model time is t = time_scale |stage - stage(initial)|; a stage on
  * the wrong side of the initial one is an error naming the row.
  *

@@ -478,15 +478,12 @@ static int moduli_dataset(pv_build *b, phc_dataset **out, phc_error *err)
     for (size_t L = 0; L < b->n_leaves; ++L)
         n_obs += x->res[L]->n_modulus;
     if ((rc = phc_elasticity_dataset_new(&phc_pv_curve_ops, n_obs, b->each ? b->n_leaves : 1,
-                                         b->each ? (const char *const *)x->labels : NULL, out, err)))
+                                         b->each ? (const char *const *)x->labels : NULL, 1, out, err)))
         return rc;
-    phc_dataset *ds = *out;
     /* the moduli are in MPa (psi_unit converts the potentials), so are the
-     * logistic's bounds (parameter_units.h converts a user's bar or kPa) */
-    for (size_t j = 0; j < ds->k; ++j)
-        if ((strncmp(ds->slot_names[j], "e_min", 5) == 0 || strncmp(ds->slot_names[j], "e_max", 5) == 0) &&
-            phc_dataset_declare_unit(ds, ds->slot_names[j], "MPa"))
-            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+     * logistic's bounds (parameter_units.h converts a user's bar or kPa);
+     * kappa and chi0 are on RWC, dimensionless */
+    phc_dataset *ds = *out;
     phc_elasticity_impl *impl = ds->impl;
     size_t o = 0;
     for (size_t L = 0; L < b->n_leaves; ++L) {

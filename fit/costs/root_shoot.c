@@ -395,14 +395,51 @@ static int choose_growth_slots(rs_impl *im, const phc_root_shoot_options *o, phc
     return PHC_OK;
 }
 
-/* The slots' names: the soil's, then the growth parameters'. */
+/* The UDUNITS-2 units of the growth parameters as model/growth.h states
+ * them (Rhizomorph, Li et al. 2023, Table 4; angles in degrees, rates per
+ * day); a parameter not listed has none that UDUNITS-2 can spell (the
+ * model's "vigor", the inhibitor, nutrient units) and keeps `unit:` as a
+ * label. */
+static const struct {
+    const char *name, *unit;
+} growth_units[] = {
+    {"internode_length", "m"},      {"shoot_elongation", "m/d"},     {"apical_angle", "degree"},
+    {"branching_angle", "degree"},  {"angle_sd", "degree"},          {"apical_dominance", "1"},
+    {"lateral_buds", "1"},          {"bud_flush", "d-1"},            {"inhibition_distance", "m"},
+    {"phototropism", "1"},          {"prune_ratio", "1"},            {"leaf_area", "m2"},
+    {"leaf_distance", "m"},         {"lma", "g/m2"},                 {"light_extinction", "1"},
+    {"light_voxel", "m"},           {"light", "1"},                  {"root_node_length", "m"},
+    {"root_elongation", "m/d"},     {"root_apical_angle", "degree"}, {"root_branching_angle", "degree"},
+    {"root_apical_dominance", "1"}, {"root_branching", "1"},         {"gravitropism_root", "1"},
+    {"hydrotropism", "1"},          {"tropism_switch", "1"},         {"water_uptake", "m3 m-1 d-1"},
+    {"uptake_cap", "d-1"},          {"root_resistance", "1"},        {"soil_fill", "1"},
+    {"tip_radius_shoot", "m"},      {"tip_radius_root", "m"},        {"pipe_exponent", "1"},
+    {"phi_rg", "1"},                {"wood_density", "g/m3"},        {"root_density", "g/m3"},
+    {"reserve_rate", "d-1"},
+};
+
+static const char *growth_unit(const char *name)
+{
+    for (size_t i = 0; i < sizeof growth_units / sizeof growth_units[0]; ++i)
+        if (!strcmp(growth_units[i].name, name))
+            return growth_units[i].unit;
+    return NULL;
+}
+
+/* The slots' names and units: the soil's, then the growth parameters'. */
 static int name_slots(phc_dataset *ds, const rs_impl *im)
 {
     int bad = 0;
     for (size_t q = 0; q < im->k_soil && !bad; ++q)
         bad = !(ds->slot_names[q] = strdup(im->su->slot_names[q]));
-    for (size_t j = 0; j < im->k_growth && !bad; ++j)
-        bad = !(ds->slot_names[im->k_soil + j] = strdup(phc_growth_param_name((size_t)im->gslot[j])));
+    for (size_t j = 0; j < im->k_growth && !bad; ++j) {
+        const char *name = phc_growth_param_name((size_t)im->gslot[j]);
+        const char *unit = growth_unit(name);
+        bad = !(ds->slot_names[im->k_soil + j] = strdup(name)) ||
+              (unit && phc_dataset_declare_unit(ds, name, unit));
+    }
+    if (!bad && im->su)
+        bad = phc_soil_setup_declare_units(im->su, ds) != PHC_OK;
     return bad ? PHC_ERR_NOMEM : PHC_OK;
 }
 

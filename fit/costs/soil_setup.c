@@ -505,6 +505,22 @@ done:
     return rc;
 }
 
+int phc_soil_setup_declare_units(const phc_soil_setup *su, phc_dataset *ds)
+{
+    int rc = PHC_OK;
+    for (size_t L = 0; L < su->n_layers && !rc; ++L) {
+        if (su->slot_p[L] >= 0)
+            rc = phc_dataset_declare_unit(ds, su->slot_names[su->slot_p[L]], "m/h");
+        if (!rc && su->slot_c[L] >= 0)
+            rc = phc_dataset_declare_unit(ds, su->slot_names[su->slot_c[L]], "1");
+    }
+    if (!rc && su->slot_fd >= 0)
+        rc = phc_dataset_declare_unit(ds, su->slot_names[su->slot_fd], "m");
+    if (!rc && su->slot_fg >= 0)
+        rc = phc_dataset_declare_unit(ds, su->slot_names[su->slot_fg], "1");
+    return rc;
+}
+
 phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_ops *ops, size_t n,
                                     const char *path)
 {
@@ -514,6 +530,7 @@ phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_
     int bad = 0;
     for (size_t q = 0; q < su->k && !bad; ++q)
         bad = !(ds->slot_names[q] = strdup(su->slot_names[q]));
+    bad = bad || phc_soil_setup_declare_units(su, ds);
     ds->n = n;
     ds->x = malloc((n ? n : 1) * sizeof *ds->x);
     ds->y = malloc((n ? n : 1) * sizeof *ds->y);

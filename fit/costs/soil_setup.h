@@ -33,9 +33,11 @@
  * Fitted numbers are the parameter slots below, present when is_parameter
  * says so (in a config: the problem has a parameter of that name, or the
  * data set binds the slot):
- *   p_<L>, c_<L>   permeability (m/h) and capacity of layer L (1-based)
+ *   p_<L>, c_<L>   permeability (m/h) and capacity (1) of layer L (1-based)
  *   p, c           the same for every layer without its own slot
- *   f_diff, f_grav the diffusion and gravity forces
+ *   f_diff, f_grav the diffusion (m) and gravity (1) forces
+ * (the units are declared on the data set's slots, so a parameter's `unit:`
+ * such as "cm/d" is converted; phc_soil_setup_declare_units)
  * Otherwise the values of the options are used. */
 #ifndef PHC_COSTS_SOIL_SETUP_H
 #define PHC_COSTS_SOIL_SETUP_H
@@ -189,6 +191,14 @@ double phc_soil_setup_c(const phc_soil_setup *su, size_t layer, const double *p)
  * data_file = path.  NULL when out of memory. */
 phc_dataset *phc_soil_setup_dataset(const phc_soil_setup *su, const phc_dataset_ops *ops, size_t n,
                                     const char *path);
+
+/* Declares the units of the set-up's slots in ds, which has slots of the
+ * same names (model/soil.h, Rhizomorph eqs. 25-28): p, p_<L> m/h; c, c_<L>
+ * and f_grav dimensionless ("1"); f_diff m.  A parameter's `unit:` is then
+ * converted into these (fit/parameter_units.h).  phc_soil_setup_dataset
+ * does it; a kind that names its slots itself calls it.  PHC_ERR_NOMEM, or
+ * PHC_ERR_INVALID when ds lacks one of the slots. */
+int phc_soil_setup_declare_units(const phc_soil_setup *su, phc_dataset *ds);
 
 /* A markdown description of the set-up at p and of the run's budget
  * (s after a run); malloc'd. */

@@ -501,6 +501,25 @@ static int drivers(wc_impl *m, const phc_weighings *w, const kept *k, const phc_
     return PHC_OK;
 }
 
+/* The unit a slot declares, so that a parameter's `unit:` is converted into
+ * it (fit/parameter_units.h): the model's units (model/water.h, wilting
+ * paper eqs. 4-7: cm, g, s; model/water_balance.h for the pot), NULL for a
+ * covariate's coefficient (per unit of the covariate, which has none). */
+static const char *slot_unit(const char *name)
+{
+    if (!strcmp(name, "delta"))
+        return "s-1 cm-2"; /* leaf loss l = delta A, A = r h in cm2, l in s-1 */
+    if (!strncmp(name, "initial_water", 13) || !strcmp(name, "dry_mass") || !strcmp(name, "pot_capacity"))
+        return "g";
+    if (!strcmp(name, "viscosity"))
+        return "mPa s";
+    if (!strcmp(name, "night_factor"))
+        return "1"; /* the loss multiplier g(t) by night */
+    if (!strcmp(name, "pot_conductance"))
+        return "g s-1";
+    return NULL;
+}
+
 /* Slots: delta, one initial water per piece (initial_water, then
  * initial_water_2, ...), dry_mass unless measured, viscosity when the user
  * made it a parameter, then the drivers' (night_factor, loss_<col>,
@@ -537,9 +556,11 @@ static int name_slots(phc_dataset **out, wc_impl *m, size_t n_pieces, int viscos
     m->drv_slot = n_drv ? (int)js : -1;
     if (n_drv && phc_weight_drivers_slot_names(&m->drv, ds->slot_names + js))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    for (size_t j = 0; j < k_slots; ++j)
-        if (!ds->slot_names[j])
+    for (size_t j = 0; j < k_slots; ++j) {
+        const char *unit = ds->slot_names[j] ? slot_unit(ds->slot_names[j]) : NULL;
+        if (!ds->slot_names[j] || (unit && phc_dataset_declare_unit(ds, ds->slot_names[j], unit)))
             return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
     return PHC_OK;
 }
 

@@ -20,6 +20,10 @@
  *                  options.viscosity
  *   night_factor, loss_<covariate>..., pot_capacity, pot_conductance: the
  *                  drivers' (fit/costs/weight_drivers.h), when not fixed
+ * The slots declare these units (night_factor "1", pot_capacity g,
+ * pot_conductance g s-1; a covariate's coefficient none), so a parameter's
+ * `unit:` (δ in h-1 cm-2, water in kg ...) is converted into them and the
+ * results come back in it (fit/parameter_units.h).
  * Observations are in g; time is measured in s from the first weighing kept.
  *
  * Built in C with phc_weight_curve_new from a plant graph (built in memory,

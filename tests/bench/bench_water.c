@@ -9,7 +9,8 @@
  *     W(1e4) = EXACT_W_1E4 (the authors' matrix evaluated by a contour
  *     integral, tests/realdata/test_water_reference; the eigen evaluators
  *     lose about 1e-16 x stiffness x t, 6e-9 here, and are printed too);
- *     a complete delta fit (phc_config_load + phc_fit_run) to a 1000-sample
+ *     a complete delta fit (built through the C API: plant file, CSV table,
+ *     phc_weight_curve_new, a problem; then phc_fit_run) to a 1000-sample
  *     weight curve generated from the model itself: mass = 20 g + W(t) with
  *     W from the exact evaluator in the reference mode (delta 6e-3, W0 8 g,
  *     t = 0, 10, ..., 9990 s), plus Gaussian noise sigma 0.01 g (seed 42);
@@ -33,9 +34,13 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "fit/config.h"
+#include "fit/costs/weight_curve.h"
+#include "fit/costs/weight_table.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/problem.h"
 #include "measurements/plant_io.h"
+#include "measurements/table.h"
 #include "model/water.h"
 
 #ifndef PHC_SHARED_DATA
@@ -208,36 +213,71 @@ static int write_curve(const phc_water_system *s, const char *csv)
     return 0;
 }
 
-/* tol > 0: solver tolerances (function, gradient, parameter) set to tol;
- * 0: the project's defaults (1e-15). */
-static int write_fit_config(const char *yaml, const char *csv, double tol)
+/* The delta fit built through the C API, as a user's program would: the
+ * plant file (paper format), the curve's CSV table (t_s in s, mass_g in
+ * g), a weight_curve data set (reference weights, BDF6 with a 10 s step,
+ * sigma NOISE_SIGMA, the dry mass DRY_MASS given) bound to delta and
+ * initial_water (START_DELTA s-1 cm-2, START_W0 g, both >= 0).  tol > 0:
+ * solver tolerances (function, gradient, parameter) set to tol; 0: the
+ * project's defaults (1e-15) kept above the ODE solver's accuracy, as
+ * phc_config_load does. */
+static phc_problem *fit_problem(const char *csv, double tol, phc_error *err)
 {
-    FILE *f = fopen(yaml, "w");
-    if (!f)
-        return -1;
-    if (tol > 0)
-        fprintf(f, "solver: {function_tolerance: %g, gradient_tolerance: %g, parameter_tolerance: %g}\n",
-                tol, tol, tol);
-    fprintf(f,
-            "name: bench_water_fit\n"
-            "parameters:\n"
-            "  delta: {value: %g, lower: 0, unit: \"s-1 cm-2\"}\n"
-            "  initial_water: {value: %g, lower: 0, unit: g}\n"
-            "datasets:\n"
-            "  - kind: weight_curve\n"
-            "    name: plant000\n"
-            "    file: %s\n"
-            "    time: {column: t_s, unit: s}\n"
-            "    mass: {column: mass_g, unit: g}\n"
-            "    plant: %s\n"
-            "    plant_format: paper\n"
-            "    dry_mass: {value: %g, unit: g}\n"
-            "    sigma: %g\n"
-            "    conductance: reference\n"
-            "    method: bdf6\n"
-            "    step: 10\n",
-            START_DELTA, START_W0, csv, PLANT000, DRY_MASS, NOISE_SIGMA);
-    return fclose(f) == 0 ? 0 : -1;
+    phc_problem *pb = phc_problem_new("bench_water_fit");
+    phc_plant_graph *g = NULL;
+    phc_table *t = NULL;
+    phc_weighings w = phc_weighings_default();
+    phc_dataset *ds = NULL;
+    int rc = pb ? PHC_OK : phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    static const char *const names[2] = {"delta", "initial_water"}, *const units[2] = {"s-1 cm-2", "g"};
+    const double start[2] = {START_DELTA, START_W0};
+    for (int j = 0; j < 2 && !rc; ++j) {
+        size_t i = 0;
+        if (!(rc = phc_problem_add_parameter(pb, names[j], start[j], &i, err))) {
+            pb->params[i].lower = 0;
+            if (!(pb->params[i].unit = strdup(units[j])))
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        }
+    }
+    phc_weight_curve_read_options ro = phc_weight_curve_read_options_default();
+    ro.time_column = "t_s";
+    ro.time_unit = "s";
+    ro.mass_column = "mass_g";
+    ro.mass_unit = "g";
+    phc_weight_curve_options o = phc_weight_curve_options_default();
+    o.conductance = PHC_WATER_REFERENCE;
+    o.method = PHC_WATER_BDF6;
+    o.step = 10; /* s */
+    o.sigma = NOISE_SIGMA;
+    o.dry_mass = DRY_MASS;
+    o.plant_name = PLANT000;
+    if (!rc && !(rc = phc_plant_io_read(PLANT000, PHC_PLANT_FORMAT_PAPER, 0, &g, err)) &&
+        !(rc = phc_table_read(csv, &t, err)) && !(rc = phc_weight_curve_read_table(t, &ro, &w, err)) &&
+        !(rc = phc_weight_curve_new(g, &w, &o, &ds, err))) {
+        if (!(ds->name = strdup("plant000")))
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (!rc && !(rc = phc_problem_bind_by_name(pb, ds, err))) {
+            rc = phc_problem_add_dataset(pb, ds, err);
+            ds = NULL;
+        }
+    }
+    phc_dataset_free(ds);
+    phc_weighings_release(&w);
+    phc_table_free(t);
+    phc_plant_graph_free(g);
+    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
+        double *tols[3] = {&pb->options.nls.function_tolerance, &pb->options.nls.gradient_tolerance,
+                           &pb->options.nls.parameter_tolerance};
+        const double model_tol = pb->datasets[0]->model_tolerance;
+        for (int k = 0; k < 3; ++k)
+            *tols[k] = tol > 0 ? tol : fmax(*tols[k], model_tol);
+        rc = phc_problem_validate(pb, err);
+    }
+    if (rc) {
+        phc_problem_free(pb);
+        return NULL;
+    }
+    return pb;
 }
 
 static const phc_param_result *param(const phc_fit_result *r, const char *name)
@@ -325,9 +365,8 @@ int main(void)
         printf("cannot create a temporary directory\n");
         return 1;
     }
-    char csv[256], yaml[300], tree_path[256];
+    char csv[256], tree_path[256];
     snprintf(csv, sizeof csv, "%s/curve.csv", dir);
-    snprintf(yaml, sizeof yaml, "%s/fit.yaml", dir);
     snprintf(tree_path, sizeof tree_path, "%s/tree100k.txt", dir);
 
     int have_plant = 0;
@@ -391,16 +430,12 @@ int main(void)
             for (int v = 0; v < 2; ++v) {
                 const char *sfx = v ? "_tol1e-8" : "";
                 double fs = INFINITY, ss = INFINITY;
-                if (write_fit_config(yaml, csv, v ? 1e-8 : 0.0)) {
-                    printf("fit: skipped (cannot write %s)\n", yaml);
-                    break;
-                }
                 for (int r = 0; r < 3; ++r) {
-                    phc_problem *pb = NULL;
                     phc_fit_result *res = NULL;
                     double f0 = now();
-                    int rc = phc_config_load(yaml, &pb, &err);
+                    phc_problem *pb = fit_problem(csv, v ? 1e-8 : 0.0, &err);
                     double f1 = now();
+                    int rc = pb ? PHC_OK : PHC_ERR_INPUT;
                     if (rc == 0)
                         rc = phc_fit_run(pb, NULL, NULL, &res, &err);
                     double f2 = now();
@@ -569,7 +604,6 @@ int main(void)
         printf("scipy_peer: not run\n");
     }
     unlink(csv);
-    unlink(yaml);
     unlink(tree_path);
     rmdir(dir);
     return 0;

@@ -13,7 +13,9 @@
  * 4. pot_constant.yaml (one constant loss, no pot) fails the daily-cycle
  *    check and the verdict names the day/night difference.
  * 5. The same data through covariates (g = 1 + loss_PAR PAR, PAR 600 by
- *    day, 0 by night): 1 + 600 loss_PAR is the day/night ratio, 10. */
+ *    day, 0 by night), built through the C API (phc_weight_curve_read_table,
+ *    phc_weight_curve_new, a problem of its own): 1 + 600 loss_PAR is the
+ *    day/night ratio, 10. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +23,13 @@
 
 #include "check.h"
 #include "fit/config.h"
+#include "fit/costs/weight_curve.h"
+#include "fit/costs/weight_table.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/problem.h"
+#include "measurements/plant_io.h"
+#include "measurements/table.h"
 
 #define EX PHC_SOURCE_DIR "/measurements/examples/weight_curve/"
 
@@ -59,6 +67,71 @@ static phc_fit_result *fit(phc_problem *pb)
     if (phc_fit_run(pb, NULL, NULL, &res, &err) != PHC_OK)
         fprintf(stderr, "fit: %s\n", err.message);
     return res;
+}
+
+/* Section 5's problem, built through the C API (no config): the seedling
+ * graph, pot_balance.csv read with logger timestamps in Europe/Berlin and
+ * masses in g, the PAR column as a linear covariate of the loss, a pot
+ * whose capacity and conductance are fitted, the 2024 reference weights,
+ * sigma 0.02 g; parameters delta 1e-3, loss_PAR 1e-3, initial_water 150,
+ * dry_mass 300, pot_capacity 100 (>= 1), pot_conductance 1e-2, all >= 0,
+ * bound by name; units converted and the stopping tolerances kept above the
+ * ODE solver's accuracy, as phc_config_load does. */
+static phc_problem *covariate_problem(phc_error *err)
+{
+    static const char *const names[6] = {"delta", "loss_PAR", "initial_water", "dry_mass", "pot_capacity",
+                                         "pot_conductance"};
+    static const double start[6] = {1.0e-3, 0.001, 150, 300, 100, 1.0e-2};
+    static const char *const covariates[1] = {"PAR"};
+    phc_problem *pb = phc_problem_new("pot-covariates");
+    phc_plant_graph *g = NULL;
+    phc_table *t = NULL;
+    phc_weighings w = phc_weighings_default();
+    phc_dataset *ds = NULL;
+    int rc = pb ? PHC_OK : phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (int j = 0; j < 6 && !rc; ++j) {
+        size_t i = 0;
+        if (!(rc = phc_problem_add_parameter(pb, names[j], start[j], &i, err)))
+            pb->params[i].lower = j == 4 ? 1 : 0;
+    }
+    phc_weight_curve_read_options ro = phc_weight_curve_read_options_default();
+    ro.time_column = "timestamp";
+    ro.timestamps = 1; /* ISO 8601 */
+    ro.timezone = "Europe/Berlin";
+    ro.mass_column = "mass_g";
+    ro.mass_unit = "g";
+    ro.n_covariates = 1;
+    ro.covariates = covariates;
+    phc_weight_curve_options o = phc_weight_curve_options_default();
+    o.conductance = PHC_WATER_REFERENCE_2024;
+    o.sigma = 0.02;
+    o.pot.on = 1; /* capacity and conductance NAN: fitted slots */
+    if (!rc && !(rc = phc_plant_io_read(EX "seedling.csv", PHC_PLANT_FORMAT_AUTO, 0, &g, err)) &&
+        !(rc = phc_table_read(EX "pot_balance.csv", &t, err)) &&
+        !(rc = phc_weight_curve_read_table(t, &ro, &w, err)) && !(rc = phc_weight_curve_new(g, &w, &o, &ds, err))) {
+        if (!(ds->name = strdup("pot")))
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (!rc && !(rc = phc_problem_bind_by_name(pb, ds, err))) {
+            rc = phc_problem_add_dataset(pb, ds, err);
+            ds = NULL;
+        }
+    }
+    phc_dataset_free(ds);
+    phc_weighings_release(&w);
+    phc_table_free(t);
+    phc_plant_graph_free(g);
+    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
+        const double tol = pb->datasets[0]->model_tolerance;
+        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
+        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
+        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
+        rc = phc_problem_validate(pb, err);
+    }
+    if (rc) {
+        phc_problem_free(pb);
+        return NULL;
+    }
+    return pb;
 }
 
 int main(void)
@@ -159,53 +232,26 @@ int main(void)
     phc_problem_free(pb);
 
     /* 5. covariates */
-    char path[] = "/tmp/phc_pot_cov_XXXXXX";
-    int fd = mkstemp(path);
-    CHECK(fd >= 0);
-    if (fd >= 0) {
-        FILE *f = fdopen(fd, "w");
-        fprintf(f,
-                "name: pot-covariates\n"
-                "parameters:\n"
-                "  delta: {value: 1.0e-3, lower: 0}\n"
-                "  loss_PAR: {value: 0.001, lower: 0}\n"
-                "  initial_water: {value: 150, lower: 0}\n"
-                "  dry_mass: {value: 300, lower: 0}\n"
-                "  pot_capacity: {value: 100, lower: 1}\n"
-                "  pot_conductance: {value: 1.0e-2, lower: 0}\n"
-                "datasets:\n"
-                "  - kind: weight_curve\n"
-                "    name: pot\n"
-                "    plant: %sseedling.csv\n"
-                "    conductance: reference_2024\n"
-                "    file: %spot_balance.csv\n"
-                "    time: {column: timestamp, timezone: Europe/Berlin}\n"
-                "    mass: {column: mass_g, unit: g}\n"
-                "    sigma: 0.02\n"
-                "    covariates: {columns: [PAR], law: linear}\n"
-                "    pot: {}\n",
-                EX, EX);
-        fclose(f);
-        pb = load(path);
-        CHECK(pb != NULL);
-        res = pb ? fit(pb) : NULL;
-        CHECK(res != NULL);
-        if (res) {
-            const phc_param_result *b = param(res, "loss_PAR"), *d = param(res, "delta");
-            CHECK(b && d);
-            if (b && d) {
-                /* by night g = 1 (PAR 0), by day 1 + 600 b: delta is the night's rate */
-                printf("covariates: delta %.4g (night rate; truth 4e-4), 1 + 600 loss_PAR = %.4g "
-                       "(truth 10), loss_PAR 95%% [%.4g, %.4g]\n",
-                       d->value, 1 + 600 * b->value, b->ci_lo, b->ci_hi);
-                CHECK(b->ci_lo < 0.015 && 0.015 < b->ci_hi);
-                CHECK(d->ci_lo < 4e-4 && 4e-4 < d->ci_hi);
-            }
-            phc_fit_result_free(res);
+    pb = covariate_problem(&err);
+    CHECK(pb != NULL);
+    if (!pb)
+        fprintf(stderr, "covariates: %s\n", err.message);
+    res = pb ? fit(pb) : NULL;
+    CHECK(res != NULL);
+    if (res) {
+        const phc_param_result *b = param(res, "loss_PAR"), *d = param(res, "delta");
+        CHECK(b && d);
+        if (b && d) {
+            /* by night g = 1 (PAR 0), by day 1 + 600 b: delta is the night's rate */
+            printf("covariates: delta %.4g (night rate; truth 4e-4), 1 + 600 loss_PAR = %.4g "
+                   "(truth 10), loss_PAR 95%% [%.4g, %.4g]\n",
+                   d->value, 1 + 600 * b->value, b->ci_lo, b->ci_hi);
+            CHECK(b->ci_lo < 0.015 && 0.015 < b->ci_hi);
+            CHECK(d->ci_lo < 4e-4 && 4e-4 < d->ci_hi);
         }
-        phc_problem_free(pb);
-        remove(path);
+        phc_fit_result_free(res);
     }
+    phc_problem_free(pb);
     (void)err;
     return check_finish("test_weight_curve_pot");
 }

@@ -4,10 +4,11 @@
  * A "pot on a balance" as a curve data set: mass (g) every 30 min over 5
  * days, losing water along a straight line plus, in "cycle", a day/night
  * difference the straight-line model cannot follow; "flat" has only noise.
- * The data set kind is the generic curve kind (fit/costs), so the test does
- * not depend on the weight_curve loader: the test sets x_seconds (x in
- * hours) and time_of_day (the first reading at 06:00) itself, as a loader
- * would.  Checks: the check fails with a period near 24 h and the verdict
+ * The data set kind is the generic curve kind (fit/costs), built through
+ * the C API (phc_curve_new over the CSV table, a problem of its own), so
+ * the test does not depend on the weight_curve loader: the test sets
+ * x_seconds (x in hours) and time_of_day (the first reading at 06:00)
+ * itself, as a loader would.  Checks: the check fails with a period near 24 h and the verdict
  * says so in words; the flat data set passes; result.json round-trips
  * x_seconds, time_of_day, the check and the time-lag ACF; the plots
  * (<name>_acf.png over time lags, <name>_time_of_day.png) are written.
@@ -20,8 +21,11 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "fit/config.h"
+#include "fit/costs/curve.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/parameter_units.h"
+#include "fit/engine/problem.h"
+#include "measurements/table.h"
 #include "fit/fit_plots.h"
 #include "fit/report.h"
 #include "fit/result_json.h"
@@ -74,38 +78,47 @@ static void write_data(const char *name, int cycle)
     fclose(f);
 }
 
+/* The straight line m0 - e t fitted to the table `csv` (t in h, m in g) as
+ * a curve data set "pot" built through the C API: m0 from 700 g, e from
+ * 0.1 g h-1, unbounded. */
 static phc_fit_result *fit_pot(const char *csv)
 {
-    char yaml[4096];
-    snprintf(yaml, sizeof yaml,
-             "name: pot\n"
-             "parameters:\n"
-             "  m0: {value: 700, unit: g}\n"
-             "  e: {value: 0.1, unit: \"g h-1\"}\n"
-             "datasets:\n"
-             "  - kind: curve\n"
-             "    name: pot\n"
-             "    file: %s\n"
-             "    x: t\n"
-             "    y: m\n"
-             "    expression: \"m0 - e*t\"\n",
-             csv);
-    FILE *f = fopen(path_in("pot.yaml"), "w");
-    CHECK(f != NULL);
-    if (!f)
-        return NULL;
-    fputs(yaml, f);
-    fclose(f);
-    phc_problem *pb = NULL;
+    phc_problem *pb = phc_problem_new("pot");
     phc_fit_result *res = NULL;
+    phc_table *t = NULL;
+    phc_dataset *built = NULL;
     phc_error err;
     phc_error_clear(&err);
-    int rc = phc_config_load(path_in("pot.yaml"), &pb, &err);
+    static const char *const names[2] = {"m0", "e"}, *const units[2] = {"g", "g h-1"};
+    static const double start[2] = {700, 0.1};
+    for (int j = 0; j < 2; ++j) {
+        size_t i = 0;
+        CHECK(phc_problem_add_parameter(pb, names[j], start[j], &i, &err) == PHC_OK);
+        pb->params[i].unit = strdup(units[j]);
+    }
+    phc_curve_options o = phc_curve_options_default();
+    o.x = "t";
+    o.y = "m";
+    o.expression = "m0 - e*t";
+    int rc = phc_table_read(path_in(csv), &t, &err);
+    if (!rc)
+        rc = phc_curve_new(t, &o, &built, &err);
+    phc_table_free(t);
+    if (!rc && !(built->name = strdup("pot")))
+        rc = PHC_ERR_NOMEM;
+    if (!rc && (rc = phc_problem_bind_by_name(pb, built, &err)))
+        phc_dataset_free(built);
+    if (!rc)
+        rc = phc_problem_add_dataset(pb, built, &err);
+    if (!rc && !(rc = phc_problem_convert_units(pb, &err)))
+        rc = phc_problem_validate(pb, &err);
     if (rc)
         fprintf(stderr, "%s\n", err.message);
     CHECK(rc == PHC_OK);
-    if (rc)
+    if (rc) {
+        phc_problem_free(pb);
         return NULL;
+    }
     phc_dataset *ds = pb->datasets[0];
     ds->x_seconds = 3600.0; /* x in hours */
     ds->time_of_day = malloc(ds->n * sizeof *ds->time_of_day);
@@ -266,7 +279,6 @@ int main(void)
     test_flat();
     unlink(path_in("cycle.csv"));
     unlink(path_in("flat.csv"));
-    unlink(path_in("pot.yaml"));
     CHECK(rmdir(tmp_dir) == 0);
     return check_finish("test_daily_cycle");
 }

@@ -9,7 +9,15 @@
  * come back in g h-1, the model sees g s-1 through unit_scale; an unknown
  * unit, a unit of another dimension and two slot units on one parameter are
  * errors naming the parameter; a parameter without `unit:` takes the
- * slot's. */
+ * slot's.
+ *
+ * A kind's declared slot: a weight_curve (a five-segment plant built in
+ * memory, 37 weighings made by the water model with delta = 1.5e-4 s-1 cm-2,
+ * 1.5 g of water, 0.8 g dry mass, plus a small deterministic disturbance)
+ * fitted once with delta in s-1 cm-2, water and dry mass in g, and once with
+ * delta in h-1 cm-2, water in mg and dry mass in kg: the second fit reports
+ * every value, standard error and interval in its own units, equal to the
+ * first times 3600, 1000 and 1/1000; delta in g is an error naming it. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,9 +25,12 @@
 
 #include "check.h"
 #include "fit/costs/curve.h"
+#include "fit/costs/weight_curve.h"
 #include "fit/engine/fit.h"
 #include "fit/engine/parameter_units.h"
 #include "fit/engine/problem.h"
+#include "model/plant_graph.h"
+#include "model/water.h"
 
 /* Mass loss y (g) at times t (s) for a = 2e-3 g s-1, with a small
  * deterministic disturbance so that the standard error is not zero. */
@@ -150,9 +161,138 @@ static void test_errors(void)
     phc_problem_free(pb);
 }
 
+/* A stem of two segments (radius 2 mm) carrying three leaf segments (radius
+ * 1 mm), every segment 5 cm long. */
+static phc_plant_graph *small_plant(void)
+{
+    static const size_t parent[5] = {PHC_PLANT_NO_PARENT, 0, 1, 1, 0};
+    phc_plant_graph *g = phc_plant_graph_new(5);
+    if (!g)
+        return NULL;
+    for (size_t i = 0; i < 5; ++i) {
+        g->parent[i] = parent[i];
+        g->length[i] = 0.05;
+        g->radius[i] = i < 2 ? 2e-3 : 1e-3;
+        g->leaf[i] = i >= 2;
+        g->tail[3 * i + 2] = g->head[3 * i + 2] + 0.05;
+    }
+    phc_error err;
+    if (phc_plant_graph_finish(g, "", &err)) {
+        phc_plant_graph_free(g);
+        return NULL;
+    }
+    return g;
+}
+
+/* The weight curve bound to delta, initial_water, dry_mass given in the
+ * units named (NULL: no `unit:`), starting at the values given in them;
+ * fitted, the result (NULL on failure); *status the conversion's status
+ * and msg (1024 bytes) its message. */
+static phc_fit_result *weight_fit(const phc_plant_graph *g, const double *t_h, const double *mass, size_t n,
+                                  const char *const units[3], const double start[3], int *status, char *msg)
+{
+    static const char *const names[3] = {"delta", "initial_water", "dry_mass"};
+    phc_weighings w = phc_weighings_default();
+    w.n = n;
+    w.t = t_h;
+    w.mass = mass;
+    w.seconds_per_unit = 3600;
+    w.time_unit = "h";
+    phc_weight_curve_options o = phc_weight_curve_options_default();
+    o.sigma = 0.002;
+    phc_dataset *ds = NULL;
+    phc_error err;
+    phc_error_clear(&err);
+    CHECK(phc_weight_curve_new(g, &w, &o, &ds, &err) == PHC_OK);
+    if (!ds)
+        return NULL;
+    CHECK(ds->slot_units[0] && strcmp(ds->slot_units[0], "s-1 cm-2") == 0);
+    CHECK(ds->slot_units[1] && strcmp(ds->slot_units[1], "g") == 0);
+    CHECK(ds->slot_units[2] && strcmp(ds->slot_units[2], "g") == 0);
+    ds->name = strdup("balance");
+    phc_problem *pb = phc_problem_new("weight-units");
+    for (int j = 0; j < 3; ++j) {
+        size_t idx = 0;
+        CHECK(phc_problem_add_parameter(pb, names[j], start[j], &idx, &err) == PHC_OK);
+        pb->params[idx].lower = 0;
+        if (units[j])
+            pb->params[idx].unit = strdup(units[j]);
+    }
+    CHECK(phc_problem_bind_by_name(pb, ds, &err) == PHC_OK);
+    CHECK(phc_problem_add_dataset(pb, ds, &err) == PHC_OK);
+    phc_fit_result *res = NULL;
+    if (!(*status = phc_problem_convert_units(pb, &err)))
+        CHECK(phc_fit_run(pb, NULL, NULL, &res, &err) == PHC_OK);
+    else
+        snprintf(msg, 1024, "%s", err.message);
+    phc_problem_free(pb);
+    return res;
+}
+
+static void test_weight_curve_units(void)
+{
+    phc_plant_graph *g = small_plant();
+    CHECK(g != NULL);
+    if (!g)
+        return;
+    enum { N = 37 };
+    double t_h[N], t_s[N], W[N], mass[N];
+    for (int i = 0; i < N; ++i) {
+        t_h[i] = 0.5 * i;
+        t_s[i] = 3600.0 * t_h[i];
+    }
+    phc_water_params wp = phc_water_params_default();
+    wp.loss_rate = 1.5e-4;
+    wp.initial_water = 1.5;
+    wp.viscosity = 0.89;
+    phc_error err;
+    CHECK(phc_water_total_curve(g, &wp, PHC_WATER_AUTO, 0, t_s, N, W, NULL, &err) == PHC_OK);
+    for (int i = 0; i < N; ++i)
+        mass[i] = 0.8 + W[i] + 0.002 * ((i % 3) - 1);
+
+    const char *const model_units[3] = {"s-1 cm-2", "g", "g"};
+    const char *const user_units[3] = {"h-1 cm-2", "mg", "kg"};
+    const double factor[3] = {3600.0, 1000.0, 1e-3}; /* user value = factor * model value */
+    const double start_model[3] = {1e-4, 1.0, 0.5};
+    const double start_user[3] = {0.36, 1000.0, 5e-4};
+    int status = 0;
+    char msg[1024] = "";
+    phc_fit_result *a = weight_fit(g, t_h, mass, N, model_units, start_model, &status, msg);
+    CHECK(status == PHC_OK && a != NULL);
+    phc_fit_result *b = weight_fit(g, t_h, mass, N, user_units, start_user, &status, msg);
+    CHECK(status == PHC_OK && b != NULL);
+    if (a && b) {
+        for (int j = 0; j < 3; ++j) {
+            const phc_param_result *pa = &a->params[j], *pb = &b->params[j];
+            const double rel = fabs(pb->value - factor[j] * pa->value) / fabs(factor[j] * pa->value);
+            const double rel_se = fabs(pb->stderr_ - factor[j] * pa->stderr_) / (factor[j] * pa->stderr_);
+            printf("weight_curve %s: %.10g +- %.4g %s  vs  %.10g +- %.4g %s (relative differences %.2g, %.2g)\n",
+                   pa->name, pa->value, pa->stderr_, pa->unit, pb->value, pb->stderr_, pb->unit, rel, rel_se);
+            CHECK(strcmp(pa->unit, model_units[j]) == 0 && strcmp(pb->unit, user_units[j]) == 0);
+            CHECK(rel < 1e-9);
+            CHECK(rel_se < 1e-9);
+            CHECK_NEAR(pb->ci_lo, factor[j] * pa->ci_lo, 0, 1e-6);
+            CHECK_NEAR(pb->ci_hi, factor[j] * pa->ci_hi, 0, 1e-6);
+            CHECK_NEAR(pb->start, start_user[j], 0, 1e-12);
+        }
+        CHECK_NEAR(a->params[0].value, 1.5e-4, 0, 1e-2); /* the data's delta */
+    }
+    phc_fit_result_free(a);
+    phc_fit_result_free(b);
+
+    const char *const wrong[3] = {"g", NULL, NULL}; /* delta in a mass unit */
+    phc_fit_result *c = weight_fit(g, t_h, mass, N, wrong, start_model, &status, msg);
+    CHECK(status == PHC_ERR_INPUT && c == NULL);
+    printf("delta in g: %s\n", msg);
+    CHECK(strstr(msg, "parameter 'delta': unit") != NULL && strstr(msg, "cannot be converted") != NULL);
+    phc_fit_result_free(c);
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_conversion_and_fit();
     test_errors();
+    test_weight_curve_units();
     return check_finish("test_parameter_units");
 }
