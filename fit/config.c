@@ -647,29 +647,19 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
     for (size_t i = 0; i < datasets->count; ++i)
         if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, err)))
             goto fail;
-    /* parameters' `unit:` into the units their slots declare */
-    if ((rc = phc_problem_convert_units(pb, err)))
-        goto fail;
-    /* A model computed to a relative accuracy tol (an ODE solver) cannot
-     * resolve cost changes below it: stopping tolerances the user did not
-     * set are raised to it instead of iterating on round-off. */
-    double model_tol = 0;
-    for (size_t d = 0; d < pb->n_datasets; ++d)
-        model_tol = fmax(model_tol, pb->datasets[d]->model_tolerance);
-    if (model_tol > 0) {
-        static const char *const tol_keys[] = {"function_tolerance", "gradient_tolerance",
-                                               "parameter_tolerance"};
-        double *tols[] = {&pb->options.nls.function_tolerance, &pb->options.nls.gradient_tolerance,
-                          &pb->options.nls.parameter_tolerance};
-        for (size_t t = 0; t < 3; ++t)
-            if (!solver || !phc_yaml_get(solver, tol_keys[t]))
-                *tols[t] = fmax(*tols[t], model_tol);
+    /* units converted, tolerances kept above the models' accuracy unless
+     * the solver: block names them, the problem checked (problem.h) */
+    unsigned keep = 0;
+    if (solver) {
+        keep |= phc_yaml_get(solver, "function_tolerance") ? PHC_KEEP_FUNCTION_TOLERANCE : 0;
+        keep |= phc_yaml_get(solver, "gradient_tolerance") ? PHC_KEEP_GRADIENT_TOLERANCE : 0;
+        keep |= phc_yaml_get(solver, "parameter_tolerance") ? PHC_KEEP_PARAMETER_TOLERANCE : 0;
     }
     if (collect_seeds(root, "", pb)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
-    if ((rc = phc_problem_validate(pb, err)))
+    if ((rc = phc_problem_finish(pb, keep, err)))
         goto fail;
     *out = pb;
     pb = NULL;

@@ -438,13 +438,8 @@ static phc_problem *build_problem(const char *soil, int des, const plan *pl, dou
         ds = NULL;
     }
     phc_dataset_free(ds);
-    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
-        const double tol = pb->datasets[0]->model_tolerance;
-        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
-        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
-        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
-        rc = phc_problem_validate(pb, err);
-    }
+    if (!rc)
+        rc = phc_problem_finish(pb, 0, err);
     if (rc) {
         phc_problem_free(pb);
         return NULL;

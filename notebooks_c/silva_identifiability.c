@@ -227,8 +227,8 @@ static phc_problem *build_problem(const char *dir, int cs, int st, phc_error *er
         }
     }
     phc_dataset_free(ds);
-    if (!rc && !(rc = phc_problem_convert_units(pb, err)))
-        rc = phc_problem_validate(pb, err);
+    if (!rc)
+        rc = phc_problem_finish(pb, 0, err);
     if (rc) {
         phc_problem_free(pb);
         return NULL;

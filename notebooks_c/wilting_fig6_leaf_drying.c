@@ -127,15 +127,8 @@ static phc_problem *joint_problem(const char *csv, phc_error *err)
                                                                              ? ds->slot_names[j] : w);
         rc = phc_problem_add_dataset(pb, ds, err);
     }
-    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
-        double tol = 0;
-        for (size_t d = 0; d < pb->n_datasets; ++d)
-            tol = fmax(tol, pb->datasets[d]->model_tolerance);
-        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
-        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
-        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
-        rc = phc_problem_validate(pb, err);
-    }
+    if (!rc)
+        rc = phc_problem_finish(pb, 0, err);
     phc_table_free(t);
     phc_units_free(units);
     if (rc) {

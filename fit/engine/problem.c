@@ -1,5 +1,6 @@
 /* Calibration problems: see problem.h. */
 #include "fit/engine/problem.h"
+#include "fit/engine/parameter_units.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -236,4 +237,25 @@ int phc_problem_validate(const phc_problem *pb, phc_error *err)
     if (pb->options.starts < 1)
         return phc_error_set(err, PHC_ERR_INPUT, "%s: solver.starts must be at least 1", src);
     return PHC_OK;
+}
+
+int phc_problem_finish(phc_problem *pb, unsigned keep, phc_error *err)
+{
+    double model_tol = 0;
+    int rc;
+    if (!pb)
+        return phc_error_set(err, PHC_ERR_INVALID, "phc_problem_finish: no problem");
+    if ((rc = phc_problem_convert_units(pb, err)))
+        return rc;
+    for (size_t d = 0; d < pb->n_datasets; ++d)
+        model_tol = fmax(model_tol, pb->datasets[d]->model_tolerance);
+    if (model_tol > 0) {
+        if (!(keep & PHC_KEEP_FUNCTION_TOLERANCE))
+            pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, model_tol);
+        if (!(keep & PHC_KEEP_GRADIENT_TOLERANCE))
+            pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, model_tol);
+        if (!(keep & PHC_KEEP_PARAMETER_TOLERANCE))
+            pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, model_tol);
+    }
+    return phc_problem_validate(pb, err);
 }

@@ -90,6 +90,26 @@ int phc_problem_bind_by_name(const phc_problem *pb, phc_dataset *ds, phc_error *
  * ("cfg.yaml:4: parameter 'vmax': ..."). */
 int phc_problem_validate(const phc_problem *pb, phc_error *err);
 
+/* Stopping tolerances phc_problem_finish leaves as they are (the caller set
+ * them on purpose): bits of PHC_KEEP_*. */
+enum {
+    PHC_KEEP_FUNCTION_TOLERANCE = 1,
+    PHC_KEEP_GRADIENT_TOLERANCE = 2,
+    PHC_KEEP_PARAMETER_TOLERANCE = 4
+};
+
+/* What a problem needs once its parameters and data sets are in, whether
+ * it was built in C or from a config (phc_config_load calls it):
+ *   1. every parameter's `unit` converted into its slots' units
+ *      (phc_problem_convert_units, fit/engine/parameter_units.h);
+ *   2. a model computed to a relative accuracy tol (an ODE solver: the
+ *      largest model_tolerance of the data sets) cannot resolve cost
+ *      changes below it, so the stopping tolerances not named in `keep`
+ *      are raised to at least tol instead of iterating on round-off;
+ *   3. phc_problem_validate.
+ * Returns the first error. */
+int phc_problem_finish(phc_problem *pb, unsigned keep, phc_error *err);
+
 /* The scale used for parameter i (explicit, or |value|, or 1). */
 double phc_problem_scale(const phc_problem *pb, size_t i);
 

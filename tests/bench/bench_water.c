@@ -265,14 +265,17 @@ static phc_problem *fit_problem(const char *csv, double tol, phc_error *err)
     phc_weighings_release(&w);
     phc_table_free(t);
     phc_plant_graph_free(g);
-    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
-        double *tols[3] = {&pb->options.nls.function_tolerance, &pb->options.nls.gradient_tolerance,
-                           &pb->options.nls.parameter_tolerance};
-        const double model_tol = pb->datasets[0]->model_tolerance;
-        for (int k = 0; k < 3; ++k)
-            *tols[k] = tol > 0 ? tol : fmax(*tols[k], model_tol);
-        rc = phc_problem_validate(pb, err);
+    if (!rc && tol > 0) {
+        pb->options.nls.function_tolerance = tol;
+        pb->options.nls.gradient_tolerance = tol;
+        pb->options.nls.parameter_tolerance = tol;
     }
+    if (!rc)
+        rc = phc_problem_finish(pb,
+                                tol > 0 ? PHC_KEEP_FUNCTION_TOLERANCE | PHC_KEEP_GRADIENT_TOLERANCE |
+                                              PHC_KEEP_PARAMETER_TOLERANCE
+                                        : 0,
+                                err);
     if (rc) {
         phc_problem_free(pb);
         return NULL;

@@ -149,15 +149,8 @@ static phc_fit_result *run(const phc_table *t, phc_units *units, const char *nam
     }
     /* as phc_config_load does: parameter units, and stopping tolerances no
      * finer than the ODE solver's accuracy */
-    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
-        double tol = 0;
-        for (size_t d = 0; d < pb->n_datasets; ++d)
-            tol = fmax(tol, pb->datasets[d]->model_tolerance);
-        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
-        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
-        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
-        rc = phc_problem_validate(pb, err);
-    }
+    if (!rc)
+        rc = phc_problem_finish(pb, 0, err);
     phc_fit_result *res = NULL;
     if (!rc)
         rc = phc_fit_run(pb, NULL, NULL, &res, err);

@@ -120,13 +120,8 @@ static phc_problem *covariate_problem(phc_error *err)
     phc_weighings_release(&w);
     phc_table_free(t);
     phc_plant_graph_free(g);
-    if (!rc && !(rc = phc_problem_convert_units(pb, err))) {
-        const double tol = pb->datasets[0]->model_tolerance;
-        pb->options.nls.function_tolerance = fmax(pb->options.nls.function_tolerance, tol);
-        pb->options.nls.gradient_tolerance = fmax(pb->options.nls.gradient_tolerance, tol);
-        pb->options.nls.parameter_tolerance = fmax(pb->options.nls.parameter_tolerance, tol);
-        rc = phc_problem_validate(pb, err);
-    }
+    if (!rc)
+        rc = phc_problem_finish(pb, 0, err);
     if (rc) {
         phc_problem_free(pb);
         return NULL;

@@ -110,8 +110,8 @@ static phc_fit_result *fit_pot(const char *csv)
         phc_dataset_free(built);
     if (!rc)
         rc = phc_problem_add_dataset(pb, built, &err);
-    if (!rc && !(rc = phc_problem_convert_units(pb, &err)))
-        rc = phc_problem_validate(pb, &err);
+    if (!rc)
+        rc = phc_problem_finish(pb, 0, &err);
     if (rc)
         fprintf(stderr, "%s\n", err.message);
     CHECK(rc == PHC_OK);
