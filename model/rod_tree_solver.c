@@ -1,0 +1,282 @@
+/* Block tree factorisation: see rod_tree_solver.h. */
+#include "model/rod_tree_solver.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+phc_rod_tree *phc_rod_tree_new(size_t n)
+{
+    phc_rod_tree *t = calloc(1, sizeof *t);
+    if (!t)
+        return NULL;
+    t->n = n;
+    t->parent = malloc(n * sizeof *t->parent);
+    t->dim = calloc(n, sizeof *t->dim);
+    t->order = calloc(n, sizeof *t->order);
+    t->diag = calloc(144 * n, sizeof *t->diag);
+    t->coup = calloc(72 * n, sizeof *t->coup);
+    t->y = calloc(72 * n, sizeof *t->y);
+    t->piv = calloc(12 * n, sizeof *t->piv);
+    if (!t->parent || !t->dim || !t->order || !t->diag || !t->coup || !t->y || !t->piv) {
+        phc_rod_tree_free(t);
+        return NULL;
+    }
+    for (size_t i = 0; i < n; ++i)
+        t->parent[i] = PHC_TREE_NONE;
+    return t;
+}
+
+void phc_rod_tree_free(phc_rod_tree *t)
+{
+    if (!t)
+        return;
+    free(t->parent);
+    free(t->dim);
+    free(t->order);
+    free(t->diag);
+    free(t->coup);
+    free(t->y);
+    free(t->piv);
+    free(t);
+}
+
+int phc_rod_tree_set_order(phc_rod_tree *t)
+{
+    /* breadth-first from the roots, then reversed: children before parents */
+    size_t n = t->n, head = 0, tail = 0;
+    size_t *count = calloc(n + 1, sizeof *count), *kids = malloc((n ? n : 1) * sizeof *kids);
+    size_t *bfs = malloc((n ? n : 1) * sizeof *bfs);
+    int rc = 0;
+    if (!count || !kids || !bfs) {
+        rc = -1;
+        goto done;
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (t->parent[i] != PHC_TREE_NONE)
+            ++count[t->parent[i] + 1];
+    for (size_t i = 0; i < n; ++i)
+        count[i + 1] += count[i];
+    {
+        size_t *fill = malloc((n ? n : 1) * sizeof *fill);
+        if (!fill) {
+            rc = -1;
+            goto done;
+        }
+        memcpy(fill, count, n * sizeof *fill);
+        for (size_t i = 0; i < n; ++i)
+            if (t->parent[i] != PHC_TREE_NONE)
+                kids[fill[t->parent[i]]++] = i;
+        free(fill);
+    }
+    for (size_t i = 0; i < n; ++i)
+        if (t->parent[i] == PHC_TREE_NONE)
+            bfs[tail++] = i;
+    while (head < tail) {
+        const size_t i = bfs[head++];
+        for (size_t k = count[i]; k < count[i + 1]; ++k)
+            bfs[tail++] = kids[k];
+    }
+    if (tail != n) {
+        rc = -1;
+        goto done;
+    }
+    for (size_t i = 0; i < n; ++i)
+        t->order[i] = bfs[n - 1 - i];
+done:
+    free(count);
+    free(kids);
+    free(bfs);
+    return rc;
+}
+
+static inline int lu_inline(double *a, const int n, int *piv)
+{
+    for (int k = 0; k < n; ++k) {
+        int p = k;
+        double best = fabs(a[k * n + k]);
+        for (int r = k + 1; r < n; ++r)
+            if (fabs(a[r * n + k]) > best) {
+                best = fabs(a[r * n + k]);
+                p = r;
+            }
+        piv[k] = p;
+        if (!(best > 0.0) || !isfinite(best))
+            return -1;
+        if (p != k)
+            for (int c = 0; c < n; ++c) {
+                const double tmp = a[k * n + c];
+                a[k * n + c] = a[p * n + c];
+                a[p * n + c] = tmp;
+            }
+        const double inv = 1.0 / a[k * n + k];
+        for (int r = k + 1; r < n; ++r) {
+            const double f = a[r * n + k] * inv;
+            a[r * n + k] = f;
+            if (f != 0.0)
+                for (int c = k + 1; c < n; ++c)
+                    a[r * n + c] -= f * a[k * n + c];
+        }
+    }
+    return 0;
+}
+
+static inline void lu_solve_inline(const double *a, const int n, const int *piv, double *b)
+{
+    /* rows were swapped whole during the factorisation (the multipliers
+     * too), so apply every swap first, then the unit lower triangle */
+    for (int k = 0; k < n; ++k) {
+        const int p = piv[k];
+        if (p != k) {
+            const double tmp = b[k];
+            b[k] = b[p];
+            b[p] = tmp;
+        }
+    }
+    for (int k = 0; k < n; ++k)
+        for (int r = k + 1; r < n; ++r)
+            b[r] -= a[r * n + k] * b[k];
+    for (int k = n - 1; k >= 0; --k) {
+        double s = b[k];
+        for (int c = k + 1; c < n; ++c)
+            s -= a[k * n + c] * b[c];
+        b[k] = s / a[k * n + k];
+    }
+}
+
+int phc_dense_lu(double *a, int n, int *piv) { return lu_inline(a, n, piv); }
+
+void phc_dense_lu_solve(const double *a, int n, const int *piv, double *b)
+{
+    lu_solve_inline(a, n, piv, b);
+}
+
+/* Solves with the LU factors of a (n x n) for the 6 columns of the n x 6
+ * row-major matrix y at once (row operations 6 wide). */
+static inline void lu_solve6_inline(const double *a, const int n, const int *piv, double *y)
+{
+    for (int k = 0; k < n; ++k) {
+        const int p = piv[k];
+        if (p != k)
+            for (int c = 0; c < 6; ++c) {
+                const double tmp = y[k * 6 + c];
+                y[k * 6 + c] = y[p * 6 + c];
+                y[p * 6 + c] = tmp;
+            }
+    }
+    for (int k = 0; k < n; ++k)
+        for (int r = k + 1; r < n; ++r) {
+            const double f = a[r * n + k];
+            for (int c = 0; c < 6; ++c)
+                y[r * 6 + c] -= f * y[k * 6 + c];
+        }
+    for (int k = n - 1; k >= 0; --k) {
+        for (int j = k + 1; j < n; ++j) {
+            const double f = a[k * n + j];
+            for (int c = 0; c < 6; ++c)
+                y[k * 6 + c] -= f * y[j * 6 + c];
+        }
+        const double inv = 1.0 / a[k * n + k];
+        for (int c = 0; c < 6; ++c)
+            y[k * 6 + c] *= inv;
+    }
+}
+
+/* the node sizes: 12 (paired) and 6 (free top of a loose part), as
+ * compile-time constants so the loops unroll */
+static int node_lu(double *a, int d, int *piv)
+{
+    return d == 12 ? lu_inline(a, 12, piv) : lu_inline(a, d, piv);
+}
+
+static void node_solve(const double *a, int d, const int *piv, double *b)
+{
+    if (d == 12)
+        lu_solve_inline(a, 12, piv, b);
+    else
+        lu_solve_inline(a, d, piv, b);
+}
+
+static void node_solve6(const double *a, int d, const int *piv, double *y)
+{
+    if (d == 12)
+        lu_solve6_inline(a, 12, piv, y);
+    else
+        lu_solve6_inline(a, d, piv, y);
+}
+
+/* The node's d x d block lives in diag with stride 12: copy to and from a
+ * packed d x d buffer for the LU. */
+size_t phc_rod_tree_factor(phc_rod_tree *t)
+{
+    for (size_t o = 0; o < t->n; ++o) {
+        const size_t i = t->order[o];
+        const int d = t->dim[i];
+        if (d == 0)
+            continue;
+        double *D = t->diag + 144 * i, packed[144];
+        for (int r = 0; r < d; ++r)
+            for (int c = 0; c < d; ++c)
+                packed[r * d + c] = D[r * 12 + c];
+        if (node_lu(packed, d, t->piv + 12 * i) != 0)
+            return i;
+        memcpy(D, packed, (size_t)(d * d) * sizeof *D); /* packed d x d from here on */
+        const size_t p = t->parent[i];
+        if (p == PHC_TREE_NONE || t->dim[p] == 0)
+            continue;
+        /* Y = D⁻¹ A (d x 6); parent body block −= Aᵀ Y */
+        const double *A = t->coup + 72 * i;
+        double *Y = t->y + 72 * i;
+        memcpy(Y, A, (size_t)(d * 6) * sizeof *Y);
+        node_solve6(D, d, t->piv + 12 * i, Y);
+        double *P = t->diag + 144 * p;
+        for (int r = 0; r < 6; ++r)
+            for (int c = 0; c < 6; ++c) {
+                double s = 0.0;
+                for (int k = 0; k < d; ++k)
+                    s += A[k * 6 + r] * Y[k * 6 + c];
+                P[r * 12 + c] -= s;
+            }
+    }
+    return PHC_TREE_NONE;
+}
+
+void phc_rod_tree_solve(const phc_rod_tree *t, double *rhs)
+{
+    /* forward (leaves first): y_i = D_i⁻¹ r_i;  r_p −= A_iᵀ y_i */
+    for (size_t o = 0; o < t->n; ++o) {
+        const size_t i = t->order[o];
+        const int d = t->dim[i];
+        if (d == 0)
+            continue;
+        double *r = rhs + 12 * i;
+        node_solve(t->diag + 144 * i, d, t->piv + 12 * i, r);
+        const size_t p = t->parent[i];
+        if (p != PHC_TREE_NONE && t->dim[p] != 0) {
+            const double *A = t->coup + 72 * i;
+            double *rp = rhs + 12 * p;
+            for (int c = 0; c < 6; ++c) {
+                double s = 0.0;
+                for (int k = 0; k < d; ++k)
+                    s += A[k * 6 + c] * r[k];
+                rp[c] -= s;
+            }
+        }
+    }
+    /* backward (parents first): u_i = y_i − Y_i u_p */
+    for (size_t o = t->n; o-- > 0;) {
+        const size_t i = t->order[o];
+        const int d = t->dim[i];
+        const size_t p = t->parent[i];
+        if (d == 0 || p == PHC_TREE_NONE || t->dim[p] == 0)
+            continue;
+        const double *Y = t->y + 72 * i, *up = rhs + 12 * p;
+        double *u = rhs + 12 * i;
+        for (int k = 0; k < d; ++k) {
+            double s = 0.0;
+            for (int c = 0; c < 6; ++c)
+                s += Y[k * 6 + c] * up[c];
+            u[k] -= s;
+        }
+    }
+}
