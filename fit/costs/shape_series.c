@@ -466,7 +466,7 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
                        phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: series '%s': the angle is not a finite number",
                                      tr->source, tr->line[i], sp->series);
         const double first = track->value[0];
-        const double beta = isnan(sp->base_angle) ? first : sp->base_angle;
+        const double beta = isnan(sp->base_angle) ? remainder(first, 2.0 * PHC_SS_PI) : sp->base_angle;
         const double shift = beta + remainder(first - beta, 2.0 * PHC_SS_PI) - first; /* a multiple of 2π */
         stalk *st = &m->stalks[s];
         st->offset_slot = -1;

@@ -77,7 +77,7 @@ typedef struct phc_shape_stalk {
     double tip_mass;     /* kg, >= 0: the flower */
     double base_angle;   /* β, rad, counter-clockwise from +x with z up; NaN: the
                             first observed angle (the stalk starts where the organ
-                            pointed at the first sample) */
+                            pointed at the first sample), taken in [−π, π] */
     int offset;          /* 1: a slot offset_<series> (rad) added to the model angle */
     const char *where;   /* for messages (e.g. "cfg.yaml:14"); may be NULL */
 } phc_shape_stalk;
