@@ -235,7 +235,8 @@ static void test_fit(const double *a, const double *b)
     CHECK(phc_fit_run(pb, NULL, NULL, &res, &err) == PHC_OK);
     if (res) {
         for (size_t i = 0; i < 5; ++i) {
-            printf("fitted %-8s %.10g (truth %g)\n", res->params[i].name, res->params[i].value, truth[i]);
+            printf("fitted %-8s %.12g (truth %g, relative error %.2g)\n", res->params[i].name, res->params[i].value, truth[i],
+                   fabs(res->params[i].value / truth[i] - 1));
             CHECK_NEAR(res->params[i].value, truth[i], 1e-6, 1e-4);
         }
     } else {
