@@ -369,9 +369,9 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
     const size_t n = spec->segments + 1;
     const double h = spec->length / (double)spec->segments, c = cos(beta), s = sin(beta);
     phc_plant_graph *g = phc_plant_graph_new(n);
+    out->g = g; /* freed with the data set, whatever happens below */
     if (!g || !(out->young = malloc(n * sizeof *out->young)) || !(out->id = strdup(spec->series)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    out->g = g;
     out->beta = beta;
     out->tip_mass = spec->tip_mass;
     /* The clamp is short (CLAMP_FRACTION of a segment): the base joint then
