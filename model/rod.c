@@ -1,5 +1,7 @@
 /* Elastic rods on the plant graph: see rod.h (model), rod_joint.h (the joint
- * constraints and their derivatives), rod_tree_solver.h (the direct solver). */
+ * constraints and their derivatives), rod_tree_solver.h (the direct solver),
+ * rod_gauss_seidel.c (the authors' reference scheme), rod_internal.h (the
+ * struct and the helpers they share). */
 #include "model/rod.h"
 
 #include <math.h>
@@ -17,36 +19,6 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-struct phc_rod {
-    const phc_plant_graph *g;
-    size_t n;
-    phc_rod_options opt;
-    double *young;      /* n, Pa */
-    double *extra;      /* n, kg */
-    double *mass;       /* n, kg */
-    double *inertia;    /* 3n: body-frame principal moments (d1, d2, d3), kg m² */
-    unsigned char *fixed;
-    double *factor;     /* n: joint to the parent (root unused) */
-    double *load;       /* 3n, N at the tail */
-    phc_rod_joint_geometry *joint; /* n: joint of segment c with its parent */
-    double *stiff;      /* 3n: ℓK of joint c (N m³... energy per Ω²), before the factor */
-    /* state */
-    double *x, *q, *v, *w, *lambda; /* 3n, 4n, 3n, 3n, 6n */
-    double *x0, *q0;
-    /* scratch */
-    double *xs, *qs, *ls;           /* saved state for line search / refusal */
-    double *xo, *qo, *xp, *qp;      /* old and predicted (dynamics) */
-    double *res, *rhs, *sol;        /* 12 per node */
-    size_t *epar, *ejoint, *jnode;  /* elimination parent, the node's joint, joint -> node */
-    size_t *anchors, n_anchors;
-    size_t *queue;
-    unsigned char *mark;
-    double *schur;                  /* (6 n_anchors)² */
-    int *schur_piv;
-    double reach;
-    double load_scale;              /* continuation factor on gravity and loads */
-    phc_rod_tree *tree;
-};
 
 void phc_rod_options_default(phc_rod_options *o)
 {
@@ -370,7 +342,7 @@ void phc_rod_reset(phc_rod *rod)
     memset(rod->lambda, 0, 6 * rod->n * sizeof *rod->lambda);
 }
 
-static void tail_offset(const phc_rod *rod, size_t i, double u[3])
+void phc_rod_internal_tail_offset(const phc_rod *rod, size_t i, double u[3])
 {
     const double e[3] = {0.0, 0.0, 0.5 * rod->g->length[i]};
     phc_quat_rotate(rod->q + 4 * i, e, u);
@@ -379,7 +351,7 @@ static void tail_offset(const phc_rod *rod, size_t i, double u[3])
 void phc_rod_head(const phc_rod *rod, size_t i, double out[3])
 {
     double u[3];
-    tail_offset(rod, i, u);
+    phc_rod_internal_tail_offset(rod, i, u);
     for (int k = 0; k < 3; ++k)
         out[k] = rod->x[3 * i + k] - u[k];
 }
@@ -387,7 +359,7 @@ void phc_rod_head(const phc_rod *rod, size_t i, double out[3])
 void phc_rod_tail(const phc_rod *rod, size_t i, double out[3])
 {
     double u[3];
-    tail_offset(rod, i, u);
+    phc_rod_internal_tail_offset(rod, i, u);
     for (int k = 0; k < 3; ++k)
         out[k] = rod->x[3 * i + k] + u[k];
 }
@@ -403,7 +375,7 @@ void phc_rod_tip_deflection(const phc_rod *rod, size_t i, double out[3])
 double phc_rod_mass(const phc_rod *rod, size_t i) { return rod->mass[i]; }
 
 /* world inertia R diag(I) Rᵀ (3x3) */
-static void world_inertia(const phc_rod *rod, size_t i, double out[9], int inverse)
+void phc_rod_internal_world_inertia(const phc_rod *rod, size_t i, double out[9], int inverse)
 {
     double r[9];
     phc_quat_to_matrix(rod->q + 4 * i, r);
@@ -424,7 +396,7 @@ double phc_rod_kinetic_energy(const phc_rod *rod)
     for (size_t i = 0; i < rod->n; ++i) {
         const double *v = rod->v + 3 * i, *w = rod->w + 3 * i;
         e += 0.5 * rod->mass[i] * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        world_inertia(rod, i, iw, 0);
+        phc_rod_internal_world_inertia(rod, i, iw, 0);
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
                 e += 0.5 * w[a] * iw[a * 3 + b] * w[b];
@@ -591,7 +563,7 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
         const double F[3] = {ts * rod->load[3 * i], ts * rod->load[3 * i + 1],
                              ts * rod->load[3 * i + 2]};
         double u[3];
-        tail_offset(rod, i, u);
+        phc_rod_internal_tail_offset(rod, i, u);
         for (int k = 0; k < 3; ++k)
             r[k] = -m * ts * rod->opt.gravity[k] - F[k];
         /* torque of the tail load: ∇_θ(−F·(x + Ru)) = −u × F */
@@ -610,7 +582,7 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
             for (int k = 0; k < 3; ++k)
                 r[k] += m * ((rod->x[3 * i + k] - rod->xp[3 * i + k]) * s2 +
                              (rod->x[3 * i + k] - rod->xo[3 * i + k]) * s1);
-            world_inertia(rod, i, iw, 0);
+            phc_rod_internal_world_inertia(rod, i, iw, 0);
             phc_quat_conj(rod->qp + 4 * i, qc);
             phc_quat_mul(rod->q + 4 * i, qc, rel);
             phc_quat_log(rel, th_p);
@@ -738,7 +710,9 @@ static residual_norm residual_measure(const phc_rod *rod, const step_params *sp)
 }
 
 /* Solves the Newton system for −res into rod->sol, supports by Schur
- * complement.  Returns PHC_TREE_NONE or the singular node. */
+ * complement.  Returns PHC_TREE_NONE, the singular node, or DIRECTION_NOMEM. */
+#define DIRECTION_NOMEM ((size_t)-2)
+
 static size_t newton_direction(phc_rod *rod)
 {
     phc_rod_tree *t = rod->tree;
@@ -756,7 +730,7 @@ static size_t newton_direction(phc_rod *rod)
     /* u0 = K⁻¹(−r); S = G K⁻¹ Gᵀ; μ = S⁻¹ G u0; u = K⁻¹(−r − Gᵀ μ) */
     double *mu = malloc(m * sizeof *mu);
     if (!mu)
-        return 0;
+        return DIRECTION_NOMEM;
     memcpy(rod->rhs, rod->sol, 12 * n * sizeof *rod->rhs);
     phc_rod_tree_solve(t, rod->rhs);
     for (size_t a = 0; a < na; ++a)
@@ -780,7 +754,8 @@ static size_t newton_direction(phc_rod *rod)
         double *sv = malloc(m * sizeof *sv), *tmp = malloc(m * sizeof *tmp);
         double *U = malloc(m * m * sizeof *U), *VT = malloc(m * m * sizeof *VT);
         double *superb = malloc((m > 1 ? m : 2) * sizeof *superb);
-        int bad = !sv || !tmp || !U || !VT || !superb;
+        const int nomem = !sv || !tmp || !U || !VT || !superb;
+        int bad = nomem;
         if (!bad) {
             for (size_t r = 0; r < m; ++r) {
                 const double sr = (r % 6 >= 3) ? L : 1.0;
@@ -814,7 +789,7 @@ static size_t newton_direction(phc_rod *rod)
         free(superb);
         if (bad) {
             free(mu);
-            return rod->anchors[0];
+            return nomem ? DIRECTION_NOMEM : rod->anchors[0];
         }
     }
     for (size_t a = 0; a < na; ++a)
@@ -887,6 +862,8 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         if (rn.max <= tol)
             return PHC_OK;
         const size_t bad = newton_direction(rod);
+        if (bad == DIRECTION_NOMEM)
+            return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory for the supports' system");
         if (bad != PHC_TREE_NONE)
             return phc_error_set(err, PHC_ERR_NUMERIC,
                                  "rod: segment %ld: the Newton system is singular at iteration %d "
@@ -1007,6 +984,8 @@ int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err)
             rc = newton(rod, &sp, left < cap ? left : cap, &stage, err);
             rep->total_iterations += stage.iterations;
             rep->residual = stage.residual;
+            if (rc == PHC_ERR_NOMEM)
+                break;
             if (rc == PHC_OK) {
                 t = tt;
                 dt = fmin(2.0 * dt, 1.0);
@@ -1050,7 +1029,7 @@ static void rotation_between(const double qa[4], const double qb[4], double v[3]
 }
 
 /* after a sub-step from (xo, qo): velocities; refuse large rotations */
-static int finish_substep(phc_rod *rod, double h, phc_error *err)
+int phc_rod_internal_finish_substep(phc_rod *rod, double h, phc_error *err)
 {
     for (size_t i = 0; i < rod->n; ++i) {
         double th[3];
@@ -1070,7 +1049,7 @@ static int finish_substep(phc_rod *rod, double h, phc_error *err)
     return PHC_OK;
 }
 
-static void predict(phc_rod *rod, double h)
+void phc_rod_internal_predict(phc_rod *rod, double h)
 {
     for (size_t i = 0; i < rod->n; ++i) {
         memcpy(rod->xo + 3 * i, rod->x + 3 * i, 3 * sizeof *rod->x);
@@ -1089,7 +1068,7 @@ static void predict(phc_rod *rod, double h)
 static int substep_direct(phc_rod *rod, double h, phc_rod_report *rep, phc_error *err)
 {
     step_params sp = {1, h, rod->opt.damping};
-    predict(rod, h);
+    phc_rod_internal_predict(rod, h);
     /* start from the prediction (fixed bodies stay) */
     for (size_t i = 0; i < rod->n; ++i)
         if (!rod->fixed[i]) {
@@ -1102,114 +1081,7 @@ static int substep_direct(phc_rod *rod, double h, phc_rod_report *rep, phc_error
                                 "rod: the implicit step of %g s did not converge (time step too "
                                 "large?)",
                                 h);
-    return finish_substep(rod, h, err);
-}
-
-/* The authors' scheme: XPBD Gauss–Seidel over the joints in graph order,
- * multipliers reset each sub-step, explicit prediction with gravity. */
-static int substep_gauss_seidel(phc_rod *rod, double h, phc_error *err)
-{
-    const phc_plant_graph *g = rod->g;
-    const size_t n = rod->n;
-    for (size_t i = 0; i < n; ++i) {
-        if (rod->fixed[i])
-            continue;
-        double u[3], tq[3], iwi[9];
-        const double *F = rod->load + 3 * i;
-        for (int k = 0; k < 3; ++k)
-            rod->v[3 * i + k] += h * (rod->opt.gravity[k] + F[k] / rod->mass[i]);
-        tail_offset(rod, i, u);
-        tq[0] = u[1] * F[2] - u[2] * F[1];
-        tq[1] = u[2] * F[0] - u[0] * F[2];
-        tq[2] = u[0] * F[1] - u[1] * F[0];
-        world_inertia(rod, i, iwi, 1);
-        for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < 3; ++b)
-                rod->w[3 * i + a] += h * iwi[a * 3 + b] * tq[b];
-    }
-    predict(rod, h);
-    for (size_t i = 0; i < n; ++i)
-        if (!rod->fixed[i]) {
-            memcpy(rod->x + 3 * i, rod->xp + 3 * i, 3 * sizeof *rod->x);
-            memcpy(rod->q + 4 * i, rod->qp + 4 * i, 4 * sizeof *rod->q);
-        }
-    memset(rod->lambda, 0, 6 * n * sizeof *rod->lambda);
-    for (int it = 0; it < rod->opt.gs_iterations; ++it)
-        for (size_t o = 0; o < n; ++o) {
-            const size_t c = g->order[o], p = g->parent[c];
-            if (p == PHC_PLANT_NO_PARENT || !(rod->factor[c] > 0.0))
-                continue;
-            double C[6], Jp[36], Jc[36], S[36], WJp[36], WJc[36], iw[9];
-            int piv[6];
-            phc_rod_joint_eval(rod->joint + c, rod->x + 3 * p, rod->q + 4 * p, rod->x + 3 * c,
-                               rod->q + 4 * c, C, Jp, Jc);
-            /* W Jᵀ for both bodies (6x6, rows z, columns constraint rows) */
-            const size_t body[2] = {p, c};
-            const double *J[2] = {Jp, Jc};
-            double *WJ[2] = {WJp, WJc};
-            for (int b = 0; b < 2; ++b) {
-                const size_t i = body[b];
-                memset(WJ[b], 0, 36 * sizeof(double));
-                if (rod->fixed[i])
-                    continue;
-                world_inertia(rod, i, iw, 1);
-                for (int r = 0; r < 6; ++r) {
-                    for (int k = 0; k < 3; ++k)
-                        WJ[b][k * 6 + r] = J[b][r * 6 + k] / rod->mass[i];
-                    for (int k = 0; k < 3; ++k) {
-                        double s = 0.0;
-                        for (int l = 0; l < 3; ++l)
-                            s += iw[k * 3 + l] * J[b][r * 6 + 3 + l];
-                        WJ[b][(3 + k) * 6 + r] = s;
-                    }
-                }
-            }
-            double rhs[6], *lam = rod->lambda + 6 * c;
-            for (int a = 0; a < 6; ++a) {
-                for (int b = 0; b < 6; ++b) {
-                    double s = 0.0;
-                    for (int k = 0; k < 6; ++k)
-                        s += Jp[a * 6 + k] * WJp[k * 6 + b] + Jc[a * 6 + k] * WJc[k * 6 + b];
-                    S[a * 6 + b] = s;
-                }
-                const double at = a < 3 ? 0.0
-                                        : 1.0 / (rod->factor[c] * rod->stiff[3 * c + a - 3] * h * h);
-                S[a * 6 + a] += at;
-                rhs[a] = -C[a] - at * lam[a];
-            }
-            if (phc_dense_lu(S, 6, piv) != 0)
-                return phc_error_set(err, PHC_ERR_NUMERIC,
-                                     "rod: segment %ld: singular joint system (gauss_seidel)",
-                                     g->source_id[c]);
-            phc_dense_lu_solve(S, 6, piv, rhs);
-            for (int a = 0; a < 6; ++a)
-                lam[a] += rhs[a];
-            for (int b = 0; b < 2; ++b) {
-                const size_t i = body[b];
-                if (rod->fixed[i])
-                    continue;
-                double dz[6], e[4];
-                for (int k = 0; k < 6; ++k) {
-                    dz[k] = 0.0;
-                    for (int a = 0; a < 6; ++a)
-                        dz[k] += WJ[b][k * 6 + a] * rhs[a];
-                }
-                for (int k = 0; k < 3; ++k)
-                    rod->x[3 * i + k] += dz[k];
-                phc_quat_exp(dz + 3, e);
-                phc_quat_mul(e, rod->q + 4 * i, rod->q + 4 * i);
-                phc_quat_normalize(rod->q + 4 * i);
-            }
-        }
-    int rc = finish_substep(rod, h, err);
-    if (rc != PHC_OK)
-        return rc;
-    const double damp = 1.0 / (1.0 + rod->opt.damping * h);
-    for (size_t i = 0; i < 3 * n; ++i) {
-        rod->v[i] *= damp;
-        rod->w[i] *= damp;
-    }
-    return PHC_OK;
+    return phc_rod_internal_finish_substep(rod, h, err);
 }
 
 int phc_rod_step(phc_rod *rod, double dt, phc_rod_report *report, phc_error *err)
@@ -1241,7 +1113,7 @@ int phc_rod_step(phc_rod *rod, double dt, phc_rod_report *report, phc_error *err
     const double h = dt / rod->opt.substeps;
     for (int s = 0; s < rod->opt.substeps && rc == PHC_OK; ++s) {
         if (rod->opt.scheme == PHC_ROD_GAUSS_SEIDEL) {
-            rc = substep_gauss_seidel(rod, h, err);
+            rc = phc_rod_internal_gauss_seidel_substep(rod, h, err);
             rep->iterations = rod->opt.gs_iterations;
         } else {
             rc = substep_direct(rod, h, rep, err);

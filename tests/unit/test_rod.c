@@ -517,6 +517,26 @@ static void test_elastica(void)
         phc_rod_free(rod);
         phc_plant_graph_free(g);
     }
+    /* with too small an iteration budget the solve refuses and keeps the
+     * state it started from */
+    {
+        phc_plant_graph *g = cantilever(25, L, r, 1e-6 * L / 25.0, 0);
+        o.max_iterations = 2;
+        phc_rod *rod = make_rod(g, E, &o);
+        const double Fv[3] = {0, 0, -P};
+        phc_error err;
+        phc_rod_set_load(rod, 25, Fv, &err);
+        const int rc = phc_rod_solve_static(rod, NULL, &err);
+        double d[3];
+        phc_rod_tip_deflection(rod, 25, d);
+        printf("  max_iterations 2 -> %d: %s; tip moved %.1e m\n", rc, err.message,
+               fabs(d[0]) + fabs(d[1]) + fabs(d[2]));
+        CHECK(rc == PHC_ERR_NOT_CONVERGED);
+        CHECK_STR_CONTAINS(err.message, "2 Newton iterations");
+        CHECK(fabs(d[0]) + fabs(d[1]) + fabs(d[2]) <= 1e-15); /* the rest shape, to rounding */
+        phc_rod_free(rod);
+        phc_plant_graph_free(g);
+    }
 }
 
 /* Runs the dynamics with frames of dt until t_end; 0 on success. */
