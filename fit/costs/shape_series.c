@@ -27,6 +27,8 @@ typedef struct stalk {
     double beta;        /* base angle, rad */
     double tip_mass;    /* kg */
     long offset_slot;   /* slot of offset_<id>, or -1 */
+    size_t seg;         /* the segment whose direction is the angle */
+    int shared;         /* 1: g and rod are the data set's plant (not owned) */
 } stalk;
 
 typedef struct shape_impl {
@@ -37,6 +39,8 @@ typedef struct shape_impl {
     double t0, rwc0, e_min, fd_step;
     long e_min_slot;    /* slot of e_min, or -1 */
     size_t frames;
+    phc_plant_graph *plant; /* options.plant's copy, or NULL */
+    phc_rod *plant_rod;
 } shape_impl;
 
 static void impl_free(void *p)
@@ -45,12 +49,16 @@ static void impl_free(void *p)
     if (!m)
         return;
     for (size_t s = 0; s < m->n_stalks; ++s) {
-        phc_rod_free(m->stalks[s].rod);
-        phc_plant_graph_free(m->stalks[s].g);
+        if (!m->stalks[s].shared) {
+            phc_rod_free(m->stalks[s].rod);
+            phc_plant_graph_free(m->stalks[s].g);
+        }
         free(m->stalks[s].young);
         free(m->stalks[s].id);
     }
     free(m->stalks);
+    phc_rod_free(m->plant_rod);
+    phc_plant_graph_free(m->plant);
     free(m->stalk_of);
     free(m->t);
     free(m);
@@ -112,10 +120,9 @@ static int solve_angle(stalk *st, double young, double *angle)
     phc_rod_report rep;
     if (phc_rod_set_modulus(st->rod, st->young, &e) || phc_rod_solve_static(st->rod, &rep, &e))
         return 1;
-    const size_t last = st->g->n - 1;
     double h[3], t[3];
-    phc_rod_head(st->rod, last, h);
-    phc_rod_tail(st->rod, last, t);
+    phc_rod_head(st->rod, st->seg, h);
+    phc_rod_tail(st->rod, st->seg, t);
     const double a = atan2(t[2] - h[2], t[0] - h[0]);
     *angle = st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
     return isfinite(*angle) ? 0 : 1;
@@ -347,12 +354,23 @@ static int check_options(const phc_shape_series *tr, const phc_shape_series_opti
             const char *key, *unit;
             double v;
             int zero_ok;
-        } pos[] = {{"length", "m", st->length, 0}, {"radius", "m", st->radius, 0}, {"tip_mass", "kg", st->tip_mass, 1}};
-        for (int q = 0; q < 3; ++q)
+        } pos[] = {{"tip_mass", "kg", st->tip_mass, 1}, {"length", "m", st->length, 0}, {"radius", "m", st->radius, 0}};
+        for (int q = 0; q < (o->plant ? 1 : 3); ++q)
             if (!(isfinite(pos[q].v) && (pos[q].v > 0 || (pos[q].zero_ok && pos[q].v == 0))))
                 return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key '%s': must be %s (%s), found %g", ws,
                                      st->series, pos[q].key, pos[q].zero_ok ? "zero or positive" : "positive",
                                      pos[q].unit, pos[q].v);
+        if (o->plant) {
+            if (!isnan(st->base_angle))
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s: series '%s': key 'base_angle': not with a plant (the segment's rest "
+                                     "direction is the base angle)", ws, st->series);
+            for (size_t j = 0; j < s; ++j)
+                if (o->stalks[j].segment == st->segment)
+                    return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key 'segment': segment %ld is already "
+                                         "mapped to series '%s'", ws, st->series, st->segment, o->stalks[j].series);
+            continue;
+        }
         if (st->segments < 1 || st->segments > 10000)
             return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key 'segments': expected 1 to 10000, found %zu", ws,
                                  st->series, st->segments);
@@ -360,6 +378,55 @@ static int check_options(const phc_shape_series *tr, const phc_shape_series_opti
             return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key 'base_angle': must be finite", ws, st->series);
     }
     return PHC_OK;
+}
+
+/* A series mapped to segment spec->segment (a source id) of the data set's
+ * plant: its rest direction in the x–z plane is β; the tip mass hangs at the
+ * segment's tail. */
+static int plant_stalk(shape_impl *m, stalk *out, const phc_shape_stalk *spec, double *beta, phc_error *err)
+{
+    const phc_plant_graph *g = m->plant;
+    size_t i = 0;
+    while (i < g->n && g->source_id[i] != spec->segment)
+        ++i;
+    if (i == g->n)
+        return phc_error_set(err, PHC_ERR_INPUT, "series '%s': key 'segment': the plant has no segment %ld",
+                             spec->series, spec->segment);
+    const double dx = g->tail[3 * i] - g->head[3 * i], dz = g->tail[3 * i + 2] - g->head[3 * i + 2];
+    if (!(hypot(dx, dz) > 1e-9 * g->length[i]))
+        return phc_error_set(err, PHC_ERR_INPUT, "series '%s': segment %ld lies along y: it has no angle in the x-z plane",
+                             spec->series, spec->segment);
+    out->shared = 1;
+    out->g = m->plant;
+    out->rod = m->plant_rod;
+    out->seg = i;
+    out->beta = *beta = atan2(dz, dx);
+    out->tip_mass = spec->tip_mass;
+    if (!(out->young = malloc(g->n * sizeof *out->young)) || !(out->id = strdup(spec->series)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    phc_rod_options ro;
+    phc_rod_options_default(&ro);
+    const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
+                             spec->tip_mass * ro.gravity[2]};
+    return phc_rod_set_load(m->plant_rod, i, force, err);
+}
+
+/* The data set's plant: a copy of options.plant and its rod. */
+static int plant_rod(shape_impl *m, const phc_shape_series_options *o, phc_error *err)
+{
+    if (!(m->plant = phc_plant_graph_copy(o->plant)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    double *young = malloc(m->plant->n * sizeof *young);
+    if (!young)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < m->plant->n; ++i)
+        young[i] = 1e6;
+    phc_rod_options ro;
+    phc_rod_options_default(&ro);
+    ro.density = o->density;
+    const int rc = phc_rod_new(m->plant, young, &ro, &m->plant_rod, err);
+    free(young);
+    return rc;
 }
 
 /* The stalk's graph: a clamp segment and `segments` free ones along β. */
@@ -374,6 +441,7 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     out->beta = beta;
     out->tip_mass = spec->tip_mass;
+    out->seg = n - 1;
     /* The clamp is short (CLAMP_FRACTION of a segment): the base joint then
      * spans half a free segment, as the base node of the continuum's
      * discretisation does (a clamp of a whole segment would lengthen the
@@ -456,6 +524,10 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
     if (o->e_min_slot && !(ds->slot_names[N_SHARED] = strdup("e_min")))
         goto nomem;
     size_t slot = N_SHARED + (o->e_min_slot ? 1 : 0), obs = 0;
+    if (o->plant && (rc = plant_rod(m, o, err))) {
+        phc_dataset_free(ds);
+        return rc;
+    }
     char wb[4200];
     for (size_t s = 0; s < o->n_stalks; ++s) {
         const phc_shape_stalk *sp = &o->stalks[s];
@@ -466,15 +538,15 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
                        phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: series '%s': the angle is not a finite number",
                                      tr->source, tr->line[i], sp->series);
         const double first = track->value[0];
-        const double beta = isnan(sp->base_angle) ? remainder(first, 2.0 * PHC_SS_PI) : sp->base_angle;
-        const double shift = beta + remainder(first - beta, 2.0 * PHC_SS_PI) - first; /* a multiple of 2π */
+        double beta = isnan(sp->base_angle) ? remainder(first, 2.0 * PHC_SS_PI) : sp->base_angle;
         stalk *st = &m->stalks[s];
         st->offset_slot = -1;
-        if ((rc = build_stalk(st, sp, beta, o, err))) {
+        if ((rc = o->plant ? plant_stalk(m, st, sp, &beta, err) : build_stalk(st, sp, beta, o, err))) {
             phc_error_prefix(err, rc, "%s", where_of(sp, o, wb, sizeof wb));
             phc_dataset_free(ds);
             return rc;
         }
+        const double shift = beta + remainder(first - beta, 2.0 * PHC_SS_PI) - first; /* a multiple of 2π */
         if (sp->offset) {
             char name[300];
             snprintf(name, sizeof name, "offset_%s", sp->series);

@@ -21,6 +21,11 @@
  * static equilibrium (phc_rod_solve_static, Newton to the rod's tolerance),
  * taken within π of β; plus the series' angle offset when it has one.
  *
+ * With options.plant, the organ model is the plant itself: one rod over the
+ * whole graph (its root fixed), every segment at the same E(t), each series
+ * the direction of one segment (named by its source id) in the x–z plane,
+ * β that segment's rest direction; tip masses hang at those segments' tails.
+ *
  * Observations: the tracks of measurements/shape_series.h of kind
  * PHC_SHAPE_ANGLE, in rad, counter-clockwise with y up (read image angles
  * with y_down, which negates them: an image angle measured clockwise on
@@ -66,6 +71,7 @@
 #include "fit/costs/origin.h"
 #include "fit/engine/dataset.h"
 #include "measurements/shape_series.h"
+#include "model/plant_graph.h"
 #include "model/status.h"
 
 /* One tracked series mapped to a stalk. */
@@ -79,6 +85,10 @@ typedef struct phc_shape_stalk {
                             first observed angle (the stalk starts where the organ
                             pointed at the first sample), taken in [−π, π] */
     int offset;          /* 1: a slot offset_<series> (rad) added to the model angle */
+    long segment;        /* with options.plant: the source id of the plant's segment
+                            whose direction is the series' angle (length, radius,
+                            segments and base_angle are then unused; base_angle must
+                            be NaN); tip_mass hangs at its tail */
     const char *where;   /* for messages (e.g. "cfg.yaml:14"); may be NULL */
 } phc_shape_stalk;
 
@@ -96,6 +106,10 @@ typedef struct phc_shape_series_options {
     size_t frames;                 /* simulate/fit outputs: frames (side views, graphs),
                                       evenly spaced over the data's times; default 6, 0 none */
     const phc_origin *origin;      /* where the options came from, for messages; NULL */
+    const phc_plant_graph *plant;  /* NULL: one stalk per series (above); else a finished
+                                      plant graph (m, z up; copied): one rod for the whole
+                                      plant, every segment at E(t), each series the angle
+                                      of its stalk's `segment`, β its rest direction */
 } phc_shape_series_options;
 
 /* The defaults above (no stalks). */

@@ -12,7 +12,10 @@
  * 3. the Jacobian (d angle / d E by central differences, chained with the
  *    exact d E / d slot) against central differences of the whole model in
  *    every slot, and against a second fd_step;
- * 4. errors: an unknown series, a zero radius, a negative E_min. */
+ * 4. errors: an unknown series, a zero radius, a negative E_min;
+ * 5. a plant graph (options.plant) laid out as a stalk, its series mapped to
+ *    the last segment, gives the stalk's angles; an unknown segment id is
+ *    refused. */
 #include <math.h>
 
 #define PHC_SS_PI 3.14159265358979323846
@@ -25,6 +28,7 @@
 #include "fit/engine/fit.h"
 #include "fit/engine/problem.h"
 #include "measurements/shape_series.h"
+#include "model/plant_graph.h"
 
 #define N_T 61
 static const double truth[] = {12.0, 0.7, 1e8, 2e-4, 0.05}; /* kappa chi0 e_max delta offset_b */
@@ -272,6 +276,61 @@ static void test_errors(void)
     phc_shape_series_free(tr);
 }
 
+/* A plant graph laid out like stalk "a" (a clamp 1/1000 of a segment long,
+ * then 6 segments at 30°), its series mapped to segment 6: the same angles
+ * as the stalk model; an unknown segment is refused. */
+static void test_plant(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    const size_t n = 7;
+    const double h = 0.05 / 6, beta = 30 * PHC_SS_PI / 180;
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    for (size_t i = 0; i < n; ++i) {
+        g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
+        g->radius[i] = 1e-3;
+        g->length[i] = i ? h : 1e-3 * h;
+        const double s0 = i ? (double)(i - 1) * h : -1e-3 * h, s1 = i ? s0 + h : 0.0;
+        g->head[3 * i] = s0 * cos(beta);
+        g->head[3 * i + 2] = s0 * sin(beta);
+        g->tail[3 * i] = s1 * cos(beta);
+        g->tail[3 * i + 2] = s1 * sin(beta);
+        g->source_id[i] = (long)i;
+    }
+    phc_error err;
+    CHECK(phc_plant_graph_finish(g, "test plant", &err) == PHC_OK);
+    phc_shape_series_options o = options();
+    phc_shape_stalk st = {.series = "a", .tip_mass = 1e-3, .base_angle = NAN, .segment = 6};
+    o.n_stalks = 1;
+    o.stalks = &st;
+    o.plant = g;
+    phc_dataset *ds = NULL;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        double yhat[N_T];
+        const double p[] = {truth[0], truth[1], truth[2], truth[3]};
+        CHECK(ds->k == 4 && ds->ops->predict(ds, p, yhat, NULL) == 0);
+        double worst = 0;
+        for (int i = 0; i < N_T; ++i)
+            worst = fmax(worst, fabs(yhat[i] - a[i]));
+        printf("plant graph laid out as stalk a, segment 6: largest angle difference %.3g rad\n", worst);
+        CHECK(worst < 1e-9);
+        phc_dataset_free(ds);
+        ds = NULL;
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    st.segment = 99;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_ERR_INPUT && !ds);
+    CHECK_STR_CONTAINS(err.message, "no segment 99");
+    printf("unknown segment: %s\n", err.message);
+    phc_plant_graph_free(g);
+    phc_shape_series_free(tr);
+}
+
 int main(void)
 {
     test_limits();
@@ -279,6 +338,7 @@ int main(void)
     if (synthetic(a, b) == 0) {
         test_jacobian(a, b);
         test_fit(a, b);
+        test_plant(a, b);
     }
     test_errors();
     return check_finish("shape_series_new");
