@@ -1257,6 +1257,16 @@ fit_case "shape_series: unknown stalk key" "$C/ss_key.yaml" "ss_key.yaml:12" "se
 ss_config ss_series.yaml ss_ok.csv "$SS_F1" '      - {id: flower1, column: "Flower 2 Angle (deg)", unit: deg, length: 0.04, radius: 0.001, tip_mass: 0.001}
 '
 fit_case "shape_series: duplicate series id" "$C/ss_series.yaml" "ss_series.yaml:13" "flower1"
+printf '# unit: m\nid,parent,radius,length,x_head,y_head,z_head,x_tail,y_tail,z_tail,leaf,fixed\n0,-1,0.001,0.01,0,0,0,0.01,0,0,0,1\n1,0,0.001,0.01,0.01,0,0,0.02,0,0,0,0\n2,1,0.001,0.01,0.02,0,0,0.03,0,0,0,0\n' >"$C/ss_plant.csv"
+printf 'name: t\nparameters:\n  kappa: {value: 10}\n  chi0: {value: 0.8}\n  e_max: {value: 1e8}\n  delta: {value: 1e-4}\ndatasets:\n  - kind: shape_series\n    file: ss_ok.csv\n    time: {column: "Time (s)", unit: s}\n    plant: ss_plant.csv\n    series:\n      - {id: flower1, column: "Flower 1 Angle (deg)", unit: deg, tip_mass: 0.001, segment: %s}\n' 2 >"$C/ss_pgood.yaml"
+sed 's/segment: 2}/segment: 7}/' "$C/ss_pgood.yaml" >"$C/ss_pseg.yaml"
+WHY=""
+run_phc simulate "$C/ss_pgood.yaml" -o "$T/out_ss_pgood"
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+ls "$T/out_ss_pgood"/*flower1_frame00.vtk >/dev/null 2>&1 || add_why "no VTK frame written"
+report_case "shape_series: control: a plant graph with a segment per series simulates"
+rm -rf "$T/out_ss_pgood"
+fit_case "shape_series: unknown segment" "$C/ss_pseg.yaml" "ss_pseg.yaml:13" "flower1" "no segment 7"
 # ---- end shape_series ------------------------------------------------------
 
 # ----------------------------------------------------------------------------
