@@ -13,7 +13,8 @@
  *    exact d E / d slot) against central differences of the whole model in
  *    every slot, and against a second fd_step;
  * 4. errors: an unknown series, a zero radius, a negative E_min;
- * 5. a plant graph (options.plant) laid out as a stalk, its series mapped to
+ * 5. e_min as a slot: its Jacobian column against central differences;
+ * 6. a plant graph (options.plant) laid out as a stalk, its series mapped to
  *    the last segment, gives the stalk's angles; an unknown segment id is
  *    refused. */
 #include <math.h>
@@ -276,6 +277,46 @@ static void test_errors(void)
     phc_shape_series_free(tr);
 }
 
+/* e_min as a slot: named, in Pa, and its Jacobian column against central
+ * differences (d angle/d e_min = d angle/dE). */
+static void test_e_min_slot(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    phc_shape_series_options o = options();
+    o.e_min_slot = 1;
+    phc_dataset *ds = NULL;
+    phc_error err;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        CHECK(ds->k == 6 && strcmp(ds->slot_names[4], "e_min") == 0 && strcmp(ds->slot_units[4], "Pa") == 0);
+        const double p0[] = {11.0, 0.72, 0.9e8, 1.8e-4, 2e6, 0.02};
+        double jac[2 * N_T * 6], y0[2 * N_T], yp[2 * N_T], ym[2 * N_T], p[6];
+        CHECK(ds->ops->predict(ds, p0, y0, jac) == 0);
+        memcpy(p, p0, sizeof p);
+        const double h = 1e-5 * p0[4];
+        p[4] = p0[4] + h;
+        CHECK(ds->ops->predict(ds, p, yp, NULL) == 0);
+        p[4] = p0[4] - h;
+        CHECK(ds->ops->predict(ds, p, ym, NULL) == 0);
+        double worst = 0, scale = 0;
+        for (int i = 0; i < 2 * N_T; ++i)
+            scale = fmax(scale, fabs(jac[i * 6 + 4]));
+        for (int i = 0; i < 2 * N_T; ++i)
+            worst = fmax(worst, fabs(jac[i * 6 + 4] - (yp[i] - ym[i]) / (2 * h)) / scale);
+        printf("e_min slot: Jacobian column vs central differences: largest error %.3g (relative to the column)\n",
+               worst);
+        CHECK(scale > 0 && worst < 1e-5);
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_dataset_free(ds);
+    phc_shape_series_free(tr);
+}
+
 /* A plant graph laid out like stalk "a" (a clamp 1/1000 of a segment long,
  * then 6 segments at 30°), its series mapped to segment 6: the same angles
  * as the stalk model; an unknown segment is refused. */
@@ -339,6 +380,7 @@ int main(void)
         test_jacobian(a, b);
         test_fit(a, b);
         test_plant(a, b);
+        test_e_min_slot(a, b);
     }
     test_errors();
     return check_finish("shape_series_new");
