@@ -26,6 +26,7 @@ static const phc_kind *const kinds[] = {
     &phc_leaf_photos_kind,
     &phc_pv_curve_kind,
     &phc_root_shoot_kind,
+    &phc_shape_series_kind,
     &phc_soil_probe_kind,
     &phc_weight_curve_kind,
 };

@@ -1266,6 +1266,56 @@ fuzz_case "fuzz: time unit with a line break" "$C/wc_unit_nl.yaml" \
 # fell on its start (a zero-length segment); the plant_graphs case list has
 # the file (treeqsm_length_lost_in_rounding.txt, measurements/plant_io.c).
 
+# ---- shape_series (issue 19) -----------------------------------------------
+printf 'Time (s),Flower 1 Angle (deg),Flower 2 Angle (deg)\n10,30,120\n20,29,119\n30,28,118\n40,27,117\n' >"$C/ss_ok.csv"
+printf 'Time (s),Flower 1 Angle (deg),Flower 2 Angle (deg)\n10,30,120\n20,29,119\n15,28,118\n40,27,117\n' >"$C/ss_back.csv"
+printf 'Time (s),Flower 1 Angle (deg),Flower 2 Angle (deg)\n10,30,120\n20,nan,119\n30,28,118\n40,27,117\n' >"$C/ss_nan.csv"
+# ss_config FILE CSV SERIES_ITEM [EXTRA_DATASET_LINES]: the series item is on line 12
+ss_config() {
+    printf 'name: t\nparameters:\n  kappa: {value: 10}\n  chi0: {value: 0.8}\n  e_max: {value: 1e6}\n  delta: {value: 1e-4}\ndatasets:\n  - kind: shape_series\n    file: %s\n    time: {column: "Time (s)", unit: s}\n    series:\n      - %s\n%s' \
+        "$2" "$3" "${4:-}" >"$C/$1"
+}
+SS_F1='{id: flower1, column: "Flower 1 Angle (deg)", unit: deg, length: 0.04, radius: 0.001, tip_mass: 0.001}'
+ss_config ss_good.yaml ss_ok.csv "$SS_F1"
+WHY=""
+run_phc simulate "$C/ss_good.yaml" -o "$T/out_ss_good"
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+ls "$T/out_ss_good"/*flower1_frames.png >/dev/null 2>&1 || add_why "no side views written"
+ls "$T/out_ss_good"/*flower1_frame00.vtk >/dev/null 2>&1 || add_why "no VTK frame written"
+report_case "shape_series: control: a valid config simulates"
+rm -rf "$T/out_ss_good"
+ss_config ss_col.yaml ss_ok.csv '{id: flower1, column: "Flower 9 Angle (deg)", unit: deg, length: 0.04, radius: 0.001, tip_mass: 0.001}'
+fit_case "shape_series: unknown column" "$C/ss_col.yaml" "ss_col.yaml:12" "Flower 9 Angle (deg)"
+ss_config ss_unit.yaml ss_ok.csv '{id: flower1, column: "Flower 1 Angle (deg)", unit: gradians, length: 0.04, radius: 0.001, tip_mass: 0.001}'
+fit_case "shape_series: unknown angle unit" "$C/ss_unit.yaml" "ss_unit.yaml:12" "gradians"
+ss_config ss_back.yaml ss_back.csv "$SS_F1"
+fit_case "shape_series: time runs backwards" "$C/ss_back.yaml" "ss_back.csv:4" "Time (s)" "not after"
+ss_config ss_nan.yaml ss_nan.csv "$SS_F1"
+fit_case "shape_series: NaN angle" "$C/ss_nan.yaml" "ss_nan.csv:3" "Flower 1 Angle (deg)"
+ss_config ss_radius.yaml ss_ok.csv '{id: flower1, column: "Flower 1 Angle (deg)", unit: deg, length: 0.04, radius: 0, tip_mass: 0.001}'
+fit_case "shape_series: zero radius" "$C/ss_radius.yaml" "ss_radius.yaml:12" "'radius'" "positive"
+ss_config ss_length.yaml ss_ok.csv '{id: flower1, column: "Flower 1 Angle (deg)", unit: deg, length: -0.04, radius: 0.001, tip_mass: 0.001}'
+fit_case "shape_series: negative length" "$C/ss_length.yaml" "ss_length.yaml:12" "'length'" "positive"
+ss_config ss_emin.yaml ss_ok.csv "$SS_F1" '    e_min: -5
+'
+fit_case "shape_series: negative modulus" "$C/ss_emin.yaml" "ss_emin.yaml:13" "'e_min'" "positive"
+ss_config ss_key.yaml ss_ok.csv '{id: flower1, column: "Flower 1 Angle (deg)", unit: deg, length: 0.04, radius: 0.001, tip_mass: 0.001, segmnts: 4}'
+fit_case "shape_series: unknown stalk key" "$C/ss_key.yaml" "ss_key.yaml:12" "segmnts" "segments"
+ss_config ss_series.yaml ss_ok.csv "$SS_F1" '      - {id: flower1, column: "Flower 2 Angle (deg)", unit: deg, length: 0.04, radius: 0.001, tip_mass: 0.001}
+'
+fit_case "shape_series: duplicate series id" "$C/ss_series.yaml" "ss_series.yaml:13" "flower1"
+printf '# unit: m\nid,parent,radius,length,x_head,y_head,z_head,x_tail,y_tail,z_tail,leaf,fixed\n0,-1,0.001,0.01,0,0,0,0.01,0,0,0,1\n1,0,0.001,0.01,0.01,0,0,0.02,0,0,0,0\n2,1,0.001,0.01,0.02,0,0,0.03,0,0,0,0\n' >"$C/ss_plant.csv"
+printf 'name: t\nparameters:\n  kappa: {value: 10}\n  chi0: {value: 0.8}\n  e_max: {value: 1e8}\n  delta: {value: 1e-4}\ndatasets:\n  - kind: shape_series\n    file: ss_ok.csv\n    time: {column: "Time (s)", unit: s}\n    plant: ss_plant.csv\n    series:\n      - {id: flower1, column: "Flower 1 Angle (deg)", unit: deg, tip_mass: 0.001, segment: %s}\n' 2 >"$C/ss_pgood.yaml"
+sed 's/segment: 2}/segment: 7}/' "$C/ss_pgood.yaml" >"$C/ss_pseg.yaml"
+WHY=""
+run_phc simulate "$C/ss_pgood.yaml" -o "$T/out_ss_pgood"
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+ls "$T/out_ss_pgood"/*flower1_frame00.vtk >/dev/null 2>&1 || add_why "no VTK frame written"
+report_case "shape_series: control: a plant graph with a segment per series simulates"
+rm -rf "$T/out_ss_pgood"
+fit_case "shape_series: unknown segment" "$C/ss_pseg.yaml" "ss_pseg.yaml:13" "flower1" "no segment 7"
+# ---- end shape_series ------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

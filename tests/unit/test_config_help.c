@@ -128,7 +128,7 @@ static void test_tables(void)
     CHECK(phc_config_kind_find("weight_curv") == NULL);
     CHECK(phc_config_kind_find(NULL) == NULL);
     static const char *const expected[] = {"curve", "elasticity_curve", "infiltration", "leaf_photos",
-                                           "pv_curve", "root_shoot", "soil_probe", "weight_curve"};
+                                           "pv_curve", "root_shoot", "shape_series", "soil_probe", "weight_curve"};
     for (size_t i = 0; i < sizeof expected / sizeof expected[0]; ++i)
         CHECK(phc_config_kind_find(expected[i]) != NULL);
     for (int b = 0; b < PHC_CONFIG_N_BLOCKS; ++b)

@@ -1,0 +1,596 @@
+/* `shape_series` data sets: see shape_series.h. */
+#include "fit/costs/shape_series.h"
+
+#include <math.h>
+
+#define PHC_SS_PI 3.14159265358979323846
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/run_dir.h"
+#include "fit/shape_plots.h"
+#include "measurements/plant_io.h"
+#include "model/elasticity.h"
+#include "model/plant_graph.h"
+#include "model/rod.h"
+
+#define CLAMP_FRACTION 1e-3
+
+enum { SLOT_KAPPA = 0, SLOT_CHI0, SLOT_E_MAX, SLOT_DELTA, N_SHARED };
+
+typedef struct stalk {
+    char *id;
+    phc_plant_graph *g; /* segment 0: the clamp (root), 1..n free */
+    phc_rod *rod;
+    double *young;      /* g->n moduli, Pa (work) */
+    double beta;        /* base angle, rad */
+    double tip_mass;    /* kg */
+    long offset_slot;   /* slot of offset_<id>, or -1 */
+    size_t seg;         /* the segment whose direction is the angle */
+    int shared;         /* 1: g and rod are the data set's plant (not owned) */
+} stalk;
+
+typedef struct shape_impl {
+    size_t n_stalks;
+    stalk *stalks;
+    size_t *stalk_of;   /* [n] stalk of each observation */
+    double *t;          /* [n] s */
+    double t0, rwc0, e_min, fd_step;
+    long e_min_slot;    /* slot of e_min, or -1 */
+    size_t frames;
+    phc_plant_graph *plant; /* options.plant's copy, or NULL */
+    phc_rod *plant_rod;
+} shape_impl;
+
+static void impl_free(void *p)
+{
+    shape_impl *m = p;
+    if (!m)
+        return;
+    for (size_t s = 0; s < m->n_stalks; ++s) {
+        if (!m->stalks[s].shared) {
+            phc_rod_free(m->stalks[s].rod);
+            phc_plant_graph_free(m->stalks[s].g);
+        }
+        free(m->stalks[s].young);
+        free(m->stalks[s].id);
+    }
+    free(m->stalks);
+    phc_rod_free(m->plant_rod);
+    phc_plant_graph_free(m->plant);
+    free(m->stalk_of);
+    free(m->t);
+    free(m);
+}
+
+phc_shape_series_options phc_shape_series_options_default(void)
+{
+    phc_shape_series_options o = {0};
+    o.rwc0 = 1.0;
+    o.t0 = NAN;
+    o.e_min = 1e4;
+    o.density = 1000.0;
+    o.every = 1;
+    o.fd_step = 1e-4;
+    o.frames = 6;
+    return o;
+}
+
+/* E(t) = E_min + E_max σ(κ (RWC(t) − χ0)), RWC(t) = RWC0 exp(−δ (t − t0))
+ * (wilting eq. 9 with a single compartment); grad (optional, k entries,
+ * zeroed by the caller): d E / d slot. */
+static double modulus(const phc_dataset *ds, const double *p, double t, double *rwc_out, double *grad)
+{
+    const shape_impl *m = ds->impl;
+    const double kappa = p[SLOT_KAPPA], chi0 = p[SLOT_CHI0], e_max = p[SLOT_E_MAX], delta = p[SLOT_DELTA];
+    const double e_min = m->e_min_slot >= 0 ? p[m->e_min_slot] : m->e_min;
+    const double dt = t - m->t0;
+    const double rwc = m->rwc0 * exp(-delta * dt);
+    const double s = phc_elasticity_sigmoid(kappa * (rwc - chi0));
+    const double ds_du = s * (1.0 - s);
+    if (rwc_out)
+        *rwc_out = rwc;
+    if (grad) {
+        grad[SLOT_KAPPA] = e_max * ds_du * (rwc - chi0);
+        grad[SLOT_CHI0] = -e_max * ds_du * kappa;
+        grad[SLOT_E_MAX] = s;
+        grad[SLOT_DELTA] = e_max * ds_du * kappa * (-dt * rwc);
+        if (m->e_min_slot >= 0)
+            grad[m->e_min_slot] = 1.0;
+    }
+    return e_min + e_max * s;
+}
+
+int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, double *young, double *rwc)
+{
+    *young = modulus(ds, p, t, rwc, NULL);
+    return isfinite(*young) && *young > 0 ? 0 : 1;
+}
+
+/* Equilibrium from the rod's current state at modulus E; the last
+ * segment's direction within π of β. */
+static int solve_angle(stalk *st, double young, double *angle)
+{
+    if (!(young > 0) || !isfinite(young))
+        return 1;
+    for (size_t i = 0; i < st->g->n; ++i)
+        st->young[i] = young;
+    phc_error e;
+    phc_rod_report rep;
+    if (phc_rod_set_modulus(st->rod, st->young, &e) || phc_rod_solve_static(st->rod, &rep, &e))
+        return 1;
+    double h[3], t[3];
+    phc_rod_head(st->rod, st->seg, h);
+    phc_rod_tail(st->rod, st->seg, t);
+    const double a = atan2(t[2] - h[2], t[0] - h[0]);
+    *angle = st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
+    return isfinite(*angle) ? 0 : 1;
+}
+
+int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double young, double *angle)
+{
+    shape_impl *m = ds->impl;
+    if (s >= m->n_stalks)
+        return 1;
+    phc_rod_reset(m->stalks[s].rod);
+    return solve_angle(&m->stalks[s], young, angle);
+}
+
+static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    shape_impl *m = ds->impl;
+    double *grad = calloc(ds->k, sizeof *grad);
+    if (!grad)
+        return -1;
+    if (jac)
+        memset(jac, 0, ds->n * ds->k * sizeof *jac);
+    size_t prev = (size_t)-1;
+    int rc = 0;
+    for (size_t i = 0; i < ds->n && !rc; ++i) {
+        stalk *st = &m->stalks[m->stalk_of[i]];
+        if (m->stalk_of[i] != prev) { /* a new series: from the rest shape */
+            phc_rod_reset(st->rod);
+            prev = m->stalk_of[i];
+        }
+        memset(grad, 0, ds->k * sizeof *grad);
+        const double E = modulus(ds, p, m->t[i], NULL, jac ? grad : NULL);
+        double a;
+        if ((rc = solve_angle(st, E, &a)))
+            break;
+        yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
+        if (!jac)
+            continue;
+        /* d angle / dE by a central difference in E, warm-started */
+        const double h = m->fd_step * E;
+        double ap, am;
+        if ((rc = solve_angle(st, E + h, &ap)) || (rc = solve_angle(st, E - h, &am)))
+            break;
+        const double da_dE = (ap - am) / (2.0 * h);
+        double *row = jac + i * ds->k;
+        for (size_t j = 0; j < ds->k; ++j)
+            row[j] = da_dE * grad[j];
+        if (st->offset_slot >= 0)
+            row[st->offset_slot] = 1.0;
+    }
+    free(grad);
+    return rc;
+}
+
+/* A frame: the stalk's equilibrium at time t as a graph copy (head, tail
+ * updated) plus the per-segment values; *out owned by the caller. */
+static int frame_graph(stalk *st, double young, phc_plant_graph **out)
+{
+    double a;
+    *out = NULL;
+    phc_rod_reset(st->rod);
+    if (solve_angle(st, young, &a))
+        return 1;
+    phc_plant_graph *c = phc_plant_graph_copy(st->g);
+    if (!c)
+        return -1;
+    for (size_t i = 0; i < c->n; ++i) {
+        phc_rod_head(st->rod, i, c->head + 3 * i);
+        phc_rod_tail(st->rod, i, c->tail + 3 * i);
+    }
+    *out = c;
+    return 0;
+}
+
+/* Side views (one PNG per stalk, one panel per frame), the graph of every
+ * frame in the native format and as legacy VTK. */
+static int write_frames(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err)
+{
+    shape_impl *m = ds->impl;
+    if (m->frames == 0 || ds->n == 0)
+        return PHC_OK;
+    double t_lo = m->t[0], t_hi = m->t[0];
+    for (size_t i = 0; i < ds->n; ++i) {
+        t_lo = fmin(t_lo, m->t[i]);
+        t_hi = fmax(t_hi, m->t[i]);
+    }
+    const size_t nf = m->frames > 64 ? 64 : m->frames;
+    int rc = PHC_OK;
+    for (size_t s = 0; s < m->n_stalks && !rc; ++s) {
+        stalk *st = &m->stalks[s];
+        const size_t ns = st->g->n;
+        phc_shape_panel panels[64];
+        phc_plant_graph *graphs[64] = {0};
+        double *values = calloc(nf * ns, sizeof *values);
+        double *young = calloc(nf * ns, sizeof *young);
+        char (*titles)[128] = calloc(nf, sizeof *titles);
+        char sid[256], path[8192];
+        phc_run_dir_safe_name(st->id, sid, sizeof sid);
+        if (!values || !young || !titles)
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t f = 0; f < nf && !rc; ++f) {
+            const double t = nf > 1 ? t_lo + (t_hi - t_lo) * (double)f / (double)(nf - 1) : t_lo;
+            double E, rwc;
+            if (phc_shape_series_modulus(ds, p, t, &E, &rwc) || frame_graph(st, E, &graphs[f])) {
+                rc = phc_error_set(err, PHC_ERR_DOMAIN,
+                                   "data set '%s': series '%s': no static equilibrium at t = %g s "
+                                   "(E = %g Pa)", ds->name, st->id, t, E);
+                break;
+            }
+            for (size_t i = 0; i < ns; ++i) {
+                values[f * ns + i] = rwc;
+                young[f * ns + i] = E;
+            }
+            snprintf(titles[f], sizeof titles[f], "t = %.3g h, E = %.3g MPa", t / 3600.0, E * 1e-6);
+            panels[f] = (phc_shape_panel){.n = ns,
+                                          .head = graphs[f]->head,
+                                          .tail = graphs[f]->tail,
+                                          .radius = graphs[f]->radius,
+                                          .value = values + f * ns,
+                                          .title = titles[f]};
+            const phc_plant_field fields[2] = {{"relative_water", values + f * ns},
+                                               {"young_modulus_Pa", young + f * ns}};
+            snprintf(path, sizeof path, "%s/%s_%s_frame%02zu.csv", dir, base, sid, f);
+            if ((rc = phc_plant_io_write_native(path, graphs[f], err)))
+                break;
+            snprintf(path, sizeof path, "%s/%s_%s_frame%02zu.vtk", dir, base, sid, f);
+            char vtitle[256];
+            snprintf(vtitle, sizeof vtitle, "phytocal shape_series %s %s", st->id, titles[f]);
+            if ((rc = phc_plant_io_write_vtk(path, graphs[f], vtitle, fields, 2, err)))
+                break;
+        }
+        if (!rc) {
+            phc_shape_plot_options po = phc_shape_plot_options_default();
+            char title[512];
+            snprintf(title, sizeof title, "%s: series '%s', stalk side views", ds->name, st->id);
+            po.title = title;
+            po.value_min = 0.0;
+            po.value_max = 1.0;
+            snprintf(path, sizeof path, "%s/%s_%s_frames.png", dir, base, sid);
+            rc = phc_shape_plot(path, panels, nf, &po, err);
+        }
+        for (size_t f = 0; f < nf; ++f)
+            phc_plant_graph_free(graphs[f]);
+        free(values);
+        free(young);
+        free(titles);
+    }
+    return rc;
+}
+
+static void name_of(const phc_dataset *ds, size_t g, char *buf, size_t size)
+{
+    const shape_impl *m = ds->impl;
+    snprintf(buf, size, "%s", g < m->n_stalks ? m->stalks[g].id : "?");
+}
+
+static int name_series(phc_dataset *ds, phc_error *err)
+{
+    const shape_impl *m = ds->impl;
+    return phc_dataset_name_series(ds, "series", m->n_stalks, name_of, err);
+}
+
+const phc_dataset_ops phc_shape_series_ops = {.kind = "shape_series",
+                                              .predict = predict,
+                                              .free_impl = impl_free,
+                                              .simulate_outputs = write_frames,
+                                              .fit_outputs = write_frames,
+                                              .name_series = name_series};
+
+/* ---- construction ---- */
+
+static const char *where_of(const phc_shape_stalk *st, const phc_shape_series_options *o, char *buf,
+                            size_t size)
+{
+    if (st && st->where)
+        return st->where;
+    snprintf(buf, size, "%s", phc_origin_key(o->origin, "shape_series", NULL).text);
+    return buf;
+}
+
+static int check_options(const phc_shape_series *tr, const phc_shape_series_options *o, phc_error *err)
+{
+    char wb[4200];
+    const char *w = where_of(NULL, o, wb, sizeof wb);
+    if (o->n_stalks == 0 || !o->stalks)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: shape_series: at least one series must be mapped to a stalk", w);
+    if (!(o->rwc0 > 0 && o->rwc0 <= 1.5))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'rwc0': expected a relative water content in (0, 1.5], found %g",
+                             phc_origin_key(o->origin, "shape_series", "rwc0").text, o->rwc0);
+    if (!o->e_min_slot && !(o->e_min > 0 && isfinite(o->e_min)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'e_min': the modulus must be positive (Pa), found %g",
+                             phc_origin_key(o->origin, "shape_series", "e_min").text, o->e_min);
+    if (!(o->density > 0 && isfinite(o->density)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'density': must be positive (kg m-3), found %g",
+                             phc_origin_key(o->origin, "shape_series", "density").text, o->density);
+    if (!(o->sigma >= 0 && isfinite(o->sigma)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': must be positive (rad), found %g",
+                             phc_origin_key(o->origin, "shape_series", "sigma").text, o->sigma);
+    if (o->every < 1)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'every': must be at least 1",
+                             phc_origin_key(o->origin, "shape_series", "every").text);
+    if (!(o->fd_step > 1e-10 && o->fd_step < 0.1))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'fd_step': expected a relative step in (1e-10, 0.1), found %g",
+                             phc_origin_key(o->origin, "shape_series", "fd_step").text, o->fd_step);
+    if (!isnan(o->t0) && !isfinite(o->t0))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 't0': must be finite", w);
+    for (size_t s = 0; s < o->n_stalks; ++s) {
+        const phc_shape_stalk *st = &o->stalks[s];
+        const char *ws = where_of(st, o, wb, sizeof wb);
+        if (!st->series || !st->series[0])
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: stalk %zu: key 'series' is required", ws, s + 1);
+        const long k = phc_shape_series_find(tr, st->series);
+        if (k < 0) {
+            char known[2048] = "";
+            size_t used = 0;
+            for (size_t j = 0; j < tr->n_tracks && used < sizeof known - 1; ++j)
+                used += (size_t)snprintf(known + used, sizeof known - used, "%s'%s'", j ? ", " : "", tr->tracks[j].id);
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'series': unknown series '%s' (series of %s: %s)", ws,
+                                 st->series, tr->source ? tr->source : "the tracks", known);
+        }
+        if (tr->tracks[k].kind != PHC_SHAPE_ANGLE)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s: series '%s': a stalk is fitted to an angle track, this one holds points", ws,
+                                 st->series);
+        for (size_t j = 0; j < s; ++j)
+            if (strcmp(o->stalks[j].series, st->series) == 0)
+                return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s' is mapped twice", ws, st->series);
+        const struct {
+            const char *key, *unit;
+            double v;
+            int zero_ok;
+        } pos[] = {{"tip_mass", "kg", st->tip_mass, 1}, {"length", "m", st->length, 0}, {"radius", "m", st->radius, 0}};
+        for (int q = 0; q < (o->plant ? 1 : 3); ++q)
+            if (!(isfinite(pos[q].v) && (pos[q].v > 0 || (pos[q].zero_ok && pos[q].v == 0))))
+                return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key '%s': must be %s (%s), found %g", ws,
+                                     st->series, pos[q].key, pos[q].zero_ok ? "zero or positive" : "positive",
+                                     pos[q].unit, pos[q].v);
+        if (o->plant) {
+            if (!isnan(st->base_angle))
+                return phc_error_set(err, PHC_ERR_INPUT,
+                                     "%s: series '%s': key 'base_angle': not with a plant (the segment's rest "
+                                     "direction is the base angle)", ws, st->series);
+            for (size_t j = 0; j < s; ++j)
+                if (o->stalks[j].segment == st->segment)
+                    return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key 'segment': segment %ld is already "
+                                         "mapped to series '%s'", ws, st->series, st->segment, o->stalks[j].series);
+            continue;
+        }
+        if (st->segments < 1 || st->segments > 10000)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key 'segments': expected 1 to 10000, found %zu", ws,
+                                 st->series, st->segments);
+        if (!isnan(st->base_angle) && !isfinite(st->base_angle))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: series '%s': key 'base_angle': must be finite", ws, st->series);
+    }
+    return PHC_OK;
+}
+
+/* A series mapped to segment spec->segment (a source id) of the data set's
+ * plant: its rest direction in the x–z plane is β; the tip mass hangs at the
+ * segment's tail. */
+static int plant_stalk(shape_impl *m, stalk *out, const phc_shape_stalk *spec, double *beta, phc_error *err)
+{
+    const phc_plant_graph *g = m->plant;
+    size_t i = 0;
+    while (i < g->n && g->source_id[i] != spec->segment)
+        ++i;
+    if (i == g->n)
+        return phc_error_set(err, PHC_ERR_INPUT, "series '%s': key 'segment': the plant has no segment %ld",
+                             spec->series, spec->segment);
+    const double dx = g->tail[3 * i] - g->head[3 * i], dz = g->tail[3 * i + 2] - g->head[3 * i + 2];
+    if (!(hypot(dx, dz) > 1e-9 * g->length[i]))
+        return phc_error_set(err, PHC_ERR_INPUT, "series '%s': segment %ld lies along y: it has no angle in the x-z plane",
+                             spec->series, spec->segment);
+    out->shared = 1;
+    out->g = m->plant;
+    out->rod = m->plant_rod;
+    out->seg = i;
+    out->beta = *beta = atan2(dz, dx);
+    out->tip_mass = spec->tip_mass;
+    if (!(out->young = malloc(g->n * sizeof *out->young)) || !(out->id = strdup(spec->series)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    phc_rod_options ro;
+    phc_rod_options_default(&ro);
+    const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
+                             spec->tip_mass * ro.gravity[2]};
+    return phc_rod_set_load(m->plant_rod, i, force, err);
+}
+
+/* The data set's plant: a copy of options.plant and its rod. */
+static int plant_rod(shape_impl *m, const phc_shape_series_options *o, phc_error *err)
+{
+    if (!(m->plant = phc_plant_graph_copy(o->plant)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    double *young = malloc(m->plant->n * sizeof *young);
+    if (!young)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t i = 0; i < m->plant->n; ++i)
+        young[i] = 1e6;
+    phc_rod_options ro;
+    phc_rod_options_default(&ro);
+    ro.density = o->density;
+    const int rc = phc_rod_new(m->plant, young, &ro, &m->plant_rod, err);
+    free(young);
+    return rc;
+}
+
+/* The stalk's graph: a clamp segment and `segments` free ones along β. */
+static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, const phc_shape_series_options *o,
+                       phc_error *err)
+{
+    const size_t n = spec->segments + 1;
+    const double h = spec->length / (double)spec->segments, c = cos(beta), s = sin(beta);
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    out->g = g; /* freed with the data set, whatever happens below */
+    if (!g || !(out->young = malloc(n * sizeof *out->young)) || !(out->id = strdup(spec->series)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    out->beta = beta;
+    out->tip_mass = spec->tip_mass;
+    out->seg = n - 1;
+    /* The clamp is short (CLAMP_FRACTION of a segment): the base joint then
+     * spans half a free segment, as the base node of the continuum's
+     * discretisation does (a clamp of a whole segment would lengthen the
+     * beam by half a segment: tip slopes (1 + 1/(2n))² too large). */
+    const double hc = CLAMP_FRACTION * h;
+    for (size_t i = 0; i < n; ++i) {
+        g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
+        g->radius[i] = spec->radius;
+        g->length[i] = i ? h : hc;
+        const double a = i ? (double)(i - 1) * h : -hc, b = i ? a + h : 0.0;
+        g->head[3 * i] = a * c;
+        g->head[3 * i + 2] = a * s;
+        g->tail[3 * i] = b * c;
+        g->tail[3 * i + 2] = b * s;
+        g->source_id[i] = (long)i;
+        out->young[i] = 1e6;
+    }
+    g->fixed[0] = 1;
+    char where[4200];
+    snprintf(where, sizeof where, "series '%s'", spec->series);
+    int rc;
+    if ((rc = phc_plant_graph_finish(g, where, err)))
+        return rc;
+    phc_rod_options ro;
+    phc_rod_options_default(&ro);
+    ro.density = o->density;
+    if ((rc = phc_rod_new(g, out->young, &ro, &out->rod, err)))
+        return rc;
+    const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
+                             spec->tip_mass * ro.gravity[2]};
+    return phc_rod_set_load(out->rod, n - 1, force, err);
+}
+
+int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_options *o, phc_dataset **out,
+                         phc_error *err)
+{
+    *out = NULL;
+    if (!tr || !o)
+        return phc_error_set(err, PHC_ERR_INVALID, "shape_series: tracks and options are required");
+    int rc;
+    if ((rc = check_options(tr, o, err)))
+        return rc;
+    if (tr->n_times == 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:1: no samples", tr->source ? tr->source : "shape_series");
+    size_t n_offsets = 0;
+    for (size_t s = 0; s < o->n_stalks; ++s)
+        n_offsets += o->stalks[s].offset != 0;
+    const size_t k = N_SHARED + (o->e_min_slot ? 1 : 0) + n_offsets;
+    size_t per = 0;
+    for (size_t i = 0; i < tr->n_times; i += o->every)
+        ++per;
+    const size_t n = per * o->n_stalks;
+    phc_dataset *ds = phc_dataset_new(&phc_shape_series_ops, k);
+    shape_impl *m = calloc(1, sizeof *m);
+    if (!ds || !m) {
+        free(m);
+        phc_dataset_free(ds);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    ds->impl = m;
+    ds->n = n;
+    ds->derivatives = PHC_DERIV_ANALYTIC;
+    m->t0 = isnan(o->t0) ? tr->t[0] : o->t0;
+    m->rwc0 = o->rwc0;
+    m->e_min = o->e_min;
+    m->fd_step = o->fd_step;
+    m->frames = o->frames;
+    m->e_min_slot = o->e_min_slot ? N_SHARED : -1;
+    m->n_stalks = o->n_stalks;
+    static const char *const shared[N_SHARED] = {"kappa", "chi0", "e_max", "delta"};
+    static const char *const shared_unit[N_SHARED] = {"1", "1", "Pa", "s-1"};
+    if (!(m->stalks = calloc(o->n_stalks, sizeof *m->stalks)) || !(m->stalk_of = calloc(n, sizeof *m->stalk_of)) ||
+        !(m->t = calloc(n, sizeof *m->t)) || !(ds->x = calloc(n, sizeof *ds->x)) ||
+        !(ds->y = calloc(n, sizeof *ds->y)) || !(ds->data_lines = calloc(n, sizeof *ds->data_lines)) ||
+        !(ds->series = calloc(n, sizeof *ds->series)))
+        goto nomem;
+    for (size_t j = 0; j < N_SHARED; ++j)
+        if (!(ds->slot_names[j] = strdup(shared[j])))
+            goto nomem;
+    if (o->e_min_slot && !(ds->slot_names[N_SHARED] = strdup("e_min")))
+        goto nomem;
+    size_t slot = N_SHARED + (o->e_min_slot ? 1 : 0), obs = 0;
+    if (o->plant && (rc = plant_rod(m, o, err))) {
+        phc_dataset_free(ds);
+        return rc;
+    }
+    char wb[4200];
+    for (size_t s = 0; s < o->n_stalks; ++s) {
+        const phc_shape_stalk *sp = &o->stalks[s];
+        const phc_shape_track *track = &tr->tracks[phc_shape_series_find(tr, sp->series)];
+        for (size_t i = 0; i < tr->n_times; ++i)
+            if (!isfinite(track->value[i]))
+                return phc_dataset_free(ds),
+                       phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: series '%s': the angle is not a finite number",
+                                     tr->source, tr->line[i], sp->series);
+        const double first = track->value[0];
+        double beta = isnan(sp->base_angle) ? remainder(first, 2.0 * PHC_SS_PI) : sp->base_angle;
+        stalk *st = &m->stalks[s];
+        st->offset_slot = -1;
+        if ((rc = o->plant ? plant_stalk(m, st, sp, &beta, err) : build_stalk(st, sp, beta, o, err))) {
+            phc_error_prefix(err, rc, "%s", where_of(sp, o, wb, sizeof wb));
+            phc_dataset_free(ds);
+            return rc;
+        }
+        const double shift = beta + remainder(first - beta, 2.0 * PHC_SS_PI) - first; /* a multiple of 2π */
+        if (sp->offset) {
+            char name[300];
+            snprintf(name, sizeof name, "offset_%s", sp->series);
+            for (char *c = name; *c; ++c)
+                if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_'))
+                    *c = '_';
+            st->offset_slot = (long)slot;
+            if (!(ds->slot_names[slot++] = strdup(name)))
+                goto nomem;
+        }
+        for (size_t i = 0; i < tr->n_times; i += o->every) {
+            m->stalk_of[obs] = s;
+            m->t[obs] = tr->t[i];
+            ds->x[obs] = tr->t[i] / 3600.0;
+            ds->y[obs] = track->value[i] + shift;
+            ds->data_lines[obs] = tr->line[i];
+            ds->series[obs] = s;
+            ++obs;
+        }
+    }
+    for (size_t j = 0; j < N_SHARED; ++j)
+        if (phc_dataset_declare_unit(ds, shared[j], shared_unit[j]))
+            goto nomem;
+    if (o->e_min_slot && phc_dataset_declare_unit(ds, "e_min", "Pa"))
+        goto nomem;
+    for (size_t s = 0; s < o->n_stalks; ++s)
+        if (m->stalks[s].offset_slot >= 0 &&
+            phc_dataset_declare_unit(ds, ds->slot_names[m->stalks[s].offset_slot], "rad"))
+            goto nomem;
+    if (o->sigma > 0) {
+        if (!(ds->sigma = malloc(n * sizeof *ds->sigma)))
+            goto nomem;
+        for (size_t i = 0; i < n; ++i)
+            ds->sigma[i] = o->sigma;
+    }
+    ds->x_seconds = 3600.0;
+    if (!(ds->x_label = strdup("time (h)")) ||
+        !(ds->y_label = strdup("organ angle (rad, counter-clockwise from +x, z up)")) ||
+        (tr->source && !(ds->data_file = strdup(tr->source))))
+        goto nomem;
+    ds->config_line = phc_origin_line(o->origin, NULL);
+    *out = ds;
+    return PHC_OK;
+nomem:
+    phc_dataset_free(ds);
+    return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+}

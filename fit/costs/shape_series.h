@@ -1,0 +1,136 @@
+/* `shape_series` data sets (issue 19, Calibration): tracked organ angles over
+ * time against the droop of an elastic stalk whose stiffness follows its
+ * water (wilting paper, Maggioli et al. 2023, eq. 9, and §4.3's rods).
+ *
+ * Organ model (one per tracked series), a "stalk": a rod (model/rod.h) of
+ * `segments` equal segments of total length L (m) and radius r (m), tissue
+ * density ρ (kg m⁻³), carrying a terminal mass m_tip (kg, a dead load m_tip·g
+ * at the tip), clamped at its base in the direction β (the base angle) in
+ * the vertical x–z plane (x right, z up, gravity −z).  The clamp is the rod's
+ * fixed root segment, a short segment (1e-3 · L/segments) pointing along β
+ * (it carries no load and does not move).  Every segment has the same
+ * Young's modulus
+ *     E(t) = E_min + E_max · σ(κ (RWC(t) − χ0))        Pa      (eq. 9)
+ * with the relative water content of a single compartment losing water at
+ * the rate δ (s⁻¹) from RWC0 at t0:
+ *     RWC(t) = RWC0 · exp(−δ (t − t0)).
+ * (The water model on the stalk's graph is not used: a stalk's segments
+ * would all dry alike, and the data carry no water measurement.)
+ * The model angle at time t is the direction of the stalk's last segment,
+ * head → tail, in the x–z plane, counter-clockwise from +x (rad), from the
+ * static equilibrium (phc_rod_solve_static, Newton to the rod's tolerance),
+ * taken within π of β; plus the series' angle offset when it has one.
+ *
+ * With options.plant, the organ model is the plant itself: one rod over the
+ * whole graph (its root fixed), every segment at the same E(t), each series
+ * the direction of one segment (named by its source id) in the x–z plane,
+ * β that segment's rest direction; tip masses hang at those segments' tails.
+ *
+ * Observations: the tracks of measurements/shape_series.h of kind
+ * PHC_SHAPE_ANGLE, in rad, counter-clockwise with y up (read image angles
+ * with y_down, which negates them: an image angle measured clockwise on
+ * screen, 0 = right, 90° = down, becomes the model's counter-clockwise
+ * angle with z up).  Each track is moved by the multiple of 2π that brings
+ * its first sample within π of β, so the observed and model angles are on
+ * the same branch.  Residual = observed − model angle (rad), divided by
+ * sigma when given.
+ *
+ * Parameter slots (bound by name; phc_problem_bind_by_name or a config's
+ * `parameters:`), with the units the model works in:
+ *   kappa   κ, 1 (RWC is a fraction)
+ *   chi0    χ0, 1
+ *   e_max   E_max, Pa
+ *   delta   δ, s⁻¹ (a joint fit with weight_curve shares it by name; note
+ *           that weight_curve's δ is a loss per unit of area proxy, so a
+ *           shared δ assumes the stalk's compartment loses water at that rate)
+ *   e_min   E_min, Pa: a slot only when options.e_min_slot, else fixed at
+ *           options.e_min
+ *   offset_<series>  rad, per stalk with `offset`: added to its model angle
+ *           (what the camera's view and the unknown base angle add)
+ *
+ * Derivatives ("analytic" to the engine): the model angle depends on the
+ * shared slots only through the scalar E(t), so d angle / d p = (d angle /
+ * d E) · (d E / d p) with d E / d p exact and d angle / d E by a central
+ * difference in E with relative step options.fd_step (two more static
+ * solves per observation, warm-started from the previous solution);
+ * d angle / d offset = 1.  tests/unit/test_shape_series_new.c checks the
+ * Jacobian against central differences of the whole model in every slot and
+ * against a second fd_step.
+ *
+ * Errors (PHC_ERR_INPUT) say what and where: a stalk naming a series that
+ * is not in the tracks (with the list), a track that is not an angle,
+ * a length, radius, density, tip mass, segment count, RWC0, sigma or fd_step
+ * out of range (zero/negative radius, ...), a non-finite observation (data
+ * file and line).  Places are the stalk's `where` (e.g. "cfg.yaml:14") or
+ * the options' origin, else "shape_series". */
+#ifndef PHC_COSTS_SHAPE_SERIES_H
+#define PHC_COSTS_SHAPE_SERIES_H
+
+#include <stddef.h>
+
+#include "fit/costs/origin.h"
+#include "fit/engine/dataset.h"
+#include "measurements/shape_series.h"
+#include "model/plant_graph.h"
+#include "model/status.h"
+
+/* One tracked series mapped to a stalk. */
+typedef struct phc_shape_stalk {
+    const char *series;  /* id of a track in the phc_shape_series (an angle track) */
+    double length;       /* L, m, > 0: the free stalk */
+    double radius;       /* r, m, > 0 */
+    size_t segments;     /* free segments, >= 1 (default 8) */
+    double tip_mass;     /* kg, >= 0: the flower */
+    double base_angle;   /* β, rad, counter-clockwise from +x with z up; NaN: the
+                            first observed angle (the stalk starts where the organ
+                            pointed at the first sample), taken in [−π, π] */
+    int offset;          /* 1: a slot offset_<series> (rad) added to the model angle */
+    long segment;        /* with options.plant: the source id of the plant's segment
+                            whose direction is the series' angle (length, radius,
+                            segments and base_angle are then unused; base_angle must
+                            be NaN); tip_mass hangs at its tail */
+    const char *where;   /* for messages (e.g. "cfg.yaml:14"); may be NULL */
+} phc_shape_stalk;
+
+typedef struct phc_shape_series_options {
+    size_t n_stalks;               /* >= 1 */
+    const phc_shape_stalk *stalks;
+    double rwc0;                   /* RWC at t0, in (0, 1.5]; default 1 */
+    double t0;                     /* s; NaN (default): the first sample's time */
+    double e_min;                  /* Pa, > 0, when not a slot; default 1e4 */
+    int e_min_slot;                /* 1: e_min is a slot */
+    double density;                /* ρ, kg m⁻³, > 0; default 1000 */
+    double sigma;                  /* rad, > 0; 0 (default): unweighted */
+    size_t every;                  /* keep every k-th sample (>= 1, default 1) */
+    double fd_step;                /* relative step in E for d angle/dE; default 1e-4 */
+    size_t frames;                 /* simulate/fit outputs: frames (side views, graphs),
+                                      evenly spaced over the data's times; default 6, 0 none */
+    const phc_origin *origin;      /* where the options came from, for messages; NULL */
+    const phc_plant_graph *plant;  /* NULL: one stalk per series (above); else a finished
+                                      plant graph (m, z up; copied): one rod for the whole
+                                      plant, every segment at E(t), each series the angle
+                                      of its stalk's `segment`, β its rest direction */
+} phc_shape_series_options;
+
+/* The defaults above (no stalks). */
+phc_shape_series_options phc_shape_series_options_default(void);
+
+/* Builds a shape_series data set from tracks (read with
+ * phc_shape_series_read; copied, may be freed afterwards).  Slots are
+ * named; parameter indices are left to binding.  Errors as above. */
+int phc_shape_series_new(const phc_shape_series *tracks, const phc_shape_series_options *options,
+                         phc_dataset **out, phc_error *err);
+
+/* The modulus (Pa) and relative water content at time t (s) for slot
+ * values p (the data set's slot order). */
+int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, double *young,
+                             double *rwc);
+
+/* The equilibrium angle (rad, without offset) of stalk s at modulus young
+ * (Pa), solved from the rest shape.  0, or non-zero when the static solve
+ * fails. */
+int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double young, double *angle);
+
+extern const phc_dataset_ops phc_shape_series_ops;
+
+#endif /* PHC_COSTS_SHAPE_SERIES_H */

@@ -1,0 +1,387 @@
+/* `shape_series` data sets built in C (fit/costs/shape_series.h):
+ *
+ * 1. limit cases (small deflection, 50 segments, to 1e-3): a stalk clamped
+ *    horizontally with a tip mass and (almost) no weight of its own bends by
+ *    the Euler–Bernoulli tip slope P L² / (2 E I), I = π r⁴ / 4; under its
+ *    own weight only by q L³ / (6 E I);
+ *    a very stiff stalk keeps its base angle;
+ * 2. synthetic angles of two stalks made by the model from known kappa = 12,
+ *    chi0 = 0.7, e_max = 1e8 Pa (e_min 1e6 Pa), delta = 2e-4 s-1 (and an offset of 0.05 rad
+ *    on the second stalk), written as a CSV in degrees and read back
+ *    (measurements/shape_series.h), fitted back from a perturbed start;
+ * 3. the Jacobian (d angle / d E by central differences, chained with the
+ *    exact d E / d slot) against central differences of the whole model in
+ *    every slot, and against a second fd_step;
+ * 4. errors: an unknown series, a zero radius, a negative E_min;
+ * 5. e_min as a slot: its Jacobian column against central differences;
+ * 6. a plant graph (options.plant) laid out as a stalk, its series mapped to
+ *    the last segment, gives the stalk's angles; an unknown segment id is
+ *    refused. */
+#include <math.h>
+
+#define PHC_SS_PI 3.14159265358979323846
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "fit/costs/shape_series.h"
+#include "fit/engine/fit.h"
+#include "fit/engine/problem.h"
+#include "measurements/shape_series.h"
+#include "model/plant_graph.h"
+
+#define N_T 61
+static const double truth[] = {12.0, 0.7, 1e8, 2e-4, 0.05}; /* kappa chi0 e_max delta offset_b */
+
+/* Tracks from CSV text: columns "t (min)", "a (deg)", "b (deg)". */
+static phc_shape_series *tracks_from(const char *text)
+{
+    const phc_shape_series_spec sp[2] = {
+        {.id = "a", .kind = PHC_SHAPE_ANGLE, .angle = "a (deg)", .angle_unit = "deg"},
+        {.id = "b", .kind = PHC_SHAPE_ANGLE, .angle = "b (deg)", .angle_unit = "deg"}};
+    const phc_shape_spec spec = {"t (min)", "min", NULL, 2, sp};
+    phc_shape_series *s = NULL;
+    phc_error err;
+    if (phc_shape_series_parse(text, strlen(text), "synthetic.csv", &spec, NULL, &s, &err))
+        fprintf(stderr, "%s\n", err.message);
+    return s;
+}
+
+static char *csv_of(const double *a, const double *b)
+{
+    size_t cap = 64 + N_T * 80, used = 0;
+    char *text = malloc(cap);
+    used += (size_t)snprintf(text, cap, "t (min),a (deg),b (deg)\n");
+    for (int i = 0; i < N_T; ++i)
+        used += (size_t)snprintf(text + used, cap - used, "%d,%.15g,%.15g\n", i, a ? a[i] * 180 / PHC_SS_PI : 0.0,
+                                 b ? b[i] * 180 / PHC_SS_PI : 0.0);
+    return text;
+}
+
+static phc_shape_stalk stalks[2];
+
+static phc_shape_series_options options(void)
+{
+    phc_shape_series_options o = phc_shape_series_options_default();
+    stalks[0] = (phc_shape_stalk){.series = "a", .length = 0.05, .radius = 1e-3, .segments = 6,
+                                  .tip_mass = 1e-3, .base_angle = 30 * PHC_SS_PI / 180};
+    stalks[1] = (phc_shape_stalk){.series = "b", .length = 0.04, .radius = 0.8e-3, .segments = 6,
+                                  .tip_mass = 0.6e-3, .base_angle = 120 * PHC_SS_PI / 180, .offset = 1};
+    o.n_stalks = 2;
+    o.stalks = stalks;
+    o.e_min = 1e6;
+    o.frames = 0;
+    return o;
+}
+
+static void test_limits(void)
+{
+    const char *text = "t (min),a (deg),b (deg)\n0,0,0\n";
+    phc_shape_series *tr = tracks_from(text);
+    if (!tr)
+        return;
+    phc_shape_series_options o = phc_shape_series_options_default();
+    const double L = 0.1, r = 2e-3, m = 2e-3, E = 1e9, I = PHC_SS_PI * pow(r, 4) / 4;
+    phc_shape_stalk st = {.series = "a", .length = L, .radius = r, .segments = 50, .tip_mass = m, .base_angle = 0};
+    o.n_stalks = 1;
+    o.stalks = &st;
+    o.density = 1e-6; /* the stalk's own weight negligible against the tip */
+    phc_dataset *ds = NULL;
+    phc_error err;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        double a = NAN, stiff = NAN;
+        CHECK(phc_shape_series_stalk_angle(ds, 0, E, &a) == 0);
+        const double want = -m * 9.81 * L * L / (2 * E * I);
+        printf("tip slope under a tip load: %.8g rad, Euler-Bernoulli -PL^2/(2EI) = %.8g rad (ratio %.7f)\n", a,
+               want, a / want);
+        CHECK_NEAR(a, want, 0, 1e-3);
+        CHECK(phc_shape_series_stalk_angle(ds, 0, 1e15, &stiff) == 0);
+        printf("very stiff stalk (E = 1e15 Pa): angle %.3g rad\n", stiff);
+        CHECK(fabs(stiff) < 1e-7);
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_dataset_free(ds);
+    ds = NULL;
+    /* self-weight only: tip slope q L³ / (6 E I), q = ρ π r² g */
+    st.tip_mass = 0;
+    o.density = 1000;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        double a = NAN;
+        CHECK(phc_shape_series_stalk_angle(ds, 0, E, &a) == 0);
+        const double q = 1000 * PHC_SS_PI * r * r * 9.81, want = -q * L * L * L / (6 * E * I);
+        printf("tip slope under self-weight: %.8g rad, Euler-Bernoulli -qL^3/(6EI) = %.8g rad (ratio %.7f)\n", a,
+               want, a / want);
+        CHECK_NEAR(a, want, 0, 1e-3);
+    }
+    phc_dataset_free(ds);
+    phc_shape_series_free(tr);
+}
+
+/* The model's angles at the truth, through a dataset over zeros. */
+static int synthetic(double *a, double *b)
+{
+    char *text = csv_of(NULL, NULL);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return 1;
+    phc_shape_series_options o = options();
+    /* observed zeros are moved to within pi of the base angle: irrelevant here */
+    phc_dataset *ds = NULL;
+    phc_error err;
+    int rc = phc_shape_series_new(tr, &o, &ds, &err);
+    CHECK(rc == PHC_OK);
+    if (!rc) {
+        CHECK(ds->n == 2 * N_T && ds->k == 5);
+        CHECK(strcmp(ds->slot_names[3], "delta") == 0 && strcmp(ds->slot_names[4], "offset_b") == 0);
+        double yhat[2 * N_T];
+        rc = ds->ops->predict(ds, truth, yhat, NULL);
+        CHECK(rc == 0);
+        memcpy(a, yhat, N_T * sizeof *a);
+        memcpy(b, yhat + N_T, N_T * sizeof *b);
+        double E0, E1, r0, r1;
+        phc_shape_series_modulus(ds, truth, 0, &E0, &r0);
+        phc_shape_series_modulus(ds, truth, 3600, &E1, &r1);
+        printf("truth: RWC %.3f -> %.3f, E %.4g -> %.4g Pa, angle a %.4f -> %.4f rad, b %.4f -> %.4f rad\n", r0, r1,
+               E0, E1, a[0], a[N_T - 1], b[0], b[N_T - 1]);
+        CHECK(a[N_T - 1] < a[0] - 0.1); /* the stalk droops as it dries */
+    }
+    phc_dataset_free(ds);
+    phc_shape_series_free(tr);
+    return rc;
+}
+
+static phc_dataset *dataset_of(const double *a, const double *b, double fd_step)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    phc_shape_series_options o = options();
+    o.fd_step = fd_step;
+    phc_dataset *ds = NULL;
+    phc_error err;
+    if (tr && phc_shape_series_new(tr, &o, &ds, &err))
+        fprintf(stderr, "%s\n", err.message);
+    phc_shape_series_free(tr);
+    return ds;
+}
+
+static void test_jacobian(const double *a, const double *b)
+{
+    phc_dataset *ds = dataset_of(a, b, 1e-4), *ds2 = dataset_of(a, b, 1e-6);
+    CHECK(ds && ds2);
+    if (!ds || !ds2)
+        goto done;
+    const size_t n = ds->n, k = ds->k;
+    double *jac = malloc(n * k * sizeof *jac), *jac2 = malloc(n * k * sizeof *jac2);
+    double *yp = malloc(n * sizeof *yp), *ym = malloc(n * sizeof *ym), *y0 = malloc(n * sizeof *y0);
+    const double p0[] = {11.0, 0.72, 0.9e8, 1.8e-4, 0.02};
+    CHECK(ds->ops->predict(ds, p0, y0, jac) == 0);
+    CHECK(ds2->ops->predict(ds2, p0, y0, jac2) == 0);
+    double worst = 0, worst2 = 0;
+    for (size_t j = 0; j < k; ++j) {
+        double p[5];
+        memcpy(p, p0, sizeof p);
+        const double h = 1e-5 * fabs(p0[j]);
+        p[j] = p0[j] + h;
+        CHECK(ds->ops->predict(ds, p, yp, NULL) == 0);
+        p[j] = p0[j] - h;
+        CHECK(ds->ops->predict(ds, p, ym, NULL) == 0);
+        double scale = 0;
+        for (size_t i = 0; i < n; ++i)
+            scale = fmax(scale, fabs(jac[i * k + j]));
+        for (size_t i = 0; i < n; ++i) {
+            const double fd = (yp[i] - ym[i]) / (2 * h);
+            const double e = fabs(jac[i * k + j] - fd) / scale;
+            const double e2 = fabs(jac[i * k + j] - jac2[i * k + j]) / scale;
+            worst = fmax(worst, e);
+            worst2 = fmax(worst2, e2);
+        }
+        printf("slot %-8s largest |d angle/d slot| %.4g\n", ds->slot_names[j], scale);
+    }
+    printf("Jacobian vs central differences of the whole model: largest error %.3g (relative to the column)\n",
+           worst);
+    printf("Jacobian with fd_step 1e-4 vs 1e-6: largest difference %.3g (relative to the column)\n", worst2);
+    CHECK(worst < 1e-5);
+    CHECK(worst2 < 1e-5);
+    free(jac);
+    free(jac2);
+    free(yp);
+    free(ym);
+    free(y0);
+done:
+    phc_dataset_free(ds);
+    phc_dataset_free(ds2);
+}
+
+static void test_fit(const double *a, const double *b)
+{
+    phc_dataset *ds = dataset_of(a, b, 1e-4);
+    CHECK(ds != NULL);
+    if (!ds)
+        return;
+    phc_error err;
+    phc_problem *pb = phc_problem_new("synthetic droop");
+    const char *names[] = {"kappa", "chi0", "e_max", "delta", "offset_b"};
+    const double start[] = {9.0, 0.65, 0.7e8, 1.6e-4, 0.0};
+    for (int j = 0; j < 5; ++j)
+        CHECK(phc_problem_add_parameter(pb, names[j], start[j], NULL, &err) == PHC_OK);
+    pb->params[0].lower = 0;
+    pb->params[2].lower = 0;
+    pb->params[3].lower = 0;
+    ds->name = strdup("droop");
+    CHECK(phc_problem_bind_by_name(pb, ds, &err) == PHC_OK);
+    CHECK(phc_problem_add_dataset(pb, ds, &err) == PHC_OK);
+    phc_fit_result *res = NULL;
+    CHECK(phc_fit_run(pb, NULL, NULL, &res, &err) == PHC_OK);
+    if (res) {
+        for (size_t i = 0; i < 5; ++i) {
+            printf("fitted %-8s %.12g (truth %g, relative error %.2g)\n", res->params[i].name, res->params[i].value, truth[i],
+                   fabs(res->params[i].value / truth[i] - 1));
+            CHECK_NEAR(res->params[i].value, truth[i], 1e-6, 1e-4);
+        }
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_fit_result_free(res);
+    phc_problem_free(pb);
+}
+
+static void test_errors(void)
+{
+    phc_shape_series *tr = tracks_from("t (min),a (deg),b (deg)\n0,10,20\n1,11,21\n");
+    if (!tr)
+        return;
+    phc_error err;
+    phc_dataset *ds = NULL;
+    phc_shape_series_options o = options();
+    stalks[1].series = "flower9";
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_ERR_INPUT && !ds);
+    CHECK_STR_CONTAINS(err.message, "unknown series 'flower9'");
+    CHECK_STR_CONTAINS(err.message, "'a', 'b'");
+    printf("unknown series: %s\n", err.message);
+    o = options();
+    stalks[0].radius = 0;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_ERR_INPUT && !ds);
+    CHECK_STR_CONTAINS(err.message, "key 'radius': must be positive");
+    printf("zero radius: %s\n", err.message);
+    o = options();
+    o.e_min = -1;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_ERR_INPUT && !ds);
+    CHECK_STR_CONTAINS(err.message, "key 'e_min'");
+    printf("negative e_min: %s\n", err.message);
+    phc_shape_series_free(tr);
+}
+
+/* e_min as a slot: named, in Pa, and its Jacobian column against central
+ * differences (d angle/d e_min = d angle/dE). */
+static void test_e_min_slot(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    phc_shape_series_options o = options();
+    o.e_min_slot = 1;
+    phc_dataset *ds = NULL;
+    phc_error err;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        CHECK(ds->k == 6 && strcmp(ds->slot_names[4], "e_min") == 0 && strcmp(ds->slot_units[4], "Pa") == 0);
+        const double p0[] = {11.0, 0.72, 0.9e8, 1.8e-4, 2e6, 0.02};
+        double jac[2 * N_T * 6], y0[2 * N_T], yp[2 * N_T], ym[2 * N_T], p[6];
+        CHECK(ds->ops->predict(ds, p0, y0, jac) == 0);
+        memcpy(p, p0, sizeof p);
+        const double h = 1e-5 * p0[4];
+        p[4] = p0[4] + h;
+        CHECK(ds->ops->predict(ds, p, yp, NULL) == 0);
+        p[4] = p0[4] - h;
+        CHECK(ds->ops->predict(ds, p, ym, NULL) == 0);
+        double worst = 0, scale = 0;
+        for (int i = 0; i < 2 * N_T; ++i)
+            scale = fmax(scale, fabs(jac[i * 6 + 4]));
+        for (int i = 0; i < 2 * N_T; ++i)
+            worst = fmax(worst, fabs(jac[i * 6 + 4] - (yp[i] - ym[i]) / (2 * h)) / scale);
+        printf("e_min slot: Jacobian column vs central differences: largest error %.3g (relative to the column)\n",
+               worst);
+        CHECK(scale > 0 && worst < 1e-5);
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_dataset_free(ds);
+    phc_shape_series_free(tr);
+}
+
+/* A plant graph laid out like stalk "a" (a clamp 1/1000 of a segment long,
+ * then 6 segments at 30°), its series mapped to segment 6: the same angles
+ * as the stalk model; an unknown segment is refused. */
+static void test_plant(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    const size_t n = 7;
+    const double h = 0.05 / 6, beta = 30 * PHC_SS_PI / 180;
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    for (size_t i = 0; i < n; ++i) {
+        g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
+        g->radius[i] = 1e-3;
+        g->length[i] = i ? h : 1e-3 * h;
+        const double s0 = i ? (double)(i - 1) * h : -1e-3 * h, s1 = i ? s0 + h : 0.0;
+        g->head[3 * i] = s0 * cos(beta);
+        g->head[3 * i + 2] = s0 * sin(beta);
+        g->tail[3 * i] = s1 * cos(beta);
+        g->tail[3 * i + 2] = s1 * sin(beta);
+        g->source_id[i] = (long)i;
+    }
+    phc_error err;
+    CHECK(phc_plant_graph_finish(g, "test plant", &err) == PHC_OK);
+    phc_shape_series_options o = options();
+    phc_shape_stalk st = {.series = "a", .tip_mass = 1e-3, .base_angle = NAN, .segment = 6};
+    o.n_stalks = 1;
+    o.stalks = &st;
+    o.plant = g;
+    phc_dataset *ds = NULL;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        double yhat[N_T];
+        const double p[] = {truth[0], truth[1], truth[2], truth[3]};
+        CHECK(ds->k == 4 && ds->ops->predict(ds, p, yhat, NULL) == 0);
+        double worst = 0;
+        for (int i = 0; i < N_T; ++i)
+            worst = fmax(worst, fabs(yhat[i] - a[i]));
+        printf("plant graph laid out as stalk a, segment 6: largest angle difference %.3g rad\n", worst);
+        CHECK(worst < 1e-9);
+        phc_dataset_free(ds);
+        ds = NULL;
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    st.segment = 99;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_ERR_INPUT && !ds);
+    CHECK_STR_CONTAINS(err.message, "no segment 99");
+    printf("unknown segment: %s\n", err.message);
+    phc_plant_graph_free(g);
+    phc_shape_series_free(tr);
+}
+
+int main(void)
+{
+    test_limits();
+    double a[N_T], b[N_T];
+    if (synthetic(a, b) == 0) {
+        test_jacobian(a, b);
+        test_fit(a, b);
+        test_plant(a, b);
+        test_e_min_slot(a, b);
+    }
+    test_errors();
+    return check_finish("shape_series_new");
+}
