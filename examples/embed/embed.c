@@ -178,7 +178,7 @@ int main(void)
     pb->params[i_delta].lower = 0;          /* a loss rate is not negative */
     pb->params[i_water].lower = 0;
     if (phc_problem_add_dataset(pb, ds, &err) || /* takes ds, also on failure */
-        phc_problem_convert_units(pb, &err))     /* parameters take the slots' units */
+        phc_problem_finish(pb, 0, &err))         /* slots' units, tolerances, checks */
         goto fail;
 
     /* 3. Fit: solve, covariance, intervals, residual checks. */
