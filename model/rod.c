@@ -1132,7 +1132,18 @@ int phc_rod_step(phc_rod *rod, double dt, phc_rod_report *report, phc_error *err
     return rc;
 }
 
-/* ---- test hook (rod_internal.h) ------------------------------------------ */
+/* ---- test hooks (rod_internal.h) ----------------------------------------- */
+
+int phc_rod_internal_prepare_static(phc_rod *rod, phc_error *err)
+{
+    return build_tree(rod, 1, err);
+}
+
+void phc_rod_internal_assemble_static(phc_rod *rod, int matrix)
+{
+    const step_params sp = {0, 0.0, 0.0};
+    assemble(rod, &sp, matrix);
+}
 
 /* the matrix entry (row of node a, column of node b) as assembled */
 static double matrix_entry(const phc_rod_tree *t, const double *diag, const double *coup, size_t a,
