@@ -59,10 +59,9 @@
 static double E_PLANT = 5e7;
 #define E_TREE 2e8
 #define REPEAT 5
-#define GS_SUBSTEP 0.0025
+static double GS_SUBSTEP = 0.0025;
 #define GS_SUBSTEPS 5
-#define GS_DAMPING 4.04 /* 1/(1 + c h) = 0.99 at h = 0.0025 s */
-#define GS_FRAMES 4000
+#define GS_FRAMES 2000
 #define REFERENCE_TOL 1e-13
 #define TARGET_US 1.0
 #define TARGET_STATIC_MS 50.0
@@ -271,7 +270,7 @@ static int run_plant000(void)
     o.scheme = PHC_ROD_GAUSS_SEIDEL;
     o.substeps = GS_SUBSTEPS;
     o.gs_iterations = 1;
-    o.damping = GS_DAMPING;
+    o.damping = (1.0 / 0.99 - 1.0) / GS_SUBSTEP; /* v x 0.99 per sub-step */
     phc_rod_set_options(rod, &o, &err);
     phc_rod_reset(rod);
     const double frame = GS_SUBSTEP * GS_SUBSTEPS;
@@ -348,6 +347,8 @@ int main(int argc, char **argv)
 {
     if (argc > 1)
         E_PLANT = atof(argv[1]);
+    if (getenv("GS_SUBSTEP"))
+        GS_SUBSTEP = atof(getenv("GS_SUBSTEP"));
     cpu_mark m0 = cpu_now();
     int rc = run_plant000();
     if (argc <= 2)
