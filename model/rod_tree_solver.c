@@ -274,6 +274,52 @@ static int inv6(double *a, double *inv)
     return 0;
 }
 
+/* J⁻¹ of a rods joint Jacobian J = [[s I, X], [0, M]] (s = ±1; rod_joint.h)
+ * as [[s I, −s X M⁻¹], [0, M⁻¹]], M⁻¹ by the adjugate: 0; 1 when J does not
+ * have that structure or M is singular (then the caller inverts J by
+ * Gauss–Jordan). */
+static int inv_joint(const double *J, double *inv)
+{
+    const double s = J[0];
+    if (s != 1.0 && s != -1.0)
+        return 1;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            if (J[r * 6 + c] != (r == c ? s : 0.0) || J[(3 + r) * 6 + c] != 0.0)
+                return 1;
+    const double *m = J + 21; /* M[r][c] = m[r * 6 + c] */
+    double a[9];
+    a[0] = m[7] * m[14] - m[8] * m[13];
+    a[1] = m[2] * m[13] - m[1] * m[14];
+    a[2] = m[1] * m[8] - m[2] * m[7];
+    a[3] = m[8] * m[12] - m[6] * m[14];
+    a[4] = m[0] * m[14] - m[2] * m[12];
+    a[5] = m[2] * m[6] - m[0] * m[8];
+    a[6] = m[6] * m[13] - m[7] * m[12];
+    a[7] = m[1] * m[12] - m[0] * m[13];
+    a[8] = m[0] * m[7] - m[1] * m[6];
+    const double det = m[0] * a[0] + m[1] * a[3] + m[2] * a[6];
+    if (!(fabs(det) > 0.0) || !isfinite(det))
+        return 1;
+    const double id = 1.0 / det;
+    for (int k = 0; k < 9; ++k)
+        a[k] *= id;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+            inv[r * 6 + c] = (r == c) ? s : 0.0;
+            inv[(3 + r) * 6 + c] = 0.0;
+            inv[(3 + r) * 6 + 3 + c] = a[r * 3 + c];
+            double x = 0.0;
+            for (int k = 0; k < 3; ++k)
+                x += J[r * 6 + 3 + k] * a[k * 3 + c];
+            inv[r * 6 + 3 + c] = -s * x;
+        }
+    for (int k = 0; k < 36; ++k)
+        if (!isfinite(inv[k]))
+            return 1;
+    return 0;
+}
+
 /* out = a b (6x6 row-major) */
 static inline void mul6(const double *a, const double *b, double *out)
 {
@@ -314,7 +360,7 @@ static int block_factor(const double *a, double *F, int *piv)
         }
     for (int k = 0; k < 6; ++k)
         C[k] = a[(6 + k) * 12 + 6 + k];
-    if (inv6(J, Jinv) != 0)
+    if (inv_joint(J, Jinv) != 0 && inv6(J, Jinv) != 0)
         return -1;
     mul6(H, Jinv, W);
     for (int r = 0; r < 6; ++r)
