@@ -553,10 +553,19 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n;
     memset(rod->res, 0, 12 * n * sizeof *rod->res);
-    if (matrix) {
-        memset(t->diag, 0, 144 * n * sizeof *t->diag);
-        memset(t->coup, 0, 72 * n * sizeof *t->coup);
-    }
+    if (matrix)
+        /* Only what is accumulated or not written below is zeroed: the body
+         * block (rows and columns 0..5) and the multipliers' block (6..11,
+         * where only the diagonal −α is written).  The joint blocks of a
+         * 12-node and its whole coupling block are assigned below; a 6-node
+         * has no coupling. */
+        for (size_t i = 0; i < n; ++i) {
+            double *D = t->diag + 144 * i;
+            for (int r = 0; r < 6; ++r) {
+                memset(D + r * 12, 0, 6 * sizeof *D);
+                memset(D + (6 + r) * 12 + 6, 0, 6 * sizeof *D);
+            }
+        }
     for (size_t i = 0; i < n; ++i) {
         double *r = rod->res + 12 * i, *D = t->diag + 144 * i;
         const double m = rod->mass[i], ts = rod->load_scale;
