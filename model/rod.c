@@ -893,13 +893,16 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         save_state(rod);
         const double phi0 = rn.sq;
         residual_norm trial = rn;
-        int accepted = 0;
+        int accepted = 0, have_matrix = 0;
         for (int ls = 0; ls < 30; ++ls, s *= 0.5) {
             apply_step(rod, s);
-            assemble(rod, sp, 0);
+            /* the first trial (almost always accepted) assembles the matrix
+             * too: the next iteration's, then not assembled again */
+            assemble(rod, sp, ls == 0);
             trial = residual_measure(rod, sp);
             if (trial.sq < (1.0 - 1e-4 * s) * phi0 || trial.max <= tol) {
                 accepted = 1;
+                have_matrix = ls == 0;
                 break;
             }
         }
@@ -922,7 +925,8 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         if (maxdx * s <= 1e-12 * L && maxrot * s <= 1e-12 && s == 1.0 &&
             rn.max <= STEP_RESIDUAL * tol)
             return PHC_OK;
-        assemble(rod, sp, 1);
+        if (!have_matrix)
+            assemble(rod, sp, 1);
     }
     if (rn.max <= tol)
         return PHC_OK;

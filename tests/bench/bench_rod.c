@@ -17,21 +17,23 @@
  *     heap before and after) / n; also the peak during a static solve
  *     (the solve allocates its saved states).
  * (d) peer in the same run: the authors' Gauss–Seidel scheme
- *     (PHC_ROD_GAUSS_SEIDEL, 1 iteration × 5 sub-steps of 0.0025 s per
- *     frame, velocities × 0.99 per sub-step as in their PlantDemo, i.e.
- *     damping 4.04 s⁻¹) on plant000 from rest, timed per frame; its error
+ *     (PHC_ROD_GAUSS_SEIDEL, 1 iteration × 5 sub-steps per frame,
+ *     velocities × 0.99 per sub-step as in their PlantDemo) on plant000
+ *     from rest, at their sub-step of 0.0025 s and at a small one of
+ *     0.0002 s, timed per frame (at most GS_FRAMES frames); its error
  *     against the converged equilibrium (the static solve at tolerance
  *     1e-13, REFERENCE) after the same wall time as the direct static solve
- *     (best of REPEAT) and after GS_FRAMES frames.  The direct solve's error
- *     is that of its default-tolerance result against the same reference.
- *     Error: the largest distance of a segment's tail from its position in
- *     the reference equilibrium, m, and that over the reference's largest
- *     tail displacement from rest.
+ *     (best of REPEAT) and at the end.  The direct solve's error is that of
+ *     its default-tolerance result against the same reference.  Error: the
+ *     largest distance of a segment's tail from its position in the
+ *     reference equilibrium, m, and that over the reference's largest tail
+ *     displacement from rest (the droop).
  *
  * Moduli (Young's modulus, the same for every segment, Pa): plant000
- * E_PLANT = 5e7 Pa (a soft green stem; its 25 cm plant droops by several
- * cm and the Gauss–Seidel scheme stays stable at the authors' step), the
- * 100k tree E_TREE = 2e8 Pa as in tests/unit/test_rod.c.  Density 1000
+ * E_PLANT = 5e7 Pa (a soft green stem: the 25 cm plant droops visibly, its
+ * tails move by up to 6 cm, and Newton converges from rest in 4 iterations), the
+ * 100k tree E_TREE = 2e8 Pa as in tests/unit/test_rod.c.  `bench_bench_rod E`
+ * uses E for plant000; `bench_bench_rod E x` skips the 100k tree.  Density 1000
  * kg m⁻³, ν 0.5, gravity (0, 0, −9.81) m s⁻² (the defaults).
  *
  * Times are wall-clock (CLOCK_MONOTONIC) on a shared machine: the CPUs kept
