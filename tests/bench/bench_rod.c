@@ -260,7 +260,7 @@ static double gauss_seidel(phc_rod *rod, const double *ref, double droop, double
     const double floor_e = 1e-16 * droop, ratio = e_equal / fmax(e_direct, floor_e);
     printf("error_ratio_at_equal_time_gauss_seidel_over_direct%s: %.3g x (direct error %s)\n", sfx, ratio,
            e_direct < floor_e ? "below 1e-16 of the droop: floored there" : "as measured");
-    printf("gauss_seidel_frames_per_direct_static_solve%s: %.1f (wall time ratio)\n", sfx,
+    printf("gauss_seidel_frames_in_direct_solve_time%s: %.1f (frames in the wall time of one direct static solve)\n", sfx,
            t_direct / (spent / (frames ? frames : 1)));
     phc_rod_options_default(&o);
     phc_rod_set_options(rod, &o, &err);
