@@ -553,10 +553,19 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n;
     memset(rod->res, 0, 12 * n * sizeof *rod->res);
-    if (matrix) {
-        memset(t->diag, 0, 144 * n * sizeof *t->diag);
-        memset(t->coup, 0, 72 * n * sizeof *t->coup);
-    }
+    if (matrix)
+        /* Only what is accumulated or not written below is zeroed: the body
+         * block (rows and columns 0..5) and the multipliers' block (6..11,
+         * where only the diagonal −α is written).  The joint blocks of a
+         * 12-node and its whole coupling block are assigned below; a 6-node
+         * has no coupling. */
+        for (size_t i = 0; i < n; ++i) {
+            double *D = t->diag + 144 * i;
+            for (int r = 0; r < 6; ++r) {
+                memset(D + r * 12, 0, 6 * sizeof *D);
+                memset(D + (6 + r) * 12 + 6, 0, 6 * sizeof *D);
+            }
+        }
     for (size_t i = 0; i < n; ++i) {
         double *r = rod->res + 12 * i, *D = t->diag + 144 * i;
         const double m = rod->mass[i], ts = rod->load_scale;
@@ -884,13 +893,16 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         save_state(rod);
         const double phi0 = rn.sq;
         residual_norm trial = rn;
-        int accepted = 0;
+        int accepted = 0, have_matrix = 0;
         for (int ls = 0; ls < 30; ++ls, s *= 0.5) {
             apply_step(rod, s);
-            assemble(rod, sp, 0);
+            /* the first trial (almost always accepted) assembles the matrix
+             * too: the next iteration's, then not assembled again */
+            assemble(rod, sp, ls == 0);
             trial = residual_measure(rod, sp);
             if (trial.sq < (1.0 - 1e-4 * s) * phi0 || trial.max <= tol) {
                 accepted = 1;
+                have_matrix = ls == 0;
                 break;
             }
         }
@@ -913,7 +925,8 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
         if (maxdx * s <= 1e-12 * L && maxrot * s <= 1e-12 && s == 1.0 &&
             rn.max <= STEP_RESIDUAL * tol)
             return PHC_OK;
-        assemble(rod, sp, 1);
+        if (!have_matrix)
+            assemble(rod, sp, 1);
     }
     if (rn.max <= tol)
         return PHC_OK;
@@ -1132,7 +1145,18 @@ int phc_rod_step(phc_rod *rod, double dt, phc_rod_report *report, phc_error *err
     return rc;
 }
 
-/* ---- test hook (rod_internal.h) ------------------------------------------ */
+/* ---- test hooks (rod_internal.h) ----------------------------------------- */
+
+int phc_rod_internal_prepare_static(phc_rod *rod, phc_error *err)
+{
+    return build_tree(rod, 1, err);
+}
+
+void phc_rod_internal_assemble_static(phc_rod *rod, int matrix)
+{
+    const step_params sp = {0, 0.0, 0.0};
+    assemble(rod, &sp, matrix);
+}
 
 /* the matrix entry (row of node a, column of node b) as assembled */
 static double matrix_entry(const phc_rod_tree *t, const double *diag, const double *coup, size_t a,

@@ -72,6 +72,15 @@ int phc_rod_internal_gauss_seidel_substep(phc_rod *rod, double h, phc_error *err
 int phc_rod_internal_jacobian_check(phc_rod *rod, double eps, double *max_error,
                                     double *max_entry, phc_error *err);
 
+/* The parts of one static Newton iteration, for the benchmark
+ * (tests/bench/bench_rod.c): _prepare_static builds the elimination tree of
+ * the statics (as phc_rod_solve_static does; PHC_OK or its error);
+ * _assemble_static fills the residual (rod->res) and, when `matrix`, the
+ * Newton matrix (rod->tree) at the current state; then phc_rod_tree_factor
+ * and phc_rod_tree_solve on rod->tree (rhs rod->sol) are the direct solve. */
+int phc_rod_internal_prepare_static(phc_rod *rod, phc_error *err);
+void phc_rod_internal_assemble_static(phc_rod *rod, int matrix);
+
 #ifdef __cplusplus
 }
 #endif

@@ -10,8 +10,10 @@
  * unknowns of its parent node (coupling: dim × 6, the block A[node, parent
  * body]; A[parent body, node] is its transpose).  Eliminating nodes leaves
  * first touches only the parent's 6x6 body block, so there is no fill-in
- * and factor + solve cost O(n) with dense 12x12 LU (partial pivoting) per
- * node.  The caller fills diag (12x12 row-major, stride 12) and coupling
+ * and factor + solve cost O(n).  A 12-node whose block has the rods' form
+ * [[H, B], [J, C]] (C diagonal, J invertible) is eliminated through J with
+ * 6x6 kernels (rod_tree_solver.c); any other node by dense LU with partial
+ * pivoting.  The caller fills diag (12x12 row-major, stride 12) and coupling
  * (12x6 row-major) per node.  Pure C, no I/O, no allocation after _new. */
 #ifndef PHC_ROD_TREE_SOLVER_H
 #define PHC_ROD_TREE_SOLVER_H
@@ -29,10 +31,11 @@ typedef struct phc_rod_tree {
     size_t *parent;  /* n: elimination parent node or PHC_TREE_NONE */
     int *dim;        /* n: 0, 6 or 12 */
     size_t *order;   /* n: children before parents (leaves first) */
-    double *diag;    /* 144 n: the node blocks; factorised in place */
+    double *diag;    /* 144 n: the node blocks; factorised in place (layout of
+                        the factors: rod_tree_solver.c) */
     double *coup;    /* 72 n: A[node, parent body] (A[parent body, node] = Aᵀ) */
     double *y;       /* 72 n: D⁻¹A after factor */
-    int *piv;        /* 12 n: LU pivots */
+    int *piv;        /* 12 n: LU pivots (and the block-elimination mark) */
 } phc_rod_tree;
 
 /* Allocates a tree of n nodes (arrays zeroed, parent PHC_TREE_NONE, dim 0);
