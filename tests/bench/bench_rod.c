@@ -50,6 +50,8 @@
 #include "bench_machine.h"
 #include "measurements/plant_io.h"
 #include "model/rod.h"
+#include "model/segment_stiffness.h"
+#include "model/water.h"
 #include "model/rod_internal.h"
 #include "model/rod_tree_solver.h"
 
@@ -267,6 +269,97 @@ static double gauss_seidel(phc_rod *rod, const double *ref, double droop, double
     return equal_frames > 0 ? ratio : 0.0;
 }
 
+/* (e) the water model and the water -> stiffness mapping against the rods,
+ * per frame of a wilting simulation (the wilting paper's Fig. 11 puts the
+ * water model at about 1% of a PBD frame).  A frame: the water model
+ * advanced by one BDF6 step of WATER_STEP s, theta read, Young's moduli
+ * mapped by eq. 9 on relative water (E_min 5e6, E_max 1e8 Pa, kappa 20,
+ * chi0 0.8: the wilting notebooks' values); then the rods: the moduli set
+ * and the static equilibrium solved warm from the previous frame's.  The
+ * loss rate makes the plant lose water visibly over the FRAMES frames. */
+#define WATER_STEP 60.0 /* s of water time per frame */
+#define FRAMES 60
+static void water_share(const phc_plant_graph *g, phc_rod *rod)
+{
+    phc_error err;
+    const size_t n = g->n;
+    double *theta = malloc(n * sizeof *theta), *E = malloc(n * sizeof *E);
+    double volume = 0.0, t_water = 0.0, t_rod = 0.0, load = 0.0;
+    int iterations = 0;
+    phc_water_system *sys = NULL;
+    phc_water_bdf6 *b = NULL;
+    phc_water_params wp = phc_water_params_default();
+    phc_segment_stiffness_params sp = phc_segment_stiffness_params_default();
+    phc_rod_report rep;
+    for (size_t i = 0; i < n; ++i)
+        volume += phc_segment_volume_cm3(g, i);
+    wp.initial_water = volume; /* relative water content 1 */
+    wp.loss_rate = 1.5e-2;     /* 1/(cm^2 s): about 10% of the water in the FRAMES frames */
+    sp.law = PHC_STIFFNESS_WATER;
+    sp.content = PHC_STIFFNESS_RELATIVE;
+    sp.logistic.kappa = 20.0;
+    sp.logistic.chi0 = 0.8;
+    sp.logistic.e_min = 5e6;
+    sp.logistic.e_max = 1e8;
+    if (!theta || !E || phc_water_system_new(g, &wp, &sys, &err) ||
+        phc_water_bdf6_new(sys, WATER_STEP, 0, &b, &err)) {
+        printf("water_share_plant000: set-up failed: %s\n", theta && E ? err.message : "out of memory");
+        goto done;
+    }
+    phc_water_system_theta0(sys, theta);
+    phc_rod_reset(rod);
+    if (phc_segment_stiffness_water(g, &sp, theta, E, NULL, NULL, &err) ||
+        phc_rod_set_modulus(rod, E, &err) || phc_rod_solve_static(rod, &rep, &err)) {
+        printf("water_share_plant000: first frame failed: %s\n", err.message);
+        goto done;
+    }
+    for (int k = 1; k <= FRAMES; ++k) {
+        cpu_mark m0 = cpu_now();
+        if (phc_water_bdf6_advance(b, k * WATER_STEP, &err)) {
+            printf("water_share_plant000: water model failed: %s\n", err.message);
+            goto done;
+        }
+        phc_water_bdf6_state(b, theta, NULL);
+        if (phc_segment_stiffness_water(g, &sp, theta, E, NULL, NULL, &err)) {
+            printf("water_share_plant000: mapping failed: %s\n", err.message);
+            goto done;
+        }
+        cpu_mark m1 = cpu_now();
+        if (phc_rod_set_modulus(rod, E, &err) || phc_rod_solve_static(rod, &rep, &err)) {
+            printf("water_share_plant000: rod frame %d failed: %s\n", k, err.message);
+            goto done;
+        }
+        cpu_mark m2 = cpu_now();
+        t_water += m1.wall - m0.wall;
+        t_rod += m2.wall - m1.wall;
+        iterations += rep.iterations;
+        load = fmax(load, other_load(m0, m2));
+    }
+    {
+        double w = 0.0;
+        for (size_t i = 0; i < n; ++i)
+            w += theta[i];
+        const double fraction = t_water / (t_water + t_rod);
+        printf("water_frames_plant000: %d frames of %.0f s water time, water %.4f -> %.4f g, E %.3g Pa "
+               "at the end\n",
+               FRAMES, WATER_STEP, volume, w, E[0]);
+        printf("water_mapping_us_per_frame_plant000: %.1f us (BDF6 step, state, eq. 9 mapping; other "
+               "load %.2f CPUs)\n",
+               1e6 * t_water / FRAMES, load);
+        printf("rod_frame_ms_plant000: %.2f ms (moduli set, static solve warm from the last frame, "
+               "%.1f Newton iterations per frame)\n",
+               1e3 * t_rod / FRAMES, (double)iterations / FRAMES);
+        printf("water_fraction_of_frame_plant000: %.2f %%\n", 100.0 * fraction);
+        printf("target_water_1pct_of_frame: %s (%.2f %%)\n", fraction <= 0.01 ? "met" : "not met",
+               100.0 * fraction);
+    }
+done:
+    phc_water_bdf6_free(b);
+    phc_water_system_free(sys);
+    free(theta);
+    free(E);
+}
+
 static int run_plant000(void)
 {
     struct stat st;
@@ -334,6 +427,7 @@ static int run_plant000(void)
            1e3 * t_direct);
     printf("target_error_ratio_100x: %s (at the authors' sub-step)\n",
            e_ratio >= TARGET_ERROR_RATIO ? "met" : "not met");
+    water_share(g, rod);
     free(ref);
     phc_rod_free(rod);
     phc_plant_graph_free(g);
