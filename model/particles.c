@@ -2,6 +2,7 @@
  * §4.3; Müller & Chentanez 2011).  See particles.h for the model, the
  * choices made where the paper is terse, and the units. */
 #include "model/particles.h"
+#include "model/quaternion.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -60,54 +61,6 @@ phc_particles_options phc_particles_options_default(void)
 
 /* ---- small linear algebra (row-major 3x3) -------------------------------- */
 
-void phc_particles_quat_to_matrix(const double q[4], double R[9])
-{
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    R[0] = 1 - 2 * (y * y + z * z);
-    R[1] = 2 * (x * y - w * z);
-    R[2] = 2 * (x * z + w * y);
-    R[3] = 2 * (x * y + w * z);
-    R[4] = 1 - 2 * (x * x + z * z);
-    R[5] = 2 * (y * z - w * x);
-    R[6] = 2 * (x * z - w * y);
-    R[7] = 2 * (y * z + w * x);
-    R[8] = 1 - 2 * (x * x + y * y);
-}
-
-/* Shepperd's method: the largest of w², x², y², z² is taken from the
- * diagonal, the others from off-diagonal sums (no cancellation). */
-void phc_particles_matrix_to_quat(const double R[9], double q[4])
-{
-    const double t = R[0] + R[4] + R[8];
-    if (t >= R[0] && t >= R[4] && t >= R[8]) {
-        const double r = sqrt(1 + t), h = 0.5 / r;
-        q[0] = 0.5 * r;
-        q[1] = (R[7] - R[5]) * h;
-        q[2] = (R[2] - R[6]) * h;
-        q[3] = (R[3] - R[1]) * h;
-    } else if (R[0] >= R[4] && R[0] >= R[8]) {
-        const double r = sqrt(1 + R[0] - R[4] - R[8]), h = 0.5 / r;
-        q[0] = (R[7] - R[5]) * h;
-        q[1] = 0.5 * r;
-        q[2] = (R[1] + R[3]) * h;
-        q[3] = (R[2] + R[6]) * h;
-    } else if (R[4] >= R[8]) {
-        const double r = sqrt(1 - R[0] + R[4] - R[8]), h = 0.5 / r;
-        q[0] = (R[2] - R[6]) * h;
-        q[1] = (R[1] + R[3]) * h;
-        q[2] = 0.5 * r;
-        q[3] = (R[5] + R[7]) * h;
-    } else {
-        const double r = sqrt(1 - R[0] - R[4] + R[8]), h = 0.5 / r;
-        q[0] = (R[3] - R[1]) * h;
-        q[1] = (R[2] + R[6]) * h;
-        q[2] = (R[5] + R[7]) * h;
-        q[3] = 0.5 * r;
-    }
-    if (q[0] < 0)
-        for (int k = 0; k < 4; ++k)
-            q[k] = -q[k];
-}
 
 static void quat_mul(const double a[4], const double b[4], double c[4])
 {
@@ -197,7 +150,7 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     double R[9];
     int converged = 0;
     for (int it = 0; it < 100; ++it) {
-        phc_particles_quat_to_matrix(q, R);
+        phc_quat_to_matrix(q, R);
         double om[3] = {0, 0, 0}, dot = 0;
         for (int c = 0; c < 3; ++c) {
             const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
@@ -225,7 +178,7 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
         /* Certificate: at a maximum of tr(Rᵀa) over rotations, S = Rᵀa is
          * symmetric and nᵀSn <= tr S for all unit n (second variation
          * along a rotation about n). */
-        phc_particles_quat_to_matrix(q, R);
+        phc_quat_to_matrix(q, R);
         double S[9];
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
@@ -248,7 +201,7 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     }
     if (polar_svd(a, R) != 0)
         return -1;
-    phc_particles_matrix_to_quat(R, q);
+    phc_quat_from_matrix(R, q);
     return 1;
 }
 
@@ -706,8 +659,8 @@ static long match_group(phc_particles *p, size_t k, const double *X, const doubl
             dx[d] = X[3 * j + d] - c[d];
             d0[d] = p->x0[3 * j + d] - c0[d];
         }
-        phc_particles_quat_to_matrix(Q + 4 * j, Rj);
-        phc_particles_quat_to_matrix(p->q0 + 4 * j, R0);
+        phc_quat_to_matrix(Q + 4 * j, Rj);
+        phc_quat_to_matrix(p->q0 + 4 * j, R0);
         const double *e = p->ax + 3 * j;
         const double D[3] = {e[0] * e[0], e[1] * e[1], e[2] * e[2]};
         for (int r = 0; r < 3; ++r)
@@ -724,7 +677,7 @@ static long match_group(phc_particles *p, size_t k, const double *X, const doubl
         return -1;
     ++p->polar_total;
     p->polar_fallbacks += how == 1;
-    phc_particles_quat_to_matrix(gq, R);
+    phc_quat_to_matrix(gq, R);
     double num = 0, den = 0;
     for (size_t a = 0; a < n; ++a) {
         const size_t j = p->mem[a];
@@ -957,7 +910,7 @@ void phc_particles_segment_ends(const phc_particles *p, double *head, double *ta
 {
     for (size_t i = 0; i < p->n; ++i) {
         double R[9], e[3] = {0, 0, p->ax[3 * i + 2]}, r[3];
-        phc_particles_quat_to_matrix(p->q + 4 * i, R);
+        phc_quat_to_matrix(p->q + 4 * i, R);
         mat_vec(R, e, r);
         for (int d = 0; d < 3; ++d) {
             head[3 * i + d] = p->x[3 * i + d] - r[d];

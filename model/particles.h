@@ -193,9 +193,7 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
  * iteration, 1 with the SVD fallback, -1 when A is not finite or zero. */
 int phc_particles_polar_rotation(const double A[9], double q[4]);
 
-/* Quaternion (w,x,y,z) to row-major rotation matrix and back. */
-void phc_particles_quat_to_matrix(const double q[4], double R[9]);
-void phc_particles_matrix_to_quat(const double R[9], double q[4]);
+/* Quaternions to and from matrices: model/quaternion.h. */
 
 #ifdef __cplusplus
 }

@@ -128,3 +128,38 @@ void phc_quat_from_two_vectors(const double a[3], const double b[3], double out[
     out[3] = c[2];
     phc_quat_normalize(out);
 }
+
+/* Shepperd's method: the largest of w², x², y², z² is taken from the
+ * diagonal, the others from off-diagonal sums (no cancellation). */
+void phc_quat_from_matrix(const double R[9], double q[4])
+{
+    const double t = R[0] + R[4] + R[8];
+    if (t >= R[0] && t >= R[4] && t >= R[8]) {
+        const double r = sqrt(1 + t), h = 0.5 / r;
+        q[0] = 0.5 * r;
+        q[1] = (R[7] - R[5]) * h;
+        q[2] = (R[2] - R[6]) * h;
+        q[3] = (R[3] - R[1]) * h;
+    } else if (R[0] >= R[4] && R[0] >= R[8]) {
+        const double r = sqrt(1 + R[0] - R[4] - R[8]), h = 0.5 / r;
+        q[0] = (R[7] - R[5]) * h;
+        q[1] = 0.5 * r;
+        q[2] = (R[1] + R[3]) * h;
+        q[3] = (R[2] + R[6]) * h;
+    } else if (R[4] >= R[8]) {
+        const double r = sqrt(1 - R[0] + R[4] - R[8]), h = 0.5 / r;
+        q[0] = (R[2] - R[6]) * h;
+        q[1] = (R[1] + R[3]) * h;
+        q[2] = 0.5 * r;
+        q[3] = (R[5] + R[7]) * h;
+    } else {
+        const double r = sqrt(1 - R[0] - R[4] + R[8]), h = 0.5 / r;
+        q[0] = (R[3] - R[1]) * h;
+        q[1] = (R[2] + R[6]) * h;
+        q[2] = (R[5] + R[7]) * h;
+        q[3] = 0.5 * r;
+    }
+    if (q[0] < 0)
+        for (int k = 0; k < 4; ++k)
+            q[k] = -q[k];
+}

@@ -30,6 +30,9 @@ void phc_quat_rotate_inverse(const double q[4], const double u[3], double out[3]
 
 /* Rotation matrix R(q), row-major 3x3 (q unit). */
 void phc_quat_to_matrix(const double q[4], double r[9]);
+/* The unit quaternion (w >= 0) of a rotation matrix r (row-major), by
+ * Shepperd's method. */
+void phc_quat_from_matrix(const double r[9], double q[4]);
 
 /* exp(v) for a rotation vector v in radians: exact, also for |v| -> 0. */
 void phc_quat_exp(const double v[3], double out[4]);

@@ -18,6 +18,7 @@
  *     free fall of the centre of mass: exact one-step answers.
  *  8. Bad input: messages name the particle. */
 #include "model/particles.h"
+#include "model/quaternion.h"
 #include "model/plant_graph.h"
 
 #include <lapacke.h>
@@ -97,8 +98,8 @@ static void test_polar(void)
         double q[4], Q[9], v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9], A[9];
         random_quat(q);
         random_quat(v);
-        phc_particles_quat_to_matrix(q, Q);
-        phc_particles_quat_to_matrix(v, V);
+        phc_quat_to_matrix(q, Q);
+        phc_quat_to_matrix(v, V);
         for (int i = 0; i < 3; ++i) {
             L[4 * i] = 1e-3 + fabs(urand());
             for (int j = 0; j < 3; ++j)
@@ -109,7 +110,7 @@ static void test_polar(void)
         matmul(Q, S, A);
         double start[4] = {1, 0, 0, 0}, R[9];
         fallbacks += phc_particles_polar_rotation(A, start) == 1;
-        phc_particles_quat_to_matrix(start, R);
+        phc_quat_to_matrix(start, R);
         const double e = maxdiff(R, Q, 9);
         if (e > worst_exact)
             worst_exact = e;
@@ -122,13 +123,13 @@ static void test_polar(void)
         negdet += det < 0;
         svd_rotation(B, Rs);
         fallbacks += phc_particles_polar_rotation(B, qb) == 1;
-        phc_particles_quat_to_matrix(qb, Rp);
+        phc_quat_to_matrix(qb, Rp);
         const double es = maxdiff(Rp, Rs, 9);
         if (es > worst_svd)
             worst_svd = es;
         /* a bad start: the solution turned by pi about a random axis */
         double flip[4] = {0, 0, 0, 0}, qs[4], qn[4];
-        phc_particles_matrix_to_quat(Rs, qs);
+        phc_quat_from_matrix(Rs, qs);
         random_quat(flip);
         flip[0] = 0;
         {
@@ -142,7 +143,7 @@ static void test_polar(void)
         qn[2] = flip[0] * qs[2] - flip[1] * qs[3] + flip[2] * qs[0] + flip[3] * qs[1];
         qn[3] = flip[0] * qs[3] + flip[1] * qs[2] - flip[2] * qs[1] + flip[3] * qs[0];
         phc_particles_polar_rotation(B, qn);
-        phc_particles_quat_to_matrix(qn, Rp);
+        phc_quat_to_matrix(qn, Rp);
         const double eb = maxdiff(Rp, Rs, 9);
         if (eb > worst_bad)
             worst_bad = eb;
@@ -167,8 +168,8 @@ static void test_polar(void)
         if (q[0] < 0)
             for (int k = 0; k < 4; ++k)
                 q[k] = -q[k];
-        phc_particles_quat_to_matrix(q, R);
-        phc_particles_matrix_to_quat(R, q2);
+        phc_quat_to_matrix(q, R);
+        phc_quat_from_matrix(R, q2);
         const double e = maxdiff(q, q2, 4);
         if (e > worst_rt)
             worst_rt = e;
@@ -219,7 +220,7 @@ static void test_ellipsoid_term(void)
         /* Turn the whole group rigidly by Q about its centre of mass. */
         double Qq[4], Q[9], c[3] = {0, 0, 0}, M = 0;
         random_quat(Qq);
-        phc_particles_quat_to_matrix(Qq, Q);
+        phc_quat_to_matrix(Qq, Q);
         for (size_t i = 0; i < n; ++i) {
             double x[3];
             phc_particles_position(p, i, x);
@@ -279,7 +280,7 @@ static void test_ellipsoid_term(void)
 static void rotate_rigidly(phc_particles *p, const double Qq[4], const double t[3])
 {
     double Q[9];
-    phc_particles_quat_to_matrix(Qq, Q);
+    phc_quat_to_matrix(Qq, Q);
     phc_error err;
     for (size_t i = 0; i < phc_particles_count(p); ++i) {
         double x[3], y[3], q0[4], q1[4];
