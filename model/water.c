@@ -831,6 +831,47 @@ int phc_water_bdf6_advance(phc_water_bdf6 *b, double t_end, phc_error *err)
 size_t phc_water_bdf6_steps(const phc_water_bdf6 *b) { return b->steps; }
 double phc_water_bdf6_time(const phc_water_bdf6 *b) { return (double)b->steps * b->h; }
 
+int phc_water_bdf6_state_at(const phc_water_bdf6 *b, double t, double *theta, double *dtheta_ddelta,
+                            phc_error *err)
+{
+    if (!b || !theta)
+        return phc_error_set(err, PHC_ERR_INVALID, "water BDF6: NULL argument");
+    if (dtheta_ddelta && !b->sens)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "water BDF6: derivatives need an integrator with sensitivities");
+    /* the ring holds the states at steps - 5 .. steps (slot m % 6 for step m) */
+    const size_t first = b->steps >= 5 ? b->steps - 5 : 0;
+    const double lo = (double)first * b->h, hi = (double)b->steps * b->h;
+    if (!(t >= lo * (1.0 - 1e-12)) || t > hi * (1.0 + 1e-12) || b->steps < 5)
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "water BDF6: state at %g s asked outside the last five steps [%g, %g] s "
+                             "(advance to it first)",
+                             t, lo, hi);
+    /* 6-point Lagrange interpolation (degree 5) in x = t / h */
+    const double xs = t / b->h;
+    double L[6];
+    for (int i = 0; i < 6; ++i) {
+        L[i] = 1.0;
+        for (int j = 0; j < 6; ++j)
+            if (j != i)
+                L[i] *= (xs - (double)(first + (size_t)j)) / (double)(i - j);
+    }
+    const size_t len = b->nv * b->n;
+    for (size_t k = 0; k < b->n; ++k) {
+        double th = 0.0, sd = 0.0;
+        for (int i = 0; i < 6; ++i) {
+            const double *x = b->ring + ((first + (size_t)i) % 6) * len;
+            th += L[i] * x[k];
+            if (dtheta_ddelta)
+                sd += L[i] * x[b->n + k];
+        }
+        theta[b->s->perm[k]] = th;
+        if (dtheta_ddelta)
+            dtheta_ddelta[b->s->perm[k]] = sd;
+    }
+    return PHC_OK;
+}
+
 void phc_water_bdf6_state(const phc_water_bdf6 *b, double *theta, double *dtheta_ddelta)
 {
     size_t len = b->nv * b->n;

@@ -180,6 +180,15 @@ double phc_water_bdf6_time(const phc_water_bdf6 *b);
 /* Current state (g, graph segment order) and, with sensitivities,
  * d theta/d delta; dtheta may be NULL. */
 void phc_water_bdf6_state(const phc_water_bdf6 *b, double *theta, double *dtheta_ddelta);
+/* The state (g, graph segment order) and, with sensitivities, d theta /
+ * d delta (may be NULL) at a time t (s) within the last five steps,
+ * [time() - 5h, time()], by 6-point Lagrange interpolation (degree 5, the
+ * order of the method) of the stored states: dense output for times that
+ * are not multiples of h.  A new integrator covers [0, 5h]; advance to
+ * cover a later t first (only when t > time(): advancing moves the window
+ * on).  PHC_ERR_DOMAIN outside the window. */
+int phc_water_bdf6_state_at(const phc_water_bdf6 *b, double t, double *theta, double *dtheta_ddelta,
+                            phc_error *err);
 /* W at t (s) within [0, time()] by 6th-order Lagrange interpolation of the
  * stored step totals; dW (3, may be NULL; needs sensitivities) as in
  * phc_water_exact_sensitivity. */
