@@ -100,28 +100,6 @@ static void lp_yaml_free(lp_yaml *y)
     free(y->reference_path);
 }
 
-/* One of `names` (NULL-terminated) for key `key`; *choice its index. */
-static int choose(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key, const char *const *names,
-                  int *choice, phc_error *err)
-{
-    const char *v = NULL;
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, node, key, 0, ctx, &v, err)) || !v)
-        return rc;
-    for (int i = 0; names[i]; ++i)
-        if (!strcmp(v, names[i])) {
-            *choice = i;
-            return PHC_OK;
-        }
-    char list[256] = "";
-    for (int i = 0; names[i]; ++i) {
-        strncat(list, i ? ", " : "", sizeof list - strlen(list) - 1);
-        strncat(list, names[i], sizeof list - strlen(list) - 1);
-    }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not one of %s", doc->path,
-                         phc_key_line(node, key), key, v, list);
-}
-
 /* A map key: the keywords in `names` (their index in *source), or a file. */
 static int map_key(const lp_yaml *y, const char *key, const char *const *names, const phc_leaf_map_source *sources,
                    phc_leaf_map_source *source, char **file, phc_error *err)
@@ -166,10 +144,10 @@ static int read_values(lp_yaml *y, phc_error *err)
         (rc = phc_yaml_map_string(doc, node, "id", 0, ctx, &y->id_col, err)) ||
         (rc = phc_yaml_map_string(doc, node, "x_label", 0, ctx, &o->x_label, err)) ||
         (rc = phc_yaml_map_string(doc, node, "y_label", 0, ctx, &o->y_label, err)) ||
-        (rc = choose(doc, node, "residual", residual_names, &residual, err)) ||
-        (rc = choose(doc, node, "difference", difference_names, &difference, err)) ||
-        (rc = choose(doc, node, "colour_space", space_names, &space, err)) ||
-        (rc = choose(doc, node, "colour_correction", correction_names, &correction, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "residual", ctx, residual_names, &residual, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "difference", ctx, difference_names, &difference, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "colour_space", ctx, space_names, &space, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "colour_correction", ctx, correction_names, &correction, err)) ||
         (rc = phc_yaml_map_boolean(doc, node, "register", 0, ctx, &o->register_photos, err)) ||
         (rc = phc_yaml_map_boolean(doc, node, "cross_validate", 0, ctx, &o->cross_validate, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "grid", 0, ctx, &grid, err)) ||
@@ -209,7 +187,7 @@ static int read_stage(lp_yaml *y, phc_error *err)
     if (sn->kind == PHC_YAML_MAPPING) {
         if ((rc = phc_yaml_check_keys(y->doc, sn, stage_keys, "stage", err)) ||
             (rc = phc_yaml_map_string(y->doc, sn, "column", 1, "stage", &y->stage_col, err)) ||
-            (rc = choose(y->doc, sn, "direction", direction_names, &direction, err)))
+            (rc = phc_yaml_map_choice(y->doc, sn, "direction", ctx, direction_names, &direction, err)))
             return rc;
     } else if ((rc = phc_yaml_string(y->doc, sn, "stage", &y->stage_col, err)))
         return rc;

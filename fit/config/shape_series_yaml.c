@@ -19,7 +19,8 @@
 
 static const char *const shape_series_keys[] = {"file",  "time",  "y_down", "series", "rwc0",    "t0",
                                                 "e_min", "sigma", "every",  "density", "fd_step", "frames",
-                                                "plant", "plant_format", "plant_unit", NULL};
+                                                "plant", "plant_format", "plant_unit", "water", "conductance",
+                                                "viscosity", "water_step", NULL};
 static const char *const stalk_keys[] = {"id",     "column",   "unit",           "length", "radius",
                                          "segments", "tip_mass", "base_angle_deg", "offset", "segment", NULL};
 static const phc_key_help shape_series_help[] = {
@@ -49,6 +50,17 @@ static const phc_key_help shape_series_help[] = {
               "segments and base_angle_deg. Default: one stalk per series."},
     {"plant_format", "Format of the plant file: auto, paper, treeqsm, swc, native. Default auto."},
     {"plant_unit", "Length unit of the plant file (UDUNITS-2, e.g. mm). Default: the format's."},
+    {"water", "What drives the modulus: compartment (one compartment per stalk, RWC(t) = rwc0 "
+              "exp(-delta (t - t0)), delta in s-1) or plant (with `plant:`: the wilting paper's water "
+              "model on the plant graph, each segment its own relative water content and modulus; "
+              "delta is then the leaf loss in s-1 cm-2, the delta of a weight_curve on the same "
+              "plant, so a joint fit can share it). Default compartment."},
+    {"conductance", "With water: plant, the water model's edge weights: poiseuille, mean, paper, "
+                    "reference or reference_2024 (as in weight_curve). Default poiseuille."},
+    {"viscosity", "With water: plant, the sap viscosity, mPa s (> 0). Default 0.89 (0.9 with the "
+                  "reference weights)."},
+    {"water_step", "With water: plant, the BDF6 step of the water model, s (> 0). Default a "
+                   "thousandth of the data's time span."},
     {"frames", "Frames (side views, graphs in native format and VTK) that simulate and fit write "
                "per series, evenly spaced over the data's times; 0 none. Default 6."},
     {NULL, NULL}};
@@ -147,7 +159,12 @@ static int read_numbers(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
 {
     const char *ctx = "shape_series data set";
     long every = 1, frames = (long)o->frames;
-    int rc;
+    int rc, water = 0, cond = 0;
+    static const char *const water_names[] = {"compartment", "plant", NULL};
+    static const char *const cond_names[] = {"poiseuille", "mean", "paper", "reference", "reference_2024", NULL};
+    static const phc_water_weights cond_values[] = {PHC_WATER_POISEUILLE, PHC_WATER_MEAN_CONDUCTANCE,
+                                                    PHC_WATER_PAPER, PHC_WATER_REFERENCE,
+                                                    PHC_WATER_REFERENCE_2024};
     if ((rc = phc_yaml_map_number(doc, node, "rwc0", 0, ctx, &o->rwc0, err)) ||
         (rc = phc_yaml_map_number(doc, node, "t0", 0, ctx, &o->t0, err)) ||
         (rc = phc_yaml_map_number(doc, node, "e_min", 0, ctx, &o->e_min, err)) ||
@@ -155,8 +172,25 @@ static int read_numbers(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
         (rc = phc_yaml_map_number(doc, node, "density", 0, ctx, &o->density, err)) ||
         (rc = phc_yaml_map_number(doc, node, "fd_step", 0, ctx, &o->fd_step, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "every", 0, ctx, &every, err)) ||
-        (rc = phc_yaml_map_integer(doc, node, "frames", 0, ctx, &frames, err)))
+        (rc = phc_yaml_map_integer(doc, node, "frames", 0, ctx, &frames, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "water", ctx, water_names, &water, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "conductance", ctx, cond_names, &cond, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "viscosity", 0, ctx, &o->viscosity, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "water_step", 0, ctx, &o->water_step, err)))
         return rc;
+    o->water_model = water;
+    o->conductance = cond_values[cond];
+    if (!water)
+        for (const char *const *k = (const char *const[]){"conductance", "viscosity", "water_step", NULL}; *k; ++k)
+            if (phc_yaml_get(node, *k))
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': only with `water: plant`", doc->path,
+                                     phc_key_line(node, *k), *k);
+    if (phc_yaml_get(node, "viscosity") && !(o->viscosity > 0 && isfinite(o->viscosity)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'viscosity': must be positive (mPa s), found %g",
+                             doc->path, phc_key_line(node, "viscosity"), o->viscosity);
+    if (phc_yaml_get(node, "water_step") && !(o->water_step > 0 && isfinite(o->water_step)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'water_step': must be positive (s), found %g",
+                             doc->path, phc_key_line(node, "water_step"), o->water_step);
     if (every < 1)
         return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'every': expected an integer >= 1, found %ld", doc->path,
                              phc_key_line(node, "every"), every);

@@ -213,28 +213,6 @@ static int quantity(const wc_yaml *y, const phc_yaml_node *v, const char *key, c
     return PHC_OK;
 }
 
-/* One of `names` (NULL-terminated) under `key`: *out its index; left alone
- * when the key is absent. */
-static int parse_choice(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
-                        const char *const *names, int *out, phc_error *err)
-{
-    const char *s = NULL;
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, node, key, 0, ctx, &s, err)) || !s)
-        return rc;
-    char list[160] = "";
-    for (int i = 0; names[i]; ++i) {
-        if (strcmp(names[i], s) == 0) {
-            *out = i;
-            return PHC_OK;
-        }
-        size_t used = strlen(list);
-        snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", names[i]);
-    }
-    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not one of %s", doc->path,
-                         phc_yaml_get(node, key)->line, key, s, list);
-}
-
 /* "HH:MM" or "HH:MM:SS" -> s since midnight, or -1. */
 static double clock_seconds(const char *s)
 {
@@ -410,7 +388,7 @@ static int table_keys(wc_yaml *y, phc_error *err)
         (rc = phc_yaml_map_string(y->doc, y->node, "x_label", 0, ctx, &y->o.x_label, err)) ||
         (rc = phc_yaml_map_string(y->doc, y->node, "y_label", 0, ctx, &y->o.y_label, err)) ||
         (rc = select_key(y, err)) ||
-        (rc = parse_choice(y->doc, y->node, "tare", tare_names, &tare, err)) ||
+        (rc = phc_yaml_map_choice(y->doc, y->node, "tare", ctx, tare_names, &tare, err)) ||
         (rc = exclude_key(y, err)) || (rc = covariates_key(y, err)))
         return rc;
     y->ro.mass_unit = y->munit;
@@ -480,9 +458,9 @@ static int model_keys(wc_yaml *y, phc_error *err)
     static const phc_weight_jumps jump_values[] = {PHC_WEIGHT_JUMPS_ERROR, PHC_WEIGHT_JUMPS_SPLIT,
                                                    PHC_WEIGHT_JUMPS_KEEP};
     int cond = 0, method = 0, jumps = 0, rc;
-    if ((rc = parse_choice(y->doc, y->node, "conductance", cond_names, &cond, err)) ||
-        (rc = parse_choice(y->doc, y->node, "method", method_names, &method, err)) ||
-        (rc = parse_choice(y->doc, y->node, "jumps", jump_names, &jumps, err)) ||
+    if ((rc = phc_yaml_map_choice(y->doc, y->node, "conductance", ctx, cond_names, &cond, err)) ||
+        (rc = phc_yaml_map_choice(y->doc, y->node, "method", ctx, method_names, &method, err)) ||
+        (rc = phc_yaml_map_choice(y->doc, y->node, "jumps", ctx, jump_names, &jumps, err)) ||
         (rc = phc_yaml_map_number(y->doc, y->node, "step", 0, ctx, &y->o.step, err)) ||
         (rc = phc_yaml_map_number(y->doc, y->node, "jump_threshold", 0, ctx, &y->o.jump_threshold, err)) ||
         (rc = phc_yaml_map_number(y->doc, y->node, "viscosity", 0, ctx, &y->o.viscosity, err)) ||

@@ -64,3 +64,23 @@ int phc_column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const ch
         return rc;
     return PHC_OK;
 }
+
+int phc_yaml_map_choice(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                        const char *context, const char *const *names, int *choice, phc_error *err)
+{
+    const char *v = NULL;
+    int rc;
+    if ((rc = phc_yaml_map_string(doc, node, key, 0, context, &v, err)) || !v)
+        return rc;
+    char list[256] = "";
+    for (int i = 0; names[i]; ++i) {
+        if (!strcmp(v, names[i])) {
+            *choice = i;
+            return PHC_OK;
+        }
+        const size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", names[i]);
+    }
+    return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': '%s' is not one of %s", doc->path,
+                         phc_key_line(node, key), key, v, list);
+}

@@ -37,4 +37,11 @@ int phc_column_spec(const phc_yaml_doc *doc, const phc_yaml_node *node, const ch
                     const char *context, const char *default_unit, const char **column,
                     const char **unit, phc_error *err);
 
+/* One of `names` (NULL-terminated) under `key` of `node`: *choice its
+ * index; left alone when the key is absent.  PHC_ERR_INPUT otherwise:
+ * "cfg.yaml:7: key 'method': 'bfd6' is not one of auto, exact, bdf6".
+ * context names the mapping in the message of a value that is not a string. */
+int phc_yaml_map_choice(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *key,
+                        const char *context, const char *const *names, int *choice, phc_error *err);
+
 #endif /* PHC_CONFIG_YAML_KEYS_H */

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/costs/shape_water.h"
 #include "fit/run_dir.h"
 #include "fit/shape_plots.h"
 #include "measurements/plant_io.h"
@@ -41,6 +42,10 @@ typedef struct shape_impl {
     size_t frames;
     phc_plant_graph *plant; /* options.plant's copy, or NULL */
     phc_rod *plant_rod;
+    phc_shape_water *water; /* options.water_model: the water model on the plant, or NULL */
+    double *x, *dx;         /* plant->n: relative water content, d x / d δ (work) */
+    double *grad_e;         /* k x plant->n: d E_i / d slot (work) */
+    double *e_step;         /* plant->n: E ± h dE/dp (work) */
 } shape_impl;
 
 static void impl_free(void *p)
@@ -59,6 +64,11 @@ static void impl_free(void *p)
     free(m->stalks);
     phc_rod_free(m->plant_rod);
     phc_plant_graph_free(m->plant);
+    phc_shape_water_free(m->water);
+    free(m->x);
+    free(m->dx);
+    free(m->grad_e);
+    free(m->e_step);
     free(m->stalk_of);
     free(m->t);
     free(m);
@@ -104,21 +114,34 @@ static double modulus(const phc_dataset *ds, const double *p, double t, double *
 
 int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, double *young, double *rwc)
 {
+    if (((const shape_impl *)ds->impl)->water)
+        return 1; /* a modulus per segment */
     *young = modulus(ds, p, t, rwc, NULL);
     return isfinite(*young) && *young > 0 ? 0 : 1;
 }
 
 /* Equilibrium from the rod's current state at modulus E; the last
  * segment's direction within π of β. */
+static int solve_angle_young(stalk *st, const double *young, double *angle);
+
 static int solve_angle(stalk *st, double young, double *angle)
 {
     if (!(young > 0) || !isfinite(young))
         return 1;
     for (size_t i = 0; i < st->g->n; ++i)
         st->young[i] = young;
+    return solve_angle_young(st, st->young, angle);
+}
+
+/* The same with a modulus per segment (Pa, g->n; may be st->young). */
+static int solve_angle_young(stalk *st, const double *young, double *angle)
+{
+    for (size_t i = 0; i < st->g->n; ++i)
+        if (!(young[i] > 0) || !isfinite(young[i]))
+            return 1;
     phc_error e;
     phc_rod_report rep;
-    if (phc_rod_set_modulus(st->rod, st->young, &e) || phc_rod_solve_static(st->rod, &rep, &e))
+    if (phc_rod_set_modulus(st->rod, young, &e) || phc_rod_solve_static(st->rod, &rep, &e))
         return 1;
     double h[3], t[3];
     phc_rod_head(st->rod, st->seg, h);
@@ -137,9 +160,92 @@ int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double young, double
     return solve_angle(&m->stalks[s], young, angle);
 }
 
+/* With the water model: every segment's relative water content x_i(t)
+ * (m->x) and modulus E_i (young, Pa), and with grad the exact d E_i / d slot
+ * (m->grad_e, k x n).  The pass over the times must be started first. */
+static int segment_moduli(const phc_dataset *ds, const double *p, double t, double *young, int grad)
+{
+    shape_impl *m = ds->impl;
+    const double kappa = p[SLOT_KAPPA], chi0 = p[SLOT_CHI0], e_max = p[SLOT_E_MAX];
+    const double e_min = m->e_min_slot >= 0 ? p[m->e_min_slot] : m->e_min;
+    phc_error e;
+    if (!(t >= m->t0) || phc_shape_water_at(m->water, t - m->t0, m->x, grad ? m->dx : NULL, &e))
+        return 1;
+    const size_t n = m->plant->n;
+    if (grad)
+        memset(m->grad_e, 0, ds->k * n * sizeof *m->grad_e);
+    for (size_t i = 0; i < n; ++i) {
+        const double s = phc_elasticity_sigmoid(kappa * (m->x[i] - chi0)), ds_du = s * (1.0 - s);
+        young[i] = e_min + e_max * s;
+        if (!grad)
+            continue;
+        m->grad_e[SLOT_KAPPA * n + i] = e_max * ds_du * (m->x[i] - chi0);
+        m->grad_e[SLOT_CHI0 * n + i] = -e_max * ds_du * kappa;
+        m->grad_e[SLOT_E_MAX * n + i] = s;
+        m->grad_e[SLOT_DELTA * n + i] = e_max * ds_du * kappa * m->dx[i];
+        if (m->e_min_slot >= 0)
+            m->grad_e[(size_t)m->e_min_slot * n + i] = 1.0;
+    }
+    return 0;
+}
+
+/* predict with the water model: one pass of the water per series. */
+static int predict_water(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    shape_impl *m = ds->impl;
+    const size_t n = m->plant->n;
+    if (jac)
+        memset(jac, 0, ds->n * ds->k * sizeof *jac);
+    size_t prev = (size_t)-1;
+    phc_error e;
+    for (size_t i = 0; i < ds->n; ++i) {
+        stalk *st = &m->stalks[m->stalk_of[i]];
+        if (m->stalk_of[i] != prev) { /* a new series: from the rest shape and t0 */
+            phc_rod_reset(st->rod);
+            if (phc_shape_water_start(m->water, p[SLOT_DELTA], m->rwc0, jac != NULL, &e))
+                return 1;
+            prev = m->stalk_of[i];
+        }
+        double a;
+        if (segment_moduli(ds, p, m->t[i], st->young, jac != NULL) || solve_angle_young(st, st->young, &a))
+            return 1;
+        yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
+        if (!jac)
+            continue;
+        double e_top = 0.0;
+        for (size_t q = 0; q < n; ++q)
+            e_top = fmax(e_top, st->young[q]);
+        double *row = jac + i * ds->k;
+        for (size_t j = 0; j < ds->k; ++j) {
+            const double *d = m->grad_e + j * n;
+            double d_top = 0.0;
+            for (size_t q = 0; q < n; ++q)
+                d_top = fmax(d_top, fabs(d[q]));
+            if (!(d_top > 0.0))
+                continue; /* offsets, and slots E does not depend on here */
+            const double h = m->fd_step * e_top / d_top;
+            double ap, am;
+            for (size_t q = 0; q < n; ++q)
+                m->e_step[q] = st->young[q] + h * d[q];
+            if (solve_angle_young(st, m->e_step, &ap))
+                return 1;
+            for (size_t q = 0; q < n; ++q)
+                m->e_step[q] = st->young[q] - h * d[q];
+            if (solve_angle_young(st, m->e_step, &am))
+                return 1;
+            row[j] = (ap - am) / (2.0 * h);
+        }
+        if (st->offset_slot >= 0)
+            row[st->offset_slot] = 1.0;
+    }
+    return 0;
+}
+
 static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
 {
     shape_impl *m = ds->impl;
+    if (m->water)
+        return predict_water(ds, p, yhat, jac);
     double *grad = calloc(ds->k, sizeof *grad);
     if (!grad)
         return -1;
@@ -179,12 +285,12 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
 
 /* A frame: the stalk's equilibrium at time t as a graph copy (head, tail
  * updated) plus the per-segment values; *out owned by the caller. */
-static int frame_graph(stalk *st, double young, phc_plant_graph **out)
+static int frame_graph(stalk *st, const double *young, phc_plant_graph **out)
 {
     double a;
     *out = NULL;
     phc_rod_reset(st->rod);
-    if (solve_angle(st, young, &a))
+    if (solve_angle_young(st, young, &a))
         return 1;
     phc_plant_graph *c = phc_plant_graph_copy(st->g);
     if (!c)
@@ -223,20 +329,38 @@ static int write_frames(phc_dataset *ds, const double *p, const char *dir, const
         phc_run_dir_safe_name(st->id, sid, sizeof sid);
         if (!values || !young || !titles)
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        phc_error we;
+        if (!rc && m->water && phc_shape_water_start(m->water, p[SLOT_DELTA], m->rwc0, 0, &we))
+            rc = phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the water model: %s", ds->name, we.message);
         for (size_t f = 0; f < nf && !rc; ++f) {
             const double t = nf > 1 ? t_lo + (t_hi - t_lo) * (double)f / (double)(nf - 1) : t_lo;
-            double E, rwc;
-            if (phc_shape_series_modulus(ds, p, t, &E, &rwc) || frame_graph(st, E, &graphs[f])) {
+            double E = NAN, rwc = NAN, *yf = young + f * ns;
+            if (m->water) {
+                if (!segment_moduli(ds, p, t, yf, 0)) {
+                    E = yf[0], rwc = m->x[0];
+                    for (size_t i = 0; i < ns; ++i) {
+                        values[f * ns + i] = m->x[i];
+                        E = fmin(E, yf[i]);
+                        rwc = fmin(rwc, m->x[i]);
+                    }
+                }
+            } else if (!phc_shape_series_modulus(ds, p, t, &E, &rwc)) {
+                for (size_t i = 0; i < ns; ++i) {
+                    values[f * ns + i] = rwc;
+                    yf[i] = E;
+                }
+            }
+            if (!isfinite(E) || frame_graph(st, yf, &graphs[f])) {
                 rc = phc_error_set(err, PHC_ERR_DOMAIN,
                                    "data set '%s': series '%s': no static equilibrium at t = %g s "
                                    "(E = %g Pa)", ds->name, st->id, t, E);
                 break;
             }
-            for (size_t i = 0; i < ns; ++i) {
-                values[f * ns + i] = rwc;
-                young[f * ns + i] = E;
-            }
-            snprintf(titles[f], sizeof titles[f], "t = %.3g h, E = %.3g MPa", t / 3600.0, E * 1e-6);
+            if (m->water)
+                snprintf(titles[f], sizeof titles[f], "t = %.3g h, E >= %.3g MPa, RWC >= %.3g", t / 3600.0,
+                         E * 1e-6, rwc);
+            else
+                snprintf(titles[f], sizeof titles[f], "t = %.3g h, E = %.3g MPa", t / 3600.0, E * 1e-6);
             panels[f] = (phc_shape_panel){.n = ns,
                                           .head = graphs[f]->head,
                                           .tail = graphs[f]->tail,
@@ -329,6 +453,17 @@ static int check_options(const phc_shape_series *tr, const phc_shape_series_opti
                              phc_origin_key(o->origin, "shape_series", "fd_step").text, o->fd_step);
     if (!isnan(o->t0) && !isfinite(o->t0))
         return phc_error_set(err, PHC_ERR_INPUT, "%s: key 't0': must be finite", w);
+    if (o->water_model && !o->plant)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: key 'water': the water model runs on a plant graph: give `plant:` too (a "
+                             "stalk has one compartment)",
+                             phc_origin_key(o->origin, "shape_series", "water").text);
+    if (o->water_model && !(o->water_step >= 0 && isfinite(o->water_step)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'water_step': must be zero or positive (s), found %g",
+                             phc_origin_key(o->origin, "shape_series", "water_step").text, o->water_step);
+    if (o->water_model && !(o->viscosity >= 0 && isfinite(o->viscosity)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'viscosity': must be positive (mPa s), found %g",
+                             phc_origin_key(o->origin, "shape_series", "viscosity").text, o->viscosity);
     for (size_t s = 0; s < o->n_stalks; ++s) {
         const phc_shape_stalk *st = &o->stalks[s];
         const char *ws = where_of(st, o, wb, sizeof wb);
@@ -429,6 +564,31 @@ static int plant_rod(shape_impl *m, const phc_shape_series_options *o, phc_error
     return rc;
 }
 
+/* options.water_model: the water model on the data set's plant, its work
+ * arrays, and no observation before t0. */
+static int plant_water(shape_impl *m, const phc_shape_series_options *o, const phc_dataset *ds, phc_error *err)
+{
+    double t_hi = m->t0;
+    for (size_t i = 0; i < ds->n; ++i) {
+        if (m->t[i] < m->t0)
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s: key 't0': the water model runs forward from t0 = %g s, but a sample "
+                                 "(line %zu) is at %g s",
+                                 phc_origin_key(o->origin, "shape_series", "t0").text, m->t0,
+                                 ds->data_lines[i], m->t[i]);
+        t_hi = fmax(t_hi, m->t[i]);
+    }
+    const double step = o->water_step > 0 ? o->water_step : (t_hi > m->t0 ? (t_hi - m->t0) / 1000.0 : 1.0);
+    const size_t n = m->plant->n;
+    int rc = phc_shape_water_new(m->plant, o->conductance, o->viscosity, step, &m->water, err);
+    if (rc)
+        return phc_error_prefix(err, rc, "%s: the water model", phc_origin_key(o->origin, "shape_series", "water").text);
+    if (!(m->x = malloc(n * sizeof *m->x)) || !(m->dx = malloc(n * sizeof *m->dx)) ||
+        !(m->grad_e = malloc(ds->k * n * sizeof *m->grad_e)) || !(m->e_step = malloc(n * sizeof *m->e_step)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    return PHC_OK;
+}
+
 /* The stalk's graph: a clamp segment and `segments` free ones along β. */
 static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, const phc_shape_series_options *o,
                        phc_error *err)
@@ -512,7 +672,7 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
     m->e_min_slot = o->e_min_slot ? N_SHARED : -1;
     m->n_stalks = o->n_stalks;
     static const char *const shared[N_SHARED] = {"kappa", "chi0", "e_max", "delta"};
-    static const char *const shared_unit[N_SHARED] = {"1", "1", "Pa", "s-1"};
+    const char *const shared_unit[N_SHARED] = {"1", "1", "Pa", o->water_model ? "s-1 cm-2" : "s-1"};
     if (!(m->stalks = calloc(o->n_stalks, sizeof *m->stalks)) || !(m->stalk_of = calloc(n, sizeof *m->stalk_of)) ||
         !(m->t = calloc(n, sizeof *m->t)) || !(ds->x = calloc(n, sizeof *ds->x)) ||
         !(ds->y = calloc(n, sizeof *ds->y)) || !(ds->data_lines = calloc(n, sizeof *ds->data_lines)) ||
@@ -566,6 +726,10 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
             ds->series[obs] = s;
             ++obs;
         }
+    }
+    if (o->water_model && (rc = plant_water(m, o, ds, err))) {
+        phc_dataset_free(ds);
+        return rc;
     }
     for (size_t j = 0; j < N_SHARED; ++j)
         if (phc_dataset_declare_unit(ds, shared[j], shared_unit[j]))

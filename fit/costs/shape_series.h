@@ -26,6 +26,14 @@
  * the direction of one segment (named by its source id) in the x–z plane,
  * β that segment's rest direction; tip masses hang at those segments' tails.
  *
+ * With options.plant and options.water_model, the water is the wilting
+ * paper's water model on that plant (fit/costs/shape_water.h): each segment
+ * i has its own relative water content x_i(t) = θ_i(t)/V_i from θ(t0) =
+ * RWC0·V with the leaf loss δ·A_i, so δ is in s⁻¹ cm⁻² and means what it
+ * means in a `weight_curve` on the same plant (a joint fit shares it by
+ * name), and its own modulus E_i(t) = E_min + E_max σ(κ (x_i − χ0)).
+ * Observations before t0 are refused (the water runs forward from t0).
+ *
  * Observations: the tracks of measurements/shape_series.h of kind
  * PHC_SHAPE_ANGLE, in rad, counter-clockwise with y up (read image angles
  * with y_down, which negates them: an image angle measured clockwise on
@@ -40,9 +48,10 @@
  *   kappa   κ, 1 (RWC is a fraction)
  *   chi0    χ0, 1
  *   e_max   E_max, Pa
- *   delta   δ, s⁻¹ (a joint fit with weight_curve shares it by name; note
- *           that weight_curve's δ is a loss per unit of area proxy, so a
- *           shared δ assumes the stalk's compartment loses water at that rate)
+ *   delta   δ, s⁻¹ with one compartment; s⁻¹ cm⁻² with water_model (the
+ *           water model's leaf loss per unit of area proxy, as weight_curve's
+ *           δ: only then can a joint fit share it by name; the slot units
+ *           differ otherwise and the engine refuses the binding)
  *   e_min   E_min, Pa: a slot only when options.e_min_slot, else fixed at
  *           options.e_min
  *   offset_<series>  rad, per stalk with `offset`: added to its model angle
@@ -53,7 +62,11 @@
  * d E) · (d E / d p) with d E / d p exact and d angle / d E by a central
  * difference in E with relative step options.fd_step (two more static
  * solves per observation, warm-started from the previous solution);
- * d angle / d offset = 1.  tests/unit/test_shape_series_new.c checks the
+ * d angle / d offset = 1.  With water_model the moduli form a vector E(t):
+ * d E / d p is exact per segment (d x / d δ from the water model's BDF6
+ * sensitivities) and d angle / d p is a central difference along that
+ * direction, E ± h·dE/dp with h·max|dE/dp| = fd_step·max E (two static
+ * solves per slot and observation).  tests/unit/test_shape_series_new.c checks the
  * Jacobian against central differences of the whole model in every slot and
  * against a second fd_step.
  *
@@ -73,6 +86,7 @@
 #include "measurements/shape_series.h"
 #include "model/plant_graph.h"
 #include "model/status.h"
+#include "model/water.h"
 
 /* One tracked series mapped to a stalk. */
 typedef struct phc_shape_stalk {
@@ -110,6 +124,15 @@ typedef struct phc_shape_series_options {
                                       plant graph (m, z up; copied): one rod for the whole
                                       plant, every segment at E(t), each series the angle
                                       of its stalk's `segment`, β its rest direction */
+    int water_model;               /* with plant: 1 drives every segment's modulus by the water
+                                      model on the plant graph (fit/costs/shape_water.h), δ then
+                                      in s⁻¹ cm⁻² as in weight_curve; 0 (default): one
+                                      compartment, RWC0 exp(−δ t), δ in s⁻¹ */
+    phc_water_weights conductance; /* water_model: edge weights (model/water.h); default
+                                      Poiseuille */
+    double viscosity;              /* water_model: sap viscosity, mPa s; 0 = the mode's default */
+    double water_step;             /* water_model: BDF6 step, s, >= 0; 0 = a thousandth of the
+                                      data's time span */
 } phc_shape_series_options;
 
 /* The defaults above (no stalks). */
@@ -122,7 +145,8 @@ int phc_shape_series_new(const phc_shape_series *tracks, const phc_shape_series_
                          phc_dataset **out, phc_error *err);
 
 /* The modulus (Pa) and relative water content at time t (s) for slot
- * values p (the data set's slot order). */
+ * values p (the data set's slot order).  Non-zero with water_model (each
+ * segment has its own). */
 int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, double *young,
                              double *rwc);
 
