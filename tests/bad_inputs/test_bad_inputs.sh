@@ -1315,6 +1315,26 @@ report_case "shape_series: control: a plant graph with a segment per series simu
 rm -rf "$T/out_ss_pgood"
 fit_case "shape_series: unknown segment" "$C/ss_pseg.yaml" "ss_pseg.yaml:13" "flower1" "no segment 7"
 # ---- end shape_series ------------------------------------------------------
+# ---- shape_series with water: plant (the water model drives the moduli) ----
+sed 's/,0,0$/,1,0/' "$C/ss_plant.csv" >"$C/ss_leafplant.csv" # leaf segments lose water
+sed -e 's/ss_plant.csv/ss_leafplant.csv/' -e 's/^    plant:/    water: plant\n    plant:/' "$C/ss_pgood.yaml" >"$C/ss_wgood.yaml"
+WHY=""
+run_phc simulate "$C/ss_wgood.yaml" -o "$T/out_ss_wgood"
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+ls "$T/out_ss_wgood"/*flower1_frame00.vtk >/dev/null 2>&1 || add_why "no VTK frame written"
+report_case "shape_series: control: water: plant simulates"
+rm -rf "$T/out_ss_wgood"
+ss_config ss_wnoplant.yaml ss_ok.csv "$SS_F1" '    water: plant
+'
+fit_case "shape_series: water: plant without a plant" "$C/ss_wnoplant.yaml" "ss_wnoplant.yaml:13" "'water'" "plant"
+ss_config ss_wbad.yaml ss_ok.csv "$SS_F1" '    water: soil
+'
+fit_case "shape_series: unknown water driver" "$C/ss_wbad.yaml" "ss_wbad.yaml:13" "'soil'" "compartment, plant"
+ss_config ss_wvisc.yaml ss_ok.csv "$SS_F1" '    viscosity: 1.0
+'
+fit_case "shape_series: viscosity without the water model" "$C/ss_wvisc.yaml" "ss_wvisc.yaml:13" "'viscosity'" "water: plant"
+sed 's/^    water: plant/    water: plant\n    water_step: -1/' "$C/ss_wgood.yaml" >"$C/ss_wstep.yaml"
+fit_case "shape_series: negative water step" "$C/ss_wstep.yaml" "ss_wstep.yaml:11" "'water_step'" "positive"
 
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
