@@ -81,6 +81,36 @@ static void print_checks_md(const phc_dataset_result *d, double level, FILE *f)
     }
 }
 
+/* "converged", or "converged, not identifiable (rank 1 of 4)" when the
+ * Jacobian is rank-deficient. */
+static const char *status_text(const phc_fit_result *res, char *buf, size_t size)
+{
+    if (res->n_free && res->rank < res->n_free)
+        snprintf(buf, size, "%s, not identifiable (rank %zu of %zu)", phc_fit_status_name(res->summary.outcome),
+                 res->rank, res->n_free);
+    else
+        snprintf(buf, size, "%s", phc_fit_status_name(res->summary.outcome));
+    return buf;
+}
+
+/* The model beside its baselines (baseline.h), on the same data and weights. */
+static void print_baselines_md(const phc_dataset_result *d, FILE *f)
+{
+    if (!d->n_baselines)
+        return;
+    char v[4][32];
+    fprintf(f, "\nBaselines fitted to the same data and weights (the model should beat each; the verdict warns "
+               "when it does not):\n\n");
+    fprintf(f, "| | parameters | weighted RSS | R² | AICc |\n|---|---:|---:|---:|---:|\n");
+    fprintf(f, "| the model | %zu | %s | %s | %s |\n", d->goodness.k, fmt_num(v[0], 32, d->goodness.wrss),
+            fmt_num(v[1], 32, d->goodness.r2), fmt_num(v[2], 32, d->goodness.aicc));
+    for (size_t b = 0; b < d->n_baselines; ++b) {
+        const phc_goodness *g = &d->baselines[b].goodness;
+        fprintf(f, "| %s | %zu | %s | %s | %s |\n", d->baselines[b].what, g->k, fmt_num(v[0], 32, g->wrss),
+                fmt_num(v[1], 32, g->r2), fmt_num(v[2], 32, g->aicc));
+    }
+}
+
 static void print_goodness_md(const phc_dataset_result *d, FILE *f)
 {
     const phc_goodness *g = &d->goodness;
@@ -107,7 +137,8 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
     fprintf(f, "## Verdict\n\n");
     if (res->n_warnings == 0) {
         fprintf(f, "**No problems found**: the solver converged, every parameter is determined, no parameter is at "
-                   "a bound, no strong correlation or collinearity, and every residual check passes at level %g.\n\n",
+                   "a bound and no interval crosses one, no strong correlation or collinearity, the model beats "
+                   "its baselines, and every residual check passes at level %g.\n\n",
                 res->level);
     } else {
         fprintf(f, "**%zu warning%s** — read these before trusting the parameters:\n\n", res->n_warnings,
@@ -117,7 +148,8 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
         fprintf(f, "\n");
     }
     fprintf(f, "## Solver\n\n");
-    fprintf(f, "- status: **%s** (%s)\n", phc_fit_status_name(res->summary.outcome), res->summary.termination);
+    char st[96];
+    fprintf(f, "- status: **%s** (%s)\n", status_text(res, st, sizeof st), res->summary.termination);
     fprintf(f, "- iterations: %d; residual evaluations: %d; Jacobian evaluations: %d\n", res->summary.iterations,
             res->summary.residual_evaluations, res->summary.jacobian_evaluations);
     fprintf(f, "- cost: initial %s, final %s (½ Σ ρ(r²) of weighted residuals)\n",
@@ -197,6 +229,7 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
         const phc_dataset_result *ds = &res->datasets[d];
         fprintf(f, "\n### %s (%s)\n\n", ds->name, ds->kind);
         print_goodness_md(ds, f);
+        print_baselines_md(ds, f);
         fprintf(f, "\nResidual checks (residuals ordered by %s):\n\n", ds->x_label);
         print_checks_md(ds, res->level, f);
         fprintf(f, "\n");
@@ -237,8 +270,8 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
 
 void phc_report_print_summary(const phc_fit_result *res, FILE *out)
 {
-    char a[32], b[32], c[32], d[32];
-    fprintf(out, "%s: %s after %d iterations (%s)\n", res->name, phc_fit_status_name(res->summary.outcome),
+    char a[32], b[32], c[32], d[32], st[96];
+    fprintf(out, "%s: %s after %d iterations (%s)\n", res->name, status_text(res, st, sizeof st),
             res->summary.iterations, res->summary.termination);
     if (res->starts > 1)
         fprintf(out, "starts: %zu%s, %zu reached the best cost\n", res->starts,
@@ -262,6 +295,10 @@ void phc_report_print_summary(const phc_fit_result *res, FILE *out)
             if (ds->checks[i].applicable && !ds->checks[i].pass)
                 fprintf(out, "%s%s", failed++ ? ", " : "; failed: ", ds->checks[i].name);
         fprintf(out, "%s\n", failed ? "" : "; all residual checks pass");
+        for (size_t bl = 1; bl < ds->n_baselines; ++bl) /* the kind's; the mean is what R² measures */
+            fprintf(out, "  baseline: %s: R²=%s AICc=%s\n", ds->baselines[bl].what,
+                    fmt_num(a, sizeof a, ds->baselines[bl].goodness.r2),
+                    fmt_num(b, sizeof b, ds->baselines[bl].goodness.aicc));
     }
     if (res->n_warnings == 0)
         fprintf(out, "verdict: no problems found\n");

@@ -84,6 +84,11 @@ static json_t *dataset_json(const phc_dataset_result *d)
         json_object_set_new(o, "extra_markdown", json_string(d->extra_markdown));
     if (d->series)
         json_object_set_new(o, "series", series_json(d));
+    json_t *bl = json_array();
+    for (size_t b = 0; b < d->n_baselines; ++b)
+        json_array_append_new(bl, json_pack("{s:s, s:s, s:o}", "name", d->baselines[b].name, "description",
+                                            d->baselines[b].what, "goodness", goodness_json(&d->baselines[b].goodness)));
+    json_object_set_new(o, "baselines", bl);
     return o;
 }
 
@@ -94,6 +99,7 @@ static json_t *result_json(const phc_fit_result *res)
     if (res->provenance)
         json_object_set_new(root, "provenance", phc_provenance_to_json(res->provenance));
     json_object_set_new(root, "status", json_string(phc_fit_status_name(res->summary.outcome)));
+    json_object_set_new(root, "identifiable", json_boolean(res->rank >= res->n_free));
     json_object_set_new(root, "termination", json_string(res->summary.termination));
     json_object_set_new(root, "iterations", json_integer(res->summary.iterations));
     json_object_set_new(root, "initial_cost", num(res->summary.initial_cost));
@@ -125,6 +131,9 @@ static json_t *result_json(const phc_fit_result *res)
                                       p->at_bound != 0, "bound_side", p->at_bound, "unit",
                                       p->unit ? json_string(p->unit) : json_null(), "start", num(p->start),
                                       "sensitivity_l1", num(p->sens_l1), "sensitivity_l2", num(p->sens_l2)));
+        json_object_set_new(json_object_get(params, p->name), "bounds",
+                            json_pack("[o, o]", isfinite(p->lower) ? num(p->lower) : json_null(),
+                                      isfinite(p->upper) ? num(p->upper) : json_null()));
         if (p->unit_scale != 1.0 || p->unit_offset != 0.0) /* value is in the user's unit */
             json_object_set_new(json_object_get(params, p->name), "to_model_unit",
                                 json_pack("{s:o, s:o}", "scale", num(p->unit_scale), "offset",
@@ -294,6 +303,32 @@ static int read_series(reader *rd, json_t *o, const char *where, phc_dataset_res
     return PHC_OK;
 }
 
+/* A goodness object (goodness_json) into *g; n observations. */
+static int read_goodness(reader *rd, json_t *g, const char *where, size_t n, phc_goodness *out)
+{
+    if (!json_is_object(g))
+        return fail_field(rd, where, "an object");
+    char prefix[96];
+    snprintf(prefix, sizeof prefix, "%s.", where);
+    struct {
+        const char *key;
+        double *dst;
+    } fields[] = {{"rss", &out->rss},   {"wrss", &out->wrss},
+                  {"rmse", &out->rmse}, {"mae", &out->mae},
+                  {"bias", &out->bias}, {"r2", &out->r2},
+                  {"nse", &out->nse},   {"reduced_chi2", &out->reduced_chi2},
+                  {"aic", &out->aic},   {"aicc", &out->aicc},
+                  {"bic", &out->bic},   {"log_likelihood", &out->log_likelihood}};
+    int rc;
+    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i)
+        if ((rc = get_number(rd, g, fields[i].key, prefix, fields[i].dst)))
+            return rc;
+    out->n = n;
+    json_t *k = json_object_get(g, "k");
+    out->k = json_is_integer(k) ? (size_t)json_integer_value(k) : 0;
+    return PHC_OK;
+}
+
 static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result *d)
 {
     char where[64];
@@ -331,24 +366,25 @@ static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result 
     json_t *series = json_object_get(o, "series");
     if (series && !json_is_null(series) && (rc = read_series(rd, series, where, d)))
         return rc;
-    json_t *g = json_object_get(o, "goodness");
-    if (!json_is_object(g))
-        return fail_field(rd, "datasets[].goodness", "an object");
-    struct {
-        const char *key;
-        double *dst;
-    } fields[] = {{"rss", &d->goodness.rss},   {"wrss", &d->goodness.wrss},
-                  {"rmse", &d->goodness.rmse}, {"mae", &d->goodness.mae},
-                  {"bias", &d->goodness.bias}, {"r2", &d->goodness.r2},
-                  {"nse", &d->goodness.nse},   {"reduced_chi2", &d->goodness.reduced_chi2},
-                  {"aic", &d->goodness.aic},   {"aicc", &d->goodness.aicc},
-                  {"bic", &d->goodness.bic},   {"log_likelihood", &d->goodness.log_likelihood}};
-    for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i)
-        if ((rc = get_number(rd, g, fields[i].key, "datasets[].goodness.", fields[i].dst)))
+    if ((rc = read_goodness(rd, json_object_get(o, "goodness"), "datasets[].goodness", d->n, &d->goodness)))
+        return rc;
+    d->k = d->goodness.k;
+    /* optional (results written before the baselines have none) */
+    json_t *bl = json_object_get(o, "baselines");
+    for (size_t b = 0; json_is_array(bl) && b < json_array_size(bl) && b < PHC_MAX_BASELINES; ++b) {
+        json_t *e = json_array_get(bl, b);
+        const char *nm = json_string_value(json_object_get(e, "name"));
+        const char *what = json_string_value(json_object_get(e, "description"));
+        if (!nm || !what)
+            return fail_field(rd, "datasets[].baselines[]", "{name, description, goodness}");
+        phc_baseline *x = &d->baselines[d->n_baselines];
+        snprintf(x->name, sizeof x->name, "%s", nm);
+        snprintf(x->what, sizeof x->what, "%s", what);
+        if ((rc = read_goodness(rd, json_object_get(e, "goodness"), "datasets[].baselines[].goodness", d->n,
+                                &x->goodness)))
             return rc;
-    d->goodness.n = d->n;
-    json_t *k = json_object_get(g, "k");
-    d->k = d->goodness.k = json_is_integer(k) ? (size_t)json_integer_value(k) : 0;
+        d->n_baselines++;
+    }
     /* The stored Durbin–Watson p-value is kept (its exact moments need the
      * Jacobian); everything else is recomputed by phc_fit_recheck. */
     json_t *checks = json_object_get(o, "checks");
@@ -457,6 +493,10 @@ int phc_result_read_json(const char *path, phc_fit_result **out, phc_error *err)
         p->fixed = json_is_true(json_object_get(pv, "fixed"));
         json_t *side = json_object_get(pv, "bound_side");
         p->at_bound = json_is_integer(side) ? (int)json_integer_value(side) : 0;
+        json_t *bounds = json_object_get(pv, "bounds"); /* optional: older results have none */
+        json_t *blo = json_array_get(bounds, 0), *bhi = json_array_get(bounds, 1);
+        p->lower = json_is_number(blo) ? json_number_value(blo) : -INFINITY;
+        p->upper = json_is_number(bhi) ? json_number_value(bhi) : INFINITY;
         p->unit_scale = 1.0; /* model unit = value's unit, unless stored */
         p->unit_offset = 0.0;
         json_t *to_model = json_object_get(pv, "to_model_unit");

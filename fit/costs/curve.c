@@ -5,6 +5,7 @@
  * at a time with scalar variables; the expression's byte code is compiled
  * once and reused. */
 #include "fit/costs/curve.h"
+#include "fit/engine/baseline.h"
 
 #include <math.h>
 #include <muParserDLL.h>
@@ -99,8 +100,17 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     return 0;
 }
 
+/* The straight line in x (fit/engine/baseline.h): what a curve must beat. */
+static int curve_baseline(const phc_dataset *ds, phc_baseline *out)
+{
+    char what[128];
+    snprintf(what, sizeof what, "a straight line in %s", ds->x_label ? ds->x_label : "x");
+    return phc_baseline_line(ds->x, ds->y, ds->sigma, ds->n, "line", what, out);
+}
+
 const phc_dataset_ops phc_curve_ops = {.kind = "curve", .predict = curve_predict,
-                                       .predict_at = curve_predict_at, .free_impl = curve_free};
+                                       .predict_at = curve_predict_at, .free_impl = curve_free,
+                                       .baseline = curve_baseline};
 
 /* Compiles the derivative tape and binds its names to the slots and to the
  * columns muparser registered (same names, same order as c->cols). */

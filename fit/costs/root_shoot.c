@@ -1,5 +1,6 @@
 /* `root_shoot` data sets: see root_shoot.h. */
 #include "fit/costs/root_shoot.h"
+#include "fit/engine/baseline.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -304,7 +305,23 @@ done:
     return rc;
 }
 
+/* The allometric line ln(root:shoot) = a + b ln D (D the basal diameter):
+ * the usual description of harvests (fit/engine/baseline.h). */
+static int rs_baseline(const phc_dataset *ds, phc_baseline *out)
+{
+    double *u = malloc(ds->n * sizeof *u);
+    if (!u)
+        return PHC_ERR_NOMEM;
+    for (size_t i = 0; i < ds->n; ++i)
+        u[i] = log(ds->x[i]); /* x: diameter, mm, > 0 */
+    const int rc = phc_baseline_line(u, ds->y, ds->sigma, ds->n, "allometric",
+                                     "the allometric line ln(root:shoot) = a + b ln(diameter)", out);
+    free(u);
+    return rc;
+}
+
 const phc_dataset_ops phc_root_shoot_ops = {
+    .baseline = rs_baseline,
     .kind = "root_shoot",
     .predict = rs_predict,
     .predict_at = rs_predict_at,

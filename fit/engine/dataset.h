@@ -21,6 +21,8 @@ struct phc_cv_plan; /* fit/engine/cross_validation.h */
 typedef int (*phc_is_parameter_fn)(const char *name, void *user_data);
 struct phc_problem;
 
+struct phc_baseline;
+
 typedef struct phc_dataset_ops {
     const char *kind; /* "curve", ... */
     /* Model values yhat[0..n-1] at the slot values p[0..k-1]; jac (n x k
@@ -60,6 +62,12 @@ typedef struct phc_dataset_ops {
      * plan->n_groups 0 when the data set asks for none.  The engine runs
      * the refits after the fit and adds the predictions to the report. */
     int (*cross_validation)(phc_dataset *ds, struct phc_cv_plan *plan, phc_error *err);
+    /* Optional (NULL = none): the simpler model a kind's data are usually
+     * described by, fitted to the data set's observations and weights
+     * (fit/engine/baseline.h: the straight line for curves, the allometric
+     * line for root:shoot).  Returns 0 with *out filled, 1 when the kind has
+     * none for these data, or an error code. */
+    int (*baseline)(const phc_dataset *ds, struct phc_baseline *out);
 } phc_dataset_ops;
 
 struct phc_dataset {

@@ -350,6 +350,59 @@ static int compute_checks(phc_dataset_result *d, const double *X, size_t kx, dou
     return PHC_OK;
 }
 
+/* The verdict's warnings about identifiability and intervals: a
+ * rank-deficient Jacobian, and 95% intervals that cross a parameter's own
+ * bound (the Wald interval assumes the model is linear near the optimum; a
+ * bound it crosses is where that fails: κ from −26 to 126 with κ >= 0). */
+static int interval_warnings(phc_fit_result *res)
+{
+    int rc = 0;
+    if (res->n_free && res->rank < res->n_free)
+        rc |= add_warning(res, "the Jacobian has rank %zu of %zu free parameters: they are not identifiable from "
+                               "these data (fix or tie parameters, or add data that separate them)",
+                          res->rank, res->n_free);
+    for (size_t i = 0; i < res->n_params; ++i) {
+        const phc_param_result *p = &res->params[i];
+        if (p->fixed || p->at_bound || !isfinite(p->ci_lo) || !isfinite(p->ci_hi))
+            continue;
+        const int below = p->ci_lo < p->lower, above = p->ci_hi > p->upper;
+        if (below || above)
+            rc |= add_warning(res, "parameter '%s': its 95%% interval [%.6g, %.6g] crosses its %s bound %.6g: the "
+                                   "interval is not reliable (the model is far from linear over it; a profile "
+                                   "likelihood gives an interval within the bounds)",
+                              p->name, p->ci_lo, p->ci_hi, below ? "lower" : "upper", below ? p->lower : p->upper);
+    }
+    return rc;
+}
+
+/* The verdict's warnings about baselines (baseline.h): the model must
+ * predict the data better than their mean (R² > 0 for unweighted data), and
+ * a kind's simpler model must not have a clearly lower AICc (by more than
+ * 2, the usual "substantially better" threshold of Burnham & Anderson). */
+static int baseline_warnings(phc_fit_result *res)
+{
+    int rc = 0;
+    for (size_t d = 0; d < res->n_datasets; ++d) {
+        const phc_dataset_result *ds = &res->datasets[d];
+        const phc_goodness *g = &ds->goodness;
+        for (size_t b = 0; b < ds->n_baselines; ++b) {
+            const phc_baseline *bl = &ds->baselines[b];
+            if (b == 0) {
+                if (g->wrss > bl->goodness.wrss * (1.0 + 1e-9))
+                    rc |= add_warning(res, "data set '%s': the model predicts these data worse than their mean: "
+                                           "R² = %.3g (weighted RSS %.4g against %.4g for the mean)",
+                                      ds->name, g->r2, g->wrss, bl->goodness.wrss);
+            } else if (isfinite(g->aicc) && isfinite(bl->goodness.aicc) && bl->goodness.aicc < g->aicc - 2.0) {
+                rc |= add_warning(res, "data set '%s': %s (%zu parameters) fits these data better than the model: "
+                                       "AICc %.4g against %.4g (R² %.3g against %.3g)",
+                                  ds->name, bl->what, bl->goodness.k, bl->goodness.aicc, g->aicc, bl->goodness.r2,
+                                  g->r2);
+            }
+        }
+    }
+    return rc;
+}
+
 /* Warnings that make up the verdict. */
 static int build_verdict(phc_fit_result *res)
 {
@@ -367,6 +420,7 @@ static int build_verdict(phc_fit_result *res)
             rc |= add_warning(res, "parameter '%s' ended at its %s bound (%g): its interval is not reliable",
                               p->name, p->at_bound < 0 ? "lower" : "upper", p->value);
     }
+    rc |= interval_warnings(res);
     for (size_t i = 0; i < res->n_undetermined; ++i)
         rc |= add_warning(res, "the data cannot determine the combination %s", res->undetermined[i]);
     const size_t nf = res->n_free;
@@ -413,6 +467,7 @@ static int build_verdict(phc_fit_result *res)
         }
     if (res->dof <= 0)
         rc |= add_warning(res, "no degrees of freedom left (%ld): standard errors are not available", res->dof);
+    rc |= baseline_warnings(res);
     return rc ? PHC_ERR_NOMEM : PHC_OK;
 }
 
@@ -487,6 +542,11 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
     d->k = kx;
     if (phc_goodness_compute(d->y, d->yhat, ds->sigma, n, kx, &d->goodness) != PHC_OK)
         memset(&d->goodness, 0, sizeof d->goodness);
+    d->n_baselines = 0;
+    if (phc_baseline_mean(d->y, ds->sigma, n, &d->baselines[0]) == PHC_OK)
+        d->n_baselines = 1;
+    if (d->n_baselines && ds->ops->baseline && ds->ops->baseline(ds, &d->baselines[1]) == 0)
+        d->n_baselines = 2;
     if (kx) {
         X = malloc(n * kx * sizeof *X);
         if (!X) {
@@ -868,6 +928,12 @@ static int param_results(const phc_problem *pb, const double *best, const phc_co
         pr->unit_scale = p->unit_scale;
         pr->unit_offset = p->unit_offset;
         pr->fixed = p->fixed;
+        { /* a negative unit scale swaps the bounds */
+            const double a = isfinite(p->lower) ? phc_parameter_to_user(p, p->lower) : (p->unit_scale > 0 ? -INFINITY : INFINITY);
+            const double b = isfinite(p->upper) ? phc_parameter_to_user(p, p->upper) : (p->unit_scale > 0 ? INFINITY : -INFINITY);
+            pr->lower = fmin(a, b);
+            pr->upper = fmax(a, b);
+        }
         pr->stderr_ = pr->ci_lo = pr->ci_hi = pr->sens_l1 = pr->sens_l2 = NAN;
         if (p->fixed)
             continue;

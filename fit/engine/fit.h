@@ -8,6 +8,7 @@
 #include <stddef.h>
 
 #include "fit/engine/ceres_bridge.h"
+#include "fit/engine/baseline.h"
 #include "fit/engine/goodness.h"
 #include "fit/engine/problem.h"
 #include "fit/engine/sensitivity.h"
@@ -76,6 +77,8 @@ typedef struct phc_dataset_result {
                                     bins (>= 2 h) to the span, hours, */
     double peak_power, peak_fap; /* its normalised power and Baluev false-alarm probability */
     char *extra_markdown;        /* the kind's own report section, or NULL */
+    size_t n_baselines;          /* baselines[0] is the mean; then the kind's (baseline.h) */
+    phc_baseline baselines[PHC_MAX_BASELINES];
 } phc_dataset_result;
 
 typedef struct phc_param_result {
@@ -87,6 +90,7 @@ typedef struct phc_param_result {
     double ci_lo, ci_hi;         /* t-based 95% interval */
     int fixed;
     int at_bound;                /* -1 at lower, +1 at upper, 0 inside */
+    double lower, upper;         /* bounds in the user's unit (-inf, +inf when none) */
     double sens_l1, sens_l2;     /* FME summaries (NAN for fixed) */
 } phc_param_result;
 

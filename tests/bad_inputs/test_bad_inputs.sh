@@ -1334,7 +1334,7 @@ ss_config ss_wvisc.yaml ss_ok.csv "$SS_F1" '    viscosity: 1.0
 '
 fit_case "shape_series: viscosity without the water model" "$C/ss_wvisc.yaml" "ss_wvisc.yaml:13" "'viscosity'" "water: plant"
 sed 's/^    water: plant/    water: plant\n    water_step: -1/' "$C/ss_wgood.yaml" >"$C/ss_wstep.yaml"
-fit_case "shape_series: negative water step" "$C/ss_wstep.yaml" "ss_wstep.yaml:11" "'water_step'" "positive"
+fit_case "shape_series: negative water step" "$C/ss_wstep.yaml" "ss_wstep.yaml:12" "'water_step'" "positive"
 
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
