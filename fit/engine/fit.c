@@ -368,9 +368,10 @@ static int interval_warnings(phc_fit_result *res)
         const int below = p->ci_lo < p->lower, above = p->ci_hi > p->upper;
         if (below || above)
             rc |= add_warning(res, "parameter '%s': its 95%% interval [%.6g, %.6g] crosses its %s bound %.6g: the "
-                                   "interval is not reliable (the model is far from linear over it; a profile "
-                                   "likelihood gives an interval within the bounds)",
-                              p->name, p->ci_lo, p->ci_hi, below ? "lower" : "upper", below ? p->lower : p->upper);
+                                   "estimate is %.3g standard errors from the bound, where an interval of value "
+                                   "± t·stderr is not reliable",
+                              p->name, p->ci_lo, p->ci_hi, below ? "lower" : "upper", below ? p->lower : p->upper,
+                              fabs(p->value - (below ? p->lower : p->upper)) / p->stderr_);
     }
     return rc;
 }
@@ -392,7 +393,13 @@ static int baseline_warnings(phc_fit_result *res)
                     rc |= add_warning(res, "data set '%s': the model predicts these data worse than their mean: "
                                            "R² = %.3g (weighted RSS %.4g against %.4g for the mean)",
                                       ds->name, g->r2, g->wrss, bl->goodness.wrss);
-            } else if (isfinite(g->aicc) && isfinite(bl->goodness.aicc) && bl->goodness.aicc < g->aicc - 2.0) {
+            } else if ((isfinite(g->aicc) && isfinite(bl->goodness.aicc) && bl->goodness.aicc < g->aicc - 2.0) ||
+                       (bl->goodness.wrss == 0 && g->wrss > 0)) {
+                if (bl->goodness.wrss == 0) /* through every point: no likelihood to compare */
+                    rc |= add_warning(res, "data set '%s': %s (%zu parameters) fits these data exactly, the model "
+                                           "does not (weighted RSS %.4g)",
+                                      ds->name, bl->what, bl->goodness.k, g->wrss);
+                else
                 rc |= add_warning(res, "data set '%s': %s (%zu parameters) fits these data better than the model: "
                                        "AICc %.4g against %.4g (R² %.3g against %.3g)",
                                   ds->name, bl->what, bl->goodness.k, bl->goodness.aicc, g->aicc, bl->goodness.r2,
