@@ -33,7 +33,7 @@ int phc_plot_bars(const char *path, const char *title, const char *y_label, cons
     if (!(hi > lo))
         hi = lo + 1;
     const double pad = 0.08 * (hi - lo);
-    hi += pad;
+    hi += 0.40 * (hi - lo); /* headroom: the legend sits above the tallest bar */
     if (lo < 0)
         lo -= pad;
     const int dev = phc_plot_device_available("pngcairo");

@@ -50,17 +50,26 @@ struct phc_study_eval {
     double *p, *yhat; /* the largest data set's slots and observations */
 };
 
+/* Output layout: 0 the cost; then per data set its cost (only when there
+ * are several: with one it is the cost) and its mean prediction. */
+static size_t per_dataset(const phc_problem *pb)
+{
+    return pb->n_datasets > 1 ? 2 : 1;
+}
+
 size_t phc_study_outputs(const phc_problem *pb)
 {
-    return 1 + 2 * pb->n_datasets;
+    return 1 + per_dataset(pb) * pb->n_datasets;
 }
 
 void phc_study_output_name(const phc_problem *pb, size_t j, char *buf, size_t size)
 {
+    const size_t m = per_dataset(pb);
     if (j == 0)
         snprintf(buf, size, "cost");
     else
-        snprintf(buf, size, "%s.%s", pb->datasets[(j - 1) / 2]->name, (j - 1) % 2 ? "mean" : "cost");
+        snprintf(buf, size, "%s.%s", pb->datasets[(j - 1) / m]->name,
+                 m == 2 && (j - 1) % 2 == 0 ? "cost" : "mean");
 }
 
 phc_study_eval *phc_study_eval_new(const phc_problem *pb)
@@ -109,8 +118,10 @@ int phc_study_evaluate(phc_study_eval *w, const double *x, double *out)
             cost += 0.5 * r * r;
             sum += w->yhat[i];
         }
-        out[1 + 2 * d] = cost;
-        out[2 + 2 * d] = ds->n ? sum / (double)ds->n : NAN;
+        const size_t m = per_dataset(pb);
+        if (m == 2)
+            out[1 + 2 * d] = cost;
+        out[1 + m * d + (m - 1)] = ds->n ? sum / (double)ds->n : NAN;
         out[0] += cost;
     }
     for (size_t j = 0; j < n_out; ++j)

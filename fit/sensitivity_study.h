@@ -9,7 +9,8 @@
  *
  * Outputs of every evaluation (phc_study_evaluate): the cost (1/2 the sum of
  * squared weighted residuals over all data sets) and, per data set, its own
- * cost and its mean prediction over its observations.
+ * cost (when there are several data sets) and its mean prediction over its
+ * observations.
  *
  * Methods: Sobol indices from a Saltelli design (fit/engine/sobol_indices.h)
  * or Morris elementary effects (fit/engine/morris.h).  The design is
@@ -71,7 +72,8 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *o, const phc_p
 
 /* ---- the evaluation seam ---------------------------------------------------------------- */
 
-/* Number of outputs of one evaluation: 1 + 2 per data set. */
+/* Number of outputs of one evaluation: 1 + 1 per data set (its mean), or
+ * 1 + 2 per data set (its cost and mean) when there are several. */
 size_t phc_study_outputs(const phc_problem *pb);
 /* Name of output j ("cost", "<data set>.cost", "<data set>.mean"), into buf. */
 void phc_study_output_name(const phc_problem *pb, size_t j, char *buf, size_t size);
