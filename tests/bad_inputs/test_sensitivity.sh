@@ -161,5 +161,20 @@ grep -q "failed after one retry: $n_failed" out/report.md || why "report does no
 grep -q "\"failed_evaluations\": $n_failed" out/result.json || why "result.json does not count them"
 finish "failed evaluations ($n_failed) recorded in the ledger and counted in the report"
 
+# ---- a prior in the user's unit: the same study in s-1 cm-2 and in h-1 cm-2 ----
+SEED_DIR="$SCRIPT_DIR/../../measurements/examples/weight_curve"
+cp "$SEED_DIR/seedling.csv" "$SEED_DIR/balance.csv" .
+cp "$SEED_DIR/seedling_sensitivity.yaml" per_s.yaml
+sed -e 's/unit: "s-1 cm-2",/unit: "h-1 cm-2",/' -e 's/lower: 3.0e-4, upper: 3.0e-3/lower: 1.08, upper: 10.8/' \
+    -e 's/value: 1.0e-3, lower: 0/value: 3.6, lower: 0/' per_s.yaml > per_h.yaml
+rm -rf sec hour
+run sensitivity per_s.yaml -o sec --samples 64
+cp "$T/stdout" sec.txt
+run sensitivity per_h.yaml -o hour --samples 64
+[ "$RC" -eq 0 ] || why "exit $RC"
+grep -q 'h-1 cm-2' per_h.yaml || why "the unit was not changed"
+diff <(sed '/^results/d' sec.txt) <(sed '/^results/d' "$T/stdout") >/dev/null || why "the verdicts differ"
+finish "a prior in h-1 cm-2 gives the study of the same prior in s-1 cm-2"
+
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
