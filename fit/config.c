@@ -59,7 +59,7 @@ static const phc_key_help top_help[] = {
     {"name", "Run name, used for the output directory runs/<name>/ and in the report. "
              "Default: the config file's name without its extension."},
     {"parameters", "The global parameters: {NAME: {value, lower, upper, fixed, unit, scale, "
-                   "range}, ...} or NAME: number (the start value). Required."},
+                   "range, prior}, ...} or NAME: number (the start value). Required."},
     {"datasets", "Non-empty list of data sets, each with `kind`, the common data-set keys and "
                  "its kind's keys. Required."},
     {"solver", "Mapping: how the fit is solved (keys below). Optional."},
@@ -135,7 +135,7 @@ static const phc_config_section blocks[PHC_CONFIG_N_BLOCKS] = {
                                      "unknown keys anywhere are errors naming the nearest valid key",
                         top_keys, top_help},
     [PHC_CONFIG_PARAMETER] = {"parameters", "NAME: {value, lower, upper, fixed, unit, scale, "
-                                            "range} or NAME: number (the start value)",
+                                            "range, prior} or NAME: number (the start value)",
                               parameter_keys, parameter_help},
     [PHC_CONFIG_DATASET] = {"datasets", "a list; every data set has these keys besides its "
                                         "kind's own",

@@ -90,7 +90,7 @@ int phc_saltelli_design_new(size_t k, const size_t *group_of, size_t n_factors, 
             goto fail;
         }
         double skip[40];
-        gsl_qrng_get(q, skip); /* the origin: on the corner of the cube */
+        gsl_qrng_get(q, skip); /* the centre: A_0 = B_0 (header) */
         for (size_t j = 0; j < o->n; ++j)
             gsl_qrng_get(q, d->base + j * 2 * k);
         gsl_qrng_free(q);

@@ -10,7 +10,9 @@
  * points is evaluated block by block.
  *
  * Base points: by default the quasi-random Sobol sequence of GSL
- * (gsl_qrng_sobol, dimension 2k <= 40, its first point (the origin) skipped)
+ * (gsl_qrng_sobol, dimension 2k <= 40; its first point, the centre
+ * (1/2, ..., 1/2), is skipped: it would make A_j = B_j, a row that adds
+ * nothing to the estimates but weight to the variance)
  * with A its first k and B its last k coordinates, as Saltelli et al. 2010
  * recommend: for the same N its error is smaller than random sampling's.
  * `randomised` draws A and B from a seeded Mersenne Twister instead (GSL's
