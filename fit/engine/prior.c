@@ -127,8 +127,15 @@ double phc_prior_quantile(const phc_prior *p, double u)
             z = gsl_cdf_ugaussian_Pinv(q);
         else
             z = -gsl_cdf_ugaussian_Pinv((1.0 - phi) + (1.0 - u) * (phi - plo));
-        const double x = p->a + p->b * z;
-        return p->kind == PHC_PRIOR_NORMAL ? x : exp(x);
+        const double x = p->kind == PHC_PRIOR_NORMAL ? p->a + p->b * z : exp(p->a + p->b * z);
+        /* Phi and its inverse round: a draw from the truncated distribution can
+           land a few ulps beyond a bound, which the model must never see; that
+           round-off (and only that: q lies inside the window) goes on the bound */
+        if (x < p->lower)
+            return p->lower;
+        if (x > p->upper)
+            return p->upper;
+        return x;
     }
     default:
         return NAN;

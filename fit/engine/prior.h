@@ -13,7 +13,8 @@
  *                (R's dlnorm names: the mean and sd of ln x)
  * normal and log-normal are truncated to [lower, upper] (the parameter's
  * bounds, -inf/+inf when open): the study never draws a value the model is
- * not allowed to see, and it never clamps one either.  Pure: no I/O. */
+ * not allowed to see (the inverse CDF's round-off, a few ulps beyond a
+ * bound, is put on the bound).  Pure: no I/O. */
 #ifndef PHC_PRIOR_H
 #define PHC_PRIOR_H
 

@@ -43,7 +43,7 @@ int phc_saltelli_design_new(size_t k, const size_t *group_of, size_t n_factors, 
                              "found %zu and %g", o->bootstrap, o->level);
     if (!o->randomised && 2 * k > 40)
         return phc_error_set(err, PHC_ERR_INPUT, "%zu parameters need %zu Sobol dimensions; GSL's sequence has 40: "
-                             "use the randomised design", k, 2 * k);
+                             "use the randomised design (phytocal sensitivity --design random)", k, 2 * k);
     phc_saltelli_design *d = calloc(1, sizeof *d);
     if (!d)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
