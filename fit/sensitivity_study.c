@@ -65,11 +65,16 @@ size_t phc_study_outputs(const phc_problem *pb)
 void phc_study_output_name(const phc_problem *pb, size_t j, char *buf, size_t size)
 {
     const size_t m = per_dataset(pb);
-    if (j == 0)
+    if (j == 0) {
         snprintf(buf, size, "cost");
-    else
-        snprintf(buf, size, "%s.%s", pb->datasets[(j - 1) / m]->name,
-                 m == 2 && (j - 1) % 2 == 0 ? "cost" : "mean");
+        return;
+    }
+    const size_t d = (j - 1) / m;
+    const char *what = m == 2 && (j - 1) % 2 == 0 ? "cost" : "mean";
+    if (pb->datasets[d]->name)
+        snprintf(buf, size, "%s.%s", pb->datasets[d]->name, what);
+    else /* a data set built in C may have no name */
+        snprintf(buf, size, "dataset-%zu.%s", d + 1, what);
 }
 
 phc_study_eval *phc_study_eval_new(const phc_problem *pb)
