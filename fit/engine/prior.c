@@ -77,7 +77,9 @@ int phc_prior_resolve(const phc_prior *p, double lower, double upper, const char
         if (p->kind == PHC_PRIOR_LOG_UNIFORM && !(p->a > 0))
             return phc_error_set(err, PHC_ERR_INPUT, "%s: prior log-uniform: lower must be positive, found %g",
                                  what, p->a);
-        if (p->a < lower || p->b > upper)
+        /* 1e-12 relative: bounds converted to a slot's unit and back may have
+           moved by round-off */
+        if (p->a < lower - 1e-12 * fabs(lower) || p->b > upper + 1e-12 * fabs(upper))
             return phc_error_set(err, PHC_ERR_INPUT, "%s: prior %s [%g, %g] reaches outside the bounds [%g, %g]",
                                  what, phc_prior_kind_name(p->kind), p->a, p->b, lower, upper);
         break;
