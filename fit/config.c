@@ -12,6 +12,7 @@
 #include "fit/config/yaml_keys.h"
 #include "fit/costs/source_file.h"
 #include "fit/engine/parameter_units.h"
+#include "fit/engine/prior.h"
 #include "measurements/suggest.h"
 #include "measurements/yaml_doc.h"
 
@@ -53,20 +54,23 @@ static const phc_key_help common_dataset_help[] = {
                     "has it, else central."},
     {NULL, NULL}};
 
-static const char *const top_keys[] = {"name", "parameters", "datasets", "solver", "report", NULL};
+static const char *const top_keys[] = {"name", "parameters", "datasets", "solver", "report", "groups", NULL};
 static const phc_key_help top_help[] = {
     {"name", "Run name, used for the output directory runs/<name>/ and in the report. "
              "Default: the config file's name without its extension."},
     {"parameters", "The global parameters: {NAME: {value, lower, upper, fixed, unit, scale, "
-                   "range}, ...} or NAME: number (the start value). Required."},
+                   "range, prior}, ...} or NAME: number (the start value). Required."},
     {"datasets", "Non-empty list of data sets, each with `kind`, the common data-set keys and "
                  "its kind's keys. Required."},
     {"solver", "Mapping: how the fit is solved (keys below). Optional."},
     {"report", "Mapping: the report's checks (keys below). Optional."},
+    {"groups", "Mapping {GROUP: [parameter, ...], ...}: parameters that `phytocal sensitivity` "
+               "varies together as one factor, with one index per group. A parameter belongs to "
+               "at most one group; a group is not empty. Optional."},
     {NULL, NULL}};
 
 static const char *const parameter_keys[] = {"value", "lower", "upper", "fixed", "unit",
-                                             "scale", "range", "per_piece", NULL};
+                                             "scale", "range", "per_piece", "prior", NULL};
 static const phc_key_help parameter_help[] = {
     {"value", "Start value, within the bounds. Required (or write NAME: number)."},
     {"lower", "Lower bound; not above upper. Default: none (-inf)."},
@@ -84,6 +88,11 @@ static const phc_key_help parameter_help[] = {
     {"per_piece", "true: the slots NAME_2, NAME_3, ... of a weight curve split at irrigations "
                   "(jumps: split) get their own copies of this parameter, with its start, "
                   "bounds, unit and scale, named as the slots. Default: false."},
+    {"prior", "The distribution `phytocal sensitivity` samples, in the parameter's unit: "
+              "{dist: uniform | log-uniform, lower, upper} (default: the bounds), "
+              "{dist: normal, mean, sd} or {dist: log-normal, meanlog, sdlog} (of ln x); normal "
+              "kinds are truncated to the bounds. Default: uniform on the bounds, which must then "
+              "be finite."},
     {NULL, NULL}};
 
 static const char *const solver_keys[] = {"method", "max_iterations", "function_tolerance",
@@ -126,7 +135,7 @@ static const phc_config_section blocks[PHC_CONFIG_N_BLOCKS] = {
                                      "unknown keys anywhere are errors naming the nearest valid key",
                         top_keys, top_help},
     [PHC_CONFIG_PARAMETER] = {"parameters", "NAME: {value, lower, upper, fixed, unit, scale, "
-                                            "range} or NAME: number (the start value)",
+                                            "range, prior} or NAME: number (the start value)",
                               parameter_keys, parameter_help},
     [PHC_CONFIG_DATASET] = {"datasets", "a list; every data set has these keys besides its "
                                         "kind's own",
@@ -175,6 +184,57 @@ static int expect_kind(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_y
     return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu:%zu: %s: expected %s, found %s", doc->path,
                          node ? node->line : 1, node ? node->column : 1, what, names[kind],
                          node ? names[node->kind] : "nothing");
+}
+
+/* prior: {dist, lower, upper | mean, sd | meanlog, sdlog} (fit/engine/prior.h);
+ * the numbers are checked here (phc_prior_resolve) so that a bad prior
+ * names its line whatever command reads the config. */
+static int parse_prior(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *ctx, phc_parameter *p,
+                       phc_error *err)
+{
+    static const char *const prior_keys[] = {"dist", "lower", "upper", "mean", "sd", "meanlog", "sdlog", NULL};
+    char pctx[200], what[400];
+    snprintf(pctx, sizeof pctx, "%s: prior", ctx);
+    snprintf(what, sizeof what, "%s:%zu: %s", doc->path, node->line, ctx);
+    int rc;
+    const char *dist = NULL;
+    if ((rc = expect_kind(doc, node, PHC_YAML_MAPPING, pctx, err)) ||
+        (rc = phc_yaml_check_keys(doc, node, prior_keys, pctx, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "dist", 1, pctx, &dist, err)))
+        return rc;
+    const int kind = phc_prior_kind_parse(dist);
+    if (kind < 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: dist: unknown distribution '%s'; expected uniform, "
+                             "log-uniform, normal or log-normal", doc->path, phc_yaml_get(node, "dist")->line, pctx,
+                             dist);
+    /* the keys each kind takes */
+    const char *first = "lower", *second = "upper";
+    if (kind == PHC_PRIOR_NORMAL) {
+        first = "mean";
+        second = "sd";
+    } else if (kind == PHC_PRIOR_LOG_NORMAL) {
+        first = "meanlog";
+        second = "sdlog";
+    }
+    for (size_t i = 0; i < node->count; ++i)
+        if (strcmp(node->keys[i], "dist") && strcmp(node->keys[i], first) && strcmp(node->keys[i], second))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: key '%s' does not belong to a %s prior (it takes "
+                                 "%s and %s)", doc->path, node->key_lines[i], pctx, node->keys[i], dist, first,
+                                 second);
+    const int bounded = kind == PHC_PRIOR_UNIFORM || kind == PHC_PRIOR_LOG_UNIFORM;
+    /* uniform kinds default to the bounds (in the same unit) */
+    double a = bounded ? p->lower : NAN, b = bounded ? p->upper : NAN;
+    if ((rc = phc_yaml_map_number(doc, node, first, !bounded, pctx, &a, err)) ||
+        (rc = phc_yaml_map_number(doc, node, second, !bounded, pctx, &b, err)))
+        return rc;
+    p->prior.kind = (phc_prior_kind)kind;
+    p->prior.a = a;
+    p->prior.b = b;
+    p->prior.lower = p->lower;
+    p->prior.upper = p->upper;
+    p->prior_line = node->line;
+    phc_prior check;
+    return phc_prior_resolve(&p->prior, p->lower, p->upper, what, &check, err);
 }
 
 static int parse_parameter(const phc_yaml_doc *doc, phc_problem *pb, const char *name,
@@ -235,6 +295,9 @@ static int parse_parameter(const phc_yaml_doc *doc, phc_problem *pb, const char 
             return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: range [%g, %g] is empty",
                                  doc->path, range->line, ctx, p->range_lo, p->range_hi);
     }
+    const phc_yaml_node *prior = phc_yaml_get(spec, "prior");
+    if (prior)
+        return parse_prior(doc, prior, ctx, p, err);
     return PHC_OK;
 }
 
@@ -349,6 +412,8 @@ static int per_piece_copy(phc_problem *pb, const char *global, long *idx, phc_er
     p->range_lo = copy.range_lo;
     p->range_hi = copy.range_hi;
     p->config_line = copy.config_line;
+    p->prior = copy.prior;
+    p->prior_line = copy.prior_line;
     if (copy.unit && !(p->unit = strdup(copy.unit)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     *idx = (long)index;
@@ -585,6 +650,50 @@ static char *stem_of(const char *path)
     return s;
 }
 
+/* groups: {NAME: [parameter, ...]}: parameters a sensitivity study varies
+ * as one factor.  Read after the data sets, whose per_piece copies may be
+ * named. */
+static int parse_groups(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_problem *pb, phc_error *err)
+{
+    int rc;
+    if ((rc = expect_kind(doc, node, PHC_YAML_MAPPING, "groups", err)))
+        return rc;
+    if (!(pb->groups = calloc(node->count ? node->count : 1, sizeof *pb->groups)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t g = 0; g < node->count; ++g) {
+        const phc_yaml_node *list = node->values[g];
+        phc_parameter_group *grp = &pb->groups[pb->n_groups++];
+        grp->config_line = node->key_lines[g];
+        if (!(grp->name = strdup(node->keys[g])))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (list->kind != PHC_YAML_SEQUENCE)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: groups: group '%s': expected a list of parameter "
+                                 "names", doc->path, list->line, node->keys[g]);
+        if (list->count == 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: groups: group '%s' is empty", doc->path, list->line,
+                                 node->keys[g]);
+        if (!(grp->members = calloc(list->count, sizeof *grp->members)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t i = 0; i < list->count; ++i) {
+            const phc_yaml_node *item = list->items[i];
+            const char *pname = NULL;
+            if ((rc = phc_yaml_string(doc, item, "groups", &pname, err)))
+                return rc;
+            const long idx = phc_problem_find_parameter(pb, pname);
+            if (idx < 0)
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: groups: group '%s': '%s' is not a parameter",
+                                     doc->path, item->line, node->keys[g], pname);
+            for (size_t h = 0; h < pb->n_groups; ++h)
+                for (size_t m = 0; m < pb->groups[h].n_members; ++m)
+                    if (pb->groups[h].members[m] == (size_t)idx)
+                        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: groups: parameter '%s' is already in "
+                                             "group '%s'", doc->path, item->line, pname, pb->groups[h].name);
+            grp->members[grp->n_members++] = (size_t)idx;
+        }
+    }
+    return PHC_OK;
+}
+
 int phc_config_load(const char *path, phc_problem **out, phc_error *err)
 {
     phc_yaml_doc *doc = NULL;
@@ -648,6 +757,9 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
     for (size_t i = 0; i < datasets->count; ++i)
         if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, err)))
             goto fail;
+    const phc_yaml_node *groups = phc_yaml_get(root, "groups");
+    if (groups && (rc = parse_groups(doc, groups, pb, err)))
+        goto fail;
     /* units converted, tolerances kept above the models' accuracy unless
      * the solver: block names them, the problem checked (problem.h) */
     unsigned keep = 0;

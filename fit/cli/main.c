@@ -2,6 +2,7 @@
  *
  *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S] [--resume] ...
  *   phytocal report DIR/result.json [--strict] [--level L]
  *   phytocal report --check DIR
  *   phytocal help [COMMAND | KIND | config | soil]   phytocal COMMAND --help
@@ -10,6 +11,7 @@
  * Exit codes: 0 success; 1 usage; 2 bad input; 3 the fit did not converge or
  * (with --strict) a report check failed, or (--check) an input or output
  * changed; 4 internal error. */
+#include <errno.h>
 #include <gsl/gsl_errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,6 +28,7 @@
 #include "fit/report.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
+#include "fit/sensitivity_study.h"
 #include "fit/simulate.h"
 #include "fit/version.h"
 #include "phc_git_commit.h"
@@ -66,6 +69,28 @@ static const command_help commands[] = {
      "(fields, frames, plant files), so start values can be checked before a fit.\n"
      "\n"
      "options: -o DIR, --force, --quiet, --help as for fit."},
+    {"sensitivity", "phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S]\n"
+                    "                     [--resume] [--second-order] [--design sobol|random] [--levels P]\n"
+                    "                     [--force] [--quiet]",
+     "Global sensitivity study over the free parameters' priors (`prior:`, else uniform on\n"
+     "the bounds; a `groups:` entry is one factor) of the model's outputs: the cost, and\n"
+     "per data set its cost and mean prediction.  Writes a run directory (default\n"
+     "runs/<name>-sensitivity/): result.json (indices with 95% bootstrap intervals),\n"
+     "report.md (which factors matter), <output>_sensitivity.png, ledger.tsv.\n"
+     "\n"
+     "options:\n"
+     "  --method M         sobol (default: first-order and total indices, Saltelli design)\n"
+     "                     or morris (elementary effects mu*, sigma; Morris 1991 trajectories)\n"
+     "  --samples N        sobol: base samples (default 512; N (k + 2) evaluations for k\n"
+     "                     factors); morris: trajectories (default 20; N (k + 1) evaluations)\n"
+     "  --seed S           design (morris, --design random) and bootstrap (default 1)\n"
+     "  --second-order     sobol: also the second-order indices (N (2k + 2) evaluations)\n"
+     "  --design D         sobol: GSL's Sobol sequence (default) or random (Mersenne Twister)\n"
+     "  --levels P         morris: grid levels, even (default 4)\n"
+     "  --resume           continue an interrupted study from DIR.ledger (its finished\n"
+     "                     evaluations are not recomputed; a ledger of another config or\n"
+     "                     design is refused, naming what differs)\n"
+     "  -o DIR, --force, --quiet as for fit."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",
      "Prints the summary of an earlier fit from its result.json; with --level L the\n"
@@ -160,7 +185,7 @@ static int cmd_help(int argc, char **argv)
     phc_error_clear(&err);
     if (phc_config_write_help(stdout, strcmp(argv[0], "config") == 0 ? NULL : argv[0], &err) == PHC_OK)
         return EXIT_OK;
-    fprintf(stderr, "phytocal: %s; commands: fit, simulate, report, help, version\n", err.message);
+    fprintf(stderr, "phytocal: %s; commands: fit, simulate, sensitivity, report, help, version\n", err.message);
     return EXIT_USAGE;
 }
 
@@ -420,6 +445,127 @@ static int cmd_simulate(int full_argc, char **full_argv, int argc, char **argv)
     return rc ? fail(&err) : EXIT_OK;
 }
 
+/* sensitivity: a global sensitivity study (sensitivity_study.h).  Its own
+ * options are taken out first; the rest goes through load_for_run. */
+static int parse_count(const char *opt, const char *text, unsigned long long max, unsigned long long *value)
+{
+    char *end = NULL;
+    errno = 0;
+    if (!text || !*text || *text == '-' || (*value = strtoull(text, &end, 10), errno != 0) || *end != '\0' ||
+        *value > max) {
+        fprintf(stderr, "phytocal sensitivity: %s: expected a whole number from 0 to %llu, found '%s'\n", opt, max,
+                text ? text : "");
+        return -1;
+    }
+    return 0;
+}
+
+static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+{
+    phc_study_options so = phc_study_options_default();
+    char **rest = calloc((size_t)argc + 1, sizeof *rest);
+    int n_rest = 0;
+    if (!rest)
+        return EXIT_INTERNAL;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        const int has_value = i + 1 < argc;
+        unsigned long long v = 0;
+        if (strcmp(a, "--method") == 0 || strcmp(a, "--design") == 0 || strcmp(a, "--samples") == 0 ||
+            strcmp(a, "--seed") == 0 || strcmp(a, "--levels") == 0) {
+            if (!has_value) {
+                fprintf(stderr, "phytocal sensitivity: %s needs a value\nusage: %s\n", a,
+                        find_command("sensitivity")->synopsis);
+                free(rest);
+                return EXIT_USAGE;
+            }
+            const char *val = argv[++i];
+            if (strcmp(a, "--method") == 0) {
+                if (strcmp(val, "sobol") == 0)
+                    so.method = PHC_STUDY_SOBOL;
+                else if (strcmp(val, "morris") == 0)
+                    so.method = PHC_STUDY_MORRIS;
+                else {
+                    fprintf(stderr, "phytocal sensitivity: --method: unknown method '%s'; expected morris or sobol\n",
+                            val);
+                    free(rest);
+                    return EXIT_INPUT;
+                }
+            } else if (strcmp(a, "--design") == 0) {
+                if (strcmp(val, "sobol") == 0)
+                    so.randomised = 0;
+                else if (strcmp(val, "random") == 0)
+                    so.randomised = 1;
+                else {
+                    fprintf(stderr, "phytocal sensitivity: --design: unknown design '%s'; expected sobol or random\n",
+                            val);
+                    free(rest);
+                    return EXIT_INPUT;
+                }
+            } else if (parse_count(a, val, strcmp(a, "--seed") == 0 ? 4294967295ULL : 1ULL << 30, &v) != 0) {
+                free(rest);
+                return EXIT_INPUT;
+            } else if (strcmp(a, "--samples") == 0) {
+                so.samples = (size_t)v;
+                if (v == 0) {
+                    fprintf(stderr, "phytocal sensitivity: --samples: N = 0 is too small\n");
+                    free(rest);
+                    return EXIT_INPUT;
+                }
+            } else if (strcmp(a, "--seed") == 0) {
+                so.seed = (unsigned long)v;
+            } else {
+                so.levels = (unsigned)v;
+            }
+        } else if (strcmp(a, "--resume") == 0) {
+            so.resume = 1;
+        } else if (strcmp(a, "--second-order") == 0) {
+            so.second_order = 1;
+        } else {
+            rest[n_rest++] = argv[i];
+        }
+    }
+    cli_options o;
+    phc_problem *pb = NULL;
+    phc_provenance *pv = NULL;
+    char dir[4096];
+    int code;
+    if (load_for_run("sensitivity", full_argc, full_argv, n_rest, rest, "-sensitivity", &o, &pb, &pv, dir,
+                     sizeof dir, &code)) {
+        free(rest);
+        return code;
+    }
+    free(rest);
+    /* test hook: stop after k new evaluations, as a killed study would */
+    const char *stop = getenv("PHYTOCAL_STOP_AFTER");
+    if (stop && *stop)
+        so.stop_after = (size_t)strtoull(stop, NULL, 10);
+    so.force = o.force;
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    so.progress = o.quiet ? NULL : progress_cb;
+    so.progress_data = &prog;
+    phc_error err;
+    phc_error_clear(&err);
+    phc_study_summary sum;
+    const int rc = phc_study_run(pb, &so, pv, dir, &sum, &err);
+    progress_end(&prog);
+    phc_provenance_free(pv);
+    phc_problem_free(pb);
+    if (rc) {
+        phc_study_summary_clear(&sum);
+        return fail(&err);
+    }
+    if (!o.quiet) {
+        printf("%s study: %zu evaluations (%zu computed, %zu from the ledger, %zu failed)\n",
+               so.method == PHC_STUDY_MORRIS ? "Morris" : "Sobol", sum.evaluations, sum.computed, sum.reused,
+               sum.failed);
+        fputs(sum.verdict ? sum.verdict : "", stdout);
+        printf("results: %s/ (result.json, report.md, plots, ledger.tsv)\n", dir);
+    }
+    phc_study_summary_clear(&sum);
+    return EXIT_OK;
+}
+
 /* report --check DIR: the run's inputs and outputs against its manifest. */
 static int check_run(const char *arg)
 {
@@ -513,6 +659,8 @@ int main(int argc, char **argv)
         return cmd_fit(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "simulate") == 0)
         return cmd_simulate(argc, argv, argc - 2, argv + 2);
+    if (strcmp(cmd, "sensitivity") == 0)
+        return cmd_sensitivity(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "report") == 0)
         return cmd_report(argc - 2, argv + 2);
     fprintf(stderr, "phytocal: unknown command '%s'\n", cmd);

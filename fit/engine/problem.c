@@ -57,6 +57,11 @@ void phc_problem_free(phc_problem *pb)
     for (size_t i = 0; i < pb->n_seeds; ++i)
         free(pb->seeds[i]);
     free(pb->seeds);
+    for (size_t i = 0; i < pb->n_groups; ++i) {
+        free(pb->groups[i].name);
+        free(pb->groups[i].members);
+    }
+    free(pb->groups);
     free(pb);
 }
 

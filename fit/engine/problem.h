@@ -8,6 +8,7 @@
 
 #include "fit/engine/ceres_bridge.h"
 #include "fit/engine/dataset.h"
+#include "fit/engine/prior.h"
 #include "model/status.h"
 
 typedef struct phc_parameter {
@@ -29,7 +30,19 @@ typedef struct phc_parameter {
     int per_piece;       /* the config's `per_piece: true`: a slot NAME_<k> (k >= 2) of a
                             curve split at irrigations gets its own copy of this
                             parameter (same start, bounds, unit and scale) */
+    phc_prior prior;     /* the config's `prior:` for sensitivity studies, in the user's unit
+                            (kind NONE: the bounds make a uniform one; fit/engine/prior.h) */
+    size_t prior_line;   /* line of `prior:` in the config, 0 when none */
 } phc_parameter;
+
+/* A group of parameters that a sensitivity study varies as one factor
+ * (`groups:` in the config). */
+typedef struct phc_parameter_group {
+    char *name;
+    size_t *members;     /* parameter indices */
+    size_t n_members;    /* >= 1 */
+    size_t config_line;
+} phc_parameter_group;
 
 /* The largest magnitude of a start value, finite bound or range end.  The
  * fit works on multiples of these (the automatic multi-start box spans 10x
@@ -61,6 +74,8 @@ typedef struct phc_problem {
     char **seeds;                 /* every `seed:` of the config as "datasets[1].soil.rocks.seed: 7",
                                      for provenance */
     size_t n_seeds;
+    phc_parameter_group *groups;  /* for sensitivity studies; a parameter is in at most one */
+    size_t n_groups;
 } phc_problem;
 
 phc_problem *phc_problem_new(const char *name);

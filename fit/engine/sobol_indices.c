@@ -1,0 +1,301 @@
+/* Sobol indices from a Saltelli design: see sobol_indices.h. */
+#include "fit/engine/sobol_indices.h"
+
+#include <gsl/gsl_qrng.h>
+#include <gsl/gsl_rng.h>
+#include <gsl/gsl_sort.h>
+#include <gsl/gsl_statistics_double.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct phc_saltelli_design {
+    size_t k, f, n, block; /* columns, factors, base samples, rows per base sample */
+    size_t *group_of;      /* k */
+    double *base;          /* n x 2k: A_j = base[j][0..k-1], B_j = base[j][k..2k-1] */
+    phc_saltelli_options o;
+};
+
+phc_saltelli_options phc_saltelli_options_default(void)
+{
+    phc_saltelli_options o = {1024, 0, 0, 1, 1000, 0.95};
+    return o;
+}
+
+int phc_saltelli_design_new(size_t k, const size_t *group_of, size_t n_factors, const phc_saltelli_options *o,
+                            phc_saltelli_design **out, phc_error *err)
+{
+    *out = NULL;
+    if (k == 0 || n_factors == 0 || n_factors > k)
+        return phc_error_set(err, PHC_ERR_INPUT, "a sensitivity study needs at least one factor to vary "
+                             "(found %zu parameters in %zu factors)", k, n_factors);
+    if (!group_of && n_factors != k)
+        return phc_error_set(err, PHC_ERR_INVALID, "without groups every parameter is its own factor");
+    const size_t n_min = o->second_order ? 16 : 8;
+    if (o->n < n_min)
+        return phc_error_set(err, PHC_ERR_INPUT, "samples: N = %zu is too small for %s indices: use at least %zu "
+                             "(a few hundred for useful intervals)", o->n,
+                             o->second_order ? "second-order" : "first-order and total", n_min);
+    if (o->n > (size_t)1 << 30)
+        return phc_error_set(err, PHC_ERR_INPUT, "samples: N = %zu is beyond 2^30", o->n);
+    if (o->bootstrap < 100 || !(o->level > 0 && o->level < 1))
+        return phc_error_set(err, PHC_ERR_INPUT, "bootstrap: needs >= 100 resamples and a level in (0, 1), "
+                             "found %zu and %g", o->bootstrap, o->level);
+    if (!o->randomised && 2 * k > 40)
+        return phc_error_set(err, PHC_ERR_INPUT, "%zu parameters need %zu Sobol dimensions; GSL's sequence has 40: "
+                             "use the randomised design (phytocal sensitivity --design random)", k, 2 * k);
+    phc_saltelli_design *d = calloc(1, sizeof *d);
+    if (!d)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    d->k = k;
+    d->f = n_factors;
+    d->n = o->n;
+    d->o = *o;
+    d->block = o->second_order ? 2 * n_factors + 2 : n_factors + 2;
+    d->group_of = malloc(k * sizeof *d->group_of);
+    d->base = malloc(o->n * 2 * k * sizeof *d->base);
+    size_t *count = calloc(n_factors, sizeof *count);
+    int rc = PHC_OK;
+    if (!d->group_of || !d->base || !count) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    for (size_t c = 0; c < k; ++c) {
+        d->group_of[c] = group_of ? group_of[c] : c;
+        if (d->group_of[c] >= n_factors) {
+            rc = phc_error_set(err, PHC_ERR_INVALID, "column %zu: factor %zu of %zu", c, d->group_of[c], n_factors);
+            goto fail;
+        }
+        count[d->group_of[c]]++;
+    }
+    for (size_t g = 0; g < n_factors; ++g)
+        if (!count[g]) {
+            rc = phc_error_set(err, PHC_ERR_INPUT, "factor %zu holds no parameter", g + 1);
+            goto fail;
+        }
+    if (o->randomised) {
+        gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+        if (!r) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        gsl_rng_set(r, o->seed);
+        for (size_t i = 0; i < o->n * 2 * k; ++i)
+            d->base[i] = gsl_rng_uniform_pos(r); /* (0, 1): unbounded priors stay finite */
+        gsl_rng_free(r);
+    } else {
+        gsl_qrng *q = gsl_qrng_alloc(gsl_qrng_sobol, (unsigned)(2 * k));
+        if (!q) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        double skip[40];
+        gsl_qrng_get(q, skip); /* the centre: A_0 = B_0 (header) */
+        for (size_t j = 0; j < o->n; ++j)
+            gsl_qrng_get(q, d->base + j * 2 * k);
+        gsl_qrng_free(q);
+    }
+    free(count);
+    *out = d;
+    return PHC_OK;
+fail:
+    free(count);
+    phc_saltelli_design_free(d);
+    return rc;
+}
+
+void phc_saltelli_design_free(phc_saltelli_design *d)
+{
+    if (!d)
+        return;
+    free(d->group_of);
+    free(d->base);
+    free(d);
+}
+
+size_t phc_saltelli_design_rows(const phc_saltelli_design *d)
+{
+    return d->n * d->block;
+}
+
+size_t phc_saltelli_design_factors(const phc_saltelli_design *d)
+{
+    return d->f;
+}
+
+void phc_saltelli_design_point(const phc_saltelli_design *d, size_t row, double *u)
+{
+    const size_t j = row / d->block, s = row % d->block, k = d->k;
+    const double *a = d->base + j * 2 * k, *b = a + k;
+    if (s == 0) {
+        memcpy(u, a, k * sizeof *u);
+    } else if (s == 1) {
+        memcpy(u, b, k * sizeof *u);
+    } else if (s < 2 + d->f) { /* A_B^i: A with factor i from B */
+        const size_t i = s - 2;
+        for (size_t c = 0; c < k; ++c)
+            u[c] = d->group_of[c] == i ? b[c] : a[c];
+    } else { /* B_A^i: B with factor i from A */
+        const size_t i = s - 2 - d->f;
+        for (size_t c = 0; c < k; ++c)
+            u[c] = d->group_of[c] == i ? a[c] : b[c];
+    }
+}
+
+void phc_sobol_indices_clear(phc_sobol_indices *s)
+{
+    if (!s)
+        return;
+    free(s->s1);
+    free(s->st);
+    free(s->s2);
+    memset(s, 0, sizeof *s);
+}
+
+/* The indices from the base samples idx[0..m-1] (repeats allowed), with y
+ * centred on its own mean over A and B of those samples (two passes: a cost
+ * of 1e6 varying by 1 keeps its digits).  s1, st: f values; s2: f*f or NULL. */
+static void estimate(const phc_saltelli_design *d, const double *y, const size_t *idx, size_t m, double *s1,
+                     double *st, double *s2)
+{
+    const size_t f = d->f, bl = d->block;
+    double sum = 0, sum2 = 0;
+    for (size_t t = 0; t < m; ++t)
+        sum += y[idx[t] * bl] + y[idx[t] * bl + 1];
+    const double mean = sum / (double)(2 * m);
+    for (size_t t = 0; t < m; ++t) {
+        const double a = y[idx[t] * bl] - mean, b = y[idx[t] * bl + 1] - mean;
+        sum2 += a * a + b * b;
+    }
+    const double var = sum2 / (double)(2 * m);
+    for (size_t i = 0; i < f; ++i) {
+        double a1 = 0, at = 0;
+        for (size_t t = 0; t < m; ++t) {
+            const double *yb = y + idx[t] * bl;
+            const double fa = yb[0] - mean, fb = yb[1] - mean, fab = yb[2 + i] - mean;
+            a1 += fb * (fab - fa);
+            at += (fa - fab) * (fa - fab);
+        }
+        s1[i] = var > 0 ? a1 / (double)m / var : NAN;
+        st[i] = var > 0 ? at / (2.0 * (double)m) / var : NAN;
+    }
+    if (!s2)
+        return;
+    for (size_t i = 0; i < f; ++i)
+        for (size_t j = 0; j < f; ++j) {
+            if (j <= i) {
+                s2[i * f + j] = NAN;
+                continue;
+            }
+            double acc = 0;
+            for (size_t t = 0; t < m; ++t) {
+                const double *yb = y + idx[t] * bl;
+                const double fa = yb[0] - mean, fb = yb[1] - mean;
+                const double fba_i = yb[2 + f + i] - mean, fab_j = yb[2 + j] - mean;
+                acc += fba_i * fab_j - fa * fb;
+            }
+            s2[i * f + j] = var > 0 ? acc / (double)m / var - s1[i] - s1[j] : NAN;
+        }
+}
+
+/* Percentile interval of the R values v (sorted here) at coverage level. */
+static void percentile(double *v, size_t r, double level, double *lo, double *hi)
+{
+    gsl_sort(v, 1, r);
+    *lo = gsl_stats_quantile_from_sorted_data(v, 1, r, 0.5 * (1 - level));
+    *hi = gsl_stats_quantile_from_sorted_data(v, 1, r, 1 - 0.5 * (1 - level));
+}
+
+int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, phc_sobol_indices *out,
+                               phc_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, nf2 = d->o.second_order ? f * f : 0;
+    size_t *used = malloc(n * sizeof *used), *draw = malloc(n * sizeof *draw);
+    double *boot = malloc(R * (2 * f + nf2) * sizeof *boot), *tmp = malloc((R > 1 ? R : 1) * sizeof *tmp);
+    out->n_factors = f;
+    out->s1 = malloc(3 * f * sizeof *out->s1);
+    out->st = malloc(3 * f * sizeof *out->st);
+    out->s2 = nf2 ? malloc(3 * nf2 * sizeof *out->s2) : NULL;
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    int rc = PHC_OK;
+    if (!used || !draw || !boot || !tmp || !out->s1 || !out->st || (nf2 && !out->s2) || !rng) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    out->s1_lo = out->s1 + f;
+    out->s1_hi = out->s1 + 2 * f;
+    out->st_lo = out->st + f;
+    out->st_hi = out->st + 2 * f;
+    if (nf2) {
+        out->s2_lo = out->s2 + nf2;
+        out->s2_hi = out->s2 + 2 * nf2;
+    }
+    size_t m = 0;
+    for (size_t j = 0; j < n; ++j) {
+        int ok = 1;
+        for (size_t s = 0; s < bl; ++s)
+            ok &= isfinite(y[j * bl + s]) != 0;
+        if (ok)
+            used[m++] = j;
+    }
+    out->n_used = m;
+    out->n_failed = n - m;
+    if (m < 4) {
+        rc = phc_error_set(err, PHC_ERR_NUMERIC, "only %zu of %zu base samples have every evaluation finished; "
+                           "the indices need at least 4", m, n);
+        goto done;
+    }
+    {
+        double sum = 0, sum2 = 0;
+        for (size_t t = 0; t < m; ++t) {
+            sum += y[used[t] * bl] + y[used[t] * bl + 1];
+        }
+        out->mean = sum / (double)(2 * m);
+        for (size_t t = 0; t < m; ++t) {
+            const double a = y[used[t] * bl] - out->mean, b = y[used[t] * bl + 1] - out->mean;
+            sum2 += a * a + b * b;
+        }
+        out->variance = sum2 / (double)(2 * m);
+    }
+    estimate(d, y, used, m, out->s1, out->st, out->s2);
+    /* bootstrap: a fixed stream per estimate call, so results do not depend
+       on which outputs were estimated before */
+    gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL);
+    for (size_t r = 0; r < R; ++r) {
+        for (size_t t = 0; t < m; ++t)
+            draw[t] = used[gsl_rng_uniform_int(rng, m)];
+        double *b = boot + r * (2 * f + nf2);
+        estimate(d, y, draw, m, b, b + f, nf2 ? b + 2 * f : NULL);
+    }
+    for (size_t i = 0; i < 2 * f + nf2; ++i) {
+        size_t cnt = 0;
+        for (size_t r = 0; r < R; ++r) {
+            const double v = boot[r * (2 * f + nf2) + i];
+            if (isfinite(v))
+                tmp[cnt++] = v;
+        }
+        double lo = NAN, hi = NAN;
+        if (cnt >= R / 2)
+            percentile(tmp, cnt, d->o.level, &lo, &hi);
+        if (i < f) {
+            out->s1_lo[i] = lo;
+            out->s1_hi[i] = hi;
+        } else if (i < 2 * f) {
+            out->st_lo[i - f] = lo;
+            out->st_hi[i - f] = hi;
+        } else {
+            out->s2_lo[i - 2 * f] = lo;
+            out->s2_hi[i - 2 * f] = hi;
+        }
+    }
+done:
+    gsl_rng_free(rng);
+    free(used);
+    free(draw);
+    free(boot);
+    free(tmp);
+    if (rc)
+        phc_sobol_indices_clear(out);
+    return rc;
+}

@@ -1,0 +1,278 @@
+/* The run ledger: see run_ledger.h. */
+#include "fit/run_ledger.h"
+
+#include <errno.h>
+#include <math.h>
+#include <nettle/sha2.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define LEDGER_MAGIC "# phytocal run ledger 1"
+
+struct phc_run_ledger {
+    FILE *f;
+    char *path;
+    size_t rows, n_out;
+    char *line; /* buffer of one record */
+    size_t line_size;
+};
+
+/* The first 16 hex digits of SHA-256(text[0..n-1]). */
+static void checksum(const char *text, size_t n, char hex[17])
+{
+    struct sha256_ctx ctx;
+    uint8_t digest[SHA256_DIGEST_SIZE];
+    sha256_init(&ctx);
+    sha256_update(&ctx, n, (const uint8_t *)text);
+    sha256_digest(&ctx, SHA256_DIGEST_SIZE, digest);
+    for (int i = 0; i < 8; ++i)
+        snprintf(hex + 2 * i, 3, "%02x", digest[i]);
+}
+
+static int read_all(const char *path, char **text, size_t *size, phc_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return phc_error_set(err, errno == ENOENT ? PHC_ERR_INPUT : PHC_ERR_IO, "%s: cannot open the ledger: %s%s",
+                             path, strerror(errno), errno == ENOENT ? " (nothing to resume)" : "");
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap + 1);
+    size_t got;
+    while (buf && (got = fread(buf + n, 1, cap - n, f)) > 0) {
+        n += got;
+        if (n == cap) {
+            char *grown = realloc(buf, 2 * cap + 1);
+            if (!grown) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = grown;
+            cap *= 2;
+        }
+    }
+    const int bad = ferror(f);
+    fclose(f);
+    if (!buf)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+    if (bad) {
+        free(buf);
+        return phc_error_set(err, PHC_ERR_IO, "%s: read error", path);
+    }
+    buf[n] = '\0';
+    *text = buf;
+    *size = n;
+    return PHC_OK;
+}
+
+/* Reads an existing ledger into y and state; *complete = bytes up to the
+ * end of the last complete line. */
+static int parse(const char *path, const char *text, size_t size, const char *const *keys,
+                 const char *const *values, size_t n_keys, size_t rows, size_t n_out, double *y,
+                 unsigned char *state, size_t *n_found, size_t *complete, phc_error *err)
+{
+    size_t pos = 0, lineno = 0, key_i = 0;
+    int in_header = 1;
+    *n_found = 0;
+    *complete = 0;
+    while (pos < size) {
+        const char *nl = memchr(text + pos, '\n', size - pos);
+        if (!nl)
+            break; /* a line cut off while being written: dropped */
+        const size_t len = (size_t)(nl - (text + pos));
+        char *line = malloc(len + 1);
+        if (!line)
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        memcpy(line, text + pos, len);
+        line[len] = '\0';
+        ++lineno;
+        int rc = PHC_OK;
+        if (lineno == 1) {
+            if (strcmp(line, LEDGER_MAGIC) != 0)
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:1: not a phytocal run ledger", path);
+        } else if (in_header) {
+            if (strcmp(line, "@ end") == 0) {
+                if (key_i != n_keys)
+                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the ledger is from another study: it has no "
+                                       "'%s'", path, lineno, keys[key_i]);
+                in_header = 0;
+            } else if (strncmp(line, "@ ", 2) != 0 || !strchr(line + 2, '\t')) {
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: expected '@ KEY<tab>VALUE' in the ledger's header",
+                                   path, lineno);
+            } else {
+                char *tab = strchr(line + 2, '\t');
+                *tab = '\0';
+                const char *k = line + 2, *v = tab + 1;
+                if (key_i >= n_keys || strcmp(k, keys[key_i]) != 0)
+                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the ledger is from another study: it records "
+                                       "'%s' where this study has '%s'", path, lineno, k,
+                                       key_i < n_keys ? keys[key_i] : "(nothing)");
+                else if (strcmp(v, values[key_i]) != 0)
+                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: the ledger is from another study: %s is '%s' "
+                                       "there and '%s' now; remove the ledger or give another -o",
+                                       path, lineno, k, v, values[key_i]);
+                ++key_i;
+            }
+        } else {
+            char *hash = strstr(line, " #");
+            char hex[17];
+            if (!hash || strlen(hash + 2) != 16) {
+                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: ledger record without its checksum", path, lineno);
+            } else {
+                checksum(line, (size_t)(hash - line), hex);
+                if (strcmp(hex, hash + 2) != 0) {
+                    rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: ledger record fails its checksum (the file "
+                                       "was changed); remove the ledger to start afresh", path, lineno);
+                } else {
+                    *hash = '\0';
+                    char *end = NULL;
+                    errno = 0;
+                    const unsigned long long row = strtoull(line, &end, 10);
+                    const int failed = strncmp(end, "\tfailed", 7) == 0;
+                    if (end == line || row >= rows || (!failed && strncmp(end, "\tok", 3) != 0)) {
+                        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: ledger record: bad row or state", path, lineno);
+                    } else if (state[row] != PHC_LEDGER_PENDING) {
+                        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: row %llu is recorded twice", path, lineno, row);
+                    } else {
+                        char *p = end + (failed ? 7 : 3);
+                        for (size_t j = 0; j < n_out && rc == PHC_OK; ++j) {
+                            if (*p != '\t') {
+                                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: ledger record: expected %zu outputs",
+                                                   path, lineno, n_out);
+                                break;
+                            }
+                            y[row * n_out + j] = strtod(p + 1, &end);
+                            if (end == p + 1)
+                                rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: ledger record: output %zu is not a "
+                                                   "number", path, lineno, j + 1);
+                            p = end;
+                        }
+                        if (rc == PHC_OK && *p != '\0')
+                            rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: ledger record: expected %zu outputs",
+                                               path, lineno, n_out);
+                        if (rc == PHC_OK) {
+                            state[row] = failed ? PHC_LEDGER_FAILED : PHC_LEDGER_OK;
+                            ++*n_found;
+                        }
+                    }
+                }
+            }
+        }
+        free(line);
+        if (rc)
+            return rc;
+        pos += len + 1;
+        *complete = pos;
+    }
+    if (in_header)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: the ledger's header is incomplete", path);
+    return PHC_OK;
+}
+
+int phc_run_ledger_open(const char *path, const char *const *keys, const char *const *values, size_t n_keys,
+                        size_t rows, size_t n_out, int resume, int replace, double *y, unsigned char *state,
+                        size_t *n_found, phc_run_ledger **out, phc_error *err)
+{
+    *out = NULL;
+    *n_found = 0;
+    for (size_t i = 0; i < rows * n_out; ++i)
+        y[i] = NAN;
+    memset(state, PHC_LEDGER_PENDING, rows);
+    phc_run_ledger *l = calloc(1, sizeof *l);
+    if (!l || !(l->path = strdup(path))) {
+        free(l);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    l->rows = rows;
+    l->n_out = n_out;
+    int rc = PHC_OK;
+    if (resume) {
+        char *text = NULL;
+        size_t size = 0, complete = 0;
+        if ((rc = read_all(path, &text, &size, err)))
+            goto fail;
+        rc = parse(path, text, size, keys, values, n_keys, rows, n_out, y, state, n_found, &complete, err);
+        free(text);
+        if (rc)
+            goto fail;
+        if (complete < size && truncate(path, (off_t)complete) != 0) {
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot cut off the unfinished last line: %s", path,
+                               strerror(errno));
+            goto fail;
+        }
+        if (!(l->f = fopen(path, "a"))) {
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot append: %s", path, strerror(errno));
+            goto fail;
+        }
+    } else {
+        struct stat st;
+        if (!replace && stat(path, &st) == 0) {
+            rc = phc_error_set(err, PHC_ERR_EXISTS, "%s: an unfinished study's ledger is here: --resume continues "
+                               "it, --force starts afresh", path);
+            goto fail;
+        }
+        if (!(l->f = fopen(path, "w"))) {
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot create the ledger: %s", path, strerror(errno));
+            goto fail;
+        }
+        fprintf(l->f, "%s\n", LEDGER_MAGIC);
+        for (size_t i = 0; i < n_keys; ++i) {
+            if (strpbrk(keys[i], "\t\n") || strpbrk(values[i], "\t\n")) {
+                rc = phc_error_set(err, PHC_ERR_INVALID, "ledger key '%s': tab or newline", keys[i]);
+                goto fail;
+            }
+            fprintf(l->f, "@ %s\t%s\n", keys[i], values[i]);
+        }
+        fprintf(l->f, "@ end\n");
+        if (fflush(l->f) != 0) {
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", path, strerror(errno));
+            goto fail;
+        }
+    }
+    l->line_size = 64 + 26 * n_out;
+    if (!(l->line = malloc(l->line_size))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    *out = l;
+    return PHC_OK;
+fail:
+    if (l->f)
+        fclose(l->f);
+    free(l->line);
+    free(l->path);
+    free(l);
+    return rc;
+}
+
+int phc_run_ledger_append(phc_run_ledger *l, size_t row, int failed, const double *y, phc_error *err)
+{
+    if (row >= l->rows)
+        return phc_error_set(err, PHC_ERR_INVALID, "ledger: row %zu of %zu", row, l->rows);
+    size_t n = (size_t)snprintf(l->line, l->line_size, "%zu\t%s", row, failed ? "failed" : "ok");
+    for (size_t j = 0; j < l->n_out; ++j) {
+        const double v = failed ? NAN : y[j];
+        n += (size_t)snprintf(l->line + n, l->line_size - n, "\t%.17g", v);
+    }
+    char hex[17];
+    checksum(l->line, n, hex);
+    if (fprintf(l->f, "%s #%s\n", l->line, hex) < 0 || fflush(l->f) != 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path, strerror(errno));
+    return PHC_OK;
+}
+
+int phc_run_ledger_close(phc_run_ledger *l, phc_error *err)
+{
+    if (!l)
+        return PHC_OK;
+    int rc = PHC_OK;
+    if (l->f && fclose(l->f) != 0)
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path, strerror(errno));
+    free(l->line);
+    free(l->path);
+    free(l);
+    return rc;
+}

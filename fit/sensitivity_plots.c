@@ -1,0 +1,164 @@
+/* Bar plots of sensitivity studies: see sensitivity_plots.h.  As in
+ * fit/plots.c, everything PLplot could fail on (the device, the file, an
+ * empty axis range) is checked before PLplot sees it, since its fatal errors
+ * exit the process. */
+#include "fit/sensitivity_plots.h"
+
+#include <math.h>
+#include <plplot.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/plot_file.h"
+
+enum { PAGE_W = 1000, PAGE_H = 700 };
+enum { COL_BG = 0, COL_FG = 1, COL_GRID = 2, COL_S0 = 3, COL_S1 = 4, COL_WHISKER = 5, COL_N = 6 };
+
+int phc_plot_bars(const char *path, const char *title, const char *y_label, const char *const *factors,
+                  size_t n_factors, const phc_bar_series *series, size_t n_series, phc_error *err)
+{
+    if (n_factors == 0 || n_series == 0 || n_series > 2)
+        return phc_error_set(err, PHC_ERR_INVALID, "%s: %zu factors, %zu series", path, n_factors, n_series);
+    double lo = 0, hi = 0;
+    for (size_t s = 0; s < n_series; ++s)
+        for (size_t i = 0; i < n_factors; ++i) {
+            const double v[3] = {series[s].value[i], series[s].lo ? series[s].lo[i] : NAN,
+                                 series[s].hi ? series[s].hi[i] : NAN};
+            for (int q = 0; q < 3; ++q)
+                if (isfinite(v[q])) {
+                    lo = v[q] < lo ? v[q] : lo;
+                    hi = v[q] > hi ? v[q] : hi;
+                }
+        }
+    if (!(hi > lo))
+        hi = lo + 1;
+    const double pad = 0.08 * (hi - lo);
+    hi += 0.40 * (hi - lo); /* headroom: the legend sits above the tallest bar */
+    if (lo < 0)
+        lo -= pad;
+    const int dev = phc_plot_device_available("pngcairo");
+    if (dev <= 0)
+        return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,
+                             "%s: PLplot has no 'pngcairo' device (install plplot-driver-cairo)", path);
+    char *etitle = phc_plot_escape(title), *ey = phc_plot_escape(y_label);
+    char **enames = calloc(n_factors, sizeof *enames);
+    char *elabel[2] = {NULL, NULL};
+    int rc = PHC_OK;
+    if (!etitle || !ey || !enames) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < n_factors; ++i)
+        if (!(enames[i] = phc_plot_escape(factors[i]))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    for (size_t s = 0; s < n_series; ++s)
+        if (!(elabel[s] = phc_plot_escape(series[s].label))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+    phc_atomic_file *af = NULL;
+    if ((rc = phc_atomic_file_open(path, &af, err)))
+        goto done;
+    PLINT old = 0, strm = -1;
+    plgstrm(&old);
+    plmkstrm(&strm);
+    if (strm < 0) {
+        plsstrm(old);
+        phc_atomic_file_abort(af);
+        rc = phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
+        goto done;
+    }
+    plsdev("pngcairo");
+    plsfnam(phc_atomic_file_temp_path(af));
+    plspage(0.0, 0.0, PAGE_W, PAGE_H, 0, 0);
+    plsfam(0, 0, 0);
+    static const PLINT rgb[COL_N][3] = {{255, 255, 255}, {0, 0, 0},      {221, 221, 221},
+                                        {31, 100, 190},  {230, 97, 1},   {40, 40, 40}};
+    plscmap0n(16);
+    for (int i = 0; i < COL_N; ++i)
+        plscol0(i, rgb[i][0], rgb[i][1], rgb[i][2]);
+    plinit();
+    pladv(0);
+    plschr(0.0, 1.1);
+    /* room below for the factor names, written at 45 degrees when many */
+    const int slanted = n_factors > 6;
+    plvpor(0.12, 0.97, slanted ? 0.26 : 0.16, 0.90);
+    plwind(-0.6, (double)n_factors - 0.4, lo, hi);
+    plcol0(COL_GRID);
+    plbox("", 0, 0, "g", 0, 0);
+    plcol0(COL_FG);
+    plbox("bc", 0, 0, "bcnstv", 0, 0);
+    if (lo < 0)
+        pljoin(-0.6, 0, (double)n_factors - 0.4, 0);
+    const double width = 0.8 / (double)n_series;
+    for (size_t s = 0; s < n_series; ++s) {
+        for (size_t i = 0; i < n_factors; ++i) {
+            const double x0 = (double)i - 0.4 + width * (double)s, x1 = x0 + width * 0.92;
+            const double v = series[s].value[i];
+            if (isfinite(v)) {
+                PLFLT px[4] = {x0, x1, x1, x0}, py[4] = {0, 0, v, v};
+                plcol0(s ? COL_S1 : COL_S0);
+                plfill(4, px, py);
+            }
+            if (series[s].lo && series[s].hi && isfinite(series[s].lo[i]) && isfinite(series[s].hi[i])) {
+                const double xm = 0.5 * (x0 + x1), cap = 0.15 * width;
+                plcol0(COL_WHISKER);
+                plwidth(2.0);
+                pljoin(xm, series[s].lo[i], xm, series[s].hi[i]);
+                pljoin(xm - cap, series[s].lo[i], xm + cap, series[s].lo[i]);
+                pljoin(xm - cap, series[s].hi[i], xm + cap, series[s].hi[i]);
+                plwidth(1.0);
+            }
+        }
+    }
+    plcol0(COL_FG);
+    for (size_t i = 0; i < n_factors; ++i) {
+        /* names under their bars: across when few, upright when many */
+        const double pos = ((double)i + 0.6) / (double)n_factors;
+        if (slanted)
+            plmtex("bv", 0.8, pos, 1.0, enames[i]);
+        else
+            plmtex("b", 1.6, pos, 0.5, enames[i]);
+    }
+    plmtex("t", 1.5, 0.5, 0.5, etitle);
+    plmtex("l", 5.5, 0.5, 0.5, ey);
+    plmtex("b", slanted ? 11.0 : 3.6, 0.5, 0.5, "factor");
+    /* legend: filled boxes; the whiskers are the 95% intervals */
+    PLINT opt[3], colours[3], fill_styles[3] = {0, 0, 0}, lcol[3] = {COL_FG, COL_FG, COL_FG},
+          lsty[3] = {1, 1, 1};
+    PLFLT fscale[3] = {1, 1, 1}, lw[3] = {1, 1, 1};
+    PLINT tcol[3] = {COL_FG, COL_FG, COL_FG};
+    const char *texts[3];
+    PLFLT lwidth, lheight;
+    size_t nl = 0;
+    for (size_t s = 0; s < n_series; ++s, ++nl) {
+        opt[nl] = PL_LEGEND_COLOR_BOX;
+        colours[nl] = s ? COL_S1 : COL_S0;
+        texts[nl] = elabel[s];
+    }
+    opt[nl] = PL_LEGEND_LINE;
+    colours[nl] = COL_WHISKER;
+    lcol[nl] = COL_WHISKER;
+    lw[nl] = 2;
+    texts[nl] = "95% bootstrap interval";
+    ++nl;
+    pllegend(&lwidth, &lheight, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, COL_BG, COL_FG, 1, 0, 0,
+             (PLINT)nl, opt, 1.0, 1.0, 2.0, 0.0, tcol, (const char *const *)texts, colours, fill_styles, fscale,
+             lw, lcol, lsty, lw, NULL, NULL, NULL, NULL);
+    plend1();
+    plsstrm(old);
+    rc = phc_plot_file_finish(af, PHC_OK, err);
+done:
+    free(etitle);
+    free(ey);
+    if (enames)
+        for (size_t i = 0; i < n_factors; ++i)
+            free(enames[i]);
+    free(enames);
+    free(elabel[0]);
+    free(elabel[1]);
+    return rc;
+}
