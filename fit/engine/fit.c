@@ -400,10 +400,10 @@ static int baseline_warnings(phc_fit_result *res)
                                            "does not (weighted RSS %.4g)",
                                       ds->name, bl->what, bl->goodness.k, g->wrss);
                 else
-                rc |= add_warning(res, "data set '%s': %s (%zu parameters) fits these data better than the model: "
-                                       "AICc %.4g against %.4g (R² %.3g against %.3g)",
-                                  ds->name, bl->what, bl->goodness.k, bl->goodness.aicc, g->aicc, bl->goodness.r2,
-                                  g->r2);
+                    rc |= add_warning(res, "data set '%s': %s (%zu parameters) fits these data better than the "
+                                           "model: AICc %.4g against %.4g (R² %.3g against %.3g)",
+                                      ds->name, bl->what, bl->goodness.k, bl->goodness.aicc, g->aicc,
+                                      bl->goodness.r2, g->r2);
             }
         }
     }
