@@ -82,6 +82,10 @@ static json_t *dataset_json(const phc_dataset_result *d)
                                       num(d->peak_fap)));
     if (d->extra_markdown)
         json_object_set_new(o, "extra_markdown", json_string(d->extra_markdown));
+    if (d->values_json) { /* the kind's numbers: stored as JSON, not as a string */
+        json_t *v = json_loads(d->values_json, JSON_DECODE_ANY, NULL);
+        json_object_set_new(o, "values", v ? v : json_string(d->values_json));
+    }
     if (d->series)
         json_object_set_new(o, "series", series_json(d));
     json_t *bl = json_array();
@@ -360,6 +364,10 @@ static int read_dataset(reader *rd, json_t *o, size_t index, phc_dataset_result 
     json_t *tod = json_object_get(o, "time_of_day");
     if (tod && !json_is_null(tod) && (rc = get_array(rd, o, "time_of_day", where, d->n, &d->time_of_day)))
         return rc;
+    json_t *values = json_object_get(o, "values");
+    if (values && !json_is_null(values) &&
+        !(d->values_json = json_dumps(values, JSON_COMPACT | JSON_REAL_PRECISION(17) | JSON_ENCODE_ANY)))
+        return phc_error_set(rd->err, PHC_ERR_NOMEM, "out of memory");
     json_t *extra = json_object_get(o, "extra_markdown");
     if (extra && (rc = get_string(rd, o, "extra_markdown", where, &d->extra_markdown)))
         return rc;

@@ -7,7 +7,15 @@
 
 phc_pv_options phc_pv_options_default(void)
 {
-    phc_pv_options o = {PHC_PV_BREAK_MIN_RSS, 3, 0};
+    phc_pv_options o = {PHC_PV_BREAK_MIN_RSS, 3, 0, PHC_PV_TLP_FITTED, PHC_PV_MODULUS_ABOVE_BREAK,
+                        PHC_PV_CUT_REGION_START};
+    return o;
+}
+
+phc_pv_options phc_pv_options_photosynthesis(void)
+{
+    phc_pv_options o = {PHC_PV_BREAK_MAX_R2, 3, 0, PHC_PV_TLP_MEASURED, PHC_PV_MODULUS_SHARED_BREAK,
+                        PHC_PV_CUT_PHOTOSYNTHESIS};
     return o;
 }
 
@@ -147,12 +155,14 @@ typedef struct split_fit {
     int ok;
 } split_fit;
 
-static void fit_split(phc_pv_result *r, size_t m, size_t *idx, split_fit *s)
+/* m driest points osmotic; the turgor line over the k wettest points (k =
+ * n − m above the break; more with a shared break). */
+static void fit_split(phc_pv_result *r, size_t m, size_t k, size_t *idx, split_fit *s)
 {
-    const size_t n = r->n, k = n - m;
+    const size_t n = r->n;
     memset(s, 0, sizeof *s);
     for (size_t i = 0; i < m; ++i)
-        idx[i] = k + i;
+        idx[i] = n - m + i;
     if (ols(r->rwc, r->inv_psi, idx, m, &s->osm))
         return;
     const double a = s->osm.p0, b = s->osm.p1;
@@ -166,7 +176,7 @@ static void fit_split(phc_pv_result *r, size_t m, size_t *idx, split_fit *s)
     if (ols(r->rwc, r->turgor, idx, k, &s->tur))
         return;
     s->rss_psi = s->tur.rss;
-    for (size_t i = k; i < n; ++i)
+    for (size_t i = n - m; i < n; ++i)
         s->rss_psi += r->turgor[i] * r->turgor[i];
 
     /* Covariances.  (c, e) = H P with H = (X_TᵀX_T)⁻¹X_Tᵀ and
@@ -288,29 +298,59 @@ int phc_pv_analyse(const double *psi, const double *rwc, size_t n, const phc_pv_
             r->warnings |= PHC_PV_WARN_RWC_ABOVE_ONE;
     }
 
-    /* The breakpoint. */
+    /* The breakpoint: m, the size of the osmotic region. */
     size_t m_lo = opt.min_points, m_hi = n - opt.min_points, m_best = 0;
     if (opt.rule == PHC_PV_BREAK_FIXED)
         m_lo = m_hi = opt.n_osmotic;
+    if (opt.rule == PHC_PV_BREAK_MAX_R2) { /* photosynthesis: i in 3:(n − 2), rows (n − i):n */
+        m_lo = 4;
+        m_hi = n - 1;
+    }
     split_fit s, best;
     memset(&best, 0, sizeof best);
     double crit_best = 0;
     for (size_t m = m_lo; m <= m_hi; ++m) {
-        fit_split(r, m, idx, &s);
+        if (opt.rule == PHC_PV_BREAK_MAX_R2) { /* the osmotic line alone decides; ties: the
+                                                  larger region, as the package's loop keeps
+                                                  the last maximum */
+            ols_fit f;
+            for (size_t i = 0; i < m; ++i)
+                idx[i] = n - m + i;
+            if (ols(r->rwc, r->inv_psi, idx, m, &f))
+                continue;
+            if (m_best == 0 || -f.r2 <= crit_best) {
+                crit_best = -f.r2;
+                m_best = m;
+            }
+            continue;
+        }
+        fit_split(r, m, n - m, idx, &s);
         if (!s.ok)
             continue;
-        const double crit = opt.rule == PHC_PV_BREAK_MAX_R2 ? -s.osm.r2 : s.rss_psi;
-        if (m_best == 0 || crit < crit_best) {
-            crit_best = crit;
+        if (m_best == 0 || s.rss_psi < crit_best) {
+            crit_best = s.rss_psi;
             m_best = m;
-            best = s;
         }
     }
     if (m_best == 0) {
         rc = phc_error_set(err, PHC_ERR_NUMERIC, "pressure-volume analysis: no split gives usable regressions");
         goto fail;
     }
-    fit_split(r, m_best, idx, &s); /* leaves osmotic[] and turgor[] of the chosen split */
+    /* The cut and the turgor points (the conventions). */
+    r->cut = opt.cut == PHC_PV_CUT_PHOTOSYNTHESIS ? m_best - 2 : n - m_best;
+    const size_t k_turgor = opt.modulus_points == PHC_PV_MODULUS_SHARED_BREAK ? r->cut + 1 : n - m_best;
+    if (k_turgor < 3) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "pressure-volume analysis: %zu point%s for the turgor line (the bulk modulus) with an "
+                           "osmotic region of %zu of %zu points; at least 3 are needed",
+                           k_turgor, k_turgor == 1 ? "" : "s", m_best, n);
+        goto fail;
+    }
+    fit_split(r, m_best, k_turgor, idx, &best); /* leaves osmotic[] and turgor[] of the chosen split */
+    if (!best.ok) {
+        rc = phc_error_set(err, PHC_ERR_NUMERIC, "pressure-volume analysis: the chosen split gives no usable regressions");
+        goto fail;
+    }
     r->n_osmotic = m_best;
     r->n_turgor = n - m_best;
     const double a = best.osm.p0, b = best.osm.p1, c = best.tur.p0, e = best.tur.p1;
@@ -334,15 +374,35 @@ int phc_pv_analyse(const double *psi, const double *rwc, size_t n, const phc_pv_
         double g[4] = {-1.0 / b, a / (b * b), 0, 0};
         r->apoplastic_fraction = delta(r->cov, g, -a / b);
     }
-    const double xt = -c / e;
-    {
-        double g[4] = {0, 0, -1.0 / e, c / (e * e)};
-        r->rwc_tlp = delta(r->cov, g, xt);
+    const double xt = opt.tlp == PHC_PV_TLP_MEASURED ? r->rwc[r->cut] : -c / e;
+    if (opt.tlp == PHC_PV_TLP_MEASURED) { /* a measured point: no standard error */
+        r->rwc_tlp = (phc_pv_estimate){r->rwc[r->cut], NAN};
+        r->psi_tlp = (phc_pv_estimate){r->psi[r->cut], NAN};
+    } else {
+        {
+            double g[4] = {0, 0, -1.0 / e, c / (e * e)};
+            r->rwc_tlp = delta(r->cov, g, xt);
+        }
+        {
+            const double Lt = a + b * xt, f = 1.0 / (Lt * Lt);
+            double g[4] = {f, f * xt, f * b * (-1.0 / e), f * b * c / (e * e)};
+            r->psi_tlp = delta(r->cov, g, -1.0 / Lt);
+        }
     }
+    /* Capacitances: slopes of RWC on ψ above and below the cut (both include it). */
     {
-        const double Lt = a + b * xt, f = 1.0 / (Lt * Lt);
-        double g[4] = {f, f * xt, f * b * (-1.0 / e), f * b * c / (e * e)};
-        r->psi_tlp = delta(r->cov, g, -1.0 / Lt);
+        ols_fit f;
+        for (size_t i = 0; i <= r->cut; ++i)
+            idx[i] = i;
+        r->capacitance_ft = (phc_pv_estimate){NAN, NAN};
+        r->capacitance_tlp = (phc_pv_estimate){NAN, NAN};
+        if (r->cut + 1 >= 2 && !ols(r->psi, r->rwc, idx, r->cut + 1, &f))
+            r->capacitance_ft = (phc_pv_estimate){f.p1, r->cut + 1 > 2 ? sqrt(f.rss / (double)(r->cut - 1) * f.inv[3]) : NAN};
+        const size_t mt = n - r->cut;
+        for (size_t i = 0; i < mt; ++i)
+            idx[i] = r->cut + i;
+        if (mt >= 2 && !ols(r->psi, r->rwc, idx, mt, &f))
+            r->capacitance_tlp = (phc_pv_estimate){f.p1, mt > 2 ? sqrt(f.rss / (double)(mt - 2) * f.inv[3]) : NAN};
     }
     {
         double g[4] = {0, 0, 0, 1};

@@ -44,6 +44,19 @@
  *                                     P against RWC above the tlp)
  *       ε_sym = e·(1 − a_f)           the same on SYMPLASTIC RWC,
  *                                     RWC_sym = (RWC − a_f)/(1 − a_f)
+ *       C_FT, C_TLP                   capacitances: slopes of RWC against ψ
+ *                                     (MPa⁻¹) above and below the cut point
+ *     Conventions (options): the tlp fitted from the turgor line, or the
+ *     measured point at the cut; ε from the points above the osmotic region,
+ *     or from the points down to and including the cut; the cut at the
+ *     osmotic region's wettest point, or where photosynthesis puts it.
+ *     photosynthesis: max_r2 over its candidates, measured tlp, shared
+ *     break, its cut (phc_pv_options_photosynthesis).  pvldcurve (R, read
+ *     from R/TurgorLossPoint.R and R/ModElasticity.R): the tlp where an
+ *     exponential and a linear part of one nls fit of −1/ψ against the
+ *     relative water deficit meet (a fitted tlp, from another model than
+ *     ours), ε from the points before it plus the point (tlp, P = 0) in
+ *     bar per % deficit.
  *     Standard errors: (a, b) from the osmotic regression (s² = RSS/(m − 2));
  *     (c, e) from the turgor regression plus the propagation of (a, b) into
  *     the P_i (the two point sets are disjoint, so their noises are
@@ -75,13 +88,49 @@ typedef enum phc_pv_breakpoint_rule {
     PHC_PV_BREAK_FIXED    /* options.n_osmotic driest points */
 } phc_pv_breakpoint_rule;
 
+/* Where the turgor loss point is read (item 5). */
+typedef enum phc_pv_tlp {
+    PHC_PV_TLP_FITTED = 0, /* where the turgor line P = c + e·RWC reaches 0 (default) */
+    PHC_PV_TLP_MEASURED    /* the measured point at the cut (ψ and RWC of that point;
+                              no standard error): the R package photosynthesis */
+} phc_pv_tlp;
+
+/* Which points the bulk modulus ε (and the turgor line) is fitted to. */
+typedef enum phc_pv_modulus_points {
+    PHC_PV_MODULUS_ABOVE_BREAK = 0, /* the points above the osmotic region only (default) */
+    PHC_PV_MODULUS_SHARED_BREAK     /* the wettest points down to and including the cut point
+                                       (photosynthesis: lm(psi_p ~ RWC) on rows 1..cut) */
+} phc_pv_modulus_points;
+
+/* The cut: the point that separates "full turgor" from "after the turgor
+ * loss point" for a measured tlp, a shared-break modulus and the
+ * capacitances. */
+typedef enum phc_pv_cut {
+    PHC_PV_CUT_REGION_START = 0, /* the wettest point of the osmotic region (default) */
+    PHC_PV_CUT_PHOTOSYNTHESIS    /* photosynthesis::fit_PV_curve's row: its loop variable i
+                                    (rows (n−i):n are the osmotic region, m = i + 1 points),
+                                    used as a row index from the wettest point, i.e. the
+                                    (m − 1)-th point; the region's first point only when
+                                    n = 2i.  Offered to reproduce the package's numbers. */
+} phc_pv_cut;
+
 typedef struct phc_pv_options {
     phc_pv_breakpoint_rule rule;
-    size_t min_points; /* per region, ≥ 3 (one residual degree of freedom) */
+    size_t min_points; /* per region, ≥ 3 (one residual degree of freedom); not used by
+                          PHC_PV_BREAK_MAX_R2, whose candidates are the package's */
     size_t n_osmotic;  /* PHC_PV_BREAK_FIXED only */
+    phc_pv_tlp tlp;
+    phc_pv_modulus_points modulus_points;
+    phc_pv_cut cut;
 } phc_pv_options;
 
-phc_pv_options phc_pv_options_default(void); /* MIN_RSS, 3, 0 */
+phc_pv_options phc_pv_options_default(void); /* MIN_RSS, 3, 0, fitted, above_break, region start */
+
+/* The conventions of photosynthesis::fit_PV_curve (C. Muir, CRAN, read from
+ * R/fit_PV_curve.R): MAX_R2 over the last 4 .. n − 1 points (ties: the
+ * larger region), the tlp measured at its cut row, the modulus over the
+ * rows down to the cut, the cut as the package takes it. */
+phc_pv_options phc_pv_options_photosynthesis(void);
 
 typedef struct phc_pv_estimate {
     double value;
@@ -122,6 +171,11 @@ typedef struct phc_pv_result {
     phc_pv_estimate apoplastic_fraction; /* dimensionless */
     phc_pv_estimate epsilon;   /* MPa per unit total RWC */
     phc_pv_estimate epsilon_sym; /* MPa per unit symplastic RWC */
+    size_t cut;          /* the cut point (sorted index, options.cut) */
+    phc_pv_estimate capacitance_ft;  /* C_FT: slope of RWC on ψ over the points from the
+                                        wettest down to the cut, MPa⁻¹ (Sack et al. 2003;
+                                        OLS standard error) */
+    phc_pv_estimate capacitance_tlp; /* C_TLP: the same over the cut and the drier points */
     size_t n_modulus;   /* n − 1 */
     double *modulus_rwc; /* [n − 1] midpoints, RWC */
     double *modulus;     /* [n − 1] ΔP/ΔRWC, MPa */

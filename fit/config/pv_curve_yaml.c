@@ -11,7 +11,8 @@
 #include "fit/costs/source_file.h"
 
 static const char *const pv_curve_keys[] = {"file", "psi", "psi_unit", "fresh_mass", "bag_mass", "dry_mass",
-                                            "saturated_mass", "group", "leaf", "breakpoint", "sigma", NULL};
+                                            "saturated_mass", "group", "leaf", "breakpoint", "sigma",
+                                            "convention", "tlp", "modulus_points", "leaf_area", NULL};
 static const phc_key_help pv_curve_help[] = {
     {"file", "CSV table of the pressure-volume points, at least 6 per leaf, relative to the "
              "config file. Required."},
@@ -34,6 +35,16 @@ static const phc_key_help pv_curve_help[] = {
                    "number >= 3 of driest points. Default: min_rss."},
     {"sigma", "Standard deviation of the moduli, a positive number, MPa. "
               "Default: unweighted."},
+    {"convention", "phytocal (the defaults below) or photosynthesis (exactly as the R package "
+                   "photosynthesis::fit_PV_curve: breakpoint max_r2 over its candidates, tlp "
+                   "measured at its cut row, modulus_points shared_break). The keys below "
+                   "override it. Default: phytocal."},
+    {"tlp", "fitted (where the turgor line reaches zero; default) or measured (the measured "
+            "point at the break)."},
+    {"modulus_points", "Points of the bulk modulus (turgor line): above_break (default) or "
+                       "shared_break (down to and including the break point)."},
+    {"leaf_area", "A column or a number, cm2 (> 0): gives C*_FT, the capacitance at full turgor "
+                  "per leaf area (mol m-2 MPa-1). Default: none."},
     {NULL, NULL}};
 
 /* `breakpoint:` min_rss | max_r2 | a whole number >= 3 of driest points. */
@@ -61,15 +72,27 @@ static int read_keys(const phc_yaml_doc *doc, const phc_yaml_node *node, const c
                      phc_pv_curve_options *o, phc_error *err)
 {
     const char *ctx = "pv_curve data set", *bp = NULL;
-    int rc;
+    static const char *const conventions[] = {"phytocal", "photosynthesis", NULL};
+    static const char *const tlps[] = {"fitted", "measured", NULL};
+    static const char *const points[] = {"above_break", "shared_break", NULL};
+    int rc, convention = 0, tlp = -1, mp = -1;
     if ((rc = phc_yaml_map_string(doc, node, "file", 1, ctx, file, err)) ||
         (rc = phc_yaml_map_string(doc, node, "psi", 1, ctx, &o->psi, err)) ||
         (rc = phc_yaml_map_string(doc, node, "psi_unit", 0, ctx, &o->psi_unit, err)) ||
         (rc = phc_yaml_map_string(doc, node, "fresh_mass", 1, ctx, &o->fresh_mass, err)) ||
         (rc = phc_yaml_map_string(doc, node, "group", 0, ctx, &o->group, err)) ||
         (rc = phc_yaml_map_string(doc, node, "leaf", 0, ctx, &o->leaf, err)) ||
-        (rc = phc_yaml_map_string(doc, node, "breakpoint", 0, ctx, &bp, err)))
+        (rc = phc_yaml_map_string(doc, node, "breakpoint", 0, ctx, &bp, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "convention", ctx, conventions, &convention, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "tlp", ctx, tlps, &tlp, err)) ||
+        (rc = phc_yaml_map_choice(doc, node, "modulus_points", ctx, points, &mp, err)))
         return rc;
+    if (convention == 1)
+        o->analysis = phc_pv_options_photosynthesis();
+    if (tlp >= 0)
+        o->analysis.tlp = tlp ? PHC_PV_TLP_MEASURED : PHC_PV_TLP_FITTED;
+    if (mp >= 0)
+        o->analysis.modulus_points = mp ? PHC_PV_MODULUS_SHARED_BREAK : PHC_PV_MODULUS_ABOVE_BREAK;
     return bp ? read_breakpoint(doc, node, bp, &o->analysis, err) : PHC_OK;
 }
 
@@ -147,7 +170,8 @@ static int pv_curve_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, con
     }
     if ((rc = read_mass(doc, node, "bag_mass", 0, table, NULL, &o.bag_mass, err)) ||
         (rc = read_mass(doc, node, "dry_mass", 1, table, NULL, &o.dry_mass, err)) ||
-        (rc = read_mass(doc, node, "saturated_mass", 1, table, &o.extrapolate_saturation, &o.saturated_mass, err)))
+        (rc = read_mass(doc, node, "saturated_mass", 1, table, &o.extrapolate_saturation, &o.saturated_mass, err)) ||
+        (rc = read_mass(doc, node, "leaf_area", 0, table, NULL, &o.leaf_area, err)))
         goto done;
     /* A sigma that is not a positive number is reported after what the
      * data themselves show, as it always was. */

@@ -21,6 +21,8 @@ typedef struct pv_extra {
     double *swc, *swc_se; /* extrapolated saturated water mass per leaf, g (NaN if measured) */
     size_t *swc_k;
     int extrapolated;
+    double *water_sat, *dry, *area; /* per leaf: saturated water g, dry mass g, area cm² (NaN: none) */
+    phc_pv_options analysis;        /* the conventions the leaves were analysed with */
 } pv_extra;
 
 static void pv_extra_free(void *p)
@@ -37,12 +39,20 @@ static void pv_extra_free(void *p)
     free(x->swc);
     free(x->swc_se);
     free(x->swc_k);
+    free(x->water_sat);
+    free(x->dry);
+    free(x->area);
     free(x);
 }
 
 static int pv_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err);
 static int pv_fit_outputs(phc_dataset *ds, const double *p, const char *dir, const char *base, phc_error *err);
 static int pv_name_series(phc_dataset *ds, phc_error *err);
+static int pv_report_values(phc_dataset *ds, const double *p, char **json, phc_error *err)
+{
+    (void)p;
+    return phc_pv_curve_values_json(ds, json, err);
+}
 
 const phc_dataset_ops phc_pv_curve_ops = {.kind = "pv_curve",
                                           .predict = phc_elasticity_predict,
@@ -50,6 +60,7 @@ const phc_dataset_ops phc_pv_curve_ops = {.kind = "pv_curve",
                                           .free_impl = phc_elasticity_impl_free,
                                           .report_section = pv_report_section,
                                           .fit_outputs = pv_fit_outputs,
+                                          .report_values = pv_report_values,
                                           .name_series = pv_name_series};
 
 static pv_extra *extra_of(const phc_dataset *ds)
@@ -110,9 +121,22 @@ int phc_pv_markdown_table(const phc_pv_result *const *results, const char *const
         put_estimate(f, r->apoplastic_fraction, 3);
         fputc('\n', f);
     }
-    fprintf(f, "\nValues ± standard errors (linear regressions, delta method). ε is dP/dRWC on total RWC, "
-               "ε_sym on symplastic RWC; the linear region is chosen by the breakpoint rule of "
-               "model/pressure_volume.h.\n");
+    fprintf(f, "\nValues ± standard errors (linear regressions, delta method; a measured turgor loss point "
+               "has none). ε is dP/dRWC on total RWC, ε_sym on symplastic RWC; the linear region is chosen by "
+               "the breakpoint rule of model/pressure_volume.h.\n\n");
+    fprintf(f, "| leaf | cut point: ψ (MPa), RWC (%%) | C_FT (MPa⁻¹) | C_TLP (MPa⁻¹) | RWC_tlp (%%) |\n");
+    fprintf(f, "|---|---:|---:|---:|---:|\n");
+    for (size_t i = 0; i < count; ++i) {
+        const phc_pv_result *r = results[i];
+        fprintf(f, "| %s | %.3f, %.2f |", labels[i], r->psi[r->cut], 100.0 * r->rwc[r->cut]);
+        put_estimate(f, r->capacitance_ft, 4);
+        put_estimate(f, r->capacitance_tlp, 4);
+        const phc_pv_estimate pct = {100.0 * r->rwc_tlp.value, 100.0 * r->rwc_tlp.stderr_};
+        put_estimate(f, pct, 2);
+        fputc('\n', f);
+    }
+    fprintf(f, "\nCapacitances: slopes of RWC against ψ from the wettest point down to the cut point (C_FT) and "
+               "from the cut point on (C_TLP).\n");
     int any = 0;
     for (size_t i = 0; i < count; ++i)
         for (unsigned b = 0; b < PHC_PV_WARN_COUNT; ++b)
@@ -142,10 +166,8 @@ int phc_pv_curve_markdown(const phc_dataset *ds, char **out, phc_error *err)
     char *table = NULL;
     int rc = phc_pv_markdown_table((const phc_pv_result *const *)x->res, (const char *const *)x->labels, x->count,
                                    title, &table, err);
-    if (rc || !x->extrapolated) {
-        *out = table;
+    if (rc)
         return rc;
-    }
     char *buf = NULL;
     size_t len = 0;
     FILE *f = open_memstream(&buf, &len);
@@ -154,10 +176,90 @@ int phc_pv_curve_markdown(const phc_dataset *ds, char **out, phc_error *err)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     fputs(table, f);
-    fprintf(f, "\nSaturated water mass extrapolated to ψ = 0 (ψ against leaf water over the wettest points):\n\n");
-    for (size_t i = 0; i < x->count; ++i)
-        fprintf(f, "- leaf %s: %.4f ± %.4f g (%zu points)\n", x->labels[i], x->swc[i], x->swc_se[i], x->swc_k[i]);
+    if (x->extrapolated) {
+        fprintf(f, "\nSaturated water mass extrapolated to ψ = 0 (ψ against leaf water over the wettest points):\n\n");
+        for (size_t i = 0; i < x->count; ++i)
+            fprintf(f, "- leaf %s: %.4f ± %.4f g (%zu points)\n", x->labels[i], x->swc[i], x->swc_se[i], x->swc_k[i]);
+    }
+    fprintf(f, "\nSaturated water content per dry mass (SWC) and the capacitance at full turgor per leaf area "
+               "(C*_FT = C_FT · saturated water / 18 g mol⁻¹ / area; photosynthesis labels it g m⁻² MPa⁻¹ but "
+               "divides by the molar mass of water, so it is mol m⁻² MPa⁻¹):\n\n");
+    for (size_t i = 0; i < x->count; ++i) {
+        fprintf(f, "- leaf %s: SWC %.4f g g⁻¹", x->labels[i], x->water_sat[i] / x->dry[i]);
+        if (isfinite(x->area[i]))
+            fprintf(f, ", C*_FT %.4f mol m⁻² MPa⁻¹ (area %.2f cm²)",
+                    x->res[i]->capacitance_ft.value * x->water_sat[i] / 18.0 / (x->area[i] * 1e-4), x->area[i]);
+        fputc('\n', f);
+    }
     free(table);
+    if (fclose(f) != 0 || !buf) {
+        free(buf);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    *out = buf;
+    return PHC_OK;
+}
+
+/* {"value": v, "stderr": s, "unit": u} with nulls for NaN. */
+static void put_json_estimate(FILE *f, const char *name, phc_pv_estimate e, const char *unit, int comma)
+{
+    fprintf(f, "\"%s\": {\"value\": ", name);
+    if (isfinite(e.value))
+        fprintf(f, "%.17g", e.value);
+    else
+        fprintf(f, "null");
+    fprintf(f, ", \"stderr\": ");
+    if (isfinite(e.stderr_))
+        fprintf(f, "%.17g", e.stderr_);
+    else
+        fprintf(f, "null");
+    fprintf(f, ", \"unit\": \"%s\"}%s", unit, comma ? ", " : "");
+}
+
+int phc_pv_curve_values_json(const phc_dataset *ds, char **out, phc_error *err)
+{
+    const pv_extra *x = extra_of(ds);
+    *out = NULL;
+    if (!x)
+        return phc_error_set(err, PHC_ERR_INVALID, "data set '%s' is not a pv_curve data set",
+                             ds && ds->name ? ds->name : "?");
+    static const char *const rules[] = {"min_rss", "max_r2", "fixed"};
+    const phc_pv_options *a = &x->analysis;
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    fprintf(f, "{\"conventions\": {\"breakpoint\": \"%s\", \"tlp\": \"%s\", \"modulus_points\": \"%s\", "
+               "\"cut\": \"%s\"}, \"leaves\": {",
+            rules[a->rule], a->tlp == PHC_PV_TLP_MEASURED ? "measured" : "fitted",
+            a->modulus_points == PHC_PV_MODULUS_SHARED_BREAK ? "shared_break" : "above_break",
+            a->cut == PHC_PV_CUT_PHOTOSYNTHESIS ? "photosynthesis" : "region_start");
+    for (size_t i = 0; i < x->count; ++i) {
+        const phc_pv_result *r = x->res[i];
+        const double swc = x->water_sat[i] / x->dry[i];
+        const double cstar = r->capacitance_ft.value * x->water_sat[i] / 18.0 / (x->area[i] * 1e-4);
+        fprintf(f, "%s\"", i ? ", " : "");
+        for (const char *c = x->labels[i]; *c; ++c) /* leaf ids are table cells: escape quotes */
+            fprintf(f, *c == '"' || *c == '\\' ? "\\%c" : "%c", *c);
+        fprintf(f, "\": {\"points\": %zu, \"osmotic_points\": %zu, \"r2_osmotic\": %.17g, ", r->n, r->n_osmotic,
+                r->r2_osmotic);
+        put_json_estimate(f, "pi_o", r->pi_o, "MPa", 1);
+        put_json_estimate(f, "psi_tlp", r->psi_tlp, "MPa", 1);
+        put_json_estimate(f, "rwc_tlp", r->rwc_tlp, "1", 1);
+        put_json_estimate(f, "rwc_tlp_percent", (phc_pv_estimate){100 * r->rwc_tlp.value, 100 * r->rwc_tlp.stderr_},
+                          "%", 1);
+        put_json_estimate(f, "epsilon", r->epsilon, "MPa", 1);
+        put_json_estimate(f, "epsilon_sym", r->epsilon_sym, "MPa", 1);
+        put_json_estimate(f, "apoplastic_fraction", r->apoplastic_fraction, "1", 1);
+        put_json_estimate(f, "c_ft", r->capacitance_ft, "MPa-1", 1);
+        put_json_estimate(f, "c_tlp", r->capacitance_tlp, "MPa-1", 1);
+        put_json_estimate(f, "swc", (phc_pv_estimate){swc, NAN}, "g g-1", 1);
+        put_json_estimate(f, "c_ft_star", (phc_pv_estimate){cstar, NAN}, "mol m-2 MPa-1", 1);
+        put_json_estimate(f, "saturated_water", (phc_pv_estimate){x->water_sat[i], x->swc_se[i]}, "g", 0);
+        fprintf(f, "}");
+    }
+    fprintf(f, "}}");
     if (fclose(f) != 0 || !buf) {
         free(buf);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -172,7 +274,7 @@ phc_pv_curve_options phc_pv_curve_options_default(void)
 {
     const phc_pv_mass none = {NULL, NAN};
     phc_pv_curve_options o = {0};
-    o.bag_mass = o.dry_mass = o.saturated_mass = none;
+    o.bag_mass = o.dry_mass = o.saturated_mass = o.leaf_area = none;
     o.analysis = phc_pv_options_default();
     return o;
 }
@@ -188,6 +290,7 @@ typedef struct pv_build {
     double to_mpa;     /* psi in that unit -> MPa */
     size_t n;          /* rows */
     double *psi, *fresh, *bag, *dry, *sat; /* per row: MPa (after check_rows), g; bag, sat may be NULL */
+    double *area;      /* per row: leaf area, cm², or NULL */
     size_t *gid;       /* per row: its leaf, an index into gname */
     const char **gname; /* the n_groups leaf ids, in order of appearance */
     size_t n_groups;
@@ -207,6 +310,7 @@ static void pv_build_free(pv_build *b)
     free(b->bag);
     free(b->dry);
     free(b->sat);
+    free(b->area);
     free(b->gid);
     free(b->gname);
     free(b->rows);
@@ -260,6 +364,9 @@ static int check_options(pv_build *b, phc_error *err)
     if (!(o->sigma >= 0 && isfinite(o->sigma)))
         return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'sigma': expected a positive number (MPa), found %g",
                              WHERE("sigma"), o->sigma);
+    if (!o->leaf_area.column && !isnan(o->leaf_area.value) && !(o->leaf_area.value > 0 && isfinite(o->leaf_area.value)))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'leaf_area': the area must be positive (cm2), found %g",
+                             WHERE("leaf_area"), o->leaf_area.value);
     return PHC_OK;
 }
 
@@ -312,7 +419,8 @@ static int read_columns(pv_build *b, phc_error *err)
         (rc = phc_table_column_numbers(b->t, o->fresh_mass, &b->fresh, err)) ||
         (rc = mass_values(b, "bag_mass", &o->bag_mass, &b->bag, err)) ||
         (rc = mass_values(b, "dry_mass", &o->dry_mass, &b->dry, err)) ||
-        (rc = mass_values(b, "saturated_mass", &o->saturated_mass, &b->sat, err)))
+        (rc = mass_values(b, "saturated_mass", &o->saturated_mass, &b->sat, err)) ||
+        (rc = mass_values(b, "leaf_area", &o->leaf_area, &b->area, err)))
         return rc;
     return PHC_OK;
 }
@@ -401,7 +509,8 @@ static int find_leaves(pv_build *b, phc_error *err)
     pv_extra *x = b->x = calloc(1, sizeof *x);
     if (!x || !(x->labels = calloc(nl, sizeof *x->labels)) || !(x->res = calloc(nl, sizeof *x->res)) ||
         !(x->swc = malloc(nl * sizeof *x->swc)) || !(x->swc_se = malloc(nl * sizeof *x->swc_se)) ||
-        !(x->swc_k = calloc(nl, sizeof *x->swc_k)))
+        !(x->swc_k = calloc(nl, sizeof *x->swc_k)) || !(x->water_sat = malloc(nl * sizeof *x->water_sat)) ||
+        !(x->dry = malloc(nl * sizeof *x->dry)) || !(x->area = malloc(nl * sizeof *x->area)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     x->extrapolated = b->opt->extrapolate_saturation;
     return PHC_OK;
@@ -448,6 +557,11 @@ static int analyse_leaf(pv_build *b, size_t L, phc_error *err)
         b->lwater[j] = b->fresh[i] - (b->bag ? b->bag[i] : 0) - b->dry[i];
     }
     x->swc[L] = x->swc_se[L] = NAN;
+    x->dry[L] = b->dry[rows[0]];
+    x->area[L] = b->area ? b->area[rows[0]] : NAN;
+    if (b->area && !(x->area[L] > 0 && isfinite(x->area[L])))
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: leaf '%s': key 'leaf_area': the area must be positive "
+                             "(cm2), found %g", b->path, first, id, x->area[L]);
     if (x->extrapolated) {
         if ((rc = phc_pv_extrapolate_saturation(b->lpsi, b->lwater, m, &x->swc[L], &x->swc_se[L], &x->swc_k[L], err)))
             return phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", b->path, first, id);
@@ -464,6 +578,8 @@ static int analyse_leaf(pv_build *b, size_t L, phc_error *err)
                                      "%s:%zu: leaf '%s': same relative water content (%g) as line %zu; masses "
                                      "must differ between points", b->path, phc_table_row_line(b->t, rows[j]), id,
                                      b->lrwc[j], phc_table_row_line(b->t, rows[q]));
+    x->water_sat[L] = x->extrapolated ? x->swc[L] : b->sat[rows[0]] - b->dry[rows[0]];
+    x->analysis = *opt;
     if ((rc = phc_pv_analyse(b->lpsi, b->lrwc, m, opt, &x->res[L], err)))
         return phc_error_prefix(err, rc, "%s:%zu: leaf '%s'", b->path, first, id);
     return PHC_OK;

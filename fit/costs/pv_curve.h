@@ -54,8 +54,14 @@ typedef struct phc_pv_curve_options {
                                or "pooled" (one logistic for all leaves' moduli; every leaf
                                still gets its own PV analysis); NULL only when the group
                                column holds one id */
-    phc_pv_options analysis; /* the breakpoint rule (model/pressure_volume.h); default
-                                min_rss */
+    phc_pv_options analysis; /* the breakpoint rule and the conventions (tlp, modulus
+                                points, cut; model/pressure_volume.h); default min_rss,
+                                fitted tlp, modulus above the break.
+                                phc_pv_options_photosynthesis() reproduces
+                                photosynthesis::fit_PV_curve */
+    phc_pv_mass leaf_area;  /* optional: the leaf's area, cm², a column (first row of a
+                               leaf) or a number (> 0); gives C*_FT, the capacitance at full
+                               turgor per leaf area, mol m⁻² MPa⁻¹ */
     double sigma;           /* > 0: standard deviation of the moduli, MPa; 0 = unweighted */
     const phc_origin *origin; /* where the options came from, for messages; NULL */
 } phc_pv_curve_options;
@@ -85,13 +91,22 @@ const phc_pv_result *phc_pv_curve_leaf(const phc_dataset *ds, size_t i, const ch
 
 /* A markdown section: one table row per leaf with π_o, ψ_tlp (MPa), RWC_tlp,
  * ε and ε_sym (MPa), apoplastic fraction, each "value ± standard error", the
- * linear-region size and R², then the warnings.  labels[i] names results[i].
+ * linear-region size and R²; a second table with the cut point, C_FT and
+ * C_TLP (MPa⁻¹) and RWC_tlp in percent; then the warnings.  labels[i] names
+ * results[i].
  * *out is malloc'd (free it).  `title` may be NULL. */
 int phc_pv_markdown_table(const phc_pv_result *const *results, const char *const *labels, size_t count,
                           const char *title, char **out, phc_error *err);
 
 /* The same for every leaf of a pv_curve data set (PHC_ERR_INVALID for other
- * kinds); adds how the saturated mass was obtained. */
+ * kinds); adds how the saturated mass was obtained, the saturated water
+ * content per dry mass SWC (g g⁻¹) and, with a leaf area, C*_FT
+ * (mol m⁻² MPa⁻¹). */
 int phc_pv_curve_markdown(const phc_dataset *ds, char **out, phc_error *err);
+
+/* Every leaf's parameters as a JSON object in text (full precision, null
+ * where undefined): {"conventions": {...}, "leaves": {"<id>": {"pi_o":
+ * {"value": v, "stderr": s, "unit": "MPa"}, ...}}}.  *out is malloc'd. */
+int phc_pv_curve_values_json(const phc_dataset *ds, char **out, phc_error *err);
 
 #endif /* PHC_COSTS_PV_CURVE_H */

@@ -68,6 +68,12 @@ typedef struct phc_dataset_ops {
      * line for root:shoot).  Returns 0 with *out filled, 1 when the kind has
      * none for these data, or an error code. */
     int (*baseline)(const phc_dataset *ds, struct phc_baseline *out);
+    /* Optional (NULL = none): the kind's own results as numbers at full
+     * precision, a JSON object in text (for example every pressure–volume
+     * parameter and its standard error per leaf), at the fitted slot values
+     * p; result.json stores it under the data set's "values".  *json is
+     * malloc'd. */
+    int (*report_values)(phc_dataset *ds, const double *p, char **json, phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {

@@ -47,6 +47,7 @@ static void dataset_result_clear(phc_dataset_result *d)
     free(d->curve_x);
     free(d->curve_y);
     free(d->extra_markdown);
+    free(d->values_json);
     free(d->series);
     for (size_t g = 0; d->series_names && g < d->n_series; ++g)
         free(d->series_names[g]);
@@ -534,6 +535,8 @@ static int fill_dataset_result(phc_dataset *ds, const double *x, const double *r
         goto fail;
     }
     if (ds->ops->report_section && (rc = ds->ops->report_section(ds, p, &d->extra_markdown, err)))
+        goto fail;
+    if (ds->ops->report_values && (rc = ds->ops->report_values(ds, p, &d->values_json, err)))
         goto fail;
     for (size_t i = 0; i < n; ++i) {
         d->residual[i] = d->y[i] - d->yhat[i];

@@ -77,6 +77,7 @@ typedef struct phc_dataset_result {
                                     bins (>= 2 h) to the span, hours, */
     double peak_power, peak_fap; /* its normalised power and Baluev false-alarm probability */
     char *extra_markdown;        /* the kind's own report section, or NULL */
+    char *values_json;           /* the kind's own numbers (a JSON object in text), or NULL */
     size_t n_baselines;          /* baselines[0] is the mean; then the kind's (baseline.h) */
     phc_baseline baselines[PHC_MAX_BASELINES];
 } phc_dataset_result;
