@@ -703,6 +703,24 @@ pv_config pv_text.yaml pv_text.csv '    dry_mass: dry
     leaf: A
 '
 fit_case "pv_curve: non-numeric mass" "$C/pv_text.yaml" "pv_text.csv:4:" "n/a"
+pv_config pv_tlp.yaml pv_ok.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+    tlp: guessed
+'
+fit_case "pv_curve: unknown tlp convention" "$C/pv_tlp.yaml" "pv_tlp.yaml:16" "'guessed'" "fitted, measured"
+pv_config pv_conv.yaml pv_ok.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+    convention: pvldcurve
+'
+fit_case "pv_curve: unknown convention" "$C/pv_conv.yaml" "pv_conv.yaml:16" "'pvldcurve'" "photosynthesis"
+pv_config pv_area.yaml pv_ok.csv '    dry_mass: dry
+    saturated_mass: sat
+    leaf: A
+    leaf_area: 0
+'
+fit_case "pv_curve: leaf area not positive" "$C/pv_area.yaml" "pv_area.yaml:16" "'leaf_area'" "positive"
 pv_config pv_group.yaml pv_ok.csv '    dry_mass: dry
     saturated_mass: sat
     leaf: L9
