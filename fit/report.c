@@ -159,7 +159,9 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
                 res->starts_at_best);
     if (res->rescue_starts)
         fprintf(f, "- the first start stalled (not converged, or a parameter with no effect on the model); "
-                   "%zu rescue starts were added\n", res->rescue_starts);
+                   "%zu rescue starts were added%s\n", res->rescue_starts,
+                res->rescue_stopped ? " and then stopped: each stalled on a plateau again without a lower cost, "
+                                      "so some parameter has no effect wherever the box was sampled" : "");
     fprintf(f, "- observations: %zu; free parameters: %zu; degrees of freedom: %ld\n", res->n_obs, res->n_free,
             res->dof);
     fprintf(f, "- variance factor s² = %s (%s)\n", fmt_num(a, sizeof a, res->s2),
@@ -275,7 +277,10 @@ void phc_report_print_summary(const phc_fit_result *res, FILE *out)
             res->summary.iterations, res->summary.termination);
     if (res->starts > 1)
         fprintf(out, "starts: %zu%s, %zu reached the best cost\n", res->starts,
-                res->rescue_starts ? " (first start stalled: rescue starts added)" : "", res->starts_at_best);
+                res->rescue_stopped  ? " (first start stalled: rescue starts added, stopped when they stalled too)"
+                : res->rescue_starts ? " (first start stalled: rescue starts added)"
+                                     : "",
+                res->starts_at_best);
     fprintf(out, "%-16s %15s %13s %29s  %s\n", "parameter", "value", "std. error", "95% interval", "unit");
     for (size_t i = 0; i < res->n_params; ++i) {
         const phc_param_result *p = &res->params[i];

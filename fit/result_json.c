@@ -125,6 +125,7 @@ static json_t *result_json(const phc_fit_result *res)
                                   num(res->summary.wall_time), "wall_time_total", num(res->total_time),
                                   "starts", (json_int_t)res->starts, "starts_at_best",
                                   (json_int_t)res->starts_at_best, "rescue_starts", (json_int_t)res->rescue_starts));
+    json_object_set_new(json_object_get(root, "solver"), "rescue_stopped", json_boolean(res->rescue_stopped));
     json_t *params = json_object();
     for (size_t i = 0; i < res->n_params; ++i) {
         const phc_param_result *p = &res->params[i];

@@ -765,6 +765,8 @@ static int add_cross_validation(const phc_problem *pb, phc_dataset *ds, const do
 
 /* ---- the solve stage: starts, rescue, polish ---------------------------- */
 
+#define RESCUE_PATIENCE 3 /* rescue starts that all stall on a plateau before the rest are skipped */
+
 /* Declares pb's parameters (bounds, fixed flags, scales) and one residual
  * block per data set to nls, and writes the configured start into x (np
  * values).  Every data set must be able to evaluate its model there
@@ -802,7 +804,7 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
 {
     const phc_fit_options *opt = &pb->options;
     const size_t np = pb->n_params;
-    size_t planned = opt->starts;
+    size_t planned = opt->starts, useless = 0;
     double best_cost = INFINITY;
     double *costs = calloc(opt->starts + opt->rescue_starts, sizeof *costs);
     phc_multistart *ms = NULL;
@@ -852,6 +854,20 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
             (res->summary.outcome != PHC_NLS_CONVERGED || stalled_on_plateau(nls, pb, best))) {
             planned += opt->rescue_starts;
             res->rescue_starts = opt->rescue_starts;
+        } else if (s > 0 && res->rescue_starts) {
+            /* A rescue start that stalls on a plateau again without a lower
+             * cost did not help.  When the first RESCUE_PATIENCE all do so,
+             * the parameter has no effect wherever the box was sampled (a
+             * rank-deficient problem, not a bad start): stop, rather than
+             * run every rescue start (16 by default, each as slow as the
+             * first on a simulation model). */
+            if (!better && stalled_on_plateau(nls, pb, x))
+                ++useless;
+            if (useless == s && s >= RESCUE_PATIENCE) {
+                res->rescue_stopped = 1;
+                res->rescue_starts = s;
+                planned = s + 1;
+            }
         }
     }
     res->starts = planned;

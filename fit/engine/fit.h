@@ -104,6 +104,8 @@ typedef struct phc_fit_result {
     double total_time;           /* all starts, seconds */
     size_t starts;               /* starts run */
     size_t rescue_starts;        /* of which added because start 0 stalled or failed */
+    int rescue_stopped;          /* 1: the rescue starts were stopped early, every one having
+                                    stalled on a plateau without a lower cost */
     size_t starts_at_best;       /* starts whose cost is within 1e-8 (relative) of the best */
     size_t n_obs, n_free;
     long dof;                    /* n_obs - n_free */
