@@ -257,9 +257,6 @@ static void test_bad(void)
     /* a unit of the wrong dimension */
     expect_error("WrongDim", good_data, edit(good_match, "\"g\",\"m.lf\"", "\"cm\",\"m.lf\""),
                  good_new, PHC_ERR_INPUT, "dataMatchColumns.csv:6:", "'cm' cannot be converted");
-    /* var_in that data.csv lacks */
-    expect_error("MissingVarIn", good_data, edit(good_match, "\"height (cm)\"", "\"height (in)\""),
-                 good_new, PHC_ERR_INPUT, "dataMatchColumns.csv:5:", "'height (in)'");
     /* var_out BAAD does not define */
     expect_error("BadVarOut", good_data, edit(good_match, "\"h.t\"", "\"h.tt\""), good_new,
                  PHC_ERR_INPUT, "dataMatchColumns.csv:5:", "var_out 'h.tt'");
@@ -283,6 +280,29 @@ static void test_bad(void)
     expect_error("NoData", NULL, good_match, good_new, PHC_ERR_IO, "data.csv", NULL);
     /* no dataMatchColumns.csv */
     expect_error("NoMatch", good_data, NULL, good_new, PHC_ERR_IO, "dataMatchColumns.csv", NULL);
+}
+
+/* A var_in that data.csv lacks (BAAD's dataManipulate.R would make it):
+ * the mapping row is skipped with a warning naming the file and line. */
+static void test_missing_var_in(void)
+{
+    const char *dir = make_study("MissingVarIn", good_data,
+                                 edit(good_match, "\"height (cm)\"", "\"height (in)\""), good_new);
+    phc_baad_study *s = NULL;
+    phc_error err;
+    const char *const *w = NULL;
+    CHECK(dir != NULL);
+    CHECK(phc_baad_read(dir, &s, &err) == 0);
+    if (!s)
+        return;
+    CHECK(phc_baad_warnings(s, &w) == 1);
+    CHECK_STR_CONTAINS(w[0], "dataMatchColumns.csv:5: var_in 'height (in)' (var_out h.t)");
+    CHECK_STR_CONTAINS(w[0], "mapping skipped");
+    CHECK(phc_baad_count(s).skipped_mappings == 1);
+    CHECK(isnan(phc_baad_row_at(s, 0)->h_t));
+    CHECK(phc_baad_row_at(s, 0)->d_ba == 0.002);
+    printf("  MissingVarIn: %s\n", w[0]);
+    phc_baad_free(s);
 }
 
 static void test_optional_and_free(void)
@@ -316,6 +336,7 @@ int main(void)
     }
     test_good();
     test_bad();
+    test_missing_var_in();
     test_optional_and_free();
     remove_all();
     return check_finish("test_baad");
