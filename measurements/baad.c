@@ -37,8 +37,10 @@ struct phc_baad_study {
     phc_baad_change *changes;
     size_t n_changes;
     double site_shift;
-    char *inputs[5]; /* the files read, as opened (phc_baad_inputs) */
+    char *inputs[6]; /* the files read, as opened (phc_baad_inputs) */
     size_t n_inputs;
+    char *na[8];           /* dataImportOptions.csv na.strings (R's read.csv) */
+    size_t n_na;
     const char **warnings; /* into strings */
     size_t n_warnings, cap_warnings;
     phc_baad_counts counts;
@@ -49,6 +51,18 @@ struct phc_baad_study {
 static int is_na(const char *t)
 {
     return !t || !*t || !strcmp(t, "NA");
+}
+
+/* Absent: empty, "NA" or one of the study's na.strings. */
+static int is_absent(const phc_baad_study *s, const char *t)
+{
+    size_t k;
+    if (is_na(t))
+        return 1;
+    for (k = 0; k < s->n_na; ++k)
+        if (!strcmp(t, s->na[k]))
+            return 1;
+    return 0;
 }
 
 /* A whole cell as a number in C syntax; 0 on success. */
@@ -434,6 +448,261 @@ static int read_csv(phc_baad_study *s, const char *dir, const char *file, int op
     return PHC_OK;
 }
 
+/* Adds path to the files read. */
+static int add_input(phc_baad_study *s, const char *path, phc_error *err)
+{
+    if (s->n_inputs >= sizeof s->inputs / sizeof s->inputs[0] ||
+        !(s->inputs[s->n_inputs] = dup_str(path)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    s->n_inputs++;
+    return PHC_OK;
+}
+
+/* dataImportOptions.csv (optional): the options BAAD's build passes to R's
+ * read.csv for data.csv.  Its first line is a header ("name","data.csv");
+ * then one option a line: header (TRUE), skip (lines before the header),
+ * na.strings (a cell text that means "absent", any number of lines).
+ * name must be data.csv and header TRUE (every BAAD study); *skip out. */
+static int read_import_options(phc_baad_study *s, const char *dir, size_t *skip, phc_error *err)
+{
+    phc_table *t = NULL;
+    size_t r;
+    int rc;
+    *skip = 0;
+    if ((rc = read_csv(s, dir, "dataImportOptions.csv", 1, &t, err)) || !t)
+        return rc;
+    if (phc_table_columns(t) != 2 || strcmp(phc_table_column_name(t, 0), "name") ||
+        strcmp(phc_table_column_name(t, 1), "data.csv")) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:1: expected the header \"name\",\"data.csv\" (BAAD reads data.csv)",
+                           phc_table_source(t));
+        goto done;
+    }
+    for (r = 0; r < phc_table_rows(t); ++r) {
+        const char *key = phc_table_cell(t, r, 0), *val = phc_table_cell(t, r, 1);
+        size_t line = phc_table_row_line(t, r);
+        double x;
+        if (!strcmp(key, "skip")) {
+            if (parse_number(val, &x) || x < 0 || x > 1e6 || x != floor(x)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: skip must be a whole number of lines, found '%s'",
+                                   phc_table_source(t), line, val);
+                goto done;
+            }
+            *skip = (size_t)x;
+        } else if (!strcmp(key, "header")) {
+            if (strcmp(val, "TRUE")) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: header '%s': only data.csv files with a header "
+                                   "line (TRUE) are read",
+                                   phc_table_source(t), line, val);
+                goto done;
+            }
+        } else if (!strcmp(key, "na.strings")) {
+            if (s->n_na < sizeof s->na / sizeof s->na[0]) {
+                if (!(s->na[s->n_na] = dup_str(val))) {
+                    rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                    goto done;
+                }
+                s->n_na++;
+            }
+        }
+        /* other read.csv options do not change what is read here */
+    }
+done:
+    phc_table_free(t);
+    return rc;
+}
+
+/* One CSV field of the header line at *p (stops at ',' or the line end);
+ * writes the unquoted text to out (cap bytes).  Returns 0, or -1 when a
+ * quoted field does not close on this line. */
+static int header_field(const char **p, char *out, size_t cap)
+{
+    const char *q = *p;
+    size_t n = 0;
+    while (*q == ' ' || *q == '\t')
+        ++q;
+    if (*q == '"') {
+        ++q;
+        for (;;) {
+            if (!*q || *q == '\n' || *q == '\r')
+                return -1;
+            if (*q == '"') {
+                if (q[1] == '"') {
+                    if (n + 1 < cap)
+                        out[n++] = '"';
+                    q += 2;
+                    continue;
+                }
+                ++q;
+                break;
+            }
+            if (n + 1 < cap)
+                out[n++] = *q;
+            ++q;
+        }
+        while (*q && *q != ',' && *q != '\n' && *q != '\r')
+            ++q;
+    } else {
+        while (*q && *q != ',' && *q != '\n' && *q != '\r') {
+            if (n + 1 < cap)
+                out[n++] = *q;
+            ++q;
+        }
+        while (n && (out[n - 1] == ' ' || out[n - 1] == '\t'))
+            --n;
+    }
+    out[n] = '\0';
+    *p = q;
+    return 0;
+}
+
+/* data.csv as BAAD's build reads it (R's read.csv with the study's
+ * dataImportOptions.csv, check.names = FALSE): the first `skip` lines are
+ * not read (each becomes a '#' comment line here, so line numbers stay the
+ * file's), and a header with empty or repeated names (R keeps them; a
+ * mapping finds the first) gets unique names for the columns no mapping can
+ * name: "(column N)" for an empty name, "NAME (column N)" for a repeat. */
+static int read_data(phc_baad_study *s, const char *dir, size_t skip, phc_error *err)
+{
+    char path[4096];
+    FILE *f;
+    char *buf = NULL, *fixed = NULL;
+    size_t len = 0, cap = 0, pos = 0, line, hdr, hdr_end;
+    int rc, changed = 0;
+    if ((size_t)snprintf(path, sizeof path, "%s/data.csv", dir) >= sizeof path)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s/data.csv: path too long", dir);
+    if (!(f = fopen(path, "rb")))
+        return phc_table_read(path, &s->data, err); /* its message names the path */
+    for (;;) {
+        size_t got;
+        if (cap - len < 65536) {
+            char *b = realloc(buf, cap + 65536 + 1);
+            if (!b) {
+                fclose(f);
+                free(buf);
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+            }
+            buf = b;
+            cap += 65536;
+        }
+        got = fread(buf + len, 1, cap - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    fclose(f);
+    buf[len] = '\0';
+    /* the skipped lines become comments */
+    for (line = 0; line < skip && pos < len; ++line) {
+        if (buf[pos] != '\n' && buf[pos] != '\r')
+            buf[pos] = '#';
+        while (pos < len && buf[pos] != '\n' && buf[pos] != '\r')
+            ++pos;
+        if (pos < len && buf[pos] == '\r' && pos + 1 < len && buf[pos + 1] == '\n')
+            ++pos;
+        if (pos < len)
+            ++pos;
+    }
+    /* the header: the next line that is neither blank nor a comment */
+    hdr = pos;
+    for (;;) {
+        size_t b = hdr;
+        while (b < len && (buf[b] == ' ' || buf[b] == '\t'))
+            ++b;
+        if (b < len && buf[b] != '#' && buf[b] != '\n' && buf[b] != '\r')
+            break;
+        while (hdr < len && buf[hdr] != '\n')
+            ++hdr;
+        if (hdr >= len)
+            break;
+        ++hdr;
+    }
+    hdr_end = hdr;
+    while (hdr_end < len && buf[hdr_end] != '\n' && buf[hdr_end] != '\r')
+        ++hdr_end;
+    if (hdr < len && memchr(buf + hdr, ',', hdr_end - hdr)) {
+        /* rebuild the header with unique, non-empty names */
+        size_t ncap = 4 * (hdr_end - hdr) + 4096, nlen = 0, ncol = 0;
+        char **names = NULL;
+        const char *p = buf + hdr;
+        int ok = 1;
+        if (hdr == 0 && len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3))
+            p += 3;
+        fixed = malloc(ncap);
+        names = malloc(((hdr_end - hdr) + 2) * sizeof *names);
+        if (!fixed || !names) {
+            free(fixed);
+            free(names);
+            free(buf);
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+        }
+        for (;;) {
+            char field[1024], name[1200];
+            size_t k;
+            if (header_field(&p, field, sizeof field)) {
+                ok = 0;
+                break;
+            }
+            if (!*field) {
+                snprintf(name, sizeof name, "(column %zu)", ncol + 1);
+                changed = 1;
+            } else {
+                snprintf(name, sizeof name, "%s", field);
+                for (k = 0; k < ncol; ++k)
+                    if (!strcmp(names[k], field))
+                        break;
+                if (k < ncol) {
+                    snprintf(name, sizeof name, "%s (column %zu)", field, ncol + 1);
+                    changed = 1;
+                }
+            }
+            if (nlen + 2 * strlen(name) + 4 >= ncap || !(names[ncol] = dup_str(field))) {
+                ok = 0;
+                break;
+            }
+            fixed[nlen++] = '"';
+            for (k = 0; name[k]; ++k) {
+                if (name[k] == '"')
+                    fixed[nlen++] = '"';
+                fixed[nlen++] = name[k];
+            }
+            fixed[nlen++] = '"';
+            fixed[nlen] = '\0';
+            ++ncol;
+            if (*p != ',')
+                break;
+            fixed[nlen++] = ',';
+            ++p;
+        }
+        while (ncol)
+            free(names[--ncol]);
+        free(names);
+        if (ok && changed) {
+            char *b = malloc(hdr + nlen + (len - hdr_end) + 1);
+            if (!b) {
+                free(fixed);
+                free(buf);
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+            }
+            memcpy(b, buf, hdr);
+            memcpy(b + hdr, fixed, nlen);
+            memcpy(b + hdr + nlen, buf + hdr_end, len - hdr_end);
+            len = hdr + nlen + (len - hdr_end);
+            b[len] = '\0';
+            free(buf);
+            buf = b;
+        }
+        free(fixed);
+    }
+    rc = phc_table_parse(buf, len, path, &s->data, err);
+    free(buf);
+    if (rc)
+        return rc;
+    return add_input(s, path, err);
+}
+
 static int need_column(const phc_table *t, const char *name, long *col, phc_error *err)
 {
     *col = phc_table_find(t, name);
@@ -462,9 +731,10 @@ static int fill_numeric(phc_baad_study *s, long k, size_t col, phc_unit_conversi
     baad_var *v = &s->vars[k];
     const char *src = phc_table_source(s->data);
     const char *var_in = phc_table_column_name(s->data, col);
-    phc_geo_axis axis;
+    phc_geo_axis axis = PHC_GEO_LATITUDE;
     int coord = is_coordinate(v->name, &axis);
-    size_t i;
+    size_t i, n_bad = 0;
+    char first[1024] = "";
     v->column = (long)col;
     for (i = 0; i < s->n; ++i) {
         const char *t = phc_table_cell(s->data, i, col);
@@ -472,22 +742,38 @@ static int fill_numeric(phc_baad_study *s, long k, size_t col, phc_unit_conversi
         double x;
         /* A lone dash marks a value not measured (Baltzer2007 data.csv:398,
          * d.ba '-'); R's as.numeric makes it NA in BAAD's build too. */
-        int absent = is_na(t) || !strcmp(t, "-");
+        int absent = is_absent(s, t) || !strcmp(t, "-");
         v->text[i] = absent ? NULL : t;
         if (absent)
             continue;
         if (coord) {
             char where[512];
+            phc_error e2;
             int rc;
             snprintf(where, sizeof where, "%s:%zu: column '%s' (%s)", src, line, var_in,
                      v->name);
-            rc = phc_geo_parse_angle(t, axis, where, &x, err);
-            if (rc)
-                return rc == PHC_ERR_INPUT ? rc : phc_error_prefix(err, rc, "%s", src);
+            rc = phc_geo_parse_angle(t, axis, where, &x, &e2);
+            if (rc == PHC_ERR_INPUT) {
+                /* BAAD's build (R's as.numeric) makes it NA; dataNew.csv
+                 * usually gives the site */
+                if (!n_bad++)
+                    snprintf(first, sizeof first, "%s", e2.message);
+                v->text[i] = NULL;
+                continue;
+            }
+            if (rc) {
+                if (err)
+                    *err = e2;
+                return phc_error_prefix(err, rc, "%s", src);
+            }
         } else if (parse_number(t, &x)) {
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: column '%s' (%s): expected a number, found '%s'", src,
-                                 line, var_in, v->name, t);
+            /* '#N/A', '#NULL!', '?', '24_5': R's as.numeric in BAAD's build
+             * makes such a cell NA; so does this reader, with a warning */
+            if (!n_bad++)
+                snprintf(first, sizeof first, "%s:%zu: column '%s' (%s): '%s' is not a number",
+                         src, line, var_in, v->name, t);
+            v->text[i] = NULL;
+            continue;
         }
         if (expr) {
             double y;
@@ -498,6 +784,17 @@ static int fill_numeric(phc_baad_study *s, long k, size_t col, phc_unit_conversi
         } else {
             v->num[i] = phc_unit_apply(c, x);
         }
+    }
+    if (n_bad) {
+        char w[1400];
+        if (n_bad > 1)
+            snprintf(w, sizeof w, "%s; read as absent, as are %zu more such cells of the column",
+                     first, n_bad - 1);
+        else
+            snprintf(w, sizeof w, "%s; read as absent", first);
+        s->counts.not_numbers += n_bad;
+        if (warn(s, w))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", src);
     }
     return PHC_OK;
 }
@@ -601,7 +898,7 @@ static int map_columns(phc_baad_study *s, const phc_table *match, const phc_tabl
             s->vars[k].column = col;
             for (i = 0; i < s->n; ++i) {
                 const char *t = phc_table_cell(s->data, i, (size_t)col);
-                s->vars[k].text[i] = is_na(t) ? NULL : trimmed(s, t, &oom);
+                s->vars[k].text[i] = is_absent(s, t) ? NULL : trimmed(s, t, &oom);
             }
             if (oom)
                 return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", msrc);
@@ -1081,7 +1378,9 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
         /* BAAD's config/ beside the study folders; else the parent itself */
         char config[4200];
         snprintf(config, sizeof config, "%s/config", parent);
-        if ((rc = read_csv(s, study_dir, "data.csv", 0, &s->data, err)) ||
+        size_t skip = 0;
+        if ((rc = read_import_options(s, study_dir, &skip, err)) ||
+            (rc = read_data(s, study_dir, skip, err)) ||
             (rc = read_csv(s, study_dir, "dataMatchColumns.csv", 0, &match, err)) ||
             (rc = read_csv(s, study_dir, "dataNew.csv", 1, &nw, err)) ||
             (rc = read_csv(s, config, "variableDefinitions.csv", 1, &defs, err)) ||
@@ -1282,6 +1581,8 @@ void phc_baad_free(phc_baad_study *s)
     free(s->species);
     free(s->changes);
     free(s->warnings);
+    for (k = 0; k < s->n_na; ++k)
+        free(s->na[k]);
     phc_table_free(s->data);
     for (k = 0; k < s->n_inputs; ++k)
         free(s->inputs[k]);

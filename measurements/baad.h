@@ -134,6 +134,8 @@ typedef struct phc_baad_counts {
     size_t conversions;       /* mapped numeric columns converted to BAAD's unit */
     size_t skipped_mappings;  /* mapping rows skipped: var_in not a column of data.csv */
     size_t trimmed;           /* text cells trimmed of blanks (data.csv and dataNew.csv) */
+    size_t not_numbers;       /* cells of mapped numeric columns read as absent: not numbers
+                                 (or unreadable coordinates) */
     size_t derived_diameters; /* rows whose d.ba comes from a.stba */
     size_t derived_roots;     /* rows whose m.rt is m.rf + m.rc */
     size_t derived_shoots;    /* rows whose m.so is m.st + m.lf */
