@@ -50,7 +50,7 @@ static int usable(const phc_baad_row *r)
 
 int main(void)
 {
-    char root[4096], *names[MAX_STUDIES];
+    char root[4096], *names[MAX_STUDIES], with_list[4096] = "", empty_list[2048] = "";
     size_t n_names = 0, i;
     size_t loaded = 0, errors = 0, with_rows = 0, lacking = 0, empty = 0;
     size_t total_rows = 0, total_usable = 0, total_aged = 0, total_conv = 0, total_skipped = 0;
@@ -141,15 +141,19 @@ int main(void)
         total_derived_rt += c.derived_roots;
         total_trimmed += c.trimmed;
         total_nan += c.not_numbers;
-        if (use)
+        if (use) {
             ++with_rows;
-        else if (lacks) {
+            snprintf(with_list + strlen(with_list), sizeof with_list - strlen(with_list), "%s%s (%zu)",
+                     *with_list ? ", " : "", names[i], use);
+        } else if (lacks) {
             ++lacking;
             lack_root += !strncmp(lacks, "no root", 7);
             lack_shoot += !strncmp(lacks, "no shoot", 8);
             lack_diameter += !strncmp(lacks, "no basal", 8);
         } else {
             ++empty;
+            snprintf(empty_list + strlen(empty_list), sizeof empty_list - strlen(empty_list), "%s%s",
+                     *empty_list ? ", " : "", names[i]);
         }
         /* a study with usable rows has the three variables */
         CHECK(!use || !lacks);
@@ -171,6 +175,8 @@ int main(void)
            "no shoot mass %zu, no basal diameter %zu); variables present but no row with all "
            "three %zu\n",
            with_rows, lacking, lack_root, lack_shoot, lack_diameter, empty);
+    printf("  with usable rows: %s\n", with_list);
+    printf("  variables present, no row with all three: %s\n", empty_list);
     printf("  Baltzer2007 Quercus rubra rows %zu\n", q_rubra);
 
     CHECK(n_names > 0);
