@@ -142,16 +142,19 @@ typedef struct phc_baad_counts {
     size_t ages;              /* rows with an age */
 } phc_baad_counts;
 
-/* Reads the study folder `study_dir` (variableDefinitions.csv is taken from
- * its parent folder).  On success *out owns everything; free with
- * phc_baad_free.  On failure *out is NULL and err says where and why. */
+/* Reads the study folder `study_dir` (BAAD's config files are taken from
+ * its parent folder's config/, else from the parent itself).  On success
+ * *out owns everything; free with phc_baad_free.  On failure *out is NULL
+ * and err says where and why. */
 int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err);
 void phc_baad_free(phc_baad_study *s); /* accepts NULL */
 
 const char *phc_baad_name(const phc_baad_study *s); /* folder name, e.g. "Baltzer2007" */
-/* The files the study was read from, as opened (data.csv,
- * dataMatchColumns.csv, dataNew.csv when present, ../variableDefinitions.csv),
- * for provenance; *paths (may be NULL) points into the study. */
+/* The files the study was read from, as opened (dataImportOptions.csv when
+ * present, data.csv, dataMatchColumns.csv, dataNew.csv when present,
+ * ../config/variableDefinitions.csv and ../config/variableConversion.csv, or
+ * the parent's own copies), for provenance; *paths (may be NULL) points into
+ * the study. */
 size_t phc_baad_inputs(const phc_baad_study *s, const char *const **paths);
 size_t phc_baad_rows(const phc_baad_study *s);
 const phc_baad_row *phc_baad_row_at(const phc_baad_study *s, size_t i); /* NULL if i is out of range */
