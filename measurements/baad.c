@@ -37,8 +37,13 @@ struct phc_baad_study {
     phc_baad_change *changes;
     size_t n_changes;
     double site_shift;
-    char *inputs[4]; /* the files read, as opened (phc_baad_inputs) */
+    char *inputs[6]; /* the files read, as opened (phc_baad_inputs) */
     size_t n_inputs;
+    char *na[8];           /* dataImportOptions.csv na.strings (R's read.csv) */
+    size_t n_na;
+    const char **warnings; /* into strings */
+    size_t n_warnings, cap_warnings;
+    phc_baad_counts counts;
 };
 
 /* ---- small helpers ------------------------------------------------------ */
@@ -46,6 +51,18 @@ struct phc_baad_study {
 static int is_na(const char *t)
 {
     return !t || !*t || !strcmp(t, "NA");
+}
+
+/* Absent: empty, "NA" or one of the study's na.strings. */
+static int is_absent(const phc_baad_study *s, const char *t)
+{
+    size_t k;
+    if (is_na(t))
+        return 1;
+    for (k = 0; k < s->n_na; ++k)
+        if (!strcmp(t, s->na[k]))
+            return 1;
+    return 0;
 }
 
 /* A whole cell as a number in C syntax; 0 on success. */
@@ -95,6 +112,183 @@ static char *dup_str(const char *t)
     if (c)
         strcpy(c, t);
     return c;
+}
+
+/* A warning sentence, kept in the study's pool. */
+static int warn(phc_baad_study *s, const char *text)
+{
+    int oom = 0;
+    const char *w;
+    if (s->n_warnings == s->cap_warnings) {
+        size_t cap = s->cap_warnings ? 2 * s->cap_warnings : 8;
+        const char **p = realloc(s->warnings, cap * sizeof *p);
+        if (!p)
+            return PHC_ERR_NOMEM;
+        s->warnings = p;
+        s->cap_warnings = cap;
+    }
+    w = keep(s, text, &oom);
+    if (oom)
+        return PHC_ERR_NOMEM;
+    s->warnings[s->n_warnings++] = w;
+    return PHC_OK;
+}
+
+/* `t` without leading and trailing blanks: t itself when it has none, else
+ * a pooled copy (counted in counts.trimmed).  NULL stays NULL. */
+static const char *trimmed(phc_baad_study *s, const char *t, int *oom)
+{
+    size_t a = 0, b;
+    char buf[1024];
+    if (!t)
+        return NULL;
+    b = strlen(t);
+    while (a < b && isspace((unsigned char)t[a]))
+        ++a;
+    while (b > a && isspace((unsigned char)t[b - 1]))
+        --b;
+    if (a == 0 && t[b] == '\0')
+        return t;
+    s->counts.trimmed++;
+    if (b - a < sizeof buf) {
+        memcpy(buf, t + a, b - a);
+        buf[b - a] = '\0';
+        return keep(s, buf, oom);
+    }
+    {
+        char *c = malloc(b - a + 1);
+        const char *k;
+        if (!c) {
+            *oom = 1;
+            return NULL;
+        }
+        memcpy(c, t + a, b - a);
+        c[b - a] = '\0';
+        k = keep(s, c, oom);
+        free(c);
+        return k;
+    }
+}
+
+/* ---- BAAD's conversion expressions ---------------------------------------
+ * config/variableConversion.csv gives each conversion as an R expression in
+ * x: "x/1000", "1/x", "10/x", "x*10^-6", "x/(10^6)", "x*14e-6".  The
+ * grammar read here (R's precedence: ^ binds tighter than unary minus, and
+ * is right-associative):
+ *   expr  = term {('+'|'-') term}      term  = unary {('*'|'/') unary}
+ *   unary = '-' unary | power          power = atom ['^' unary]
+ *   atom  = number | 'x' | '(' expr ')'
+ * Each parser returns 0 and advances *p, or -1 on a syntax error. */
+static int conv_expr(const char **p, double x, double *v);
+
+static void conv_blanks(const char **p)
+{
+    while (**p == ' ' || **p == '\t')
+        ++*p;
+}
+
+static int conv_atom(const char **p, double x, double *v)
+{
+    char *end = NULL;
+    conv_blanks(p);
+    if (**p == 'x') {
+        ++*p;
+        *v = x;
+        return 0;
+    }
+    if (**p == '(') {
+        ++*p;
+        if (conv_expr(p, x, v))
+            return -1;
+        conv_blanks(p);
+        if (**p != ')')
+            return -1;
+        ++*p;
+        return 0;
+    }
+    if (!isdigit((unsigned char)**p) && **p != '.')
+        return -1;
+    *v = phc_strtod_c(*p, &end);
+    if (end == *p)
+        return -1;
+    *p = end;
+    return 0;
+}
+
+static int conv_unary(const char **p, double x, double *v);
+
+static int conv_power(const char **p, double x, double *v)
+{
+    double e;
+    if (conv_atom(p, x, v))
+        return -1;
+    conv_blanks(p);
+    if (**p != '^')
+        return 0;
+    ++*p;
+    if (conv_unary(p, x, &e))
+        return -1;
+    *v = pow(*v, e);
+    return 0;
+}
+
+static int conv_unary(const char **p, double x, double *v)
+{
+    conv_blanks(p);
+    if (**p == '-') {
+        ++*p;
+        if (conv_unary(p, x, v))
+            return -1;
+        *v = -*v;
+        return 0;
+    }
+    return conv_power(p, x, v);
+}
+
+static int conv_term(const char **p, double x, double *v)
+{
+    double r;
+    if (conv_unary(p, x, v))
+        return -1;
+    for (;;) {
+        char op;
+        conv_blanks(p);
+        op = **p;
+        if (op != '*' && op != '/')
+            return 0;
+        ++*p;
+        if (conv_unary(p, x, &r))
+            return -1;
+        *v = op == '*' ? *v * r : *v / r;
+    }
+}
+
+static int conv_expr(const char **p, double x, double *v)
+{
+    double r;
+    if (conv_term(p, x, v))
+        return -1;
+    for (;;) {
+        char op;
+        conv_blanks(p);
+        op = **p;
+        if (op != '+' && op != '-')
+            return 0;
+        ++*p;
+        if (conv_term(p, x, &r))
+            return -1;
+        *v = op == '+' ? *v + r : *v - r;
+    }
+}
+
+/* The whole expression at x; 0 on success. */
+static int conv_eval(const char *expr, double x, double *v)
+{
+    const char *p = expr;
+    if (conv_expr(&p, x, v))
+        return -1;
+    conv_blanks(&p);
+    return *p ? -1 : 0;
 }
 
 static long var_find(const phc_baad_study *s, const char *name)
@@ -254,6 +448,261 @@ static int read_csv(phc_baad_study *s, const char *dir, const char *file, int op
     return PHC_OK;
 }
 
+/* Adds path to the files read. */
+static int add_input(phc_baad_study *s, const char *path, phc_error *err)
+{
+    if (s->n_inputs >= sizeof s->inputs / sizeof s->inputs[0] ||
+        !(s->inputs[s->n_inputs] = dup_str(path)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    s->n_inputs++;
+    return PHC_OK;
+}
+
+/* dataImportOptions.csv (optional): the options BAAD's build passes to R's
+ * read.csv for data.csv.  Its first line is a header ("name","data.csv");
+ * then one option a line: header (TRUE), skip (lines before the header),
+ * na.strings (a cell text that means "absent", any number of lines).
+ * name must be data.csv and header TRUE (every BAAD study); *skip out. */
+static int read_import_options(phc_baad_study *s, const char *dir, size_t *skip, phc_error *err)
+{
+    phc_table *t = NULL;
+    size_t r;
+    int rc;
+    *skip = 0;
+    if ((rc = read_csv(s, dir, "dataImportOptions.csv", 1, &t, err)) || !t)
+        return rc;
+    if (phc_table_columns(t) != 2 || strcmp(phc_table_column_name(t, 0), "name") ||
+        strcmp(phc_table_column_name(t, 1), "data.csv")) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:1: expected the header \"name\",\"data.csv\" (BAAD reads data.csv)",
+                           phc_table_source(t));
+        goto done;
+    }
+    for (r = 0; r < phc_table_rows(t); ++r) {
+        const char *key = phc_table_cell(t, r, 0), *val = phc_table_cell(t, r, 1);
+        size_t line = phc_table_row_line(t, r);
+        double x;
+        if (!strcmp(key, "skip")) {
+            if (parse_number(val, &x) || x < 0 || x > 1e6 || x != floor(x)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: skip must be a whole number of lines, found '%s'",
+                                   phc_table_source(t), line, val);
+                goto done;
+            }
+            *skip = (size_t)x;
+        } else if (!strcmp(key, "header")) {
+            if (strcmp(val, "TRUE")) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: header '%s': only data.csv files with a header "
+                                   "line (TRUE) are read",
+                                   phc_table_source(t), line, val);
+                goto done;
+            }
+        } else if (!strcmp(key, "na.strings")) {
+            if (s->n_na < sizeof s->na / sizeof s->na[0]) {
+                if (!(s->na[s->n_na] = dup_str(val))) {
+                    rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                    goto done;
+                }
+                s->n_na++;
+            }
+        }
+        /* other read.csv options do not change what is read here */
+    }
+done:
+    phc_table_free(t);
+    return rc;
+}
+
+/* One CSV field of the header line at *p (stops at ',' or the line end);
+ * writes the unquoted text to out (cap bytes).  Returns 0, or -1 when a
+ * quoted field does not close on this line. */
+static int header_field(const char **p, char *out, size_t cap)
+{
+    const char *q = *p;
+    size_t n = 0;
+    while (*q == ' ' || *q == '\t')
+        ++q;
+    if (*q == '"') {
+        ++q;
+        for (;;) {
+            if (!*q || *q == '\n' || *q == '\r')
+                return -1;
+            if (*q == '"') {
+                if (q[1] == '"') {
+                    if (n + 1 < cap)
+                        out[n++] = '"';
+                    q += 2;
+                    continue;
+                }
+                ++q;
+                break;
+            }
+            if (n + 1 < cap)
+                out[n++] = *q;
+            ++q;
+        }
+        while (*q && *q != ',' && *q != '\n' && *q != '\r')
+            ++q;
+    } else {
+        while (*q && *q != ',' && *q != '\n' && *q != '\r') {
+            if (n + 1 < cap)
+                out[n++] = *q;
+            ++q;
+        }
+        while (n && (out[n - 1] == ' ' || out[n - 1] == '\t'))
+            --n;
+    }
+    out[n] = '\0';
+    *p = q;
+    return 0;
+}
+
+/* data.csv as BAAD's build reads it (R's read.csv with the study's
+ * dataImportOptions.csv, check.names = FALSE): the first `skip` lines are
+ * not read (each becomes a '#' comment line here, so line numbers stay the
+ * file's), and a header with empty or repeated names (R keeps them; a
+ * mapping finds the first) gets unique names for the columns no mapping can
+ * name: "(column N)" for an empty name, "NAME (column N)" for a repeat. */
+static int read_data(phc_baad_study *s, const char *dir, size_t skip, phc_error *err)
+{
+    char path[4096];
+    FILE *f;
+    char *buf = NULL, *fixed = NULL;
+    size_t len = 0, cap = 0, pos = 0, line, hdr, hdr_end;
+    int rc, changed = 0;
+    if ((size_t)snprintf(path, sizeof path, "%s/data.csv", dir) >= sizeof path)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s/data.csv: path too long", dir);
+    if (!(f = fopen(path, "rb")))
+        return phc_table_read(path, &s->data, err); /* its message names the path */
+    for (;;) {
+        size_t got;
+        if (cap - len < 65536) {
+            char *b = realloc(buf, cap + 65536 + 1);
+            if (!b) {
+                fclose(f);
+                free(buf);
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+            }
+            buf = b;
+            cap += 65536;
+        }
+        got = fread(buf + len, 1, cap - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    fclose(f);
+    buf[len] = '\0';
+    /* the skipped lines become comments */
+    for (line = 0; line < skip && pos < len; ++line) {
+        if (buf[pos] != '\n' && buf[pos] != '\r')
+            buf[pos] = '#';
+        while (pos < len && buf[pos] != '\n' && buf[pos] != '\r')
+            ++pos;
+        if (pos < len && buf[pos] == '\r' && pos + 1 < len && buf[pos + 1] == '\n')
+            ++pos;
+        if (pos < len)
+            ++pos;
+    }
+    /* the header: the next line that is neither blank nor a comment */
+    hdr = pos;
+    for (;;) {
+        size_t b = hdr;
+        while (b < len && (buf[b] == ' ' || buf[b] == '\t'))
+            ++b;
+        if (b < len && buf[b] != '#' && buf[b] != '\n' && buf[b] != '\r')
+            break;
+        while (hdr < len && buf[hdr] != '\n')
+            ++hdr;
+        if (hdr >= len)
+            break;
+        ++hdr;
+    }
+    hdr_end = hdr;
+    while (hdr_end < len && buf[hdr_end] != '\n' && buf[hdr_end] != '\r')
+        ++hdr_end;
+    if (hdr < len && memchr(buf + hdr, ',', hdr_end - hdr)) {
+        /* rebuild the header with unique, non-empty names */
+        size_t ncap = 4 * (hdr_end - hdr) + 4096, nlen = 0, ncol = 0;
+        char **names = NULL;
+        const char *p = buf + hdr;
+        int ok = 1;
+        if (hdr == 0 && len >= 3 && !memcmp(buf, "\xEF\xBB\xBF", 3))
+            p += 3;
+        fixed = malloc(ncap);
+        names = malloc(((hdr_end - hdr) + 2) * sizeof *names);
+        if (!fixed || !names) {
+            free(fixed);
+            free(names);
+            free(buf);
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+        }
+        for (;;) {
+            char field[1024], name[1200];
+            size_t k;
+            if (header_field(&p, field, sizeof field)) {
+                ok = 0;
+                break;
+            }
+            if (!*field) {
+                snprintf(name, sizeof name, "(column %zu)", ncol + 1);
+                changed = 1;
+            } else {
+                snprintf(name, sizeof name, "%s", field);
+                for (k = 0; k < ncol; ++k)
+                    if (!strcmp(names[k], field))
+                        break;
+                if (k < ncol) {
+                    snprintf(name, sizeof name, "%s (column %zu)", field, ncol + 1);
+                    changed = 1;
+                }
+            }
+            if (nlen + 2 * strlen(name) + 4 >= ncap || !(names[ncol] = dup_str(field))) {
+                ok = 0;
+                break;
+            }
+            fixed[nlen++] = '"';
+            for (k = 0; name[k]; ++k) {
+                if (name[k] == '"')
+                    fixed[nlen++] = '"';
+                fixed[nlen++] = name[k];
+            }
+            fixed[nlen++] = '"';
+            fixed[nlen] = '\0';
+            ++ncol;
+            if (*p != ',')
+                break;
+            fixed[nlen++] = ',';
+            ++p;
+        }
+        while (ncol)
+            free(names[--ncol]);
+        free(names);
+        if (ok && changed) {
+            char *b = malloc(hdr + nlen + (len - hdr_end) + 1);
+            if (!b) {
+                free(fixed);
+                free(buf);
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", path);
+            }
+            memcpy(b, buf, hdr);
+            memcpy(b + hdr, fixed, nlen);
+            memcpy(b + hdr + nlen, buf + hdr_end, len - hdr_end);
+            len = hdr + nlen + (len - hdr_end);
+            b[len] = '\0';
+            free(buf);
+            buf = b;
+        }
+        free(fixed);
+    }
+    rc = phc_table_parse(buf, len, path, &s->data, err);
+    free(buf);
+    if (rc)
+        return rc;
+    return add_input(s, path, err);
+}
+
 static int need_column(const phc_table *t, const char *name, long *col, phc_error *err)
 {
     *col = phc_table_find(t, name);
@@ -273,17 +722,19 @@ static long def_find(const phc_table *defs, long c_var, const char *name)
     return -1;
 }
 
-/* Fills a numeric variable from data.csv column `col` through conversion c;
- * coordinates go through phc_geo_parse_angle.  `var_in` names the column. */
+/* Fills a numeric variable from data.csv column `col` through BAAD's
+ * expression `expr` (variableConversion.csv) when not NULL, else through the
+ * linear conversion c; coordinates go through phc_geo_parse_angle. */
 static int fill_numeric(phc_baad_study *s, long k, size_t col, phc_unit_conversion c,
-                        phc_error *err)
+                        const char *expr, phc_error *err)
 {
     baad_var *v = &s->vars[k];
     const char *src = phc_table_source(s->data);
     const char *var_in = phc_table_column_name(s->data, col);
-    phc_geo_axis axis;
+    phc_geo_axis axis = PHC_GEO_LATITUDE;
     int coord = is_coordinate(v->name, &axis);
-    size_t i;
+    size_t i, n_bad = 0;
+    char first[1024] = "";
     v->column = (long)col;
     for (i = 0; i < s->n; ++i) {
         const char *t = phc_table_cell(s->data, i, col);
@@ -291,36 +742,107 @@ static int fill_numeric(phc_baad_study *s, long k, size_t col, phc_unit_conversi
         double x;
         /* A lone dash marks a value not measured (Baltzer2007 data.csv:398,
          * d.ba '-'); R's as.numeric makes it NA in BAAD's build too. */
-        int absent = is_na(t) || !strcmp(t, "-");
+        int absent = is_absent(s, t) || !strcmp(t, "-");
         v->text[i] = absent ? NULL : t;
         if (absent)
             continue;
         if (coord) {
             char where[512];
+            phc_error e2;
             int rc;
             snprintf(where, sizeof where, "%s:%zu: column '%s' (%s)", src, line, var_in,
                      v->name);
-            rc = phc_geo_parse_angle(t, axis, where, &x, err);
-            if (rc)
-                return rc == PHC_ERR_INPUT ? rc : phc_error_prefix(err, rc, "%s", src);
+            rc = phc_geo_parse_angle(t, axis, where, &x, &e2);
+            if (rc == PHC_ERR_INPUT) {
+                /* BAAD's build (R's as.numeric) makes it NA; dataNew.csv
+                 * usually gives the site */
+                if (!n_bad++)
+                    snprintf(first, sizeof first, "%s", e2.message);
+                v->text[i] = NULL;
+                continue;
+            }
+            if (rc) {
+                if (err)
+                    *err = e2;
+                return phc_error_prefix(err, rc, "%s", src);
+            }
         } else if (parse_number(t, &x)) {
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: column '%s' (%s): expected a number, found '%s'", src,
-                                 line, var_in, v->name, t);
+            /* '#N/A', '#NULL!', '?', '24_5': R's as.numeric in BAAD's build
+             * makes such a cell NA; so does this reader, with a warning */
+            if (!n_bad++)
+                snprintf(first, sizeof first, "%s:%zu: column '%s' (%s): '%s' is not a number",
+                         src, line, var_in, v->name, t);
+            v->text[i] = NULL;
+            continue;
         }
-        v->num[i] = phc_unit_apply(c, x);
+        if (expr) {
+            double y;
+            if (conv_eval(expr, x, &y)) /* checked at x = 1 before: cannot fail */
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: column '%s': cannot convert '%s' by '%s'",
+                                     src, line, var_in, t, expr);
+            v->num[i] = y;
+        } else {
+            v->num[i] = phc_unit_apply(c, x);
+        }
+    }
+    if (n_bad) {
+        char w[1400];
+        if (n_bad > 1)
+            snprintf(w, sizeof w, "%s; read as absent, as are %zu more such cells of the column",
+                     first, n_bad - 1);
+        else
+            snprintf(w, sizeof w, "%s; read as absent", first);
+        s->counts.not_numbers += n_bad;
+        if (warn(s, w))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", src);
     }
     return PHC_OK;
 }
 
-/* Step 1: dataMatchColumns.csv. */
+/* The expression of BAAD's conversion from unit_in to unit (a row of
+ * variableConversion.csv, checked at x = 1), or an error naming the mapping
+ * line.  `where` is "dataMatchColumns.csv:LINE: ...". */
+static int find_conversion(const phc_table *conv, const char *unit_in, const char *unit,
+                           const char *where, const char **expr, phc_error *err)
+{
+    const char *csrc = phc_table_source(conv);
+    long c_in, c_out, c_ex;
+    size_t r;
+    int rc;
+    *expr = NULL;
+    if ((rc = need_column(conv, "unit_in", &c_in, err)) ||
+        (rc = need_column(conv, "unit_out", &c_out, err)) ||
+        (rc = need_column(conv, "conversion", &c_ex, err)))
+        return rc;
+    for (r = 0; r < phc_table_rows(conv); ++r) {
+        const char *ex = phc_table_cell(conv, r, (size_t)c_ex);
+        double y;
+        if (strcmp(phc_table_cell(conv, r, (size_t)c_in), unit_in) ||
+            strcmp(phc_table_cell(conv, r, (size_t)c_out), unit))
+            continue;
+        if (conv_eval(ex, 1.0, &y))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "%s:%zu: conversion '%s' (%s -> %s) is not an expression in x "
+                                 "this reader knows (numbers, x, + - * / ^ and parentheses)",
+                                 csrc, phc_table_row_line(conv, r), ex, unit_in, unit);
+        *expr = ex;
+        return PHC_OK;
+    }
+    return phc_error_set(err, PHC_ERR_INPUT,
+                         "%s: no conversion from '%s' to '%s' is defined in %s (BAAD converts "
+                         "only the unit pairs listed there)",
+                         where, unit_in, unit, csrc);
+}
+
+/* Step 1: dataMatchColumns.csv.  conv: BAAD's variableConversion.csv, or
+ * NULL for UDUNITS-2. */
 static int map_columns(phc_baad_study *s, const phc_table *match, const phc_table *defs,
-                       phc_units *units, phc_error *err)
+                       const phc_table *conv, phc_units *units, phc_error *err)
 {
     const char *msrc = phc_table_source(match), *dsrc = phc_table_source(defs);
     long c_in, c_unit, c_out, c_var, c_units, c_type;
     size_t r;
-    int rc;
+    int rc, oom = 0;
     if ((rc = need_column(match, "var_in", &c_in, err)) ||
         (rc = need_column(match, "unit_in", &c_unit, err)) ||
         (rc = need_column(match, "var_out", &c_out, err)) ||
@@ -334,15 +856,24 @@ static int map_columns(phc_baad_study *s, const phc_table *match, const phc_tabl
         const char *unit_in = phc_table_cell(match, r, (size_t)c_unit);
         const char *var_out = phc_table_cell(match, r, (size_t)c_out);
         long col = phc_table_find(s->data, var_in), def, k;
-        const char *unit, *type;
+        const char *unit, *type, *expr = NULL;
         int numeric;
-        phc_unit_conversion conv = {1.0, 0.0};
-        if (col < 0)
-            return phc_error_set(err, PHC_ERR_INPUT,
-                                 "%s:%zu: var_in '%s' is not a column of %s", msrc, line,
-                                 var_in, phc_table_source(s->data));
+        phc_unit_conversion lin = {1.0, 0.0};
         if (is_na(var_out))
+            continue; /* not used by BAAD either */
+        if (col < 0) {
+            /* BAAD's build runs the study's dataManipulate.R first, which
+             * makes such columns; it is not run here */
+            char w[1024];
+            snprintf(w, sizeof w,
+                     "%s:%zu: var_in '%s' (var_out %s) is not a column of data.csv (the study's "
+                     "dataManipulate.R makes it; not run here): mapping skipped",
+                     msrc, line, var_in, var_out);
+            s->counts.skipped_mappings++;
+            if (warn(s, w))
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", msrc);
             continue;
+        }
         def = def_find(defs, c_var, var_out);
         if (def < 0)
             return phc_error_set(err, PHC_ERR_INPUT,
@@ -367,8 +898,10 @@ static int map_columns(phc_baad_study *s, const phc_table *match, const phc_tabl
             s->vars[k].column = col;
             for (i = 0; i < s->n; ++i) {
                 const char *t = phc_table_cell(s->data, i, (size_t)col);
-                s->vars[k].text[i] = is_na(t) ? NULL : t;
+                s->vars[k].text[i] = is_absent(s, t) ? NULL : trimmed(s, t, &oom);
             }
+            if (oom)
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", msrc);
             continue;
         }
         if (unit) {
@@ -380,12 +913,18 @@ static int map_columns(phc_baad_study *s, const phc_table *match, const phc_tabl
                                      msrc, line, var_out, var_in, unit);
             snprintf(where, sizeof where, "%s:%zu: unit_in of '%s' (%s)", msrc, line, var_in,
                      var_out);
-            rc = phc_units_conversion(units, udunits_spelling(unit_in, var_out),
-                                      udunits_spelling(unit, var_out), where, &conv, err);
-            if (rc)
-                return rc;
+            if (strcmp(unit_in, unit)) {
+                if (conv)
+                    rc = find_conversion(conv, unit_in, unit, where, &expr, err);
+                else
+                    rc = phc_units_conversion(units, udunits_spelling(unit_in, var_out),
+                                              udunits_spelling(unit, var_out), where, &lin, err);
+                if (rc)
+                    return rc;
+                s->counts.conversions++;
+            }
         }
-        if ((rc = fill_numeric(s, k, (size_t)col, conv, err)))
+        if ((rc = fill_numeric(s, k, (size_t)col, lin, expr, err)))
             return rc;
     }
     return PHC_OK;
@@ -425,7 +964,7 @@ static int site_coordinates(phc_baad_study *s, const phc_table *match, phc_error
             v = var_add(s, var[a], 1, "deg");
             if (v < 0)
                 return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            if ((rc = fill_numeric(s, v, c, id, err)))
+            if ((rc = fill_numeric(s, v, c, id, NULL, err)))
                 return rc;
             break;
         }
@@ -433,12 +972,29 @@ static int site_coordinates(phc_baad_study *s, const phc_table *match, phc_error
     return PHC_OK;
 }
 
+/* Text equal up to leading and trailing blanks. */
+static int same_trimmed(const char *a, const char *b)
+{
+    size_t la, lb;
+    while (isspace((unsigned char)*a))
+        ++a;
+    while (isspace((unsigned char)*b))
+        ++b;
+    la = strlen(a);
+    lb = strlen(b);
+    while (la && isspace((unsigned char)a[la - 1]))
+        --la;
+    while (lb && isspace((unsigned char)b[lb - 1]))
+        --lb;
+    return la == lb && !memcmp(a, b, la);
+}
+
 static int lookup_matches(const char *have, const char *want)
 {
     double a, b;
     if (is_na(have) || is_na(want))
         return is_na(have) && is_na(want);
-    if (!strcmp(have, want))
+    if (same_trimmed(have, want))
         return 1;
     return !parse_number(have, &a) && !parse_number(want, &b) && a == b;
 }
@@ -465,15 +1021,17 @@ static int apply_new(phc_baad_study *s, const phc_table *nw, const phc_table *de
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", src);
     for (r = 0; r < phc_table_rows(nw); ++r) {
         size_t line = phc_table_row_line(nw, r);
-        const char *lv = phc_table_cell(nw, r, (size_t)c_lv);
-        const char *lval = phc_table_cell(nw, r, (size_t)c_lval);
-        const char *nv = phc_table_cell(nw, r, (size_t)c_nv);
-        const char *nval = phc_table_cell(nw, r, (size_t)c_nval);
+        const char *lv = trimmed(s, phc_table_cell(nw, r, (size_t)c_lv), &oom);
+        const char *lval = trimmed(s, phc_table_cell(nw, r, (size_t)c_lval), &oom);
+        const char *nv = trimmed(s, phc_table_cell(nw, r, (size_t)c_nv), &oom);
+        const char *nval = trimmed(s, phc_table_cell(nw, r, (size_t)c_nval), &oom);
         phc_baad_change *ch = &s->changes[s->n_changes];
         long def, k, lk = -1, lcol = -1;
         double x = NAN;
         phc_geo_axis axis;
         const char *kept;
+        if (oom)
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory reading %s", src);
         if (is_na(nv))
             return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: newVariable is empty", src, line);
         def = def_find(defs, c_var, nv);
@@ -759,7 +1317,7 @@ static void free_reasons(char **reasons, size_t n)
 int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
 {
     phc_baad_study *s = NULL;
-    phc_table *match = NULL, *nw = NULL, *defs = NULL;
+    phc_table *match = NULL, *nw = NULL, *defs = NULL, *conv = NULL;
     phc_units *units = NULL;
     double *raw_lat = NULL, *raw_lon = NULL, *lx = NULL, *work = NULL, *za = NULL;
     char **reasons = NULL;
@@ -802,19 +1360,43 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
     else
         strcpy(parent, ".");
 
-    if ((rc = read_csv(s, study_dir, "data.csv", 0, &s->data, err)) ||
-        (rc = read_csv(s, study_dir, "dataMatchColumns.csv", 0, &match, err)) ||
-        (rc = read_csv(s, study_dir, "dataNew.csv", 1, &nw, err)) ||
-        (rc = read_csv(s, parent, "variableDefinitions.csv", 0, &defs, err)))
-        goto fail;
+    {
+        /* a study folder is one with dataMatchColumns.csv: say so plainly */
+        char mpath[4096];
+        FILE *f;
+        snprintf(mpath, sizeof mpath, "%s/dataMatchColumns.csv", study_dir);
+        if (!(f = fopen(mpath, "rb"))) {
+            rc = phc_error_set(err, PHC_ERR_IO,
+                               "%s: not a BAAD study folder: it has no dataMatchColumns.csv (the "
+                               "table that maps data.csv's columns to BAAD variables)",
+                               study_dir);
+            goto fail;
+        }
+        fclose(f);
+    }
+    {
+        /* BAAD's config/ beside the study folders; else the parent itself */
+        char config[4200];
+        snprintf(config, sizeof config, "%s/config", parent);
+        size_t skip = 0;
+        if ((rc = read_import_options(s, study_dir, &skip, err)) ||
+            (rc = read_data(s, study_dir, skip, err)) ||
+            (rc = read_csv(s, study_dir, "dataMatchColumns.csv", 0, &match, err)) ||
+            (rc = read_csv(s, study_dir, "dataNew.csv", 1, &nw, err)) ||
+            (rc = read_csv(s, config, "variableDefinitions.csv", 1, &defs, err)) ||
+            (!defs && (rc = read_csv(s, parent, "variableDefinitions.csv", 0, &defs, err))) ||
+            (rc = read_csv(s, config, "variableConversion.csv", 1, &conv, err)) ||
+            (!conv && (rc = read_csv(s, parent, "variableConversion.csv", 1, &conv, err))))
+            goto fail;
+    }
     s->n = phc_table_rows(s->data);
-    if (!(units = phc_units_new(err))) {
+    if (!conv && !(units = phc_units_new(err))) {
         rc = err ? err->status : PHC_ERR_IO;
         goto fail;
     }
 
     /* 1. mapped columns, converted */
-    if ((rc = map_columns(s, match, defs, units, err)))
+    if ((rc = map_columns(s, match, defs, conv, units, err)))
         goto fail;
     /* 2. raw site coordinates */
     if ((rc = site_coordinates(s, match, err)))
@@ -863,13 +1445,24 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
         long k_sp = var_find(s, "species"), k_gc = var_find(s, "growingCondition");
         long k_age = var_find(s, "age"), k_dba = var_find(s, "d.ba"), k_ht = var_find(s, "h.t");
         long k_rt = var_find(s, "m.rt"), k_st = var_find(s, "m.st"), k_lf = var_find(s, "m.lf");
-        long k_so = var_find(s, "m.so");
-        if (k_so < 0 && k_st >= 0 && k_lf >= 0) {
+        long k_so = var_find(s, "m.so"), k_stba = var_find(s, "a.stba");
+        long k_rf = var_find(s, "m.rf"), k_rc = var_find(s, "m.rc");
+        if (k_so < 0 && k_st >= 0 && k_lf >= 0)
             k_so = var_add(s, "m.so", 1, "kg");
-            if (k_so < 0) {
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-                goto fail;
-            }
+        if (k_rt < 0 && k_rf >= 0 && k_rc >= 0)
+            k_rt = var_add(s, "m.rt", 1, "kg");
+        if (k_dba < 0 && k_stba >= 0)
+            k_dba = var_add(s, "d.ba", 1, "m");
+        if ((k_so < 0 && k_st >= 0 && k_lf >= 0) || (k_rt < 0 && k_rf >= 0 && k_rc >= 0) ||
+            (k_dba < 0 && k_stba >= 0)) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        if (k_stba >= 0 && strcmp(s->vars[k_stba].unit ? s->vars[k_stba].unit : "", "m2")) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s: a.stba is in '%s', not m2: cannot derive d.ba from it",
+                               phc_table_source(defs), s->vars[k_stba].unit ? s->vars[k_stba].unit : "");
+            goto fail;
         }
         for (i = 0; i < s->n; ++i) {
             phc_baad_row *r = &s->rows[i];
@@ -878,6 +1471,23 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
             r->species = k_sp >= 0 ? s->vars[k_sp].text[i] : NULL;
             r->growing_condition = k_gc >= 0 ? s->vars[k_gc].text[i] : NULL;
             r->age = value_of(s, k_age, i);
+            if (isfinite(r->age))
+                s->counts.ages++;
+            if (k_dba >= 0 && isnan(s->vars[k_dba].num[i]) && !s->vars[k_dba].text[i] &&
+                isfinite(value_of(s, k_stba, i))) {
+                /* d.ba = 2 sqrt(a.stba / pi): the stem's cross-section at
+                 * its base taken as a circle; m from m2 */
+                double a = value_of(s, k_stba, i);
+                s->vars[k_dba].num[i] = a >= 0 ? 2.0 * sqrt(a / 3.14159265358979323846) : NAN;
+                r->d_ba_derived = 1;
+                s->counts.derived_diameters++;
+            }
+            if (k_rt >= 0 && isnan(s->vars[k_rt].num[i]) && !s->vars[k_rt].text[i] &&
+                isfinite(value_of(s, k_rf, i)) && isfinite(value_of(s, k_rc, i))) {
+                s->vars[k_rt].num[i] = value_of(s, k_rf, i) + value_of(s, k_rc, i);
+                r->m_rt_derived = 1;
+                s->counts.derived_roots++;
+            }
             r->d_ba = value_of(s, k_dba, i);
             r->h_t = value_of(s, k_ht, i);
             r->m_rt = value_of(s, k_rt, i);
@@ -891,6 +1501,7 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
                 r->m_so = r->m_st + r->m_lf; /* BAAD's fillDerivedVariables */
                 r->m_so_derived = 1;
                 s->vars[k_so].num[i] = r->m_so;
+                s->counts.derived_shoots++;
             }
             r->root_shoot = isfinite(r->m_rt) && isfinite(r->m_so) && r->m_rt > 0 && r->m_so > 0
                                 ? r->m_rt / r->m_so
@@ -946,6 +1557,7 @@ fail:
     phc_table_free(match);
     phc_table_free(nw);
     phc_table_free(defs);
+    phc_table_free(conv);
     phc_baad_free(s);
     return rc;
 }
@@ -968,6 +1580,9 @@ void phc_baad_free(phc_baad_study *s)
     free(s->rows);
     free(s->species);
     free(s->changes);
+    free(s->warnings);
+    for (k = 0; k < s->n_na; ++k)
+        free(s->na[k]);
     phc_table_free(s->data);
     for (k = 0; k < s->n_inputs; ++k)
         free(s->inputs[k]);
@@ -1050,6 +1665,32 @@ size_t phc_baad_changes(const phc_baad_study *s, const phc_baad_change **changes
     if (changes)
         *changes = s ? s->changes : NULL;
     return s ? s->n_changes : 0;
+}
+
+phc_baad_counts phc_baad_count(const phc_baad_study *s)
+{
+    phc_baad_counts none = {0};
+    return s ? s->counts : none;
+}
+
+size_t phc_baad_warnings(const phc_baad_study *s, const char *const **warnings)
+{
+    if (warnings)
+        *warnings = s ? (const char *const *)s->warnings : NULL;
+    return s ? s->n_warnings : 0;
+}
+
+const char *phc_baad_lacks(const phc_baad_study *s)
+{
+    if (!s)
+        return NULL;
+    if (var_find(s, "m.rt") < 0)
+        return "no root mass: no column of data.csv is mapped to m.rt (nor to both m.rf and m.rc)";
+    if (var_find(s, "m.so") < 0)
+        return "no shoot mass: no column of data.csv is mapped to m.so (nor to both m.st and m.lf)";
+    if (var_find(s, "d.ba") < 0)
+        return "no basal diameter: no column of data.csv is mapped to d.ba (nor to a.stba)";
+    return NULL;
 }
 
 size_t phc_baad_flagged(const phc_baad_study *s, int flag)

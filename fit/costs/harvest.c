@@ -258,6 +258,7 @@ done:
 /* What the rows of one species came to, for the notes and messages. */
 typedef struct baad_counts {
     size_t species, select, missing, excluded;
+    size_t derived_d, derived_rt, derived_so, aged; /* of the plants used */
 } baad_counts;
 
 /* The plants of the species: usable rows into h, the others counted and
@@ -301,6 +302,10 @@ static int baad_rows(const phc_baad_study *st, const char *path, const phc_harve
         if (rows_push(h, &cap, r->d_ba, r->m_rt * 1e3, r->m_so * 1e3,
                       isfinite(r->age) ? r->age * 365.25 : NAN, r->line))
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        k->derived_d += (size_t)r->d_ba_derived;
+        k->derived_rt += (size_t)r->m_rt_derived;
+        k->derived_so += (size_t)r->m_so_derived;
+        k->aged += (size_t)isfinite(r->age);
     }
     return rc;
 }
@@ -374,14 +379,32 @@ int phc_harvest_read_baad(const char *path, const phc_harvest_baad_options *b, p
     FILE *nf = h ? open_memstream(&nb, &nlen) : NULL;
     rc = nf ? baad_rows(st, path, b, h, nf, &k, err) : phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if (nf) {
+        const char *const *w = NULL;
+        size_t nw = phc_baad_warnings(st, &w);
         if (k.missing)
             fprintf(nf, "- %zu rows of %s lack a basal diameter, root or shoot mass and are not used.\n",
                     k.missing, b->species);
+        if (k.derived_d)
+            fprintf(nf, "- %zu of the plants used have no basal diameter in the study; it is derived "
+                        "from the stem area at base, d.ba = 2 sqrt(a.stba / pi).\n", k.derived_d);
+        if (k.derived_rt)
+            fprintf(nf, "- %zu of the plants used have their root mass as fine + coarse roots "
+                        "(m.rf + m.rc).\n", k.derived_rt);
+        if (k.derived_so)
+            fprintf(nf, "- %zu of the plants used have their shoot mass as stem + leaves (m.st + m.lf).\n",
+                    k.derived_so);
+        if (k.aged)
+            fprintf(nf, "- %zu of the plants used have an age (the study's age column).\n", k.aged);
+        for (size_t i = 0; i < nw; ++i)
+            fprintf(nf, "- Reading the study: %s\n", w[i]);
         fclose(nf);
     }
     if (h) { h->notes = nb; nb = NULL; }
     if (!rc && k.species == 0)
         rc = baad_no_species(st, path, b, err);
+    if (!rc && h->n == 0 && phc_baad_lacks(st))
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: %s cannot give root:shoot data: %s",
+                           WHERE(b->origin, "baad"), path, phc_baad_lacks(st));
     if (!rc && h->n == 0)
         rc = phc_error_set(err, PHC_ERR_INPUT,
                            "%s: no usable rows of '%s' in %s (%zu rows, %zu selected, %zu "

@@ -71,9 +71,13 @@ typedef struct phc_harvest_baad_options {
 } phc_harvest_baad_options;
 
 /* The plants of one species in the BAAD study folder `dir` (basal
- * diameter, root and shoot mass, age), with the files read as inputs and
- * the rows left out in the notes.  Errors name the folder's files and
- * lines, or the option. */
+ * diameter, root and shoot mass, age in d from the study's age in yr), with
+ * the files read as inputs.  The notes list the rows left out, how many
+ * plants have a derived diameter (from a.stba), root mass (m.rf + m.rc) or
+ * shoot mass (m.st + m.lf), how many have an age, and every warning of the
+ * reader (mapping rows skipped, cells that are not numbers).  Errors name
+ * the folder's files and lines, or the option; a study without root mass,
+ * shoot mass or basal diameter says which (phc_baad_lacks). */
 int phc_harvest_read_baad(const char *dir, const phc_harvest_baad_options *options, phc_harvest **out,
                           phc_error *err);
 

@@ -1230,6 +1230,27 @@ if [ -n "$RS_SHARED" ] && [ -f "$RS_SHARED/baad/Baltzer2007/data.csv" ]; then
 else
     echo "# skip - root_shoot BAAD study cases: no shared data folder (second argument)"
 fi
+# A tiny BAAD tree (config/ beside the study folders, as in the database):
+# a study folder without dataMatchColumns.csv, and a unit_in that BAAD's
+# variableConversion.csv does not convert.
+mkdir -p "$C/rs_baad/config" "$C/rs_baad/NoMatch2020" "$C/rs_baad/BadConv2020"
+printf 'variable,units,group,type\nspecies,NA,species,character\nd.ba,m,tree,numeric\nm.rt,kg,tree,numeric\nm.so,kg,tree,numeric\n' \
+    >"$C/rs_baad/config/variableDefinitions.csv"
+printf 'unit_in,unit_out,conversion\ng,kg,x/1000\nmm,m,x/1000\nm2/kg,kg/m2,1/x\n' >"$C/rs_baad/config/variableConversion.csv"
+printf 'sp,d,root,shoot\nQuercus rubra,2.0,0.05,0.10\nQuercus rubra,2.5,0.08,0.15\n' >"$C/rs_baad/NoMatch2020/data.csv"
+cp "$C/rs_baad/NoMatch2020/data.csv" "$C/rs_baad/BadConv2020/data.csv"
+printf 'var_in,unit_in,var_out\nsp,NA,species\nd,furlong,d.ba\nroot,g,m.rt\nshoot,g,m.so\n' \
+    >"$C/rs_baad/BadConv2020/dataMatchColumns.csv"
+rs_config rs_nomatch.yaml '    baad: rs_baad/NoMatch2020
+    species: Quercus rubra
+'
+fit_case "root_shoot: BAAD study folder without dataMatchColumns.csv" "$C/rs_nomatch.yaml" "rs_nomatch.yaml:" \
+    "rs_baad/NoMatch2020" "no dataMatchColumns.csv"
+rs_config rs_badconv.yaml '    baad: rs_baad/BadConv2020
+    species: Quercus rubra
+'
+fit_case "root_shoot: BAAD unit conversion BAAD does not define" "$C/rs_badconv.yaml" \
+    "BadConv2020/dataMatchColumns.csv:3:" "no conversion from 'furlong' to 'm'" "variableConversion.csv"
 rs_table_config rs_tsel.yaml rs_ok.csv '    select: {column: shade, equals: L}
 '
 fit_case "root_shoot: table select column does not exist" "$C/rs_tsel.yaml" "rs_tsel.yaml:" "'shade'" "light"

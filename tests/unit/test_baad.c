@@ -257,22 +257,12 @@ static void test_bad(void)
     /* a unit of the wrong dimension */
     expect_error("WrongDim", good_data, edit(good_match, "\"g\",\"m.lf\"", "\"cm\",\"m.lf\""),
                  good_new, PHC_ERR_INPUT, "dataMatchColumns.csv:6:", "'cm' cannot be converted");
-    /* var_in that data.csv lacks */
-    expect_error("MissingVarIn", good_data, edit(good_match, "\"height (cm)\"", "\"height (in)\""),
-                 good_new, PHC_ERR_INPUT, "dataMatchColumns.csv:5:", "'height (in)'");
     /* var_out BAAD does not define */
     expect_error("BadVarOut", good_data, edit(good_match, "\"h.t\"", "\"h.tt\""), good_new,
                  PHC_ERR_INPUT, "dataMatchColumns.csv:5:", "var_out 'h.tt'");
     /* a numeric variable without unit_in */
     expect_error("NoUnit", good_data, edit(good_match, "\"cm\",\"h.t\"", "NA,\"h.t\""), good_new,
                  PHC_ERR_INPUT, "dataMatchColumns.csv:5:", "no unit_in");
-    /* a non-number in a mapped numeric column: data.csv line 4, column diam */
-    expect_error("NotANumber", edit(good_data, "AA,3,1.9,", "AA,3,1.9mm,"), good_match, good_new,
-                 PHC_ERR_INPUT, "data.csv:4: column 'diam (mm)' (d.ba)", "found '1.9mm'");
-    /* a malformed latitude string: data.csv line 3 */
-    expect_error("BadLatitude", edit(good_data, "2.1,4.6,0.025563,0.038344,0.031953,,10.5 S",
-                                     "2.1,4.6,0.025563,0.038344,0.031953,,10.5 E"),
-                 good_match, good_new, PHC_ERR_INPUT, "data.csv:3: column 'Lat'", "10.5 E");
     /* dataNew: a newValue that is not a number for a numeric variable */
     expect_error("BadNewValue", good_data, good_match, edit(good_new, "1.3", "tall"),
                  PHC_ERR_INPUT, "dataNew.csv:7:", "found 'tall'");
@@ -283,6 +273,61 @@ static void test_bad(void)
     expect_error("NoData", NULL, good_match, good_new, PHC_ERR_IO, "data.csv", NULL);
     /* no dataMatchColumns.csv */
     expect_error("NoMatch", good_data, NULL, good_new, PHC_ERR_IO, "dataMatchColumns.csv", NULL);
+}
+
+/* A var_in that data.csv lacks (BAAD's dataManipulate.R would make it):
+ * the mapping row is skipped with a warning naming the file and line. */
+static void test_missing_var_in(void)
+{
+    const char *dir = make_study("MissingVarIn", good_data,
+                                 edit(good_match, "\"height (cm)\"", "\"height (in)\""), good_new);
+    phc_baad_study *s = NULL;
+    phc_error err;
+    const char *const *w = NULL;
+    CHECK(dir != NULL);
+    CHECK(phc_baad_read(dir, &s, &err) == 0);
+    if (!s)
+        return;
+    CHECK(phc_baad_warnings(s, &w) == 1);
+    CHECK_STR_CONTAINS(w[0], "dataMatchColumns.csv:5: var_in 'height (in)' (var_out h.t)");
+    CHECK_STR_CONTAINS(w[0], "mapping skipped");
+    CHECK(phc_baad_count(s).skipped_mappings == 1);
+    CHECK(isnan(phc_baad_row_at(s, 0)->h_t));
+    CHECK(phc_baad_row_at(s, 0)->d_ba == 0.002);
+    printf("  MissingVarIn: %s\n", w[0]);
+    phc_baad_free(s);
+}
+
+/* A cell that is not a number, a latitude that cannot be read: absent, as
+ * R's as.numeric makes them in BAAD's build, with a warning naming the
+ * file, line and column. */
+static void test_not_numbers(void)
+{
+    const char *data = edit(edit(good_data, "AA,3,1.9,", "AA,3,1.9mm,"),
+                            "2.1,4.6,0.025563,0.038344,0.031953,,10.5 S",
+                            "2.1,4.6,0.025563,0.038344,0.031953,,10.5 E");
+    const char *dir = make_study("NotANumber", data, good_match, good_new);
+    phc_baad_study *s = NULL;
+    phc_error err;
+    const char *const *w = NULL;
+    size_t n;
+    CHECK(dir != NULL);
+    CHECK(phc_baad_read(dir, &s, &err) == 0);
+    if (!s)
+        return;
+    n = phc_baad_warnings(s, &w);
+    CHECK(n == 2);
+    if (n == 2) {
+        CHECK_STR_CONTAINS(w[0], "data.csv:4: column 'diam (mm)' (d.ba): '1.9mm' is not a number");
+        CHECK_STR_CONTAINS(w[1], "data.csv:3: column 'Lat' (latitude)");
+        CHECK_STR_CONTAINS(w[1], "10.5 E");
+        printf("  NotANumber: %s\n  NotANumber: %s\n", w[0], w[1]);
+    }
+    CHECK(phc_baad_count(s).not_numbers == 2);
+    CHECK(isnan(phc_baad_row_at(s, 2)->d_ba));
+    CHECK(phc_baad_text(s, 2, "d.ba") == NULL);
+    CHECK(phc_baad_row_at(s, 3)->d_ba == 0.0022);
+    phc_baad_free(s);
 }
 
 static void test_optional_and_free(void)
@@ -316,6 +361,8 @@ int main(void)
     }
     test_good();
     test_bad();
+    test_missing_var_in();
+    test_not_numbers();
     test_optional_and_free();
     remove_all();
     return check_finish("test_baad");
