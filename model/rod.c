@@ -726,16 +726,14 @@ static size_t newton_direction(phc_rod *rod)
 {
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n, na = rod->n_anchors, m = 6 * na;
-    const size_t bad = phc_rod_tree_factor(t);
-    if (bad != PHC_TREE_NONE)
-        return bad;
     for (size_t i = 0; i < n; ++i)
         for (int k = 0; k < 12; ++k)
             rod->sol[12 * i + k] = (k < t->dim[i]) ? -rod->res[12 * i + k] : 0.0;
-    if (na == 0) {
-        phc_rod_tree_solve(t, rod->sol);
-        return PHC_TREE_NONE;
-    }
+    if (na == 0) /* factorisation and solve in one sweep */
+        return phc_rod_tree_factor_solve(t, rod->sol);
+    const size_t bad = phc_rod_tree_factor(t);
+    if (bad != PHC_TREE_NONE)
+        return bad;
     /* u0 = K⁻¹(−r); S = G K⁻¹ Gᵀ; μ = S⁻¹ G u0; u = K⁻¹(−r − Gᵀ μ) */
     double *mu = malloc(m * sizeof *mu);
     if (!mu)
