@@ -951,19 +951,22 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
  * of the Newton step, rotations of 20–170 rad proposed).  Each step is
  * solved loosely (scaled residual PT_INNER_TOL, at most PT_INNER_CAP Newton
  * iterations; Kelley & Keyes take one): h doubles after a step solved in
- * one iteration, stays after two, halves after more, and halves with the
- * step undone when it is not solved.  After every step the static residual
+ * PT_EASY iterations or fewer, stays after PT_HARD or fewer, halves after
+ * more.  A step not solved within PT_INNER_CAP is kept (Newton only
+ * accepts iterates that decrease its residual: an inexact proximal step)
+ * and h halves; a singular one is undone.  After every step the static residual
  * is measured (done when within the tolerance), and when a step moved no
  * segment by more than PT_REST × reach, a static Newton from there is tried
  * (undone when it fails).  So the result always meets the statics'
  * tolerance.  Where a plant has several stable equilibria, the one reached
  * depends on the path: plant000 at 1e6 Pa settles with a largest tail
- * displacement of 0.469 m this way, 0.501 m when each step is solved to
- * 1e-8 (both within the tolerance; README "Plant shape"). */
-#define PT_INNER_CAP 4    /* Newton iterations per pseudo-time step */
+ * displacement of 0.501 m this way (and when each step is solved to 1e-8),
+ * 0.469 m when each step is solved to 1e-3 in at most 4 iterations (both
+ * within the tolerance). */
+#define PT_INNER_CAP 6    /* Newton iterations per pseudo-time step */
 #define PT_INNER_TOL 1e-3 /* their scaled tolerance (loose: one step is no answer) */
-#define PT_EASY 1         /* h doubles after a step that took this many or fewer, */
-#define PT_HARD 2         /* stays after one that took this many or fewer, else halves */
+#define PT_EASY 2         /* h doubles after a step that took this many or fewer, */
+#define PT_HARD 4         /* stays after one that took this many or fewer, else halves */
 #define PT_SHRINK 0.5
 #define PT_INNER_REL 1e-2 /* and this times the static residual before the step */
 #define PT_POLISH_CAP 12  /* Newton iterations of a static attempt */
@@ -1012,13 +1015,15 @@ static int pseudo_transient(phc_rod *rod, int budget, double *save, phc_rod_repo
         rep->iterations += stage.iterations;
         if (rc == PHC_ERR_NOMEM)
             return rc;
-        if (rc != PHC_OK) {
+        if (rc != PHC_OK && rc != PHC_ERR_NOT_CONVERGED) { /* singular, not finite */
             memcpy(rod->x, xk, 3 * n * sizeof *xk);
             memcpy(rod->q, qk, 4 * n * sizeof *qk);
             memcpy(rod->lambda, lk, 6 * n * sizeof *lk);
             h *= PT_SHRINK;
             continue;
         }
+        if (rc != PHC_OK) /* not solved, but its residual decreased: kept, h halves */
+            stage.iterations = PT_INNER_CAP + 1;
         ++steps;
         double moved = 0.0;
         for (size_t i = 0; i < n; ++i) {
