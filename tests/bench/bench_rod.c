@@ -300,6 +300,7 @@ static void water_share(const phc_plant_graph *g, phc_rod *rod)
     const size_t n = g->n;
     double *theta = malloc(n * sizeof *theta), *E = malloc(n * sizeof *E);
     double volume = 0.0, t_water = 0.0, t_rod = 0.0, load = 0.0;
+    double t_step = 0.0, t_state = 0.0, t_map = 0.0; /* the parts of t_water */
     int iterations = 0;
     phc_water_system *sys = NULL;
     phc_water_bdf6 *b = NULL;
@@ -334,12 +335,17 @@ static void water_share(const phc_plant_graph *g, phc_rod *rod)
             printf("water_share_plant000: water model failed: %s\n", err.message);
             goto done;
         }
+        const double ta = now();
         phc_water_bdf6_state(b, theta, NULL);
+        const double tb = now();
         if (phc_segment_stiffness_water(g, &sp, theta, E, NULL, NULL, &err)) {
             printf("water_share_plant000: mapping failed: %s\n", err.message);
             goto done;
         }
         cpu_mark m1 = cpu_now();
+        t_step += ta - m0.wall;
+        t_state += tb - ta;
+        t_map += m1.wall - tb;
         if (phc_rod_set_modulus(rod, E, &err) || phc_rod_solve_static(rod, &rep, &err)) {
             printf("water_share_plant000: rod frame %d failed: %s\n", k, err.message);
             goto done;
@@ -358,9 +364,10 @@ static void water_share(const phc_plant_graph *g, phc_rod *rod)
         printf("water_frames_plant000: %d frames of %.0f s water time, water %.4f -> %.4f g, E %.3g Pa "
                "at the end\n",
                FRAMES, WATER_STEP, volume, w, E[0]);
-        printf("water_mapping_us_per_frame_plant000: %.1f us (BDF6 step, state, eq. 9 mapping; other "
-               "load %.2f CPUs)\n",
-               1e6 * t_water / FRAMES, load);
+        printf("water_mapping_us_per_frame_plant000: %.1f us (BDF6 step %.1f + state %.1f + eq. 9 "
+               "mapping %.1f; other load %.2f CPUs)\n",
+               1e6 * t_water / FRAMES, 1e6 * t_step / FRAMES, 1e6 * t_state / FRAMES,
+               1e6 * t_map / FRAMES, load);
         printf("rod_frame_ms_plant000: %.2f ms (moduli set, static solve warm from the last frame, "
                "%.1f Newton iterations per frame)\n",
                1e3 * t_rod / FRAMES, (double)iterations / FRAMES);
