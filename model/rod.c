@@ -109,7 +109,8 @@ void phc_rod_free(phc_rod *rod)
                  rod->load, rod->joint, rod->stiff, rod->x, rod->q, rod->v, rod->w,
                  rod->lambda, rod->x0, rod->q0, rod->xs, rod->qs, rod->ls, rod->xo, rod->qo,
                  rod->xp, rod->qp, rod->res, rod->rhs, rod->sol, rod->epar, rod->ejoint,
-                 rod->jnode, rod->anchors, rod->queue, rod->mark, rod->schur, rod->schur_piv};
+                 rod->jnode, rod->anchors, rod->queue, rod->mark, rod->schur, rod->schur_piv,
+                 rod->jdeg, rod->jleft};
     for (size_t k = 0; k < sizeof p / sizeof p[0]; ++k)
         free(p[k]);
     phc_rod_tree_free(rod->tree);
@@ -187,6 +188,7 @@ int phc_rod_new(const phc_plant_graph *g, const double *young, const phc_rod_opt
         ALLOC(qo, 4 * n) || ALLOC(xp, 3 * n) || ALLOC(qp, 4 * n) || ALLOC(res, 12 * n) ||
         ALLOC(rhs, 12 * n) || ALLOC(sol, 12 * n) || ALLOC(epar, n) || ALLOC(ejoint, n) ||
         ALLOC(jnode, n) || ALLOC(anchors, n) || ALLOC(queue, n) || ALLOC(mark, n) ||
+        ALLOC(jdeg, n) || ALLOC(jleft, n) ||
         (rod->tree = phc_rod_tree_new(n)) == NULL) {
         phc_rod_free(rod);
         return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory for %zu segments", n);
@@ -496,6 +498,13 @@ static int build_tree(phc_rod *rod, int statics, phc_error *err)
         }
     }
 #undef ACTIVE
+    /* the assembled joints touching each body (assemble counts them down) */
+    memset(rod->jdeg, 0, n * sizeof *rod->jdeg);
+    for (size_t c = 0; c < n; ++c)
+        if (rod->jnode[c] != PHC_TREE_NONE) {
+            ++rod->jdeg[c];
+            ++rod->jdeg[g->parent[c]];
+        }
     if (phc_rod_tree_set_order(t) != 0)
         return phc_error_set(err, PHC_ERR_INTERNAL, "rod: elimination tree has a cycle");
     free(rod->schur);
@@ -546,6 +555,28 @@ static double load_total(const phc_rod *rod)
     return f * rod->load_scale;
 }
 
+/* The residual's rotation rows are gradients with respect to an increment
+ * at the CURRENT orientation (a moving chart): their exact derivative is
+ * the pullback Hessian plus −½[r_θ]× (from exp(ε)exp(δ) =
+ * exp(δ + ε + ½ ε×δ + …)), r_θ the body's rotation residual.  It vanishes
+ * at equilibrium; with it the Newton matrix is the exact Jacobian of the
+ * residual map, so Newton converges quadratically from farther away and
+ * the line search on the residual is consistent.  (The block is no longer
+ * symmetric: the tree solver does not assume it is.)  Added to body i's
+ * block once its residual is complete (assemble: after its last joint,
+ * while the block is still in the cache). */
+static inline void moving_chart_term(phc_rod_tree *t, const double *res, size_t i)
+{
+    const double *g = res + 12 * i + 3;
+    double *D = t->diag + 144 * i + 3 * 12 + 3;
+    D[0 * 12 + 1] += 0.5 * g[2];
+    D[0 * 12 + 2] -= 0.5 * g[1];
+    D[1 * 12 + 0] -= 0.5 * g[2];
+    D[1 * 12 + 2] += 0.5 * g[0];
+    D[2 * 12 + 0] += 0.5 * g[1];
+    D[2 * 12 + 1] -= 0.5 * g[0];
+}
+
 /* Residual (rod->res) and, when `matrix`, the Newton matrix in rod->tree.
  * Body rows: ∇E + Σ Jᵀλ (+ inertia); joint rows: C − Aλ. */
 static void assemble(phc_rod *rod, const step_params *sp, int matrix)
@@ -553,22 +584,22 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
     const phc_plant_graph *g = rod->g;
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n;
-    memset(rod->res, 0, 12 * n * sizeof *rod->res);
     if (matrix)
-        /* Only what is accumulated or not written below is zeroed: the body
-         * block (rows and columns 0..5) and the multipliers' block (6..11,
-         * where only the diagonal −α is written).  The joint blocks of a
-         * 12-node and its whole coupling block are assigned below; a 6-node
-         * has no coupling. */
-        for (size_t i = 0; i < n; ++i) {
-            double *D = t->diag + 144 * i;
-            for (int r = 0; r < 6; ++r) {
-                memset(D + r * 12, 0, 6 * sizeof *D);
-                memset(D + (6 + r) * 12 + 6, 0, 6 * sizeof *D);
-            }
-        }
+        memcpy(rod->jleft, rod->jdeg, n * sizeof *rod->jleft);
     for (size_t i = 0; i < n; ++i) {
         double *r = rod->res + 12 * i, *D = t->diag + 144 * i;
+        memset(r + 6, 0, 6 * sizeof *r);
+        if (matrix)
+            /* Only what is accumulated or not written below is zeroed: the
+             * body block (rows and columns 0..5) and the multipliers' block
+             * (6..11, where only the diagonal −α is written).  The joint
+             * blocks of a 12-node and its whole coupling block are assigned
+             * below; a 6-node has no coupling.  Zeroed here, in the pass
+             * that writes the block next, not in a pass of its own. */
+            for (int a = 0; a < 6; ++a) {
+                memset(D + a * 12, 0, 6 * sizeof *D);
+                memset(D + (6 + a) * 12 + 6, 0, 6 * sizeof *D);
+            }
         const double m = rod->mass[i], ts = rod->load_scale;
         const double F[3] = {ts * rod->load[3 * i], ts * rod->load[3 * i + 1],
                              ts * rod->load[3 * i + 2]};
@@ -610,6 +641,8 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
                         D[(3 + a) * 12 + 3 + b] += iw[a * 3 + b] * (s2 + s1);
             }
         }
+        if (matrix && rod->jleft[i] == 0) /* no joint: its residual is complete */
+            moving_chart_term(t, rod->res, i);
     }
     for (size_t c = 0; c < n; ++c) {
         const size_t k = rod->jnode[c];
@@ -649,26 +682,11 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
             }
             D[(6 + a) * 12 + 6 + a] = -alpha[a];
         }
-    }
-    if (!matrix)
-        return;
-    /* The residual's rotation rows are gradients with respect to an increment
-     * at the CURRENT orientation (a moving chart): their exact derivative is
-     * the pullback Hessian above plus −½[r_θ]× (from exp(ε)exp(δ) =
-     * exp(δ + ε + ½ ε×δ + …)), r_θ the body's rotation residual.  It vanishes
-     * at equilibrium; with it the Newton matrix is the exact Jacobian of the
-     * residual map, so Newton converges quadratically from farther away and
-     * the line search on the residual is consistent.  (The block is no longer
-     * symmetric: the tree solver does not assume it is.) */
-    for (size_t i = 0; i < n; ++i) {
-        const double *g = rod->res + 12 * i + 3;
-        double *D = t->diag + 144 * i + 3 * 12 + 3;
-        D[0 * 12 + 1] += 0.5 * g[2];
-        D[0 * 12 + 2] -= 0.5 * g[1];
-        D[1 * 12 + 0] -= 0.5 * g[2];
-        D[1 * 12 + 2] += 0.5 * g[0];
-        D[2 * 12 + 0] += 0.5 * g[1];
-        D[2 * 12 + 1] -= 0.5 * g[0];
+        /* a body whose last joint this was has its residual complete */
+        if (--rod->jleft[p] == 0)
+            moving_chart_term(t, rod->res, p);
+        if (--rod->jleft[c] == 0)
+            moving_chart_term(t, rod->res, c);
     }
 }
 
