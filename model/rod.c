@@ -108,7 +108,7 @@ void phc_rod_free(phc_rod *rod)
     void *p[] = {rod->young, rod->extra, rod->mass, rod->inertia, rod->fixed, rod->factor,
                  rod->load, rod->joint, rod->stiff, rod->x, rod->q, rod->v, rod->w,
                  rod->lambda, rod->x0, rod->q0, rod->xs, rod->qs, rod->ls, rod->xo, rod->qo,
-                 rod->xp, rod->qp, rod->res, rod->rhs, rod->sol, rod->epar, rod->ejoint,
+                 rod->xp, rod->qp, rod->res, rod->rhs, rod->sol, rod->ejoint,
                  rod->jnode, rod->anchors, rod->queue, rod->mark, rod->schur, rod->schur_piv,
                  rod->jdeg, rod->jleft};
     for (size_t k = 0; k < sizeof p / sizeof p[0]; ++k)
@@ -186,7 +186,7 @@ int phc_rod_new(const phc_plant_graph *g, const double *young, const phc_rod_opt
         ALLOC(w, 3 * n) || ALLOC(lambda, 6 * n) || ALLOC(x0, 3 * n) || ALLOC(q0, 4 * n) ||
         ALLOC(xs, 3 * n) || ALLOC(qs, 4 * n) || ALLOC(ls, 6 * n) || ALLOC(xo, 3 * n) ||
         ALLOC(qo, 4 * n) || ALLOC(xp, 3 * n) || ALLOC(qp, 4 * n) || ALLOC(res, 12 * n) ||
-        ALLOC(rhs, 12 * n) || ALLOC(sol, 12 * n) || ALLOC(epar, n) || ALLOC(ejoint, n) ||
+        ALLOC(rhs, 12 * n) || ALLOC(sol, 12 * n) || ALLOC(ejoint, n) ||
         ALLOC(jnode, n) || ALLOC(anchors, n) || ALLOC(queue, n) || ALLOC(mark, n) ||
         ALLOC(jdeg, n) || ALLOC(jleft, n) ||
         (rod->tree = phc_rod_tree_new(n)) == NULL) {
