@@ -6,6 +6,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <lapacke.h>
@@ -107,8 +108,9 @@ void phc_rod_free(phc_rod *rod)
     void *p[] = {rod->young, rod->extra, rod->mass, rod->inertia, rod->fixed, rod->factor,
                  rod->load, rod->joint, rod->stiff, rod->x, rod->q, rod->v, rod->w,
                  rod->lambda, rod->x0, rod->q0, rod->xs, rod->qs, rod->ls, rod->xo, rod->qo,
-                 rod->xp, rod->qp, rod->res, rod->rhs, rod->sol, rod->epar, rod->ejoint,
-                 rod->jnode, rod->anchors, rod->queue, rod->mark, rod->schur, rod->schur_piv};
+                 rod->xp, rod->qp, rod->res, rod->rhs, rod->sol, rod->ejoint,
+                 rod->jnode, rod->anchors, rod->queue, rod->mark, rod->schur, rod->schur_piv,
+                 rod->jdeg, rod->jleft};
     for (size_t k = 0; k < sizeof p / sizeof p[0]; ++k)
         free(p[k]);
     phc_rod_tree_free(rod->tree);
@@ -184,8 +186,9 @@ int phc_rod_new(const phc_plant_graph *g, const double *young, const phc_rod_opt
         ALLOC(w, 3 * n) || ALLOC(lambda, 6 * n) || ALLOC(x0, 3 * n) || ALLOC(q0, 4 * n) ||
         ALLOC(xs, 3 * n) || ALLOC(qs, 4 * n) || ALLOC(ls, 6 * n) || ALLOC(xo, 3 * n) ||
         ALLOC(qo, 4 * n) || ALLOC(xp, 3 * n) || ALLOC(qp, 4 * n) || ALLOC(res, 12 * n) ||
-        ALLOC(rhs, 12 * n) || ALLOC(sol, 12 * n) || ALLOC(epar, n) || ALLOC(ejoint, n) ||
+        ALLOC(rhs, 12 * n) || ALLOC(sol, 12 * n) || ALLOC(ejoint, n) ||
         ALLOC(jnode, n) || ALLOC(anchors, n) || ALLOC(queue, n) || ALLOC(mark, n) ||
+        ALLOC(jdeg, n) || ALLOC(jleft, n) ||
         (rod->tree = phc_rod_tree_new(n)) == NULL) {
         phc_rod_free(rod);
         return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory for %zu segments", n);
@@ -495,6 +498,13 @@ static int build_tree(phc_rod *rod, int statics, phc_error *err)
         }
     }
 #undef ACTIVE
+    /* the assembled joints touching each body (assemble counts them down) */
+    memset(rod->jdeg, 0, n * sizeof *rod->jdeg);
+    for (size_t c = 0; c < n; ++c)
+        if (rod->jnode[c] != PHC_TREE_NONE) {
+            ++rod->jdeg[c];
+            ++rod->jdeg[g->parent[c]];
+        }
     if (phc_rod_tree_set_order(t) != 0)
         return phc_error_set(err, PHC_ERR_INTERNAL, "rod: elimination tree has a cycle");
     free(rod->schur);
@@ -545,6 +555,28 @@ static double load_total(const phc_rod *rod)
     return f * rod->load_scale;
 }
 
+/* The residual's rotation rows are gradients with respect to an increment
+ * at the CURRENT orientation (a moving chart): their exact derivative is
+ * the pullback Hessian plus −½[r_θ]× (from exp(ε)exp(δ) =
+ * exp(δ + ε + ½ ε×δ + …)), r_θ the body's rotation residual.  It vanishes
+ * at equilibrium; with it the Newton matrix is the exact Jacobian of the
+ * residual map, so Newton converges quadratically from farther away and
+ * the line search on the residual is consistent.  (The block is no longer
+ * symmetric: the tree solver does not assume it is.)  Added to body i's
+ * block once its residual is complete (assemble: after its last joint,
+ * while the block is still in the cache). */
+static inline void moving_chart_term(phc_rod_tree *t, const double *res, size_t i)
+{
+    const double *g = res + 12 * i + 3;
+    double *D = t->diag + 144 * i + 3 * 12 + 3;
+    D[0 * 12 + 1] += 0.5 * g[2];
+    D[0 * 12 + 2] -= 0.5 * g[1];
+    D[1 * 12 + 0] -= 0.5 * g[2];
+    D[1 * 12 + 2] += 0.5 * g[0];
+    D[2 * 12 + 0] += 0.5 * g[1];
+    D[2 * 12 + 1] -= 0.5 * g[0];
+}
+
 /* Residual (rod->res) and, when `matrix`, the Newton matrix in rod->tree.
  * Body rows: ∇E + Σ Jᵀλ (+ inertia); joint rows: C − Aλ. */
 static void assemble(phc_rod *rod, const step_params *sp, int matrix)
@@ -552,22 +584,22 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
     const phc_plant_graph *g = rod->g;
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n;
-    memset(rod->res, 0, 12 * n * sizeof *rod->res);
     if (matrix)
-        /* Only what is accumulated or not written below is zeroed: the body
-         * block (rows and columns 0..5) and the multipliers' block (6..11,
-         * where only the diagonal −α is written).  The joint blocks of a
-         * 12-node and its whole coupling block are assigned below; a 6-node
-         * has no coupling. */
-        for (size_t i = 0; i < n; ++i) {
-            double *D = t->diag + 144 * i;
-            for (int r = 0; r < 6; ++r) {
-                memset(D + r * 12, 0, 6 * sizeof *D);
-                memset(D + (6 + r) * 12 + 6, 0, 6 * sizeof *D);
-            }
-        }
+        memcpy(rod->jleft, rod->jdeg, n * sizeof *rod->jleft);
     for (size_t i = 0; i < n; ++i) {
         double *r = rod->res + 12 * i, *D = t->diag + 144 * i;
+        memset(r + 6, 0, 6 * sizeof *r);
+        if (matrix)
+            /* Only what is accumulated or not written below is zeroed: the
+             * body block (rows and columns 0..5) and the multipliers' block
+             * (6..11, where only the diagonal −α is written).  The joint
+             * blocks of a 12-node and its whole coupling block are assigned
+             * below; a 6-node has no coupling.  Zeroed here, in the pass
+             * that writes the block next, not in a pass of its own. */
+            for (int a = 0; a < 6; ++a) {
+                memset(D + a * 12, 0, 6 * sizeof *D);
+                memset(D + (6 + a) * 12 + 6, 0, 6 * sizeof *D);
+            }
         const double m = rod->mass[i], ts = rod->load_scale;
         const double F[3] = {ts * rod->load[3 * i], ts * rod->load[3 * i + 1],
                              ts * rod->load[3 * i + 2]};
@@ -609,6 +641,8 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
                         D[(3 + a) * 12 + 3 + b] += iw[a * 3 + b] * (s2 + s1);
             }
         }
+        if (matrix && rod->jleft[i] == 0) /* no joint: its residual is complete */
+            moving_chart_term(t, rod->res, i);
     }
     for (size_t c = 0; c < n; ++c) {
         const size_t k = rod->jnode[c];
@@ -648,26 +682,11 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
             }
             D[(6 + a) * 12 + 6 + a] = -alpha[a];
         }
-    }
-    if (!matrix)
-        return;
-    /* The residual's rotation rows are gradients with respect to an increment
-     * at the CURRENT orientation (a moving chart): their exact derivative is
-     * the pullback Hessian above plus −½[r_θ]× (from exp(ε)exp(δ) =
-     * exp(δ + ε + ½ ε×δ + …)), r_θ the body's rotation residual.  It vanishes
-     * at equilibrium; with it the Newton matrix is the exact Jacobian of the
-     * residual map, so Newton converges quadratically from farther away and
-     * the line search on the residual is consistent.  (The block is no longer
-     * symmetric: the tree solver does not assume it is.) */
-    for (size_t i = 0; i < n; ++i) {
-        const double *g = rod->res + 12 * i + 3;
-        double *D = t->diag + 144 * i + 3 * 12 + 3;
-        D[0 * 12 + 1] += 0.5 * g[2];
-        D[0 * 12 + 2] -= 0.5 * g[1];
-        D[1 * 12 + 0] -= 0.5 * g[2];
-        D[1 * 12 + 2] += 0.5 * g[0];
-        D[2 * 12 + 0] += 0.5 * g[1];
-        D[2 * 12 + 1] -= 0.5 * g[0];
+        /* a body whose last joint this was has its residual complete */
+        if (--rod->jleft[p] == 0)
+            moving_chart_term(t, rod->res, p);
+        if (--rod->jleft[c] == 0)
+            moving_chart_term(t, rod->res, c);
     }
 }
 
@@ -726,16 +745,14 @@ static size_t newton_direction(phc_rod *rod)
 {
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n, na = rod->n_anchors, m = 6 * na;
-    const size_t bad = phc_rod_tree_factor(t);
-    if (bad != PHC_TREE_NONE)
-        return bad;
     for (size_t i = 0; i < n; ++i)
         for (int k = 0; k < 12; ++k)
             rod->sol[12 * i + k] = (k < t->dim[i]) ? -rod->res[12 * i + k] : 0.0;
-    if (na == 0) {
-        phc_rod_tree_solve(t, rod->sol);
-        return PHC_TREE_NONE;
-    }
+    if (na == 0) /* factorisation and solve in one sweep */
+        return phc_rod_tree_factor_solve(t, rod->sol);
+    const size_t bad = phc_rod_tree_factor(t);
+    if (bad != PHC_TREE_NONE)
+        return bad;
     /* u0 = K⁻¹(−r); S = G K⁻¹ Gᵀ; μ = S⁻¹ G u0; u = K⁻¹(−r − Gᵀ μ) */
     double *mu = malloc(m * sizeof *mu);
     if (!mu)
@@ -937,6 +954,132 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
                          tol);
 }
 
+/* ---- pseudo-transient continuation (the statics' last resort) ----------
+ *
+ * Kelley & Keyes 1998, "Convergence analysis of pseudo-transient
+ * continuation" (SIAM J. Numer. Anal. 35(2), 508–523): implicit steps of a
+ * pseudo-time h of the motion released at rest from the current shape,
+ *     r(x) + M (x − x_k)/h² = 0,   rotations: r_θ + I_w log(q q̄_k)/h² = 0
+ * (the dynamics' backward-Euler residual with zero velocity and no damping;
+ * M the masses, I_w the world inertia).  A step is a proximal step on the
+ * potential energy in the mass metric: the plant moves downhill towards a
+ * stable equilibrium instead of taking the huge, rotation-wrapping Newton
+ * steps of a soft plant released from rest (on plant000 at E = 1e6 Pa,
+ * Newton and the load continuation stall there: line-search steps of 1e-3
+ * of the Newton step, rotations of 20–170 rad proposed).  Each step is
+ * solved loosely (scaled residual PT_INNER_TOL, at most PT_INNER_CAP Newton
+ * iterations; Kelley & Keyes take one): h doubles after a step solved in
+ * PT_EASY iterations or fewer, stays after PT_HARD or fewer, halves after
+ * more.  A step not solved within PT_INNER_CAP is kept (Newton only
+ * accepts iterates that decrease its residual: an inexact proximal step)
+ * and h halves; a singular one is undone.  After every step the static residual
+ * is measured (done when within the tolerance), and when a step moved no
+ * segment by more than PT_REST × reach, a static Newton from there is tried
+ * (undone when it fails).  So the result always meets the statics'
+ * tolerance.  Where a plant has several stable equilibria, the one reached
+ * depends on the path: plant000 at 1e6 Pa settles with a largest tail
+ * displacement of 0.501 m this way (and when each step is solved to 1e-8),
+ * 0.469 m when each step is solved to 1e-3 in at most 4 iterations (both
+ * within the tolerance). */
+#define PT_INNER_CAP 6    /* Newton iterations per pseudo-time step */
+#define PT_INNER_TOL 1e-3 /* their scaled tolerance (loose: one step is no answer) */
+#define PT_EASY 2         /* h doubles after a step that took this many or fewer, */
+#define PT_HARD 4         /* stays after one that took this many or fewer, else halves */
+#define PT_SHRINK 0.5
+#define PT_INNER_REL 1e-2 /* and this times the static residual before the step */
+#define PT_POLISH_CAP 12  /* Newton iterations of a static attempt */
+#define PT_REST 1e-3      /* a step this short (× reach): try the statics */
+#define PT_H_MIN 1e-9     /* s: below this the pseudo-time stalls */
+#define PT_BUDGET 4       /* its Newton iterations: this × options.max_iterations */
+
+static int pseudo_transient(phc_rod *rod, int budget, double *save, phc_rod_report *rep,
+                            phc_error *err)
+{
+    const size_t n = rod->n;
+    const double tol = rod->opt.tolerance, L = rod->reach;
+    const double *gv = rod->opt.gravity;
+    const double gn = sqrt(gv[0] * gv[0] + gv[1] * gv[1] + gv[2] * gv[2]);
+    /* a tenth of the free-fall time over the reach, s */
+    double h = gn > 0.0 ? 0.1 * sqrt(L / gn) : 1e-3;
+    double *xk = save, *qk = save + 3 * n, *lk = save + 7 * n;
+    step_params dyn = {1, h, 0.0}, sta = {0, 0.0, 0.0};
+    phc_rod_report stage;
+    int steps = 0;
+    rep->iterations = 0;
+    rep->residual = INFINITY;
+    memset(rod->v, 0, 3 * n * sizeof *rod->v);
+    memset(rod->w, 0, 3 * n * sizeof *rod->w);
+    assemble(rod, &sta, 0);
+    rep->residual = residual_measure(rod, &sta).max;
+    while (rep->iterations < budget) {
+        if (h < PT_H_MIN)
+            return phc_error_set(err, PHC_ERR_NOT_CONVERGED,
+                                 "rod: no static equilibrium: the pseudo-time steps of the plant "
+                                 "released at rest shrank below %g s after %d steps (scaled "
+                                 "residual %.3g, tolerance %.3g)",
+                                 PT_H_MIN, steps, rep->residual, tol);
+        memcpy(xk, rod->x, 3 * n * sizeof *xk);
+        memcpy(qk, rod->q, 4 * n * sizeof *qk);
+        memcpy(lk, rod->lambda, 6 * n * sizeof *lk);
+        dyn.h = h;
+        phc_rod_internal_predict(rod, h); /* v = ω = 0: xo = xp = x, qo = qp = q */
+        /* relative to the static residual: the dynamics' measure has a
+         * larger force scale (it adds the largest joint force), so a fixed
+         * tolerance could pass a step with no iteration at all */
+        rod->opt.tolerance = fmax(tol, fmin(PT_INNER_TOL, PT_INNER_REL * rep->residual));
+        const int left = budget - rep->iterations;
+        int rc = newton(rod, &dyn, left < PT_INNER_CAP ? left : PT_INNER_CAP, &stage, err);
+        rod->opt.tolerance = tol;
+        rep->iterations += stage.iterations;
+        if (rc == PHC_ERR_NOMEM)
+            return rc;
+        if (rc != PHC_OK && rc != PHC_ERR_NOT_CONVERGED) { /* singular, not finite */
+            memcpy(rod->x, xk, 3 * n * sizeof *xk);
+            memcpy(rod->q, qk, 4 * n * sizeof *qk);
+            memcpy(rod->lambda, lk, 6 * n * sizeof *lk);
+            h *= PT_SHRINK;
+            continue;
+        }
+        if (rc != PHC_OK) /* not solved, but its residual decreased: kept, h halves */
+            stage.iterations = PT_INNER_CAP + 1;
+        ++steps;
+        double moved = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            double d = 0.0;
+            for (int k = 0; k < 3; ++k)
+                d += (rod->x[3 * i + k] - xk[3 * i + k]) * (rod->x[3 * i + k] - xk[3 * i + k]);
+            moved = fmax(moved, sqrt(d));
+        }
+        h *= stage.iterations <= PT_EASY ? 2.0 : (stage.iterations <= PT_HARD ? 1.0 : PT_SHRINK);
+        assemble(rod, &sta, 0);
+        rep->residual = residual_measure(rod, &sta).max;
+        if (rep->residual <= tol)
+            return PHC_OK;
+        if (moved > PT_REST * L || rep->iterations >= budget)
+            continue;
+        /* near rest: the statics from here */
+        memcpy(xk, rod->x, 3 * n * sizeof *xk);
+        memcpy(qk, rod->q, 4 * n * sizeof *qk);
+        memcpy(lk, rod->lambda, 6 * n * sizeof *lk);
+        const int left2 = budget - rep->iterations;
+        rc = newton(rod, &sta, left2 < PT_POLISH_CAP ? left2 : PT_POLISH_CAP, &stage, err);
+        rep->iterations += stage.iterations;
+        if (rc == PHC_OK) {
+            rep->residual = stage.residual;
+            return PHC_OK;
+        }
+        if (rc == PHC_ERR_NOMEM)
+            return rc;
+        memcpy(rod->x, xk, 3 * n * sizeof *xk);
+        memcpy(rod->q, qk, 4 * n * sizeof *qk);
+        memcpy(rod->lambda, lk, 6 * n * sizeof *lk);
+    }
+    return phc_error_set(err, PHC_ERR_NOT_CONVERGED,
+                         "rod: no static equilibrium within %d Newton iterations of pseudo-time "
+                         "steps (%d steps, the last of %g s; scaled residual %.3g, tolerance %.3g)",
+                         budget, steps, h, rep->residual, tol);
+}
+
 /* Newton at load factor 1 from the current state; when that fails, load
  * continuation from the rest shape (the equilibrium at load factor 0): the
  * factor grows by doubling increments, an increment halves when its Newton
@@ -955,7 +1098,7 @@ int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err)
     if (rc != PHC_OK)
         return rc;
     /* the start (restored on failure) and the last converged stage */
-    double *keep = malloc(26 * n * sizeof *keep);
+    double *keep = malloc(32 * n * sizeof *keep);
     if (!keep)
         return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory");
     double *x = keep, *q = keep + 3 * n, *l = keep + 7 * n;
@@ -963,6 +1106,8 @@ int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err)
     memcpy(x, rod->x, 3 * n * sizeof *x);
     memcpy(q, rod->q, 4 * n * sizeof *q);
     memcpy(l, rod->lambda, 6 * n * sizeof *l);
+    memcpy(keep + 26 * n, rod->v, 3 * n * sizeof *keep);
+    memcpy(keep + 29 * n, rod->w, 3 * n * sizeof *keep);
     const int budget = rod->opt.max_iterations;
     const int cap = budget < STAGE_CAP ? budget : STAGE_CAP;
     rod->load_scale = 1.0;
@@ -1016,11 +1161,27 @@ int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err)
             rc = PHC_OK;
     }
     rod->load_scale = 1.0;
+    if (rc != PHC_OK && rc != PHC_ERR_NOMEM) {
+        /* the plant released at rest from the start shape, in pseudo-time,
+         * with a budget of its own (PT_BUDGET × max_iterations) */
+        char first[PHC_ERROR_MESSAGE_SIZE];
+        snprintf(first, sizeof first, "%s", err ? err->message : "");
+        memcpy(rod->x, x, 3 * n * sizeof *x);
+        memcpy(rod->q, q, 4 * n * sizeof *q);
+        memcpy(rod->lambda, l, 6 * n * sizeof *l);
+        rc = pseudo_transient(rod, PT_BUDGET * budget, xg, &stage, err);
+        rep->total_iterations += stage.iterations;
+        rep->residual = stage.residual;
+        if (rc != PHC_OK && rc != PHC_ERR_NOMEM && err)
+            phc_error_prefix(err, PHC_ERR_NOT_CONVERGED, "%s; then", first);
+    }
     rep->iterations = rep->total_iterations;
     if (rc != PHC_OK) {
         memcpy(rod->x, x, 3 * n * sizeof *x);
         memcpy(rod->q, q, 4 * n * sizeof *q);
         memcpy(rod->lambda, l, 6 * n * sizeof *l);
+        memcpy(rod->v, keep + 26 * n, 3 * n * sizeof *keep);
+        memcpy(rod->w, keep + 29 * n, 3 * n * sizeof *keep);
     } else {
         memset(rod->v, 0, 3 * n * sizeof *rod->v);
         memset(rod->w, 0, 3 * n * sizeof *rod->w);

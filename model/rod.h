@@ -37,7 +37,11 @@
  *     bending / (load × reach²); reach = longest root-to-tip path), or when
  *     the step is ≤ 1e-12·reach with the residual within 1e3 × tolerance
  *     (rounding).  When Newton from the current state fails: load
- *     continuation from the rest shape.
+ *     continuation from the rest shape; when that fails too (a soft plant
+ *     that flops over, e.g. plant000 at 1e6 Pa), pseudo-transient
+ *     continuation: implicit pseudo-time steps of the plant released at
+ *     rest from the start shape, then Newton (rod.c; its own budget of
+ *     4 × max_iterations).  Converged means within the tolerance, always.
  *   phc_rod_step, scheme PHC_ROD_DIRECT (default): the implicit (backward
  *     Euler) step in XPBD's compliant form: multipliers accumulated over the
  *     Newton iterations of each sub-step, each iteration one direct solve,
@@ -73,7 +77,9 @@ typedef struct phc_rod_options {
     double gravity[3];      /* m s⁻²; default (0, 0, −9.81) */
     double tolerance;       /* scaled residual; default 1e-10 */
     int max_iterations;     /* Newton iterations per static solve (all load
-                               stages) or per sub-step; default 200 */
+                               stages; the pseudo-transient fallback has
+                               4 × this of its own) or per sub-step;
+                               default 200 */
     double damping;         /* c, s⁻¹ (>= 0); default 0 */
     phc_rod_scheme scheme;  /* for phc_rod_step; default PHC_ROD_DIRECT */
     int substeps;           /* sub-steps per phc_rod_step; default 1 */

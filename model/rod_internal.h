@@ -35,7 +35,8 @@ struct phc_rod {
     double *xs, *qs, *ls;           /* saved state for line search / refusal */
     double *xo, *qo, *xp, *qp;      /* old and predicted (dynamics) */
     double *res, *rhs, *sol;        /* 12 per node */
-    size_t *epar, *ejoint, *jnode;  /* elimination parent, the node's joint, joint -> node */
+    size_t *ejoint, *jnode;         /* the node's joint, joint -> node */
+    int *jdeg, *jleft;              /* joints touching each body; not yet assembled */
     size_t *anchors, n_anchors;
     size_t *queue;
     unsigned char *mark;

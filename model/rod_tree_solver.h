@@ -52,6 +52,14 @@ int phc_rod_tree_set_order(phc_rod_tree *t);
  * whose (updated) block is singular or not finite. */
 size_t phc_rod_tree_factor(phc_rod_tree *t);
 
+/* phc_rod_tree_factor and phc_rod_tree_solve in one sweep: each node's
+ * forward substitution runs right after its factorisation, while its
+ * blocks are in the cache (the same operations in the same order, so the
+ * same result to the last bit).  rhs (12 per node) is overwritten by u;
+ * on failure (returns as phc_rod_tree_factor) it is left partly
+ * transformed. */
+size_t phc_rod_tree_factor_solve(phc_rod_tree *t, double *rhs);
+
 /* Solves A u = rhs in place after phc_rod_tree_factor.  rhs/u: 12 entries
  * per node (entries beyond dim unused). */
 void phc_rod_tree_solve(const phc_rod_tree *t, double *rhs);
