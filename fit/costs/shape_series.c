@@ -12,6 +12,7 @@
 #include "fit/shape_plots.h"
 #include "measurements/plant_io.h"
 #include "model/elasticity.h"
+#include "model/particles.h"
 #include "model/plant_graph.h"
 #include "model/rod.h"
 
@@ -22,8 +23,12 @@ enum { SLOT_KAPPA = 0, SLOT_CHI0, SLOT_E_MAX, SLOT_DELTA, N_SHARED };
 typedef struct stalk {
     char *id;
     phc_plant_graph *g; /* segment 0: the clamp (root), 1..n free */
-    phc_rod *rod;
+    phc_rod *rod;       /* rods only */
     double *young;      /* g->n moduli, Pa (work) */
+    double *force;      /* particles: 3 g->n external forces, N (the tip masses' weight);
+                           the data set's plant_force when shared */
+    double *head, *tail;/* particles: 3 g->n segment ends of the last solve, m (work) */
+    double rest_length; /* particles: shortest free segment, m (the rest test's scale) */
     double beta;        /* base angle, rad */
     double tip_mass;    /* kg */
     long offset_slot;   /* slot of offset_<id>, or -1 */
@@ -40,7 +45,12 @@ typedef struct shape_impl {
     long e_min_slot;    /* slot of e_min, or -1 */
     size_t frames;
     phc_plant_graph *plant; /* options.plant's copy, or NULL */
-    phc_rod *plant_rod;
+    phc_rod *plant_rod;     /* rods with a plant */
+    double *plant_force;    /* particles with a plant: 3n forces, N */
+    int dynamics;           /* phc_shape_dynamics */
+    phc_particles_options popt; /* particles: density, iterations, damping, parent weight */
+    double pdt;             /* particles: time step, s */
+    size_t psteps;          /* particles: step cap */
 } shape_impl;
 
 static void impl_free(void *p)
@@ -52,12 +62,16 @@ static void impl_free(void *p)
         if (!m->stalks[s].shared) {
             phc_rod_free(m->stalks[s].rod);
             phc_plant_graph_free(m->stalks[s].g);
+            free(m->stalks[s].force);
         }
+        free(m->stalks[s].head);
+        free(m->stalks[s].tail);
         free(m->stalks[s].young);
         free(m->stalks[s].id);
     }
     free(m->stalks);
     phc_rod_free(m->plant_rod);
+    free(m->plant_force);
     phc_plant_graph_free(m->plant);
     free(m->stalk_of);
     free(m->t);
@@ -74,6 +88,12 @@ phc_shape_series_options phc_shape_series_options_default(void)
     o.every = 1;
     o.fd_step = 1e-4;
     o.frames = 6;
+    o.dynamics = PHC_SHAPE_RODS;
+    o.particle_iterations = 4;
+    o.particle_time_step = 1.0 / 120.0;
+    o.particle_steps = 20000;
+    o.particle_damping = 0.05;
+    o.parent_weight = 2.0;
     return o;
 }
 
@@ -108,33 +128,128 @@ int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, d
     return isfinite(*young) && *young > 0 ? 0 : 1;
 }
 
+/* The scalar the angle depends on: E(t) (Pa) with rods, s(t) = E(t) /
+ * (E_min + E_max) with particles; grad (optional, zeroed by the caller) its
+ * derivative in every slot. */
+static double driver(const phc_dataset *ds, const double *p, double t, double *grad)
+{
+    const shape_impl *m = ds->impl;
+    const double E = modulus(ds, p, t, NULL, grad);
+    if (m->dynamics != PHC_SHAPE_PARTICLES)
+        return E;
+    const double e_min = m->e_min_slot >= 0 ? p[m->e_min_slot] : m->e_min;
+    const double D = e_min + p[SLOT_E_MAX], s = E / D;
+    if (grad) {
+        for (size_t j = 0; j < ds->k; ++j)
+            grad[j] /= D;
+        grad[SLOT_E_MAX] -= s / D;
+        if (m->e_min_slot >= 0)
+            grad[m->e_min_slot] -= s / D;
+    }
+    return s;
+}
+
+int phc_shape_series_stiffness(const phc_dataset *ds, const double *p, double t, double *stiffness)
+{
+    const shape_impl *m = ds->impl;
+    const double e_min = m->e_min_slot >= 0 ? p[m->e_min_slot] : m->e_min;
+    *stiffness = modulus(ds, p, t, NULL, NULL) / (e_min + p[SLOT_E_MAX]);
+    return isfinite(*stiffness) && *stiffness >= 0 && *stiffness <= 1 ? 0 : 1;
+}
+
+/* The direction of segment seg (head h → tail t) in the x–z plane, within π
+ * of β. */
+static double direction(const stalk *st, const double h[3], const double t[3])
+{
+    const double a = atan2(t[2] - h[2], t[0] - h[0]);
+    return st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
+}
+
+/* Particles at stiffness s relaxed from the rest pose to rest (see the
+ * header); the segment ends are left in st->head, st->tail. */
+static int particles_solve(const shape_impl *m, stalk *st, double s, double *angle, phc_error *err)
+{
+    if (!(s >= 0 && s <= 1))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "series '%s': particle stiffness s = E/(E_min + E_max) = %g is outside [0, 1] "
+                             "(E_max or E_min negative?)", st->id, s);
+    phc_particles_options po = m->popt;
+    po.stiffness = s;
+    phc_particles *p = phc_particles_new(st->g, &po, err);
+    if (!p)
+        return err ? err->status : PHC_ERR_INPUT;
+    const size_t n = st->g->n;
+    int rc = PHC_OK;
+    for (size_t i = 0; i < n && !rc; ++i)
+        if (st->force[3 * i] != 0 || st->force[3 * i + 1] != 0 || st->force[3 * i + 2] != 0)
+            rc = phc_particles_set_force(p, i, st->force + 3 * i, err);
+    const double tol = PHC_SHAPE_REST_FRACTION * st->rest_length / m->pdt; /* m s^-1 */
+    double vmax = INFINITY;
+    size_t k = 0;
+    while (!rc && k < m->psteps && !(vmax < tol)) {
+        if ((rc = phc_particles_step(p, m->pdt, NULL, err)))
+            break;
+        ++k;
+        vmax = 0;
+        for (size_t i = 0; i < n; ++i) {
+            double v[3];
+            phc_particles_velocity(p, i, v);
+            vmax = fmax(vmax, sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+        }
+        if (!isfinite(vmax))
+            rc = phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the particles' speed is not finite after %zu steps",
+                               st->id, k);
+    }
+    if (!rc && !(vmax < tol))
+        rc = phc_error_set(err, PHC_ERR_DOMAIN,
+                           "series '%s': the particles are not at rest after particle_steps = %zu steps of %g s "
+                           "(stiffness s = %g, largest speed %.3g m/s, at rest below %.3g m/s): raise particle_steps "
+                           "or particle_damping",
+                           st->id, m->psteps, m->pdt, s, vmax, tol);
+    if (!rc) {
+        phc_particles_segment_ends(p, st->head, st->tail);
+        *angle = direction(st, st->head + 3 * st->seg, st->tail + 3 * st->seg);
+        if (!isfinite(*angle))
+            rc = phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the angle at rest is not finite", st->id);
+    }
+    phc_particles_free(p);
+    return rc;
+}
+
 /* Equilibrium from the rod's current state at modulus E; the last
  * segment's direction within π of β. */
-static int solve_angle(stalk *st, double young, double *angle)
+static int rod_solve(stalk *st, double young, double *angle, phc_error *err)
 {
     if (!(young > 0) || !isfinite(young))
-        return 1;
+        return phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the modulus E = %g Pa is not positive", st->id,
+                             young);
     for (size_t i = 0; i < st->g->n; ++i)
         st->young[i] = young;
-    phc_error e;
     phc_rod_report rep;
-    if (phc_rod_set_modulus(st->rod, st->young, &e) || phc_rod_solve_static(st->rod, &rep, &e))
-        return 1;
+    int rc;
+    if ((rc = phc_rod_set_modulus(st->rod, st->young, err)) || (rc = phc_rod_solve_static(st->rod, &rep, err)))
+        return rc;
     double h[3], t[3];
     phc_rod_head(st->rod, st->seg, h);
     phc_rod_tail(st->rod, st->seg, t);
-    const double a = atan2(t[2] - h[2], t[0] - h[0]);
-    *angle = st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
-    return isfinite(*angle) ? 0 : 1;
+    *angle = direction(st, h, t);
+    return isfinite(*angle) ? 0 : phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the angle is not finite", st->id);
 }
 
-int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double young, double *angle)
+/* The angle at the driver z (E with rods, s with particles). */
+static int solve_angle(const shape_impl *m, stalk *st, double z, double *angle, phc_error *err)
+{
+    return m->dynamics == PHC_SHAPE_PARTICLES ? particles_solve(m, st, z, angle, err) : rod_solve(st, z, angle, err);
+}
+
+int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double z, double *angle, phc_error *err)
 {
     shape_impl *m = ds->impl;
     if (s >= m->n_stalks)
-        return 1;
-    phc_rod_reset(m->stalks[s].rod);
-    return solve_angle(&m->stalks[s], young, angle);
+        return phc_error_set(err, PHC_ERR_INVALID, "shape_series: no stalk %zu", s);
+    if (m->dynamics != PHC_SHAPE_PARTICLES)
+        phc_rod_reset(m->stalks[s].rod);
+    return solve_angle(m, &m->stalks[s], z, angle, err);
 }
 
 static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
@@ -150,23 +265,33 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
     for (size_t i = 0; i < ds->n && !rc; ++i) {
         stalk *st = &m->stalks[m->stalk_of[i]];
         if (m->stalk_of[i] != prev) { /* a new series: from the rest shape */
-            phc_rod_reset(st->rod);
+            if (m->dynamics != PHC_SHAPE_PARTICLES)
+                phc_rod_reset(st->rod);
             prev = m->stalk_of[i];
         }
         memset(grad, 0, ds->k * sizeof *grad);
-        const double E = modulus(ds, p, m->t[i], NULL, jac ? grad : NULL);
+        const double z = driver(ds, p, m->t[i], jac ? grad : NULL);
         double a;
-        if ((rc = solve_angle(st, E, &a)))
+        if ((rc = solve_angle(m, st, z, &a, NULL))) {
+            yhat[i] = NAN; /* phc_dataset_check_start names this observation's line */
             break;
+        }
         yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
         if (!jac)
             continue;
-        /* d angle / dE by a central difference in E, warm-started */
-        const double h = m->fd_step * E;
-        double ap, am;
-        if ((rc = solve_angle(st, E + h, &ap)) || (rc = solve_angle(st, E - h, &am)))
-            break;
-        const double da_dE = (ap - am) / (2.0 * h);
+        /* d angle / dz by a central difference in z (rods: warm-started;
+         * particles: each from rest, backward when z + h > 1) */
+        const double h = m->fd_step * z;
+        double ap, am, da_dE;
+        if (m->dynamics == PHC_SHAPE_PARTICLES && z + h > 1.0) {
+            if ((rc = solve_angle(m, st, z - h, &am, NULL)) || (rc = solve_angle(m, st, z - 2.0 * h, &ap, NULL)))
+                break;
+            da_dE = (3.0 * a - 4.0 * am + ap) / (2.0 * h);
+        } else {
+            if ((rc = solve_angle(m, st, z + h, &ap, NULL)) || (rc = solve_angle(m, st, z - h, &am, NULL)))
+                break;
+            da_dE = (ap - am) / (2.0 * h);
+        }
         double *row = jac + i * ds->k;
         for (size_t j = 0; j < ds->k; ++j)
             row[j] = da_dE * grad[j];
@@ -174,24 +299,31 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
             row[st->offset_slot] = 1.0;
     }
     free(grad);
-    return rc;
+    return rc == PHC_ERR_NOMEM ? -1 : rc ? 1 : 0;
 }
 
 /* A frame: the stalk's equilibrium at time t as a graph copy (head, tail
  * updated) plus the per-segment values; *out owned by the caller. */
-static int frame_graph(stalk *st, double young, phc_plant_graph **out)
+static int frame_graph(const shape_impl *m, stalk *st, double z, phc_plant_graph **out, phc_error *err)
 {
     double a;
+    int rc;
     *out = NULL;
-    phc_rod_reset(st->rod);
-    if (solve_angle(st, young, &a))
-        return 1;
+    if (m->dynamics != PHC_SHAPE_PARTICLES)
+        phc_rod_reset(st->rod);
+    if ((rc = solve_angle(m, st, z, &a, err)))
+        return rc;
     phc_plant_graph *c = phc_plant_graph_copy(st->g);
     if (!c)
-        return -1;
-    for (size_t i = 0; i < c->n; ++i) {
-        phc_rod_head(st->rod, i, c->head + 3 * i);
-        phc_rod_tail(st->rod, i, c->tail + 3 * i);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (m->dynamics == PHC_SHAPE_PARTICLES) {
+        memcpy(c->head, st->head, 3 * c->n * sizeof *c->head);
+        memcpy(c->tail, st->tail, 3 * c->n * sizeof *c->tail);
+    } else {
+        for (size_t i = 0; i < c->n; ++i) {
+            phc_rod_head(st->rod, i, c->head + 3 * i);
+            phc_rod_tail(st->rod, i, c->tail + 3 * i);
+        }
     }
     *out = c;
     return 0;
@@ -218,40 +350,53 @@ static int write_frames(phc_dataset *ds, const double *p, const char *dir, const
         phc_plant_graph *graphs[64] = {0};
         double *values = calloc(nf * ns, sizeof *values);
         double *young = calloc(nf * ns, sizeof *young);
+        double *stiff = calloc(nf * ns, sizeof *stiff);
         char (*titles)[128] = calloc(nf, sizeof *titles);
         char sid[256], path[8192];
         phc_run_dir_safe_name(st->id, sid, sizeof sid);
-        if (!values || !young || !titles)
+        if (!values || !young || !stiff || !titles)
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         for (size_t f = 0; f < nf && !rc; ++f) {
             const double t = nf > 1 ? t_lo + (t_hi - t_lo) * (double)f / (double)(nf - 1) : t_lo;
-            double E, rwc;
-            if (phc_shape_series_modulus(ds, p, t, &E, &rwc) || frame_graph(st, E, &graphs[f])) {
+            double E, rwc, sp = NAN;
+            const int particles = m->dynamics == PHC_SHAPE_PARTICLES;
+            phc_error why;
+            why.message[0] = 0;
+            if (phc_shape_series_modulus(ds, p, t, &E, &rwc) ||
+                (particles && phc_shape_series_stiffness(ds, p, t, &sp)) ||
+                frame_graph(m, st, particles ? sp : E, &graphs[f], &why)) {
                 rc = phc_error_set(err, PHC_ERR_DOMAIN,
-                                   "data set '%s': series '%s': no static equilibrium at t = %g s "
-                                   "(E = %g Pa)", ds->name, st->id, t, E);
+                                   "data set '%s': series '%s': no %s at t = %g s (E = %g Pa%s%.6g)%s%s", ds->name,
+                                   st->id, particles ? "rest state of the particles" : "static equilibrium", t, E,
+                                   particles ? ", s = " : "", particles ? sp : 0.0, why.message[0] ? ": " : "",
+                                   why.message);
                 break;
             }
             for (size_t i = 0; i < ns; ++i) {
                 values[f * ns + i] = rwc;
                 young[f * ns + i] = E;
+                stiff[f * ns + i] = sp;
             }
-            snprintf(titles[f], sizeof titles[f], "t = %.3g h, E = %.3g MPa", t / 3600.0, E * 1e-6);
+            if (particles)
+                snprintf(titles[f], sizeof titles[f], "t = %.3g h, s = %.3g", t / 3600.0, sp);
+            else
+                snprintf(titles[f], sizeof titles[f], "t = %.3g h, E = %.3g MPa", t / 3600.0, E * 1e-6);
             panels[f] = (phc_shape_panel){.n = ns,
                                           .head = graphs[f]->head,
                                           .tail = graphs[f]->tail,
                                           .radius = graphs[f]->radius,
                                           .value = values + f * ns,
                                           .title = titles[f]};
-            const phc_plant_field fields[2] = {{"relative_water", values + f * ns},
-                                               {"young_modulus_Pa", young + f * ns}};
+            const phc_plant_field fields[3] = {{"relative_water", values + f * ns},
+                                               {"young_modulus_Pa", young + f * ns},
+                                               {"particle_stiffness", stiff + f * ns}};
             snprintf(path, sizeof path, "%s/%s_%s_frame%02zu.csv", dir, base, sid, f);
             if ((rc = phc_plant_io_write_native(path, graphs[f], err)))
                 break;
             snprintf(path, sizeof path, "%s/%s_%s_frame%02zu.vtk", dir, base, sid, f);
             char vtitle[256];
             snprintf(vtitle, sizeof vtitle, "phytocal shape_series %s %s", st->id, titles[f]);
-            if ((rc = phc_plant_io_write_vtk(path, graphs[f], vtitle, fields, 2, err)))
+            if ((rc = phc_plant_io_write_vtk(path, graphs[f], vtitle, fields, particles ? 3 : 2, err)))
                 break;
         }
         if (!rc) {
@@ -268,6 +413,7 @@ static int write_frames(phc_dataset *ds, const double *p, const char *dir, const
             phc_plant_graph_free(graphs[f]);
         free(values);
         free(young);
+        free(stiff);
         free(titles);
     }
     return rc;
@@ -329,6 +475,29 @@ static int check_options(const phc_shape_series *tr, const phc_shape_series_opti
                              phc_origin_key(o->origin, "shape_series", "fd_step").text, o->fd_step);
     if (!isnan(o->t0) && !isfinite(o->t0))
         return phc_error_set(err, PHC_ERR_INPUT, "%s: key 't0': must be finite", w);
+    if (o->dynamics != PHC_SHAPE_RODS && o->dynamics != PHC_SHAPE_PARTICLES)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'dynamics': expected rods or particles",
+                             phc_origin_key(o->origin, "shape_series", "dynamics").text);
+    if (o->dynamics == PHC_SHAPE_PARTICLES) {
+        if (o->particle_iterations < 1 || o->particle_iterations > 1000)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_iterations': expected 1 to 1000, found %zu",
+                                 phc_origin_key(o->origin, "shape_series", "particle_iterations").text,
+                                 o->particle_iterations);
+        if (!(o->particle_time_step > 0 && o->particle_time_step <= 1))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_time_step': expected a time step in (0, 1] s, "
+                                 "found %g", phc_origin_key(o->origin, "shape_series", "particle_time_step").text,
+                                 o->particle_time_step);
+        if (o->particle_steps < 1 || o->particle_steps > 10000000)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_steps': expected 1 to 10000000, found %zu",
+                                 phc_origin_key(o->origin, "shape_series", "particle_steps").text, o->particle_steps);
+        if (!(o->particle_damping > 0 && o->particle_damping < 1))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_damping': expected a fraction in (0, 1), found %g "
+                                 "(0 would never come to rest)",
+                                 phc_origin_key(o->origin, "shape_series", "particle_damping").text, o->particle_damping);
+        if (!(o->parent_weight >= 1 && isfinite(o->parent_weight)))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'parent_weight': expected a weight >= 1, found %g",
+                                 phc_origin_key(o->origin, "shape_series", "parent_weight").text, o->parent_weight);
+    }
     for (size_t s = 0; s < o->n_stalks; ++s) {
         const phc_shape_stalk *st = &o->stalks[s];
         const char *ws = where_of(st, o, wb, sizeof wb);
@@ -408,6 +577,18 @@ static int plant_stalk(shape_impl *m, stalk *out, const phc_shape_stalk *spec, d
     phc_rod_options_default(&ro);
     const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
                              spec->tip_mass * ro.gravity[2]};
+    if (m->dynamics == PHC_SHAPE_PARTICLES) {
+        out->force = m->plant_force;
+        out->rest_length = INFINITY;
+        for (size_t j = 0; j < g->n; ++j)
+            if (!g->fixed[j])
+                out->rest_length = fmin(out->rest_length, g->length[j]);
+        if (!(out->head = malloc(3 * g->n * sizeof *out->head)) || !(out->tail = malloc(3 * g->n * sizeof *out->tail)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (int d = 0; d < 3; ++d)
+            m->plant_force[3 * i + d] += force[d];
+        return PHC_OK;
+    }
     return phc_rod_set_load(m->plant_rod, i, force, err);
 }
 
@@ -416,6 +597,21 @@ static int plant_rod(shape_impl *m, const phc_shape_series_options *o, phc_error
 {
     if (!(m->plant = phc_plant_graph_copy(o->plant)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (o->dynamics == PHC_SHAPE_PARTICLES) {
+        /* the roots are clamps (anchored, orientation held), as the rod's are fixed */
+        size_t free_segments = 0;
+        for (size_t i = 0; i < m->plant->n; ++i) {
+            if (m->plant->parent[i] == PHC_PLANT_NO_PARENT)
+                m->plant->fixed[i] = 1;
+            free_segments += !m->plant->fixed[i];
+        }
+        if (free_segments == 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'plant': every segment is fixed: nothing can droop",
+                                 phc_origin_key(o->origin, "shape_series", "plant").text);
+        if (!(m->plant_force = calloc(3 * m->plant->n, sizeof *m->plant_force)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        return PHC_OK;
+    }
     double *young = malloc(m->plant->n * sizeof *young);
     if (!young)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -446,7 +642,8 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
      * spans half a free segment, as the base node of the continuum's
      * discretisation does (a clamp of a whole segment would lengthen the
      * beam by half a segment: tip slopes (1 + 1/(2n))² too large). */
-    const double hc = CLAMP_FRACTION * h;
+    const int particles = o->dynamics == PHC_SHAPE_PARTICLES;
+    const double hc = particles ? h : CLAMP_FRACTION * h; /* particles: see the header */
     for (size_t i = 0; i < n; ++i) {
         g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
         g->radius[i] = spec->radius;
@@ -468,10 +665,18 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
     phc_rod_options ro;
     phc_rod_options_default(&ro);
     ro.density = o->density;
-    if ((rc = phc_rod_new(g, out->young, &ro, &out->rod, err)))
-        return rc;
     const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
                              spec->tip_mass * ro.gravity[2]};
+    if (particles) {
+        out->rest_length = h;
+        if (!(out->force = calloc(3 * n, sizeof *out->force)) || !(out->head = malloc(3 * n * sizeof *out->head)) ||
+            !(out->tail = malloc(3 * n * sizeof *out->tail)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        memcpy(out->force + 3 * (n - 1), force, sizeof force);
+        return PHC_OK;
+    }
+    if ((rc = phc_rod_new(g, out->young, &ro, &out->rod, err)))
+        return rc;
     return phc_rod_set_load(out->rod, n - 1, force, err);
 }
 
@@ -509,6 +714,14 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
     m->e_min = o->e_min;
     m->fd_step = o->fd_step;
     m->frames = o->frames;
+    m->dynamics = o->dynamics;
+    m->popt = phc_particles_options_default();
+    m->popt.density = o->density;
+    m->popt.iterations = o->particle_iterations;
+    m->popt.damping = o->particle_damping;
+    m->popt.parent_weight = o->parent_weight;
+    m->pdt = o->particle_time_step;
+    m->psteps = o->particle_steps;
     m->e_min_slot = o->e_min_slot ? N_SHARED : -1;
     m->n_stalks = o->n_stalks;
     static const char *const shared[N_SHARED] = {"kappa", "chi0", "e_max", "delta"};
