@@ -55,8 +55,8 @@ static const phc_key_help shape_series_help[] = {
                  "particles (oriented particles of the climbing-plants paper relaxed from rest to rest "
                  "under gravity; stiffness s(t) = E(t)/(e_min + e_max), see README \"Fitting with "
                  "particles\")."},
-    {"particle_iterations", "Particles: projection iterations per time step, 1 to 1000. Default 4."},
-    {"particle_time_step", "Particles: time step, s, in (0, 1]. Default 1/120 (0.008333)."},
+    {"particle_iterations", "Particles: projection iterations per time step, 1 to 1000. Default 16."},
+    {"particle_time_step", "Particles: time step, s, in (0, 1]. Default 5e-4."},
     {"particle_steps", "Particles: most time steps of one relaxation (1 to 1e7); a system not at rest "
                        "by then is refused. Default 20000."},
     {"particle_damping", "Particles: fraction of the velocity removed per step, in (0, 1). Default "

@@ -51,6 +51,7 @@ typedef struct shape_impl {
     phc_particles_options popt; /* particles: density, iterations, damping, parent weight */
     double pdt;             /* particles: time step, s */
     size_t psteps;          /* particles: step cap */
+    size_t last_steps;      /* particles: steps of the last relaxation */
 } shape_impl;
 
 static void impl_free(void *p)
@@ -89,8 +90,8 @@ phc_shape_series_options phc_shape_series_options_default(void)
     o.fd_step = 1e-4;
     o.frames = 6;
     o.dynamics = PHC_SHAPE_RODS;
-    o.particle_iterations = 4;
-    o.particle_time_step = 1.0 / 120.0;
+    o.particle_iterations = 16;
+    o.particle_time_step = 5e-4;
     o.particle_steps = 20000;
     o.particle_damping = 0.05;
     o.parent_weight = 2.0;
@@ -167,7 +168,7 @@ static double direction(const stalk *st, const double h[3], const double t[3])
 
 /* Particles at stiffness s relaxed from the rest pose to rest (see the
  * header); the segment ends are left in st->head, st->tail. */
-static int particles_solve(const shape_impl *m, stalk *st, double s, double *angle, phc_error *err)
+static int particles_solve(shape_impl *m, stalk *st, double s, double *angle, phc_error *err)
 {
     if (!(s >= 0 && s <= 1))
         return phc_error_set(err, PHC_ERR_DOMAIN,
@@ -185,8 +186,13 @@ static int particles_solve(const shape_impl *m, stalk *st, double s, double *ang
             rc = phc_particles_set_force(p, i, st->force + 3 * i, err);
     const double tol = PHC_SHAPE_REST_FRACTION * st->rest_length / m->pdt; /* m s^-1 */
     double vmax = INFINITY;
-    size_t k = 0;
-    while (!rc && k < m->psteps && !(vmax < tol)) {
+    size_t k = 0, settle = 0, at_rest = 0;
+    /* to rest (vmax < tol), then a quarter as many steps again: the step
+     * count to rest changes in jumps with s, and the settling steps shrink
+     * the angle's jump there by the decay over k/4 steps (about 6 more
+     * decades), so that the angle is smooth in s to the differences'
+     * accuracy */
+    while (!rc && (at_rest ? settle < at_rest / 4 : k < m->psteps)) {
         if ((rc = phc_particles_step(p, m->pdt, NULL, err)))
             break;
         ++k;
@@ -199,8 +205,15 @@ static int particles_solve(const shape_impl *m, stalk *st, double s, double *ang
         if (!isfinite(vmax))
             rc = phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the particles' speed is not finite after %zu steps",
                                st->id, k);
+        else if (at_rest)
+            ++settle;
+        else if (vmax < tol)
+            at_rest = k;
     }
-    if (!rc && !(vmax < tol))
+    m->last_steps = k;
+    /* after settling the speed may have risen above tol again (the decay
+     * oscillates), not by orders of magnitude */
+    if (!rc && (!at_rest || !(vmax < 1e3 * tol)))
         rc = phc_error_set(err, PHC_ERR_DOMAIN,
                            "series '%s': the particles are not at rest after particle_steps = %zu steps of %g s "
                            "(stiffness s = %g, largest speed %.3g m/s, at rest below %.3g m/s): raise particle_steps "
@@ -237,9 +250,15 @@ static int rod_solve(stalk *st, double young, double *angle, phc_error *err)
 }
 
 /* The angle at the driver z (E with rods, s with particles). */
-static int solve_angle(const shape_impl *m, stalk *st, double z, double *angle, phc_error *err)
+static int solve_angle(shape_impl *m, stalk *st, double z, double *angle, phc_error *err)
 {
     return m->dynamics == PHC_SHAPE_PARTICLES ? particles_solve(m, st, z, angle, err) : rod_solve(st, z, angle, err);
+}
+
+size_t phc_shape_series_particle_steps(const phc_dataset *ds)
+{
+    const shape_impl *m = ds->impl;
+    return m->last_steps;
 }
 
 int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double z, double *angle, phc_error *err)
@@ -304,7 +323,7 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
 
 /* A frame: the stalk's equilibrium at time t as a graph copy (head, tail
  * updated) plus the per-segment values; *out owned by the caller. */
-static int frame_graph(const shape_impl *m, stalk *st, double z, phc_plant_graph **out, phc_error *err)
+static int frame_graph(shape_impl *m, stalk *st, double z, phc_plant_graph **out, phc_error *err)
 {
     double a;
     int rc;

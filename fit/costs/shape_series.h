@@ -154,8 +154,8 @@ typedef struct phc_shape_series_options {
                                       evenly spaced over the data's times; default 6, 0 none */
     const phc_origin *origin;      /* where the options came from, for messages; NULL */
     int dynamics;                  /* phc_shape_dynamics; default PHC_SHAPE_RODS */
-    size_t particle_iterations;    /* particles: projections per step, 1..1000; default 4 */
-    double particle_time_step;     /* particles: Δt, s, in (0, 1]; default 1/120 */
+    size_t particle_iterations;    /* particles: projections per step, 1..1000; default 16 */
+    double particle_time_step;     /* particles: Δt, s, in (0, 1]; default 5e-4 */
     size_t particle_steps;         /* particles: step cap of one relaxation, 1..10^7;
                                       default 20000 */
     double particle_damping;       /* particles: fraction of velocity removed per step,
@@ -192,6 +192,9 @@ int phc_shape_series_stiffness(const phc_dataset *ds, const double *p, double t,
  * s in [0, 1] with particles.  0, or non-zero when the solve fails (err,
  * may be NULL, then says why). */
 int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double driver, double *angle, phc_error *err);
+
+/* With particles: the time steps the last relaxation took (0 with rods). */
+size_t phc_shape_series_particle_steps(const phc_dataset *ds);
 
 extern const phc_dataset_ops phc_shape_series_ops;
 
