@@ -60,7 +60,7 @@ static const phc_key_help shape_series_help[] = {
     {"particle_steps", "Particles: most time steps of one relaxation (1 to 1e7); a system not at rest "
                        "by then is refused. Default 20000."},
     {"particle_damping", "Particles: fraction of the velocity removed per step, in (0, 1). Default "
-                         "0.05 (it does not move the rest state)."},
+                         "0.1 (it does not move the rest state)."},
     {"parent_weight", "Particles: weight of the parent's group in a particle's goal blend, >= 1. "
                       "Default 2."},
     {"frames", "Frames (side views, graphs in native format and VTK) that simulate and fit write "

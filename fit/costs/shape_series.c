@@ -93,7 +93,7 @@ phc_shape_series_options phc_shape_series_options_default(void)
     o.particle_iterations = 16;
     o.particle_time_step = 5e-4;
     o.particle_steps = 20000;
-    o.particle_damping = 0.05;
+    o.particle_damping = 0.1;
     o.parent_weight = 2.0;
     return o;
 }
@@ -728,6 +728,11 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
     ds->impl = m;
     ds->n = n;
     ds->derivatives = PHC_DERIV_ANALYTIC;
+    /* particles: the rest state ends 1e-12 of a segment per step from rest
+     * and settles further; angles are smooth in s to about 1e-10 rad (README
+     * "Fitting with particles"), so the solver need not iterate below it */
+    if (o->dynamics == PHC_SHAPE_PARTICLES)
+        ds->model_tolerance = 1e-10;
     m->t0 = isnan(o->t0) ? tr->t[0] : o->t0;
     m->rwc0 = o->rwc0;
     m->e_min = o->e_min;

@@ -159,7 +159,7 @@ typedef struct phc_shape_series_options {
     size_t particle_steps;         /* particles: step cap of one relaxation, 1..10^7;
                                       default 20000 */
     double particle_damping;       /* particles: fraction of velocity removed per step,
-                                      (0, 1); default 0.05 (it speeds up the relaxation and
+                                      (0, 1); default 0.1 (it speeds up the relaxation and
                                       does not move the rest state) */
     double parent_weight;          /* particles: weight of the parent's group, >= 1;
                                       default 2 */
