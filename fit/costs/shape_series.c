@@ -510,8 +510,7 @@ static int check_options(const phc_shape_series *tr, const phc_shape_series_opti
             return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_steps': expected 1 to 10000000, found %zu",
                                  phc_origin_key(o->origin, "shape_series", "particle_steps").text, o->particle_steps);
         if (!(o->particle_damping > 0 && o->particle_damping < 1))
-            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_damping': expected a fraction in (0, 1), found %g "
-                                 "(0 would never come to rest)",
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_damping': expected a fraction in (0, 1), found %g",
                                  phc_origin_key(o->origin, "shape_series", "particle_damping").text, o->particle_damping);
         if (!(o->parent_weight >= 1 && isfinite(o->parent_weight)))
             return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'parent_weight': expected a weight >= 1, found %g",
