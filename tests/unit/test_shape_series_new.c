@@ -423,6 +423,38 @@ static void test_particles_limits(void)
     }
     phc_dataset_free(ds);
     ds = NULL;
+    /* stalk a of options() (0.05 m, 6 segments, 1 g, base 30°): the time step
+     * sets how far it droops; the damping only how fast it comes to rest */
+    {
+        phc_shape_series_options oa = particle_options();
+        oa.n_stalks = 1;
+        const double dts[2] = {1.0 / 120, 5e-4}, damps[3] = {0.05, 0.1, 0.3};
+        double at[2][2] = {{NAN, NAN}, {NAN, NAN}}, damped[3] = {NAN, NAN, NAN};
+        for (int u = 0; u < 2; ++u) {
+            oa.particle_time_step = dts[u];
+            phc_dataset *da = NULL;
+            CHECK(phc_shape_series_new(tr, &oa, &da, &err) == PHC_OK);
+            for (int j = 0; da && j < 2; ++j)
+                CHECK(phc_shape_series_stalk_angle(da, 0, j ? 0.1 : 1.0, &at[u][j], &err) == 0);
+            printf("particles, stalk a (base 0.5236 rad), 16 iterations, dt = %.3g s: tip angle %.4f rad at s = 1, "
+                   "%.4f rad at s = 0.1\n", dts[u], at[u][0], at[u][1]);
+            phc_dataset_free(da);
+        }
+        CHECK(at[1][0] > at[0][0] && at[1][1] > at[0][1]); /* a smaller step droops less */
+        oa.particle_time_step = 5e-4;
+        for (int u = 0; u < 3; ++u) {
+            oa.particle_damping = damps[u];
+            phc_dataset *da = NULL;
+            CHECK(phc_shape_series_new(tr, &oa, &da, &err) == PHC_OK);
+            if (da) {
+                CHECK(phc_shape_series_stalk_angle(da, 0, 0.5, &damped[u], &err) == 0);
+                printf("particles, stalk a, s = 0.5, damping %.2f: tip angle %.12f rad, %zu steps\n", damps[u],
+                       damped[u], phc_shape_series_particle_steps(da));
+            }
+            phc_dataset_free(da);
+        }
+        CHECK(fabs(damped[0] - damped[1]) < 1e-9 && fabs(damped[2] - damped[1]) < 1e-9);
+    }
     /* a step cap the relaxation cannot meet: refused, naming the series */
     o.particle_steps = 10;
     CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
