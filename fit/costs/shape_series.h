@@ -39,9 +39,13 @@
  *   - steps of particle_time_step seconds, each with particle_iterations
  *     projections and particle_damping, until the largest particle speed
  *     times the time step falls below PHC_SHAPE_REST_FRACTION of the
- *     shortest free segment's length; a system not at rest after
- *     particle_steps steps is refused (PHC_ERR_DOMAIN, naming the series,
- *     the stiffness and the speed left), never a NaN;
+ *     shortest free segment's length, then a quarter as many steps again
+ *     (the step count to rest jumps with s; the settling steps shrink the
+ *     angle's jump there below what central differences resolve); a system
+ *     not at rest after particle_steps steps (settling not counted), or
+ *     whose speed rose 1000-fold during the settling, is refused
+ *     (PHC_ERR_DOMAIN, naming the series, the stiffness and the speed
+ *     left), never a NaN;
  *   - the stalk's clamp is one free segment long (not 1/1000 of one as for
  *     rods): a particle's group matches with the masses of its members, so a
  *     tiny clamp particle would hold the first free particle's rotation by

@@ -409,7 +409,7 @@ static void test_particles_limits(void)
         for (int j = 0; j < 3; ++j) {
             CHECK(phc_shape_series_stalk_angle(ds, 0, s[j], &a[j], &err) == 0);
             printf("particles, horizontal stalk 0.1 m, 16 iterations, dt = 1/480 s: s = %.1f: tip angle %.6f rad "
-                   "(%zu steps to rest)\n", s[j], a[j], phc_shape_series_particle_steps(ds));
+                   "(%zu steps, settling included)\n", s[j], a[j], phc_shape_series_particle_steps(ds));
         }
         CHECK(a[0] < 0 && a[0] > a[1] && a[1] > a[2]); /* droops, less when stiffer */
         CHECK(phc_shape_series_stalk_angle(ds, 0, 1.0, &again, &err) == 0);
