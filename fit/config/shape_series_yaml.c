@@ -51,10 +51,10 @@ static const phc_key_help shape_series_help[] = {
               "segments and base_angle_deg. Default: one stalk per series."},
     {"plant_format", "Format of the plant file: auto, paper, treeqsm, swc, native. Default auto."},
     {"plant_unit", "Length unit of the plant file (UDUNITS-2, e.g. mm). Default: the format's."},
-    {"dynamics", "The organ model's dynamics: rods (elastic rods, static equilibrium; the default) or "
+    {"dynamics", "The organ model's dynamics: rods (elastic rods, static equilibrium) or "
                  "particles (oriented particles of the climbing-plants paper relaxed from rest to rest "
                  "under gravity; stiffness s(t) = E(t)/(e_min + e_max), see README \"Fitting with "
-                 "particles\")."},
+                 "particles\"). Default rods."},
     {"particle_iterations", "Particles: projection iterations per time step, 1 to 1000. Default 16."},
     {"particle_time_step", "Particles: time step, s, in (0, 1]. Default 5e-4."},
     {"particle_steps", "Particles: most time steps of one relaxation (1 to 1e7); a system not at rest "
