@@ -22,7 +22,8 @@
  *    solve from rest does not depend on what was solved before), the
  *    Jacobian against central differences of the whole model (central and
  *    backward differences in s both taken), particle options and an unknown
- *    dynamics refused, a step cap too small refused without a NaN. */
+ *    dynamics refused, a step cap too small refused without a NaN; a plant
+ *    graph laid out as the particle stalk gives its angles (root anchored). */
 #include <math.h>
 
 #define PHC_SS_PI 3.14159265358979323846
@@ -562,6 +563,62 @@ static void test_particles_jacobian(const double *a, const double *b)
     phc_shape_series_free(tr);
 }
 
+/* Particles on a plant graph laid out as stalk "a" with the particles'
+ * clamp (a root segment one free segment long behind the base): the same
+ * particle system, so the same angles as the particle stalk; the root is
+ * anchored although the graph marks nothing fixed. */
+static void test_particles_plant(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    const size_t n = 7;
+    const double h = 0.05 / 6, beta = 30 * PHC_SS_PI / 180;
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    for (size_t i = 0; i < n; ++i) {
+        g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
+        g->radius[i] = 1e-3;
+        g->length[i] = h;
+        const double s0 = ((double)i - 1) * h, s1 = s0 + h;
+        g->head[3 * i] = s0 * cos(beta);
+        g->head[3 * i + 2] = s0 * sin(beta);
+        g->tail[3 * i] = s1 * cos(beta);
+        g->tail[3 * i + 2] = s1 * sin(beta);
+        g->source_id[i] = (long)i;
+    }
+    phc_error err;
+    CHECK(phc_plant_graph_finish(g, "test plant", &err) == PHC_OK);
+    phc_shape_series_options o = particle_options();
+    phc_dataset *stalk = NULL, *plant = NULL;
+    o.n_stalks = 1; /* stalk "a" of options() */
+    CHECK(phc_shape_series_new(tr, &o, &stalk, &err) == PHC_OK);
+    phc_shape_stalk st = {.series = "a", .tip_mass = 1e-3, .base_angle = NAN, .segment = 6};
+    o.stalks = &st;
+    o.plant = g;
+    CHECK(phc_shape_series_new(tr, &o, &plant, &err) == PHC_OK);
+    if (stalk && plant) {
+        double ys[4], yp[4];
+        const double p[] = {truth[0], truth[1], truth[2], truth[3]};
+        CHECK(stalk->n == 4 && plant->n == 4);
+        CHECK(stalk->ops->predict(stalk, p, ys, NULL) == 0 && plant->ops->predict(plant, p, yp, NULL) == 0);
+        double worst = 0;
+        for (int i = 0; i < 4; ++i)
+            worst = fmax(worst, fabs(ys[i] - yp[i]));
+        printf("particles: plant graph laid out as particle stalk a: angles %.4f .. %.4f rad, largest difference "
+               "%.3g rad\n", yp[0], yp[3], worst);
+        CHECK(worst < 1e-12);
+        CHECK(yp[3] < yp[0] - 0.1);
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_dataset_free(stalk);
+    phc_dataset_free(plant);
+    phc_plant_graph_free(g);
+    phc_shape_series_free(tr);
+}
+
 int main(void)
 {
 
@@ -573,6 +630,7 @@ int main(void)
         test_plant(a, b);
         test_e_min_slot(a, b);
         test_particles_jacobian(a, b);
+        test_particles_plant(a, b);
     }
     test_particles_limits();
     test_errors();
