@@ -20,7 +20,9 @@
 static const char *const shape_series_keys[] = {"file",  "time",  "y_down", "series", "rwc0",    "t0",
                                                 "e_min", "sigma", "every",  "density", "fd_step", "frames",
                                                 "plant", "plant_format", "plant_unit", "water", "conductance",
-                                                "viscosity", "water_step", NULL};
+                                                "viscosity", "water_step", "dynamics", "particle_iterations",
+                                                "particle_time_step", "particle_steps", "particle_damping",
+                                                "parent_weight", NULL};
 static const char *const stalk_keys[] = {"id",     "column",   "unit",           "length", "radius",
                                          "segments", "tip_mass", "base_angle_deg", "offset", "segment", NULL};
 static const phc_key_help shape_series_help[] = {
@@ -61,6 +63,18 @@ static const phc_key_help shape_series_help[] = {
                   "reference weights)."},
     {"water_step", "With water: plant, the BDF6 step of the water model, s (> 0). Default a "
                    "thousandth of the data's time span."},
+    {"dynamics", "The organ model's dynamics: rods (elastic rods, static equilibrium) or "
+                 "particles (oriented particles of the climbing-plants paper relaxed from rest to rest "
+                 "under gravity; stiffness s(t) = E(t)/(e_min + e_max), see README \"Fitting with "
+                 "particles\"). Default rods."},
+    {"particle_iterations", "Particles: projection iterations per time step, 1 to 1000. Default 16."},
+    {"particle_time_step", "Particles: time step, s, in (0, 1]. Default 5e-4."},
+    {"particle_steps", "Particles: most time steps of one relaxation (1 to 1e7); a system not at rest "
+                       "by then is refused. Default 20000."},
+    {"particle_damping", "Particles: fraction of the velocity removed per step, in (0, 1). Default "
+                         "0.1 (it does not move the rest state)."},
+    {"parent_weight", "Particles: weight of the parent's group in a particle's goal blend, >= 1. "
+                      "Default 2."},
     {"frames", "Frames (side views, graphs in native format and VTK) that simulate and fit write "
                "per series, evenly spaced over the data's times; 0 none. Default 6."},
     {NULL, NULL}};
@@ -205,6 +219,48 @@ static int read_numbers(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
     return PHC_OK;
 }
 
+/* `dynamics` and the particle keys (only with dynamics: particles). */
+static int read_dynamics(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_shape_series_options *o,
+                         phc_error *err)
+{
+    static const char *const particle_keys[] = {"particle_iterations", "particle_time_step", "particle_steps",
+                                                "particle_damping", "parent_weight", NULL};
+    const char *ctx = "shape_series data set", *dyn = "rods";
+    int rc;
+    if ((rc = phc_yaml_map_string(doc, node, "dynamics", 0, ctx, &dyn, err)))
+        return rc;
+    if (strcmp(dyn, "rods") == 0)
+        o->dynamics = PHC_SHAPE_RODS;
+    else if (strcmp(dyn, "particles") == 0)
+        o->dynamics = PHC_SHAPE_PARTICLES;
+    else
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'dynamics': '%s' is not one of rods, particles",
+                             doc->path, phc_key_line(node, "dynamics"), dyn);
+    if (o->dynamics != PHC_SHAPE_PARTICLES) {
+        for (size_t j = 0; particle_keys[j]; ++j)
+            if (phc_yaml_get(node, particle_keys[j]))
+                return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key '%s': only with `dynamics: particles`",
+                                     doc->path, phc_key_line(node, particle_keys[j]), particle_keys[j]);
+        return PHC_OK;
+    }
+    long iterations = (long)o->particle_iterations, steps = (long)o->particle_steps;
+    if ((rc = phc_yaml_map_integer(doc, node, "particle_iterations", 0, ctx, &iterations, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "particle_steps", 0, ctx, &steps, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "particle_time_step", 0, ctx, &o->particle_time_step, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "particle_damping", 0, ctx, &o->particle_damping, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "parent_weight", 0, ctx, &o->parent_weight, err)))
+        return rc;
+    if (iterations < 1 || iterations > 1000)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'particle_iterations': expected 1 to 1000, found %ld",
+                             doc->path, phc_key_line(node, "particle_iterations"), iterations);
+    if (steps < 1 || steps > 10000000)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'particle_steps': expected 1 to 10000000, found %ld",
+                             doc->path, phc_key_line(node, "particle_steps"), steps);
+    o->particle_iterations = (size_t)iterations;
+    o->particle_steps = (size_t)steps;
+    return PHC_OK; /* the numbers' ranges: phc_shape_series_new, naming the key's line */
+}
+
 /* `plant`, `plant_format`, `plant_unit`: the graph (NULL without `plant`). */
 static int read_plant(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                       phc_plant_graph **graph, char **gpath, phc_error *err)
@@ -260,7 +316,7 @@ static int shape_series_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
     if ((rc = phc_yaml_map_string(doc, node, "file", 1, "shape_series data set", &file, err)) ||
         (rc = phc_column_spec(doc, node, "time", "shape_series data set", "s", &time_col, &time_unit, err)) ||
         (rc = phc_yaml_map_boolean(doc, node, "y_down", 0, "shape_series data set", &y_down, err)) ||
-        (rc = read_numbers(doc, node, &o, err)) ||
+        (rc = read_numbers(doc, node, &o, err)) || (rc = read_dynamics(doc, node, &o, err)) ||
         (rc = read_series(doc, node, y_down, phc_yaml_get(node, "plant") != NULL, &p, err)) ||
         (rc = read_plant(doc, node, base_dir, &graph, &gpath, err)))
         goto done;
@@ -299,7 +355,7 @@ done:
 const phc_kind phc_shape_series_kind = {
     .config = {.name = "shape_series",
                .summary = "tracked organ angles over time -> kappa, chi0, e_max, delta of a drooping "
-                          "stalk whose stiffness follows its water (wilting eq. 9, elastic rods)",
+                          "stalk whose stiffness follows its water (wilting eq. 9, elastic rods or oriented particles)",
                .keys = shape_series_keys,
                .help = shape_series_help},
     .ops = &phc_shape_series_ops,

@@ -13,6 +13,7 @@
 #include "fit/shape_plots.h"
 #include "measurements/plant_io.h"
 #include "model/elasticity.h"
+#include "model/particles.h"
 #include "model/plant_graph.h"
 #include "model/rod.h"
 
@@ -23,8 +24,12 @@ enum { SLOT_KAPPA = 0, SLOT_CHI0, SLOT_E_MAX, SLOT_DELTA, N_SHARED };
 typedef struct stalk {
     char *id;
     phc_plant_graph *g; /* segment 0: the clamp (root), 1..n free */
-    phc_rod *rod;
+    phc_rod *rod;       /* rods only */
     double *young;      /* g->n moduli, Pa (work) */
+    double *force;      /* particles: 3 g->n external forces, N (the tip masses' weight);
+                           the data set's plant_force when shared */
+    double *head, *tail;/* particles: 3 g->n segment ends of the last solve, m (work) */
+    double rest_length; /* particles: shortest free segment, m (the rest test's scale) */
     double beta;        /* base angle, rad */
     double tip_mass;    /* kg */
     long offset_slot;   /* slot of offset_<id>, or -1 */
@@ -41,7 +46,13 @@ typedef struct shape_impl {
     long e_min_slot;    /* slot of e_min, or -1 */
     size_t frames;
     phc_plant_graph *plant; /* options.plant's copy, or NULL */
-    phc_rod *plant_rod;
+    phc_rod *plant_rod;     /* rods with a plant */
+    double *plant_force;    /* particles with a plant: 3n forces, N */
+    int dynamics;           /* phc_shape_dynamics */
+    phc_particles_options popt; /* particles: density, iterations, damping, parent weight */
+    double pdt;             /* particles: time step, s */
+    size_t psteps;          /* particles: step cap */
+    size_t last_steps;      /* particles: steps of the last relaxation */
     phc_shape_water *water; /* options.water_model: the water model on the plant, or NULL */
     double *x, *dx;         /* plant->n: relative water content, d x / d δ (work) */
     double *grad_e;         /* k x plant->n: d E_i / d slot (work) */
@@ -57,12 +68,16 @@ static void impl_free(void *p)
         if (!m->stalks[s].shared) {
             phc_rod_free(m->stalks[s].rod);
             phc_plant_graph_free(m->stalks[s].g);
+            free(m->stalks[s].force);
         }
+        free(m->stalks[s].head);
+        free(m->stalks[s].tail);
         free(m->stalks[s].young);
         free(m->stalks[s].id);
     }
     free(m->stalks);
     phc_rod_free(m->plant_rod);
+    free(m->plant_force);
     phc_plant_graph_free(m->plant);
     phc_shape_water_free(m->water);
     free(m->x);
@@ -84,6 +99,12 @@ phc_shape_series_options phc_shape_series_options_default(void)
     o.every = 1;
     o.fd_step = 1e-4;
     o.frames = 6;
+    o.dynamics = PHC_SHAPE_RODS;
+    o.particle_iterations = 16;
+    o.particle_time_step = 5e-4;
+    o.particle_steps = 20000;
+    o.particle_damping = 0.1;
+    o.parent_weight = 2.0;
     return o;
 }
 
@@ -120,44 +141,158 @@ int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, d
     return isfinite(*young) && *young > 0 ? 0 : 1;
 }
 
+/* The scalar the angle depends on: E(t) (Pa) with rods, s(t) = E(t) /
+ * (E_min + E_max) with particles; grad (optional, zeroed by the caller) its
+ * derivative in every slot. */
+static double driver(const phc_dataset *ds, const double *p, double t, double *grad)
+{
+    const shape_impl *m = ds->impl;
+    const double E = modulus(ds, p, t, NULL, grad);
+    if (m->dynamics != PHC_SHAPE_PARTICLES)
+        return E;
+    const double e_min = m->e_min_slot >= 0 ? p[m->e_min_slot] : m->e_min;
+    const double D = e_min + p[SLOT_E_MAX], s = E / D;
+    if (grad) {
+        for (size_t j = 0; j < ds->k; ++j)
+            grad[j] /= D;
+        grad[SLOT_E_MAX] -= s / D;
+        if (m->e_min_slot >= 0)
+            grad[m->e_min_slot] -= s / D;
+    }
+    return s;
+}
+
+int phc_shape_series_stiffness(const phc_dataset *ds, const double *p, double t, double *stiffness)
+{
+    const shape_impl *m = ds->impl;
+    const double e_min = m->e_min_slot >= 0 ? p[m->e_min_slot] : m->e_min;
+    *stiffness = modulus(ds, p, t, NULL, NULL) / (e_min + p[SLOT_E_MAX]);
+    return isfinite(*stiffness) && *stiffness >= 0 && *stiffness <= 1 ? 0 : 1;
+}
+
+/* The direction of segment seg (head h → tail t) in the x–z plane, within π
+ * of β. */
+static double direction(const stalk *st, const double h[3], const double t[3])
+{
+    const double a = atan2(t[2] - h[2], t[0] - h[0]);
+    return st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
+}
+
+/* Particles at stiffness s relaxed from the rest pose to rest (see the
+ * header); the segment ends are left in st->head, st->tail. */
+static int particles_solve(shape_impl *m, stalk *st, double s, double *angle, phc_error *err)
+{
+    if (!(s >= 0 && s <= 1))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "series '%s': particle stiffness s = E/(E_min + E_max) = %g is outside [0, 1] "
+                             "(E_max or E_min negative?)", st->id, s);
+    phc_particles_options po = m->popt;
+    po.stiffness = s;
+    phc_particles *p = phc_particles_new(st->g, &po, err);
+    if (!p)
+        return err ? err->status : PHC_ERR_INPUT;
+    const size_t n = st->g->n;
+    int rc = PHC_OK;
+    for (size_t i = 0; i < n && !rc; ++i)
+        if (st->force[3 * i] != 0 || st->force[3 * i + 1] != 0 || st->force[3 * i + 2] != 0)
+            rc = phc_particles_set_force(p, i, st->force + 3 * i, err);
+    const double tol = PHC_SHAPE_REST_FRACTION * st->rest_length / m->pdt; /* m s^-1 */
+    double vmax = INFINITY;
+    size_t k = 0, settle = 0, at_rest = 0;
+    /* to rest (vmax < tol), then a quarter as many steps again: the step
+     * count to rest changes in jumps with s, and the settling steps shrink
+     * the angle's jump there by the decay over k/4 steps (about 6 more
+     * decades), so that the angle is smooth in s to the differences'
+     * accuracy */
+    while (!rc && (at_rest ? settle < at_rest / 4 : k < m->psteps)) {
+        if ((rc = phc_particles_step(p, m->pdt, NULL, err)))
+            break;
+        ++k;
+        vmax = 0;
+        for (size_t i = 0; i < n; ++i) {
+            double v[3];
+            phc_particles_velocity(p, i, v);
+            vmax = fmax(vmax, sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+        }
+        if (!isfinite(vmax))
+            rc = phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the particles' speed is not finite after %zu steps",
+                               st->id, k);
+        else if (at_rest)
+            ++settle;
+        else if (vmax < tol)
+            at_rest = k;
+    }
+    m->last_steps = k;
+    /* after settling the speed may have risen above tol again (the decay
+     * oscillates), not by orders of magnitude */
+    if (!rc && (!at_rest || !(vmax < 1e3 * tol)))
+        rc = phc_error_set(err, PHC_ERR_DOMAIN,
+                           "series '%s': the particles are not at rest after particle_steps = %zu steps of %g s "
+                           "(stiffness s = %g, largest speed %.3g m/s, at rest below %.3g m/s): raise particle_steps "
+                           "or particle_damping",
+                           st->id, m->psteps, m->pdt, s, vmax, tol);
+    if (!rc) {
+        phc_particles_segment_ends(p, st->head, st->tail);
+        *angle = direction(st, st->head + 3 * st->seg, st->tail + 3 * st->seg);
+        if (!isfinite(*angle))
+            rc = phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the angle at rest is not finite", st->id);
+    }
+    phc_particles_free(p);
+    return rc;
+}
+
 /* Equilibrium from the rod's current state at modulus E; the last
  * segment's direction within π of β. */
-static int solve_angle_young(stalk *st, const double *young, double *angle);
+static int rod_solve_young(stalk *st, const double *young, double *angle, phc_error *err);
 
-static int solve_angle(stalk *st, double young, double *angle)
+static int rod_solve(stalk *st, double young, double *angle, phc_error *err)
 {
     if (!(young > 0) || !isfinite(young))
-        return 1;
+        return phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the modulus E = %g Pa is not positive", st->id,
+                             young);
     for (size_t i = 0; i < st->g->n; ++i)
         st->young[i] = young;
-    return solve_angle_young(st, st->young, angle);
+    return rod_solve_young(st, st->young, angle, err);
 }
 
 /* The same with a modulus per segment (Pa, g->n; may be st->young). */
-static int solve_angle_young(stalk *st, const double *young, double *angle)
+static int rod_solve_young(stalk *st, const double *young, double *angle, phc_error *err)
 {
     for (size_t i = 0; i < st->g->n; ++i)
         if (!(young[i] > 0) || !isfinite(young[i]))
-            return 1;
-    phc_error e;
+            return phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the modulus of segment %zu is %g Pa, not positive",
+                                 st->id, i, young[i]);
     phc_rod_report rep;
-    if (phc_rod_set_modulus(st->rod, young, &e) || phc_rod_solve_static(st->rod, &rep, &e))
-        return 1;
+    int rc;
+    if ((rc = phc_rod_set_modulus(st->rod, young, err)) || (rc = phc_rod_solve_static(st->rod, &rep, err)))
+        return rc;
     double h[3], t[3];
     phc_rod_head(st->rod, st->seg, h);
     phc_rod_tail(st->rod, st->seg, t);
-    const double a = atan2(t[2] - h[2], t[0] - h[0]);
-    *angle = st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
-    return isfinite(*angle) ? 0 : 1;
+    *angle = direction(st, h, t);
+    return isfinite(*angle) ? 0 : phc_error_set(err, PHC_ERR_DOMAIN, "series '%s': the angle is not finite", st->id);
 }
 
-int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double young, double *angle)
+/* The angle at the driver z (E with rods, s with particles). */
+static int solve_angle(shape_impl *m, stalk *st, double z, double *angle, phc_error *err)
+{
+    return m->dynamics == PHC_SHAPE_PARTICLES ? particles_solve(m, st, z, angle, err) : rod_solve(st, z, angle, err);
+}
+
+size_t phc_shape_series_particle_steps(const phc_dataset *ds)
+{
+    const shape_impl *m = ds->impl;
+    return m->last_steps;
+}
+
+int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double z, double *angle, phc_error *err)
 {
     shape_impl *m = ds->impl;
     if (s >= m->n_stalks)
-        return 1;
-    phc_rod_reset(m->stalks[s].rod);
-    return solve_angle(&m->stalks[s], young, angle);
+        return phc_error_set(err, PHC_ERR_INVALID, "shape_series: no stalk %zu", s);
+    if (m->dynamics != PHC_SHAPE_PARTICLES)
+        phc_rod_reset(m->stalks[s].rod);
+    return solve_angle(m, &m->stalks[s], z, angle, err);
 }
 
 /* With the water model: every segment's relative water content x_i(t)
@@ -207,7 +342,7 @@ static int predict_water(phc_dataset *ds, const double *p, double *yhat, double 
             prev = m->stalk_of[i];
         }
         double a;
-        if (segment_moduli(ds, p, m->t[i], st->young, jac != NULL) || solve_angle_young(st, st->young, &a))
+        if (segment_moduli(ds, p, m->t[i], st->young, jac != NULL) || rod_solve_young(st, st->young, &a, &e))
             return 1;
         yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
         if (!jac)
@@ -227,11 +362,11 @@ static int predict_water(phc_dataset *ds, const double *p, double *yhat, double 
             double ap, am;
             for (size_t q = 0; q < n; ++q)
                 m->e_step[q] = st->young[q] + h * d[q];
-            if (solve_angle_young(st, m->e_step, &ap))
+            if (rod_solve_young(st, m->e_step, &ap, &e))
                 return 1;
             for (size_t q = 0; q < n; ++q)
                 m->e_step[q] = st->young[q] - h * d[q];
-            if (solve_angle_young(st, m->e_step, &am))
+            if (rod_solve_young(st, m->e_step, &am, &e))
                 return 1;
             row[j] = (ap - am) / (2.0 * h);
         }
@@ -256,23 +391,33 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
     for (size_t i = 0; i < ds->n && !rc; ++i) {
         stalk *st = &m->stalks[m->stalk_of[i]];
         if (m->stalk_of[i] != prev) { /* a new series: from the rest shape */
-            phc_rod_reset(st->rod);
+            if (m->dynamics != PHC_SHAPE_PARTICLES)
+                phc_rod_reset(st->rod);
             prev = m->stalk_of[i];
         }
         memset(grad, 0, ds->k * sizeof *grad);
-        const double E = modulus(ds, p, m->t[i], NULL, jac ? grad : NULL);
+        const double z = driver(ds, p, m->t[i], jac ? grad : NULL);
         double a;
-        if ((rc = solve_angle(st, E, &a)))
+        if ((rc = solve_angle(m, st, z, &a, NULL))) {
+            yhat[i] = NAN; /* phc_dataset_check_start names this observation's line */
             break;
+        }
         yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
         if (!jac)
             continue;
-        /* d angle / dE by a central difference in E, warm-started */
-        const double h = m->fd_step * E;
-        double ap, am;
-        if ((rc = solve_angle(st, E + h, &ap)) || (rc = solve_angle(st, E - h, &am)))
-            break;
-        const double da_dE = (ap - am) / (2.0 * h);
+        /* d angle / dz by a central difference in z (rods: warm-started;
+         * particles: each from rest, backward when z + h > 1) */
+        const double h = m->fd_step * z;
+        double ap, am, da_dE;
+        if (m->dynamics == PHC_SHAPE_PARTICLES && z + h > 1.0) {
+            if ((rc = solve_angle(m, st, z - h, &am, NULL)) || (rc = solve_angle(m, st, z - 2.0 * h, &ap, NULL)))
+                break;
+            da_dE = (3.0 * a - 4.0 * am + ap) / (2.0 * h);
+        } else {
+            if ((rc = solve_angle(m, st, z + h, &ap, NULL)) || (rc = solve_angle(m, st, z - h, &am, NULL)))
+                break;
+            da_dE = (ap - am) / (2.0 * h);
+        }
         double *row = jac + i * ds->k;
         for (size_t j = 0; j < ds->k; ++j)
             row[j] = da_dE * grad[j];
@@ -280,24 +425,33 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
             row[st->offset_slot] = 1.0;
     }
     free(grad);
-    return rc;
+    return rc == PHC_ERR_NOMEM ? -1 : rc ? 1 : 0;
 }
 
 /* A frame: the stalk's equilibrium at time t as a graph copy (head, tail
  * updated) plus the per-segment values; *out owned by the caller. */
-static int frame_graph(stalk *st, const double *young, phc_plant_graph **out)
+/* young: NULL, or a modulus per segment (rods with the water model; z unused). */
+static int frame_graph(shape_impl *m, stalk *st, double z, const double *young, phc_plant_graph **out,
+                       phc_error *err)
 {
     double a;
+    int rc;
     *out = NULL;
-    phc_rod_reset(st->rod);
-    if (solve_angle_young(st, young, &a))
-        return 1;
+    if (m->dynamics != PHC_SHAPE_PARTICLES)
+        phc_rod_reset(st->rod);
+    if ((rc = young ? rod_solve_young(st, young, &a, err) : solve_angle(m, st, z, &a, err)))
+        return rc;
     phc_plant_graph *c = phc_plant_graph_copy(st->g);
     if (!c)
-        return -1;
-    for (size_t i = 0; i < c->n; ++i) {
-        phc_rod_head(st->rod, i, c->head + 3 * i);
-        phc_rod_tail(st->rod, i, c->tail + 3 * i);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (m->dynamics == PHC_SHAPE_PARTICLES) {
+        memcpy(c->head, st->head, 3 * c->n * sizeof *c->head);
+        memcpy(c->tail, st->tail, 3 * c->n * sizeof *c->tail);
+    } else {
+        for (size_t i = 0; i < c->n; ++i) {
+            phc_rod_head(st->rod, i, c->head + 3 * i);
+            phc_rod_tail(st->rod, i, c->tail + 3 * i);
+        }
     }
     *out = c;
     return 0;
@@ -324,39 +478,55 @@ static int write_frames(phc_dataset *ds, const double *p, const char *dir, const
         phc_plant_graph *graphs[64] = {0};
         double *values = calloc(nf * ns, sizeof *values);
         double *young = calloc(nf * ns, sizeof *young);
+        double *stiff = calloc(nf * ns, sizeof *stiff);
         char (*titles)[128] = calloc(nf, sizeof *titles);
         char sid[256], path[8192];
         phc_run_dir_safe_name(st->id, sid, sizeof sid);
-        if (!values || !young || !titles)
+        if (!values || !young || !stiff || !titles)
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         phc_error we;
         if (!rc && m->water && phc_shape_water_start(m->water, p[SLOT_DELTA], m->rwc0, 0, &we))
             rc = phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the water model: %s", ds->name, we.message);
         for (size_t f = 0; f < nf && !rc; ++f) {
             const double t = nf > 1 ? t_lo + (t_hi - t_lo) * (double)f / (double)(nf - 1) : t_lo;
-            double E = NAN, rwc = NAN, *yf = young + f * ns;
-            if (m->water) {
-                if (!segment_moduli(ds, p, t, yf, 0)) {
+            double E = NAN, rwc = NAN, sp = NAN, *yf = young + f * ns;
+            const int particles = m->dynamics == PHC_SHAPE_PARTICLES;
+            phc_error why;
+            why.message[0] = 0;
+            int bad;
+            if (m->water) { /* a modulus per segment */
+                bad = segment_moduli(ds, p, t, yf, 0);
+                if (!bad) {
                     E = yf[0], rwc = m->x[0];
                     for (size_t i = 0; i < ns; ++i) {
                         values[f * ns + i] = m->x[i];
+                        stiff[f * ns + i] = NAN;
                         E = fmin(E, yf[i]);
                         rwc = fmin(rwc, m->x[i]);
                     }
                 }
-            } else if (!phc_shape_series_modulus(ds, p, t, &E, &rwc)) {
-                for (size_t i = 0; i < ns; ++i) {
+                bad = bad || frame_graph(m, st, NAN, yf, &graphs[f], &why);
+            } else {
+                bad = phc_shape_series_modulus(ds, p, t, &E, &rwc) ||
+                      (particles && phc_shape_series_stiffness(ds, p, t, &sp)) ||
+                      frame_graph(m, st, particles ? sp : E, NULL, &graphs[f], &why);
+                for (size_t i = 0; i < ns && !bad; ++i) {
                     values[f * ns + i] = rwc;
                     yf[i] = E;
+                    stiff[f * ns + i] = sp;
                 }
             }
-            if (!isfinite(E) || frame_graph(st, yf, &graphs[f])) {
+            if (bad) {
                 rc = phc_error_set(err, PHC_ERR_DOMAIN,
-                                   "data set '%s': series '%s': no static equilibrium at t = %g s "
-                                   "(E = %g Pa)", ds->name, st->id, t, E);
+                                   "data set '%s': series '%s': no %s at t = %g s (E = %g Pa%s%.6g)%s%s", ds->name,
+                                   st->id, particles ? "rest state of the particles" : "static equilibrium", t, E,
+                                   particles ? ", s = " : "", particles ? sp : 0.0, why.message[0] ? ": " : "",
+                                   why.message);
                 break;
             }
-            if (m->water)
+            if (particles)
+                snprintf(titles[f], sizeof titles[f], "t = %.3g h, s = %.3g", t / 3600.0, sp);
+            else if (m->water)
                 snprintf(titles[f], sizeof titles[f], "t = %.3g h, E >= %.3g MPa, RWC >= %.3g", t / 3600.0,
                          E * 1e-6, rwc);
             else
@@ -367,15 +537,16 @@ static int write_frames(phc_dataset *ds, const double *p, const char *dir, const
                                           .radius = graphs[f]->radius,
                                           .value = values + f * ns,
                                           .title = titles[f]};
-            const phc_plant_field fields[2] = {{"relative_water", values + f * ns},
-                                               {"young_modulus_Pa", young + f * ns}};
+            const phc_plant_field fields[3] = {{"relative_water", values + f * ns},
+                                               {"young_modulus_Pa", young + f * ns},
+                                               {"particle_stiffness", stiff + f * ns}};
             snprintf(path, sizeof path, "%s/%s_%s_frame%02zu.csv", dir, base, sid, f);
             if ((rc = phc_plant_io_write_native(path, graphs[f], err)))
                 break;
             snprintf(path, sizeof path, "%s/%s_%s_frame%02zu.vtk", dir, base, sid, f);
             char vtitle[256];
             snprintf(vtitle, sizeof vtitle, "phytocal shape_series %s %s", st->id, titles[f]);
-            if ((rc = phc_plant_io_write_vtk(path, graphs[f], vtitle, fields, 2, err)))
+            if ((rc = phc_plant_io_write_vtk(path, graphs[f], vtitle, fields, particles ? 3 : 2, err)))
                 break;
         }
         if (!rc) {
@@ -392,6 +563,7 @@ static int write_frames(phc_dataset *ds, const double *p, const char *dir, const
             phc_plant_graph_free(graphs[f]);
         free(values);
         free(young);
+        free(stiff);
         free(titles);
     }
     return rc;
@@ -464,6 +636,33 @@ static int check_options(const phc_shape_series *tr, const phc_shape_series_opti
     if (o->water_model && !(o->viscosity >= 0 && isfinite(o->viscosity)))
         return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'viscosity': must be positive (mPa s), found %g",
                              phc_origin_key(o->origin, "shape_series", "viscosity").text, o->viscosity);
+    if (o->dynamics != PHC_SHAPE_RODS && o->dynamics != PHC_SHAPE_PARTICLES)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'dynamics': expected rods or particles",
+                             phc_origin_key(o->origin, "shape_series", "dynamics").text);
+    if (o->dynamics == PHC_SHAPE_PARTICLES) {
+        if (o->particle_iterations < 1 || o->particle_iterations > 1000)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_iterations': expected 1 to 1000, found %zu",
+                                 phc_origin_key(o->origin, "shape_series", "particle_iterations").text,
+                                 o->particle_iterations);
+        if (!(o->particle_time_step > 0 && o->particle_time_step <= 1))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_time_step': expected a time step in (0, 1] s, "
+                                 "found %g", phc_origin_key(o->origin, "shape_series", "particle_time_step").text,
+                                 o->particle_time_step);
+        if (o->particle_steps < 1 || o->particle_steps > 10000000)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_steps': expected 1 to 10000000, found %zu",
+                                 phc_origin_key(o->origin, "shape_series", "particle_steps").text, o->particle_steps);
+        if (!(o->particle_damping > 0 && o->particle_damping < 1))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'particle_damping': expected a fraction in (0, 1), found %g",
+                                 phc_origin_key(o->origin, "shape_series", "particle_damping").text, o->particle_damping);
+        if (!(o->parent_weight >= 1 && isfinite(o->parent_weight)))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'parent_weight': expected a weight >= 1, found %g",
+                                 phc_origin_key(o->origin, "shape_series", "parent_weight").text, o->parent_weight);
+    }
+    if (o->water_model && o->dynamics == PHC_SHAPE_PARTICLES)
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s: key 'water': water: plant needs dynamics: rods (a particle has one stiffness "
+                             "s(t) for the whole plant, not one per segment)",
+                             phc_origin_key(o->origin, "shape_series", "water").text);
     for (size_t s = 0; s < o->n_stalks; ++s) {
         const phc_shape_stalk *st = &o->stalks[s];
         const char *ws = where_of(st, o, wb, sizeof wb);
@@ -543,6 +742,18 @@ static int plant_stalk(shape_impl *m, stalk *out, const phc_shape_stalk *spec, d
     phc_rod_options_default(&ro);
     const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
                              spec->tip_mass * ro.gravity[2]};
+    if (m->dynamics == PHC_SHAPE_PARTICLES) {
+        out->force = m->plant_force;
+        out->rest_length = INFINITY;
+        for (size_t j = 0; j < g->n; ++j)
+            if (!g->fixed[j])
+                out->rest_length = fmin(out->rest_length, g->length[j]);
+        if (!(out->head = malloc(3 * g->n * sizeof *out->head)) || !(out->tail = malloc(3 * g->n * sizeof *out->tail)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (int d = 0; d < 3; ++d)
+            m->plant_force[3 * i + d] += force[d];
+        return PHC_OK;
+    }
     return phc_rod_set_load(m->plant_rod, i, force, err);
 }
 
@@ -551,6 +762,21 @@ static int plant_rod(shape_impl *m, const phc_shape_series_options *o, phc_error
 {
     if (!(m->plant = phc_plant_graph_copy(o->plant)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (o->dynamics == PHC_SHAPE_PARTICLES) {
+        /* the roots are clamps (anchored, orientation held), as the rod's are fixed */
+        size_t free_segments = 0;
+        for (size_t i = 0; i < m->plant->n; ++i) {
+            if (m->plant->parent[i] == PHC_PLANT_NO_PARENT)
+                m->plant->fixed[i] = 1;
+            free_segments += !m->plant->fixed[i];
+        }
+        if (free_segments == 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: key 'plant': every segment is fixed: nothing can droop",
+                                 phc_origin_key(o->origin, "shape_series", "plant").text);
+        if (!(m->plant_force = calloc(3 * m->plant->n, sizeof *m->plant_force)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        return PHC_OK;
+    }
     double *young = malloc(m->plant->n * sizeof *young);
     if (!young)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
@@ -606,7 +832,8 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
      * spans half a free segment, as the base node of the continuum's
      * discretisation does (a clamp of a whole segment would lengthen the
      * beam by half a segment: tip slopes (1 + 1/(2n))² too large). */
-    const double hc = CLAMP_FRACTION * h;
+    const int particles = o->dynamics == PHC_SHAPE_PARTICLES;
+    const double hc = particles ? h : CLAMP_FRACTION * h; /* particles: see the header */
     for (size_t i = 0; i < n; ++i) {
         g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
         g->radius[i] = spec->radius;
@@ -628,10 +855,18 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
     phc_rod_options ro;
     phc_rod_options_default(&ro);
     ro.density = o->density;
-    if ((rc = phc_rod_new(g, out->young, &ro, &out->rod, err)))
-        return rc;
     const double force[3] = {spec->tip_mass * ro.gravity[0], spec->tip_mass * ro.gravity[1],
                              spec->tip_mass * ro.gravity[2]};
+    if (particles) {
+        out->rest_length = h;
+        if (!(out->force = calloc(3 * n, sizeof *out->force)) || !(out->head = malloc(3 * n * sizeof *out->head)) ||
+            !(out->tail = malloc(3 * n * sizeof *out->tail)))
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        memcpy(out->force + 3 * (n - 1), force, sizeof force);
+        return PHC_OK;
+    }
+    if ((rc = phc_rod_new(g, out->young, &ro, &out->rod, err)))
+        return rc;
     return phc_rod_set_load(out->rod, n - 1, force, err);
 }
 
@@ -664,11 +899,24 @@ int phc_shape_series_new(const phc_shape_series *tr, const phc_shape_series_opti
     ds->impl = m;
     ds->n = n;
     ds->derivatives = PHC_DERIV_ANALYTIC;
+    /* particles: the rest state ends 1e-12 of a segment per step from rest
+     * and settles further; angles are smooth in s to about 1e-10 rad (README
+     * "Fitting with particles"), so the solver need not iterate below it */
+    if (o->dynamics == PHC_SHAPE_PARTICLES)
+        ds->model_tolerance = 1e-10;
     m->t0 = isnan(o->t0) ? tr->t[0] : o->t0;
     m->rwc0 = o->rwc0;
     m->e_min = o->e_min;
     m->fd_step = o->fd_step;
     m->frames = o->frames;
+    m->dynamics = o->dynamics;
+    m->popt = phc_particles_options_default();
+    m->popt.density = o->density;
+    m->popt.iterations = o->particle_iterations;
+    m->popt.damping = o->particle_damping;
+    m->popt.parent_weight = o->parent_weight;
+    m->pdt = o->particle_time_step;
+    m->psteps = o->particle_steps;
     m->e_min_slot = o->e_min_slot ? N_SHARED : -1;
     m->n_stalks = o->n_stalks;
     static const char *const shared[N_SHARED] = {"kappa", "chi0", "e_max", "delta"};

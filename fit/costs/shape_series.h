@@ -33,6 +33,44 @@
  * means in a `weight_curve` on the same plant (a joint fit shares it by
  * name), and its own modulus E_i(t) = E_min + E_max σ(κ (x_i − χ0)).
  * Observations before t0 are refused (the water runs forward from t0).
+ * (Not with particles: a particle's stiffness is one scalar s(t); water: plant
+ * with dynamics: particles is refused.)
+ *
+ * Dynamics (options.dynamics): PHC_SHAPE_RODS (default) as above, or
+ * PHC_SHAPE_PARTICLES: the same graph (stalk or plant) as oriented particles
+ * (model/particles.h, climbing plants §4.1, one particle per segment).  The
+ * model angle at time t is then the direction of the series' segment
+ * (phc_particles_segment_ends, head → tail) after relaxing the particle
+ * system under gravity to rest:
+ *   - every solve starts from the rest pose (a new system per solve, so the
+ *     result does not depend on the order of evaluations or on a warm start);
+ *   - the anchored particles are the graph's fixed segments and its roots,
+ *     held in place with their orientation (a clamp);
+ *   - steps of particle_time_step seconds, each with particle_iterations
+ *     projections and particle_damping, until the largest particle speed
+ *     times the time step falls below PHC_SHAPE_REST_FRACTION of the
+ *     shortest free segment's length, then a quarter as many steps again
+ *     (the step count to rest jumps with s; the settling steps shrink the
+ *     angle's jump there below what central differences resolve); a system
+ *     not at rest after particle_steps steps (settling not counted), or
+ *     whose speed rose 1000-fold during the settling, is refused
+ *     (PHC_ERR_DOMAIN, naming the series, the stiffness and the speed
+ *     left), never a NaN;
+ *   - the stalk's clamp is one free segment long (not 1/1000 of one as for
+ *     rods): a particle's group matches with the masses of its members, so a
+ *     tiny clamp particle would hold the first free particle's rotation by
+ *     almost nothing, a hinge instead of a clamp.  It then continues the
+ *     chain behind the base, as a fixed neighbour;
+ *   - the tip mass is an external force m_tip·g on the series' particle,
+ *     applied at its centre (particles carry no torque).
+ * The particles' stiffness s ∈ [0, 1] is not a modulus.  Eq. 9 is mapped to
+ * it by
+ *     s(t) = E(t) / (E_min + E_max)
+ * (1 only in the limit σ → 1, turgid ≈ 1, fully wilted E_min/(E_min + E_max)):
+ * the same logistic in water, scaled so that s stays in [0, 1] for any
+ * parameters.  E_max's scale is then identified only through E_min/E_max,
+ * and the fitted κ, χ0 are those of a stiffness whose effect depends on the
+ * iteration count and time step (README "Effective stiffness").
  *
  * Observations: the tracks of measurements/shape_series.h of kind
  * PHC_SHAPE_ANGLE, in rad, counter-clockwise with y up (read image angles
@@ -66,7 +104,11 @@
  * d E / d p is exact per segment (d x / d δ from the water model's BDF6
  * sensitivities) and d angle / d p is a central difference along that
  * direction, E ± h·dE/dp with h·max|dE/dp| = fd_step·max E (two static
- * solves per slot and observation).  tests/unit/test_shape_series_new.c checks the
+ * solves per slot and observation).  With particles the scalar is s(t) (d s / d p
+ * exact, including the E_max and E_min slots in its denominator) and
+ * d angle / d s a central difference with step fd_step·s, or the
+ * second-order backward difference (3 a(s) − 4 a(s − h) + a(s − 2h)) / 2h
+ * when s + h > 1; each of the two or three solves relaxes from rest.  tests/unit/test_shape_series_new.c checks the
  * Jacobian against central differences of the whole model in every slot and
  * against a second fd_step.
  *
@@ -106,6 +148,17 @@ typedef struct phc_shape_stalk {
     const char *where;   /* for messages (e.g. "cfg.yaml:14"); may be NULL */
 } phc_shape_stalk;
 
+/* The organ model's dynamics (options.dynamics, config `dynamics:`). */
+typedef enum phc_shape_dynamics {
+    PHC_SHAPE_RODS = 0,     /* elastic rods, static equilibrium (model/rod.h) */
+    PHC_SHAPE_PARTICLES = 1 /* oriented particles relaxed to rest (model/particles.h) */
+} phc_shape_dynamics;
+
+/* With particles: at rest when max |v|·Δt < this fraction of the shortest
+ * free segment's length (per step, the particles then move by less than
+ * 1e-12 of a segment). */
+#define PHC_SHAPE_REST_FRACTION 1e-12
+
 typedef struct phc_shape_series_options {
     size_t n_stalks;               /* >= 1 */
     const phc_shape_stalk *stalks;
@@ -120,6 +173,16 @@ typedef struct phc_shape_series_options {
     size_t frames;                 /* simulate/fit outputs: frames (side views, graphs),
                                       evenly spaced over the data's times; default 6, 0 none */
     const phc_origin *origin;      /* where the options came from, for messages; NULL */
+    int dynamics;                  /* phc_shape_dynamics; default PHC_SHAPE_RODS */
+    size_t particle_iterations;    /* particles: projections per step, 1..1000; default 16 */
+    double particle_time_step;     /* particles: Δt, s, in (0, 1]; default 5e-4 */
+    size_t particle_steps;         /* particles: step cap of one relaxation, 1..10^7;
+                                      default 20000 */
+    double particle_damping;       /* particles: fraction of velocity removed per step,
+                                      (0, 1); default 0.1 (it speeds up the relaxation and
+                                      does not move the rest state) */
+    double parent_weight;          /* particles: weight of the parent's group, >= 1;
+                                      default 2 */
     const phc_plant_graph *plant;  /* NULL: one stalk per series (above); else a finished
                                       plant graph (m, z up; copied): one rod for the whole
                                       plant, every segment at E(t), each series the angle
@@ -150,10 +213,18 @@ int phc_shape_series_new(const phc_shape_series *tracks, const phc_shape_series_
 int phc_shape_series_modulus(const phc_dataset *ds, const double *p, double t, double *young,
                              double *rwc);
 
-/* The equilibrium angle (rad, without offset) of stalk s at modulus young
- * (Pa), solved from the rest shape.  0, or non-zero when the static solve
- * fails. */
-int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double young, double *angle);
+/* The particles' stiffness s(t) = E(t) / (E_min + E_max) in [0, 1] at time
+ * t (s) for slot values p (any dynamics). */
+int phc_shape_series_stiffness(const phc_dataset *ds, const double *p, double t, double *stiffness);
+
+/* The equilibrium angle (rad, without offset) of stalk s, solved from the
+ * rest shape, at `driver`: the modulus E (Pa) with rods, the stiffness
+ * s in [0, 1] with particles.  0, or non-zero when the solve fails (err,
+ * may be NULL, then says why). */
+int phc_shape_series_stalk_angle(phc_dataset *ds, size_t s, double driver, double *angle, phc_error *err);
+
+/* With particles: the time steps the last relaxation took (0 with rods). */
+size_t phc_shape_series_particle_steps(const phc_dataset *ds);
 
 extern const phc_dataset_ops phc_shape_series_ops;
 

@@ -1353,6 +1353,46 @@ ls "$T/out_ss_pgood"/*flower1_frame00.vtk >/dev/null 2>&1 || add_why "no VTK fra
 report_case "shape_series: control: a plant graph with a segment per series simulates"
 rm -rf "$T/out_ss_pgood"
 fit_case "shape_series: unknown segment" "$C/ss_pseg.yaml" "ss_pseg.yaml:13" "flower1" "no segment 7"
+# dynamics: particles (the particle keys on lines 13 and 14)
+ss_config ss_pgood_particles.yaml ss_ok.csv "$SS_F1" '    dynamics: particles
+    frames: 2
+'
+WHY=""
+run_phc simulate "$C/ss_pgood_particles.yaml" -o "$T/out_ss_particles"
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+ls "$T/out_ss_particles"/*flower1_frames.png >/dev/null 2>&1 || add_why "no side views written"
+ls "$T/out_ss_particles"/*flower1_frame01.vtk >/dev/null 2>&1 || add_why "no VTK frame written"
+ls "$T/out_ss_particles"/*flower1_frame01.csv >/dev/null 2>&1 || add_why "no native graph written"
+report_case "shape_series: control: dynamics: particles simulates"
+rm -rf "$T/out_ss_particles"
+ss_config ss_dyn.yaml ss_ok.csv "$SS_F1" '    dynamics: springs
+'
+fit_case "shape_series: unknown dynamics" "$C/ss_dyn.yaml" "ss_dyn.yaml:13" "'dynamics'" "springs" "rods, particles"
+ss_config ss_prods.yaml ss_ok.csv "$SS_F1" '    particle_iterations: 8
+'
+fit_case "shape_series: particle key with rods" "$C/ss_prods.yaml" "ss_prods.yaml:13" "particle_iterations" \
+    "only with"
+ss_config ss_pdt.yaml ss_ok.csv "$SS_F1" '    dynamics: particles
+    particle_time_step: 0
+'
+fit_case "shape_series: particle time step zero" "$C/ss_pdt.yaml" "ss_pdt.yaml:14" "'particle_time_step'"
+ss_config ss_pdamp.yaml ss_ok.csv "$SS_F1" '    dynamics: particles
+    particle_damping: 1
+'
+fit_case "shape_series: particle damping 1" "$C/ss_pdamp.yaml" "ss_pdamp.yaml:14" "'particle_damping'"
+ss_config ss_piter.yaml ss_ok.csv "$SS_F1" '    dynamics: particles
+    particle_iterations: 0
+'
+fit_case "shape_series: particle iterations 0" "$C/ss_piter.yaml" "ss_piter.yaml:14" "'particle_iterations'"
+ss_config ss_pweight.yaml ss_ok.csv "$SS_F1" '    dynamics: particles
+    parent_weight: 0.5
+'
+fit_case "shape_series: parent weight below 1" "$C/ss_pweight.yaml" "ss_pweight.yaml:14" "'parent_weight'"
+ss_config ss_psteps.yaml ss_ok.csv "$SS_F1" '    dynamics: particles
+    particle_steps: 5
+'
+fit_case "shape_series: particles not at rest within the step cap" "$C/ss_psteps.yaml" "ss_ok.csv:2" \
+    "not finite at the start values"
 # ---- end shape_series ------------------------------------------------------
 # ---- shape_series with water: plant (the water model drives the moduli) ----
 sed 's/,0,0$/,1,0/' "$C/ss_plant.csv" >"$C/ss_leafplant.csv" # leaf segments lose water

@@ -16,7 +16,14 @@
  * 5. e_min as a slot: its Jacobian column against central differences;
  * 6. a plant graph (options.plant) laid out as a stalk, its series mapped to
  *    the last segment, gives the stalk's angles; an unknown segment id is
- *    refused. */
+ *    refused;
+ * 7. dynamics: particles: a limit case (s = 1 with 16 iterations and
+ *    dt = 1/480 s droops less than s = 0.1, and s = 1 less than s = 0.5; a
+ *    solve from rest does not depend on what was solved before), the
+ *    Jacobian against central differences of the whole model (central and
+ *    backward differences in s both taken), particle options and an unknown
+ *    dynamics refused, a step cap too small refused without a NaN; a plant
+ *    graph laid out as the particle stalk gives its angles (root anchored). */
 #include <math.h>
 
 #define PHC_SS_PI 3.14159265358979323846
@@ -92,12 +99,12 @@ static void test_limits(void)
     CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
     if (ds) {
         double a = NAN, stiff = NAN;
-        CHECK(phc_shape_series_stalk_angle(ds, 0, E, &a) == 0);
+        CHECK(phc_shape_series_stalk_angle(ds, 0, E, &a, &err) == 0);
         const double want = -m * 9.81 * L * L / (2 * E * I);
         printf("tip slope under a tip load: %.8g rad, Euler-Bernoulli -PL^2/(2EI) = %.8g rad (ratio %.7f)\n", a,
                want, a / want);
         CHECK_NEAR(a, want, 0, 1e-3);
-        CHECK(phc_shape_series_stalk_angle(ds, 0, 1e15, &stiff) == 0);
+        CHECK(phc_shape_series_stalk_angle(ds, 0, 1e15, &stiff, &err) == 0);
         printf("very stiff stalk (E = 1e15 Pa): angle %.3g rad\n", stiff);
         CHECK(fabs(stiff) < 1e-7);
     } else {
@@ -111,7 +118,7 @@ static void test_limits(void)
     CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
     if (ds) {
         double a = NAN;
-        CHECK(phc_shape_series_stalk_angle(ds, 0, E, &a) == 0);
+        CHECK(phc_shape_series_stalk_angle(ds, 0, E, &a, &err) == 0);
         const double q = 1000 * PHC_SS_PI * r * r * 9.81, want = -q * L * L * L / (6 * E * I);
         printf("tip slope under self-weight: %.8g rad, Euler-Bernoulli -qL^3/(6EI) = %.8g rad (ratio %.7f)\n", a,
                want, a / want);
@@ -372,8 +379,251 @@ static void test_plant(const double *a, const double *b)
     phc_shape_series_free(tr);
 }
 
+/* Particles: the stalks of options(), every 6th sample. */
+static phc_shape_series_options particle_options(void)
+{
+    phc_shape_series_options o = options();
+    o.dynamics = PHC_SHAPE_PARTICLES;
+    o.every = 20;
+    return o;
+}
+
+static void test_particles_limits(void)
+{
+    phc_shape_series *tr = tracks_from("t (min),a (deg),b (deg)\n0,0,0\n");
+    if (!tr)
+        return;
+    phc_shape_series_options o = particle_options();
+    phc_shape_stalk st = {.series = "a", .length = 0.1, .radius = 2e-3, .segments = 8, .tip_mass = 2e-3,
+                          .base_angle = 0};
+    o.n_stalks = 1;
+    o.stalks = &st;
+    o.particle_iterations = 16;
+    o.particle_time_step = 1.0 / 480;
+    o.particle_steps = 200000;
+    phc_dataset *ds = NULL;
+    phc_error err;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        const double s[] = {1.0, 0.5, 0.1};
+        double a[3] = {NAN, NAN, NAN}, again = NAN;
+        for (int j = 0; j < 3; ++j) {
+            CHECK(phc_shape_series_stalk_angle(ds, 0, s[j], &a[j], &err) == 0);
+            printf("particles, horizontal stalk 0.1 m, 16 iterations, dt = 1/480 s: s = %.1f: tip angle %.6f rad "
+                   "(%zu steps, settling included)\n", s[j], a[j], phc_shape_series_particle_steps(ds));
+        }
+        CHECK(a[0] < 0 && a[0] > a[1] && a[1] > a[2]); /* droops, less when stiffer */
+        CHECK(phc_shape_series_stalk_angle(ds, 0, 1.0, &again, &err) == 0);
+        printf("particles: s = 1 solved again after s = 0.1: difference %.3g rad\n", again - a[0]);
+        CHECK(again == a[0]); /* each solve starts from rest */
+        CHECK(phc_shape_series_stalk_angle(ds, 0, 1.5, &again, &err) != 0);
+        CHECK_STR_CONTAINS(err.message, "outside [0, 1]");
+        printf("s = 1.5: %s\n", err.message);
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_dataset_free(ds);
+    ds = NULL;
+    /* stalk a of options() (0.05 m, 6 segments, 1 g, base 30°): the time step
+     * sets how far it droops; the damping only how fast it comes to rest */
+    {
+        phc_shape_series_options oa = particle_options();
+        oa.n_stalks = 1;
+        const double dts[2] = {1.0 / 120, 5e-4}, damps[3] = {0.05, 0.1, 0.3};
+        double at[2][2] = {{NAN, NAN}, {NAN, NAN}}, damped[3] = {NAN, NAN, NAN};
+        for (int u = 0; u < 2; ++u) {
+            oa.particle_time_step = dts[u];
+            phc_dataset *da = NULL;
+            CHECK(phc_shape_series_new(tr, &oa, &da, &err) == PHC_OK);
+            for (int j = 0; da && j < 2; ++j)
+                CHECK(phc_shape_series_stalk_angle(da, 0, j ? 0.1 : 1.0, &at[u][j], &err) == 0);
+            printf("particles, stalk a (base 0.5236 rad), 16 iterations, dt = %.3g s: tip angle %.4f rad at s = 1, "
+                   "%.4f rad at s = 0.1\n", dts[u], at[u][0], at[u][1]);
+            phc_dataset_free(da);
+        }
+        CHECK(at[1][0] > at[0][0] && at[1][1] > at[0][1]); /* a smaller step droops less */
+        oa.particle_time_step = 5e-4;
+        for (int u = 0; u < 3; ++u) {
+            oa.particle_damping = damps[u];
+            phc_dataset *da = NULL;
+            CHECK(phc_shape_series_new(tr, &oa, &da, &err) == PHC_OK);
+            if (da) {
+                CHECK(phc_shape_series_stalk_angle(da, 0, 0.5, &damped[u], &err) == 0);
+                printf("particles, stalk a, s = 0.5, damping %.2f: tip angle %.12f rad, %zu steps\n", damps[u],
+                       damped[u], phc_shape_series_particle_steps(da));
+            }
+            phc_dataset_free(da);
+        }
+        CHECK(fabs(damped[0] - damped[1]) < 1e-9 && fabs(damped[2] - damped[1]) < 1e-9);
+    }
+    /* a step cap the relaxation cannot meet: refused, naming the series */
+    o.particle_steps = 10;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (ds) {
+        double a = 123.0;
+        CHECK(phc_shape_series_stalk_angle(ds, 0, 0.5, &a, &err) == PHC_ERR_DOMAIN);
+        CHECK_STR_CONTAINS(err.message, "not at rest after particle_steps = 10");
+        CHECK(a == 123.0);
+        printf("step cap 10: %s\n", err.message);
+    }
+    phc_dataset_free(ds);
+    ds = NULL;
+    /* bad options */
+    const struct {
+        const char *key;
+        phc_shape_series_options o;
+    } bad[] = {
+        {"'dynamics'", (phc_shape_series_options){0}},
+        {"'particle_iterations'", (phc_shape_series_options){0}},
+        {"'particle_time_step'", (phc_shape_series_options){0}},
+        {"'particle_steps'", (phc_shape_series_options){0}},
+        {"'particle_damping'", (phc_shape_series_options){0}},
+        {"'parent_weight'", (phc_shape_series_options){0}},
+    };
+    phc_shape_series_options b[6];
+    for (int j = 0; j < 6; ++j)
+        b[j] = o;
+    b[0].dynamics = 7;
+    b[1].particle_iterations = 0;
+    b[2].particle_time_step = -0.01;
+    b[3].particle_steps = 0;
+    b[4].particle_damping = 0;
+    b[5].parent_weight = 0.5;
+    for (int j = 0; j < 6; ++j) {
+        (void)bad[j].o;
+        CHECK(phc_shape_series_new(tr, &b[j], &ds, &err) == PHC_ERR_INPUT && !ds);
+        CHECK_STR_CONTAINS(err.message, bad[j].key);
+        printf("bad option: %s\n", err.message);
+    }
+    phc_shape_series_free(tr);
+}
+
+/* The particle path's Jacobian: d angle/ds by differences chained with the
+ * exact ds/d slot, against central differences of the whole model, at two
+ * points (stalks of 3 segments, 3 samples each): one where s stays away from 1 (central differences in s), one
+ * where early samples have s within fd_step of 1 (backward differences). */
+static void test_particles_jacobian(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    phc_shape_series_options o = particle_options();
+    o.e_min_slot = 1;
+    o.every = 30; /* t = 0, 30, 60 min; 3 segments per stalk: the test's time */
+    stalks[0].segments = stalks[1].segments = 3;
+    phc_dataset *ds = NULL;
+    phc_error err;
+    CHECK(phc_shape_series_new(tr, &o, &ds, &err) == PHC_OK);
+    if (!ds) {
+        fprintf(stderr, "%s\n", err.message);
+        phc_shape_series_free(tr);
+        return;
+    }
+    const size_t n = ds->n, k = ds->k;
+    CHECK(k == 6 && n == 6);
+    const double points[2][6] = {{11.0, 0.72, 0.9e8, 1.8e-4, 2e6, 0.02}, {40.0, 0.6, 0.9e8, 1.8e-4, 2e6, 0.02}};
+    double *jac = malloc(n * k * sizeof *jac), *y0 = malloc(n * sizeof *y0), *yp = malloc(n * sizeof *yp),
+           *ym = malloc(n * sizeof *ym);
+    for (int q = 0; q < 2; ++q) {
+        const double *p0 = points[q];
+        CHECK(ds->ops->predict(ds, p0, y0, jac) == 0);
+        double s_first, s_last;
+        phc_shape_series_stiffness(ds, p0, 0, &s_first);
+        phc_shape_series_stiffness(ds, p0, 3600, &s_last);
+        double worst = 0;
+        for (size_t j = 0; j < k; ++j) {
+            double p[6];
+            memcpy(p, p0, sizeof p);
+            const double h = 1e-5 * fabs(p0[j]);
+            p[j] = p0[j] + h;
+            CHECK(ds->ops->predict(ds, p, yp, NULL) == 0);
+            p[j] = p0[j] - h;
+            CHECK(ds->ops->predict(ds, p, ym, NULL) == 0);
+            double scale = 0, e = 0;
+            for (size_t i = 0; i < n; ++i)
+                scale = fmax(scale, fabs(jac[i * k + j]));
+            for (size_t i = 0; i < n; ++i)
+                e = fmax(e, fabs(jac[i * k + j] - (yp[i] - ym[i]) / (2 * h)) / scale);
+            CHECK(scale > 0);
+            printf("particles: slot %-8s largest |d angle/d slot| %.4g, error %.3g\n", ds->slot_names[j], scale, e);
+            worst = fmax(worst, e);
+        }
+        printf("particles: s %.6f -> %.6f over the hour%s; Jacobian vs central differences of the whole model: "
+               "largest error %.3g (relative to the column)\n", s_first, s_last,
+               1.0 - s_first < 1e-4 * s_first ? " (backward differences in s at the start)" : "", worst);
+        CHECK(worst < 1e-5);
+        if (q == 1)
+            CHECK(1.0 - s_first < 1e-4 * s_first); /* the backward branch was taken */
+    }
+    free(jac);
+    free(y0);
+    free(yp);
+    free(ym);
+    phc_dataset_free(ds);
+    phc_shape_series_free(tr);
+}
+
+/* Particles on a plant graph laid out as stalk "a" with the particles'
+ * clamp (a root segment one free segment long behind the base): the same
+ * particle system, so the same angles as the particle stalk; the root is
+ * anchored although the graph marks nothing fixed. */
+static void test_particles_plant(const double *a, const double *b)
+{
+    char *text = csv_of(a, b);
+    phc_shape_series *tr = tracks_from(text);
+    free(text);
+    if (!tr)
+        return;
+    const size_t n = 7;
+    const double h = 0.05 / 6, beta = 30 * PHC_SS_PI / 180;
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    for (size_t i = 0; i < n; ++i) {
+        g->parent[i] = i ? i - 1 : PHC_PLANT_NO_PARENT;
+        g->radius[i] = 1e-3;
+        g->length[i] = h;
+        const double s0 = ((double)i - 1) * h, s1 = s0 + h;
+        g->head[3 * i] = s0 * cos(beta);
+        g->head[3 * i + 2] = s0 * sin(beta);
+        g->tail[3 * i] = s1 * cos(beta);
+        g->tail[3 * i + 2] = s1 * sin(beta);
+        g->source_id[i] = (long)i;
+    }
+    phc_error err;
+    CHECK(phc_plant_graph_finish(g, "test plant", &err) == PHC_OK);
+    phc_shape_series_options o = particle_options();
+    phc_dataset *stalk = NULL, *plant = NULL;
+    o.n_stalks = 1; /* stalk "a" of options() */
+    CHECK(phc_shape_series_new(tr, &o, &stalk, &err) == PHC_OK);
+    phc_shape_stalk st = {.series = "a", .tip_mass = 1e-3, .base_angle = NAN, .segment = 6};
+    o.stalks = &st;
+    o.plant = g;
+    CHECK(phc_shape_series_new(tr, &o, &plant, &err) == PHC_OK);
+    if (stalk && plant) {
+        double ys[4], yp[4];
+        const double p[] = {truth[0], truth[1], truth[2], truth[3]};
+        CHECK(stalk->n == 4 && plant->n == 4);
+        CHECK(stalk->ops->predict(stalk, p, ys, NULL) == 0 && plant->ops->predict(plant, p, yp, NULL) == 0);
+        double worst = 0;
+        for (int i = 0; i < 4; ++i)
+            worst = fmax(worst, fabs(ys[i] - yp[i]));
+        printf("particles: plant graph laid out as particle stalk a: angles %.4f .. %.4f rad, largest difference "
+               "%.3g rad\n", yp[0], yp[3], worst);
+        CHECK(worst < 1e-12);
+        CHECK(yp[3] < yp[0] - 0.1);
+    } else {
+        fprintf(stderr, "%s\n", err.message);
+    }
+    phc_dataset_free(stalk);
+    phc_dataset_free(plant);
+    phc_plant_graph_free(g);
+    phc_shape_series_free(tr);
+}
+
 int main(void)
 {
+
     test_limits();
     double a[N_T], b[N_T];
     if (synthetic(a, b) == 0) {
@@ -381,7 +631,10 @@ int main(void)
         test_fit(a, b);
         test_plant(a, b);
         test_e_min_slot(a, b);
+        test_particles_jacobian(a, b);
+        test_particles_plant(a, b);
     }
+    test_particles_limits();
     test_errors();
     return check_finish("shape_series_new");
 }
