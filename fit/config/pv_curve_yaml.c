@@ -39,10 +39,11 @@ static const phc_key_help pv_curve_help[] = {
                    "photosynthesis::fit_PV_curve: breakpoint max_r2 over its candidates, tlp "
                    "measured at its cut row, modulus_points shared_break). The keys below "
                    "override it. Default: phytocal."},
-    {"tlp", "fitted (where the turgor line reaches zero; default) or measured (the measured "
-            "point at the break)."},
-    {"modulus_points", "Points of the bulk modulus (turgor line): above_break (default) or "
-                       "shared_break (down to and including the break point)."},
+    {"tlp", "fitted (where the turgor line reaches zero) or measured (the measured point at "
+            "the break). Default: fitted (measured with convention photosynthesis)."},
+    {"modulus_points", "Points of the bulk modulus (turgor line): above_break or shared_break "
+                       "(down to and including the break point). Default: above_break "
+                       "(shared_break with convention photosynthesis)."},
     {"leaf_area", "A column or a number, cm2 (> 0): gives C*_FT, the capacitance at full turgor "
                   "per leaf area (mol m-2 MPa-1). Default: none."},
     {NULL, NULL}};
