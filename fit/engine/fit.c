@@ -841,6 +841,7 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
         }
         res->total_time += sum.wall_time;
         costs[s] = sum.outcome == PHC_NLS_FAILED ? INFINITY : sum.final_cost;
+        const int improved = costs[s] < best_cost - 1e-9 * fabs(best_cost); /* beyond round-off */
         const int better = costs[s] < best_cost ||
                            (s == 0 && !isfinite(best_cost)) ||
                            (costs[s] == best_cost && res->summary.outcome != PHC_NLS_CONVERGED &&
@@ -861,7 +862,7 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
              * rank-deficient problem, not a bad start): stop, rather than
              * run every rescue start (16 by default, each as slow as the
              * first on a simulation model). */
-            if (!better && stalled_on_plateau(nls, pb, x))
+            if (!improved && stalled_on_plateau(nls, pb, x))
                 ++useless;
             if (useless == s && s >= RESCUE_PATIENCE) {
                 res->rescue_stopped = 1;

@@ -14,7 +14,10 @@
  * 5. an interval across a bound: y ≈ 0.3 with σ = 1, a ≥ 0: the 95%
  *    interval of a crosses 0 and is flagged;
  * 6. a good fit (Michaelis–Menten on its own data) has none of these;
- * 7. result.json written and read back gives the same warnings. */
+ * 7. result.json written and read back gives the same warnings;
+ * 8. a parameter without any effect (y = a x + 0 b): the first start stalls
+ *    on that plateau, and the rescue starts stop after three that stall too
+ *    (fit.c's RESCUE_PATIENCE) instead of running all 16. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -172,6 +175,16 @@ int main(void)
         fclose(mem);
         CHECK_STR_CONTAINS(line, "converged, not identifiable (rank 1 of 2)");
     }
+
+    /* a parameter with no effect anywhere: rescue starts stop after three that stall too */
+    phc_fit_result *r6 = fit("no-effect", x, yl, 10, "a * x + 0 * b", pab, 2, 0);
+    CHECK(r6 != NULL);
+    if (r6) {
+        printf("y = a x + 0 b: %zu starts, %zu rescue starts, stopped early: %s\n", r6->starts, r6->rescue_starts,
+               r6->rescue_stopped ? "yes" : "no");
+        CHECK(r6->rescue_stopped && r6->rescue_starts == 3 && r6->starts == 4);
+    }
+    phc_fit_result_free(r6);
 
     /* y ≈ 0.3 with σ = 1, a >= 0 */
     double yc[10];
