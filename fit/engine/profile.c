@@ -349,7 +349,12 @@ int phc_profile_run(phc_problem *pb, const double *x0, const double *initial_ste
                         : 0.1 * phc_problem_scale(pb, j);
         /* from the Wald standard error: about `points` steps to the threshold */
         if (initial_step && isfinite(initial_step[j]) && initial_step[j] > 0.0)
-            h0 = initial_step[j] * sqrt(2.0 * res->threshold) / (double)opt->points;
+        {
+            /* near the optimum delta = s2 (theta - theta_hat)^2 / (2 se^2), with s2 the
+               variance factor: the threshold is sqrt(2 thr / s2) se away */
+            const double s2 = res->absolute_sigma ? 1.0 : 2.0 * res->best_cost / (double)(n_obs - n_free);
+            h0 = initial_step[j] * sqrt(2.0 * res->threshold / (s2 > 0.0 ? s2 : 1.0)) / (double)opt->points;
+        }
         if ((rc = push_point(&pts, res->best[j], 0.0, res->best)) == PHC_OK)
             rc = trace_side(&tr, res->best, h0, -1, &prof->lo, &prof->lo_end);
         if (rc == PHC_OK)
