@@ -134,7 +134,8 @@ int phc_plot_profile(const char *path, const phc_profile_plot *p, phc_error *err
     char thr_text[128], prof_text[128], wald_text[128];
     snprintf(thr_text, sizeof thr_text, "threshold %.4g (%.0f%% level)", p->threshold, 100.0 * p->level);
     snprintf(prof_text, sizeof prof_text, "profile interval");
-    snprintf(wald_text, sizeof wald_text, "Wald interval (fit)");
+    snprintf(wald_text, sizeof wald_text, "%s",
+             isfinite(p->wald_lo) && isfinite(p->wald_hi) ? "Wald interval (fit)" : "Wald interval: not determined");
     PLINT opt[5] = {PL_LEGEND_LINE | PL_LEGEND_SYMBOL, PL_LEGEND_LINE, PL_LEGEND_LINE, PL_LEGEND_LINE,
                     PL_LEGEND_LINE};
     PLINT lcol[5] = {COL_FG, COL_THR, COL_PROF, COL_WALD, COL_EST}, lsty[5] = {1, 2, 1, 3, 4};

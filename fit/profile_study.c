@@ -85,7 +85,9 @@ static void verdict_of(const row *r, char *buf, size_t size)
                          : r->hi_end == PHC_PROFILE_OPEN   ? "open above"
                                                            : NULL;
         snprintf(buf, size, "%s%s%s", lo ? lo : "", lo && hi ? ", " : "", hi ? hi : "");
-    } else if (r->disagree)
+    } else if (!isfinite(r->wald_lo) || !isfinite(r->wald_hi))
+        snprintf(buf, size, "Wald interval not determined (rank-deficient fit); the profile interval is finite");
+    else if (r->disagree)
         snprintf(buf, size, "profile and Wald intervals disagree");
     else
         snprintf(buf, size, "profile and Wald intervals agree");
