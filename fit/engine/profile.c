@@ -190,6 +190,7 @@ static int trace_side(tracer *tr, const double *best, double h0, int dir, double
         return PHC_ERR_NOMEM;
     memcpy(xp, best, np * sizeof *xp);
     double tp = best[tr->j], gp = 0.0, h = h0;
+    const double reach_unit = fmax(fabs(best[tr->j]), phc_problem_scale(tr->pb, tr->j));
     int rc = PHC_OK;
     *how = PHC_PROFILE_OPEN;
     for (size_t step = 0; step < max_steps; ++step) {
@@ -200,6 +201,8 @@ static int trace_side(tracer *tr, const double *best, double h0, int dir, double
         const double tiny = 1e-12 * (fabs(tp) + phc_problem_scale(tr->pb, tr->j));
         if (!(h > tiny) || !isfinite(tp + dir * h))
             break; /* open: the step shrank to nothing or overflowed */
+        if (fabs(tp - best[tr->j]) > PHC_PROFILE_MAX_REACH * reach_unit)
+            break; /* open: far beyond any plausible interval */
         double t = tp + dir * h;
         if ((dir > 0 && t > bound) || (dir < 0 && t < bound))
             t = bound;

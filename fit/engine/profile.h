@@ -11,7 +11,8 @@
  * stops when delta reaches the threshold (the crossing is then refined by
  * regula falsi on sqrt(delta) - sqrt(threshold), exact for a linear model
  * whose sqrt(delta) is linear in theta_j), at a bound ("open to the bound"),
- * or after max_steps steps ("open").
+ * or after max_steps steps or PHC_PROFILE_MAX_REACH times max(|estimate|,
+ * scale) away from the estimate ("open").
  *
  * Threshold on delta (in cost units, cost = chi^2 / 2):
  *   absolute sigmas:  delta* = chi2_1(level) / 2      (1.9207 at 0.95);
@@ -31,6 +32,10 @@
 #include "fit/engine/problem.h"
 #include "fit/engine/progress.h"
 #include "model/status.h"
+
+/* How far (in units of max(|estimate|, the parameter's scale)) a side may go
+ * before it is called open. */
+#define PHC_PROFILE_MAX_REACH 1e6
 
 typedef struct phc_profile_options {
     double level;        /* confidence level, 0 < level < 1 (0.95) */

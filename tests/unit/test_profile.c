@@ -196,6 +196,41 @@ static void run_product_wide(const char *dir)
     phc_problem_free(pb);
 }
 
+/* The product without bounds: every side open (the reach limit), both flat. */
+static void run_product_unbounded(const char *dir)
+{
+    char cfg[512];
+    CHECK(write_case(dir, "a*b*x", "  a: {value: 1}\n  b: {value: 1}\n", "", cfg) == 0);
+    phc_problem *pb = NULL;
+    phc_error err;
+    phc_error_clear(&err);
+    if (phc_config_load(cfg, &pb, &err)) {
+        fprintf(stderr, "load: %s\n", err.message);
+        CHECK(0);
+        return;
+    }
+    phc_profile_options opt = phc_profile_options_default();
+    phc_profile_result *res = NULL;
+    CHECK(phc_profile_run(pb, NULL, NULL, &opt, &res, &err) == PHC_OK);
+    for (size_t k = 0; res && k < res->n_profiles; ++k) {
+        const phc_profile *p = &res->profiles[k];
+        const double est = res->best[p->param];
+        double md = 0;
+        for (size_t i = 0; i < p->n; ++i)
+            md = fmax(md, p->delta[i]);
+        printf("a*b*x unbounded: %s = %.6g traced over [%.6g, %.6g] ends %d %d (2 = open), max delta %.3g, flat %d, "
+               "%zu fits\n",
+               pb->params[p->param].name, est, p->lo, p->hi, (int)p->lo_end, (int)p->hi_end, md, p->flat,
+               p->inner_fits);
+        CHECK(p->lo_end == PHC_PROFILE_OPEN && p->hi_end == PHC_PROFILE_OPEN);
+        CHECK(p->flat);
+        const double unit = fmax(fabs(est), 1.0);
+        CHECK(est - p->lo > PHC_PROFILE_MAX_REACH * unit && p->hi - est > PHC_PROFILE_MAX_REACH * unit);
+    }
+    phc_profile_result_free(res);
+    phc_problem_free(pb);
+}
+
 static void run_bad(const char *dir)
 {
     char cfg[512];
@@ -232,6 +267,7 @@ int main(void)
     run_linear(dir, 1);
     run_product(dir);
     run_product_wide(dir);
+    run_product_unbounded(dir);
     run_bad(dir);
     char cmd[600];
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
