@@ -3,6 +3,7 @@
  *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S] [--resume] ...
+ *   phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]
  *   phytocal report DIR/result.json [--strict] [--level L]
  *   phytocal report --check DIR
  *   phytocal help [COMMAND | KIND | config | soil]   phytocal COMMAND --help
@@ -26,6 +27,7 @@
 #include "fit/engine/fit.h"
 #include "fit/engine/provenance.h"
 #include "fit/report.h"
+#include "fit/profile_study.h"
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
 #include "fit/sensitivity_study.h"
@@ -90,6 +92,20 @@ static const command_help commands[] = {
      "  --resume           continue an interrupted study from DIR.ledger (its finished\n"
      "                     evaluations are not recomputed; a ledger of another config or\n"
      "                     design is refused, naming what differs)\n"
+     "  -o DIR, --force, --quiet as for fit."},
+    {"profile", "phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]",
+     "Fits the configuration, then traces the profile likelihood of every free parameter:\n"
+     "the parameter is fixed at steps away from the optimum (adaptive) while Ceres\n"
+     "re-optimises the others, until the cost rises by the likelihood-ratio threshold\n"
+     "(chi2_1 / 2 with absolute sigmas, else the F test of lmfit's conf_interval) or a\n"
+     "bound is reached.  Writes a run directory (default runs/<name>-profile/):\n"
+     "result.json (profiles, likelihood-based and Wald intervals), report.md (verdict:\n"
+     "intervals that disagree, sides open to a bound, flat = practically\n"
+     "non-identifiable) and profile_<parameter>.png.\n"
+     "\n"
+     "options:\n"
+     "  --points N         target steps per side before the threshold (default 12, >= 3)\n"
+     "  --level L          confidence level, 0 < L < 1 (default 0.95)\n"
      "  -o DIR, --force, --quiet as for fit."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",
@@ -566,6 +582,90 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     return EXIT_OK;
 }
 
+/* profile: profile likelihood of every free parameter (profile_study.h).
+ * --points and --level are taken out first; the rest goes through
+ * load_for_run. */
+static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
+{
+    phc_profile_study_options po = phc_profile_study_options_default();
+    char **rest = calloc((size_t)argc + 1, sizeof *rest);
+    int n_rest = 0;
+    if (!rest)
+        return EXIT_INTERNAL;
+    for (int i = 0; i < argc; ++i) {
+        if (strcmp(argv[i], "--points") != 0 && strcmp(argv[i], "--level") != 0) {
+            rest[n_rest++] = argv[i];
+            continue;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "phytocal profile: %s needs a value\nusage: %s\n", argv[i],
+                    find_command("profile")->synopsis);
+            free(rest);
+            return EXIT_USAGE;
+        }
+        const char *opt = argv[i], *val = argv[++i];
+        char *end = NULL;
+        errno = 0;
+        if (strcmp(opt, "--points") == 0) {
+            const unsigned long long v = strtoull(val, &end, 10);
+            if (!*val || *val == '-' || errno || *end || v < 3 || v > 100000) {
+                fprintf(stderr, "phytocal profile: --points: expected a whole number from 3 to 100000, found '%s'\n",
+                        val);
+                free(rest);
+                return EXIT_INPUT;
+            }
+            po.points = (size_t)v;
+        } else {
+            const double v = strtod(val, &end);
+            if (!*val || errno || *end || !(v > 0.0 && v < 1.0)) {
+                fprintf(stderr, "phytocal profile: --level: expected a number between 0 and 1, found '%s'\n", val);
+                free(rest);
+                return EXIT_INPUT;
+            }
+            po.level = v;
+        }
+    }
+    cli_options o;
+    phc_problem *pb = NULL;
+    phc_provenance *pv = NULL;
+    char dir[4096];
+    int code;
+    if (load_for_run("profile", full_argc, full_argv, n_rest, rest, "-profile", &o, &pb, &pv, dir, sizeof dir,
+                     &code)) {
+        free(rest);
+        return code;
+    }
+    free(rest);
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    po.force = o.force;
+    po.progress = o.quiet ? NULL : progress_cb;
+    po.progress_data = &prog;
+    phc_error err;
+    phc_error_clear(&err);
+    phc_profile_summary sum;
+    const int rc = phc_profile_study_run(pb, &po, pv, dir, &sum, &err);
+    progress_end(&prog);
+    phc_provenance_free(pv);
+    phc_problem_free(pb);
+    if (rc) {
+        phc_profile_summary_clear(&sum);
+        return fail(&err);
+    }
+    if (!o.quiet) {
+        fputs(sum.table ? sum.table : "", stdout);
+        printf("%zu parameter%s profiled: %zu with intervals that disagree with Wald, %zu open, %zu flat\n",
+               sum.n_params, sum.n_params == 1 ? "" : "s", sum.n_disagree, sum.n_open, sum.n_flat);
+        printf("results: %s/ (result.json, report.md, plots)\n", dir);
+    }
+    const int converged = sum.fit_converged;
+    phc_profile_summary_clear(&sum);
+    if (!converged) {
+        fprintf(stderr, "phytocal: the fit did not converge; profiles written to %s for inspection\n", dir);
+        return EXIT_FIT;
+    }
+    return EXIT_OK;
+}
+
 /* report --check DIR: the run's inputs and outputs against its manifest. */
 static int check_run(const char *arg)
 {
@@ -661,6 +761,8 @@ int main(int argc, char **argv)
         return cmd_simulate(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "sensitivity") == 0)
         return cmd_sensitivity(argc, argv, argc - 2, argv + 2);
+    if (strcmp(cmd, "profile") == 0)
+        return cmd_profile(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "report") == 0)
         return cmd_report(argc - 2, argv + 2);
     fprintf(stderr, "phytocal: unknown command '%s'\n", cmd);
