@@ -43,6 +43,8 @@ static int begin(const char *path, int w, int h, phc_atomic_file **af, PLINT *ol
         plscol0(i, palette[i][0], palette[i][1], palette[i][2]);
     plinit();
     pladv(0);
+    plsxax(6, 0); /* plain numbers up to 6 digits: no exponent label to collide with the panel above */
+    plsyax(6, 0);
     return PHC_OK;
 }
 
@@ -197,8 +199,8 @@ int phc_plot_mcmc_pairs(const char *path, const char *title, size_t d, const cha
                     ys[k] = draws[i * d + r];
                 }
                 plcol0(COL_FILL);
-                plssym(0, 0.5);
-                plpoin((PLINT)k, xs, ys, 1);
+                plssym(0, 0.35);
+                plpoin((PLINT)k, xs, ys, 17);
                 plcol0(COL_FG);
                 plbox(r + 1 == d ? "bcnst" : "bcst", 0, 0, c == 0 ? "bcnstv" : "bcst", 0, 0);
                 if (c == 0) {

@@ -406,8 +406,14 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
     else
         snprintf(sampler, sizeof sampler, "stretch-move ensemble (Goodman & Weare 2010, a = 2), %zu walkers x %zu "
                  "sweeps", C, n);
-    bad |= append(&summary->text, "%s, seed %lu; burn-in: the first %zu draws of each chain; acceptance %.3f\n%s%s\n",
-                  sampler, o.seed, burn, acc, table, verdict);
+    if (o.method == PHC_MCMC_DRAM && ch.proposed)
+        bad |= append(&summary->text, "%s, seed %lu; burn-in: the first %zu draws of each chain; acceptance %.3f "
+                      "(first stage %.3f, delayed rejection %.3f)\n%s%s\n", sampler, o.seed, burn, acc,
+                      (double)(ch.accepted - ch.accepted_dr) / (double)ch.proposed,
+                      (double)ch.accepted_dr / (double)ch.proposed, table, verdict);
+    else
+        bad |= append(&summary->text, "%s, seed %lu; burn-in: the first %zu draws of each chain; acceptance %.3f\n%s%s\n",
+                      sampler, o.seed, burn, acc, table, verdict);
     if (bad) {
         free(table);
         free(verdict);

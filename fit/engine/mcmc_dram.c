@@ -216,11 +216,12 @@ int phc_dram_run(const phc_mcmc_target *t, const double *x0, const double *cov0,
                         if (a == b)
                             diag += cov[a * d + a];
                     }
-                const double eps = 1e-10 * diag / (double)d;
+                /* eps relative to each variance (eps I in standardised coordinates): parameters of very
+                   different magnitudes keep their own scales */
                 for (size_t i = 0; i < d * d; ++i)
                     cov[i] *= sd;
                 for (size_t j = 0; j < d; ++j)
-                    cov[j * d + j] += sd * eps;
+                    cov[j * d + j] *= 1 + 1e-10;
                 /* nothing accepted yet (a zero covariance): keep the proposal */
                 if (diag > 0 && cholesky(cov, d, ltry) == 0)
                     memcpy(l, ltry, d * d * sizeof *l);

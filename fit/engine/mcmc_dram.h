@@ -4,9 +4,11 @@
  *   - Gaussian random-walk proposal N(x, C); C starts from cov0 (the fit's
  *     covariance) scaled by s_d = 2.4^2 / d (Gelman, Roberts & Gilks 1996);
  *   - adaptation (Haario, Saksman & Tamminen 2001, eq. 3): every
- *     `adapt_every` steps C = s_d (Cov(chain so far) + eps I), eps = 1e-10
- *     times the mean diagonal of the sample covariance (keeps C positive
- *     definite);
+ *     `adapt_every` steps C = s_d (Cov(chain so far) + eps D), D the
+ *     diagonal of that covariance and eps = 1e-10 (Haario's eps I in
+ *     coordinates scaled by each parameter's sd, so parameters of very
+ *     different magnitudes keep their scales); an update that is not
+ *     positive definite (nothing accepted yet) keeps the old C;
  *   - one delayed-rejection stage (Tierney & Mira 1999; Haario et al. 2006
  *     §2.2): after a rejection, a second proposal y2 ~ N(x, gamma^2 C),
  *     accepted with probability
