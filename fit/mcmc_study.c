@@ -187,7 +187,7 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         goto done;
     }
     if (o.samples == 0)
-        o.samples = o.method == PHC_MCMC_DRAM ? 5000 : 2000;
+        o.samples = o.method == PHC_MCMC_DRAM ? 5000 : 10000;
     if (o.samples < PHC_MCMC_MIN_SAMPLES) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "--samples %zu is too small: an MCMC run needs at least %d draws per "
                            "chain (the first half is burn-in, split-R-hat halves the rest)", o.samples,

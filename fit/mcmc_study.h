@@ -41,7 +41,7 @@ typedef enum phc_mcmc_method { PHC_MCMC_DRAM = 0, PHC_MCMC_STRETCH = 1 } phc_mcm
 
 typedef struct phc_mcmc_options {
     phc_mcmc_method method;
-    size_t samples;      /* draws per chain (DRAM, default 5000) or sweeps (stretch, default 2000) */
+    size_t samples;      /* draws per chain (DRAM, default 5000) or sweeps (stretch, default 10000) */
     size_t chains;       /* DRAM: chains (default 4); stretch: walkers (default max(32, 2 d), even) */
     unsigned long seed;  /* (1) */
     int force;

@@ -108,7 +108,7 @@ static const command_help commands[] = {
      "  --method M         dram (default: adaptive Metropolis with delayed rejection, as\n"
      "                     FME's modMCMC) or stretch (affine-invariant ensemble, as emcee)\n"
      "  --samples N        draws per chain (dram, default 5000) or sweeps (stretch,\n"
-     "                     default 2000); at least 100\n"
+     "                     default 10000); at least 100\n"
      "  --chains C         dram: chains (default 4, at least 2); stretch: walkers (default\n"
      "                     max(32, 2d), even, at least 2d for d free parameters)\n"
      "  --seed S           random seed (default 1): the same seed gives the same chains\n"
