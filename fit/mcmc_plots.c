@@ -85,8 +85,9 @@ int phc_plot_mcmc_trace(const char *path, const char *title, size_t d, const cha
     }
     phc_atomic_file *af = NULL;
     PLINT old = 0;
-    const int h = (int)(170 * d + 120);
-    int rc = begin(path, 1100, h < 400 ? 400 : h, &af, &old, err);
+    int h = (int)(170 * d + 130);
+    h = h < 400 ? 400 : h;
+    int rc = begin(path, 1100, h, &af, &old, err);
     if (rc) {
         free(etitle);
         free(xs);
@@ -95,7 +96,9 @@ int phc_plot_mcmc_trace(const char *path, const char *title, size_t d, const cha
     }
     plschr(0.0, 0.9);
     const size_t shown = chains < N_CHAIN_COLOURS ? chains : N_CHAIN_COLOURS;
-    const double top = 0.93, bottom = 0.08, gap = 0.02, ph = (top - bottom - gap * (double)(d - 1)) / (double)d;
+    /* margins in pixels: 45 above for the title, 75 below for the step axis and its label */
+    const double top = 1 - 45.0 / h, bottom = 75.0 / h, gap = 0.02,
+                 ph = (top - bottom - gap * (double)(d - 1)) / (double)d;
     for (size_t j = 0; j < d; ++j) {
         double lo, hi;
         range(draws + j, chains * n, d, &lo, &hi);
