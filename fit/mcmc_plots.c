@@ -43,8 +43,8 @@ static int begin(const char *path, int w, int h, phc_atomic_file **af, PLINT *ol
         plscol0(i, palette[i][0], palette[i][1], palette[i][2]);
     plinit();
     pladv(0);
-    plsxax(6, 0); /* plain numbers up to 6 digits: no exponent label to collide with the panel above */
-    plsyax(6, 0);
+    plsxax(10, 0); /* plain numbers (up to 10 digits): no exponent label to collide with a neighbour */
+    plsyax(10, 0);
     return PHC_OK;
 }
 
@@ -165,7 +165,7 @@ int phc_plot_mcmc_pairs(const char *path, const char *title, size_t d, const cha
     int rc = begin(path, side < 600 ? 600 : side, side < 600 ? 600 : side, &af, &old, err);
     if (rc)
         goto out;
-    plschr(0.0, d > 3 ? 0.7 : 0.9);
+    plschr(0.0, d > 2 ? 0.6 : 0.9);
     const double left = 0.12, right = 0.97, bottom = 0.10, top = 0.93;
     const double gap = 0.015, w = (right - left - gap * (double)(d - 1)) / (double)d,
                  hgt = (top - bottom - gap * (double)(d - 1)) / (double)d;
@@ -191,7 +191,7 @@ int phc_plot_mcmc_pairs(const char *path, const char *title, size_t d, const cha
                     plfill(4, px, py);
                 }
                 plcol0(COL_FG);
-                plbox(r + 1 == d ? "bcnst" : "bcst", 0, 0, "bc", 0, 0);
+                plbox(r + 1 == d ? "bcnst" : "bcst", phc_plot_nice_step(hi[c] - lo[c], 2), 0, "bc", 0, 0);
                 if (c == 0)
                     plmtex("l", 2.0, 0.5, 0.5, "count");
             } else { /* scatter of c (x) against r (y) */
@@ -205,7 +205,8 @@ int phc_plot_mcmc_pairs(const char *path, const char *title, size_t d, const cha
                 plssym(0, 0.35);
                 plpoin((PLINT)k, xs, ys, 17);
                 plcol0(COL_FG);
-                plbox(r + 1 == d ? "bcnst" : "bcst", 0, 0, c == 0 ? "bcnstv" : "bcst", 0, 0);
+                plbox(r + 1 == d ? "bcnst" : "bcst", phc_plot_nice_step(hi[c] - lo[c], 2), 0,
+                      c == 0 ? "bcnstv" : "bcst", phc_plot_nice_step(hi[r] - lo[r], 4), 0);
                 if (c == 0) {
                     char *el = phc_plot_escape(labels[r]);
                     plmtex("l", 6.0, 0.5, 0.5, el ? el : "");
