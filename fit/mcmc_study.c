@@ -9,6 +9,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "fit/engine/fit.h"
 #include "fit/engine/mcmc_diagnostics.h"
@@ -17,6 +20,7 @@
 #include "fit/engine/prior.h"
 #include "fit/mcmc_plots.h"
 #include "fit/run_dir.h"
+#include "fit/run_ledger.h"
 #include "fit/sensitivity_study.h"
 #include "measurements/atomic_file.h"
 
@@ -118,6 +122,51 @@ static json_t *jnum(double v)
     return isfinite(v) ? json_real(v) : json_null();
 }
 
+/* ---- the ledger (DRAM resume) ----------------------------------------------------------- */
+
+typedef struct chain_ledger {
+    phc_run_ledger *l;
+    size_t n_out, computed, stop_after;
+    double *row;
+    const char *path;
+} chain_ledger;
+
+static int chain_done(void *data, size_t c, const phc_mcmc_chains *out, const size_t counts[4], phc_error *err)
+{
+    chain_ledger *cl = data;
+    const size_t n = out->n_iter, d = out->d;
+    double *v = cl->row;
+    for (int k = 0; k < 4; ++k)
+        *v++ = (double)counts[k];
+    memcpy(v, out->theta + c * n * d, n * d * sizeof *v);
+    v += n * d;
+    memcpy(v, out->s2 + c * n, n * sizeof *v);
+    v += n;
+    memcpy(v, out->log_post + c * n, n * sizeof *v);
+    int rc = phc_run_ledger_append(cl->l, c, 0, cl->row, err);
+    if (rc)
+        return rc;
+    cl->computed++;
+    if (cl->stop_after && cl->computed >= cl->stop_after)
+        return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new chains (stop_after); %s holds them: "
+                             "--resume continues", cl->computed, cl->path);
+    return PHC_OK;
+}
+
+static int make_parents(const char *path, phc_error *err)
+{
+    char buf[4400];
+    snprintf(buf, sizeof buf, "%s", path);
+    for (char *c = buf + 1; *c; ++c)
+        if (*c == '/') {
+            *c = '\0';
+            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+                return phc_error_set(err, PHC_ERR_IO, "%s: cannot create: %s", buf, strerror(errno));
+            *c = '/';
+        }
+    return PHC_OK;
+}
+
 int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_provenance *pv, const char *dir,
                  phc_mcmc_run_summary *summary, phc_error *err)
 {
@@ -134,8 +183,9 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
     phc_mcmc_summary *sum = NULL, s2sum;
     char **labels = NULL;
     gsl_rng *rng = NULL;
-    char tmpdir[4096] = "";
-    int rc = PHC_OK;
+    char tmpdir[4096] = "", ledger_path[4200] = "";
+    int rc = PHC_OK, have_ledger = 0;
+    size_t reused_chains = 0;
     /* the free parameters and their priors */
     const size_t np = pb->n_params ? pb->n_params : 1;
     q.col = malloc(np * sizeof *q.col);
@@ -321,7 +371,86 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         dop.seed = o.seed;
         dop.progress = o.progress ? relay : NULL;
         dop.progress_data = &pr;
-        rc = phc_dram_run(&t, x0, cov0, &dop, &ch, err);
+        /* the ledger: its identity is everything the chains depend on */
+        chain_ledger cl;
+        memset(&cl, 0, sizeof cl);
+        snprintf(ledger_path, sizeof ledger_path, "%s.ledger", dir);
+        cl.path = ledger_path;
+        cl.stop_after = o.stop_after;
+        cl.n_out = 4 + o.samples * (d + 2);
+        char *ident[6] = {NULL, NULL, NULL, NULL, NULL, NULL};
+        int bad = 0;
+        bad |= append(&ident[0], "%s", pv && pv->config ? pv->config->sha256 : "none");
+        bad |= append(&ident[1], "%s", "");
+        if (pv)
+            for (size_t i = 0; i < pv->n_inputs; ++i)
+                bad |= append(&ident[1], "%s%s", i ? "," : "", pv->inputs[i].sha256);
+        bad |= append(&ident[2], "dram adapt=100 dr=0.2 draws=%zu chains=%zu seed=%lu", o.samples, C, o.seed);
+        bad |= append(&ident[3], "%s", "");
+        for (size_t c = 0; c < d; ++c)
+            bad |= append(&ident[3], "%s%s=%s(%.17g,%.17g)[%.17g,%.17g]", c ? "," : "", pb->params[q.col[c]].name,
+                          q.improper[c] ? "flat" : phc_prior_kind_name(q.prior[c].kind), q.prior[c].a, q.prior[c].b,
+                          q.prior[c].lower, q.prior[c].upper);
+        bad |= append(&ident[4], "%s", "");
+        for (size_t i = 0; i < C * d; ++i)
+            bad |= append(&ident[4], "%s%.17g", i ? "," : "", x0[i]);
+        bad |= append(&ident[5], "known_sigma=%d var0=%.17g n0=%.17g", known_sigma, t.var0, t.n0);
+        const char *keys[6] = {"config-sha256", "data-sha256", "sampler", "priors", "starts", "error-variance"};
+        double *y = malloc(C * cl.n_out * sizeof *y);
+        unsigned char *state = malloc(C);
+        size_t *counts = calloc(4 * C, sizeof *counts);
+        phc_mcmc_chains have;
+        memset(&have, 0, sizeof have);
+        have.theta = malloc(C * o.samples * d * sizeof *have.theta);
+        have.s2 = malloc(C * o.samples * sizeof *have.s2);
+        have.log_post = malloc(C * o.samples * sizeof *have.log_post);
+        cl.row = malloc(cl.n_out * sizeof *cl.row);
+        size_t found = 0;
+        if (bad || !y || !state || !counts || !have.theta || !have.s2 || !have.log_post || !cl.row)
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (rc == PHC_OK && (rc = make_parents(ledger_path, err)) == PHC_OK)
+            rc = phc_run_ledger_open(ledger_path, keys, (const char *const *)ident, 6, C, cl.n_out, o.resume, o.force,
+                                     y, state, &found, &cl.l, err);
+        if (rc == PHC_OK) {
+            for (size_t c = 0; c < C; ++c) {
+                state[c] = state[c] == PHC_LEDGER_OK;
+                if (!state[c])
+                    continue;
+                const double *v = y + c * cl.n_out;
+                for (int k = 0; k < 4; ++k)
+                    counts[4 * c + k] = (size_t)v[k];
+                memcpy(have.theta + c * o.samples * d, v + 4, o.samples * d * sizeof *v);
+                memcpy(have.s2 + c * o.samples, v + 4 + o.samples * d, o.samples * sizeof *v);
+                memcpy(have.log_post + c * o.samples, v + 4 + o.samples * (d + 1), o.samples * sizeof *v);
+            }
+            reused_chains = found;
+            dop.have = state;
+            dop.have_draws = &have;
+            dop.have_counts = counts;
+            dop.chain_done = chain_done;
+            dop.chain_data = &cl;
+            rc = phc_dram_run(&t, x0, cov0, &dop, &ch, err);
+        }
+        if (cl.l) {
+            phc_error ignored;
+            const int crc = phc_run_ledger_close(cl.l, rc ? &ignored : err);
+            if (rc == PHC_OK)
+                rc = crc;
+        }
+        for (int i = 0; i < 6; ++i)
+            free(ident[i]);
+        free(y);
+        free(state);
+        free(counts);
+        free(have.theta);
+        free(have.s2);
+        free(have.log_post);
+        free(cl.row);
+        if (rc == PHC_OK)
+            have_ledger = 1;
+    } else if (o.resume) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "--resume: only --method dram resumes (its chains are independent); "
+                           "the stretch ensemble moves every walker together");
     } else {
         phc_stretch_options sop = phc_stretch_options_default();
         sop.n_iter = o.samples;
@@ -432,12 +561,12 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
     {
         json_t *root = json_object(), *params = json_object();
         json_object_set_new(root, "mcmc",
-                            json_pack("{s:s, s:I, s:I, s:I, s:I, s:f, s:I, s:I, s:b, s:I}", "method",
+                            json_pack("{s:s, s:I, s:I, s:I, s:I, s:f, s:I, s:b, s:I}", "method",
                                       o.method == PHC_MCMC_DRAM ? "dram" : "stretch", "chains", (json_int_t)C,
                                       "draws_per_chain", (json_int_t)n, "burn_in", (json_int_t)burn, "seed",
                                       (json_int_t)o.seed, "acceptance", isfinite(acc) ? acc : 0.0,
-                                      "delayed_rejection_accepted", (json_int_t)ch.accepted_dr, "evaluations",
-                                      (json_int_t)q.evaluations, "proposal_from_fit_covariance", cov_from_fit,
+                                      "delayed_rejection_accepted", (json_int_t)ch.accepted_dr,
+                                      "proposal_from_fit_covariance", cov_from_fit,
                                       "failed_proposals", (json_int_t)ch.failed));
         json_object_set_new(root, "error_variance",
                             known_sigma ? json_pack("{s:s}", "treatment", "known sigmas from the data sets")
@@ -497,7 +626,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
                       o.seed, burn, acc);
         if (o.method == PHC_MCMC_DRAM)
             bad |= append(&md, " (%zu of the accepted moves at the delayed-rejection stage)", ch.accepted_dr);
-        bad |= append(&md, ". Model evaluations: %zu.\n\n## Verdict\n\n%s\n\n", q.evaluations, verdict);
+        bad |= append(&md, ". Model evaluations in this run: %zu; chains taken from the ledger (--resume): %zu.\n\n"
+                           "## Verdict\n\n%s\n\n", q.evaluations, reused_chains, verdict);
         bad |= append(&md, "## Posterior\n\nLikelihood: Gaussian in the weighted residuals. Error variance: %s.\n\n",
                       known_sigma ? "the data sets' sigmas are the known standard deviations"
                                   : "sampled from its inverse-gamma full conditional (prior worth n0 = 0.1 n "
@@ -555,6 +685,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         rc = phc_run_dir_commit(tmpdir, dir, pv, err);
     else
         phc_run_dir_discard(tmpdir);
+    if (rc == PHC_OK && have_ledger)
+        unlink(ledger_path); /* the run directory holds the result */
 done:
     if (rc)
         phc_mcmc_run_summary_clear(summary);

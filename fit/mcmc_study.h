@@ -22,7 +22,15 @@
  * sd, median, 95% interval, tau, ESS, split-R-hat; the sampler's settings and
  * acceptance; the kept chains thinned to at most 500 draws each), report.md
  * (verdict: the chains mixed when every R-hat < 1.01 and every ESS > 400),
- * mcmc_trace.png, mcmc_pairs.png and the manifest. */
+ * mcmc_trace.png, mcmc_pairs.png and the manifest.
+ *
+ * Resume (DRAM): every finished chain goes to the run ledger
+ * (fit/run_ledger.h) at DIR.ledger, one row per chain (its counts, then its
+ * draws, error variances and log posterior densities at full precision);
+ * `resume` takes the chains it holds and runs the others (each chain has its
+ * own seeded generator, so the result equals an uninterrupted run's).  The
+ * ledger is removed when the run directory is written.  The stretch ensemble
+ * moves all walkers together and cannot resume. */
 #ifndef PHC_MCMC_STUDY_H
 #define PHC_MCMC_STUDY_H
 
@@ -44,7 +52,9 @@ typedef struct phc_mcmc_options {
     size_t samples;      /* draws per chain (DRAM, default 5000) or sweeps (stretch, default 10000) */
     size_t chains;       /* DRAM: chains (default 4); stretch: walkers (default max(32, 2 d), even) */
     unsigned long seed;  /* (1) */
-    int force;
+    int force;           /* replace DIR and a stale DIR.ledger */
+    int resume;          /* DRAM: take the chains DIR.ledger holds, run the others */
+    size_t stop_after;   /* for tests: stop after this many chains, as a killed run would (0: never) */
     phc_progress_fn progress;
     void *progress_data;
 } phc_mcmc_options;

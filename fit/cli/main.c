@@ -94,7 +94,7 @@ static const command_help commands[] = {
      "                     design is refused, naming what differs)\n"
      "  -o DIR, --force, --quiet as for fit."},
     {"mcmc", "phytocal mcmc CONFIG.yaml [-o DIR] [--method dram|stretch] [--samples N] [--chains C] [--seed S]\n"
-             "                     [--force] [--quiet]",
+             "                     [--resume] [--force] [--quiet]",
      "Bayesian posterior of the free parameters by MCMC: Gaussian likelihood of the\n"
      "weighted residuals times the priors (`prior:`, else uniform on the bounds; flat and\n"
      "improper on an open bound, said in the report).  Known sigmas when every data set\n"
@@ -112,6 +112,9 @@ static const command_help commands[] = {
      "  --chains C         dram: chains (default 4, at least 2); stretch: walkers (default\n"
      "                     max(32, 2d), even, at least 2d for d free parameters)\n"
      "  --seed S           random seed (default 1): the same seed gives the same chains\n"
+     "  --resume           dram: continue an interrupted run from DIR.ledger (the chains it\n"
+     "                     holds are not rerun; a ledger of another config or setting is\n"
+     "                     refused, naming what differs)\n"
      "  -o DIR, --force, --quiet as for fit."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",
@@ -600,7 +603,10 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
         const char *a = argv[i];
         if (strcmp(a, "--method") != 0 && strcmp(a, "--samples") != 0 && strcmp(a, "--seed") != 0 &&
             strcmp(a, "--chains") != 0) {
-            rest[n_rest++] = argv[i];
+            if (strcmp(a, "--resume") == 0)
+                mo.resume = 1;
+            else
+                rest[n_rest++] = argv[i];
             continue;
         }
         if (i + 1 >= argc) {
@@ -652,6 +658,9 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
     }
     free(rest);
     mo.force = o.force;
+    const char *stop = getenv("PHYTOCAL_STOP_AFTER"); /* test hook: stop after k chains, as a killed run would */
+    if (stop && *stop)
+        mo.stop_after = (size_t)strtoull(stop, NULL, 10);
     progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
     mo.progress = o.quiet ? NULL : progress_cb;
     mo.progress_data = &prog;

@@ -127,8 +127,19 @@ int phc_dram_run(const phc_mcmc_target *t, const double *x0, const double *cov0,
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    gsl_rng_set(r, o->seed);
     for (size_t c = 0; c < C && rc == PHC_OK; ++c) {
+        if (o->have && o->have[c]) {
+            memcpy(out->theta + c * n * d, o->have_draws->theta + c * n * d, n * d * sizeof *out->theta);
+            memcpy(out->s2 + c * n, o->have_draws->s2 + c * n, n * sizeof *out->s2);
+            memcpy(out->log_post + c * n, o->have_draws->log_post + c * n, n * sizeof *out->log_post);
+            out->accepted += o->have_counts[4 * c];
+            out->accepted_dr += o->have_counts[4 * c + 1];
+            out->proposed += o->have_counts[4 * c + 2];
+            out->failed += o->have_counts[4 * c + 3];
+            continue;
+        }
+        const size_t before[4] = {out->accepted, out->accepted_dr, out->proposed, out->failed};
+        gsl_rng_set(r, o->seed + 7919UL * c);
         for (size_t i = 0; i < d * d; ++i)
             cov[i] = sd * cov0[i];
         if (cholesky(cov, d, l) != 0) {
@@ -231,6 +242,12 @@ int phc_dram_run(const phc_mcmc_target *t, const double *x0, const double *cov0,
                 rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
                 goto done;
             }
+        }
+        if (o->chain_done) {
+            const size_t counts[4] = {out->accepted - before[0], out->accepted_dr - before[1],
+                                      out->proposed - before[2], out->failed - before[3]};
+            if ((rc = o->chain_done(o->chain_data, c, out, counts, err)))
+                goto done;
         }
     }
 done:

@@ -14,8 +14,8 @@
  *     accepted with probability
  *       a2 = min(1, pi(y2) q1(y2, y1) (1 - a1(y2, y1)) / (pi(x) q1(x, y1) (1 - a1(x, y1))))
  *     with q1 the first-stage Gaussian density and a1 its acceptance.
- * Independent chains (for split-R-hat) share one seeded GSL Mersenne Twister
- * and run one after the other: the same seed gives the same chains.
+ * Independent chains (for split-R-hat) run one after the other, each with its
+ * own seeded GSL Mersenne Twister: the same seed gives the same chains.
  * Pure: no I/O. */
 #ifndef PHC_MCMC_DRAM_H
 #define PHC_MCMC_DRAM_H
@@ -28,9 +28,21 @@ typedef struct phc_dram_options {
     size_t chains;       /* independent chains (>= 1) */
     size_t adapt_every;  /* steps between covariance updates (100; 0 = no adaptation) */
     double dr_scale;     /* gamma of the second stage (0.2; 0 = no delayed rejection) */
-    unsigned long seed;
+    unsigned long seed;  /* chain c draws from its own Mersenne Twister seeded seed + 7919 c, so
+                            that a chain does not depend on the others (resume) */
     phc_mcmc_progress_fn progress;
     void *progress_data;
+    /* Resume (optional): chains with have[c] = 1 are not run; their draws
+       come from have_draws (laid out as phc_mcmc_chains' arrays, chains x
+       n_iter) and their counts from have_counts[4 c ..]: accepted,
+       accepted_dr, proposed, failed. */
+    const unsigned char *have;
+    const phc_mcmc_chains *have_draws;
+    const size_t *have_counts;
+    /* Called after each chain that was run (counts as above); non-zero stops
+       the run with that status (the caller has set err). */
+    int (*chain_done)(void *data, size_t c, const phc_mcmc_chains *out, const size_t counts[4], phc_error *err);
+    void *chain_data;
 } phc_dram_options;
 
 phc_dram_options phc_dram_options_default(void);

@@ -110,5 +110,37 @@ grep -q "vmax: flat and IMPROPER" d/report.md || why "report does not say the pr
 grep -q '"dist": "flat-improper"' d/result.json || why "result.json does not say flat-improper"
 finish "an open bound without a prior: flat improper prior, said in the report"
 
+# ---- an interrupted DRAM run resumed equals an uninterrupted one ----------------
+rm -rf full part part.ledger
+run mcmc good.yaml -o full --samples 1000 -q
+[ "$RC" -eq 0 ] || why "uninterrupted run: exit $RC"
+PHYTOCAL_STOP_AFTER=3 "$PHC" mcmc good.yaml -o part --samples 1000 -q >"$T/stdout" 2>"$T/stderr"
+RC=$?
+[ "$RC" -ne 0 ] || why "the stopped run exited 0"
+[ -f part.ledger ] || why "no ledger after the stop"
+[ ! -e part ] || why "the stopped run wrote its directory"
+n_before=$(grep -c '^[0-9]' part.ledger 2>/dev/null)
+[ "$n_before" = 3 ] || why "ledger holds $n_before chains, expected 3"
+run mcmc good.yaml -o part --samples 1000 -q --resume
+[ "$RC" -eq 0 ] || why "resume: exit $RC"
+cmp -s full/result.json part/result.json || why "resumed result.json differs from the uninterrupted one"
+grep -q "chains taken from the ledger (--resume): 3" part/report.md || why "report does not count 3 chains from the ledger"
+[ ! -e part.ledger ] || why "the ledger was left behind after the run"
+finish "an interrupted DRAM run resumed gives the same result.json"
+
+rm -rf part part.ledger
+PHYTOCAL_STOP_AFTER=1 "$PHC" mcmc good.yaml -o part --samples 1000 -q >/dev/null 2>&1
+run mcmc good.yaml -o part --samples 1000 --seed 2 -q --resume
+[ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+grep -qF "the ledger is from another study: sampler is" "$T/stderr" || why "message does not say what differs"
+[ ! -e part ] || why "wrote part/"
+finish "a ledger of another run is refused, saying what differs"
+run mcmc good.yaml -o part --samples 1000 -q
+[ "$RC" -eq 2 ] || [ "$RC" -eq 4 ] || why "exit $RC: a fresh run overwrote an unfinished ledger"
+[ -f part.ledger ] || why "the unfinished ledger is gone"
+finish "a fresh run does not overwrite an unfinished ledger without --force"
+rm -rf part part.ledger
+bad_case "stretch cannot resume" 2 good.yaml "--resume: only --method dram resumes" --method stretch --resume
+
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
