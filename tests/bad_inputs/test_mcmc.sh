@@ -136,7 +136,8 @@ grep -qF "the ledger is from another study: sampler is" "$T/stderr" || why "mess
 [ ! -e part ] || why "wrote part/"
 finish "a ledger of another run is refused, saying what differs"
 run mcmc good.yaml -o part --samples 1000 -q
-[ "$RC" -eq 2 ] || [ "$RC" -eq 4 ] || why "exit $RC: a fresh run overwrote an unfinished ledger"
+[ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+grep -qF "an unfinished study's ledger is here" "$T/stderr" || why "message does not name the ledger"
 [ -f part.ledger ] || why "the unfinished ledger is gone"
 finish "a fresh run does not overwrite an unfinished ledger without --force"
 rm -rf part part.ledger

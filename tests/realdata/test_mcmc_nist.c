@@ -39,6 +39,7 @@ static const char *emcee_script =
     "rng = np.random.default_rng(42)\n"
     "p0 = np.array([b1, b2]) * (1 + 1e-3 * rng.standard_normal((nw, 2)))\n"
     "s = emcee.EnsembleSampler(nw, 2, logp)\n"
+    "s.random_state = np.random.RandomState(42).get_state()  # seeded: the same numbers every run\n"
     "s.run_mcmc(p0, steps, progress=False)\n"
     "ch = s.get_chain(discard=steps // 2)\n"
     "tau = s.get_autocorr_time(discard=steps // 2, quiet=True)\n"
