@@ -25,6 +25,7 @@
 #include "fit/engine/mcmc_diagnostics.h"
 #include "fit/engine/mcmc_dram.h"
 #include "fit/engine/mcmc_stretch.h"
+#include "fit/engine/prior.h"
 
 #define NOBS 20
 typedef struct lin {
@@ -215,6 +216,28 @@ int main(void)
         CHECK(phc_stretch_run(&tu, x0, &sop, &c1, &err) == PHC_OK);
         compare("stretch, sigma sampled", &c1, mean, covt);
         phc_mcmc_chains_clear(&c1);
+    }
+    /* ---- prior log densities: differences equal those of GSL's densities */
+    {
+        const phc_prior nrm = {PHC_PRIOR_NORMAL, 2.0, 0.5, 0.0, INFINITY};
+        const phc_prior lnm = {PHC_PRIOR_LOG_NORMAL, -1.0, 0.7, 0.0, INFINITY};
+        const phc_prior lun = {PHC_PRIOR_LOG_UNIFORM, 0.1, 10.0, 0.1, 10.0};
+        const phc_prior uni = {PHC_PRIOR_UNIFORM, 1.0, 3.0, 1.0, 3.0};
+        const double x1 = 1.3, x2 = 2.9;
+        const double dn = phc_prior_log_density(&nrm, x1) - phc_prior_log_density(&nrm, x2);
+        const double dn_gsl = log(gsl_ran_gaussian_pdf(x1 - 2.0, 0.5) / gsl_ran_gaussian_pdf(x2 - 2.0, 0.5));
+        const double dl = phc_prior_log_density(&lnm, x1) - phc_prior_log_density(&lnm, x2);
+        const double dl_gsl = log(gsl_ran_lognormal_pdf(x1, -1.0, 0.7) / gsl_ran_lognormal_pdf(x2, -1.0, 0.7));
+        const double du = phc_prior_log_density(&lun, x1) - phc_prior_log_density(&lun, x2);
+        printf("prior log-density differences: normal %.15g (GSL %.15g), log-normal %.15g (GSL %.15g), "
+               "log-uniform %.15g (exact %.15g)\n", dn, dn_gsl, dl, dl_gsl, du, log(x2 / x1));
+        CHECK_NEAR(dn, dn_gsl, 1e-12, 1e-12);
+        CHECK_NEAR(dl, dl_gsl, 1e-12, 1e-12);
+        CHECK_NEAR(du, log(x2 / x1), 1e-12, 1e-12);
+        CHECK(phc_prior_log_density(&uni, 2.0) == 0);
+        CHECK(phc_prior_log_density(&uni, 3.5) == -INFINITY);
+        CHECK(phc_prior_log_density(&nrm, -0.1) == -INFINITY); /* truncated at 0 */
+        CHECK(phc_prior_log_density(&lnm, 0.0) == -INFINITY);
     }
     /* ---- bad input */
     sop.walkers = 3;
