@@ -632,6 +632,13 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
                       known_sigma ? "the data sets' sigmas are the known standard deviations"
                                   : "sampled from its inverse-gamma full conditional (prior worth n0 = 0.1 n "
                                     "observations at the fit's s2, as FME modMCMC's wvar0 = 0.1)");
+        if (known_sigma && !res->absolute_sigma && isfinite(res->s2))
+            bad |= append(&md, "The sigmas are taken as true standard deviations (as `absolute_sigma`), while "
+                               "`fit` scales its covariance by the variance factor WRSS/dof = %.4g: its Wald "
+                               "intervals are about %.3g times these widths.\n\n", res->s2, sqrt(res->s2));
+        if (res->summary.outcome != PHC_NLS_CONVERGED)
+            bad |= append(&md, "The fit that gave the start did not converge (%s): the chains start at its last "
+                               "point.\n\n", phc_fit_status_name(res->summary.outcome));
         bad |= append(&md, "Priors (user units):\n\n");
         for (size_t j = 0; j < d; ++j) {
             const phc_prior *pr_ = &q.prior[j];
