@@ -4,6 +4,7 @@
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S] [--resume] ...
  *   phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]
+ *   phytocal mcmc CONFIG.yaml [-o DIR] [--method dram|stretch] [--samples N] [--chains C] [--seed S] ...
  *   phytocal report DIR/result.json [--strict] [--level L]
  *   phytocal report --check DIR
  *   phytocal help [COMMAND | KIND | config | soil]   phytocal COMMAND --help
@@ -26,6 +27,7 @@
 #include "fit/config_help.h"
 #include "fit/engine/fit.h"
 #include "fit/engine/provenance.h"
+#include "fit/mcmc_study.h"
 #include "fit/report.h"
 #include "fit/profile_study.h"
 #include "fit/result_json.h"
@@ -106,6 +108,29 @@ static const command_help commands[] = {
      "options:\n"
      "  --points N         target steps per side before the threshold (default 12, >= 3)\n"
      "  --level L          confidence level, 0 < L < 1 (default 0.95)\n"
+     "  -o DIR, --force, --quiet as for fit."},
+    {"mcmc", "phytocal mcmc CONFIG.yaml [-o DIR] [--method dram|stretch] [--samples N] [--chains C] [--seed S]\n"
+             "                     [--resume] [--force] [--quiet]",
+     "Bayesian posterior of the free parameters by MCMC: Gaussian likelihood of the\n"
+     "weighted residuals times the priors (`prior:`, else uniform on the bounds; flat and\n"
+     "improper on an open bound, said in the report).  Known sigmas when every data set\n"
+     "gives them, otherwise the error variance is sampled (inverse-gamma full conditional).\n"
+     "Fits first and starts at the optimum.  Burn-in: the first half of each chain.\n"
+     "Writes a run directory (default runs/<name>-mcmc/): result.json (medians, 95%\n"
+     "intervals, tau, ESS, split-R-hat, thinned chains), report.md (did the chains mix:\n"
+     "R-hat < 1.01 and ESS > 400), mcmc_trace.png, mcmc_pairs.png.\n"
+     "\n"
+     "options:\n"
+     "  --method M         dram (default: adaptive Metropolis with delayed rejection, as\n"
+     "                     FME's modMCMC) or stretch (affine-invariant ensemble, as emcee)\n"
+     "  --samples N        draws per chain (dram, default 5000) or sweeps (stretch,\n"
+     "                     default 10000); at least 100\n"
+     "  --chains C         dram: chains (default 4, at least 2); stretch: walkers (default\n"
+     "                     max(32, 2d), even, at least 2d for d free parameters)\n"
+     "  --seed S           random seed (default 1): the same seed gives the same chains\n"
+     "  --resume           dram: continue an interrupted run from DIR.ledger (the chains it\n"
+     "                     holds are not rerun; a ledger of another config or setting is\n"
+     "                     refused, naming what differs)\n"
      "  -o DIR, --force, --quiet as for fit."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",
@@ -201,7 +226,7 @@ static int cmd_help(int argc, char **argv)
     phc_error_clear(&err);
     if (phc_config_write_help(stdout, strcmp(argv[0], "config") == 0 ? NULL : argv[0], &err) == PHC_OK)
         return EXIT_OK;
-    fprintf(stderr, "phytocal: %s; commands: fit, simulate, sensitivity, report, help, version\n", err.message);
+    fprintf(stderr, "phytocal: %s; commands: fit, simulate, sensitivity, profile, mcmc, report, help, version\n", err.message);
     return EXIT_USAGE;
 }
 
@@ -666,6 +691,95 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
     return EXIT_OK;
 }
 
+/* mcmc: posterior sampling (mcmc_study.h).  Its own options first, the rest through load_for_run. */
+static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
+{
+    phc_mcmc_options mo = phc_mcmc_options_default();
+    char **rest = calloc((size_t)argc + 1, sizeof *rest);
+    int n_rest = 0;
+    if (!rest)
+        return EXIT_INTERNAL;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "--method") != 0 && strcmp(a, "--samples") != 0 && strcmp(a, "--seed") != 0 &&
+            strcmp(a, "--chains") != 0) {
+            if (strcmp(a, "--resume") == 0)
+                mo.resume = 1;
+            else
+                rest[n_rest++] = argv[i];
+            continue;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "phytocal mcmc: %s needs a value\nusage: %s\n", a, find_command("mcmc")->synopsis);
+            free(rest);
+            return EXIT_USAGE;
+        }
+        const char *val = argv[++i];
+        if (strcmp(a, "--method") == 0) {
+            if (strcmp(val, "dram") == 0 || strcmp(val, "stretch") == 0) {
+                mo.method = val[0] == 'd' ? PHC_MCMC_DRAM : PHC_MCMC_STRETCH;
+                continue;
+            }
+            fprintf(stderr, "phytocal mcmc: --method: unknown method '%s'; expected dram or stretch\n", val);
+            free(rest);
+            return EXIT_INPUT;
+        }
+        char *end = NULL;
+        errno = 0;
+        const unsigned long long v = strtoull(val, &end, 10);
+        if (!*val || *val == '-' || errno || *end || v > 4294967295ULL) {
+            fprintf(stderr, "phytocal mcmc: %s: expected a whole number from 0 to 4294967295, found '%s'\n", a, val);
+            free(rest);
+            return EXIT_INPUT;
+        }
+        if (strcmp(a, "--samples") == 0)
+            mo.samples = (size_t)v;
+        else if (strcmp(a, "--chains") == 0)
+            mo.chains = (size_t)v;
+        else
+            mo.seed = (unsigned long)v;
+        if ((strcmp(a, "--samples") == 0 && v < PHC_MCMC_MIN_SAMPLES) || (strcmp(a, "--chains") == 0 && v < 2)) {
+            fprintf(stderr, "phytocal mcmc: %s %llu is too small: at least %d %s\n", a, v,
+                    a[2] == 's' ? PHC_MCMC_MIN_SAMPLES : 2, a[2] == 's' ? "draws per chain (the first half is "
+                    "burn-in, split-R-hat halves the rest)" : "chains (split-R-hat compares chains; the stretch move "
+                    "needs at least 2 d walkers)");
+            free(rest);
+            return EXIT_INPUT;
+        }
+    }
+    cli_options o;
+    phc_problem *pb = NULL;
+    phc_provenance *pv = NULL;
+    char dir[4096];
+    int code;
+    if (load_for_run("mcmc", full_argc, full_argv, n_rest, rest, "-mcmc", &o, &pb, &pv, dir, sizeof dir, &code)) {
+        free(rest);
+        return code;
+    }
+    free(rest);
+    mo.force = o.force;
+    const char *stop = getenv("PHYTOCAL_STOP_AFTER"); /* test hook: stop after k chains, as a killed run would */
+    if (stop && *stop)
+        mo.stop_after = (size_t)strtoull(stop, NULL, 10);
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    mo.progress = o.quiet ? NULL : progress_cb;
+    mo.progress_data = &prog;
+    phc_error err;
+    phc_error_clear(&err);
+    phc_mcmc_run_summary sum;
+    const int rc = phc_mcmc_run(pb, &mo, pv, dir, &sum, &err);
+    progress_end(&prog);
+    phc_provenance_free(pv);
+    phc_problem_free(pb);
+    if (rc)
+        return fail(&err);
+    if (!o.quiet)
+        printf("%sresults: %s/ (result.json, report.md, mcmc_trace.png, mcmc_pairs.png)\n", sum.text ? sum.text : "",
+               dir);
+    phc_mcmc_run_summary_clear(&sum);
+    return EXIT_OK;
+}
+
 /* report --check DIR: the run's inputs and outputs against its manifest. */
 static int check_run(const char *arg)
 {
@@ -763,6 +877,8 @@ int main(int argc, char **argv)
         return cmd_sensitivity(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "profile") == 0)
         return cmd_profile(argc, argv, argc - 2, argv + 2);
+    if (strcmp(cmd, "mcmc") == 0)
+        return cmd_mcmc(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "report") == 0)
         return cmd_report(argc - 2, argv + 2);
     fprintf(stderr, "phytocal: unknown command '%s'\n", cmd);

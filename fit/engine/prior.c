@@ -148,3 +148,27 @@ double phc_prior_median(const phc_prior *p)
 {
     return phc_prior_quantile(p, 0.5);
 }
+
+double phc_prior_log_density(const phc_prior *p, double x)
+{
+    if (!(x >= p->lower && x <= p->upper))
+        return -INFINITY;
+    switch (p->kind) {
+    case PHC_PRIOR_NONE:
+    case PHC_PRIOR_UNIFORM:
+        return 0;
+    case PHC_PRIOR_LOG_UNIFORM:
+        return x > 0 ? -log(x) : -INFINITY;
+    case PHC_PRIOR_NORMAL: {
+        const double z = (x - p->a) / p->b;
+        return -0.5 * z * z;
+    }
+    case PHC_PRIOR_LOG_NORMAL: {
+        if (!(x > 0))
+            return -INFINITY;
+        const double z = (log(x) - p->a) / p->b;
+        return -log(x) - 0.5 * z * z;
+    }
+    }
+    return -INFINITY;
+}

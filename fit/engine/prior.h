@@ -56,4 +56,11 @@ double phc_prior_quantile(const phc_prior *p, double u);
 /* Median of a resolved prior (its quantile at 1/2). */
 double phc_prior_median(const phc_prior *p);
 
+/* Log density of a resolved prior at x, up to an additive constant (for an
+ * MCMC posterior; the truncation's normalisation is a constant):
+ *   uniform 0, log-uniform -ln x, normal -(x - a)^2 / (2 b^2),
+ *   log-normal -ln x - (ln x - a)^2 / (2 b^2),
+ * -INFINITY outside [lower, upper] (and for x <= 0 where ln x is taken). */
+double phc_prior_log_density(const phc_prior *p, double x);
+
 #endif /* PHC_PRIOR_H */
