@@ -832,6 +832,9 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
             phc_error_set(err, rc, "cannot draw start %zu", s + 1);
             goto done;
         }
+        /* a rescue start where some parameter already has no effect before
+         * any step (see below) */
+        const int flat_start = s > 0 && res->rescue_starts && stalled_on_plateau(nls, pb, x);
         phc_nls_summary sum;
         if ((rc = phc_nls_solve(nls, &nls_opt, x, &sum, err)))
             goto done;
@@ -856,13 +859,17 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
             planned += opt->rescue_starts;
             res->rescue_starts = opt->rescue_starts;
         } else if (s > 0 && res->rescue_starts) {
-            /* A rescue start that stalls on a plateau again without a lower
-             * cost did not help.  When the first RESCUE_PATIENCE all do so,
-             * the parameter has no effect wherever the box was sampled (a
-             * rank-deficient problem, not a bad start): stop, rather than
-             * run every rescue start (16 by default, each as slow as the
-             * first on a simulation model). */
-            if (!improved && stalled_on_plateau(nls, pb, x))
+            /* A rescue start at which some parameter has no effect already
+             * at its starting point, and that ends on a plateau again
+             * without a lower cost, did not help.  When the first
+             * RESCUE_PATIENCE all are such, the parameter has no effect
+             * wherever the box was sampled (a rank-deficient problem, not a
+             * bad start): stop, rather than run every rescue start (16 by
+             * default, each as slow as the first on a simulation model).
+             * A start that only drifts onto a plateau while solving (NIST
+             * BoxBOD from Start 1: the exponential saturates) keeps the
+             * rescue going. */
+            if (flat_start && !improved && stalled_on_plateau(nls, pb, x))
                 ++useless;
             if (useless == s && s >= RESCUE_PATIENCE) {
                 res->rescue_stopped = 1;
