@@ -225,17 +225,12 @@ static int read_dynamics(const phc_yaml_doc *doc, const phc_yaml_node *node, phc
 {
     static const char *const particle_keys[] = {"particle_iterations", "particle_time_step", "particle_steps",
                                                 "particle_damping", "parent_weight", NULL};
-    const char *ctx = "shape_series data set", *dyn = "rods";
-    int rc;
-    if ((rc = phc_yaml_map_string(doc, node, "dynamics", 0, ctx, &dyn, err)))
+    static const char *const dynamics_names[] = {"rods", "particles", NULL};
+    const char *ctx = "shape_series data set";
+    int rc, dynamics = 0;
+    if ((rc = phc_yaml_map_choice(doc, node, "dynamics", ctx, dynamics_names, &dynamics, err)))
         return rc;
-    if (strcmp(dyn, "rods") == 0)
-        o->dynamics = PHC_SHAPE_RODS;
-    else if (strcmp(dyn, "particles") == 0)
-        o->dynamics = PHC_SHAPE_PARTICLES;
-    else
-        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'dynamics': '%s' is not one of rods, particles",
-                             doc->path, phc_key_line(node, "dynamics"), dyn);
+    o->dynamics = dynamics ? PHC_SHAPE_PARTICLES : PHC_SHAPE_RODS;
     if (o->dynamics != PHC_SHAPE_PARTICLES) {
         for (size_t j = 0; particle_keys[j]; ++j)
             if (phc_yaml_get(node, particle_keys[j]))
