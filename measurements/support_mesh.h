@@ -1,0 +1,66 @@
+/* Support meshes for climbing plants (Hädrich, Benes, Deussen, Pirk,
+ * "Interactive Modeling and Authoring of Climbing Plants", CGF 36(2) 2017,
+ * §4.2: shoots adapt to and anchor on the closest point of a support).
+ *
+ * A support is a triangle mesh: read from an OBJ or PLY file (assimp), or
+ * given as vertex and triangle arrays.  Closest-point queries use CGAL's
+ * AABB tree over the triangles (exact closest point on a triangle in double
+ * precision; Simple_cartesian<double> kernel).  Both libraries live in
+ * measurements/support_mesh_bridge.cc only; this header is plain C.
+ *
+ * phc_support_mesh_closest has the signature of phc_climbing_closest_fn
+ * (model/climbing_growth.h), so a mesh plugs into the growth model as
+ *   opts.closest = phc_support_mesh_closest; opts.closest_user = mesh;
+ * and model/ stays free of any mesh library.
+ *
+ * Units: coordinates as in the file, taken as metres. */
+#ifndef PHC_SUPPORT_MESH_H
+#define PHC_SUPPORT_MESH_H
+
+#include <stddef.h>
+
+#include "model/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct phc_support_mesh phc_support_mesh;
+
+/* Reads every triangle of an OBJ or PLY file (polygons are triangulated,
+ * node transforms applied; points and lines are ignored).  Errors (NULL,
+ * err filled, PHC_ERR_INPUT): the file does not parse ("PATH: assimp: ..."
+ * with assimp's reason, which names the line where the format gives one),
+ * the file has no triangles ("PATH: no triangles ..."), a non-finite
+ * vertex ("PATH: mesh 0 vertex 12: coordinate is not finite"); PHC_ERR_IO
+ * when it cannot be opened. */
+phc_support_mesh *phc_support_mesh_read(const char *path, phc_error *err);
+
+/* A mesh from arrays: vertices 3·nv (m), triangles 3·nt vertex indices.
+ * Errors: nt == 0, an index >= nv, a non-finite vertex (messages name
+ * `where` and the triangle or vertex). */
+phc_support_mesh *phc_support_mesh_from_arrays(const double *vertices, size_t nv,
+                                               const size_t *triangles, size_t nt,
+                                               const char *where, phc_error *err);
+
+void phc_support_mesh_free(phc_support_mesh *m); /* accepts NULL */
+
+size_t phc_support_mesh_triangle_count(const phc_support_mesh *m);
+size_t phc_support_mesh_vertex_count(const phc_support_mesh *m);
+/* Axis-aligned bounding box: lo[3], hi[3] (m). */
+void phc_support_mesh_bounds(const phc_support_mesh *m, double lo[3], double hi[3]);
+/* Vertex i (3 doubles) and triangle t (3 indices), for drawing. */
+void phc_support_mesh_vertex(const phc_support_mesh *m, size_t i, double v[3]);
+void phc_support_mesh_triangle(const phc_support_mesh *m, size_t t, size_t idx[3]);
+
+/* Closest point c (m) on the mesh to x (m), and the unit normal n of the
+ * triangle it lies on (right-hand rule over the triangle's vertex order;
+ * (0,0,0) for a degenerate triangle).  `mesh` is a phc_support_mesh *.
+ * Returns 0, or -1 when x is not finite (c, n untouched). */
+int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double n[3]);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PHC_SUPPORT_MESH_H */

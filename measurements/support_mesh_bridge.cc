@@ -1,0 +1,258 @@
+// Support meshes: the only file in phytocal that touches assimp (reading
+// OBJ/PLY) and CGAL (AABB tree closest-point queries).  See
+// measurements/support_mesh.h.  Every extern "C" function catches every
+// exception; none crosses into C.
+
+#include "measurements/support_mesh.h"
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+#include <vector>
+
+namespace {
+
+// Simple_cartesian<double>: plain double arithmetic.  A closest point on a
+// triangle is a projection, computed exactly up to rounding; no predicate
+// needs exactness here.
+typedef CGAL::Simple_cartesian<double> Kernel;
+typedef Kernel::Point_3 Point;
+typedef Kernel::Triangle_3 Triangle;
+typedef std::vector<Triangle>::const_iterator TriangleIterator;
+typedef CGAL::AABB_triangle_primitive<Kernel, TriangleIterator> Primitive;
+typedef CGAL::AABB_traits<Kernel, Primitive> Traits;
+typedef CGAL::AABB_tree<Traits> Tree;
+
+}  // namespace
+
+struct phc_support_mesh {
+    std::vector<double> vertices;     // 3 nv
+    std::vector<size_t> triangles;    // 3 nt
+    std::vector<Triangle> cgal;       // nt, same order
+    std::vector<double> normals;      // 3 nt, unit or zero
+    double lo[3], hi[3];
+    std::unique_ptr<Tree> tree;
+};
+
+namespace {
+
+// Builds triangles, normals, bounds and the tree from vertices/triangles.
+void build(phc_support_mesh *m)
+{
+    const size_t nt = m->triangles.size() / 3;
+    m->cgal.reserve(nt);
+    m->normals.assign(3 * nt, 0.0);
+    for (int k = 0; k < 3; ++k) {
+        m->lo[k] = HUGE_VAL;
+        m->hi[k] = -HUGE_VAL;
+    }
+    for (size_t i = 0; i < m->vertices.size() / 3; ++i)
+        for (int k = 0; k < 3; ++k) {
+            m->lo[k] = std::fmin(m->lo[k], m->vertices[3 * i + k]);
+            m->hi[k] = std::fmax(m->hi[k], m->vertices[3 * i + k]);
+        }
+    for (size_t t = 0; t < nt; ++t) {
+        const double *a = &m->vertices[3 * m->triangles[3 * t]];
+        const double *b = &m->vertices[3 * m->triangles[3 * t + 1]];
+        const double *c = &m->vertices[3 * m->triangles[3 * t + 2]];
+        m->cgal.emplace_back(Point(a[0], a[1], a[2]), Point(b[0], b[1], b[2]),
+                             Point(c[0], c[1], c[2]));
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                       u[0] * v[1] - u[1] * v[0]};
+        const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (len > 0)
+            for (int k = 0; k < 3; ++k)
+                m->normals[3 * t + k] = n[k] / len;
+    }
+    m->tree.reset(new Tree(m->cgal.begin(), m->cgal.end()));
+    // Builds the search structure now, so that later queries only read.
+    m->tree->accelerate_distance_queries();
+}
+
+}  // namespace
+
+extern "C" {
+
+phc_support_mesh *phc_support_mesh_read(const char *path, phc_error *err)
+{
+    if (!path) {
+        phc_error_set(err, PHC_ERR_INVALID, "support mesh: no file name");
+        return nullptr;
+    }
+    std::FILE *f = std::fopen(path, "rb");
+    if (!f) {
+        phc_error_set(err, PHC_ERR_IO, "%s: cannot open: %s", path, std::strerror(errno));
+        return nullptr;
+    }
+    std::fclose(f);
+    phc_support_mesh *m = nullptr;
+    try {
+        Assimp::Importer importer;
+        const aiScene *scene = importer.ReadFile(
+            path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_SortByPType);
+        if (!scene || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE && scene->mNumMeshes == 0)) {
+            const char *why = importer.GetErrorString();
+            if (!why || !*why)
+                why = "no reason given";
+            // assimp refuses a file whose meshes hold no faces (an OBJ of
+            // vertices only) as "No output meshes": say what that means.
+            if (std::strstr(why, "No output meshes") || std::strstr(why, "no meshes"))
+                phc_error_set(err, PHC_ERR_INPUT,
+                              "%s: no triangles (assimp: %s); a support must be a surface", path,
+                              why);
+            else
+                phc_error_set(err, PHC_ERR_INPUT, "%s: assimp cannot read it as a mesh: %s", path,
+                              why);
+            return nullptr;
+        }
+        m = new phc_support_mesh();
+        for (unsigned im = 0; im < scene->mNumMeshes; ++im) {
+            const aiMesh *mesh = scene->mMeshes[im];
+            const size_t base = m->vertices.size() / 3;
+            for (unsigned iv = 0; iv < mesh->mNumVertices; ++iv) {
+                const aiVector3D &p = mesh->mVertices[iv];
+                const double xyz[3] = {p.x, p.y, p.z};
+                for (int k = 0; k < 3; ++k) {
+                    if (!std::isfinite(xyz[k])) {
+                        phc_error_set(err, PHC_ERR_INPUT,
+                                      "%s: mesh %u vertex %u: coordinate %c is not finite", path,
+                                      im, iv, "xyz"[k]);
+                        delete m;
+                        return nullptr;
+                    }
+                    m->vertices.push_back(xyz[k]);
+                }
+            }
+            for (unsigned it = 0; it < mesh->mNumFaces; ++it) {
+                const aiFace &face = mesh->mFaces[it];
+                if (face.mNumIndices != 3)
+                    continue;  // points and lines: not a surface
+                for (int k = 0; k < 3; ++k)
+                    m->triangles.push_back(base + face.mIndices[k]);
+            }
+        }
+        if (m->triangles.empty()) {
+            phc_error_set(err, PHC_ERR_INPUT,
+                          "%s: no triangles (%zu vertices in %u meshes; a support must be a "
+                          "surface: faces with 3 or more vertices)",
+                          path, m->vertices.size() / 3, scene->mNumMeshes);
+            delete m;
+            return nullptr;
+        }
+        build(m);
+        return m;
+    } catch (const std::bad_alloc &) {
+        delete m;
+        phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory reading the mesh", path);
+    } catch (const std::exception &e) {
+        delete m;
+        phc_error_set(err, PHC_ERR_INPUT, "%s: cannot read the mesh: %s", path, e.what());
+    }
+    return nullptr;
+}
+
+phc_support_mesh *phc_support_mesh_from_arrays(const double *vertices, size_t nv,
+                                               const size_t *triangles, size_t nt,
+                                               const char *where, phc_error *err)
+{
+    if (!where)
+        where = "support mesh";
+    if (nt == 0 || !triangles || !vertices || nv == 0) {
+        phc_error_set(err, PHC_ERR_INPUT, "%s: no triangles", where);
+        return nullptr;
+    }
+    for (size_t i = 0; i < 3 * nv; ++i)
+        if (!std::isfinite(vertices[i])) {
+            phc_error_set(err, PHC_ERR_INPUT, "%s: vertex %zu: coordinate %c is not finite", where,
+                          i / 3, "xyz"[i % 3]);
+            return nullptr;
+        }
+    for (size_t i = 0; i < 3 * nt; ++i)
+        if (triangles[i] >= nv) {
+            phc_error_set(err, PHC_ERR_INPUT,
+                          "%s: triangle %zu: vertex index %zu out of range (%zu vertices)", where,
+                          i / 3, triangles[i], nv);
+            return nullptr;
+        }
+    phc_support_mesh *m = nullptr;
+    try {
+        m = new phc_support_mesh();
+        m->vertices.assign(vertices, vertices + 3 * nv);
+        m->triangles.assign(triangles, triangles + 3 * nt);
+        build(m);
+        return m;
+    } catch (const std::exception &) {
+        delete m;
+        phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory for %zu triangles", where, nt);
+    }
+    return nullptr;
+}
+
+void phc_support_mesh_free(phc_support_mesh *m) { delete m; }
+
+size_t phc_support_mesh_triangle_count(const phc_support_mesh *m)
+{
+    return m ? m->triangles.size() / 3 : 0;
+}
+
+size_t phc_support_mesh_vertex_count(const phc_support_mesh *m)
+{
+    return m ? m->vertices.size() / 3 : 0;
+}
+
+void phc_support_mesh_bounds(const phc_support_mesh *m, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        lo[k] = m->lo[k];
+        hi[k] = m->hi[k];
+    }
+}
+
+void phc_support_mesh_vertex(const phc_support_mesh *m, size_t i, double v[3])
+{
+    for (int k = 0; k < 3; ++k)
+        v[k] = m->vertices[3 * i + k];
+}
+
+void phc_support_mesh_triangle(const phc_support_mesh *m, size_t t, size_t idx[3])
+{
+    for (int k = 0; k < 3; ++k)
+        idx[k] = m->triangles[3 * t + k];
+}
+
+int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double n[3])
+{
+    const phc_support_mesh *m = static_cast<const phc_support_mesh *>(mesh);
+    if (!m || !std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+        return -1;
+    try {
+        const Tree::Point_and_primitive_id pp = m->tree->closest_point_and_primitive(
+            Point(x[0], x[1], x[2]));
+        const size_t t = static_cast<size_t>(pp.second - m->cgal.begin());
+        c[0] = pp.first.x();
+        c[1] = pp.first.y();
+        c[2] = pp.first.z();
+        for (int k = 0; k < 3; ++k)
+            n[k] = m->normals[3 * t + k];
+        return 0;
+    } catch (const std::exception &) {
+        return -1;
+    }
+}
+
+}  // extern "C"

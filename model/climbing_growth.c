@@ -1,0 +1,637 @@
+/* Climbing-plant growth (Hädrich et al., CGF 36(2) 2017, §4.2–4.3): see
+ * model/climbing_growth.h for the model, its equations and units. */
+#include "model/climbing_growth.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/climbing_rng.h"
+#include "model/climbing_tropism.h"
+#include "model/plant_graph.h"
+
+static const double PI = 3.14159265358979323846;
+
+struct phc_climbing {
+    phc_climbing_options o;
+    phc_climbing_rng rng;
+    double base[3];          /* the seed particle's base, m (fixed) */
+    size_t n, cap;
+    size_t *parent;
+    unsigned *order;
+    unsigned char *apical, *lateral, *anchored;
+    double *sigma, *radius, *age, *light;
+    double *x, *d;           /* 3n current centre (m), direction (unit) */
+    double *xr, *dr;         /* 3n rest centre, rest direction */
+    double *anchor_at;       /* 3n, m */
+    double *anchor_t0;       /* n, s: when the anchor was made */
+    double *vol;             /* n scratch: particle volumes, m^3 */
+    double *phi;             /* light grid scratch */
+    phc_climbing_stats stats;
+};
+
+static double dot(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+phc_climbing_options phc_climbing_options_default(void)
+{
+    phc_climbing_options o;
+    memset(&o, 0, sizeof o);
+    o.seed = 1;
+    o.max_length = 0.02;
+    o.bud_fraction = 0.25;
+    o.growth_rate = 0.1;
+    o.radius = 0.002;
+    o.max_particles = 20000;
+    o.branch_probability = 0.3;
+    o.max_buds = 1;
+    o.direction_variance = 0.5;
+    o.thickness_falloff = 0.7;
+    o.max_order = 3;
+    o.light.cell = 0.05;
+    o.light.dims[0] = o.light.dims[1] = o.light.dims[2] = 1;
+    o.light.extinction = 0;
+    o.light.direction[2] = 1;
+    o.phototropism = 0;
+    o.surface_adaption = 0;
+    o.adaption_radius = 0.1;
+    o.contact_distance = 0.004;
+    o.attach_distance = 0.005;
+    o.release_distance = 0.02;
+    o.anchor_strength = 0.5;
+    o.anchor_time = 10;
+    o.dynamics_substeps = 0;
+    o.particles = phc_particles_options_default();
+    o.particles.maturity_age = 50;
+    return o;
+}
+
+void phc_climbing_free(phc_climbing *c)
+{
+    if (!c)
+        return;
+    free(c->parent);
+    free(c->order);
+    free(c->apical);
+    free(c->lateral);
+    free(c->anchored);
+    free(c->sigma);
+    free(c->radius);
+    free(c->age);
+    free(c->light);
+    free(c->x);
+    free(c->d);
+    free(c->xr);
+    free(c->dr);
+    free(c->anchor_at);
+    free(c->anchor_t0);
+    free(c->vol);
+    free(c->phi);
+    free(c);
+}
+
+/* Grows every array to hold `want` particles; 0 or -1 (out of memory). */
+static int reserve(phc_climbing *c, size_t want)
+{
+    if (want <= c->cap)
+        return 0;
+    size_t cap = c->cap ? c->cap : 64;
+    while (cap < want)
+        cap *= 2;
+#define GROW(field, per)                                                    \
+    do {                                                                    \
+        void *q = realloc(c->field, (cap) * (per) * sizeof *c->field);      \
+        if (!q)                                                             \
+            return -1;                                                      \
+        c->field = q;                                                       \
+    } while (0)
+    GROW(parent, 1);
+    GROW(order, 1);
+    GROW(apical, 1);
+    GROW(lateral, 1);
+    GROW(anchored, 1);
+    GROW(sigma, 1);
+    GROW(radius, 1);
+    GROW(age, 1);
+    GROW(light, 1);
+    GROW(x, 3);
+    GROW(d, 3);
+    GROW(xr, 3);
+    GROW(dr, 3);
+    GROW(anchor_at, 3);
+    GROW(anchor_t0, 1);
+    GROW(vol, 1);
+#undef GROW
+    c->cap = cap;
+    return 0;
+}
+
+static int bad(phc_error *err, const char *key, double v, const char *range)
+{
+    return phc_error_set(err, PHC_ERR_INVALID, "climbing: %s = %g is outside %s", key, v, range);
+}
+
+static int check_options(const phc_climbing_options *o, phc_error *err)
+{
+#define NEED(cond, key, v, range) \
+    if (!(cond)) return bad(err, key, (double)(v), range)
+    NEED(o->max_length > 0 && isfinite(o->max_length), "max_length", o->max_length, "(0, inf) m");
+    NEED(o->bud_fraction > 0 && o->bud_fraction < 1, "bud_fraction", o->bud_fraction, "(0, 1)");
+    NEED(o->growth_rate >= 0 && isfinite(o->growth_rate), "growth_rate", o->growth_rate,
+         "[0, inf) 1/s");
+    NEED(o->radius > 0 && isfinite(o->radius), "radius", o->radius, "(0, inf) m");
+    NEED(o->max_particles >= 1, "max_particles", o->max_particles, "[1, inf)");
+    NEED(o->branch_probability >= 0 && o->branch_probability <= 1, "branch_probability",
+         o->branch_probability, "[0, 1]");
+    NEED(o->direction_variance >= 0 && o->direction_variance <= 1, "direction_variance",
+         o->direction_variance, "[0, 1] (1 = 90 degrees)");
+    NEED(o->thickness_falloff > 0 && o->thickness_falloff <= 1, "thickness_falloff",
+         o->thickness_falloff, "(0, 1]");
+    NEED(o->light.cell > 0 && isfinite(o->light.cell), "light.cell", o->light.cell, "(0, inf) m");
+    for (int k = 0; k < 3; ++k) {
+        NEED(o->light.dims[k] >= 1, "light.dims", o->light.dims[k], "[1, inf)");
+        NEED(isfinite(o->light.origin[k]), "light.origin", o->light.origin[k], "finite numbers");
+    }
+    NEED(o->light.extinction >= 0 && isfinite(o->light.extinction), "light.extinction",
+         o->light.extinction, "[0, inf) 1/m");
+    const double ll = sqrt(dot(o->light.direction, o->light.direction));
+    NEED(ll > 0 && isfinite(ll), "|light.direction|", ll, "(0, inf)");
+    NEED(o->phototropism >= 0 && isfinite(o->phototropism), "phototropism", o->phototropism,
+         "[0, inf) 1/s");
+    NEED(o->surface_adaption >= 0 && isfinite(o->surface_adaption), "surface_adaption",
+         o->surface_adaption, "[0, inf) 1/s");
+    NEED(o->adaption_radius >= 0 && isfinite(o->adaption_radius), "adaption_radius",
+         o->adaption_radius, "[0, inf) m");
+    NEED(o->contact_distance >= 0 && isfinite(o->contact_distance), "contact_distance",
+         o->contact_distance, "[0, inf) m");
+    NEED(o->attach_distance >= 0 && isfinite(o->attach_distance), "attach_distance",
+         o->attach_distance, "[0, inf) m");
+    NEED(o->release_distance > o->attach_distance && isfinite(o->release_distance),
+         "release_distance", o->release_distance, "(attach_distance, inf) m");
+    NEED(o->anchor_strength > 0 && o->anchor_strength <= 1, "anchor_strength",
+         o->anchor_strength, "(0, 1]");
+    NEED(o->anchor_time > 0 && isfinite(o->anchor_time), "anchor_time", o->anchor_time,
+         "(0, inf) s");
+#undef NEED
+    return 0;
+}
+
+static int unit(const double v[3], double u[3])
+{
+    const double l = sqrt(dot(v, v));
+    if (!(l > 0) || !isfinite(l))
+        return -1;
+    for (int k = 0; k < 3; ++k)
+        u[k] = v[k] / l;
+    return 0;
+}
+
+/* Appends a particle of size sigma whose base is at b along direction dir
+ * (current and rest alike); returns its index or NONE (out of memory). */
+static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int lateral,
+                           double sigma, double radius, const double b[3],
+                           const double dir[3], const double brest[3])
+{
+    if (reserve(c, c->n + 1))
+        return PHC_CLIMBING_NONE;
+    const size_t i = c->n++;
+    c->parent[i] = parent;
+    c->order[i] = order;
+    c->apical[i] = 1;
+    c->lateral[i] = (unsigned char)lateral;
+    c->anchored[i] = 0;
+    c->sigma[i] = sigma;
+    c->radius[i] = radius;
+    c->age[i] = 0;
+    c->light[i] = 1;
+    c->anchor_t0[i] = 0;
+    const double h = 0.5 * sigma * c->o.max_length;
+    for (int k = 0; k < 3; ++k) {
+        c->d[3 * i + k] = c->dr[3 * i + k] = dir[k];
+        c->x[3 * i + k] = b[k] + h * dir[k];
+        c->xr[3 * i + k] = brest[k] + h * dir[k];
+        c->anchor_at[3 * i + k] = 0;
+    }
+    return i;
+}
+
+phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
+                               const phc_climbing_options *options, phc_error *err)
+{
+    const phc_climbing_options o = options ? *options : phc_climbing_options_default();
+    if (check_options(&o, err))
+        return NULL;
+    double dir[3];
+    if (!base || !isfinite(base[0]) || !isfinite(base[1]) || !isfinite(base[2])) {
+        phc_error_set(err, PHC_ERR_INVALID, "climbing: the seed position is not finite");
+        return NULL;
+    }
+    if (!direction || unit(direction, dir)) {
+        phc_error_set(err, PHC_ERR_INVALID,
+                      "climbing: the seed direction must be a finite, non-zero vector");
+        return NULL;
+    }
+    phc_climbing *c = calloc(1, sizeof *c);
+    if (!c)
+        goto nomem;
+    c->o = o;
+    unit(o.light.direction, c->o.light.direction);
+    phc_climbing_rng_seed(&c->rng, o.seed);
+    memcpy(c->base, base, sizeof c->base);
+    if (o.light.extinction > 0) {
+        c->phi = malloc(phc_climbing_light_cells(&o.light) * sizeof *c->phi);
+        if (!c->phi)
+            goto nomem;
+    }
+    if (add_particle(c, PHC_CLIMBING_NONE, 0, 0, o.bud_fraction, o.radius, base, dir, base) ==
+        PHC_CLIMBING_NONE)
+        goto nomem;
+    c->stats.particles = 1;
+    c->stats.apical = 1;
+    return c;
+nomem:
+    phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory");
+    phc_climbing_free(c);
+    return NULL;
+}
+
+static double seg_half(const phc_climbing *c, size_t i)
+{
+    return 0.5 * c->sigma[i] * c->o.max_length;
+}
+
+/* Base of i's current (rest when rest != 0) segment. */
+static void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
+{
+    const double *x = rest ? c->xr : c->x, *d = rest ? c->dr : c->d;
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        b[k] = x[3 * i + k] - h * d[3 * i + k];
+}
+
+static void seg_tip(const phc_climbing *c, size_t i, int rest, double t[3])
+{
+    const double *x = rest ? c->xr : c->x, *d = rest ? c->dr : c->d;
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        t[k] = x[3 * i + k] + h * d[3 * i + k];
+}
+
+/* A unit vector at angle theta from the unit d, at azimuth phi. */
+static void cone_direction(const double d[3], double theta, double phi, double out[3])
+{
+    int m = 0;
+    for (int k = 1; k < 3; ++k)
+        if (fabs(d[k]) < fabs(d[m]))
+            m = k;
+    double e[3] = {m == 0, m == 1, m == 2};
+    double e1[3] = {d[1] * e[2] - d[2] * e[1], d[2] * e[0] - d[0] * e[2],
+                    d[0] * e[1] - d[1] * e[0]};
+    unit(e1, e1);
+    const double e2[3] = {d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2],
+                          d[0] * e1[1] - d[1] * e1[0]};
+    const double ct = cos(theta), st = sin(theta), cp = cos(phi), sp = sin(phi);
+    for (int k = 0; k < 3; ++k)
+        out[k] = ct * d[k] + st * (cp * e1[k] + sp * e2[k]);
+    unit(out, out);
+}
+
+/* Step 2: tropisms of apical particle i (eqs. 6–10). */
+static void tropisms(phc_climbing *c, size_t i, double dt)
+{
+    const phc_climbing_options *o = &c->o;
+    double b[3];
+    seg_base(c, i, 0, b);
+    double *d = c->d + 3 * i, *dr = c->dr + 3 * i;
+    if (o->phototropism > 0) /* eq. 7 */
+        phc_climbing_turn(d, dr, o->light.direction, o->phototropism * dt);
+    if (o->closest && (o->surface_adaption > 0 || o->contact_distance > 0)) { /* eq. 6 */
+        double tip[3], cp[3], nf[3], t[3];
+        seg_tip(c, i, 0, tip);
+        if (o->closest(o->closest_user, tip, cp, nf) == 0) {
+            const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
+            const double delta = sqrt(dot(r, r));
+            if (delta <= o->adaption_radius && o->surface_adaption > 0 &&
+                phc_climbing_surface_target(tip, cp, nf, d, o->contact_distance, t))
+                phc_climbing_turn(d, dr, t, o->surface_adaption * dt);
+            /* collision rule (ours): a tip in contact keeps no inward part */
+            if (delta <= o->contact_distance) {
+                double n[3];
+                if (delta > 0)
+                    for (int k = 0; k < 3; ++k)
+                        n[k] = r[k] / delta;
+                else
+                    memcpy(n, nf, sizeof n);
+                const double dn = dot(d, n);
+                if (dn < 0) {
+                    double nd[3] = {d[0] - dn * n[0], d[1] - dn * n[1], d[2] - dn * n[2]};
+                    if (unit(nd, nd) == 0)
+                        phc_climbing_turn(d, dr, nd, 1);
+                }
+            }
+        }
+    }
+    /* the base stays where it was: the segment turns about it */
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        c->x[3 * i + k] = b[k] + h * d[k];
+}
+
+/* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
+ * Returns 0 or -1 (out of memory). */
+static int grow(phc_climbing *c, size_t i, double dsig)
+{
+    const phc_climbing_options *o = &c->o;
+    double b[3];
+    seg_base(c, i, 0, b);
+    double s = c->sigma[i] + dsig;
+    double excess = 0;
+    if (s >= 1) {
+        excess = s - 1;
+        s = 1;
+    }
+    c->sigma[i] = s;
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        c->x[3 * i + k] = b[k] + h * c->d[3 * i + k];
+    /* the rest centre: rebuilt in step 5 */
+    if (s < 1)
+        return 0;
+    c->apical[i] = 0;
+    if (c->n >= o->max_particles)
+        return 0;
+    double tip[3], tipr[3], dir[3];
+    seg_tip(c, i, 0, tip);
+    /* rest tip: the rest base is rebuilt later, a provisional one suffices */
+    for (int k = 0; k < 3; ++k)
+        tipr[k] = c->xr[3 * i + k] + h * c->dr[3 * i + k];
+    memcpy(dir, c->d + 3 * i, sizeof dir);
+    double dirr[3];
+    memcpy(dirr, c->dr + 3 * i, sizeof dirr);
+    const unsigned order = c->order[i];
+    const double radius = c->radius[i];
+    size_t j = add_particle(c, i, order, 0, o->bud_fraction + excess, radius, tip, dir, tipr);
+    if (j == PHC_CLIMBING_NONE)
+        return -1;
+    memcpy(c->dr + 3 * j, dirr, sizeof dirr);
+    if (order >= o->max_order)
+        return 0;
+    for (unsigned bud = 0; bud < o->max_buds && c->n < o->max_particles; ++bud) {
+        c->stats.bud_trials++;
+        const double u = phc_climbing_rng_uniform(&c->rng);
+        const double theta = phc_climbing_rng_uniform(&c->rng) * o->direction_variance * 0.5 * PI;
+        const double phi = 2 * PI * phc_climbing_rng_uniform(&c->rng);
+        if (!(u < o->branch_probability))
+            continue;
+        double ld[3], ldr[3];
+        cone_direction(dir, theta, phi, ld);
+        cone_direction(dirr, theta, phi, ldr);
+        const size_t k = add_particle(c, i, order + 1, 1, o->bud_fraction,
+                                      radius * o->thickness_falloff, tip, ld, tipr);
+        if (k == PHC_CLIMBING_NONE)
+            return -1;
+        memcpy(c->dr + 3 * k, ldr, sizeof ldr);
+        c->stats.laterals++;
+        if (order + 1 > c->stats.max_order)
+            c->stats.max_order = order + 1;
+    }
+    return 0;
+}
+
+/* Step 5: rest centres from rest directions, parents first (indices grow
+ * away from the seed). */
+static void rebuild_rest(phc_climbing *c)
+{
+    for (size_t i = 0; i < c->n; ++i) {
+        double b[3];
+        if (c->parent[i] == PHC_CLIMBING_NONE)
+            memcpy(b, c->base, sizeof b);
+        else
+            seg_tip(c, c->parent[i], 1, b);
+        const double h = seg_half(c, i);
+        for (int k = 0; k < 3; ++k)
+            c->xr[3 * i + k] = b[k] + h * c->dr[3 * i + k];
+    }
+}
+
+/* The shortest-arc rotation taking z to the unit d (as model/particles.c
+ * builds its rest orientations, so current and rest agree when d = rest). */
+static void quat_from_z(const double d[3], double q[4])
+{
+    if (d[2] < -1 + 1e-12) {
+        q[0] = 0;
+        q[1] = 1;
+        q[2] = q[3] = 0;
+        return;
+    }
+    q[0] = 1 + d[2];
+    q[1] = -d[1];
+    q[2] = d[0];
+    q[3] = 0;
+    const double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+    for (int k = 0; k < 4; ++k)
+        q[k] /= l;
+}
+
+double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
+{
+    if (!c->anchored[i])
+        return 0;
+    const double ramp = fmin(1, (c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
+    return c->o.anchor_strength * c->sigma[i] * ramp;
+}
+
+/* Step 6: the particles' dynamics on the grown shape. */
+static int dynamics(phc_climbing *c, double dt, phc_error *err)
+{
+    const size_t n = c->n;
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    phc_particles *p = NULL;
+    int rc = -1;
+    if (!g) {
+        phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu particles", n);
+        return -1;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double h = seg_half(c, i);
+        for (int k = 0; k < 3; ++k) {
+            g->head[3 * i + k] = c->xr[3 * i + k] - h * c->dr[3 * i + k];
+            g->tail[3 * i + k] = c->xr[3 * i + k] + h * c->dr[3 * i + k];
+        }
+        g->radius[i] = c->radius[i];
+        g->length[i] = 2 * h;
+        g->parent[i] = c->parent[i] == PHC_CLIMBING_NONE ? PHC_PLANT_NO_PARENT : c->parent[i];
+    }
+    g->fixed[0] = 1; /* the seed is in the ground */
+    if (phc_plant_graph_finish(g, "climbing", err))
+        goto done;
+    p = phc_particles_new(g, &c->o.particles, err);
+    if (!p)
+        goto done;
+    for (size_t i = 1; i < n; ++i) {
+        double q[4];
+        quat_from_z(c->d + 3 * i, q);
+        if (phc_particles_set_position(p, i, c->x + 3 * i, err) ||
+            phc_particles_set_orientation(p, i, q, err) ||
+            phc_particles_set_age(p, i, c->age[i], err))
+            goto done;
+        if (c->anchored[i]) {
+            const double k = phc_climbing_anchor_strength(c, i);
+            if (k > 0 && phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err))
+                goto done;
+        }
+    }
+    const double h = dt / (double)c->o.dynamics_substeps;
+    for (size_t s = 0; s < c->o.dynamics_substeps; ++s)
+        if (phc_particles_step(p, h, NULL, err))
+            goto done;
+    for (size_t i = 1; i < n; ++i) {
+        double q[4], R[9];
+        phc_particles_position(p, i, c->x + 3 * i);
+        phc_particles_orientation(p, i, q);
+        /* direction = R(q)·z: the third column of R */
+        const double w = q[0], a = q[1], b = q[2], cc = q[3];
+        R[2] = 2 * (a * cc + w * b);
+        R[5] = 2 * (b * cc - w * a);
+        R[8] = 1 - 2 * (a * a + b * b);
+        const double dz[3] = {R[2], R[5], R[8]};
+        unit(dz, c->d + 3 * i);
+    }
+    rc = 0;
+done:
+    phc_particles_free(p);
+    phc_plant_graph_free(g);
+    return rc;
+}
+
+/* Step 7: anchors (eq. 5). */
+static void anchors(phc_climbing *c)
+{
+    const phc_climbing_options *o = &c->o;
+    if (!o->closest)
+        return;
+    for (size_t i = 0; i < c->n; ++i) {
+        const double *x = c->x + 3 * i;
+        if (c->anchored[i]) {
+            const double *a = c->anchor_at + 3 * i;
+            const double r[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
+            if (sqrt(dot(r, r)) > o->release_distance) {
+                c->anchored[i] = 0;
+                c->stats.anchors_released++;
+            }
+            continue;
+        }
+        if (!(o->attach_distance > 0))
+            continue;
+        double cp[3], nf[3];
+        if (o->closest(o->closest_user, x, cp, nf))
+            continue;
+        const double r[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+        if (sqrt(dot(r, r)) <= o->attach_distance) {
+            c->anchored[i] = 1;
+            memcpy(c->anchor_at + 3 * i, cp, sizeof cp);
+            c->anchor_t0[i] = c->stats.time;
+            c->stats.anchors_made++;
+        }
+    }
+}
+
+int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
+{
+    const phc_climbing_options *o = &c->o;
+    if (!(dt > 0) || !isfinite(dt))
+        return phc_error_set(err, PHC_ERR_INVALID, "climbing: time step dt = %g s must be > 0",
+                             dt);
+    if (!(o->growth_rate * dt < 1 - o->bud_fraction))
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "climbing: growth_rate * dt = %g must be below 1 - bud_fraction = "
+                             "%g (one successor per tip and step)",
+                             o->growth_rate * dt, 1 - o->bud_fraction);
+    c->stats.time += dt;
+    const size_t n0 = c->n;
+    for (size_t i = 0; i < n0; ++i)
+        c->age[i] += dt;
+    /* 1. light */
+    if (o->light.extinction > 0) {
+        for (size_t i = 0; i < n0; ++i) {
+            const double L = c->sigma[i] * o->max_length;
+            c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
+        }
+        phc_climbing_light(&o->light, c->x, c->vol, n0, c->phi, c->light);
+    }
+    /* 2.–4. tropisms, growth, branching of the tips present at the start */
+    for (size_t i = 0; i < n0; ++i) {
+        if (!c->apical[i])
+            continue;
+        tropisms(c, i, dt);
+        if (grow(c, i, o->growth_rate * c->light[i] * dt))
+            return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory at %zu particles",
+                                 c->n);
+    }
+    /* 5. rest shape */
+    rebuild_rest(c);
+    /* 6. dynamics, or kinematic: current = rest */
+    if (o->dynamics_substeps > 0) {
+        if (dynamics(c, dt, err))
+            return -1;
+    } else {
+        memcpy(c->x, c->xr, 3 * c->n * sizeof *c->x);
+        memcpy(c->d, c->dr, 3 * c->n * sizeof *c->d);
+    }
+    /* 7. anchors */
+    anchors(c);
+    size_t apical = 0, anchored = 0;
+    for (size_t i = 0; i < c->n; ++i) {
+        apical += c->apical[i];
+        anchored += c->anchored[i];
+    }
+    c->stats.particles = c->n;
+    c->stats.apical = apical;
+    c->stats.anchored = anchored;
+    return 0;
+}
+
+void phc_climbing_get_stats(const phc_climbing *c, phc_climbing_stats *s) { *s = c->stats; }
+size_t phc_climbing_count(const phc_climbing *c) { return c ? c->n : 0; }
+size_t phc_climbing_parent(const phc_climbing *c, size_t i) { return c->parent[i]; }
+unsigned phc_climbing_order(const phc_climbing *c, size_t i) { return c->order[i]; }
+int phc_climbing_is_apical(const phc_climbing *c, size_t i) { return c->apical[i]; }
+int phc_climbing_is_lateral(const phc_climbing *c, size_t i) { return c->lateral[i]; }
+double phc_climbing_size(const phc_climbing *c, size_t i) { return c->sigma[i]; }
+double phc_climbing_length(const phc_climbing *c, size_t i)
+{
+    return c->sigma[i] * c->o.max_length;
+}
+double phc_climbing_radius(const phc_climbing *c, size_t i) { return c->radius[i]; }
+double phc_climbing_age(const phc_climbing *c, size_t i) { return c->age[i]; }
+double phc_climbing_light_at(const phc_climbing *c, size_t i) { return c->light[i]; }
+void phc_climbing_position(const phc_climbing *c, size_t i, double x[3])
+{
+    memcpy(x, c->x + 3 * i, 3 * sizeof *x);
+}
+void phc_climbing_direction(const phc_climbing *c, size_t i, double d[3])
+{
+    memcpy(d, c->d + 3 * i, 3 * sizeof *d);
+}
+void phc_climbing_rest_position(const phc_climbing *c, size_t i, double x[3])
+{
+    memcpy(x, c->xr + 3 * i, 3 * sizeof *x);
+}
+void phc_climbing_rest_direction(const phc_climbing *c, size_t i, double d[3])
+{
+    memcpy(d, c->dr + 3 * i, 3 * sizeof *d);
+}
+void phc_climbing_segment(const phc_climbing *c, size_t i, double base[3], double tip[3])
+{
+    seg_base(c, i, 0, base);
+    seg_tip(c, i, 0, tip);
+}
+int phc_climbing_anchor(const phc_climbing *c, size_t i, double a[3])
+{
+    if (!c->anchored[i])
+        return 0;
+    memcpy(a, c->anchor_at + 3 * i, 3 * sizeof *a);
+    return 1;
+}

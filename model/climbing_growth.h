@@ -1,0 +1,177 @@
+/* Climbing plants that grow (Hädrich, Benes, Deussen, Pirk, "Interactive
+ * Modeling and Authoring of Climbing Plants", CGF 36(2) 2017, §4.2–4.3):
+ * apical growth, lateral branching, phototropism, surface adaption and
+ * anchors, on top of the oriented particles of model/particles.h.
+ *
+ * State.  A plant is a tree of particles, one per internode (segment), as
+ * in model/particles.h: particle i has a parent (the particle whose tip it
+ * grows from; NONE for the seed's), a branch order (0 for the main axis,
+ * +1 per lateral branch), a size σ_i ∈ (0, 1] (its length is L_i = σ_i
+ * L_max), a radius, an age, a current centre and direction (unit, from its
+ * base toward its tip) and a rest centre and direction.
+ *
+ * One step of Δt seconds (phc_climbing_step), in this order:
+ *  1. light (model/climbing_light.h) at every particle, I ∈ (0, 1];
+ *  2. tropisms of the apical (growing) particles (model/climbing_tropism.h):
+ *     phototropism toward the light direction (eq. 7, rate η), then
+ *     surface adaption toward the closest support point (eq. 6, rate τ),
+ *     each turning the current and the rest direction alike (eqs. 8–10);
+ *     a tip within the contact distance that heads into the support loses
+ *     the inward part of its direction (a collision rule of ours);
+ *  3. apical growth (§4.2): dσ/dt = r·I (r the growth rate, s⁻¹).  When σ
+ *     reaches 1 the particle stops growing and spawns a successor at its
+ *     tip, same direction, order and radius, of size σ₀ (bud_fraction)
+ *     plus the excess σ − 1 (so the total growth r∫I dt is conserved and a
+ *     shoot in full light holds exactly 1 + ⌊r t / (1 − σ₀)⌋ particles);
+ *  4. branching (§4.3, Fig. 5), at that same node: each of B lateral buds
+ *     (max_buds) independently becomes a lateral shoot with probability BP
+ *     (branch_probability), unless the node's order is already max_order.
+ *     A lateral's direction makes the angle θ = u·V·90° with its parent's
+ *     (u uniform on [0, 1), V = direction_variance ∈ [0, 1]) at a uniform
+ *     azimuth; its radius is t_c = t_p·f (thickness_falloff f) and its
+ *     size σ₀.  (The paper's V is a normalised variance with 1 ↔ 90°; the
+ *     uniform law is our choice.)
+ *  5. the rest shape is rebuilt from the rest directions (each rest centre
+ *     at its parent's rest tip plus L_i/2 along its direction; the seed's
+ *     base is fixed);
+ *  6. dynamics, when dynamics_substeps > 0: a phc_particles system is made
+ *     from the rest shape, given the current centres, directions, ages and
+ *     anchors, stepped dynamics_substeps times by Δt/substeps (stiffness
+ *     s = min(1, t_l/t_m) from the particles' maturity age t_m; the seed
+ *     particle is clamped), and the current centres and directions are read
+ *     back.  Velocities are not carried from one growth step to the next
+ *     (each starts at rest: quasi-static growth, our simplification).  With
+ *     dynamics_substeps = 0 the plant is kinematic: current = rest.
+ *  7. anchors (eq. 5): a particle without an anchor whose closest support
+ *     point lies within attach_distance is anchored there; its strength
+ *     k = k_max·σ_i·min(1, (t − t_anchor)/anchor_time) rises with the
+ *     anchor's age and is ∝ the particle's size; an anchor is released
+ *     when the particle is farther than release_distance from it.
+ *
+ * Random numbers: model/climbing_rng.h, state in the plant; the same seed
+ * and options give the same plant, bit for bit.
+ *
+ * Supports enter only as a closest-point callback (phc_climbing_closest_fn),
+ * so model/ needs no mesh library (measurements/support_mesh.h provides one).
+ *
+ * Units: SI.  Lengths m, time s, rates s⁻¹, angles rad unless named _deg. */
+#ifndef PHC_CLIMBING_GROWTH_H
+#define PHC_CLIMBING_GROWTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "model/climbing_light.h"
+#include "model/particles.h"
+#include "model/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PHC_CLIMBING_NONE ((size_t)-1)
+
+/* Closest point c (m) on the supports to x (m) and the unit face normal n
+ * there; returns 0, or nonzero when there is none (no support). */
+typedef int (*phc_climbing_closest_fn)(void *user, const double x[3], double c[3],
+                                       double n[3]);
+
+typedef struct phc_climbing_options {
+    uint64_t seed;              /* random seed; default 1 */
+    /* growth (§4.2) */
+    double max_length;          /* L_max, m, > 0: length of a grown particle; default 0.02 */
+    double bud_fraction;        /* σ₀ ∈ (0, 1): size of a new particle / L_max; default 0.25 */
+    double growth_rate;         /* r, s^-1, >= 0: dσ/dt in full light; default 0.1 */
+    double radius;              /* m, > 0: radius of the main axis; default 0.002 */
+    size_t max_particles;       /* growth stops when reached (>= 1); default 20000 */
+    /* branching (§4.3, Fig. 5) */
+    double branch_probability;  /* BP ∈ [0, 1]; default 0.3 */
+    unsigned max_buds;          /* B: lateral buds per node; default 1 */
+    double direction_variance;  /* V ∈ [0, 1]: lateral angle up to V·90°; default 0.5 */
+    double thickness_falloff;   /* f ∈ (0, 1]: t_child = t_parent·f; default 0.7 */
+    unsigned max_order;         /* nodes of this order bear no laterals; default 3 */
+    /* light (model/climbing_light.h); its direction is also phototropism's */
+    phc_climbing_light_grid light; /* default: no shading (λ = 0), ℓ = (0, 0, 1) */
+    /* tropisms (eqs. 6–10) */
+    double phototropism;        /* η, s^-1, >= 0; default 0 */
+    double surface_adaption;    /* τ, s^-1, >= 0; default 0 */
+    double adaption_radius;     /* m: supports farther from a tip do not attract; default 0.1 */
+    double contact_distance;    /* m: within it a tip crawls along the support; default 0.004 */
+    /* anchors (eq. 5) */
+    double attach_distance;     /* m, >= 0 (0: no anchors); default 0.005 */
+    double release_distance;    /* m, > attach_distance; default 0.02 */
+    double anchor_strength;     /* k_max ∈ (0, 1]; default 0.5 */
+    double anchor_time;         /* s, > 0: time for an anchor to reach full strength; default 10 */
+    /* dynamics (model/particles.h) */
+    size_t dynamics_substeps;   /* 0: kinematic (default) */
+    phc_particles_options particles; /* its maturity_age is t_m; default
+                                        phc_particles_options_default() with
+                                        maturity_age 50 s */
+    /* supports */
+    phc_climbing_closest_fn closest; /* NULL: no supports */
+    void *closest_user;
+} phc_climbing_options;
+
+phc_climbing_options phc_climbing_options_default(void);
+
+typedef struct phc_climbing phc_climbing;
+
+/* A seed: one particle of size σ₀ whose base is at `base` (m) and which
+ * grows along `direction` (any non-zero length; normalised here).  Errors
+ * (NULL, err filled, PHC_ERR_INVALID, message naming the option as in
+ * "climbing: branch_probability = 1.5 is outside [0, 1]"): any option out
+ * of its range above, a non-finite or zero vector, the light grid's cell
+ * or dims; out of memory. */
+phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
+                               const phc_climbing_options *options, phc_error *err);
+void phc_climbing_free(phc_climbing *c); /* accepts NULL */
+
+/* One growth step of dt seconds (> 0, with r·dt < 1 − σ₀ so that one step
+ * spawns at most one successor per tip).  Errors: a bad dt (PHC_ERR_INVALID),
+ * a dynamics failure (its message), out of memory; the plant is then left
+ * as it was before the step's growth where possible. */
+int phc_climbing_step(phc_climbing *c, double dt, phc_error *err);
+
+/* Counters since the seed. */
+typedef struct phc_climbing_stats {
+    double time;            /* s */
+    size_t particles;
+    size_t apical;          /* growing tips */
+    size_t bud_trials;      /* lateral buds drawn (B per node of order < max_order) */
+    size_t laterals;        /* of which became shoots */
+    size_t anchored;        /* particles holding an anchor now */
+    size_t anchors_made;    /* anchors created */
+    size_t anchors_released;
+    size_t max_order;       /* highest branch order present */
+} phc_climbing_stats;
+
+void phc_climbing_get_stats(const phc_climbing *c, phc_climbing_stats *s);
+
+/* Accessors (i < count). */
+size_t phc_climbing_count(const phc_climbing *c);
+size_t phc_climbing_parent(const phc_climbing *c, size_t i);
+unsigned phc_climbing_order(const phc_climbing *c, size_t i);
+int phc_climbing_is_apical(const phc_climbing *c, size_t i);
+/* 1 when i starts a lateral shoot (its order exceeds its parent's). */
+int phc_climbing_is_lateral(const phc_climbing *c, size_t i);
+double phc_climbing_size(const phc_climbing *c, size_t i);    /* σ, 1 */
+double phc_climbing_length(const phc_climbing *c, size_t i);  /* m */
+double phc_climbing_radius(const phc_climbing *c, size_t i);  /* m */
+double phc_climbing_age(const phc_climbing *c, size_t i);     /* s */
+double phc_climbing_light_at(const phc_climbing *c, size_t i);/* I, last step */
+void phc_climbing_position(const phc_climbing *c, size_t i, double x[3]);      /* centre, m */
+void phc_climbing_direction(const phc_climbing *c, size_t i, double d[3]);     /* unit */
+void phc_climbing_rest_position(const phc_climbing *c, size_t i, double x[3]); /* m */
+void phc_climbing_rest_direction(const phc_climbing *c, size_t i, double d[3]);
+/* Base and tip of the current segment: centre ∓ L/2·direction (m). */
+void phc_climbing_segment(const phc_climbing *c, size_t i, double base[3], double tip[3]);
+/* 1 and the anchor point a (m) when i is anchored; else 0. */
+int phc_climbing_anchor(const phc_climbing *c, size_t i, double a[3]);
+/* The anchor's strength now (eq. 5), 0 when not anchored. */
+double phc_climbing_anchor_strength(const phc_climbing *c, size_t i);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PHC_CLIMBING_GROWTH_H */
