@@ -63,6 +63,7 @@ phc_climbing_options phc_climbing_options_default(void)
     o.anchor_strength = 0.5;
     o.anchor_time = 10;
     o.dynamics_substeps = 0;
+    o.min_stiffness = 0.1;
     o.particles = phc_particles_options_default();
     o.particles.maturity_age = 50;
     return o;
@@ -172,6 +173,10 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
          "release_distance", o->release_distance, "(attach_distance, inf) m");
     NEED(o->anchor_strength > 0 && o->anchor_strength <= 1, "anchor_strength",
          o->anchor_strength, "(0, 1]");
+    NEED(o->min_stiffness >= 0 && o->min_stiffness <= 1, "min_stiffness", o->min_stiffness,
+         "[0, 1]");
+    NEED(o->particles.maturity_age > 0 || o->dynamics_substeps == 0, "particles.maturity_age",
+         o->particles.maturity_age, "(0, inf) s when dynamics_substeps > 0");
     NEED(o->anchor_time > 0 && isfinite(o->anchor_time), "anchor_time", o->anchor_time,
          "(0, inf) s");
 #undef NEED
@@ -475,7 +480,7 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         quat_from_z(c->d + 3 * i, q);
         if (phc_particles_set_position(p, i, c->x + 3 * i, err) ||
             phc_particles_set_orientation(p, i, q, err) ||
-            phc_particles_set_age(p, i, c->age[i], err))
+            phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age), err))
             goto done;
         if (c->anchored[i]) {
             const double k = phc_climbing_anchor_strength(c, i);
@@ -523,7 +528,7 @@ static void anchors(phc_climbing *c)
             }
             continue;
         }
-        if (!(o->attach_distance > 0))
+        if (!(o->attach_distance > 0) || c->apical[i])
             continue;
         double cp[3], nf[3];
         if (o->closest(o->closest_user, x, cp, nf))

@@ -21,7 +21,7 @@
  *  3. apical growth (§4.2): dσ/dt = r·I (r the growth rate, s⁻¹).  When σ
  *     reaches 1 the particle stops growing and spawns a successor at its
  *     tip, same direction, order and radius, of size σ₀ (bud_fraction)
- *     plus the excess σ − 1 (so the total growth r∫I dt is conserved and a
+ *     plus the excess σ − 1 (no growth is lost: Σσ = n σ₀ + r∫I dt, and a
  *     shoot in full light holds exactly 1 + ⌊r t / (1 − σ₀)⌋ particles);
  *  4. branching (§4.3, Fig. 5), at that same node: each of B lateral buds
  *     (max_buds) independently becomes a lateral shoot with probability BP
@@ -37,13 +37,15 @@
  *  6. dynamics, when dynamics_substeps > 0: a phc_particles system is made
  *     from the rest shape, given the current centres, directions, ages and
  *     anchors, stepped dynamics_substeps times by Δt/substeps (stiffness
- *     s = min(1, t_l/t_m) from the particles' maturity age t_m; the seed
+ *     s = max(s_min, min(1, t_l/t_m)) from the particles' maturity age t_m,
+ *     passed to model/particles as the age max(t_l, s_min·t_m); the seed
  *     particle is clamped), and the current centres and directions are read
  *     back.  Velocities are not carried from one growth step to the next
  *     (each starts at rest: quasi-static growth, our simplification).  With
  *     dynamics_substeps = 0 the plant is kinematic: current = rest.
- *  7. anchors (eq. 5): a particle without an anchor whose closest support
- *     point lies within attach_distance is anchored there; its strength
+ *  7. anchors (eq. 5): a grown particle (not apical: an anchor never fights
+ *     elongation; our rule) without an anchor whose closest support point
+ *     lies within attach_distance is anchored there; its strength
  *     k = k_max·σ_i·min(1, (t − t_anchor)/anchor_time) rises with the
  *     anchor's age and is ∝ the particle's size; an anchor is released
  *     when the particle is farther than release_distance from it.
@@ -104,6 +106,9 @@ typedef struct phc_climbing_options {
     double anchor_time;         /* s, > 0: time for an anchor to reach full strength; default 10 */
     /* dynamics (model/particles.h) */
     size_t dynamics_substeps;   /* 0: kinematic (default) */
+    double min_stiffness;       /* s_min ∈ [0, 1]: s = max(s_min, min(1, t_l/t_m)); default 0.1
+                                   (ours: with s = 0 a newborn particle has no
+                                   link to the plant and falls free) */
     phc_particles_options particles; /* its maturity_age is t_m; default
                                         phc_particles_options_default() with
                                         maturity_age 50 s */

@@ -1,0 +1,430 @@
+/* Unit test of climbing-plant growth (model/climbing_growth.h; Hädrich et
+ * al., CGF 36(2) 2017, §4.2–4.3, eqs. 5–10).  Every checked number is
+ * printed.
+ *  1. Determinism: the same seed gives the same plant bit for bit; another
+ *     seed gives another plant.
+ *  2. Apical growth without branching: after k steps of Δt in full light a
+ *     shoot holds exactly 1 + ⌊r k Δt / (1 − σ₀)⌋ particles (every k up to
+ *     400), its length is L_max(n σ₀ + r k Δt) and its tip lies on the
+ *     straight line.
+ *  3. Branching frequency: over 300 seeds the laterals made out of the buds
+ *     drawn lie within 4 binomial standard deviations of BP·trials for
+ *     BP = 0.1, 0.3, 0.7; BP = 0 makes none and BP = 1 makes one per bud.
+ *  4. Direction variance: every lateral leaves its parent at an angle in
+ *     [0, V·90°] and the largest angle seen comes near V·90°; V = 0 gives 0;
+ *     thickness t_c = t_p·f exactly.
+ *  5. Phototropism (eq. 7): a horizontal shoot, light from above: the tip's
+ *     angle to the light falls at every step, as θ₀(1 − ηΔt)^k.
+ *  6. Surface adaption (eq. 6) and anchors (eq. 5): a shoot grown level
+ *     5 cm above a plane support bends down onto it, crawls along it and
+ *     anchors; with τ = 0 it never comes near.
+ *  7. Light: the Beer–Lambert sum on a 1×1×3 grid exactly; a vine hanging
+ *     down shades itself: full light at the seed, less below, monotone,
+ *     and it grows fewer particles than in full light.
+ *  8. Dynamics (model/particles.h) under gravity, 0.01 s dynamics steps:
+ *     the young shoot sags below its rest shape, its links stretch less
+ *     than 25%, the seed particle stays.
+ *  9. Bad options are refused naming the option. */
+#include "model/climbing_growth.h"
+#include "model/climbing_light.h"
+#include "model/climbing_tropism.h"
+#include "measurements/support_mesh.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+
+static const double PI = 3.14159265358979323846;
+
+static phc_climbing *grow(const phc_climbing_options *o, const double base[3],
+                          const double dir[3], size_t steps, double dt)
+{
+    phc_error err;
+    phc_climbing *c = phc_climbing_new(base, dir, o, &err);
+    if (!c) {
+        fprintf(stderr, "%s\n", err.message);
+        return NULL;
+    }
+    for (size_t k = 0; k < steps; ++k)
+        if (phc_climbing_step(c, dt, &err)) {
+            fprintf(stderr, "%s\n", err.message);
+            phc_climbing_free(c);
+            return NULL;
+        }
+    return c;
+}
+
+static size_t apical_tip(const phc_climbing *c)
+{
+    for (size_t i = phc_climbing_count(c); i-- > 0;)
+        if (phc_climbing_is_apical(c, i))
+            return i;
+    return PHC_CLIMBING_NONE;
+}
+
+int main(void)
+{
+    const double origin[3] = {0, 0, 0}, up[3] = {0, 0, 1}, east[3] = {1, 0, 0};
+    phc_error err;
+
+    /* 1. determinism */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.branch_probability = 0.5;
+        o.max_buds = 2;
+        o.seed = 42;
+        phc_climbing *a = grow(&o, origin, up, 300, 0.5);
+        phc_climbing *b = grow(&o, origin, up, 300, 0.5);
+        o.seed = 43;
+        phc_climbing *c = grow(&o, origin, up, 300, 0.5);
+        CHECK(a && b && c);
+        const size_t n = phc_climbing_count(a);
+        int same = n == phc_climbing_count(b), differ = n != phc_climbing_count(c);
+        for (size_t i = 0; same && i < n; ++i) {
+            double x[3], y[3];
+            phc_climbing_position(a, i, x);
+            phc_climbing_position(b, i, y);
+            same = memcmp(x, y, sizeof x) == 0 && phc_climbing_parent(a, i) == phc_climbing_parent(b, i);
+        }
+        for (size_t i = 0; !differ && i < n; ++i) {
+            double x[3], y[3];
+            phc_climbing_position(a, i, x);
+            phc_climbing_position(c, i, y);
+            differ = memcmp(x, y, sizeof x) != 0;
+        }
+        printf("determinism: seed 42 twice: %zu and %zu particles, identical: %d; seed 43: %zu "
+               "particles, differs: %d\n",
+               n, phc_climbing_count(b), same, phc_climbing_count(c), differ);
+        CHECK(same);
+        CHECK(differ);
+        phc_climbing_free(a);
+        phc_climbing_free(b);
+        phc_climbing_free(c);
+    }
+
+    /* 2. exact particle count of one apical shoot */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.branch_probability = 0;
+        o.growth_rate = 0.2;
+        o.bud_fraction = 0.25;
+        const double dt = 0.1;
+        phc_climbing *c = phc_climbing_new(origin, east, &o, &err);
+        CHECK(c != NULL);
+        size_t wrong = 0;
+        double worst_len = 0, worst_line = 0;
+        for (size_t k = 1; k <= 400; ++k) {
+            phc_climbing_step(c, dt, &err);
+            /* r Δt / (1 − σ₀) = 0.02 / 0.75: a successor every 37.5 steps */
+            const size_t expect = 1 + (size_t)floor(0.2 * (double)k * dt / 0.75);
+            if (phc_climbing_count(c) != expect)
+                ++wrong;
+            double total = 0;
+            for (size_t i = 0; i < phc_climbing_count(c); ++i)
+                total += phc_climbing_length(c, i);
+            /* every particle starts at sigma0 and the growth r t is shared out */
+            const double n = (double)phc_climbing_count(c);
+            worst_len = fmax(worst_len, fabs(total - o.max_length * (0.25 * n + 0.2 * (double)k * dt)));
+            double base[3], tip[3];
+            phc_climbing_segment(c, phc_climbing_count(c) - 1, base, tip);
+            worst_line = fmax(worst_line, fmax(fabs(tip[0] - total), fmax(fabs(tip[1]), fabs(tip[2]))));
+        }
+        printf("apical growth: %zu particles after 40 s (expected 1 + floor(0.2*40/0.75) = 11), "
+               "steps with a wrong count: %zu of 400, max |total length - L_max(n s0 + r t)| = %.3g m, "
+               "max tip off the line = %.3g m\n",
+               phc_climbing_count(c), wrong, worst_len, worst_line);
+        CHECK(phc_climbing_count(c) == 11);
+        CHECK(wrong == 0);
+        CHECK(worst_len < 1e-12);
+        CHECK(worst_line < 1e-12);
+        phc_climbing_free(c);
+    }
+
+    /* 3. branching frequency */
+    {
+        const double bps[5] = {0, 0.1, 0.3, 0.7, 1};
+        for (int b = 0; b < 5; ++b) {
+            size_t trials = 0, laterals = 0, nodes_ok = 1;
+            for (unsigned seed = 1; seed <= 300; ++seed) {
+                phc_climbing_options o = phc_climbing_options_default();
+                o.branch_probability = bps[b];
+                o.max_buds = 2;
+                o.max_order = 1;
+                o.seed = seed;
+                o.max_particles = 200;
+                phc_climbing *c = grow(&o, origin, up, 60, 0.5);
+                if (!c) {
+                    CHECK(c != NULL);
+                    break;
+                }
+                phc_climbing_stats s;
+                phc_climbing_get_stats(c, &s);
+                trials += s.bud_trials;
+                laterals += s.laterals;
+                /* laterals counted by the model = lateral particles present */
+                size_t lat = 0;
+                for (size_t i = 0; i < phc_climbing_count(c); ++i)
+                    lat += (size_t)phc_climbing_is_lateral(c, i);
+                nodes_ok &= lat == s.laterals;
+                phc_climbing_free(c);
+            }
+            const double p = bps[b], mean = p * (double)trials;
+            const double sd = sqrt((double)trials * p * (1 - p));
+            printf("branching BP = %.1f: %zu laterals of %zu buds (expected %.1f +- %.1f, z = %.2f)\n",
+                   p, laterals, trials, mean, sd, sd > 0 ? ((double)laterals - mean) / sd : 0.0);
+            CHECK(trials > 1000);
+            CHECK(fabs((double)laterals - mean) <= 4 * sd);
+            CHECK(nodes_ok);
+        }
+    }
+
+    /* 4. direction variance and thickness */
+    {
+        const double vs[3] = {0, 0.3, 1};
+        for (int v = 0; v < 3; ++v) {
+            double largest = 0, worst_thick = 0;
+            size_t count = 0;
+            for (unsigned seed = 1; seed <= 40; ++seed) {
+                phc_climbing_options o = phc_climbing_options_default();
+                o.branch_probability = 0.5;
+                o.max_buds = 2;
+                o.direction_variance = vs[v];
+                o.thickness_falloff = 0.6;
+                o.seed = seed;
+                o.max_particles = 300;
+                phc_climbing *c = grow(&o, origin, up, 60, 0.5);
+                CHECK(c != NULL);
+                if (!c)
+                    break;
+                for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+                    if (!phc_climbing_is_lateral(c, i))
+                        continue;
+                    const size_t p = phc_climbing_parent(c, i);
+                    double di[3], dp[3];
+                    phc_climbing_direction(c, i, di);
+                    phc_climbing_direction(c, p, dp);
+                    largest = fmax(largest, phc_climbing_angle(di, dp));
+                    worst_thick = fmax(worst_thick, fabs(phc_climbing_radius(c, i) -
+                                                         0.6 * phc_climbing_radius(c, p)));
+                    ++count;
+                }
+                phc_climbing_free(c);
+            }
+            const double bound = vs[v] * 0.5 * PI;
+            printf("direction variance V = %.1f: %zu laterals, largest angle to the parent %.4f "
+                   "deg (bound %.1f deg); max |t_c - 0.6 t_p| = %.3g m\n",
+                   vs[v], count, largest * 180 / PI, bound * 180 / PI, worst_thick);
+            CHECK(count > 100);
+            CHECK(largest <= bound + 1e-12);
+            if (vs[v] > 0)
+                CHECK(largest >= 0.95 * bound);
+            CHECK(worst_thick <= 1e-18);
+        }
+    }
+
+    /* 5. phototropism */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.branch_probability = 0;
+        o.phototropism = 0.5;
+        const double dt = 0.1;
+        phc_climbing *c = phc_climbing_new(origin, east, &o, &err);
+        CHECK(c != NULL);
+        double prev = PI / 2, worst = 0;
+        int monotone = 1;
+        for (int k = 1; k <= 100; ++k) {
+            phc_climbing_step(c, dt, &err);
+            double d[3];
+            phc_climbing_direction(c, apical_tip(c), d);
+            const double th = phc_climbing_angle(d, up);
+            monotone &= th < prev;
+            prev = th;
+            const double expect = 0.5 * PI * pow(1 - 0.5 * dt, k);
+            worst = fmax(worst, fabs(th - expect) / expect);
+        }
+        printf("phototropism eta = 0.5/s: tip angle to the light after 10 s %.6f rad "
+               "(theta0 (1 - eta dt)^100 = %.6f), falls at every step: %d, max relative "
+               "error %.3g\n",
+               prev, 0.5 * PI * pow(0.95, 100), monotone, worst);
+        CHECK(monotone);
+        CHECK(worst < 1e-12);
+        /* the rest shape is bent too (eqs. 8-10): rest = current, kinematic */
+        double d[3], dr[3];
+        phc_climbing_direction(c, apical_tip(c), d);
+        phc_climbing_rest_direction(c, apical_tip(c), dr);
+        CHECK(phc_climbing_angle(d, dr) < 1e-12);
+        phc_climbing_free(c);
+    }
+
+    /* 6. surface adaption and anchors on a plane support */
+    {
+        const double V[12] = {-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, 2, 0};
+        const size_t F[6] = {0, 1, 2, 0, 2, 3};
+        phc_support_mesh *m = phc_support_mesh_from_arrays(V, 4, F, 2, "plane", &err);
+        CHECK(m != NULL);
+        const double seed[3] = {0, 0, 0.05};
+        for (int on = 0; on < 2; ++on) {
+            phc_climbing_options o = phc_climbing_options_default();
+            o.branch_probability = 0;
+            o.surface_adaption = on ? 0.5 : 0;
+            o.closest = phc_support_mesh_closest;
+            o.closest_user = m;
+            phc_climbing *c = grow(&o, seed, east, 600, 0.2);
+            CHECK(c != NULL);
+            if (!c)
+                continue;
+            double base[3], tip[3], lowest = 1;
+            phc_climbing_segment(c, apical_tip(c), base, tip);
+            for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+                double x[3];
+                phc_climbing_position(c, i, x);
+                lowest = fmin(lowest, x[2]);
+            }
+            phc_climbing_stats s;
+            phc_climbing_get_stats(c, &s);
+            size_t far = 0;
+            for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+                double a[3], x[3];
+                if (phc_climbing_anchor(c, i, a)) {
+                    phc_climbing_position(c, i, x);
+                    far += hypot(hypot(x[0] - a[0], x[1] - a[1]), x[2] - a[2]) > o.attach_distance;
+                }
+            }
+            printf("surface adaption tau = %.1f/s: %zu particles, tip height %.5f m, lowest "
+                   "centre %.5f m, anchored %zu (made %zu), anchors farther than attach: %zu\n",
+                   o.surface_adaption, s.particles, tip[2], lowest, s.anchored, s.anchors_made, far);
+            if (on) {
+                CHECK(tip[2] <= o.contact_distance + 1e-12);
+                CHECK(lowest >= -1e-12); /* never through the support */
+                CHECK(s.anchored >= 5);
+                CHECK(far == 0);
+                /* the tip crawls along the plane: direction nearly level */
+                double d[3];
+                phc_climbing_direction(c, apical_tip(c), d);
+                CHECK(fabs(d[2]) < 0.05);
+            } else {
+                CHECK_NEAR(tip[2], 0.05, 1e-12, 0);
+                CHECK(s.anchored == 0);
+            }
+            phc_climbing_free(c);
+        }
+        phc_support_mesh_free(m);
+    }
+
+    /* 7. light */
+    {
+        phc_climbing_light_grid g;
+        memset(&g, 0, sizeof g);
+        g.cell = 1;
+        g.dims[0] = g.dims[1] = 1;
+        g.dims[2] = 3;
+        g.extinction = 2;
+        g.direction[2] = 1;
+        const double x[6] = {0.5, 0.5, 0.5, 0.5, 0.5, 2.5};
+        const double vol[2] = {0.5, 0.2};
+        double phi[3], light[2];
+        phc_climbing_light(&g, x, vol, 2, phi, light);
+        printf("light grid 1x1x3: I(bottom) = %.15f (exp(-2*0.2) = %.15f), I(top) = %g\n",
+               light[0], exp(-0.4), light[1]);
+        CHECK_NEAR(light[0], exp(-0.4), 1e-15, 0);
+        CHECK(light[1] == 1);
+
+        /* a vine hanging from z = 0.95 m into its own shade, light from above */
+        phc_climbing_options o = phc_climbing_options_default();
+        o.branch_probability = 0;
+        o.radius = 0.01;
+        o.light.origin[0] = o.light.origin[1] = -0.05;
+        o.light.cell = 0.1;
+        o.light.dims[0] = o.light.dims[1] = 1;
+        o.light.dims[2] = 10;
+        o.light.extinction = 200;
+        const double top[3] = {0, 0, 0.95}, down[3] = {0, 0, -1};
+        phc_climbing *c = grow(&o, top, down, 400, 0.2);
+        CHECK(c != NULL);
+        /* the light of the last step, from the seed down (the newest
+           particle, spawned in that step, has not been lit yet) */
+        int monotone = 1;
+        const size_t n = phc_climbing_count(c);
+        for (size_t i = 1; i + 1 < n; ++i)
+            monotone &= phc_climbing_light_at(c, i) <= phc_climbing_light_at(c, i - 1);
+        printf("hanging vine, self-shaded: %zu particles, I(seed) = %.4f, I(lowest lit) = %.4f, "
+               "falls downward: %d\n",
+               n, phc_climbing_light_at(c, 0), phc_climbing_light_at(c, n - 2), monotone);
+        CHECK(monotone);
+        CHECK(phc_climbing_light_at(c, 0) == 1); /* nothing above its cell */
+        CHECK(phc_climbing_light_at(c, n - 2) < 0.9);
+        /* shading slows growth: fewer particles than in full light */
+        o.light.extinction = 0;
+        phc_climbing *full = grow(&o, top, down, 400, 0.2);
+        printf("  the same vine in full light: %zu particles\n", phc_climbing_count(full));
+        CHECK(phc_climbing_count(full) > n);
+        phc_climbing_free(c);
+        phc_climbing_free(full);
+    }
+
+    /* 8. dynamics */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.branch_probability = 0;
+        o.growth_rate = 0.2;
+        o.dynamics_substeps = 20; /* 0.01 s dynamics steps */
+        o.particles.maturity_age = 5;
+        o.min_stiffness = 0.3;
+        const double seed[3] = {0, 0, 1};
+        phc_climbing *c = grow(&o, seed, east, 100, 0.2);
+        CHECK(c != NULL);
+        if (c) {
+            const size_t t = phc_climbing_count(c) - 1;
+            double x[3], xr[3], x0[3], x0r[3];
+            phc_climbing_position(c, t, x);
+            phc_climbing_rest_position(c, t, xr);
+            phc_climbing_position(c, 0, x0);
+            phc_climbing_rest_position(c, 0, x0r);
+            printf("dynamics: %zu particles, tip centre z = %.5f m against rest %.5f m; seed "
+                   "particle moved %.3g m\n",
+                   t + 1, x[2], xr[2], fabs(x0[2] - x0r[2]) + fabs(x0[0] - x0r[0]));
+            /* links stretch little: centre spacing against rest spacing */
+            double worst = 0;
+            for (size_t i = 1; i <= t; ++i) {
+                double a[3], b[3], ar[3], br[3];
+                phc_climbing_position(c, i, a);
+                phc_climbing_position(c, i - 1, b);
+                phc_climbing_rest_position(c, i, ar);
+                phc_climbing_rest_position(c, i - 1, br);
+                const double d = hypot(hypot(a[0] - b[0], a[1] - b[1]), a[2] - b[2]);
+                const double dr = hypot(hypot(ar[0] - br[0], ar[1] - br[1]), ar[2] - br[2]);
+                worst = fmax(worst, d / dr);
+            }
+            printf("  largest centre spacing / rest spacing: %.3f\n", worst);
+            CHECK(worst < 1.25);
+            CHECK(x[2] < xr[2] - 1e-4);
+            CHECK(isfinite(x[0]) && isfinite(x[1]) && isfinite(x[2]));
+            CHECK(fabs(x0[2] - x0r[2]) + fabs(x0[0] - x0r[0]) < 1e-12);
+        }
+        phc_climbing_free(c);
+    }
+
+    /* 9. bad options */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.branch_probability = 1.5;
+        CHECK(phc_climbing_new(origin, up, &o, &err) == NULL);
+        CHECK_STR_CONTAINS(err.message, "climbing: branch_probability = 1.5 is outside [0, 1]");
+        o = phc_climbing_options_default();
+        o.direction_variance = 1.2;
+        CHECK(phc_climbing_new(origin, up, &o, &err) == NULL);
+        CHECK_STR_CONTAINS(err.message, "direction_variance = 1.2");
+        o = phc_climbing_options_default();
+        const double zero[3] = {0, 0, 0};
+        CHECK(phc_climbing_new(origin, zero, &o, &err) == NULL);
+        CHECK_STR_CONTAINS(err.message, "seed direction");
+        phc_climbing *c = phc_climbing_new(origin, up, &o, &err);
+        CHECK(phc_climbing_step(c, 10, &err) != 0); /* r dt = 1 > 1 - sigma0 */
+        CHECK_STR_CONTAINS(err.message, "growth_rate * dt");
+        phc_climbing_free(c);
+    }
+    return check_finish("test_climbing_growth");
+}
