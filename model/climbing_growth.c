@@ -598,6 +598,16 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     return 0;
 }
 
+int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
+{
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(g[k]))
+            return phc_error_set(err, PHC_ERR_INVALID, "climbing: gravity %c is not finite",
+                                 "xyz"[k]);
+    memcpy(c->o.particles.gravity, g, sizeof c->o.particles.gravity);
+    return 0;
+}
+
 void phc_climbing_get_stats(const phc_climbing *c, phc_climbing_stats *s) { *s = c->stats; }
 size_t phc_climbing_count(const phc_climbing *c) { return c ? c->n : 0; }
 size_t phc_climbing_parent(const phc_climbing *c, size_t i) { return c->parent[i]; }

@@ -137,6 +137,10 @@ void phc_climbing_free(phc_climbing *c); /* accepts NULL */
  * as it was before the step's growth where possible. */
 int phc_climbing_step(phc_climbing *c, double dt, phc_error *err);
 
+/* Changes the gravity of the dynamics (m s^-2, finite), e.g. when the scene
+ * is turned or tilted while the plant grows. */
+int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err);
+
 /* Counters since the seed. */
 typedef struct phc_climbing_stats {
     double time;            /* s */

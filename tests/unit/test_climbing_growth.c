@@ -17,7 +17,11 @@
  *     angle to the light falls at every step, as θ₀(1 − ηΔt)^k.
  *  6. Surface adaption (eq. 6) and anchors (eq. 5): a shoot grown level
  *     5 cm above a plane support bends down onto it, crawls along it and
- *     anchors; with τ = 0 it never comes near.
+ *     anchors, each anchor's strength k_max·σ·min(1, age/t_a) at every
+ *     step; with τ = 0 it never comes near.  Release: a shoot anchored on
+ *     a floor (dynamics, no gravity), then turned upside down: weak
+ *     anchors (k_max 0.01) let go, strong ones (1) hold, and no anchored
+ *     particle is ever beyond the release distance.
  *  7. Light: the Beer–Lambert sum on a 1×1×3 grid exactly; a vine hanging
  *     down shades itself: full light at the seed, less below, monotone,
  *     and it grows fewer particles than in full light.
@@ -272,10 +276,34 @@ int main(void)
             o.surface_adaption = on ? 0.5 : 0;
             o.closest = phc_support_mesh_closest;
             o.closest_user = m;
-            phc_climbing *c = grow(&o, seed, east, 600, 0.2);
+            phc_climbing *c = phc_climbing_new(seed, east, &o, &err);
             CHECK(c != NULL);
             if (!c)
                 continue;
+            /* eq. 5 strength k_max sigma min(1, (t - t_made)/t_a), checked at
+               every step against the time the test saw each anchor appear */
+            double made_at[64], worst_k = 0;
+            for (size_t i = 0; i < 64; ++i)
+                made_at[i] = -1;
+            for (int k = 1; k <= 600; ++k) {
+                phc_climbing_step(c, 0.2, &err);
+                const double t = 0.2 * k;
+                for (size_t i = 0; i < phc_climbing_count(c) && i < 64; ++i) {
+                    double a[3];
+                    if (!phc_climbing_anchor(c, i, a))
+                        continue;
+                    if (made_at[i] < 0)
+                        made_at[i] = t;
+                    const double expect = o.anchor_strength * phc_climbing_size(c, i) *
+                                          fmin(1, (t - made_at[i]) / o.anchor_time);
+                    worst_k = fmax(worst_k, fabs(phc_climbing_anchor_strength(c, i) - expect));
+                }
+            }
+            if (on) {
+                printf("anchor strength: max |k - k_max sigma min(1, age/t_a)| over the run = %.3g\n",
+                       worst_k);
+                CHECK(worst_k < 1e-12);
+            }
             double base[3], tip[3], lowest = 1;
             phc_climbing_segment(c, apical_tip(c), base, tip);
             for (size_t i = 0; i < phc_climbing_count(c); ++i) {
@@ -312,6 +340,72 @@ int main(void)
             phc_climbing_free(c);
         }
         phc_support_mesh_free(m);
+    }
+
+    /* 6b. release: a shoot anchored on a floor without gravity, then the
+       scene turned upside down (gravity +z): weak anchors let go beyond
+       the release distance, strong ones hold */
+    {
+        const double V[12] = {-2, -2, 0, 2, -2, 0, 2, 2, 0, -2, 2, 0};
+        const size_t F[6] = {0, 1, 2, 0, 2, 3};
+        phc_support_mesh *m = phc_support_mesh_from_arrays(V, 4, F, 2, "floor", &err);
+        const double seed[3] = {0, 0, 0.003}, flip[3] = {0, 0, 9.81};
+        const double strengths[2] = {0.01, 1};
+        size_t released[2] = {0, 0}, held[2] = {0, 0}, beyond[2] = {0, 0};
+        for (int w = 0; w < 2; ++w) {
+            phc_climbing_options o = phc_climbing_options_default();
+            o.branch_probability = 0;
+            o.growth_rate = 0.2;
+            o.surface_adaption = 0.5;
+            o.closest = phc_support_mesh_closest;
+            o.closest_user = m;
+            o.dynamics_substeps = 20;
+            o.particles.maturity_age = 5;
+            o.min_stiffness = 0.3;
+            o.particles.gravity[2] = 0;
+            o.anchor_strength = strengths[w];
+            o.anchor_time = 1;
+            phc_climbing *c = phc_climbing_new(seed, east, &o, &err);
+            CHECK(c != NULL);
+            if (!c)
+                continue;
+            size_t before = 0;
+            for (int k = 0; k < 300; ++k) {
+                if (k == 200) {
+                    phc_climbing_stats s;
+                    phc_climbing_get_stats(c, &s);
+                    before = s.anchored;
+                    CHECK(phc_climbing_set_gravity(c, flip, &err) == 0);
+                }
+                CHECK(phc_climbing_step(c, 0.2, &err) == 0);
+            }
+            phc_climbing_stats s;
+            phc_climbing_get_stats(c, &s);
+            released[w] = s.anchors_released;
+            held[w] = s.anchored;
+            /* no particle still anchored lies beyond the release distance */
+            for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+                double a[3], x[3];
+                if (phc_climbing_anchor(c, i, a)) {
+                    phc_climbing_position(c, i, x);
+                    beyond[w] += hypot(hypot(x[0] - a[0], x[1] - a[1]), x[2] - a[2]) > o.release_distance;
+                }
+            }
+            printf("upside down, k_max = %.2f: %zu anchors before the flip, %zu released, %zu held, "
+                   "held beyond the release distance: %zu\n",
+                   strengths[w], before, released[w], held[w], beyond[w]);
+            CHECK(before >= 8);
+            CHECK(beyond[w] == 0);
+            phc_climbing_free(c);
+        }
+        CHECK(released[0] >= 8); /* weak: all but the clamped seed particle let go */
+        CHECK(released[1] == 0);
+        phc_support_mesh_free(m);
+        const double bad[3] = {0, NAN, 0};
+        phc_climbing *c = phc_climbing_new(seed, east, NULL, &err);
+        CHECK(phc_climbing_set_gravity(c, bad, &err) != 0);
+        CHECK_STR_CONTAINS(err.message, "gravity y is not finite");
+        phc_climbing_free(c);
     }
 
     /* 7. light */
