@@ -238,6 +238,24 @@ phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
                       "climbing: the seed direction must be a finite, non-zero vector");
         return NULL;
     }
+    if (o.closest) {
+        /* a seed behind a support face (inside a closed support, or on the
+           back of an open one; the face's front is where its right-hand
+           normal points) cannot grow out of it */
+        double cp[3], nf[3];
+        if (o.closest(o.closest_user, base, cp, nf) == 0) {
+            const double r[3] = {base[0] - cp[0], base[1] - cp[1], base[2] - cp[2]};
+            const double side = dot(r, nf);
+            if (side < -1e-9 * (1 + sqrt(dot(base, base)))) {
+                phc_error_set(err, PHC_ERR_INPUT,
+                              "climbing: the seed (%g, %g, %g) m lies behind the support face "
+                              "at (%g, %g, %g) m (%g m inside); a seed must be outside every "
+                              "support",
+                              base[0], base[1], base[2], cp[0], cp[1], cp[2], -side);
+                return NULL;
+            }
+        }
+    }
     phc_climbing *c = calloc(1, sizeof *c);
     if (!c)
         goto nomem;

@@ -126,7 +126,10 @@ typedef struct phc_climbing phc_climbing;
  * (NULL, err filled, PHC_ERR_INVALID, message naming the option as in
  * "climbing: branch_probability = 1.5 is outside [0, 1]"): any option out
  * of its range above, a non-finite or zero vector, the light grid's cell
- * or dims; out of memory. */
+ * or dims; PHC_ERR_INPUT for a seed behind the face of its closest support
+ * point (inside a closed support whose normals point out, or behind an
+ * open one: the front of a face is where its right-hand normal points);
+ * out of memory. */
 phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
                                const phc_climbing_options *options, phc_error *err);
 void phc_climbing_free(phc_climbing *c); /* accepts NULL */

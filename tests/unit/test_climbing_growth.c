@@ -28,9 +28,11 @@
  *  8. Dynamics (model/particles.h) under gravity, 0.01 s dynamics steps:
  *     the young shoot sags below its rest shape, its links stretch less
  *     than 25%, the seed particle stays.
- *  9. Bad options are refused naming the option. */
+ *  9. The generator against reference outputs; a seed behind a support
+ *     face and bad options are refused naming the option. */
 #include "model/climbing_growth.h"
 #include "model/climbing_light.h"
+#include "model/climbing_rng.h"
 #include "model/climbing_tropism.h"
 #include "measurements/support_mesh.h"
 
@@ -502,6 +504,35 @@ int main(void)
     }
 
     /* 9. bad options */
+    {
+        /* the plant's generator: xoshiro256** seeded by splitmix64, against
+           an independent Python transcription of the published algorithms */
+        phc_climbing_rng r;
+        phc_climbing_rng_seed(&r, 42);
+        const uint64_t expect[5] = {0x15780b2e0c2ec716ULL, 0x6104d9866d113a7eULL,
+                                    0xae17533239e499a1ULL, 0xecb8ad4703b360a1ULL,
+                                    0xfde6dc7fe2ec5e64ULL};
+        int same = 1;
+        for (int k = 0; k < 5; ++k)
+            same &= phc_climbing_rng_next(&r) == expect[k];
+        printf("xoshiro256** seed 42: first five outputs as the reference: %d\n", same);
+        CHECK(same);
+        /* a seed below a floor whose normal points up */
+        const double V[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+        const size_t F[6] = {0, 1, 2, 0, 2, 3};
+        phc_support_mesh *m = phc_support_mesh_from_arrays(V, 4, F, 2, "floor", &err);
+        phc_climbing_options so = phc_climbing_options_default();
+        so.closest = phc_support_mesh_closest;
+        so.closest_user = m;
+        const double under[3] = {0.1, 0.2, -0.01}, over[3] = {0.1, 0.2, 0.01};
+        CHECK(phc_climbing_new(under, up, &so, &err) == NULL);
+        printf("seed under the floor: %s\n", err.message);
+        CHECK_STR_CONTAINS(err.message, "climbing: the seed (0.1, 0.2, -0.01) m lies behind the support face");
+        phc_climbing *ok = phc_climbing_new(over, up, &so, &err);
+        CHECK(ok != NULL);
+        phc_climbing_free(ok);
+        phc_support_mesh_free(m);
+    }
     {
         phc_climbing_options o = phc_climbing_options_default();
         o.branch_probability = 1.5;
