@@ -546,7 +546,7 @@ static void anchors(phc_climbing *c)
             }
             continue;
         }
-        if (!(o->attach_distance > 0) || c->apical[i])
+        if (!(o->attach_distance > 0))
             continue;
         double cp[3], nf[3];
         if (o->closest(o->closest_user, x, cp, nf))

@@ -43,12 +43,12 @@
  *     back.  Velocities are not carried from one growth step to the next
  *     (each starts at rest: quasi-static growth, our simplification).  With
  *     dynamics_substeps = 0 the plant is kinematic: current = rest.
- *  7. anchors (eq. 5): a grown particle (not apical: an anchor never fights
- *     elongation; our rule) without an anchor whose closest support point
- *     lies within attach_distance is anchored there; its strength
+ *  7. anchors (eq. 5): a particle without an anchor whose closest support
+ *     point lies within attach_distance is anchored there; its strength
  *     k = k_max·σ_i·min(1, (t − t_anchor)/anchor_time) rises with the
- *     anchor's age and is ∝ the particle's size; an anchor is released
- *     when the particle is farther than release_distance from it.
+ *     anchor's age and is ∝ the particle's size, so a growing tip holds
+ *     weakly and lets its elongation win; an anchor is released when the
+ *     particle is farther than release_distance from it.
  *
  * Random numbers: model/climbing_rng.h, state in the plant; the same seed
  * and options give the same plant, bit for bit.

@@ -320,11 +320,11 @@ int main(void)
                 double a[3], x[3];
                 if (phc_climbing_anchor(c, i, a)) {
                     phc_climbing_position(c, i, x);
-                    far += hypot(hypot(x[0] - a[0], x[1] - a[1]), x[2] - a[2]) > o.attach_distance;
+                    far += hypot(hypot(x[0] - a[0], x[1] - a[1]), x[2] - a[2]) > o.release_distance;
                 }
             }
             printf("surface adaption tau = %.1f/s: %zu particles, tip height %.5f m, lowest "
-                   "centre %.5f m, anchored %zu (made %zu), anchors farther than attach: %zu\n",
+                   "centre %.5f m, anchored %zu (made %zu), anchored beyond the release distance: %zu\n",
                    o.surface_adaption, s.particles, tip[2], lowest, s.anchored, s.anchors_made, far);
             if (on) {
                 CHECK(tip[2] <= o.contact_distance + 1e-12);
