@@ -56,6 +56,10 @@
  * Supports enter only as a closest-point callback (phc_climbing_closest_fn),
  * so model/ needs no mesh library (measurements/support_mesh.h provides one).
  *
+ * The paper's text of eqs. 5–10 was not available to us, only descriptions
+ * of the model; the forms here are our readings, and our own choices are
+ * marked "ours".
+ *
  * Units: SI.  Lengths m, time s, rates s⁻¹, angles rad unless named _deg. */
 #ifndef PHC_CLIMBING_GROWTH_H
 #define PHC_CLIMBING_GROWTH_H
