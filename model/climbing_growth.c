@@ -561,6 +561,19 @@ static void anchors(phc_climbing *c)
     }
 }
 
+/* The counters of the current state. */
+static void count(phc_climbing *c)
+{
+    size_t apical = 0, anchored = 0;
+    for (size_t i = 0; i < c->n; ++i) {
+        apical += c->apical[i];
+        anchored += c->anchored[i];
+    }
+    c->stats.particles = c->n;
+    c->stats.apical = apical;
+    c->stats.anchored = anchored;
+}
+
 int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
 {
     const phc_climbing_options *o = &c->o;
@@ -589,30 +602,27 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         if (!c->apical[i])
             continue;
         tropisms(c, i, dt);
-        if (grow(c, i, o->growth_rate * c->light[i] * dt))
+        if (grow(c, i, o->growth_rate * c->light[i] * dt)) {
+            count(c);
             return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory at %zu particles",
                                  c->n);
+        }
     }
     /* 5. rest shape */
     rebuild_rest(c);
     /* 6. dynamics, or kinematic: current = rest */
     if (o->dynamics_substeps > 0) {
-        if (dynamics(c, dt, err))
+        if (dynamics(c, dt, err)) {
+            count(c);
             return -1;
+        }
     } else {
         memcpy(c->x, c->xr, 3 * c->n * sizeof *c->x);
         memcpy(c->d, c->dr, 3 * c->n * sizeof *c->d);
     }
     /* 7. anchors */
     anchors(c);
-    size_t apical = 0, anchored = 0;
-    for (size_t i = 0; i < c->n; ++i) {
-        apical += c->apical[i];
-        anchored += c->anchored[i];
-    }
-    c->stats.particles = c->n;
-    c->stats.apical = apical;
-    c->stats.anchored = anchored;
+    count(c);
     return 0;
 }
 

@@ -139,9 +139,10 @@ phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
 void phc_climbing_free(phc_climbing *c); /* accepts NULL */
 
 /* One growth step of dt seconds (> 0, with r·dt < 1 − σ₀ so that one step
- * spawns at most one successor per tip).  Errors: a bad dt (PHC_ERR_INVALID),
- * a dynamics failure (its message), out of memory; the plant is then left
- * as it was before the step's growth where possible. */
+ * spawns at most one successor per tip).  Errors: a bad dt (PHC_ERR_INVALID,
+ * nothing changed); a dynamics failure (its message: the step's growth is
+ * kept, the current shape is the one before the dynamics, anchors are not
+ * updated); out of memory (the tips grown so far in the step are kept). */
 int phc_climbing_step(phc_climbing *c, double dt, phc_error *err);
 
 /* Changes the gravity of the dynamics (m s^-2, finite), e.g. when the scene
