@@ -9,8 +9,9 @@
  *     minus the model's own predict call timed directly on the same design
  *     points.  Two models:
  *       - expression: the Ishigami function (a = 7, b = 0.1) as a `curve`
- *         data set with one observation (y = 0, sigma 1) and an expression
- *         of three parameters on [-pi, pi], N = 8192 (40 960 evaluations);
+ *         data set with three observations (y = 0, sigma 1; the config needs
+ *         as many observations as parameters) and an expression of the three
+ *         parameters on [-pi, pi] (not of x), N = 8192 (40 960 evaluations);
  *       - weight curve: the demo's seedling_sensitivity.yaml (water model on
  *         the seedling's plant graph, 3 factors, 4 parameters), N = 64 (320
  *         evaluations).
@@ -210,8 +211,48 @@ static void design_points_free(design_points *d)
 
 /* ---- (a) overhead per evaluation ------------------------------------------------------ */
 
+/* The model's own time inside a study: each data set's predict is wrapped
+ * (its ops swapped for a copy whose predict times the original's call), so
+ * that the overhead is measured within the same run, paired, and not as the
+ * difference of two noisy runs.  The two clock reads per call (about 40 ns)
+ * count as overhead. */
+#define MAX_DATASETS 8
+static const phc_dataset_ops *orig_ops[MAX_DATASETS];
+static phc_dataset_ops timed_ops[MAX_DATASETS];
+static const phc_dataset *timed_ds[MAX_DATASETS];
+static double predict_seconds;
+static size_t predict_calls;
+
+static int timed_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    size_t d = 0;
+    while (timed_ds[d] != ds)
+        ++d;
+    const double t0 = now();
+    const int rc = orig_ops[d]->predict(ds, p, yhat, jac);
+    predict_seconds += now() - t0;
+    predict_calls++;
+    return rc;
+}
+
+static void wrap_predict(const phc_problem *pb, int on)
+{
+    for (size_t d = 0; d < pb->n_datasets && d < MAX_DATASETS; ++d) {
+        phc_dataset *ds = pb->datasets[d];
+        if (on) {
+            orig_ops[d] = ds->ops;
+            timed_ops[d] = *ds->ops;
+            timed_ops[d].predict = timed_predict;
+            timed_ds[d] = ds;
+            ds->ops = &timed_ops[d];
+        } else {
+            ds->ops = orig_ops[d];
+        }
+    }
+}
+
 typedef struct overhead_result {
-    double run_us, direct_us, evaluate_us, ledger_us, loop_us, estimate_s, write_s, other_load;
+    double run_us, direct_us, evaluate_us, ledger_us, loop_us, model_in_run_us, estimate_s, write_s, other_load;
     size_t evaluations;
     int ok;
 } overhead_result;
@@ -314,9 +355,13 @@ static int time_study(const phc_problem *pb, size_t n, const char *name, overhea
         phc_study_summary sum;
         phc_error err;
         phc_error_clear(&err);
+        predict_seconds = 0;
+        predict_calls = 0;
+        wrap_predict(pb, 1);
         const cpu_mark m0 = cpu_now();
         const int rc = phc_study_run(pb, &o, NULL, dir, &sum, &err);
         const cpu_mark m1 = cpu_now();
+        wrap_predict(pb, 0);
         if (rc) {
             printf("study_%s: failed: %s\n", name, err.message);
             return -1;
@@ -327,6 +372,7 @@ static int time_study(const phc_problem *pb, size_t n, const char *name, overhea
             res->evaluations = sum.evaluations;
             res->run_us = 1e6 * t / (double)sum.evaluations;
             res->loop_us = 1e6 * (c.t_estimating - m0.wall) / (double)sum.evaluations;
+            res->model_in_run_us = 1e6 * predict_seconds / (double)sum.evaluations;
             res->estimate_s = c.t_writing - c.t_estimating;
             res->write_s = m1.wall - c.t_writing;
             res->other_load = other_load(m0, m1);
@@ -353,19 +399,22 @@ static int overhead(const phc_problem *pb, size_t n, const char *name, overhead_
     if (time_study(pb, n, name, res, dir, dir_size))
         return -1;
     res->ok = 1;
-    const double ovh = res->run_us - res->direct_us;
+    const double ovh = res->loop_us - res->model_in_run_us, whole = res->run_us - res->direct_us;
     printf("study_evaluations_%s: %zu (N = %zu)\n", name, res->evaluations, n);
-    printf("study_direct_model_us_%s: %.3f us/eval (the data set's predict alone, best of %d)\n", name,
-           res->direct_us, REPEAT);
+    printf("study_direct_model_us_%s: %.3f us/eval (the data set's predict alone at the design's points, best of "
+           "%d)\n", name, res->direct_us, REPEAT);
     printf("study_evaluate_us_%s: %.3f us/eval (phc_study_evaluate: predict + cost and mean)\n", name,
            res->evaluate_us);
     printf("study_ledger_append_us_%s: %.3f us/record (%zu outputs, formatted, checksummed, flushed)\n", name,
            res->ledger_us, phc_study_outputs(pb));
-    printf("study_run_us_%s: %.3f us/eval (whole phc_study_run / evaluations, best of %d; loop %.3f us/eval, "
-           "estimates %.4f s, writing %.4f s; other load %.2f CPUs)\n",
-           name, res->run_us, REPEAT, res->loop_us, res->estimate_s, res->write_s, res->other_load);
-    printf("study_overhead_%s: %.3f us/eval (run minus direct model call; target <= %.0f: %s)\n", name, ovh,
-           TARGET_OVERHEAD_US, ovh <= TARGET_OVERHEAD_US ? "met" : "not met");
+    printf("study_run_time_%s: %.4f s (whole phc_study_run, best of %d: evaluating %.4f s, estimates %.4f s, "
+           "writing %.4f s; other load %.2f CPUs)\n", name, res->run_us * 1e-6 * (double)res->evaluations, REPEAT,
+           res->loop_us * 1e-6 * (double)res->evaluations, res->estimate_s, res->write_s, res->other_load);
+    printf("study_overhead_%s: %.3f us/eval (evaluating stage minus the model's own predict time in the same run, "
+           "per evaluation; target <= %.0f: %s)\n", name, ovh, TARGET_OVERHEAD_US,
+           ovh <= TARGET_OVERHEAD_US ? "met" : "not met");
+    printf("study_overhead_whole_%s: %.3f us/eval (whole run / evaluations minus the direct call timed apart: "
+           "estimates and writing included)\n", name, whole);
     return 0;
 }
 
@@ -379,7 +428,7 @@ static phc_problem *ishigami(void)
     FILE *f = fopen(csv, "w");
     if (!f)
         return NULL;
-    fprintf(f, "x,y\n0,0\n");
+    fprintf(f, "x,y\n0,0\n1,0\n2,0\n"); /* three observations: a config needs as many as parameters */
     fclose(f);
     if (!(f = fopen(yaml, "w")))
         return NULL;
