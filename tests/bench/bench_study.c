@@ -2,12 +2,15 @@
  * and `phytocal mcmc --method stretch` cost beyond the model, and how they
  * compare with NumPy and emcee run in the same run.
  *
- * (a) Overhead per evaluation, one core: phc_study_run (the library call
+ * (a) Overhead per evaluation, one core, of phc_study_run (the library call
  *     behind `phytocal sensitivity`: design, evaluations through
  *     phc_study_evaluate, the run ledger, estimators with 1000 bootstrap
- *     resamples, result.json, report.md, plots) divided by its evaluations,
- *     minus the model's own predict call timed directly on the same design
- *     points.  Two models:
+ *     resamples, result.json, report.md, plots): its evaluating stage after
+ *     the first evaluation (the set-up before it is a fixed cost), per
+ *     evaluation, minus the model's predict call: timed directly on the same
+ *     design points for the expression, clocked inside the same run for the
+ *     weight curve (whose cost drifts between runs by more than the
+ *     overhead).  The whole run per evaluation is printed too.  Two models:
  *       - expression: the Ishigami function (a = 7, b = 0.1) as a `curve`
  *         data set with three observations (y = 0, sigma 1; the config needs
  *         as many observations as parameters) and an expression of the three
@@ -31,8 +34,9 @@
  *     integrated out), 32 walkers x 6000 steps each: both make 192 000
  *     proposals (ours: n_iter = 6001 with the start included).
  *
- * Prints `name: value unit` lines; other processes' load beside every
- * timing (bench_machine.h).  Runs from the build directory or anywhere:
+ * Times are CPU seconds of this thread (the peers': Python's process_time);
+ * wall time and other processes' load (bench_machine.h) are printed beside
+ * them.  Prints `name: value unit` lines.  Runs from the build directory or anywhere:
  * files are found through PHC_SOURCE_DIR and PHC_SHARED_DATA. */
 #include <jansson.h>
 #include <math.h>
