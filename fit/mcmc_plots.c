@@ -70,6 +70,43 @@ static void range(const double *v, size_t n, size_t stride, double *lo, double *
     }
 }
 
+/* A chain's n values v[t * stride] as a line `px` pixels wide: with more
+ * than two steps per pixel, each run of b = ceil(n / px) steps is drawn
+ * through its lowest and its highest value in the order they occur (the
+ * envelope a line through every step covers at that width, at a fraction
+ * of the segments to stroke); otherwise every step.  Returns the points
+ * written to xs, ys (at most n). */
+static size_t trace_points(const double *v, size_t n, size_t stride, size_t px, PLFLT *xs, PLFLT *ys)
+{
+    size_t k = 0;
+    if (n <= 2 * px) {
+        for (size_t t = 0; t < n; ++t, ++k) {
+            xs[k] = (double)t;
+            ys[k] = v[t * stride];
+        }
+        return k;
+    }
+    const size_t b = (n + px - 1) / px;
+    for (size_t t0 = 0; t0 < n; t0 += b) {
+        const size_t t1 = t0 + b < n ? t0 + b : n;
+        size_t lo = t0, hi = t0;
+        for (size_t t = t0 + 1; t < t1; ++t) {
+            if (v[t * stride] < v[lo * stride])
+                lo = t;
+            if (v[t * stride] > v[hi * stride])
+                hi = t;
+        }
+        const size_t first = lo < hi ? lo : hi, second = lo < hi ? hi : lo;
+        xs[k] = (double)first;
+        ys[k++] = v[first * stride];
+        if (second != first) {
+            xs[k] = (double)second;
+            ys[k++] = v[second * stride];
+        }
+    }
+    return k;
+}
+
 int phc_plot_mcmc_trace(const char *path, const char *title, size_t d, const char *const *labels,
                         const double *draws, size_t chains, size_t n, size_t burn, phc_error *err)
 {
@@ -111,12 +148,10 @@ int phc_plot_mcmc_trace(const char *path, const char *title, size_t d, const cha
         plcol0(COL_GRID);
         plbox("g", 0, 0, "g", 0, 0);
         for (size_t c = 0; c < shown; ++c) {
-            for (size_t t = 0; t < n; ++t) {
-                xs[t] = (double)t;
-                ys[t] = draws[(c * n + t) * d + j];
-            }
+            /* the plot box is 0.85 of the 1100-pixel width */
+            const size_t k = trace_points(draws + c * n * d + j, n, d, 935, xs, ys);
             plcol0(COL_CHAIN0 + (PLINT)c);
-            plline((PLINT)n, xs, ys);
+            plline((PLINT)k, xs, ys);
         }
         plcol0(COL_FG);
         plbox(j + 1 == d ? "bcnst" : "bcst", 0, 0, "bcnstv", 0, 0);

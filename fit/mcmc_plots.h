@@ -1,6 +1,7 @@
 /* Plots of an MCMC run (PLplot, pngcairo, white page, labelled axes):
  *  - trace: one panel per parameter, the value of each chain (at most 8
- *    drawn) against the step, the burn-in shaded grey;
+ *    drawn) against the step, the burn-in shaded grey; beyond two steps per
+ *    pixel a chain is drawn through each pixel's lowest and highest value;
  *  - pairs: a d x d grid, histograms of each parameter's kept draws on the
  *    diagonal and scatter plots of every pair below it. */
 #ifndef PHC_MCMC_PLOTS_H

@@ -28,8 +28,12 @@ static void checksum(const char *text, size_t n, char hex[17])
     sha256_init(&ctx);
     sha256_update(&ctx, n, (const uint8_t *)text);
     sha256_digest(&ctx, SHA256_DIGEST_SIZE, digest);
-    for (int i = 0; i < 8; ++i)
-        snprintf(hex + 2 * i, 3, "%02x", digest[i]);
+    static const char digits[] = "0123456789abcdef";
+    for (int i = 0; i < 8; ++i) {
+        hex[2 * i] = digits[digest[i] >> 4];
+        hex[2 * i + 1] = digits[digest[i] & 15];
+    }
+    hex[16] = '\0';
 }
 
 static int read_all(const char *path, char **text, size_t *size, phc_error *err)
@@ -232,7 +236,7 @@ int phc_run_ledger_open(const char *path, const char *const *keys, const char *c
             goto fail;
         }
     }
-    l->line_size = 64 + 26 * n_out;
+    l->line_size = 96 + 26 * n_out; /* row, state, n_out x (tab, %.17g), " #", 16 hex digits, newline */
     if (!(l->line = malloc(l->line_size))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
@@ -259,8 +263,23 @@ int phc_run_ledger_append(phc_run_ledger *l, size_t row, int failed, const doubl
     }
     char hex[17];
     checksum(l->line, n, hex);
-    if (fprintf(l->f, "%s #%s\n", l->line, hex) < 0 || fflush(l->f) != 0)
-        return phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path, strerror(errno));
+    /* the record and its checksum in one write(2): flushed to the operating
+       system as it is written (the header went through the stream, flushed;
+       nothing else is buffered there) */
+    if (n + 20 > l->line_size)
+        return phc_error_set(err, PHC_ERR_INTERNAL, "%s: ledger record of %zu bytes", l->path, n);
+    memcpy(l->line + n, " #", 2);
+    memcpy(l->line + n + 2, hex, 16);
+    l->line[n + 18] = '\n';
+    const size_t total = n + 19;
+    for (size_t done = 0; done < total;) {
+        const ssize_t w = write(fileno(l->f), l->line + done, total - done);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path, w < 0 ? strerror(errno) : "nothing written");
+        done += (size_t)w;
+    }
     return PHC_OK;
 }
 

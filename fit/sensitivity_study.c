@@ -814,15 +814,16 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
         s.state[r] = failed ? PHC_LEDGER_FAILED : PHC_LEDGER_OK;
         summary->computed++;
         /* the count goes in the detail, not as steps: a log gets a line every
-           few seconds rather than one per evaluation */
-        char count[96];
-        snprintf(count, sizeof count, "%zu of %zu evaluations", found + summary->computed, s.rows);
-        if (summary->computed % report_every == 0 || r + 1 == s.rows)
+           few seconds rather than one per evaluation (and is formatted only then) */
+        if (summary->computed % report_every == 0 || r + 1 == s.rows) {
+            char count[96];
+            snprintf(count, sizeof count, "%zu of %zu evaluations", found + summary->computed, s.rows);
             if (phc_progress_report(o.progress, o.progress_data, "evaluating", 0, 0, -1, NAN, count)) {
                 rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled; %s holds the finished evaluations: --resume "
                                    "continues", ledger_path);
                 goto done;
             }
+        }
     }
     if ((rc = phc_run_ledger_close(ledger, err))) {
         ledger = NULL;
@@ -843,11 +844,12 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    for (size_t j = 0; j < s.n_out && rc == PHC_OK; ++j) {
+    if (s.saltelli) /* all outputs at once: they share the bootstrap resamples */
+        rc = phc_sobol_indices_estimate_outputs(s.saltelli, s.y, s.n_out, s.sobol, err);
+    for (size_t j = 0; j < s.n_out && rc == PHC_OK && !s.saltelli; ++j) {
         for (size_t r = 0; r < s.rows; ++r)
             col[r] = s.y[r * s.n_out + j];
-        rc = s.saltelli ? phc_sobol_indices_estimate(s.saltelli, col, &s.sobol[j], err)
-                        : phc_morris_estimate(s.morris, col, &s.effects[j], err);
+        rc = phc_morris_estimate(s.morris, col, &s.effects[j], err);
     }
     free(col);
     if (rc)

@@ -97,6 +97,66 @@ double phc_mcmc_split_rhat(const double *x, size_t chains, size_t n)
     return sqrt(var_plus / w);
 }
 
+static void swap_d(double *v, size_t a, size_t b)
+{
+    const double t = v[a];
+    v[a] = v[b];
+    v[b] = t;
+}
+
+/* Reorders v[0..n-1] so that v[k] is its k-th smallest value, with nothing
+ * larger before it and nothing smaller after it (Hoare's selection,
+ * median-of-three pivot): expected O(n), where a sort takes O(n log n). */
+static void select_kth(double *v, size_t n, size_t k)
+{
+    size_t lo = 0, hi = n - 1;
+    while (hi > lo) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (v[mid] < v[lo])
+            swap_d(v, lo, mid);
+        if (v[hi] < v[lo])
+            swap_d(v, lo, hi);
+        if (v[hi] < v[mid])
+            swap_d(v, mid, hi);
+        const double pivot = v[mid];
+        size_t i = lo, j = hi;
+        for (;;) {
+            while (v[i] < pivot)
+                ++i;
+            while (v[j] > pivot)
+                --j;
+            if (i >= j)
+                break;
+            swap_d(v, i, j);
+            ++i;
+            --j;
+        }
+        /* now v[lo..j] <= pivot <= v[j+1..hi] */
+        if (k <= j)
+            hi = j;
+        else
+            lo = j + 1;
+    }
+}
+
+/* The f-quantile of v (n values, reordered here), the value
+ * gsl_stats_quantile_from_sorted_data gives on the sorted values: that
+ * function reads the order statistics at floor(f (n - 1)) and the next
+ * one, which are put in their sorted places first. */
+static double quantile_select(double *v, size_t n, double f)
+{
+    const size_t lhs = (size_t)(int)(f * (double)(n - 1));
+    select_kth(v, n, lhs);
+    if (lhs + 1 < n) {
+        size_t next = lhs + 1;
+        for (size_t i = lhs + 2; i < n; ++i)
+            if (v[i] < v[next])
+                next = i;
+        swap_d(v, lhs + 1, next);
+    }
+    return gsl_stats_quantile_from_sorted_data(v, 1, n, f);
+}
+
 int phc_mcmc_summarise(const double *x, size_t chains, size_t n, phc_mcmc_summary *out, phc_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -110,12 +170,11 @@ int phc_mcmc_summarise(const double *x, size_t chains, size_t n, phc_mcmc_summar
     if (!sorted)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     memcpy(sorted, x, total * sizeof *sorted);
-    gsl_sort(sorted, 1, total);
     out->mean = gsl_stats_mean(x, 1, total);
     out->sd = gsl_stats_sd_m(x, 1, total, out->mean);
-    out->median = gsl_stats_quantile_from_sorted_data(sorted, 1, total, 0.5);
-    out->q025 = gsl_stats_quantile_from_sorted_data(sorted, 1, total, 0.025);
-    out->q975 = gsl_stats_quantile_from_sorted_data(sorted, 1, total, 0.975);
+    out->median = quantile_select(sorted, total, 0.5);
+    out->q025 = quantile_select(sorted, total, 0.025);
+    out->q975 = quantile_select(sorted, total, 0.975);
     free(sorted);
     out->tau = phc_mcmc_autocorr_time(x, chains, n, 5.0, &out->window, &out->reliable);
     out->ess = isfinite(out->tau) && out->tau > 0 ? (double)total / out->tau : NAN;

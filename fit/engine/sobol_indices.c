@@ -154,9 +154,12 @@ void phc_sobol_indices_clear(phc_sobol_indices *s)
 
 /* The indices from the base samples idx[0..m-1] (repeats allowed), with y
  * centred on its own mean over A and B of those samples (two passes: a cost
- * of 1e6 varying by 1 keeps its digits).  s1, st: f values; s2: f*f or NULL. */
+ * of 1e6 varying by 1 keeps its digits).  s1, st: f values; s2: f*f or NULL.
+ * acc: scratch of 2f + f*f values.  The third pass accumulates every factor's
+ * sums at once, each in the order of t (the same sums, term by term, as one
+ * pass per factor: the results do not depend on the loop order). */
 static void estimate(const phc_saltelli_design *d, const double *y, const size_t *idx, size_t m, double *s1,
-                     double *st, double *s2)
+                     double *st, double *s2, double *acc)
 {
     const size_t f = d->f, bl = d->block;
     double sum = 0, sum2 = 0;
@@ -168,34 +171,34 @@ static void estimate(const phc_saltelli_design *d, const double *y, const size_t
         sum2 += a * a + b * b;
     }
     const double var = sum2 / (double)(2 * m);
-    for (size_t i = 0; i < f; ++i) {
-        double a1 = 0, at = 0;
-        for (size_t t = 0; t < m; ++t) {
-            const double *yb = y + idx[t] * bl;
-            const double fa = yb[0] - mean, fb = yb[1] - mean, fab = yb[2 + i] - mean;
-            a1 += fb * (fab - fa);
-            at += (fa - fab) * (fa - fab);
+    double *a1 = acc, *at = acc + f, *a2 = acc + 2 * f;
+    memset(acc, 0, (s2 ? 2 * f + f * f : 2 * f) * sizeof *acc);
+    for (size_t t = 0; t < m; ++t) {
+        const double *yb = y + idx[t] * bl;
+        const double fa = yb[0] - mean, fb = yb[1] - mean;
+        for (size_t i = 0; i < f; ++i) {
+            const double fab = yb[2 + i] - mean;
+            a1[i] += fb * (fab - fa);
+            at[i] += (fa - fab) * (fa - fab);
         }
-        s1[i] = var > 0 ? a1 / (double)m / var : NAN;
-        st[i] = var > 0 ? at / (2.0 * (double)m) / var : NAN;
+        if (s2)
+            for (size_t i = 0; i < f; ++i) {
+                const double fba_i = yb[2 + f + i] - mean;
+                for (size_t j = i + 1; j < f; ++j) {
+                    const double fab_j = yb[2 + j] - mean;
+                    a2[i * f + j] += fba_i * fab_j - fa * fb;
+                }
+            }
+    }
+    for (size_t i = 0; i < f; ++i) {
+        s1[i] = var > 0 ? a1[i] / (double)m / var : NAN;
+        st[i] = var > 0 ? at[i] / (2.0 * (double)m) / var : NAN;
     }
     if (!s2)
         return;
     for (size_t i = 0; i < f; ++i)
-        for (size_t j = 0; j < f; ++j) {
-            if (j <= i) {
-                s2[i * f + j] = NAN;
-                continue;
-            }
-            double acc = 0;
-            for (size_t t = 0; t < m; ++t) {
-                const double *yb = y + idx[t] * bl;
-                const double fa = yb[0] - mean, fb = yb[1] - mean;
-                const double fba_i = yb[2 + f + i] - mean, fab_j = yb[2 + j] - mean;
-                acc += fba_i * fab_j - fa * fb;
-            }
-            s2[i * f + j] = var > 0 ? acc / (double)m / var - s1[i] - s1[j] : NAN;
-        }
+        for (size_t j = 0; j < f; ++j)
+            s2[i * f + j] = j <= i ? NAN : var > 0 ? a2[i * f + j] / (double)m / var - s1[i] - s1[j] : NAN;
 }
 
 /* Percentile interval of the R values v (sorted here) at coverage level. */
@@ -206,47 +209,67 @@ static void percentile(double *v, size_t r, double level, double *lo, double *hi
     *hi = gsl_stats_quantile_from_sorted_data(v, 1, r, 1 - 0.5 * (1 - level));
 }
 
-int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, phc_sobol_indices *out,
-                               phc_error *err)
+/* The base samples whose whole block is finite in y (stride between a
+ * row's values: ys); returns their count. */
+static size_t usable(const phc_saltelli_design *d, const double *y, size_t ys, size_t *used)
 {
-    memset(out, 0, sizeof *out);
-    const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, nf2 = d->o.second_order ? f * f : 0;
-    size_t *used = malloc(n * sizeof *used), *draw = malloc(n * sizeof *draw);
-    double *boot = malloc(R * (2 * f + nf2) * sizeof *boot), *tmp = malloc((R > 1 ? R : 1) * sizeof *tmp);
-    out->n_factors = f;
-    out->s1 = malloc(3 * f * sizeof *out->s1);
-    out->st = malloc(3 * f * sizeof *out->st);
-    out->s2 = nf2 ? malloc(3 * nf2 * sizeof *out->s2) : NULL;
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
-    int rc = PHC_OK;
-    if (!used || !draw || !boot || !tmp || !out->s1 || !out->st || (nf2 && !out->s2) || !rng) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    out->s1_lo = out->s1 + f;
-    out->s1_hi = out->s1 + 2 * f;
-    out->st_lo = out->st + f;
-    out->st_hi = out->st + 2 * f;
-    if (nf2) {
-        out->s2_lo = out->s2 + nf2;
-        out->s2_hi = out->s2 + 2 * nf2;
-    }
     size_t m = 0;
-    for (size_t j = 0; j < n; ++j) {
+    for (size_t j = 0; j < d->n; ++j) {
         int ok = 1;
-        for (size_t s = 0; s < bl; ++s)
-            ok &= isfinite(y[j * bl + s]) != 0;
+        for (size_t s = 0; s < d->block; ++s)
+            ok &= isfinite(y[(j * d->block + s) * ys]) != 0;
         if (ok)
             used[m++] = j;
     }
-    out->n_used = m;
-    out->n_failed = n - m;
-    if (m < 4) {
-        rc = phc_error_set(err, PHC_ERR_NUMERIC, "only %zu of %zu base samples have every evaluation finished; "
-                           "the indices need at least 4", m, n);
+    return m;
+}
+
+/* The indices of n_out outputs (columns y[c * M ..], contiguous) that share
+ * the usable base samples used[0..m-1]: every output's bootstrap draws the
+ * same resamples (the generator is seeded the same for every output, so
+ * each output's result is what estimating it alone gives), drawn once. */
+static int estimate_outputs(const phc_saltelli_design *d, const double *cols, size_t n_out, const size_t *used,
+                            size_t m, phc_sobol_indices *outs, phc_error *err)
+{
+    const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, nf2 = d->o.second_order ? f * f : 0;
+    const size_t M = n * bl, per = 2 * f + nf2;
+    size_t *draw = malloc(n * sizeof *draw);
+    double *boot = malloc(n_out * R * per * sizeof *boot), *tmp = malloc((R > 1 ? R : 1) * sizeof *tmp);
+    double *acc = malloc((2 * f + f * f) * sizeof *acc);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    int rc = PHC_OK;
+    for (size_t c = 0; c < n_out; ++c) {
+        phc_sobol_indices *out = &outs[c];
+        memset(out, 0, sizeof *out);
+        out->n_factors = f;
+        out->s1 = malloc(3 * f * sizeof *out->s1);
+        out->st = malloc(3 * f * sizeof *out->st);
+        out->s2 = nf2 ? malloc(3 * nf2 * sizeof *out->s2) : NULL;
+        if (!out->s1 || !out->st || (nf2 && !out->s2))
+            rc = PHC_ERR_NOMEM;
+    }
+    if (rc || !draw || !boot || !tmp || !acc || !rng) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    {
+    for (size_t c = 0; c < n_out; ++c) {
+        phc_sobol_indices *out = &outs[c];
+        const double *y = cols + c * M;
+        out->s1_lo = out->s1 + f;
+        out->s1_hi = out->s1 + 2 * f;
+        out->st_lo = out->st + f;
+        out->st_hi = out->st + 2 * f;
+        if (nf2) {
+            out->s2_lo = out->s2 + nf2;
+            out->s2_hi = out->s2 + 2 * nf2;
+        }
+        out->n_used = m;
+        out->n_failed = n - m;
+        if (m < 4) {
+            rc = phc_error_set(err, PHC_ERR_NUMERIC, "only %zu of %zu base samples have every evaluation finished; "
+                               "the indices need at least 4", m, n);
+            goto done;
+        }
         double sum = 0, sum2 = 0;
         for (size_t t = 0; t < m; ++t) {
             sum += y[used[t] * bl] + y[used[t] * bl + 1];
@@ -257,45 +280,102 @@ int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, ph
             sum2 += a * a + b * b;
         }
         out->variance = sum2 / (double)(2 * m);
+        estimate(d, y, used, m, out->s1, out->st, out->s2, acc);
     }
-    estimate(d, y, used, m, out->s1, out->st, out->s2);
-    /* bootstrap: a fixed stream per estimate call, so results do not depend
-       on which outputs were estimated before */
+    /* bootstrap: a fixed stream per estimate, so results do not depend on
+       which outputs were estimated before or together */
     gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL);
     for (size_t r = 0; r < R; ++r) {
         for (size_t t = 0; t < m; ++t)
             draw[t] = used[gsl_rng_uniform_int(rng, m)];
-        double *b = boot + r * (2 * f + nf2);
-        estimate(d, y, draw, m, b, b + f, nf2 ? b + 2 * f : NULL);
-    }
-    for (size_t i = 0; i < 2 * f + nf2; ++i) {
-        size_t cnt = 0;
-        for (size_t r = 0; r < R; ++r) {
-            const double v = boot[r * (2 * f + nf2) + i];
-            if (isfinite(v))
-                tmp[cnt++] = v;
+        for (size_t c = 0; c < n_out; ++c) {
+            double *b = boot + (c * R + r) * per;
+            estimate(d, cols + c * M, draw, m, b, b + f, nf2 ? b + 2 * f : NULL, acc);
         }
-        double lo = NAN, hi = NAN;
-        if (cnt >= R / 2)
-            percentile(tmp, cnt, d->o.level, &lo, &hi);
-        if (i < f) {
-            out->s1_lo[i] = lo;
-            out->s1_hi[i] = hi;
-        } else if (i < 2 * f) {
-            out->st_lo[i - f] = lo;
-            out->st_hi[i - f] = hi;
-        } else {
-            out->s2_lo[i - 2 * f] = lo;
-            out->s2_hi[i - 2 * f] = hi;
+    }
+    for (size_t c = 0; c < n_out; ++c) {
+        phc_sobol_indices *out = &outs[c];
+        for (size_t i = 0; i < per; ++i) {
+            size_t cnt = 0;
+            for (size_t r = 0; r < R; ++r) {
+                const double v = boot[(c * R + r) * per + i];
+                if (isfinite(v))
+                    tmp[cnt++] = v;
+            }
+            double lo = NAN, hi = NAN;
+            if (cnt >= R / 2)
+                percentile(tmp, cnt, d->o.level, &lo, &hi);
+            if (i < f) {
+                out->s1_lo[i] = lo;
+                out->s1_hi[i] = hi;
+            } else if (i < 2 * f) {
+                out->st_lo[i - f] = lo;
+                out->st_hi[i - f] = hi;
+            } else {
+                out->s2_lo[i - 2 * f] = lo;
+                out->s2_hi[i - 2 * f] = hi;
+            }
         }
     }
 done:
     gsl_rng_free(rng);
-    free(used);
     free(draw);
     free(boot);
     free(tmp);
+    free(acc);
     if (rc)
-        phc_sobol_indices_clear(out);
+        for (size_t c = 0; c < n_out; ++c)
+            phc_sobol_indices_clear(&outs[c]);
+    return rc;
+}
+
+int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, phc_sobol_indices *out,
+                               phc_error *err)
+{
+    size_t *used = malloc(d->n * sizeof *used);
+    if (!used) {
+        memset(out, 0, sizeof *out);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    const size_t m = usable(d, y, 1, used);
+    const int rc = estimate_outputs(d, y, 1, used, m, out, err);
+    free(used);
+    return rc;
+}
+
+int phc_sobol_indices_estimate_outputs(const phc_saltelli_design *d, const double *y, size_t n_out,
+                                       phc_sobol_indices *outs, phc_error *err)
+{
+    const size_t M = d->n * d->block;
+    size_t *used = malloc(d->n * sizeof *used), *other = malloc(d->n * sizeof *other);
+    double *cols = malloc((n_out ? n_out : 1) * M * sizeof *cols);
+    int rc = PHC_OK;
+    for (size_t c = 0; c < n_out; ++c)
+        memset(&outs[c], 0, sizeof outs[c]);
+    if (!used || !other || !cols) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t c = 0; c < n_out; ++c)
+        for (size_t r = 0; r < M; ++r)
+            cols[c * M + r] = y[r * n_out + c];
+    /* runs of outputs with the same usable base samples share their
+       resamples (a failed evaluation makes every output of its row NAN, so
+       in a study all outputs are one run) */
+    for (size_t c0 = 0; c0 < n_out && rc == PHC_OK;) {
+        const size_t m = usable(d, cols + c0 * M, 1, used);
+        size_t c1 = c0 + 1;
+        while (c1 < n_out && usable(d, cols + c1 * M, 1, other) == m && memcmp(used, other, m * sizeof *used) == 0)
+            ++c1;
+        rc = estimate_outputs(d, cols + c0 * M, c1 - c0, used, m, outs + c0, err);
+        c0 = c1;
+    }
+    if (rc)
+        for (size_t c = 0; c < n_out; ++c)
+            phc_sobol_indices_clear(&outs[c]);
+done:
+    free(used);
+    free(other);
+    free(cols);
     return rc;
 }

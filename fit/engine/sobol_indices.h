@@ -81,6 +81,13 @@ typedef struct phc_sobol_indices {
  * samples: PHC_ERR_NUMERIC. */
 int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, phc_sobol_indices *out,
                                phc_error *err);
+/* The same for n_out outputs at once: y holds M rows of n_out values
+ * (row-major, y[row * n_out + j]), out n_out results.  Each output's result
+ * is bit for bit what phc_sobol_indices_estimate gives for its column;
+ * outputs with the same usable base samples draw their bootstrap resamples
+ * once. */
+int phc_sobol_indices_estimate_outputs(const phc_saltelli_design *d, const double *y, size_t n_out,
+                                       phc_sobol_indices *out, phc_error *err);
 void phc_sobol_indices_clear(phc_sobol_indices *s); /* frees the arrays; accepts zeroed */
 
 #endif /* PHC_SOBOL_INDICES_H */

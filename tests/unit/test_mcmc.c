@@ -13,9 +13,14 @@
  *    exact mean, their standard deviations within 4 sqrt(1 / (2 ESS))
  *    (relative; the large-sample standard error of a standard deviation)
  *    and the correlation within 4 (1 - rho^2) / sqrt(ESS);
- *  - the same seed gives the same chains, bit for bit. */
+ *  - the same seed gives the same chains, bit for bit;
+ *  - phc_mcmc_summarise's median and 2.5% / 97.5% quantiles (found by
+ *    selection) equal, bit for bit, GSL's quantiles of the sorted draws, on
+ *    random, tied, sorted, reversed and tiny samples. */
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
+#include <gsl/gsl_sort.h>
+#include <gsl/gsl_statistics_double.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -92,8 +97,47 @@ static void compare(const char *what, const phc_mcmc_chains *c, const double *me
     free(v[1]);
 }
 
+/* The quantiles of phc_mcmc_summarise against a full sort. */
+static void test_quantiles_by_selection(void)
+{
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(r, 5);
+    const size_t sizes[6] = {2, 3, 7, 40, 1001, 96032};
+    int all = 1, cases = 0;
+    for (int kind = 0; kind < 4; ++kind)
+        for (int si = 0; si < 6; ++si) {
+            const size_t n = sizes[si];
+            double *x = malloc(n * sizeof *x), *sorted = malloc(n * sizeof *sorted);
+            for (size_t i = 0; i < n; ++i) {
+                const double g = gsl_ran_gaussian(r, 2.0);
+                x[i] = kind == 0 ? g : kind == 1 ? floor(g) /* many ties */ : kind == 2 ? (double)i : -(double)i;
+            }
+            /* one chain of n draws (two when n is even: the summary needs n >= 2 per chain) */
+            const size_t chains = n % 2 == 0 && n > 2 ? 2 : 1;
+            phc_mcmc_summary sm;
+            phc_error err;
+            CHECK(phc_mcmc_summarise(x, chains, n / chains, &sm, &err) == PHC_OK);
+            memcpy(sorted, x, n * sizeof *x);
+            gsl_sort(sorted, 1, n);
+            const double q[3] = {gsl_stats_quantile_from_sorted_data(sorted, 1, n, 0.5),
+                                 gsl_stats_quantile_from_sorted_data(sorted, 1, n, 0.025),
+                                 gsl_stats_quantile_from_sorted_data(sorted, 1, n, 0.975)};
+            const int same = memcmp(&q[0], &sm.median, sizeof q[0]) == 0 && memcmp(&q[1], &sm.q025, sizeof q[1]) == 0 &&
+                             memcmp(&q[2], &sm.q975, sizeof q[2]) == 0;
+            CHECK(same);
+            all &= same;
+            ++cases;
+            free(x);
+            free(sorted);
+        }
+    printf("quantiles by selection: %d samples (random, tied, sorted, reversed; n = 2 to 96032): %s bit for bit to "
+           "GSL's on the sorted draws\n", cases, all ? "equal" : "NOT equal");
+    gsl_rng_free(r);
+}
+
 int main(void)
 {
+    test_quantiles_by_selection();
     phc_error err;
     /* ---- AR(1): tau = (1 + phi) / (1 - phi) */
     {
