@@ -42,17 +42,10 @@ typedef struct rz_pot_setup {
     /* optional: edits the soil's fields after the layers (e.g. nutrients) */
     void (*fields)(phc_soil *s, void *user);
     void *user;
-    /* optional, 0 = off: the initial water as a fill w/c (the same relative
-     * moisture in every soil) instead of w0, and a draining bottom (an
-     * ABSORB face of this many voxel layers) instead of a blocked one */
-    double fill0;
-    int drain_layers;
-    int upwind;           /* 1: the upwind gravity flux (phc_soil_gravity), 0: Lax-Wendroff */
-    double rain_nutrient; /* units per m^3 of rain water */
+    /* optional (0 = off) */
+    int upwind;                 /* 1: the upwind gravity flux (phc_soil_gravity) instead of Lax-Wendroff */
     double nutrient_allocation; /* the oak's nutrient_allocation (growth.h) */
-    double v0;            /* initial nutrients, units/m^3 */
-    double seed_reserve;  /* > 0: replaces the oak preset's seed reserve (vigor) */
-    int expected;         /* 1: EXPECTED mode (no draws; seed unused) instead of STOCHASTIC */
+    double seed_reserve;        /* > 0: replaces the oak preset's seed reserve (vigor) */
 } rz_pot_setup;
 
 static double rz_now(void)
@@ -83,17 +76,13 @@ static int rz_pot_run(const rz_pot_setup *u, const char *preset, rz_pot *R, phc_
         free(rain);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
-    phc_soil_layer L = {0.0, R->c, R->p, u->d, u->w0, u->fill0 > 0 ? u->fill0 : -1.0, u->v0};
+    phc_soil_layer L = {0.0, R->c, R->p, u->d, u->w0, -1.0, 0.0};
     for (int d = 0; d < u->days; ++d)
-        rain[d] = (phc_soil_rain){24.0 * d, 24.0 * d + 1.0, u->rain_depth, u->rain_nutrient, 0.0, 0.0, 0.0, 0.0};
+        rain[d] = (phc_soil_rain){24.0 * d, 24.0 * d + 1.0, u->rain_depth, 0.0, 0.0, 0.0, 0.0, 0.0};
     s->params.dt = 1.0;
     s->params.substep = 1;
     if (u->upwind)
         s->params.gravity = PHC_SOIL_GRAVITY_UPWIND;
-    if (u->drain_layers > 0) {
-        s->params.boundary[PHC_SOIL_ZMIN] = PHC_SOIL_ABSORB;
-        s->params.absorb_width = u->drain_layers;
-    }
     int rc = phc_soil_set_layers(s, &L, 1, err);
     if (!rc)
         rc = phc_soil_set_rain(s, rain, (size_t)u->days, err);
@@ -110,7 +99,7 @@ static int rz_pot_run(const rz_pot_setup *u, const char *preset, rz_pot *R, phc_
     if (u->seed_reserve > 0)
         P.seed_reserve = u->seed_reserve;
     phc_growth_options o = phc_growth_options_default();
-    o.mode = u->expected ? PHC_GROWTH_EXPECTED : PHC_GROWTH_STOCHASTIC;
+    o.mode = PHC_GROWTH_STOCHASTIC;
     o.seed = u->seed;
     o.base[0] = 0.5 * u->nx * u->dx, o.base[1] = 0.5 * u->ny * u->dx, o.base[2] = u->nz * u->dx;
     if (!rc)
