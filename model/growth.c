@@ -24,7 +24,7 @@ static const struct { const char *name; size_t offset; } param_table[] = {
     P(lma), P(light_extinction), P(light_voxel), P(light), P(light_use),
     P(root_node_length), P(root_elongation), P(root_apical_angle), P(root_branching_angle),
     P(root_apical_dominance), P(root_branching), P(gravitropism_root), P(hydrotropism),
-    P(tropism_switch), P(nutrient_branching), P(water_uptake), P(uptake_cap), P(water_use), P(root_resistance),
+    P(tropism_switch), P(nutrient_branching), P(nutrient_allocation), P(water_uptake), P(uptake_cap), P(water_use), P(root_resistance),
     P(soil_fill), P(tip_radius_shoot), P(tip_radius_root), P(pipe_exponent),
     P(maintenance_shoot), P(maintenance_root), P(growth_shoot), P(growth_root), P(phi_rg),
     P(wood_density), P(root_density), P(seed_reserve), P(reserve_rate),
@@ -115,7 +115,7 @@ static phc_growth_params preset_oak(void)
         .root_node_length = 0.02, .root_elongation = 0.012, .root_apical_angle = 3,
         .root_branching_angle = 60, .root_apical_dominance = 0.85, .root_branching = 1.0,
         .gravitropism_root = 0.3, .hydrotropism = 0.3, .tropism_switch = 0.2,
-        .nutrient_branching = 1,
+        .nutrient_branching = 1, .nutrient_allocation = 0,
         .water_uptake = 4e-5, .uptake_cap = 0.5, .water_use = 5e4, .root_resistance = 1,
         .soil_fill = 0.5,
         .tip_radius_shoot = 0.0005, .tip_radius_root = 0.0006, .pipe_exponent = 2,
@@ -617,8 +617,11 @@ static int inside_soil(const phc_soil *s, const phc_growth_node *n)
 static void allocate(phc_growth *g, double dt)
 {
     const phc_growth_params *p = &g->p;
-    double *wsum = g->b, *own = g->c;
+    /* own: a tip's requirement; wown, wreq: its weight and the subtree's in
+     * the propagation (= own and requirement unless nutrient_allocation) */
+    double *wsum = g->b, *own = g->c, *wreq = g->a;
     double m_sys[2] = {0, 0}, g_sys[2] = {0, 0};
+    const double na = p->nutrient_allocation;
     for (size_t i = 0; i < g->n; i++) {
         phc_growth_node *n = &g->node[i];
         double vol = 3.14159265358979323846 * n->radius * n->radius * n->length;
@@ -630,16 +633,22 @@ static void allocate(phc_growth *g, double dt)
         g_sys[n->system] += own[i];
         n->requirement = 0;
         wsum[i] = 0;
+        wreq[i] = 0;
     }
     for (size_t i = g->n; i-- > 0;) {
         phc_growth_node *n = &g->node[i];
         double lam = n->system == PHC_GROWTH_SHOOT ? p->apical_dominance : p->root_apical_dominance;
+        double wown = own[i];
+        if (na > 0 && n->system == PHC_GROWTH_ROOT && own[i] > 0)
+            wown *= pow(n->nutrient > 0 ? n->nutrient : 0, na);
         n->requirement += own[i];
-        wsum[i] += lam * own[i];
+        wreq[i] += wown;
+        wsum[i] += lam * wown;
         if (n->parent != PHC_GROWTH_NONE) {
             phc_growth_node *q = &g->node[n->parent];
             q->requirement += n->requirement;
-            wsum[n->parent] += (q->apical_child == i ? lam : 1 - lam) * n->requirement;
+            wreq[n->parent] += wreq[i];
+            wsum[n->parent] += (q->apical_child == i ? lam : 1 - lam) * wreq[i];
         }
     }
     double release = dt > 0 ? g->reserve * (1 - pow(1 - p->reserve_rate, dt)) / dt : 0;
@@ -671,14 +680,17 @@ static void allocate(phc_growth *g, double dt)
             const phc_growth_node *q = &g->node[n->parent];
             double lam =
                 n->system == PHC_GROWTH_SHOOT ? p->apical_dominance : p->root_apical_dominance;
-            double w = (q->apical_child == i ? lam : 1 - lam) * n->requirement;
+            double w = (q->apical_child == i ? lam : 1 - lam) * wreq[i];
             n->vigor = wsum[n->parent] > 0 ? q->vigor * w / wsum[n->parent] : 0;
         }
         n->potential = 0;
         if (n->tip && own[i] > 0 && wsum[i] > 0) {
             double lam =
                 n->system == PHC_GROWTH_SHOOT ? p->apical_dominance : p->root_apical_dominance;
-            double mine = n->vigor * lam * own[i] / wsum[i];
+            double wown = own[i];
+            if (na > 0 && n->system == PHC_GROWTH_ROOT)
+                wown *= pow(n->nutrient > 0 ? n->nutrient : 0, na);
+            double mine = n->vigor * lam * wown / wsum[i];
             n->potential = fmin(1.0, mine / own[i]);
         }
     }

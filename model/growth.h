@@ -53,7 +53,17 @@
  *  6. propagation (eqs. 13-15): within a system, each node hands its vigor
  *     to its children in proportion to lambda * (requirement below the
  *     child), lambda = apical_dominance for the apical child and
- *     1 - apical_dominance for laterals;
+ *     1 - apical_dominance for laterals.  With nutrient_allocation = a > 0
+ *     a root tip counts in these weights as g_R * v^a, v the nutrients of
+ *     the soil at it (its potential is still its vigor over g_R): root
+ *     vigor flows to the tips in rich soil.  This is the authors' code
+ *     (TreeModel.cpp, CalculateVigorRequirement for roots: a root tip's
+ *     vigor requirement weight is its sampled nitrite times its growth
+ *     potential; "more nitrite, more vigor"), with a = 1; a tip in soil
+ *     without nutrients then gets no vigor, as there.  The total the root
+ *     system receives does not change (the authors sum the unweighted
+ *     potentials for it, so "the overall nitrite will not affect the root
+ *     growth"); a = 0 is the unweighted law;
  *  7. growth potential (eqs. 16-17) P = min(1, vigor at the tip / g);
  *  8. pruning (eq. 18): a lateral shoot branch whose leaves earn less than
  *     prune_ratio times its maintenance is cut (roots are not pruned);
@@ -146,6 +156,9 @@ typedef struct phc_growth_params {
     double tropism_switch;      /* fill w/c below which roots follow water (eq. 23), >= 0 */
     double nutrient_branching;  /* eq. 24: branching x (1 + this * v), v the soil nutrients
                                    (units/m^3) at the segment; m^3/unit, >= 0 */
+    double nutrient_allocation; /* step 6: a root tip's weight in the propagation is its
+                                   requirement x v^this (v its soil nutrients); 0 = off
+                                   (the presets), 1 = the authors' code; >= 0 */
     double water_uptake;        /* m^3 water per m root per day at fill 1, >= 0 */
     double uptake_cap;          /* fraction of a voxel's water taken per day at most, (0, 1] */
     double water_use;           /* vigor per m^3 water, >= 0 */

@@ -50,6 +50,7 @@ phc_soil_params phc_soil_params_default(void)
     p.dt = 0.001; /* h: SoilParameters::m_deltaTime */
     p.substep = 1;
     p.safety = 0.9;
+    p.gravity = PHC_SOIL_GRAVITY_LAX_WENDROFF;
     return p;
 }
 
@@ -468,6 +469,9 @@ static int check_impl(const phc_soil *s, int strict, phc_error *err)
                              pr->f_nutrient);
     if (!(pr->dt > 0) || !isfinite(pr->dt))
         return phc_error_set(err, PHC_ERR_INPUT, "soil: the time step dt must be > 0, found %g h", pr->dt);
+    if (pr->gravity != PHC_SOIL_GRAVITY_LAX_WENDROFF && pr->gravity != PHC_SOIL_GRAVITY_UPWIND)
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: unknown gravity scheme %d (0 Lax-Wendroff, 1 upwind)",
+                             (int)pr->gravity);
     if (!(pr->safety > 0 && pr->safety <= 1))
         return phc_error_set(err, PHC_ERR_INPUT, "soil: safety must be in (0, 1], found %g", pr->safety);
     size_t dims[3] = {s->nx, s->ny, s->nz};
@@ -556,7 +560,8 @@ static void prepare_fields(phc_soil *s)
 
 /* The stability limit from the prepared face permeabilities and 1/c:
  * for every permeable voxel the positive root of a h^2 + b h = 1 with
- * b = f_diff (sum of its faces' p_f) / (c dx^2), a = (f_grav p / dx)^2. */
+ * b = f_diff (sum of its faces' p_f) / (c dx^2), a = (f_grav p / dx)^2
+ * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux. */
 static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
 {
     const phc_soil_work *wk = s->work;
@@ -577,7 +582,9 @@ static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
                 double sum = wk->kx[q] + wk->kx[qw] + wk->ky[q] + wk->ky[qs] + wk->kz[q] + wk->kz[qd];
                 double bb = s->params.f_diff * sum * wk->ic[q] / dx2;
                 double g = s->params.f_grav * s->p[q] / s->dx, a = g * g;
-                double h = (a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY;
+                double h = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND
+                               ? ((g > 0 || bb > 0) ? 1.0 / (bb + g) : INFINITY)
+                               : ((a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY);
                 if (h < best) {
                     best = h;
                     at = q;
@@ -597,14 +604,16 @@ double phc_soil_stable_dt(const phc_soil *s, size_t *voxel)
 
 /* ---- the step ------------------------------------------------------------ */
 
-/* The Lax-Wendroff face concentration of nutrients for water face flux F
- * (from voxel a to voxel b, m/h). */
+/* The nutrient flux riding on water face flux F (from voxel a to voxel b,
+ * m/h): Lax-Wendroff face concentration, or the donor's with `up`. */
 static double nutrient_face_flux(double F, double wa, double wb, double va, double vb, double h,
-                                 double dx)
+                                 double dx, int up)
 {
     if (F == 0)
         return 0;
     double ua = wa > 0 ? va / wa : 0, ub = wb > 0 ? vb / wb : 0;
+    if (up)
+        return F * (F > 0 ? ua : ub);
     double wm = 0.5 * (wa + wb);
     double nu = wm > 0 ? F * h / (dx * wm) : 0;
     return F * (0.5 * (ua + ub) - 0.5 * nu * (ub - ua));
@@ -613,13 +622,15 @@ static double nutrient_face_flux(double F, double wa, double wb, double va, doub
 /* The face terms of voxel q: f[0..5] = k_f (l_j - l_q) towards the east,
  * west, north, south, up and down neighbours (l = w/c), f[6] the downward
  * gravity flux through the top face and f[7] through the bottom face
- * (Lax-Wendroff, 0 across a closed face).  One definition for the water
- * update and for the nutrients riding on the same fluxes. */
+ * (Lax-Wendroff, or the upwind flux of the voxel above with `up`: the same
+ * form with the correction coefficient 1/2; 0 across a closed face).  One
+ * definition for the water update and for the nutrients riding on the same
+ * fluxes. */
 static inline void voxel_faces(const double *restrict w, const double *restrict ic,
                                const double *restrict p, const double *restrict kx,
                                const double *restrict ky, const double *restrict kz, size_t q,
                                size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
-                               double a, double lw, double f[8])
+                               double a, double lw, int up, double f[8])
 {
     const double l0 = w[q] * ic[q];
     f[0] = kx[q] * (w[qe] * ic[qe] - l0);
@@ -629,8 +640,8 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
     f[4] = kz[q] * (w[qu] * ic[qu] - l0);
     f[5] = kz[qd] * (w[qd] * ic[qd] - l0);
     const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
-    f[6] = kz[q] > 0 ? 0.5 * (qU + q0) - lw * kz[q] * (q0 - qU) : 0;
-    f[7] = kz[qd] > 0 ? 0.5 * (q0 + qD) - lw * kz[qd] * (qD - q0) : 0;
+    f[6] = kz[q] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kz[q]) * (q0 - qU) : 0;
+    f[7] = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
 }
 
 /* The water update of voxel q from its face terms. */
@@ -638,10 +649,10 @@ static inline double water_voxel(const double *restrict w, const double *restric
                                  const double *restrict p, const double *restrict kx,
                                  const double *restrict ky, const double *restrict kz, size_t q,
                                  size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
-                                 double a, double cd, double cg, double lw)
+                                 double a, double cd, double cg, double lw, int up)
 {
     double f[8];
-    voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, f);
+    voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, up, f);
     return w[q] + cd * (f[0] + f[1] + f[2] + f[3] + f[4] + f[5]) + cg * (f[6] - f[7]);
 }
 
@@ -657,6 +668,7 @@ static void transport_water(phc_soil *s, double h)
     double *restrict wn = wk->w_new;
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
+    const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
@@ -666,18 +678,18 @@ static void transport_water(phc_soil *s, double h)
             {
                 const size_t q = row;
                 wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
-                                    q - js, q + kup, q - kdn, a, cd, cg, lw);
+                                    q - js, q + kup, q - kdn, a, cd, cg, lw, up);
             }
 #pragma omp simd
             for (size_t i = 1; i < nx - 1; ++i) {
                 const size_t q = row + i;
                 wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, a, cd, cg, lw);
+                                    q - kdn, a, cd, cg, lw, up);
             }
             if (nx > 1) {
                 const size_t q = row + nx - 1;
                 wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, a, cd, cg, lw);
+                                    q - kdn, a, cd, cg, lw, up);
             }
         }
     }
@@ -698,6 +710,7 @@ static void transport(phc_soil *s, double h)
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const double fn = s->params.f_nutrient;
+    const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
@@ -709,7 +722,7 @@ static void transport(phc_soil *s, double h)
                 const size_t qe = i + 1 < nx ? q + 1 : q + 1 - nx, qw = i > 0 ? q - 1 : q + nx - 1;
                 const size_t qn = q + jn, qs = q - js, qu = q + kup, qd = q - kdn;
                 double f[8];
-                voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, f);
+                voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, up, f);
                 wn[q] = w[q] + cd * (f[0] + f[1] + f[2] + f[3] + f[4] + f[5]) + cg * (f[6] - f[7]);
                 /* the water face fluxes out of q (m/h), then nutrients ride on them */
                 const double dd = fd / dx;
@@ -718,7 +731,7 @@ static void transport(phc_soil *s, double h)
                                        -dd * f[5] + f[7]};
                 double acc = 0;
                 for (int e = 0; e < 6; ++e)
-                    acc -= nutrient_face_flux(out[e], w[q], w[nb[e]], v[q], v[nb[e]], h, dx);
+                    acc -= nutrient_face_flux(out[e], w[q], w[nb[e]], v[q], v[nb[e]], h, dx, up);
                 vn[q] = v[q] + fn * cg * acc;
             }
         }
@@ -930,6 +943,7 @@ static void tangent_step(phc_soil *s, double h, const phc_soil_tangent *tan, siz
     const double dfd = tan->dfd ? tan->dfd[m] : 0, dfg = tan->dfg ? tan->dfg[m] : 0;
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h / (dx * dx), cg = h / dx, lw = h / (2 * dx);
+    const int upwind = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
@@ -965,8 +979,9 @@ static void tangent_step(phc_soil *s, double h, const phc_soil_tangent *tan, siz
                     double squ = a * p[up] * sw[up], sql = a * p[lo] * sw[lo];
                     double dqu = dfg * p[up] * w[up] + (dp ? a * dp[up] * w[up] : 0);
                     double dql = dfg * p[lo] * w[lo] + (dp ? a * dp[lo] * w[lo] : 0);
-                    double G = 0.5 * (squ + sql) - lw * a * k_f * (sql - squ) + 0.5 * (dqu + dql) -
-                               lw * ((dfg * k_f + a * dk) * (ql - qu) + a * k_f * (dql - dqu));
+                    double G = upwind ? squ + dqu /* F = q_up */
+                                      : 0.5 * (squ + sql) - lw * a * k_f * (sql - squ) + 0.5 * (dqu + dql) -
+                                            lw * ((dfg * k_f + a * dk) * (ql - qu) + a * k_f * (dql - dqu));
                     grav += f == 0 ? G : -G;
                 }
                 out[q] = sw[q] + cd * diff + cg * grav;

@@ -42,6 +42,10 @@ typedef struct rz_pot_setup {
     /* optional: edits the soil's fields after the layers (e.g. nutrients) */
     void (*fields)(phc_soil *s, void *user);
     void *user;
+    /* optional (0 = off) */
+    int upwind;                 /* 1: the upwind gravity flux (phc_soil_gravity) instead of Lax-Wendroff */
+    double nutrient_allocation; /* the oak's nutrient_allocation (growth.h) */
+    double seed_reserve;        /* > 0: replaces the oak preset's seed reserve (vigor) */
 } rz_pot_setup;
 
 static double rz_now(void)
@@ -77,6 +81,8 @@ static int rz_pot_run(const rz_pot_setup *u, const char *preset, rz_pot *R, phc_
         rain[d] = (phc_soil_rain){24.0 * d, 24.0 * d + 1.0, u->rain_depth, 0.0, 0.0, 0.0, 0.0, 0.0};
     s->params.dt = 1.0;
     s->params.substep = 1;
+    if (u->upwind)
+        s->params.gravity = PHC_SOIL_GRAVITY_UPWIND;
     int rc = phc_soil_set_layers(s, &L, 1, err);
     if (!rc)
         rc = phc_soil_set_rain(s, rain, (size_t)u->days, err);
@@ -89,6 +95,9 @@ static int rz_pot_run(const rz_pot_setup *u, const char *preset, rz_pot *R, phc_
     phc_growth_params P;
     if (!rc)
         rc = phc_growth_preset("oak", &P, err);
+    P.nutrient_allocation = u->nutrient_allocation;
+    if (u->seed_reserve > 0)
+        P.seed_reserve = u->seed_reserve;
     phc_growth_options o = phc_growth_options_default();
     o.mode = PHC_GROWTH_STOCHASTIC;
     o.seed = u->seed;

@@ -775,6 +775,75 @@ static void test_nutrient_scaling(void)
     }
 }
 
+
+/* Nutrient-weighted allocation (step 6, the authors' CalculateVigorRequirement):
+ * scaling every root tip's weight by the same power of two changes no
+ * number (v = 2 everywhere with a = 1 is the plant of a = 0, bit for bit);
+ * in a pot split into a rich and a poor half, root length moves to the rich
+ * half, measured in both mirror images so the plant's own side bias cancels. */
+static double side_length(const phc_growth *g, int rich_left, double *rich, double *poor)
+{
+    size_t n;
+    const phc_growth_node *nd = phc_growth_nodes(g, &n);
+    *rich = *poor = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (nd[i].system != PHC_GROWTH_ROOT) continue;
+        int left = nd[i].head[0] + 0.5 * nd[i].length * nd[i].dir[0] < 0.5 * SOIL_N * SOIL_DX;
+        *(left == rich_left ? rich : poor) += nd[i].length;
+    }
+    return *rich / *poor;
+}
+
+static void test_nutrient_allocation(void)
+{
+    phc_growth_options o = opts_at_surface();
+    o.mode = PHC_GROWTH_STOCHASTIC;
+    o.seed = 7;
+    phc_growth_summary S[2];
+    for (int k = 0; k < 2; ++k) {
+        phc_growth_params p = preset("oak");
+        p.nutrient_branching = 0;
+        p.nutrient_allocation = k;
+        phc_soil *s = test_soil(0.5, 0, 0, 2);
+        S[k] = summary_after(&p, &o, s, 45);
+        phc_soil_free(s);
+    }
+    printf("  nutrient allocation, uniform v = 2, 45 d: a = 0 root nodes %zu, length %.17g m; a = 1 root nodes %zu, "
+           "length %.17g m\n",
+           S[0].root_nodes, S[0].root_length, S[1].root_nodes, S[1].root_length);
+    CHECK(S[0].root_nodes == S[1].root_nodes);
+    CHECK(S[0].root_length == S[1].root_length);
+    CHECK(S[0].shoot_mass == S[1].shoot_mass);
+    /* split: v = 0.2 on one half, 3 on the other; EXPECTED mode; mirrored */
+    o.mode = PHC_GROWTH_EXPECTED;
+    double ratio[2];
+    for (int k = 0; k < 2; ++k) {
+        double rich = 0, poor = 0;
+        for (int m = 0; m < 2; ++m) {
+            phc_growth_params p = preset("oak");
+            p.nutrient_branching = 0;
+            p.nutrient_allocation = k;
+            phc_soil *s = test_soil(0.5, 0, 0, 0);
+            for (size_t q = 0; q < s->n; ++q) {
+                int left = q % SOIL_N < SOIL_N / 2;
+                s->v[q] = left == (m == 0) ? 3.0 : 0.2;
+            }
+            phc_growth *g = grow(&p, &o, s, 60);
+            double r, pr;
+            side_length(g, m == 0, &r, &pr);
+            rich += r, poor += pr;
+            phc_growth_free(g);
+            phc_soil_free(s);
+        }
+        ratio[k] = rich / poor;
+    }
+    printf("  nutrient allocation, split pot (v 3 | 0.2), EXPECTED 60 d, both mirror images: root length rich / poor "
+           "%.3f with a = 0, %.3f with a = 1\n",
+           ratio[0], ratio[1]);
+    CHECK(ratio[1] > 1.5);
+    CHECK(ratio[1] > ratio[0]);
+}
+
 /* Root tips stop at the faces of the soil box: measured overshoot of the
  * deepest tail below the bottom (at most one step's elongation, since a
  * tip is stopped once its tail is outside). */
@@ -873,7 +942,8 @@ int main(void)
         {"determinism", test_determinism}, {"pipe+geometry", test_pipe_and_geometry},
         {"limits", test_limits},       {"uptake", test_uptake},
         {"exports", test_exports},     {"nutrients", test_nutrients},
-        {"nutrient scaling", test_nutrient_scaling}, {"pot walls", test_pot_walls},
+        {"nutrient scaling", test_nutrient_scaling},
+        {"nutrient allocation", test_nutrient_allocation}, {"pot walls", test_pot_walls},
         {"smoothness", test_smoothness}, {"modes", test_modes},
     };
     for (size_t i = 0; i < sizeof groups / sizeof groups[0]; ++i) {

@@ -407,6 +407,7 @@ static void test_absorb_rain(void)
 
 enum { T_NX = 6, T_NY = 5, T_NZ = 12, T_STEPS = 40 };
 static const double T_DX = 0.01;
+static int t_upwind = 0; /* 1: the tangent soils use the upwind gravity flux */
 
 /* direction 0: p of layer 1 (soil voxels); 1: 1/c of layer 2; 2: f_diff; 3: f_grav. */
 static phc_soil *tangent_soil(int dir, double eps, double *dt, size_t *layer_of_k)
@@ -424,6 +425,8 @@ static phc_soil *tangent_soil(int dir, double eps, double *dt, size_t *layer_of_
     s->params.f_diff = 0.7;
     s->params.f_grav = 1.3;
     s->params.substep = 0;
+    if (t_upwind)
+        s->params.gravity = PHC_SOIL_GRAVITY_UPWIND;
     if (*dt <= 0)
         *dt = 0.5 * phc_soil_stable_dt(s, NULL);
     s->params.dt = *dt;
@@ -528,6 +531,71 @@ static void test_tangent(void)
     free(dp0);
     free(dic1);
     phc_soil_free(s);
+}
+
+
+/* ---- 7c. the upwind gravity flux ---------------------------------------------- */
+
+/* A column of nz voxels, uniform c and p, blocked at both ends. */
+static phc_soil *column(size_t nz, double dx, double c, double p, double w0, phc_soil_gravity g)
+{
+    phc_soil *s = new_soil(1, 1, nz, dx);
+    for (size_t k = 0; k < nz; ++k)
+        s->c[k] = c, s->p[k] = p, s->w[k] = w0;
+    s->params.gravity = g;
+    s->params.dt = 1.0;
+    return s;
+}
+
+static void test_upwind(void)
+{
+    phc_error err;
+    /* the bound h (b + g) = 1 of an interior voxel (two faces) */
+    const double dx = 0.05, c = 2, p = 0.1, fd = 1, fg = 1;
+    phc_soil *s = column(10, dx, c, p, 1.0, PHC_SOIL_GRAVITY_UPWIND);
+    double lim = phc_soil_stable_dt(s, NULL), expect = 1.0 / (fd * 2 * p / (c * dx * dx) + fg * p / dx);
+    printf("7c. upwind gravity: stability limit %.15g h (1 / (b + g) = %.15g)\n", lim, expect);
+    CHECK_NEAR(lim, expect, 0, 1e-14);
+    /* exact discrete steady state: no flux through any face when
+       f_grav p w_up = f_diff p (l_low - l_up) / dx, i.e. the fill grows
+       downward by the factor 1 + f_grav c dx / f_diff per voxel */
+    double W0 = phc_soil_water_total(s);
+    must(phc_soil_run(s, 200.0, &err), &err, "upwind column");
+    double r = 1 + fg * c * dx / fd, emax = 0;
+    for (size_t k = 0; k + 1 < 10; ++k)
+        emax = fmax(emax, fabs(s->w[k] / s->w[k + 1] / r - 1));
+    printf("    column at rest after 200 h (%zu sub-steps): w[k] / w[k+1] = %.12f (exact %.12f), max rel err %.2e; "
+           "water rel change %.2e\n",
+           s->budget.substeps, s->w[0] / s->w[1], r, emax, fabs(phc_soil_water_total(s) / W0 - 1));
+    CHECK(emax < 1e-9);
+    CHECK_NEAR(phc_soil_water_total(s), W0, 0, 1e-12);
+    phc_soil_free(s);
+    /* a sandy pot whose upper half the roots have dried (w = 0 over w = 6):
+       Lax-Wendroff's nearly centred flux (q_up + q_low) / 2 at this small
+       Courant number pulls water out of the dry voxels, which go negative;
+       the upwind flux moves only what the voxel above holds */
+    double wmin[2], wtot[2], wbot[2];
+    for (int g = 0; g < 2; ++g) {
+        phc_soil *t = column(10, dx, 75, 0.033, 6.0, g ? PHC_SOIL_GRAVITY_UPWIND : PHC_SOIL_GRAVITY_LAX_WENDROFF);
+        for (size_t k = 5; k < 10; ++k)
+            t->w[k] = 0;
+        double Win = phc_soil_water_total(t);
+        wmin[g] = INFINITY;
+        for (int h = 1; h <= 480; ++h) { /* min every 0.05 h over the first 24 h */
+            must(phc_soil_run(t, 0.05 * h, &err), &err, "pot");
+            wmin[g] = fmin(wmin[g], minv(t->w, t->n));
+        }
+        wtot[g] = phc_soil_water_total(t) / Win - 1;
+        wbot[g] = t->w[0] * dx * dx * dx / phc_soil_water_total(t);
+        phc_soil_free(t);
+    }
+    printf("    sandy pot (c 75, p 0.033 m/h, w 0 over 6, 24 h, w seen every 0.05 h): lowest w Lax-Wendroff %.3g, upwind %.3g; "
+           "water rel change %.1e and %.1e; bottom voxel holds %.3f and %.3f of it\n",
+           wmin[0], wmin[1], wtot[0], wtot[1], wbot[0], wbot[1]);
+    CHECK(wmin[0] < 0);
+    CHECK(wmin[1] >= 0);
+    CHECK(fabs(wtot[1]) < 1e-12);
+    CHECK(wbot[1] > 0.7);
 }
 
 /* ---- 8. infiltration depth ----------------------------------------------------- */
@@ -749,6 +817,11 @@ int main(void)
     test_stability();
     test_absorb_rain();
     test_tangent();
+    t_upwind = 1;
+    printf("7b. the tangent again with the upwind gravity flux:\n");
+    test_tangent();
+    t_upwind = 0;
+    test_upwind();
     test_infiltration();
     test_sample();
     test_inputs();
