@@ -10,6 +10,32 @@
 #include "fit/growth_outputs.h"
 #include "measurements/atomic_file.h"
 
+/* The simulated trajectory: one state per step. */
+typedef struct rs_traj {
+    size_t m, cap;
+    double *t, *d, *lrs;         /* d, m, ln(root:shoot) */
+    phc_growth_summary last;
+} rs_traj;
+
+/* The last RS_CACHE trajectories, by the exact slot values that grew them.
+ * The plant is deterministic (expected mode, or stochastic with its fixed
+ * seed), so a second simulation at the same slot values repeats the first
+ * bit for bit; the solver asks for the same point several times (Ceres
+ * evaluates a trust-region candidate in its projected line search, again
+ * for its cost, and once more with the Jacobian when it accepts it; the
+ * analysis evaluates the solution again), and a cached trajectory answers
+ * without simulating.  A trajectory that ends at diameter D answers every
+ * request for diameters <= D (a plant grown for them would stop at the
+ * first step past the largest, and its steps are the first steps of the
+ * kept one); one that ran the whole span answers every request. */
+#define RS_CACHE 32
+
+typedef struct rs_cached {
+    double *p;                   /* k slot values; NULL: empty */
+    double reach;                /* m, the diameter it ends at (INFINITY: it ran the whole span) */
+    rs_traj tr;
+} rs_cached;
+
 typedef struct rs_impl {
     phc_soil_setup *su;          /* NULL: no soil (fill = soil_fill) */
     size_t k_soil;               /* the soil's slots come first */
@@ -24,14 +50,11 @@ typedef struct rs_impl {
     double d_max;                /* m, largest observed diameter */
     char *source;                /* a sentence naming the data */
     char *notes;                 /* markdown list of excluded / skipped rows */
+    size_t k;                    /* slot count (k_soil + k_growth) */
+    rs_cached cache[RS_CACHE];
+    size_t cache_next;           /* the slot the next new trajectory replaces */
+    phc_root_shoot_counts counts;
 } rs_impl;
-
-/* The simulated trajectory: one state per step. */
-typedef struct rs_traj {
-    size_t m, cap;
-    double *t, *d, *lrs;         /* d, m, ln(root:shoot) */
-    phc_growth_summary last;
-} rs_traj;
 
 static void traj_free(rs_traj *tr)
 {
@@ -65,6 +88,10 @@ static void rs_free(void *p)
 {
     rs_impl *im = p;
     if (!im) return;
+    for (size_t i = 0; i < RS_CACHE; ++i) {
+        free(im->cache[i].p);
+        traj_free(&im->cache[i].tr);
+    }
     phc_soil_setup_free(im->su);
     free(im->gslot);
     free(im->diameter);
@@ -77,7 +104,7 @@ static void rs_free(void *p)
 /* Grows the plant at slot values p until its diameter passes d_stop or the
  * age reaches `days`.  0, > 0 (trial point outside the model's domain) or
  * < 0 (memory); with keep the plant and its soil are handed over. */
-static int grow(const rs_impl *im, const double *p, double d_stop, rs_traj *tr,
+static int grow(rs_impl *im, const double *p, double d_stop, rs_traj *tr,
                 phc_growth **keep_plant, phc_soil **keep_soil, phc_error *err)
 {
     phc_growth_params gp = im->base;
@@ -111,6 +138,9 @@ static int grow(const rs_impl *im, const double *p, double d_stop, rs_traj *tr,
         if (sm.basal_diameter >= d_stop) break;
     }
     tr->last = sm;
+    im->counts.simulated++;
+    im->counts.days += sm.age;
+    if (s) im->counts.soil_substeps += s->budget.substeps;
     if (!rc && keep_plant) {
         *keep_plant = g;
         *keep_soil = s;
@@ -137,20 +167,67 @@ static void at_diameter(const rs_traj *tr, double d, double *lrs, double *age)
     }
 }
 
+/* The kept trajectory grown at exactly p that reaches d_stop, or NULL. */
+static const rs_traj *cache_find(const rs_impl *im, const double *p, double d_stop)
+{
+    for (size_t i = 0; i < RS_CACHE; ++i) {
+        const rs_cached *c = &im->cache[i];
+        if (c->p && c->reach >= d_stop && !memcmp(c->p, p, im->k * sizeof *p))
+            return &c->tr;
+    }
+    return NULL;
+}
+
+/* Hands tr (grown at p until the diameter passed d_stop, or over the whole
+ * span) to the cache, replacing the oldest entry; frees it when there is
+ * no memory for the key. */
+static void cache_keep(rs_impl *im, const double *p, double d_stop, rs_traj *tr)
+{
+    rs_cached *c = &im->cache[im->cache_next];
+    double *key = c->p ? c->p : malloc((im->k ? im->k : 1) * sizeof *key);
+    if (!key) {
+        traj_free(tr);
+        return;
+    }
+    traj_free(&c->tr);
+    memcpy(key, p, im->k * sizeof *p);
+    c->p = key;
+    /* a plant that never reached d_stop ran the whole span: it answers any diameter */
+    c->reach = tr->m && tr->d[tr->m - 1] >= d_stop ? tr->d[tr->m - 1] : INFINITY;
+    c->tr = *tr;
+    memset(tr, 0, sizeof *tr);
+    im->cache_next = (im->cache_next + 1) % RS_CACHE;
+}
+
 static int rs_values(phc_dataset *ds, const double *p, const double *d, size_t m, double *y)
 {
     rs_impl *im = ds->impl;
     double dmax = 0;
     for (size_t i = 0; i < m; ++i) dmax = fmax(dmax, d[i]);
+    im->counts.requested++;
+    const rs_traj *hit = cache_find(im, p, dmax);
     rs_traj tr = {0};
-    int rc = grow(im, p, dmax, &tr, NULL, NULL, NULL);
+    int rc = 0;
+    if (hit)
+        im->counts.reused++;
+    else if (!(rc = grow(im, p, dmax, &tr, NULL, NULL, NULL)))
+        hit = &tr;
     if (!rc)
         for (size_t i = 0; i < m; ++i) {
             double age;
-            at_diameter(&tr, d[i], &y[i], &age);
+            at_diameter(hit, d[i], &y[i], &age);
         }
+    if (!rc && hit == &tr)
+        cache_keep(im, p, dmax, &tr);
     traj_free(&tr);
     return rc;
+}
+
+int phc_root_shoot_counts_get(const phc_dataset *ds, phc_root_shoot_counts *out)
+{
+    if (!ds || ds->ops != &phc_root_shoot_ops || !out) return PHC_ERR_INVALID;
+    *out = ((const rs_impl *)ds->impl)->counts;
+    return PHC_OK;
 }
 
 /* Relative step of the Jacobian's central differences: the model is a
@@ -196,6 +273,7 @@ static int rs_predict_at(phc_dataset *ds, const double *p, const double *x, size
 static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
 {
     rs_impl *im = ds->impl;
+    const phc_root_shoot_counts before = im->counts;
     rs_traj tr = {0};
     int rc = grow(im, p, im->d_max, &tr, NULL, NULL, err);
     if (rc) {
@@ -228,6 +306,12 @@ static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, 
             im->d_max * 1e3, s->age, s->basal_diameter * 1e3, s->shoot_mass, s->leaf_mass,
             s->root_mass, s->root_shoot, s->height, s->rooting_depth, s->root_spread,
             s->shoot_nodes, s->root_nodes);
+    fprintf(f,
+            "Simulations before this report: %lu trajectories asked for (the fit's values and "
+            "Jacobians), %lu of them answered by one of the last %d kept, %lu plants grown "
+            "(%.0f simulated days, %lu soil sub-steps).\n\n",
+            before.requested, before.reused, RS_CACHE, before.simulated, before.days,
+            before.soil_substeps);
     if (s->basal_diameter < im->d_max)
         fprintf(f, "**Warning:** the simulated plant did not reach %.3g mm within %g d.\n\n",
                 im->d_max * 1e3, im->days);
@@ -511,6 +595,7 @@ int phc_root_shoot_new(const phc_harvest *h, const phc_root_shoot_options *o, ph
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    im->k = ds->k;
     ds->derivatives = PHC_DERIV_ANALYTIC; /* our own wide central differences */
     ds->model_tolerance = 1e-4;
     ds->config_line = phc_origin_line(o->origin, NULL);
