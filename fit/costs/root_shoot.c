@@ -104,8 +104,9 @@ static void rs_free(void *p)
 /* Grows the plant at slot values p until its diameter passes d_stop or the
  * age reaches `days`.  0, > 0 (trial point outside the model's domain) or
  * < 0 (memory); with keep the plant and its soil are handed over. */
-static int grow(rs_impl *im, const double *p, double d_stop, rs_traj *tr,
-                phc_growth **keep_plant, phc_soil **keep_soil, phc_error *err)
+static int grow(const rs_impl *im, const double *p, double d_stop, rs_traj *tr,
+                phc_growth **keep_plant, phc_soil **keep_soil, phc_root_shoot_counts *cnt,
+                phc_error *err)
 {
     phc_growth_params gp = im->base;
     for (size_t j = 0; j < im->k_growth; ++j)
@@ -138,9 +139,9 @@ static int grow(rs_impl *im, const double *p, double d_stop, rs_traj *tr,
         if (sm.basal_diameter >= d_stop) break;
     }
     tr->last = sm;
-    im->counts.simulated++;
-    im->counts.days += sm.age;
-    if (s) im->counts.soil_substeps += s->budget.substeps;
+    cnt->simulated++;
+    cnt->days += sm.age;
+    if (s) cnt->soil_substeps += s->budget.substeps;
     if (!rc && keep_plant) {
         *keep_plant = g;
         *keep_soil = s;
@@ -199,28 +200,66 @@ static void cache_keep(rs_impl *im, const double *p, double d_stop, rs_traj *tr)
     im->cache_next = (im->cache_next + 1) % RS_CACHE;
 }
 
+/* Model values y (m points x n values, row-major) at the diameters d (n)
+ * for m slot vectors q (m x k, row-major), each from a kept trajectory or
+ * a plant grown for it.  The plants to grow are independent (each builds its
+ * own soil; the model has no globals), so they grow in parallel threads
+ * (OpenMP); every trajectory is the same as grown alone, bit for bit, and
+ * the results are used in point order.  0, or the return code of the first
+ * point (in order) whose plant failed (grow). */
+static int values_many(rs_impl *im, const double *q, size_t m, const double *d, size_t n, double *y)
+{
+    const size_t k = im->k;
+    double dmax = 0;
+    for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, d[i]);
+    rs_traj *tr = calloc(m, sizeof *tr);
+    int *rc = calloc(m, sizeof *rc);
+    size_t *miss = malloc(m * sizeof *miss);
+    phc_root_shoot_counts *cnt = calloc(m, sizeof *cnt);
+    const rs_traj **use = calloc(m, sizeof *use);
+    if (!tr || !rc || !miss || !cnt || !use) {
+        free(tr); free(rc); free(miss); free(cnt); free(use);
+        return -1;
+    }
+    size_t n_miss = 0;
+    for (size_t a = 0; a < m; ++a) {
+        im->counts.requested++;
+        if ((use[a] = cache_find(im, q + a * k, dmax)))
+            im->counts.reused++;
+        else
+            miss[n_miss++] = a;
+    }
+#pragma omp parallel for schedule(dynamic, 1) if (n_miss > 1)
+    for (size_t b = 0; b < n_miss; ++b) {
+        const size_t a = miss[b];
+        rc[a] = grow(im, q + a * k, dmax, &tr[a], NULL, NULL, &cnt[a], NULL);
+    }
+    int first = 0;
+    for (size_t a = 0; a < m; ++a) {
+        im->counts.simulated += cnt[a].simulated;
+        im->counts.days += cnt[a].days;
+        im->counts.soil_substeps += cnt[a].soil_substeps;
+        if (!use[a] && !rc[a])
+            use[a] = &tr[a];
+        if (!first && rc[a]) first = rc[a];
+        if (use[a])
+            for (size_t i = 0; i < n; ++i) {
+                double age;
+                at_diameter(use[a], d[i], &y[a * n + i], &age);
+            }
+    }
+    for (size_t b = 0; b < n_miss; ++b) {
+        const size_t a = miss[b];
+        if (!rc[a]) cache_keep(im, q + a * k, dmax, &tr[a]);
+        traj_free(&tr[a]);
+    }
+    free(tr); free(rc); free(miss); free(cnt); free(use);
+    return first;
+}
+
 static int rs_values(phc_dataset *ds, const double *p, const double *d, size_t m, double *y)
 {
-    rs_impl *im = ds->impl;
-    double dmax = 0;
-    for (size_t i = 0; i < m; ++i) dmax = fmax(dmax, d[i]);
-    im->counts.requested++;
-    const rs_traj *hit = cache_find(im, p, dmax);
-    rs_traj tr = {0};
-    int rc = 0;
-    if (hit)
-        im->counts.reused++;
-    else if (!(rc = grow(im, p, dmax, &tr, NULL, NULL, NULL)))
-        hit = &tr;
-    if (!rc)
-        for (size_t i = 0; i < m; ++i) {
-            double age;
-            at_diameter(hit, d[i], &y[i], &age);
-        }
-    if (!rc && hit == &tr)
-        cache_keep(im, p, dmax, &tr);
-    traj_free(&tr);
-    return rc;
+    return values_many(ds->impl, p, 1, d, m, y);
 }
 
 int phc_root_shoot_counts_get(const phc_dataset *ds, phc_root_shoot_counts *out)
@@ -240,23 +279,30 @@ int phc_root_shoot_counts_get(const phc_dataset *ds, phc_root_shoot_counts *out)
 static int rs_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
 {
     rs_impl *im = ds->impl;
-    int rc = rs_values(ds, p, im->diameter, ds->n, yhat);
-    if (rc || !jac) return rc;
-    double *q = malloc(ds->k * sizeof *q), *lo = malloc(ds->n * sizeof *lo),
-           *hi = malloc(ds->n * sizeof *hi);
-    if (!q || !lo || !hi) rc = -1;
-    for (size_t j = 0; !rc && j < ds->k; ++j) {
-        memcpy(q, p, ds->k * sizeof *q);
-        double h = RS_FD_STEP * (fabs(p[j]) > 0 ? fabs(p[j]) : 1);
-        q[j] = p[j] + h;
-        rc = rs_values(ds, q, im->diameter, ds->n, hi);
-        q[j] = p[j] - h;
-        if (!rc) rc = rs_values(ds, q, im->diameter, ds->n, lo);
-        for (size_t i = 0; !rc && i < ds->n; ++i) jac[i * ds->k + j] = (hi[i] - lo[i]) / (2 * h);
+    if (!jac) return rs_values(ds, p, im->diameter, ds->n, yhat);
+    /* point 0: p; 2j + 1 and 2j + 2: p + h_j and p - h_j in slot j */
+    const size_t k = ds->k, n = ds->n, m = 2 * k + 1;
+    double *q = malloc(m * k * sizeof *q), *y = malloc(m * n * sizeof *y), *h = malloc((k ? k : 1) * sizeof *h);
+    int rc = !q || !y || !h ? -1 : 0;
+    for (size_t j = 0; !rc && j < k; ++j)
+        h[j] = RS_FD_STEP * (fabs(p[j]) > 0 ? fabs(p[j]) : 1);
+    for (size_t a = 0; !rc && a < m; ++a) {
+        memcpy(q + a * k, p, k * sizeof *q);
+        if (a > 0) {
+            const size_t j = (a - 1) / 2;
+            q[a * k + j] = a % 2 ? p[j] + h[j] : p[j] - h[j];
+        }
+    }
+    if (!rc) rc = values_many(im, q, m, im->diameter, n, y);
+    if (!rc) {
+        memcpy(yhat, y, n * sizeof *yhat);
+        for (size_t j = 0; j < k; ++j)
+            for (size_t i = 0; i < n; ++i)
+                jac[i * k + j] = (y[(2 * j + 1) * n + i] - y[(2 * j + 2) * n + i]) / (2 * h[j]);
     }
     free(q);
-    free(lo);
-    free(hi);
+    free(y);
+    free(h);
     return rc;
 }
 
@@ -275,7 +321,7 @@ static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, 
     rs_impl *im = ds->impl;
     const phc_root_shoot_counts before = im->counts;
     rs_traj tr = {0};
-    int rc = grow(im, p, im->d_max, &tr, NULL, NULL, err);
+    int rc = grow(im, p, im->d_max, &tr, NULL, NULL, &im->counts, err);
     if (rc) {
         traj_free(&tr);
         return rc < 0 ? phc_error_set(err, PHC_ERR_NOMEM, "out of memory")
@@ -347,7 +393,7 @@ static int rs_outputs(phc_dataset *ds, const double *p, const char *dir, const c
     rs_traj tr = {0};
     phc_growth *g = NULL;
     phc_soil *s = NULL;
-    int rc = grow(im, p, im->d_max, &tr, &g, &s, err);
+    int rc = grow(im, p, im->d_max, &tr, &g, &s, &im->counts, err);
     if (rc) {
         traj_free(&tr);
         return rc < 0 ? phc_error_set(err, PHC_ERR_NOMEM, "out of memory") : PHC_ERR_DOMAIN;
