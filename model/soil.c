@@ -789,14 +789,22 @@ static int sources_and_sinks(phc_soil *s, double t, double h, phc_soil_budget *b
         memset(wk->sink_v, 0, s->n * sizeof(double));
         if (s->sink(s->sink_user, t, h, wn, vn, wk->sink_w, wk->sink_v) != 0)
             return PHC_ERR_DOMAIN;
+        /* Only the voxels a sink takes from are touched: the sums see the
+           same non-zero terms in the same order as a sum over every voxel
+           (adding +0 changes nothing), without a chain of additions through
+           every voxel (a plant's roots sit in a few of them). */
         double sw = 0, sv = 0;
         for (size_t i = 0; i < s->n; ++i) {
-            double a = wk->sink_w[i] > 0 ? fmin(wk->sink_w[i], fmax(wn[i], 0.0)) : 0;
-            double b = wk->sink_v[i] > 0 ? fmin(wk->sink_v[i], fmax(vn[i], 0.0)) : 0;
-            wn[i] -= a;
-            vn[i] -= b;
-            sw += a;
-            sv += b;
+            if (wk->sink_w[i] > 0) {
+                double a = fmin(wk->sink_w[i], fmax(wn[i], 0.0));
+                wn[i] -= a;
+                sw += a;
+            }
+            if (wk->sink_v[i] > 0) {
+                double b = fmin(wk->sink_v[i], fmax(vn[i], 0.0));
+                vn[i] -= b;
+                sv += b;
+            }
         }
         bud->water_sunk += sw * vol;
         bud->nutrient_sunk += sv * vol;
