@@ -180,6 +180,34 @@ int phc_growth_preset(const char *name, phc_growth_params *p, phc_error *err)
     return PHC_OK;
 }
 
+const char *phc_growth_preset_for_species(const char *species, const char **group)
+{
+    static const struct { const char *genus, *preset; } described[] = {
+        {"Quercus", "oak"}, {"Prunus", "cherry"}, {"Malus", "apple"},
+        {"Populus", "poplar"}, {"Acer", "maple"},
+    };
+    static const char *const conifers[] = {
+        "Pinus", "Picea", "Abies", "Pseudotsuga", "Larix", "Tsuga", "Cedrus",
+        "Chamaecyparis", "Cryptomeria", "Cupressus", "Juniperus", "Thuja", "Sequoia",
+        "Taxodium", "Metasequoia", "Taxus", "Podocarpus", "Agathis", "Araucaria",
+    };
+    if (group) *group = "other";
+    if (!species) return NULL;
+    while (*species == ' ') species++;
+    size_t len = strcspn(species, " ");
+    for (size_t i = 0; i < sizeof described / sizeof described[0]; i++)
+        if (strlen(described[i].genus) == len && strncasecmp(species, described[i].genus, len) == 0) {
+            if (group) *group = described[i].genus;
+            return described[i].preset;
+        }
+    for (size_t i = 0; i < sizeof conifers / sizeof conifers[0]; i++)
+        if (strlen(conifers[i]) == len && strncasecmp(species, conifers[i], len) == 0) {
+            if (group) *group = "conifer";
+            return NULL;
+        }
+    return NULL;
+}
+
 phc_growth_options phc_growth_options_default(void)
 {
     phc_growth_options o;

@@ -241,6 +241,8 @@ static int root_shoot_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, c
     if ((rc = file ? harvest_table(doc, node, path, &origin, &plants, err)
                    : harvest_baad(doc, node, path, &origin, &plants, err)))
         goto done;
+    if (baad && (rc = phc_yaml_map_string(doc, node, "species", 1, ctx, &o.species, err)))
+        goto done;
     o.soil = soil ? &soil_yaml.options : NULL;
     o.is_parameter = is_parameter;
     o.user_data = user_data;

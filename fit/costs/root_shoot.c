@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "fit/growth_outputs.h"
 #include "measurements/atomic_file.h"
@@ -41,6 +42,7 @@ typedef struct rs_impl {
     size_t k_soil;               /* the soil's slots come first */
     phc_growth_params base;      /* preset + overrides */
     char preset[32];
+    char *species;               /* NULL: not given */
     phc_growth_options opt;
     long *gslot;                 /* per data-set slot past k_soil: growth parameter index */
     size_t k_growth;
@@ -98,6 +100,7 @@ static void rs_free(void *p)
     free(im->age);
     free(im->source);
     free(im->notes);
+    free(im->species);
     free(im);
 }
 
@@ -316,6 +319,34 @@ static int rs_predict_at(phc_dataset *ds, const double *p, const double *x, size
     return rc;
 }
 
+/* Which preset was used, and whether it describes the plants' species
+ * (phc_growth_preset_for_species): said plainly when it does not. */
+static void preset_sentence(FILE *f, const rs_impl *im)
+{
+    const char *group = NULL;
+    const char *own = phc_growth_preset_for_species(im->species, &group);
+    if (!im->species)
+        fprintf(f, "Preset: `%s`. The plants' species is not given, so whether the preset "
+                   "describes it is not known.\n\n", im->preset);
+    else if (own && !strcasecmp(own, im->preset))
+        fprintf(f, "Preset: `%s`, the preset for the genus *%s* of *%s*.\n\n", im->preset, group,
+                im->species);
+    else {
+        fprintf(f, "**Preset:** `%s` was used for *%s*, a species it does not describe. ", im->preset,
+                im->species);
+        if (own)
+            fprintf(f, "The preset for its genus *%s* is `%s`.", group, own);
+        else
+            fprintf(f, "No preset describes %s: the five presets are for *Quercus* (oak), *Prunus* "
+                       "(cherry), *Malus* (apple), *Populus* (poplar) and *Acer* (maple); there is "
+                       "no conifer or tropical preset.",
+                    !strcmp(group, "conifer") ? "conifers" : "its genus");
+        fprintf(f, " The growth parameters the fit does not estimate are that preset's, and every "
+                   "preset's values are ours, not measured (model/growth.c): read the fitted "
+                   "values as calibration constants of this model for these plants.\n\n");
+    }
+}
+
 static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
 {
     rs_impl *im = ds->impl;
@@ -352,6 +383,7 @@ static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, 
             im->d_max * 1e3, s->age, s->basal_diameter * 1e3, s->shoot_mass, s->leaf_mass,
             s->root_mass, s->root_shoot, s->height, s->rooting_depth, s->root_spread,
             s->shoot_nodes, s->root_nodes);
+    preset_sentence(f, im);
     fprintf(f,
             "Simulations before this report: %lu trajectories asked for (the fit's values and "
             "Jacobians), %lu of them answered by one of the last %d kept, %lu plants grown "
@@ -493,6 +525,8 @@ static int setup_growth(rs_impl *im, const phc_root_shoot_options *o, phc_error 
     else if ((rc = phc_growth_preset(preset, &im->base, err)))
         return phc_error_prefix(err, rc, "%s: key 'preset'", WHERE("preset"));
     snprintf(im->preset, sizeof im->preset, "%s", preset);
+    if (o->species && !(im->species = strdup(o->species)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     im->opt = phc_growth_options_default();
     im->opt.mode = o->mode;
     im->opt.seed = o->seed;

@@ -60,6 +60,8 @@ typedef struct phc_root_shoot_options {
     double sigma;            /* standard deviation of ln(root mass / shoot mass), > 0
                                 (required; NAN until set) */
     const char *preset;      /* growth preset: oak (default), cherry, apple, poplar, maple */
+    const char *species;     /* the plants' species (e.g. BAAD's name), for the report, which
+                                says whether the preset describes it; NULL: not given */
     const phc_growth_params *growth; /* the growth parameters (model/growth.h); NULL: the
                                         preset's */
     phc_growth_mode mode;    /* PHC_GROWTH_EXPECTED (default, smooth) or PHC_GROWTH_STOCHASTIC */
