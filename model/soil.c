@@ -645,42 +645,54 @@ static inline double water_voxel(const double *restrict w, const double *restric
     return w[q] + cd * (f[0] + f[1] + f[2] + f[3] + f[4] + f[5]) + cg * (f[6] - f[7]);
 }
 
-/* Water only (no nutrients move): the x-interior of every row has no
- * wrap-around and no branches, so the compiler vectorises it; the two
- * ends of the row are done apart. */
-static void transport_water(phc_soil *s, double h)
+/* Water only (no nutrients move), the z-plane k: the x-interior of every
+ * row has no wrap-around and no branches, so the compiler vectorises it;
+ * the two ends of the row are done apart. */
+static inline void transport_water_plane(const phc_soil *s, double h, size_t k)
 {
-    phc_soil_work *wk = s->work;
+    const phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
     const double *restrict w = s->w, *restrict ic = wk->ic, *restrict p = s->p;
     const double *restrict kx = wk->kx, *restrict ky = wk->ky, *restrict kz = wk->kz;
     double *restrict wn = wk->w_new;
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
-#pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
-    for (size_t k = 0; k < nz; ++k) {
-        const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
-        for (size_t j = 0; j < ny; ++j) {
-            const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
-            const size_t row = nx * (j + ny * k);
-            {
-                const size_t q = row;
-                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
-                                    q - js, q + kup, q - kdn, a, cd, cg, lw);
-            }
+    const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+        const size_t row = nx * (j + ny * k);
+        {
+            const size_t q = row;
+            wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
+                                q - js, q + kup, q - kdn, a, cd, cg, lw);
+        }
 #pragma omp simd
-            for (size_t i = 1; i < nx - 1; ++i) {
-                const size_t q = row + i;
-                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, a, cd, cg, lw);
-            }
-            if (nx > 1) {
-                const size_t q = row + nx - 1;
-                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, a, cd, cg, lw);
-            }
+        for (size_t i = 1; i < nx - 1; ++i) {
+            const size_t q = row + i;
+            wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
+                                q - kdn, a, cd, cg, lw);
+        }
+        if (nx > 1) {
+            const size_t q = row + nx - 1;
+            wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
+                                q - kdn, a, cd, cg, lw);
         }
     }
+}
+
+/* Water only, every plane.  A small grid does not enter an OpenMP region
+ * at all (an `if` clause still calls into libgomp on every sub-step: a
+ * tenth of a small pot's run time, more inside another parallel region,
+ * as when a root:shoot Jacobian grows its plants in parallel). */
+static void transport_water(phc_soil *s, double h)
+{
+    if (s->n >= PHC_SOIL_PARALLEL_MIN) {
+#pragma omp parallel for schedule(static)
+        for (size_t k = 0; k < s->nz; ++k)
+            transport_water_plane(s, h, k);
+    } else
+        for (size_t k = 0; k < s->nz; ++k)
+            transport_water_plane(s, h, k);
 }
 
 /* Transport over one sub-step h: w_new (and v_new) from w (and v). */
