@@ -81,6 +81,7 @@ static int bench(const char *name, const char *config, int repeat)
 
 int main(int argc, char **argv)
 {
+    setvbuf(stdout, NULL, _IOLBF, 0); /* each line as it is measured */
     int repeat = argc > 1 ? atoi(argv[1]) : 3;
     if (repeat < 1 || repeat > 16) {
         fprintf(stderr, "bench_root_shoot: REPEAT must be 1 to 16, found '%s'\n", argv[1]);
