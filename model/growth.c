@@ -180,6 +180,34 @@ int phc_growth_preset(const char *name, phc_growth_params *p, phc_error *err)
     return PHC_OK;
 }
 
+const char *phc_growth_preset_for_species(const char *species, const char **group)
+{
+    static const struct { const char *genus, *preset; } described[] = {
+        {"Quercus", "oak"}, {"Prunus", "cherry"}, {"Malus", "apple"},
+        {"Populus", "poplar"}, {"Acer", "maple"},
+    };
+    static const char *const conifers[] = {
+        "Pinus", "Picea", "Abies", "Pseudotsuga", "Larix", "Tsuga", "Cedrus",
+        "Chamaecyparis", "Cryptomeria", "Cupressus", "Juniperus", "Thuja", "Sequoia",
+        "Taxodium", "Metasequoia", "Taxus", "Podocarpus", "Agathis", "Araucaria",
+    };
+    if (group) *group = "other";
+    if (!species) return NULL;
+    while (*species == ' ') species++;
+    size_t len = strcspn(species, " ");
+    for (size_t i = 0; i < sizeof described / sizeof described[0]; i++)
+        if (strlen(described[i].genus) == len && strncasecmp(species, described[i].genus, len) == 0) {
+            if (group) *group = described[i].genus;
+            return described[i].preset;
+        }
+    for (size_t i = 0; i < sizeof conifers / sizeof conifers[0]; i++)
+        if (strlen(conifers[i]) == len && strncasecmp(species, conifers[i], len) == 0) {
+            if (group) *group = "conifer";
+            return NULL;
+        }
+    return NULL;
+}
+
 phc_growth_options phc_growth_options_default(void)
 {
     phc_growth_options o;
@@ -208,6 +236,8 @@ struct phc_growth {
     size_t *voxel;            /* per node: soil voxel of a root segment */
     size_t scratch_cap;
     double *sink_rate;        /* per soil voxel: m^3/m^3/h taken by the roots */
+    size_t *sink_voxels;      /* the voxels whose sink_rate is > 0, ascending */
+    size_t n_sink_voxels;
     double *light_grid;
     size_t light_cap;
 };
@@ -330,8 +360,12 @@ static int soil_sink(void *user, double t, double h, const double *w, const doub
     (void)t; (void)v; (void)nutrient;
     phc_growth *g = user;
     const double *rate = g->sink_rate;
-    for (size_t i = 0; i < g->soil->n; i++)
-        if (rate[i] > 0) water[i] = fmin(rate[i] * h, w[i]);
+    /* the voxels with roots (a few of a pot's), not every voxel: the soil
+       calls this on every sub-step */
+    for (size_t k = 0; k < g->n_sink_voxels; k++) {
+        const size_t i = g->sink_voxels[k];
+        water[i] = fmin(rate[i] * h, w[i]);
+    }
     return 0;
 }
 
@@ -379,7 +413,8 @@ int phc_growth_new(const phc_growth_params *p, const phc_growth_options *o, phc_
     if ((rc = reserve_nodes(g, 64, err)) || (rc = reserve_scratch(g, err))) goto fail;
     if (soil) {
         g->sink_rate = calloc(soil->n, sizeof *g->sink_rate);
-        if (!g->sink_rate) { rc = phc_error_set(err, PHC_ERR_NOMEM, "growth: out of memory"); goto fail; }
+        g->sink_voxels = malloc(soil->n * sizeof *g->sink_voxels);
+        if (!g->sink_rate || !g->sink_voxels) { rc = phc_error_set(err, PHC_ERR_NOMEM, "growth: out of memory"); goto fail; }
         if (opt.uptake == PHC_GROWTH_UPTAKE_PHYSICAL) {
             soil->sink = soil_sink;
             soil->sink_user = g;
@@ -408,6 +443,7 @@ void phc_growth_free(phc_growth *g)
     free(g->c);
     free(g->voxel);
     free(g->sink_rate);
+    free(g->sink_voxels);
     free(g->light_grid);
     free(g);
 }
@@ -592,6 +628,9 @@ static void root_flux(phc_growth *g)
             if (n->system == PHC_GROWTH_ROOT && g->voxel[i] != PHC_GROWTH_NONE)
                 g->sink_rate[g->voxel[i]] += n->uptake / (24.0 * vol); /* m^3/m^3/h */
         }
+        g->n_sink_voxels = 0;
+        for (size_t v = 0; v < s->n; v++)
+            if (g->sink_rate[v] > 0) g->sink_voxels[g->n_sink_voxels++] = v;
     }
     for (size_t i = 0; i < g->n; i++)
         if (g->node[i].system == PHC_GROWTH_ROOT) total += g->node[i].uptake;
@@ -975,8 +1014,10 @@ int phc_growth_step(phc_growth *g, double dt, phc_error *err)
     prune(g);
     thicken(g);
     if (g->soil) {
-        if (g->o.uptake != PHC_GROWTH_UPTAKE_PHYSICAL)
+        if (g->o.uptake != PHC_GROWTH_UPTAKE_PHYSICAL) {
             memset(g->sink_rate, 0, g->soil->n * sizeof *g->sink_rate);
+            g->n_sink_voxels = 0;
+        }
         rc = phc_soil_run(g->soil, g->soil->t + 24.0 * dt, err);
         if (rc) return phc_error_prefix(err, rc, "growth at day %g", g->age);
     }

@@ -193,6 +193,18 @@ long phc_growth_param_find(const char *name);
 int phc_growth_preset(const char *name, phc_growth_params *p, phc_error *err);
 const char *phc_growth_preset_name(size_t i); /* NULL past the end */
 
+/* Which preset describes a species, by its genus (the first word of the
+ * name, case ignored): Quercus "oak", Prunus "cherry", Malus "apple",
+ * Populus "poplar", Acer "maple"; NULL for every other genus.  *group (may
+ * be NULL) gets a word for the genus: the preset's genus, "conifer" for the
+ * conifer genera no preset describes (Pinaceae: Pinus, Picea, Abies,
+ * Pseudotsuga, Larix, Tsuga, Cedrus; Cupressaceae: Chamaecyparis,
+ * Cryptomeria, Cupressus, Juniperus, Thuja, Sequoia, Taxodium,
+ * Metasequoia; Taxaceae: Taxus; Podocarpaceae: Podocarpus; Araucariaceae:
+ * Agathis, Araucaria), or "other".  A genus is not called tropical: that
+ * is a property of where a plant grows, not of its name. */
+const char *phc_growth_preset_for_species(const char *species, const char **group);
+
 /* Domain checks: PHC_ERR_INPUT "growth parameter 'x': must be ..., found v". */
 int phc_growth_check(const phc_growth_params *p, phc_error *err);
 

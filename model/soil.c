@@ -22,6 +22,7 @@ struct phc_soil_work {
     double *kx, *ky, *kz;      /* face permeability (harmonic mean) to the +x, +y, +z
                                   neighbour (wrapped); 0 across closed box faces */
     double *sink_w, *sink_v;   /* sink hook buffers */
+    double *lw, *gw;           /* transport_water's per-voxel w/c and f_grav p w */
     double *plane;             /* nz partial sums */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
@@ -66,6 +67,8 @@ static void work_free(phc_soil_work *wk)
     free(wk->kz);
     free(wk->sink_w);
     free(wk->sink_v);
+    free(wk->lw);
+    free(wk->gw);
     free(wk->plane);
     free(wk->top);
     free(wk->damp_x);
@@ -108,12 +111,14 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->kx = malloc(n * sizeof(double));
     wk->ky = malloc(n * sizeof(double));
     wk->kz = malloc(n * sizeof(double));
+    wk->lw = malloc(n * sizeof(double));
+    wk->gw = malloc(n * sizeof(double));
     wk->plane = malloc(nz * sizeof(double));
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
-    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane ||
+    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->lw || !wk->gw || !wk->plane ||
         !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
@@ -644,54 +649,98 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
     f[7] = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
 }
 
-/* The water update of voxel q from its face terms. */
-static inline double water_voxel(const double *restrict w, const double *restrict ic,
-                                 const double *restrict p, const double *restrict kx,
-                                 const double *restrict ky, const double *restrict kz, size_t q,
-                                 size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
-                                 double a, double cd, double cg, double lw, int up)
+/* The water update of voxel q, voxel_faces' terms summed as transport()
+ * sums them, from the voxels' fill l = w/c and gravity flux g = f_grav p w
+ * computed once per sub-step (wk->lw, wk->gw) instead of once for each of a
+ * voxel's 7 stencil entries: the same products, the same sums in the same
+ * order, so the same numbers to the last bit. */
+static inline double water_voxel_pre(const double *restrict w, const double *restrict l,
+                                     const double *restrict g, const double *restrict kx,
+                                     const double *restrict ky, const double *restrict kz, size_t q,
+                                     size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
+                                     double cd, double cg, double lw, int up)
 {
-    double f[8];
-    voxel_faces(w, ic, p, kx, ky, kz, q, qe, qw, qn, qs, qu, qd, a, lw, up, f);
-    return w[q] + cd * (f[0] + f[1] + f[2] + f[3] + f[4] + f[5]) + cg * (f[6] - f[7]);
+    const double l0 = l[q];
+    const double f0 = kx[q] * (l[qe] - l0), f1 = kx[qw] * (l[qw] - l0);
+    const double f2 = ky[q] * (l[qn] - l0), f3 = ky[qs] * (l[qs] - l0);
+    const double f4 = kz[q] * (l[qu] - l0), f5 = kz[qd] * (l[qd] - l0);
+    const double q0 = g[q], qU = g[qu], qD = g[qd];
+    const double f6 = kz[q] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kz[q]) * (q0 - qU) : 0;
+    const double f7 = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
+    return w[q] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
 }
 
-/* Water only (no nutrients move): the x-interior of every row has no
- * wrap-around and no branches, so the compiler vectorises it; the two
- * ends of the row are done apart. */
-static void transport_water(phc_soil *s, double h)
+/* wk->lw and wk->gw of the z-plane k (voxel_faces' l and q). */
+static inline void fill_plane(const phc_soil *s, size_t k)
 {
-    phc_soil_work *wk = s->work;
-    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
+    const phc_soil_work *wk = s->work;
+    const size_t plane = s->nx * s->ny;
     const double *restrict w = s->w, *restrict ic = wk->ic, *restrict p = s->p;
+    double *restrict l = wk->lw, *restrict g = wk->gw;
+    const double a = s->params.f_grav;
+    for (size_t q = plane * k; q < plane * (k + 1); ++q) {
+        l[q] = w[q] * ic[q];
+        g[q] = a * p[q] * w[q];
+    }
+}
+
+/* Water only (no nutrients move), the z-plane k: the x-interior of every
+ * row has no wrap-around and no branches, so the compiler vectorises it;
+ * the two ends of the row are done apart. */
+static inline void transport_water_plane(const phc_soil *s, double h, size_t k)
+{
+    const phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
+    const double *restrict w = s->w, *restrict l = wk->lw, *restrict g = wk->gw;
     const double *restrict kx = wk->kx, *restrict ky = wk->ky, *restrict kz = wk->kz;
     double *restrict wn = wk->w_new;
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
-#pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
-    for (size_t k = 0; k < nz; ++k) {
-        const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
-        for (size_t j = 0; j < ny; ++j) {
-            const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
-            const size_t row = nx * (j + ny * k);
-            {
-                const size_t q = row;
-                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
-                                    q - js, q + kup, q - kdn, a, cd, cg, lw, up);
-            }
-#pragma omp simd
-            for (size_t i = 1; i < nx - 1; ++i) {
-                const size_t q = row + i;
-                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, a, cd, cg, lw, up);
-            }
-            if (nx > 1) {
-                const size_t q = row + nx - 1;
-                wn[q] = water_voxel(w, ic, p, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, a, cd, cg, lw, up);
-            }
+    const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+        const size_t row = nx * (j + ny * k);
+        {
+            const size_t q = row;
+            wn[q] = water_voxel_pre(w, l, g, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
+                                    q - js, q + kup, q - kdn, cd, cg, lw, up);
         }
+#pragma omp simd
+        for (size_t i = 1; i < nx - 1; ++i) {
+            const size_t q = row + i;
+            wn[q] = water_voxel_pre(w, l, g, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
+                                    q - kdn, cd, cg, lw, up);
+        }
+        if (nx > 1) {
+            const size_t q = row + nx - 1;
+            wn[q] = water_voxel_pre(w, l, g, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
+                                    q - kdn, cd, cg, lw, up);
+        }
+    }
+}
+
+/* Water only, every plane.  A small grid does not enter an OpenMP region
+ * at all (an `if` clause still calls into libgomp on every sub-step: a
+ * tenth of a small pot's run time, more inside another parallel region,
+ * as when a root:shoot Jacobian grows its plants in parallel). */
+static void transport_water(phc_soil *s, double h)
+{
+    if (s->n >= PHC_SOIL_PARALLEL_MIN) {
+#pragma omp parallel
+        {
+#pragma omp for schedule(static)
+            for (size_t k = 0; k < s->nz; ++k)
+                fill_plane(s, k);
+#pragma omp for schedule(static)
+            for (size_t k = 0; k < s->nz; ++k)
+                transport_water_plane(s, h, k);
+        }
+    } else {
+        for (size_t k = 0; k < s->nz; ++k)
+            fill_plane(s, k);
+        for (size_t k = 0; k < s->nz; ++k)
+            transport_water_plane(s, h, k);
     }
 }
 
@@ -802,14 +851,22 @@ static int sources_and_sinks(phc_soil *s, double t, double h, phc_soil_budget *b
         memset(wk->sink_v, 0, s->n * sizeof(double));
         if (s->sink(s->sink_user, t, h, wn, vn, wk->sink_w, wk->sink_v) != 0)
             return PHC_ERR_DOMAIN;
+        /* Only the voxels a sink takes from are touched: the sums see the
+           same non-zero terms in the same order as a sum over every voxel
+           (adding +0 changes nothing), without a chain of additions through
+           every voxel (a plant's roots sit in a few of them). */
         double sw = 0, sv = 0;
         for (size_t i = 0; i < s->n; ++i) {
-            double a = wk->sink_w[i] > 0 ? fmin(wk->sink_w[i], fmax(wn[i], 0.0)) : 0;
-            double b = wk->sink_v[i] > 0 ? fmin(wk->sink_v[i], fmax(vn[i], 0.0)) : 0;
-            wn[i] -= a;
-            vn[i] -= b;
-            sw += a;
-            sv += b;
+            if (wk->sink_w[i] > 0) {
+                double a = fmin(wk->sink_w[i], fmax(wn[i], 0.0));
+                wn[i] -= a;
+                sw += a;
+            }
+            if (wk->sink_v[i] > 0) {
+                double b = fmin(wk->sink_v[i], fmax(vn[i], 0.0));
+                vn[i] -= b;
+                sv += b;
+            }
         }
         bud->water_sunk += sw * vol;
         bud->nutrient_sunk += sv * vol;

@@ -38,7 +38,8 @@ static const phc_key_help root_shoot_help[] = {
             "with the simulated ages in the report. Optional."},
     {"baad", "A BAAD study folder (its data.csv), relative to the config file. Give exactly one "
              "of file and baad."},
-    {"species", "With baad: the species whose plants are used. Required with baad."},
+    {"species", "With baad: the species whose plants are used; the report says whether the "
+                "growth preset describes it (by genus). Required with baad."},
     {"suspicious", "With baad: exclude or keep the rows BAAD flags as suspicious (listed in the "
                    "report). Default: exclude."},
     {"select", "{column: NAME, equals: VALUE}: keep only the rows whose column (of the table, "
@@ -240,6 +241,8 @@ static int root_shoot_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, c
     }
     if ((rc = file ? harvest_table(doc, node, path, &origin, &plants, err)
                    : harvest_baad(doc, node, path, &origin, &plants, err)))
+        goto done;
+    if (baad && (rc = phc_yaml_map_string(doc, node, "species", 1, ctx, &o.species, err)))
         goto done;
     o.soil = soil ? &soil_yaml.options : NULL;
     o.is_parameter = is_parameter;

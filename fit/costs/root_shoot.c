@@ -6,15 +6,43 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "fit/growth_outputs.h"
 #include "measurements/atomic_file.h"
+
+/* The simulated trajectory: one state per step. */
+typedef struct rs_traj {
+    size_t m, cap;
+    double *t, *d, *lrs;         /* d, m, ln(root:shoot) */
+    phc_growth_summary last;
+} rs_traj;
+
+/* The last RS_CACHE trajectories, by the exact slot values that grew them.
+ * The plant is deterministic (expected mode, or stochastic with its fixed
+ * seed), so a second simulation at the same slot values repeats the first
+ * bit for bit; the solver asks for the same point several times (Ceres
+ * evaluates a trust-region candidate in its projected line search, again
+ * for its cost, and once more with the Jacobian when it accepts it; the
+ * analysis evaluates the solution again), and a cached trajectory answers
+ * without simulating.  A trajectory that ends at diameter D answers every
+ * request for diameters <= D (a plant grown for them would stop at the
+ * first step past the largest, and its steps are the first steps of the
+ * kept one); one that ran the whole span answers every request. */
+#define RS_CACHE 32
+
+typedef struct rs_cached {
+    double *p;                   /* k slot values; NULL: empty */
+    double reach;                /* m, the diameter it ends at (INFINITY: it ran the whole span) */
+    rs_traj tr;
+} rs_cached;
 
 typedef struct rs_impl {
     phc_soil_setup *su;          /* NULL: no soil (fill = soil_fill) */
     size_t k_soil;               /* the soil's slots come first */
     phc_growth_params base;      /* preset + overrides */
     char preset[32];
+    char *species;               /* NULL: not given */
     phc_growth_options opt;
     long *gslot;                 /* per data-set slot past k_soil: growth parameter index */
     size_t k_growth;
@@ -24,14 +52,11 @@ typedef struct rs_impl {
     double d_max;                /* m, largest observed diameter */
     char *source;                /* a sentence naming the data */
     char *notes;                 /* markdown list of excluded / skipped rows */
+    size_t k;                    /* slot count (k_soil + k_growth) */
+    rs_cached cache[RS_CACHE];
+    size_t cache_next;           /* the slot the next new trajectory replaces */
+    phc_root_shoot_counts counts;
 } rs_impl;
-
-/* The simulated trajectory: one state per step. */
-typedef struct rs_traj {
-    size_t m, cap;
-    double *t, *d, *lrs;         /* d, m, ln(root:shoot) */
-    phc_growth_summary last;
-} rs_traj;
 
 static void traj_free(rs_traj *tr)
 {
@@ -65,12 +90,17 @@ static void rs_free(void *p)
 {
     rs_impl *im = p;
     if (!im) return;
+    for (size_t i = 0; i < RS_CACHE; ++i) {
+        free(im->cache[i].p);
+        traj_free(&im->cache[i].tr);
+    }
     phc_soil_setup_free(im->su);
     free(im->gslot);
     free(im->diameter);
     free(im->age);
     free(im->source);
     free(im->notes);
+    free(im->species);
     free(im);
 }
 
@@ -78,7 +108,8 @@ static void rs_free(void *p)
  * age reaches `days`.  0, > 0 (trial point outside the model's domain) or
  * < 0 (memory); with keep the plant and its soil are handed over. */
 static int grow(const rs_impl *im, const double *p, double d_stop, rs_traj *tr,
-                phc_growth **keep_plant, phc_soil **keep_soil, phc_error *err)
+                phc_growth **keep_plant, phc_soil **keep_soil, phc_root_shoot_counts *cnt,
+                phc_error *err)
 {
     phc_growth_params gp = im->base;
     for (size_t j = 0; j < im->k_growth; ++j)
@@ -111,6 +142,9 @@ static int grow(const rs_impl *im, const double *p, double d_stop, rs_traj *tr,
         if (sm.basal_diameter >= d_stop) break;
     }
     tr->last = sm;
+    cnt->simulated++;
+    cnt->days += sm.age;
+    if (s) cnt->soil_substeps += s->budget.substeps;
     if (!rc && keep_plant) {
         *keep_plant = g;
         *keep_soil = s;
@@ -137,20 +171,105 @@ static void at_diameter(const rs_traj *tr, double d, double *lrs, double *age)
     }
 }
 
+/* The kept trajectory grown at exactly p that reaches d_stop, or NULL. */
+static const rs_traj *cache_find(const rs_impl *im, const double *p, double d_stop)
+{
+    for (size_t i = 0; i < RS_CACHE; ++i) {
+        const rs_cached *c = &im->cache[i];
+        if (c->p && c->reach >= d_stop && !memcmp(c->p, p, im->k * sizeof *p))
+            return &c->tr;
+    }
+    return NULL;
+}
+
+/* Hands tr (grown at p until the diameter passed d_stop, or over the whole
+ * span) to the cache, replacing the oldest entry; frees it when there is
+ * no memory for the key. */
+static void cache_keep(rs_impl *im, const double *p, double d_stop, rs_traj *tr)
+{
+    rs_cached *c = &im->cache[im->cache_next];
+    double *key = c->p ? c->p : malloc((im->k ? im->k : 1) * sizeof *key);
+    if (!key) {
+        traj_free(tr);
+        return;
+    }
+    traj_free(&c->tr);
+    memcpy(key, p, im->k * sizeof *p);
+    c->p = key;
+    /* a plant that never reached d_stop ran the whole span: it answers any diameter */
+    c->reach = tr->m && tr->d[tr->m - 1] >= d_stop ? tr->d[tr->m - 1] : INFINITY;
+    c->tr = *tr;
+    memset(tr, 0, sizeof *tr);
+    im->cache_next = (im->cache_next + 1) % RS_CACHE;
+}
+
+/* Model values y (m points x n values, row-major) at the diameters d (n)
+ * for m slot vectors q (m x k, row-major), each from a kept trajectory or
+ * a plant grown for it.  The plants to grow are independent (each builds its
+ * own soil; the model has no globals), so they grow in parallel threads
+ * (OpenMP); every trajectory is the same as grown alone, bit for bit, and
+ * the results are used in point order.  0, or the return code of the first
+ * point (in order) whose plant failed (grow). */
+static int values_many(rs_impl *im, const double *q, size_t m, const double *d, size_t n, double *y)
+{
+    const size_t k = im->k;
+    double dmax = 0;
+    for (size_t i = 0; i < n; ++i) dmax = fmax(dmax, d[i]);
+    rs_traj *tr = calloc(m, sizeof *tr);
+    int *rc = calloc(m, sizeof *rc);
+    size_t *miss = malloc(m * sizeof *miss);
+    phc_root_shoot_counts *cnt = calloc(m, sizeof *cnt);
+    const rs_traj **use = calloc(m, sizeof *use);
+    if (!tr || !rc || !miss || !cnt || !use) {
+        free(tr); free(rc); free(miss); free(cnt); free(use);
+        return -1;
+    }
+    size_t n_miss = 0;
+    for (size_t a = 0; a < m; ++a) {
+        im->counts.requested++;
+        if ((use[a] = cache_find(im, q + a * k, dmax)))
+            im->counts.reused++;
+        else
+            miss[n_miss++] = a;
+    }
+#pragma omp parallel for schedule(dynamic, 1) if (n_miss > 1)
+    for (size_t b = 0; b < n_miss; ++b) {
+        const size_t a = miss[b];
+        rc[a] = grow(im, q + a * k, dmax, &tr[a], NULL, NULL, &cnt[a], NULL);
+    }
+    int first = 0;
+    for (size_t a = 0; a < m; ++a) {
+        im->counts.simulated += cnt[a].simulated;
+        im->counts.days += cnt[a].days;
+        im->counts.soil_substeps += cnt[a].soil_substeps;
+        if (!use[a] && !rc[a])
+            use[a] = &tr[a];
+        if (!first && rc[a]) first = rc[a];
+        if (use[a])
+            for (size_t i = 0; i < n; ++i) {
+                double age;
+                at_diameter(use[a], d[i], &y[a * n + i], &age);
+            }
+    }
+    for (size_t b = 0; b < n_miss; ++b) {
+        const size_t a = miss[b];
+        if (!rc[a]) cache_keep(im, q + a * k, dmax, &tr[a]);
+        traj_free(&tr[a]);
+    }
+    free(tr); free(rc); free(miss); free(cnt); free(use);
+    return first;
+}
+
 static int rs_values(phc_dataset *ds, const double *p, const double *d, size_t m, double *y)
 {
-    rs_impl *im = ds->impl;
-    double dmax = 0;
-    for (size_t i = 0; i < m; ++i) dmax = fmax(dmax, d[i]);
-    rs_traj tr = {0};
-    int rc = grow(im, p, dmax, &tr, NULL, NULL, NULL);
-    if (!rc)
-        for (size_t i = 0; i < m; ++i) {
-            double age;
-            at_diameter(&tr, d[i], &y[i], &age);
-        }
-    traj_free(&tr);
-    return rc;
+    return values_many(ds->impl, p, 1, d, m, y);
+}
+
+int phc_root_shoot_counts_get(const phc_dataset *ds, phc_root_shoot_counts *out)
+{
+    if (!ds || ds->ops != &phc_root_shoot_ops || !out) return PHC_ERR_INVALID;
+    *out = ((const rs_impl *)ds->impl)->counts;
+    return PHC_OK;
 }
 
 /* Relative step of the Jacobian's central differences: the model is a
@@ -163,23 +282,30 @@ static int rs_values(phc_dataset *ds, const double *p, const double *d, size_t m
 static int rs_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
 {
     rs_impl *im = ds->impl;
-    int rc = rs_values(ds, p, im->diameter, ds->n, yhat);
-    if (rc || !jac) return rc;
-    double *q = malloc(ds->k * sizeof *q), *lo = malloc(ds->n * sizeof *lo),
-           *hi = malloc(ds->n * sizeof *hi);
-    if (!q || !lo || !hi) rc = -1;
-    for (size_t j = 0; !rc && j < ds->k; ++j) {
-        memcpy(q, p, ds->k * sizeof *q);
-        double h = RS_FD_STEP * (fabs(p[j]) > 0 ? fabs(p[j]) : 1);
-        q[j] = p[j] + h;
-        rc = rs_values(ds, q, im->diameter, ds->n, hi);
-        q[j] = p[j] - h;
-        if (!rc) rc = rs_values(ds, q, im->diameter, ds->n, lo);
-        for (size_t i = 0; !rc && i < ds->n; ++i) jac[i * ds->k + j] = (hi[i] - lo[i]) / (2 * h);
+    if (!jac) return rs_values(ds, p, im->diameter, ds->n, yhat);
+    /* point 0: p; 2j + 1 and 2j + 2: p + h_j and p - h_j in slot j */
+    const size_t k = ds->k, n = ds->n, m = 2 * k + 1;
+    double *q = malloc(m * k * sizeof *q), *y = malloc(m * n * sizeof *y), *h = malloc((k ? k : 1) * sizeof *h);
+    int rc = !q || !y || !h ? -1 : 0;
+    for (size_t j = 0; !rc && j < k; ++j)
+        h[j] = RS_FD_STEP * (fabs(p[j]) > 0 ? fabs(p[j]) : 1);
+    for (size_t a = 0; !rc && a < m; ++a) {
+        memcpy(q + a * k, p, k * sizeof *q);
+        if (a > 0) {
+            const size_t j = (a - 1) / 2;
+            q[a * k + j] = a % 2 ? p[j] + h[j] : p[j] - h[j];
+        }
+    }
+    if (!rc) rc = values_many(im, q, m, im->diameter, n, y);
+    if (!rc) {
+        memcpy(yhat, y, n * sizeof *yhat);
+        for (size_t j = 0; j < k; ++j)
+            for (size_t i = 0; i < n; ++i)
+                jac[i * k + j] = (y[(2 * j + 1) * n + i] - y[(2 * j + 2) * n + i]) / (2 * h[j]);
     }
     free(q);
-    free(lo);
-    free(hi);
+    free(y);
+    free(h);
     return rc;
 }
 
@@ -193,11 +319,40 @@ static int rs_predict_at(phc_dataset *ds, const double *p, const double *x, size
     return rc;
 }
 
+/* Which preset was used, and whether it describes the plants' species
+ * (phc_growth_preset_for_species): said plainly when it does not. */
+static void preset_sentence(FILE *f, const rs_impl *im)
+{
+    const char *group = NULL;
+    const char *own = phc_growth_preset_for_species(im->species, &group);
+    if (!im->species)
+        fprintf(f, "Preset: `%s`. The plants' species is not given, so whether the preset "
+                   "describes it is not known.\n\n", im->preset);
+    else if (own && !strcasecmp(own, im->preset))
+        fprintf(f, "Preset: `%s`, the preset for the genus *%s* of *%s*.\n\n", im->preset, group,
+                im->species);
+    else {
+        fprintf(f, "**Preset:** `%s` was used for *%s*, a species it does not describe. ", im->preset,
+                im->species);
+        if (own)
+            fprintf(f, "The preset for its genus *%s* is `%s`.", group, own);
+        else
+            fprintf(f, "No preset describes %s: the five presets are for *Quercus* (oak), *Prunus* "
+                       "(cherry), *Malus* (apple), *Populus* (poplar) and *Acer* (maple); there is "
+                       "no conifer or tropical preset.",
+                    !strcmp(group, "conifer") ? "conifers" : "its genus");
+        fprintf(f, " The growth parameters the fit does not estimate are that preset's, and every "
+                   "preset's values are ours, not measured (model/growth.c): read the fitted "
+                   "values as calibration constants of this model for these plants.\n\n");
+    }
+}
+
 static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
 {
     rs_impl *im = ds->impl;
+    const phc_root_shoot_counts before = im->counts;
     rs_traj tr = {0};
-    int rc = grow(im, p, im->d_max, &tr, NULL, NULL, err);
+    int rc = grow(im, p, im->d_max, &tr, NULL, NULL, &im->counts, err);
     if (rc) {
         traj_free(&tr);
         return rc < 0 ? phc_error_set(err, PHC_ERR_NOMEM, "out of memory")
@@ -228,6 +383,13 @@ static int rs_report_section(phc_dataset *ds, const double *p, char **markdown, 
             im->d_max * 1e3, s->age, s->basal_diameter * 1e3, s->shoot_mass, s->leaf_mass,
             s->root_mass, s->root_shoot, s->height, s->rooting_depth, s->root_spread,
             s->shoot_nodes, s->root_nodes);
+    preset_sentence(f, im);
+    fprintf(f,
+            "Simulations before this report: %lu trajectories asked for (the fit's values and "
+            "Jacobians), %lu of them answered by one of the last %d kept, %lu plants grown "
+            "(%.0f simulated days, %lu soil sub-steps).\n\n",
+            before.requested, before.reused, RS_CACHE, before.simulated, before.days,
+            before.soil_substeps);
     if (s->basal_diameter < im->d_max)
         fprintf(f, "**Warning:** the simulated plant did not reach %.3g mm within %g d.\n\n",
                 im->d_max * 1e3, im->days);
@@ -263,7 +425,7 @@ static int rs_outputs(phc_dataset *ds, const double *p, const char *dir, const c
     rs_traj tr = {0};
     phc_growth *g = NULL;
     phc_soil *s = NULL;
-    int rc = grow(im, p, im->d_max, &tr, &g, &s, err);
+    int rc = grow(im, p, im->d_max, &tr, &g, &s, &im->counts, err);
     if (rc) {
         traj_free(&tr);
         return rc < 0 ? phc_error_set(err, PHC_ERR_NOMEM, "out of memory") : PHC_ERR_DOMAIN;
@@ -363,6 +525,8 @@ static int setup_growth(rs_impl *im, const phc_root_shoot_options *o, phc_error 
     else if ((rc = phc_growth_preset(preset, &im->base, err)))
         return phc_error_prefix(err, rc, "%s: key 'preset'", WHERE("preset"));
     snprintf(im->preset, sizeof im->preset, "%s", preset);
+    if (o->species && !(im->species = strdup(o->species)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     im->opt = phc_growth_options_default();
     im->opt.mode = o->mode;
     im->opt.seed = o->seed;
@@ -511,6 +675,7 @@ int phc_root_shoot_new(const phc_harvest *h, const phc_root_shoot_options *o, ph
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    im->k = ds->k;
     ds->derivatives = PHC_DERIV_ANALYTIC; /* our own wide central differences */
     ds->model_tolerance = 1e-4;
     ds->config_line = phc_origin_line(o->origin, NULL);

@@ -60,6 +60,8 @@ typedef struct phc_root_shoot_options {
     double sigma;            /* standard deviation of ln(root mass / shoot mass), > 0
                                 (required; NAN until set) */
     const char *preset;      /* growth preset: oak (default), cherry, apple, poplar, maple */
+    const char *species;     /* the plants' species (e.g. BAAD's name), for the report, which
+                                says whether the preset describes it; NULL: not given */
     const phc_growth_params *growth; /* the growth parameters (model/growth.h); NULL: the
                                         preset's */
     phc_growth_mode mode;    /* PHC_GROWTH_EXPECTED (default, smooth) or PHC_GROWTH_STOCHASTIC */
@@ -93,6 +95,23 @@ phc_root_shoot_options phc_root_shoot_options_default(void);
  * config line when options.origin is set) or the plants' file and line. */
 int phc_root_shoot_new(const phc_harvest *plants, const phc_root_shoot_options *options, phc_dataset **out,
                        phc_error *err);
+
+/* What a root_shoot data set has simulated since it was built.  Each
+ * request for model values at some slot values needs one trajectory (the
+ * plant grown until its diameter passes the largest asked for); the data
+ * set keeps its last 32 trajectories by their exact slot values, and a
+ * request at the same values is answered from them (the plant is
+ * deterministic: the answer is the same to the last bit). */
+typedef struct phc_root_shoot_counts {
+    unsigned long requested;     /* trajectories asked for (values, each Jacobian column twice) */
+    unsigned long reused;        /* of those, answered by a kept trajectory */
+    unsigned long simulated;     /* plants grown (the report and the outputs grow their own) */
+    double days;                 /* simulated days over all grown plants */
+    unsigned long soil_substeps; /* soil sub-steps over all grown plants */
+} phc_root_shoot_counts;
+
+/* The counts of ds (a root_shoot data set); PHC_ERR_INVALID otherwise. */
+int phc_root_shoot_counts_get(const phc_dataset *ds, phc_root_shoot_counts *out);
 
 /* The operations of root_shoot data sets (ops->kind is "root_shoot"). */
 extern const phc_dataset_ops phc_root_shoot_ops;
