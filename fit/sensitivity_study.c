@@ -455,19 +455,12 @@ static int append(char **buf, const char *fmt, ...)
     return 0;
 }
 
-/* What identifies the study in its ledger: the config and data (SHA-256),
- * the method and design, the factors, priors and outputs. */
+/* What identifies the study in its ledger: the method and design, the
+ * factors, priors and outputs, the config and data (SHA-256). */
 static int study_identity(study *s, const phc_provenance *pv)
 {
     const phc_study_options *o = s->o;
     int bad = 0;
-    bad |= add_key(s, "config-sha256", "%s", pv && pv->config ? pv->config->sha256 : "none");
-    char *inputs = NULL;
-    if (pv)
-        for (size_t i = 0; i < pv->n_inputs; ++i)
-            bad |= append(&inputs, "%s%s", i ? "," : "", pv->inputs[i].sha256);
-    bad |= add_key(s, "data-sha256", "%s", inputs ? inputs : "none");
-    free(inputs);
     bad |= add_key(s, "method", "%s", o->method == PHC_STUDY_MORRIS ? "morris" : "sobol");
     if (o->method == PHC_STUDY_MORRIS)
         bad |= add_key(s, "design", "morris-1991 levels=%u", o->levels);
@@ -511,6 +504,16 @@ static int study_identity(study *s, const phc_provenance *pv)
     }
     bad |= add_key(s, "outputs", "%s", text ? text : "");
     free(text);
+    /* last: a refused ledger names the setting that differs before the
+       config's hash, which differs with any edit */
+    bad |= add_key(s, "config-sha256", "%s", pv && pv->config ? pv->config->sha256 : "none");
+    char *inputs = NULL;
+    if (pv)
+        for (size_t i = 0; i < pv->n_inputs; ++i)
+            bad |= append(&inputs, "%s%s", i ? "," : "", pv->inputs[i].sha256);
+    bad |= add_key(s, "data-sha256", "%s", inputs ? inputs : "none");
+    free(inputs);
+
     return bad ? -1 : 0;
 }
 
