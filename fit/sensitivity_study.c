@@ -656,7 +656,7 @@ static json_t *json_series(const study *s, size_t d)
     }
     for (size_t g = 0; g < f; ++g) {
         json_t *fg = json_object();
-        /* name, then the offset of the per-factor array in the result struct */
+        /* one array per key: the index at each of the T observations */
 #define SERIES_FIELD(key, expr)                                                                                   \
     do {                                                                                                          \
         for (size_t t = 0; t < T; ++t)                                                                            \
@@ -958,7 +958,7 @@ static int plot_series(const study *s, size_t d, const char *tmpdir, phc_error *
     dataset_label(pb, d, label, sizeof label);
     phc_run_dir_safe_name(label, base, sizeof base);
     snprintf(path, sizeof path, "%s/%s_over_x.png", tmpdir, base);
-    const size_t panels = s->sobol ? 2 : 1, per = s->sobol ? 3 : 3;
+    const size_t panels = s->sobol ? 2 : 1, per = 3; /* value, lower and upper end per line */
     double *buf = malloc((T + panels * f * per * T) * sizeof *buf);
     phc_band_line *lines = malloc(panels * f * sizeof *lines);
     if (!buf || !lines) {
