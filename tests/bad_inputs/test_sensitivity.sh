@@ -208,5 +208,18 @@ grep -q 'h-1 cm-2' per_h.yaml || why "the unit was not changed"
 diff <(sed '/^results/d' sec.txt) <(sed '/^results/d' "$T/stdout") >/dev/null || why "the verdicts differ"
 finish "a prior in h-1 cm-2 gives the study of the same prior in s-1 cm-2"
 
+# ---- a ledger of many outputs: 100 observations and two named outputs per line ----
+rm -rf sec part part.ledger
+run sensitivity per_s.yaml -o sec --samples 64 -q
+n_fields=$(grep -m1 $'^0\tok' sec/ledger.tsv | awk -F'\t' '{print NF - 2}')
+[ "$n_fields" = 104 ] || why "a ledger line holds $n_fields outputs, expected 104 (cost, mean, 2 named, 100 observations)"
+PHYTOCAL_STOP_AFTER=100 "$PHC" sensitivity per_s.yaml -o part --samples 64 -q >/dev/null 2>"$T/stderr"
+run sensitivity per_s.yaml -o part --samples 64 --resume -q
+[ "$RC" -eq 0 ] || why "resume: exit $RC"
+cmp -s sec/result.json part/result.json || why "result.json differs from the uninterrupted run's"
+grep -q '"series"' part/result.json || why "no series in result.json"
+[ -f part/balance_over_x.png ] || why "no plot against x"
+finish "104 outputs per evaluation: interrupted and resumed = uninterrupted (result.json identical)"
+
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
