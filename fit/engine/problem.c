@@ -98,6 +98,13 @@ int phc_problem_add_output(phc_problem *pb, const char *name, const char *datase
     for (size_t i = 0; i < pb->n_outputs; ++i)
         if (strcmp(pb->outputs[i].name, name) == 0)
             return phc_error_set(err, PHC_ERR_INPUT, "%s: the name is used twice", place);
+    for (size_t i = 0; i < pb->n_datasets; ++i) {
+        char own[600];
+        dataset_label(pb, i, own, sizeof own);
+        const size_t len = strlen(own);
+        if (strncmp(name, own, len) == 0 && (strcmp(name + len, ".mean") == 0 || strcmp(name + len, ".cost") == 0))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: a study names data set '%s''s own output so", place, own);
+    }
     long d = -1;
     char label[512];
     for (size_t i = 0; i < pb->n_datasets && d < 0; ++i) {

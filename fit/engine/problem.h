@@ -108,7 +108,8 @@ int phc_problem_add_parameter(phc_problem *pb, const char *name, double value,
  * `at` (observation 0) or at its 1-based `observation` (then `at` is
  * ignored).  Add the data sets first.  PHC_ERR_INPUT, naming the config
  * line when config_line > 0 ("cfg.yaml:30: outputs: 'W_6h': ..."): a
- * name that is empty, not plain, "cost" or already used; an unknown data
+ * name that is empty, not plain, "cost", "<data set>.mean" or ".cost", or
+ * already used; an unknown data
  * set; an observation beyond the data set's; `at` not finite or outside
  * the data set's x range; `at` on a kind that cannot predict at any x
  * (no predict_at) unless its observations form one series with

@@ -248,6 +248,8 @@ static void test_named_outputs(void)
     CHECK_STR_CONTAINS(err.message, "the name is used twice");
     CHECK(phc_problem_add_output(pb, "cost", "line", 1, 0, 34, &err) == PHC_ERR_INPUT);
     CHECK_STR_CONTAINS(err.message, "'cost' is the name of the study's cost output");
+    CHECK(phc_problem_add_output(pb, "line.mean", "line", 1, 0, 36, &err) == PHC_ERR_INPUT);
+    CHECK_STR_CONTAINS(err.message, "a study names data set 'line''s own output so");
     CHECK(phc_problem_add_output(pb, "a b", "line", 1, 0, 35, &err) == PHC_ERR_INPUT);
     CHECK_STR_CONTAINS(err.message, "a name holds only letters");
     CHECK(pb->n_outputs == 3);
