@@ -54,7 +54,7 @@ static const phc_key_help common_dataset_help[] = {
                     "has it, else central."},
     {NULL, NULL}};
 
-static const char *const top_keys[] = {"name", "parameters", "datasets", "solver", "report", "groups", NULL};
+static const char *const top_keys[] = {"name", "parameters", "datasets", "solver", "report", "groups", "outputs", NULL};
 static const phc_key_help top_help[] = {
     {"name", "Run name, used for the output directory runs/<name>/ and in the report. "
              "Default: the config file's name without its extension."},
@@ -67,6 +67,10 @@ static const phc_key_help top_help[] = {
     {"groups", "Mapping {GROUP: [parameter, ...], ...}: parameters that `phytocal sensitivity` "
                "varies together as one factor, with one index per group. A parameter belongs to "
                "at most one group; a group is not empty. Optional."},
+    {"outputs", "List of named outputs `phytocal sensitivity` estimates indices of, beside the "
+                "cost and the predictions: {name, dataset, at: X} (the data set's prediction at x = "
+                "X in its x unit, e.g. hours since its first row; within its x range) or {name, "
+                "dataset, observation: N} (at its N-th observation, from 1). Optional."},
     {NULL, NULL}};
 
 static const char *const parameter_keys[] = {"value", "lower", "upper", "fixed", "unit",
@@ -694,6 +698,43 @@ static int parse_groups(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
     return PHC_OK;
 }
 
+/* outputs: [{name, dataset, at | observation}, ...]: named outputs of
+ * sensitivity studies (problem.h: phc_problem_add_output checks them). */
+static int parse_outputs(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_problem *pb, phc_error *err)
+{
+    static const char *const keys[] = {"name", "dataset", "at", "observation", NULL};
+    int rc;
+    if ((rc = expect_kind(doc, node, PHC_YAML_SEQUENCE, "outputs", err)))
+        return rc;
+    for (size_t i = 0; i < node->count; ++i) {
+        const phc_yaml_node *item = node->items[i];
+        char ctx[64];
+        snprintf(ctx, sizeof ctx, "outputs[%zu]", i + 1);
+        if ((rc = expect_kind(doc, item, PHC_YAML_MAPPING, ctx, err)) ||
+            (rc = phc_yaml_check_keys(doc, item, keys, ctx, err)))
+            return rc;
+        const char *name = NULL, *dataset = NULL;
+        double at = NAN;
+        long obs = 0;
+        if ((rc = phc_yaml_map_string(doc, item, "name", 1, ctx, &name, err)) ||
+            (rc = phc_yaml_map_string(doc, item, "dataset", 1, ctx, &dataset, err)) ||
+            (rc = phc_yaml_map_number(doc, item, "at", 0, ctx, &at, err)) ||
+            (rc = phc_yaml_map_integer(doc, item, "observation", 0, ctx, &obs, err)))
+            return rc;
+        const phc_yaml_node *at_node = phc_yaml_get(item, "at"), *obs_node = phc_yaml_get(item, "observation");
+        if ((at_node != NULL) == (obs_node != NULL))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: give exactly one of 'at' (an x in the data set's "
+                                 "unit) and 'observation' (its number, from 1)", doc->path, item->line, ctx);
+        if (obs_node && obs < 1)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: observation: %ld; observations count from 1",
+                                 doc->path, obs_node->line, ctx, obs);
+        if ((rc = phc_problem_add_output(pb, name, dataset, at, obs_node ? (size_t)obs : 0,
+                                         at_node ? at_node->line : obs_node->line, err)))
+            return rc;
+    }
+    return PHC_OK;
+}
+
 int phc_config_load(const char *path, phc_problem **out, phc_error *err)
 {
     phc_yaml_doc *doc = NULL;
@@ -759,6 +800,9 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
             goto fail;
     const phc_yaml_node *groups = phc_yaml_get(root, "groups");
     if (groups && (rc = parse_groups(doc, groups, pb, err)))
+        goto fail;
+    const phc_yaml_node *named = phc_yaml_get(root, "outputs");
+    if (named && (rc = parse_outputs(doc, named, pb, err)))
         goto fail;
     /* units converted, tolerances kept above the models' accuracy unless
      * the solver: block names them, the problem checked (problem.h) */

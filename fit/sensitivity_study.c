@@ -47,34 +47,88 @@ void phc_study_summary_clear(phc_study_summary *s)
 
 struct phc_study_eval {
     const phc_problem *pb;
-    double *p, *yhat; /* the largest data set's slots and observations */
+    double *p, *yhat;   /* the largest data set's slots and observations */
+    size_t *interp_i;   /* per named output at an x without predict_at: yhat[i] (1 - w) + yhat[i + 1] w */
+    double *interp_w;
 };
 
 /* Output layout: 0 the cost; then per data set its cost (only when there
- * are several: with one it is the cost) and its mean prediction. */
+ * are several: with one it is the cost) and its mean prediction; then the
+ * named outputs; then per data set its predictions at the observations of
+ * phc_study_series_observation. */
 static size_t per_dataset(const phc_problem *pb)
 {
     return pb->n_datasets > 1 ? 2 : 1;
 }
 
+static void dataset_label(const phc_problem *pb, size_t d, char *buf, size_t size)
+{
+    if (pb->datasets[d]->name)
+        snprintf(buf, size, "%s", pb->datasets[d]->name);
+    else /* a data set built in C may have no name */
+        snprintf(buf, size, "dataset-%zu", d + 1);
+}
+
+size_t phc_study_scalar_outputs(const phc_problem *pb)
+{
+    return 1 + per_dataset(pb) * pb->n_datasets + pb->n_outputs;
+}
+
+size_t phc_study_series_points(const phc_problem *pb, size_t d)
+{
+    const size_t n = pb->datasets[d]->n, cap = pb->series_points;
+    return n < cap ? n : cap;
+}
+
+size_t phc_study_series_observation(const phc_problem *pb, size_t d, size_t t)
+{
+    const size_t n = pb->datasets[d]->n, T = phc_study_series_points(pb, d);
+    if (T == n)
+        return t;
+    if (T == 1)
+        return (n - 1) / 2;
+    /* evenly spaced by index, first and last included: round(t (n - 1) / (T - 1)) */
+    return (t * (n - 1) + (T - 1) / 2) / (T - 1);
+}
+
 size_t phc_study_outputs(const phc_problem *pb)
 {
-    return 1 + per_dataset(pb) * pb->n_datasets;
+    size_t n = phc_study_scalar_outputs(pb);
+    for (size_t d = 0; d < pb->n_datasets; ++d)
+        n += phc_study_series_points(pb, d);
+    return n;
 }
 
 void phc_study_output_name(const phc_problem *pb, size_t j, char *buf, size_t size)
 {
-    const size_t m = per_dataset(pb);
+    const size_t m = per_dataset(pb), fixed = 1 + m * pb->n_datasets;
+    char label[512];
     if (j == 0) {
         snprintf(buf, size, "cost");
         return;
     }
-    const size_t d = (j - 1) / m;
-    const char *what = m == 2 && (j - 1) % 2 == 0 ? "cost" : "mean";
-    if (pb->datasets[d]->name)
-        snprintf(buf, size, "%s.%s", pb->datasets[d]->name, what);
-    else /* a data set built in C may have no name */
-        snprintf(buf, size, "dataset-%zu.%s", d + 1, what);
+    if (j < fixed) {
+        const size_t d = (j - 1) / m;
+        const char *what = m == 2 && (j - 1) % 2 == 0 ? "cost" : "mean";
+        dataset_label(pb, d, label, sizeof label);
+        snprintf(buf, size, "%s.%s", label, what);
+        return;
+    }
+    if (j < fixed + pb->n_outputs) {
+        snprintf(buf, size, "%s", pb->outputs[j - fixed].name);
+        return;
+    }
+    j -= fixed + pb->n_outputs;
+    for (size_t d = 0; d < pb->n_datasets; ++d) {
+        const size_t T = phc_study_series_points(pb, d);
+        if (j < T) {
+            dataset_label(pb, d, label, sizeof label);
+            snprintf(buf, size, "%s@%zu", label, phc_study_series_observation(pb, d, j) + 1);
+            return;
+        }
+        j -= T;
+    }
+    snprintf(buf, size, "?");
 }
 
 phc_study_eval *phc_study_eval_new(const phc_problem *pb)
@@ -90,9 +144,28 @@ phc_study_eval *phc_study_eval_new(const phc_problem *pb)
     w->pb = pb;
     w->p = malloc(kmax * sizeof *w->p);
     w->yhat = malloc(nmax * sizeof *w->yhat);
-    if (!w->p || !w->yhat) {
+    w->interp_i = calloc(pb->n_outputs ? pb->n_outputs : 1, sizeof *w->interp_i);
+    w->interp_w = calloc(pb->n_outputs ? pb->n_outputs : 1, sizeof *w->interp_w);
+    if (!w->p || !w->yhat || !w->interp_i || !w->interp_w) {
         phc_study_eval_free(w);
         return NULL;
+    }
+    /* a named output at an x the kind cannot predict at: linear between the
+       observations around it (phc_problem_add_output checked that x
+       increases and brackets it) */
+    for (size_t o = 0; o < pb->n_outputs; ++o) {
+        const phc_named_output *no = &pb->outputs[o];
+        const phc_dataset *ds = pb->datasets[no->dataset];
+        if (no->observation || ds->ops->predict_at)
+            continue;
+        size_t i = 0;
+        while (i + 2 < ds->n && ds->x[i + 1] <= no->at)
+            ++i;
+        const double span = ds->n > 1 ? ds->x[i + 1] - ds->x[i] : 0;
+        w->interp_i[o] = i;
+        w->interp_w[o] = span > 0 ? (no->at - ds->x[i]) / span : 0;
+        if (w->interp_w[o] > 1) /* at equals the last x */
+            w->interp_w[o] = 1;
     }
     return w;
 }
@@ -103,13 +176,16 @@ void phc_study_eval_free(phc_study_eval *w)
         return;
     free(w->p);
     free(w->yhat);
+    free(w->interp_i);
+    free(w->interp_w);
     free(w);
 }
 
 int phc_study_evaluate(phc_study_eval *w, const double *x, double *out)
 {
     const phc_problem *pb = w->pb;
-    const size_t n_out = phc_study_outputs(pb);
+    const size_t n_out = phc_study_outputs(pb), m = per_dataset(pb), named = 1 + m * pb->n_datasets;
+    size_t series = named + pb->n_outputs;
     out[0] = 0;
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         phc_dataset *ds = pb->datasets[d];
@@ -123,11 +199,30 @@ int phc_study_evaluate(phc_study_eval *w, const double *x, double *out)
             cost += 0.5 * r * r;
             sum += w->yhat[i];
         }
-        const size_t m = per_dataset(pb);
         if (m == 2)
             out[1 + 2 * d] = cost;
         out[1 + m * d + (m - 1)] = ds->n ? sum / (double)ds->n : NAN;
         out[0] += cost;
+        for (size_t o = 0; o < pb->n_outputs; ++o) {
+            const phc_named_output *no = &pb->outputs[o];
+            if (no->dataset != d)
+                continue;
+            double v;
+            if (no->observation) {
+                v = w->yhat[no->observation - 1];
+            } else if (ds->ops->predict_at) {
+                if (ds->ops->predict_at(ds, w->p, &no->at, 1, &v) != 0)
+                    goto failed;
+            } else {
+                const size_t i = w->interp_i[o];
+                const double f = w->interp_w[o];
+                v = f > 0 ? (1 - f) * w->yhat[i] + f * w->yhat[i + 1] : w->yhat[i];
+            }
+            out[named + o] = v;
+        }
+        const size_t T = phc_study_series_points(pb, d);
+        for (size_t t = 0; t < T; ++t)
+            out[series++] = w->yhat[phc_study_series_observation(pb, d, t)];
     }
     for (size_t j = 0; j < n_out; ++j)
         if (!isfinite(out[j]))
@@ -151,6 +246,8 @@ typedef struct study {
     char **factor_names; /* n_factors */
     phc_prior *prior;    /* k, resolved, in the user's unit */
     size_t n_out;
+    size_t n_scalar;     /* outputs 0 .. n_scalar-1 are scalar; the rest the series */
+    size_t *series_first; /* per data set: its first series output */
     char **out_names;
     phc_saltelli_design *saltelli;
     phc_morris_design *morris;
@@ -159,6 +256,7 @@ typedef struct study {
     unsigned char *state;
     phc_sobol_indices *sobol;   /* n_out */
     phc_morris_effects *effects; /* n_out */
+    phc_sobol_indices *summary; /* Sobol: per data set, the aggregated indices of its series (n_series 0: none) */
     char **keys, **values;       /* ledger identity */
     size_t n_keys;
 } study;
@@ -188,6 +286,11 @@ static void study_free(study *s)
         for (size_t j = 0; j < s->n_out; ++j)
             phc_morris_effects_clear(&s->effects[j]);
     free(s->effects);
+    if (s->summary)
+        for (size_t d = 0; d < s->pb->n_datasets; ++d)
+            phc_sobol_indices_clear(&s->summary[d]);
+    free(s->summary);
+    free(s->series_first);
     for (size_t i = 0; i < s->n_keys; ++i) {
         free(s->keys[i]);
         free(s->values[i]);
@@ -352,19 +455,12 @@ static int append(char **buf, const char *fmt, ...)
     return 0;
 }
 
-/* What identifies the study in its ledger: the config and data (SHA-256),
- * the method and design, the factors, priors and outputs. */
+/* What identifies the study in its ledger: the method and design, the
+ * factors, priors and outputs, the config and data (SHA-256). */
 static int study_identity(study *s, const phc_provenance *pv)
 {
     const phc_study_options *o = s->o;
     int bad = 0;
-    bad |= add_key(s, "config-sha256", "%s", pv && pv->config ? pv->config->sha256 : "none");
-    char *inputs = NULL;
-    if (pv)
-        for (size_t i = 0; i < pv->n_inputs; ++i)
-            bad |= append(&inputs, "%s%s", i ? "," : "", pv->inputs[i].sha256);
-    bad |= add_key(s, "data-sha256", "%s", inputs ? inputs : "none");
-    free(inputs);
     bad |= add_key(s, "method", "%s", o->method == PHC_STUDY_MORRIS ? "morris" : "sobol");
     if (o->method == PHC_STUDY_MORRIS)
         bad |= add_key(s, "design", "morris-1991 levels=%u", o->levels);
@@ -384,10 +480,40 @@ static int study_identity(study *s, const phc_provenance *pv)
     bad |= add_key(s, "factors", "%s", text ? text : "");
     free(text);
     text = NULL;
-    for (size_t j = 0; j < s->n_out; ++j)
+    /* the scalar outputs by name (a named one with where it is), then per
+       data set how many of its observations are outputs: a line that says
+       what differs when another config's ledger is refused */
+    for (size_t j = 0; j < s->n_scalar; ++j) {
         bad |= append(&text, "%s%s", j ? "," : "", s->out_names[j]);
+        const size_t named = s->n_scalar - s->pb->n_outputs;
+        if (j >= named) {
+            const phc_named_output *no = &s->pb->outputs[j - named];
+            char label[512];
+            dataset_label(s->pb, no->dataset, label, sizeof label);
+            if (no->observation)
+                bad |= append(&text, "=%s@%zu", label, no->observation);
+            else
+                bad |= append(&text, "=%s(x=%.17g)", label, no->at);
+        }
+    }
+    for (size_t d = 0; d < s->pb->n_datasets; ++d) {
+        char label[512];
+        dataset_label(s->pb, d, label, sizeof label);
+        bad |= append(&text, ",%s@[%zu of %zu observations]", label, phc_study_series_points(s->pb, d),
+                      s->pb->datasets[d]->n);
+    }
     bad |= add_key(s, "outputs", "%s", text ? text : "");
     free(text);
+    /* last: a refused ledger names the setting that differs before the
+       config's hash, which differs with any edit */
+    bad |= add_key(s, "config-sha256", "%s", pv && pv->config ? pv->config->sha256 : "none");
+    char *inputs = NULL;
+    if (pv)
+        for (size_t i = 0; i < pv->n_inputs; ++i)
+            bad |= append(&inputs, "%s%s", i ? "," : "", pv->inputs[i].sha256);
+    bad |= add_key(s, "data-sha256", "%s", inputs ? inputs : "none");
+    free(inputs);
+
     return bad ? -1 : 0;
 }
 
@@ -422,20 +548,25 @@ static json_t *jinterval(double lo, double hi)
     return json_pack("[o, o]", jnum(lo), jnum(hi));
 }
 
-/* Verdict of factor g over the outputs: 2 matters (in some output),
- * 0 does not matter (in every output), 1 unclear; `where` lists the
- * outputs where it matters. */
+/* Verdict of factor g over the scalar outputs and (Sobol) the summaries
+ * of the series: 2 matters (in some output), 0 does not matter (in every
+ * output), 1 unclear; `where` lists the outputs where it matters. */
 static int factor_verdict(const study *s, size_t g, char **where)
 {
     int matters = 0, all_below = 1;
-    for (size_t j = 0; j < s->n_out; ++j) {
+    const size_t n_summary = s->summary ? s->pb->n_datasets : 0;
+    for (size_t j = 0; j < s->n_scalar + n_summary; ++j) {
         if (s->sobol) {
-            const phc_sobol_indices *r = &s->sobol[j];
-            if (!isfinite(r->st[g]))
+            const phc_sobol_indices *r = j < s->n_scalar ? &s->sobol[j] : &s->summary[j - s->n_scalar];
+            if (!r->st || !isfinite(r->st[g]))
                 continue;
             if (r->st[g] >= ST_MATTERS) {
                 matters = 1;
-                append(where, "%s%s (ST %.2f)", *where ? ", " : "", s->out_names[j], r->st[g]);
+                char label[512] = "";
+                if (j >= s->n_scalar)
+                    dataset_label(s->pb, j - s->n_scalar, label, sizeof label);
+                append(where, "%s%s%s (ST %.2f)", *where ? ", " : "", j < s->n_scalar ? s->out_names[j] : label,
+                       j < s->n_scalar ? "" : " over x", r->st[g]);
             }
             if (!(r->st_hi[g] < ST_MATTERS))
                 all_below = 0;
@@ -482,6 +613,92 @@ static char *verdict_text(const study *s)
     return text;
 }
 
+/* An array of the n values v[i * stride] (NAN as null). */
+static json_t *jarray(const double *v, size_t n, size_t stride)
+{
+    json_t *a = json_array();
+    for (size_t i = 0; i < n; ++i)
+        json_array_append_new(a, jnum(v[i * stride]));
+    return a;
+}
+
+/* Data set d's series: its observations, x, the mean and variance of the
+ * prediction at each, per factor the indices at each as arrays, and (Sobol)
+ * their summary over x. */
+static json_t *json_series(const study *s, size_t d)
+{
+    const phc_problem *pb = s->pb;
+    const phc_dataset *ds = pb->datasets[d];
+    const size_t T = phc_study_series_points(pb, d), j0 = s->series_first[d], f = s->n_factors;
+    char label[512];
+    dataset_label(pb, d, label, sizeof label);
+    json_t *obs = json_array(), *x = json_array(), *o = json_object(), *idx = json_object();
+    double *v = malloc((T ? T : 1) * 2 * sizeof *v);
+    for (size_t t = 0; t < T; ++t) {
+        const size_t i = phc_study_series_observation(pb, d, t);
+        json_array_append_new(obs, json_integer((json_int_t)i + 1));
+        json_array_append_new(x, ds->x ? jnum(ds->x[i]) : json_integer((json_int_t)i + 1));
+    }
+    json_object_set_new(o, "dataset", json_string(label));
+    json_object_set_new(o, "x_label", ds->x_label ? json_string(ds->x_label) : json_null());
+    json_object_set_new(o, "observations", obs);
+    json_object_set_new(o, "of_observations", json_integer((json_int_t)ds->n));
+    json_object_set_new(o, "x", x);
+    if (!v)
+        return o;
+    if (s->sobol) {
+        for (size_t t = 0; t < T; ++t) {
+            v[t] = s->sobol[j0 + t].mean;
+            v[T + t] = s->sobol[j0 + t].variance;
+        }
+        json_object_set_new(o, "mean", jarray(v, T, 1));
+        json_object_set_new(o, "variance", jarray(v + T, T, 1));
+    }
+    for (size_t g = 0; g < f; ++g) {
+        json_t *fg = json_object();
+        /* one array per key: the index at each of the T observations */
+#define SERIES_FIELD(key, expr)                                                                                   \
+    do {                                                                                                          \
+        for (size_t t = 0; t < T; ++t)                                                                            \
+            v[t] = (expr);                                                                                        \
+        json_object_set_new(fg, key, jarray(v, T, 1));                                                            \
+    } while (0)
+        if (s->sobol) {
+            SERIES_FIELD("S1", s->sobol[j0 + t].s1[g]);
+            SERIES_FIELD("S1_ci95_lower", s->sobol[j0 + t].s1_lo[g]);
+            SERIES_FIELD("S1_ci95_upper", s->sobol[j0 + t].s1_hi[g]);
+            SERIES_FIELD("ST", s->sobol[j0 + t].st[g]);
+            SERIES_FIELD("ST_ci95_lower", s->sobol[j0 + t].st_lo[g]);
+            SERIES_FIELD("ST_ci95_upper", s->sobol[j0 + t].st_hi[g]);
+        } else {
+            SERIES_FIELD("mu_star", s->effects[j0 + t].mu_star[g]);
+            SERIES_FIELD("mu_star_ci95_lower", s->effects[j0 + t].mu_star_lo[g]);
+            SERIES_FIELD("mu_star_ci95_upper", s->effects[j0 + t].mu_star_hi[g]);
+            SERIES_FIELD("mu", s->effects[j0 + t].mu[g]);
+            SERIES_FIELD("sigma", s->effects[j0 + t].sigma[g]);
+        }
+#undef SERIES_FIELD
+        json_object_set_new(idx, s->factor_names[g], fg);
+    }
+    free(v);
+    json_object_set_new(o, "indices", idx);
+    if (s->summary && s->summary[d].s1) {
+        const phc_sobol_indices *r = &s->summary[d];
+        json_t *sum = json_object(), *si = json_object();
+        json_object_set_new(sum, "estimator", json_string("generalised indices sum_t V_t S_t / sum_t V_t (Lamboni "
+                                                          "et al. 2011; Gamboa et al. 2013)"));
+        json_object_set_new(sum, "total_variance", jnum(r->variance));
+        for (size_t g = 0; g < f; ++g)
+            json_object_set_new(si, s->factor_names[g],
+                                json_pack("{s:o, s:o, s:o, s:o}", "S1", jnum(r->s1[g]), "S1_ci95",
+                                          jinterval(r->s1_lo[g], r->s1_hi[g]), "ST", jnum(r->st[g]), "ST_ci95",
+                                          jinterval(r->st_lo[g], r->st_hi[g])));
+        json_object_set_new(sum, "indices", si);
+        json_object_set_new(o, "summary", sum);
+    }
+    return o;
+}
+
 static int write_json(const study *s, const phc_study_summary *sum, const char *path, phc_error *err)
 {
     const phc_study_options *o = s->o;
@@ -512,7 +729,7 @@ static int write_json(const study *s, const phc_study_summary *sum, const char *
                                       phc_prior_kind_name(q->kind), "a", jnum(q->a), "b", jnum(q->b), "lower",
                                       jnum(q->lower), "upper", jnum(q->upper)));
     }
-    for (size_t j = 0; j < s->n_out; ++j) {
+    for (size_t j = 0; j < s->n_scalar; ++j) {
         json_t *idx = json_object(), *o_j = json_object();
         json_object_set_new(o_j, "name", json_string(s->out_names[j]));
         if (s->sobol) {
@@ -556,6 +773,11 @@ static int write_json(const study *s, const phc_study_summary *sum, const char *
     json_object_set_new(root, "factors", factors);
     json_object_set_new(root, "parameters", params);
     json_object_set_new(root, "outputs", outs);
+    json_t *series = json_array();
+    for (size_t d = 0; d < s->pb->n_datasets; ++d)
+        if (phc_study_series_points(s->pb, d))
+            json_array_append_new(series, json_series(s, d));
+    json_object_set_new(root, "series", series);
     json_t *verdict = json_array();
     for (size_t g = 0; g < s->n_factors; ++g) {
         char *where = NULL;
@@ -577,6 +799,60 @@ static int write_json(const study *s, const phc_study_summary *sum, const char *
     }
     json_decref(root);
     return rc;
+}
+
+/* The report's section on data set d's indices per observation. */
+static int report_series(const study *s, size_t d, char **md)
+{
+    const phc_problem *pb = s->pb;
+    const phc_dataset *ds = pb->datasets[d];
+    const size_t T = phc_study_series_points(pb, d), j0 = s->series_first[d];
+    if (T == 0)
+        return 0;
+    char label[512], base[256];
+    dataset_label(pb, d, label, sizeof label);
+    phc_run_dir_safe_name(label, base, sizeof base);
+    const char *xl = ds->x_label ? ds->x_label : "x";
+    int bad = 0;
+    bad |= append(md, "\n## Over x: `%s`\n\nx: %s. Indices of the prediction at %s%zu observation%s%s, plotted "
+                      "against x in `%s_over_x.png`; result.json holds them as arrays under `series`.",
+                  label, xl, T == ds->n ? "each of the " : "", T, T == 1 ? "" : "s",
+                  T == ds->n ? "" : " (evenly spaced among its observations)", base);
+    if (T != ds->n)
+        bad |= append(md, " The data set has %zu observations; `--points` sets how many are outputs.", ds->n);
+    if (s->summary && s->summary[d].s1) {
+        const phc_sobol_indices *r = &s->summary[d];
+        bad |= append(md, " Over x: the generalised indices sum_t V_t S_t / sum_t V_t (Lamboni et al. 2011; "
+                          "Gamboa et al. 2013), which weight each observation by the variance of its "
+                          "prediction (summed variance %.6g).\n\n| factor | S1 over x | 95%% interval | ST over x | "
+                          "95%% interval | largest ST | at x |\n|---|---|---|---|---|---|---|\n", r->variance);
+        for (size_t g = 0; g < s->n_factors; ++g) {
+            size_t best = 0;
+            for (size_t t = 1; t < T; ++t)
+                if (s->sobol[j0 + t].st[g] > s->sobol[j0 + best].st[g] || !isfinite(s->sobol[j0 + best].st[g]))
+                    best = t;
+            const size_t i = phc_study_series_observation(pb, d, best);
+            bad |= append(md, "| %s | %.4f | [%.4f, %.4f] | %.4f | [%.4f, %.4f] | %.4f | %.6g |\n",
+                          s->factor_names[g], r->s1[g], r->s1_lo[g], r->s1_hi[g], r->st[g], r->st_lo[g],
+                          r->st_hi[g], s->sobol[j0 + best].st[g], ds->x ? ds->x[i] : (double)(i + 1));
+        }
+    } else if (s->effects) {
+        bad |= append(md, "\n\n| factor | largest mu* | 95%% interval | at x |\n|---|---|---|---|\n");
+        for (size_t g = 0; g < s->n_factors; ++g) {
+            size_t best = 0;
+            for (size_t t = 1; t < T; ++t)
+                if (s->effects[j0 + t].mu_star[g] > s->effects[j0 + best].mu_star[g])
+                    best = t;
+            const size_t i = phc_study_series_observation(pb, d, best);
+            const phc_morris_effects *e = &s->effects[j0 + best];
+            bad |= append(md, "| %s | %.6g | [%.6g, %.6g] | %.6g |\n", s->factor_names[g], e->mu_star[g],
+                          e->mu_star_lo[g], e->mu_star_hi[g], ds->x ? ds->x[i] : (double)(i + 1));
+        }
+    } else {
+        bad |= append(md, "\n");
+    }
+    bad |= append(md, "\n![%s over x](%s_over_x.png)\n", label, base);
+    return bad;
 }
 
 static int write_report(const study *s, const phc_study_summary *sum, const phc_provenance *pv, const char *path,
@@ -617,7 +893,7 @@ static int write_report(const study *s, const phc_study_summary *sum, const phc_
         bad |= append(&md, "| %s | %s | %s(%.6g, %.6g) on [%.6g, %.6g] | %s |\n", s->factor_names[s->group_of[c]],
                       p->name, phc_prior_kind_name(q->kind), q->a, q->b, q->lower, q->upper, p->unit ? p->unit : "");
     }
-    for (size_t j = 0; j < s->n_out; ++j) {
+    for (size_t j = 0; j < s->n_scalar; ++j) {
         bad |= append(&md, "\n## Output `%s`\n\n", s->out_names[j]);
         if (s->sobol) {
             const phc_sobol_indices *r = &s->sobol[j];
@@ -648,6 +924,8 @@ static int write_report(const study *s, const phc_study_summary *sum, const phc_
         phc_run_dir_safe_name(s->out_names[j], base, sizeof base);
         bad |= append(&md, "\n![%s](%s_sensitivity.png)\n", s->out_names[j], base);
     }
+    for (size_t d = 0; d < s->pb->n_datasets; ++d)
+        bad |= report_series(s, d, &md);
     char *prov = NULL;
     if (pv && phc_provenance_markdown(pv, &prov, err) == PHC_OK && prov) {
         bad |= append(&md, "\n%s", prov);
@@ -667,9 +945,73 @@ static int write_report(const study *s, const phc_study_summary *sum, const phc_
     return rc;
 }
 
+/* Data set d's indices against x: S1 and ST (Sobol) or mu* (Morris) per
+ * factor with their bootstrap bands. */
+static int plot_series(const study *s, size_t d, const char *tmpdir, phc_error *err)
+{
+    const phc_problem *pb = s->pb;
+    const phc_dataset *ds = pb->datasets[d];
+    const size_t T = phc_study_series_points(pb, d), j0 = s->series_first[d], f = s->n_factors;
+    if (T == 0)
+        return PHC_OK;
+    char label[512], base[256], path[8192], title[700];
+    dataset_label(pb, d, label, sizeof label);
+    phc_run_dir_safe_name(label, base, sizeof base);
+    snprintf(path, sizeof path, "%s/%s_over_x.png", tmpdir, base);
+    const size_t panels = s->sobol ? 2 : 1, per = 3; /* value, lower and upper end per line */
+    double *buf = malloc((T + panels * f * per * T) * sizeof *buf);
+    phc_band_line *lines = malloc(panels * f * sizeof *lines);
+    if (!buf || !lines) {
+        free(buf);
+        free(lines);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    double *xs = buf;
+    for (size_t t = 0; t < T; ++t) {
+        const size_t i = phc_study_series_observation(pb, d, t);
+        xs[t] = ds->x ? ds->x[i] : (double)(i + 1);
+    }
+    for (size_t q = 0; q < panels; ++q)
+        for (size_t g = 0; g < f; ++g) {
+            double *v = buf + T + ((q * f + g) * per) * T, *lo = v + T, *hi = v + 2 * T;
+            for (size_t t = 0; t < T; ++t) {
+                if (s->sobol) {
+                    const phc_sobol_indices *r = &s->sobol[j0 + t];
+                    v[t] = q ? r->st[g] : r->s1[g];
+                    lo[t] = q ? r->st_lo[g] : r->s1_lo[g];
+                    hi[t] = q ? r->st_hi[g] : r->s1_hi[g];
+                } else {
+                    const phc_morris_effects *e = &s->effects[j0 + t];
+                    v[t] = e->mu_star[g];
+                    lo[t] = e->mu_star_lo[g];
+                    hi[t] = e->mu_star_hi[g];
+                }
+            }
+            lines[q * f + g] = (phc_band_line){s->factor_names[g], v, lo, hi};
+        }
+    const char *ylab_sobol[2] = {"first-order index S1", "total index ST"};
+    const char *ylab_morris[1] = {"mu* (mean |elementary effect|)"};
+    if (s->sobol)
+        snprintf(title, sizeof title, "Sobol indices of %s's prediction (N = %zu, %zu of %zu observations)", label,
+                 s->o->samples, T, ds->n);
+    else
+        snprintf(title, sizeof title, "Morris mu* of %s's prediction (r = %zu, %zu of %zu observations)", label,
+                 s->o->samples, T, ds->n);
+    const int rc = phc_plot_index_lines(path, title, ds->x_label ? ds->x_label : "observation", xs, T,
+                                        s->sobol ? ylab_sobol : ylab_morris, panels, lines, f, err);
+    free(buf);
+    free(lines);
+    return rc;
+}
+
 static int write_plots(const study *s, const char *tmpdir, phc_error *err)
 {
-    for (size_t j = 0; j < s->n_out; ++j) {
+    for (size_t d = 0; d < s->pb->n_datasets; ++d) {
+        const int rc = plot_series(s, d, tmpdir, err);
+        if (rc)
+            return rc;
+    }
+    for (size_t j = 0; j < s->n_scalar; ++j) {
         char base[256], path[8192], title[512];
         phc_run_dir_safe_name(s->out_names[j], base, sizeof base);
         snprintf(path, sizeof path, "%s/%s_sensitivity.png", tmpdir, base);
@@ -732,6 +1074,7 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
     s.pb = pb;
     s.o = &o;
     s.n_out = phc_study_outputs(pb);
+    s.n_scalar = phc_study_scalar_outputs(pb);
     phc_run_ledger *ledger = NULL;
     phc_study_eval *w = NULL;
     double *x = NULL, *u = NULL, *out = NULL;
@@ -739,6 +1082,14 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
     int rc;
     if ((rc = study_factors(&s, err)))
         goto done;
+    if (!(s.series_first = malloc((pb->n_datasets ? pb->n_datasets : 1) * sizeof *s.series_first))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t d = 0, j = s.n_scalar; d < pb->n_datasets; ++d) {
+        s.series_first[d] = j;
+        j += phc_study_series_points(pb, d);
+    }
     if (!(s.out_names = calloc(s.n_out, sizeof *s.out_names))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
@@ -854,6 +1205,30 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
     free(col);
     if (rc)
         goto done;
+    /* Sobol: per data set, the summary of its series over x */
+    if (s.saltelli) {
+        if (!(s.summary = calloc(pb->n_datasets ? pb->n_datasets : 1, sizeof *s.summary))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        for (size_t d = 0; d < pb->n_datasets && rc == PHC_OK; ++d) {
+            const size_t T = phc_study_series_points(pb, d);
+            if (T == 0)
+                continue;
+            double *cols = malloc(T * s.rows * sizeof *cols);
+            if (!cols) {
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                break;
+            }
+            for (size_t t = 0; t < T; ++t)
+                for (size_t r = 0; r < s.rows; ++r)
+                    cols[t * s.rows + r] = s.y[r * s.n_out + s.series_first[d] + t];
+            rc = phc_sobol_indices_estimate_aggregate(s.saltelli, cols, T, &s.summary[d], err);
+            free(cols);
+        }
+        if (rc)
+            goto done;
+    }
     if (!(summary->verdict = verdict_text(&s))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;

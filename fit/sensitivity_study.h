@@ -8,9 +8,14 @@
  * their values.
  *
  * Outputs of every evaluation (phc_study_evaluate): the cost (1/2 the sum of
- * squared weighted residuals over all data sets) and, per data set, its own
+ * squared weighted residuals over all data sets); per data set, its own
  * cost (when there are several data sets) and its mean prediction over its
- * observations.
+ * observations; the named outputs (a data set's prediction at an x or an
+ * observation, `outputs:` in the config); and per data set its prediction
+ * at every observation (at most pb->series_points of them, evenly spaced),
+ * whose indices are estimated per observation and summarised over them by
+ * the variance-weighted generalised indices (Sobol: sobol_indices.h,
+ * phc_sobol_indices_estimate_aggregate).
  *
  * Methods: Sobol indices from a Saltelli design (fit/engine/sobol_indices.h)
  * or Morris elementary effects (fit/engine/morris.h).  The design is
@@ -24,9 +29,12 @@
  *
  * The run directory (run_dir.h rules: written whole or not at all, an
  * earlier one replaced only with force): result.json (indices with
- * intervals per output), report.md (the verdict: which factors matter),
- * <output>_sensitivity.png per output (bars with interval whiskers),
- * ledger.tsv and the manifest. */
+ * intervals per scalar output; per data set the indices per observation as
+ * arrays and their summary), report.md (the verdict: which factors matter,
+ * from the scalar outputs and the summaries), <output>_sensitivity.png per
+ * scalar output (bars with interval whiskers), <data set>_over_x.png per
+ * data set (indices against x with bootstrap bands), ledger.tsv and the
+ * manifest. */
 #ifndef PHC_SENSITIVITY_STUDY_H
 #define PHC_SENSITIVITY_STUDY_H
 
@@ -72,10 +80,24 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *o, const phc_p
 
 /* ---- the evaluation seam ---------------------------------------------------------------- */
 
-/* Number of outputs of one evaluation: 1 + 1 per data set (its mean), or
- * 1 + 2 per data set (its cost and mean) when there are several. */
+/* The outputs of one evaluation, in this order:
+ *   the cost;
+ *   per data set its mean prediction ("<data set>.mean"), preceded by its
+ *   own cost ("<data set>.cost") when there are several data sets;
+ *   the named outputs of the config's `outputs:` (pb->outputs, by name);
+ *   per data set its predictions at phc_study_series_points(pb, d) of its
+ *   observations ("<data set>@<observation, from 1>"): all of them when it
+ *   has at most pb->series_points, else that many evenly spaced by index,
+ *   the first and the last included.
+ * The first phc_study_scalar_outputs(pb) are the scalar outputs (a table
+ * and a bar plot each); the rest are the series (indices per observation,
+ * a summary over them and a plot against x per data set). */
 size_t phc_study_outputs(const phc_problem *pb);
-/* Name of output j ("cost", "<data set>.cost", "<data set>.mean"), into buf. */
+size_t phc_study_scalar_outputs(const phc_problem *pb);
+size_t phc_study_series_points(const phc_problem *pb, size_t d);
+/* The 0-based observation of data set d behind its series output t. */
+size_t phc_study_series_observation(const phc_problem *pb, size_t d, size_t t);
+/* Name of output j, into buf. */
 void phc_study_output_name(const phc_problem *pb, size_t j, char *buf, size_t size);
 
 typedef struct phc_study_eval phc_study_eval;

@@ -75,12 +75,14 @@ static const command_help commands[] = {
      "options: -o DIR, --force, --quiet, --help as for fit."},
     {"sensitivity", "phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S]\n"
                     "                     [--resume] [--second-order] [--design sobol|random] [--levels P]\n"
-                    "                     [--force] [--quiet]",
+                    "                     [--points T] [--force] [--quiet]",
      "Global sensitivity study over the free parameters' priors (`prior:`, else uniform on\n"
-     "the bounds; a `groups:` entry is one factor) of the model's outputs: the cost, and\n"
-     "per data set its cost and mean prediction.  Writes a run directory (default\n"
-     "runs/<name>-sensitivity/): result.json (indices with 95% bootstrap intervals),\n"
-     "report.md (which factors matter), <output>_sensitivity.png, ledger.tsv.\n"
+     "the bounds; a `groups:` entry is one factor) of the model's outputs: the cost, per\n"
+     "data set its cost and mean prediction, the config's named `outputs:`, and per data\n"
+     "set its prediction at every observation (indices per observation and over x).\n"
+     "Writes a run directory (default runs/<name>-sensitivity/): result.json (indices\n"
+     "with 95% bootstrap intervals), report.md (which factors matter),\n"
+     "<output>_sensitivity.png, <data set>_over_x.png, ledger.tsv.\n"
      "\n"
      "options:\n"
      "  --method M         sobol (default: first-order and total indices, Saltelli design)\n"
@@ -91,6 +93,8 @@ static const command_help commands[] = {
      "  --second-order     sobol: also the second-order indices (N (2k + 2) evaluations)\n"
      "  --design D         sobol: GSL's Sobol sequence (default) or random (Mersenne Twister)\n"
      "  --levels P         morris: grid levels, even (default 4)\n"
+     "  --points T         per data set, at most T observations (evenly spaced) get\n"
+     "                     indices of their own (default 100; 0: none)\n"
      "  --resume           continue an interrupted study from DIR.ledger (its finished\n"
      "                     evaluations are not recomputed; a ledger of another config or\n"
      "                     design is refused, naming what differs)\n"
@@ -504,6 +508,7 @@ static int parse_count(const char *opt, const char *text, unsigned long long max
 static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
 {
     phc_study_options so = phc_study_options_default();
+    long long points = -1; /* --points: observations per data set with indices (-1: the default) */
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     int n_rest = 0;
     if (!rest)
@@ -513,7 +518,7 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
         const int has_value = i + 1 < argc;
         unsigned long long v = 0;
         if (strcmp(a, "--method") == 0 || strcmp(a, "--design") == 0 || strcmp(a, "--samples") == 0 ||
-            strcmp(a, "--seed") == 0 || strcmp(a, "--levels") == 0) {
+            strcmp(a, "--seed") == 0 || strcmp(a, "--levels") == 0 || strcmp(a, "--points") == 0) {
             if (!has_value) {
                 fprintf(stderr, "phytocal sensitivity: %s needs a value\nusage: %s\n", a,
                         find_command("sensitivity")->synopsis);
@@ -543,7 +548,10 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
                     free(rest);
                     return EXIT_INPUT;
                 }
-            } else if (parse_count(a, val, strcmp(a, "--seed") == 0 ? 4294967295ULL : 1ULL << 30, &v) != 0) {
+            } else if (parse_count(a, val, strcmp(a, "--seed") == 0     ? 4294967295ULL
+                                           : strcmp(a, "--points") == 0 ? 100000ULL
+                                                                        : 1ULL << 30,
+                                   &v) != 0) {
                 free(rest);
                 return EXIT_INPUT;
             } else if (strcmp(a, "--samples") == 0) {
@@ -555,6 +563,8 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
                 }
             } else if (strcmp(a, "--seed") == 0) {
                 so.seed = (unsigned long)v;
+            } else if (strcmp(a, "--points") == 0) {
+                points = (long long)v;
             } else {
                 so.levels = (unsigned)v;
             }
@@ -582,6 +592,8 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     if (stop && *stop)
         so.stop_after = (size_t)strtoull(stop, NULL, 10);
     so.force = o.force;
+    if (points >= 0)
+        pb->series_points = (size_t)points;
     progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
     so.progress = o.quiet ? NULL : progress_cb;
     so.progress_data = &prog;

@@ -36,6 +36,7 @@ phc_problem *phc_problem_new(const char *name)
         return NULL;
     }
     pb->options = phc_fit_options_default();
+    pb->series_points = PHC_SERIES_POINTS_DEFAULT;
     return pb;
 }
 
@@ -62,7 +63,113 @@ void phc_problem_free(phc_problem *pb)
         free(pb->groups[i].members);
     }
     free(pb->groups);
+    for (size_t i = 0; i < pb->n_outputs; ++i)
+        free(pb->outputs[i].name);
+    free(pb->outputs);
     free(pb);
+}
+
+/* A data set's name as studies print it: its own, or dataset-N. */
+static void dataset_label(const phc_problem *pb, size_t d, char *buf, size_t size)
+{
+    if (pb->datasets[d]->name)
+        snprintf(buf, size, "%s", pb->datasets[d]->name);
+    else
+        snprintf(buf, size, "dataset-%zu", d + 1);
+}
+
+int phc_problem_add_output(phc_problem *pb, const char *name, const char *dataset, double at, size_t observation,
+                           size_t config_line, phc_error *err)
+{
+    char place[600];
+    if (pb->source && config_line)
+        snprintf(place, sizeof place, "%s:%zu: outputs: '%s'", pb->source, config_line, name ? name : "");
+    else
+        snprintf(place, sizeof place, "outputs: '%s'", name ? name : "");
+    if (!name || !*name)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: an output needs a name", place);
+    for (const char *c = name; *c; ++c)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '_' ||
+              *c == '-' || *c == '.'))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: a name holds only letters, digits, '_', '-' and '.'",
+                                 place);
+    if (strcmp(name, "cost") == 0)
+        return phc_error_set(err, PHC_ERR_INPUT, "%s: 'cost' is the name of the study's cost output", place);
+    for (size_t i = 0; i < pb->n_outputs; ++i)
+        if (strcmp(pb->outputs[i].name, name) == 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: the name is used twice", place);
+    for (size_t i = 0; i < pb->n_datasets; ++i) {
+        char own[600];
+        dataset_label(pb, i, own, sizeof own);
+        const size_t len = strlen(own);
+        if (strncmp(name, own, len) == 0 && (strcmp(name + len, ".mean") == 0 || strcmp(name + len, ".cost") == 0))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: a study names data set '%s''s own output so", place, own);
+    }
+    long d = -1;
+    char label[512];
+    for (size_t i = 0; i < pb->n_datasets && d < 0; ++i) {
+        dataset_label(pb, i, label, sizeof label);
+        if (dataset && strcmp(label, dataset) == 0)
+            d = (long)i;
+    }
+    if (d < 0) {
+        char *names = NULL;
+        size_t len = 0;
+        for (size_t i = 0; i < pb->n_datasets; ++i) {
+            dataset_label(pb, i, label, sizeof label);
+            len += strlen(label) + 2;
+        }
+        names = calloc(len + 1, 1);
+        for (size_t i = 0; names && i < pb->n_datasets; ++i) {
+            dataset_label(pb, i, label, sizeof label);
+            strcat(names, i ? ", " : "");
+            strcat(names, label);
+        }
+        const int rc = phc_error_set(err, PHC_ERR_INPUT, "%s: dataset: no data set is called '%s' (the data sets: "
+                                     "%s)", place, dataset ? dataset : "", names ? names : "?");
+        free(names);
+        return rc;
+    }
+    const phc_dataset *ds = pb->datasets[d];
+    if (observation) {
+        if (observation > ds->n)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: observation: %zu is beyond the %zu observations of data "
+                                 "set '%s'", place, observation, ds->n, dataset);
+    } else {
+        if (!isfinite(at))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: at: not a finite number", place);
+        if (!ds->x || ds->n == 0)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: at: data set '%s' has no x axis; give observation: N",
+                                 place, dataset);
+        double lo = ds->x[0], hi = ds->x[0];
+        int increasing = 1;
+        for (size_t i = 1; i < ds->n; ++i) {
+            lo = ds->x[i] < lo ? ds->x[i] : lo;
+            hi = ds->x[i] > hi ? ds->x[i] : hi;
+            increasing &= ds->x[i] >= ds->x[i - 1];
+        }
+        if (at < lo || at > hi)
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: at: %.10g lies outside data set '%s''s x range [%.10g, "
+                                 "%.10g]%s%s", place, at, dataset, lo, hi, ds->x_label ? " of " : "",
+                                 ds->x_label ? ds->x_label : "");
+        if (!ds->ops->predict_at && (!increasing || ds->n_series > 1))
+            return phc_error_set(err, PHC_ERR_INPUT, "%s: at: a %s data set cannot predict at any x and its "
+                                 "observations are not one series in increasing x to interpolate; give "
+                                 "observation: N", place, ds->ops->kind);
+    }
+    phc_named_output *grown = realloc(pb->outputs, (pb->n_outputs + 1) * sizeof *grown);
+    if (!grown)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    pb->outputs = grown;
+    phc_named_output *o = &pb->outputs[pb->n_outputs];
+    if (!(o->name = strdup(name)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    o->dataset = (size_t)d;
+    o->at = observation ? NAN : at;
+    o->observation = observation;
+    o->config_line = config_line;
+    pb->n_outputs++;
+    return PHC_OK;
 }
 
 long phc_problem_find_parameter(const phc_problem *pb, const char *name)

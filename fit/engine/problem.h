@@ -44,6 +44,18 @@ typedef struct phc_parameter_group {
     size_t config_line;
 } phc_parameter_group;
 
+/* A named output of a sensitivity study (`outputs:` in the config): the
+ * prediction of data set `dataset` at x = `at` (in the data set's x unit,
+ * the axis of its plots: for a time series the time since its first row)
+ * or at its observation `observation` (1-based; 0 when `at` is used). */
+typedef struct phc_named_output {
+    char *name;          /* letters, digits, '_', '-', '.'; unique; not "cost" */
+    size_t dataset;      /* index into the problem's data sets */
+    double at;           /* x, when observation is 0 */
+    size_t observation;  /* 1-based, or 0 */
+    size_t config_line;  /* 0 when built by hand */
+} phc_named_output;
+
 /* The largest magnitude of a start value, finite bound or range end.  The
  * fit works on multiples of these (the automatic multi-start box spans 10x
  * the start, and a box's width is upper - lower), which must stay finite. */
@@ -76,7 +88,15 @@ typedef struct phc_problem {
     size_t n_seeds;
     phc_parameter_group *groups;  /* for sensitivity studies; a parameter is in at most one */
     size_t n_groups;
+    phc_named_output *outputs;    /* named outputs of sensitivity studies (phc_problem_add_output) */
+    size_t n_outputs;
+    size_t series_points;         /* sensitivity studies: per data set, the observations (at most
+                                     this many, evenly spaced by index) whose predictions are
+                                     outputs with indices per observation; 0 = none
+                                     (phc_problem_new sets PHC_SERIES_POINTS_DEFAULT) */
 } phc_problem;
+
+#define PHC_SERIES_POINTS_DEFAULT 100
 
 phc_problem *phc_problem_new(const char *name);
 void phc_problem_free(phc_problem *pb); /* accepts NULL */
@@ -84,6 +104,19 @@ void phc_problem_free(phc_problem *pb); /* accepts NULL */
 /* Adds a parameter (name copied; unique); returns its index in *index. */
 int phc_problem_add_parameter(phc_problem *pb, const char *name, double value,
                               size_t *index, phc_error *err);
+/* Adds a named output (copied name): data set `dataset` (by name) at x =
+ * `at` (observation 0) or at its 1-based `observation` (then `at` is
+ * ignored).  Add the data sets first.  PHC_ERR_INPUT, naming the config
+ * line when config_line > 0 ("cfg.yaml:30: outputs: 'W_6h': ..."): a
+ * name that is empty, not plain, "cost", "<data set>.mean" or ".cost", or
+ * already used; an unknown data
+ * set; an observation beyond the data set's; `at` not finite or outside
+ * the data set's x range; `at` on a kind that cannot predict at any x
+ * (no predict_at) unless its observations form one series with
+ * increasing x (then the prediction is interpolated linearly). */
+int phc_problem_add_output(phc_problem *pb, const char *name, const char *dataset, double at, size_t observation,
+                           size_t config_line, phc_error *err);
+
 /* Index of a parameter by name, or -1. */
 long phc_problem_find_parameter(const phc_problem *pb, const char *name);
 /* Takes ownership of ds (also on failure); names its series first

@@ -379,3 +379,127 @@ done:
     free(cols);
     return rc;
 }
+
+/* The aggregated indices from the base samples idx[0..m-1] of the T
+ * columns y + t M (M = n block). */
+static void estimate_aggregate(const phc_saltelli_design *d, const double *y, size_t T, const size_t *idx, size_t m,
+                               double *s1, double *st, double *num1, double *numt, double *var_out)
+{
+    const size_t f = d->f, bl = d->block, M = d->n * d->block;
+    double var_sum = 0;
+    for (size_t i = 0; i < f; ++i)
+        num1[i] = numt[i] = 0;
+    for (size_t t = 0; t < T; ++t) {
+        const double *yt = y + t * M;
+        double sum = 0, sum2 = 0;
+        for (size_t q = 0; q < m; ++q)
+            sum += yt[idx[q] * bl] + yt[idx[q] * bl + 1];
+        const double mean = sum / (double)(2 * m);
+        for (size_t q = 0; q < m; ++q) {
+            const double a = yt[idx[q] * bl] - mean, b = yt[idx[q] * bl + 1] - mean;
+            sum2 += a * a + b * b;
+        }
+        var_sum += sum2 / (double)(2 * m);
+        for (size_t i = 0; i < f; ++i) {
+            double a1 = 0, at = 0;
+            for (size_t q = 0; q < m; ++q) {
+                const double *yb = yt + idx[q] * bl;
+                const double fa = yb[0] - mean, fb = yb[1] - mean, fab = yb[2 + i] - mean;
+                a1 += fb * (fab - fa);
+                at += (fa - fab) * (fa - fab);
+            }
+            num1[i] += a1 / (double)m;
+            numt[i] += at / (2.0 * (double)m);
+        }
+    }
+    for (size_t i = 0; i < f; ++i) {
+        s1[i] = var_sum > 0 ? num1[i] / var_sum : NAN;
+        st[i] = var_sum > 0 ? numt[i] / var_sum : NAN;
+    }
+    if (var_out)
+        *var_out = var_sum;
+}
+
+int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const double *y, size_t n_outputs,
+                                         phc_sobol_indices *out, phc_error *err)
+{
+    memset(out, 0, sizeof *out);
+    const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, M = d->n * d->block;
+    if (n_outputs == 0)
+        return phc_error_set(err, PHC_ERR_INVALID, "aggregated indices of no output");
+    size_t *used = malloc(n * sizeof *used), *draw = malloc(n * sizeof *draw);
+    double *boot = malloc(R * 2 * f * sizeof *boot), *tmp = malloc(R * sizeof *tmp);
+    double *num = malloc(2 * f * sizeof *num);
+    out->n_factors = f;
+    out->s1 = malloc(3 * f * sizeof *out->s1);
+    out->st = malloc(3 * f * sizeof *out->st);
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    int rc = PHC_OK;
+    if (!used || !draw || !boot || !tmp || !num || !out->s1 || !out->st || !rng) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    out->s1_lo = out->s1 + f;
+    out->s1_hi = out->s1 + 2 * f;
+    out->st_lo = out->st + f;
+    out->st_hi = out->st + 2 * f;
+    size_t m = 0;
+    for (size_t j = 0; j < n; ++j) {
+        int ok = 1;
+        for (size_t t = 0; t < n_outputs && ok; ++t)
+            for (size_t s = 0; s < bl; ++s)
+                ok &= isfinite(y[t * M + j * bl + s]) != 0;
+        if (ok)
+            used[m++] = j;
+    }
+    out->n_used = m;
+    out->n_failed = n - m;
+    if (m < 4) {
+        rc = phc_error_set(err, PHC_ERR_NUMERIC, "only %zu of %zu base samples have every evaluation finished; "
+                           "the indices need at least 4", m, n);
+        goto done;
+    }
+    {
+        double mean_sum = 0;
+        for (size_t t = 0; t < n_outputs; ++t) {
+            double sum = 0;
+            for (size_t q = 0; q < m; ++q)
+                sum += y[t * M + used[q] * bl] + y[t * M + used[q] * bl + 1];
+            mean_sum += sum / (double)(2 * m);
+        }
+        out->mean = mean_sum / (double)n_outputs;
+    }
+    estimate_aggregate(d, y, n_outputs, used, m, out->s1, out->st, num, num + f, &out->variance);
+    gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL); /* the resamples of phc_sobol_indices_estimate */
+    for (size_t r = 0; r < R; ++r) {
+        for (size_t q = 0; q < m; ++q)
+            draw[q] = used[gsl_rng_uniform_int(rng, m)];
+        estimate_aggregate(d, y, n_outputs, draw, m, boot + r * 2 * f, boot + r * 2 * f + f, num, num + f, NULL);
+    }
+    for (size_t i = 0; i < 2 * f; ++i) {
+        size_t cnt = 0;
+        for (size_t r = 0; r < R; ++r)
+            if (isfinite(boot[r * 2 * f + i]))
+                tmp[cnt++] = boot[r * 2 * f + i];
+        double lo = NAN, hi = NAN;
+        if (cnt >= R / 2)
+            percentile(tmp, cnt, d->o.level, &lo, &hi);
+        if (i < f) {
+            out->s1_lo[i] = lo;
+            out->s1_hi[i] = hi;
+        } else {
+            out->st_lo[i - f] = lo;
+            out->st_hi[i - f] = hi;
+        }
+    }
+done:
+    gsl_rng_free(rng);
+    free(used);
+    free(draw);
+    free(boot);
+    free(tmp);
+    free(num);
+    if (rc)
+        phc_sobol_indices_clear(out);
+    return rc;
+}

@@ -90,4 +90,20 @@ int phc_sobol_indices_estimate_outputs(const phc_saltelli_design *d, const doubl
                                        phc_sobol_indices *out, phc_error *err);
 void phc_sobol_indices_clear(phc_sobol_indices *s); /* frees the arrays; accepts zeroed */
 
+/* Generalised (aggregated) indices of T outputs together, for a time series
+ * (Lamboni, Monod & Makowski 2011, Reliab. Eng. Syst. Saf. 96, 450;
+ * Gamboa, Janon, Klein & Lagnoux 2013, arXiv:1311.1797, "Sensitivity
+ * analysis for multidimensional and functional outputs", §2): the
+ * output variances weight the indices of the single outputs,
+ *   S_i = sum_t V_t S_i,t / sum_t V_t,   ST_i = sum_t V_t ST_i,t / sum_t V_t,
+ * computed as the ratio of the estimators' summed numerators to the summed
+ * variances (each output centred on its own mean), so an output without
+ * variance adds nothing.  y holds the T outputs one after the other (T
+ * columns of M values, column t at y + t M).  Bootstrap as for one output
+ * (the same resamples); a base sample with a non-finite value in any output
+ * is left out.  out->mean is the mean over the outputs of their means,
+ * out->variance the summed variance sum_t V_t; no second order (s2 NULL). */
+int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const double *y, size_t n_outputs,
+                                         phc_sobol_indices *out, phc_error *err);
+
 #endif /* PHC_SOBOL_INDICES_H */

@@ -98,6 +98,27 @@ bad_case "N too small for second order" good.yaml "too small for second-order" -
 bad_case "too few Morris trajectories" good.yaml "too few" --method morris --samples 3
 bad_case "unknown method" good.yaml "--method: unknown method 'fast'" --method fast
 bad_case "samples not a number" good.yaml "--samples: expected a whole number" --samples many
+bad_case "points not a number" good.yaml "--points: expected a whole number from 0 to 100000, found '-3'" --points -3
+# named outputs (outputs: in the config)
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v_half, dataset: assays, at: 0.5}]' > out_ds.yaml
+bad_case "named output of an unknown data set" out_ds.yaml \
+    "out_ds.yaml:14: outputs: 'v_half': dataset: no data set is called 'assays' (the data sets: assay)"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v_far, dataset: assay, at: 500}]' > out_range.yaml
+bad_case "named output outside the x range" out_range.yaml "out_range.yaml:14: outputs: 'v_far': at: 500 lies outside data set 'assay''s x range"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v2, dataset: assay, at: 0.5, observation: 2}]' > out_both.yaml
+bad_case "named output with at and observation" out_both.yaml "out_both.yaml:14: outputs[1]: give exactly one of 'at'"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v2, dataset: assay, observation: 0}]' > out_zero.yaml
+bad_case "named output at observation 0" out_zero.yaml "out_zero.yaml:14: outputs[1]: observation: 0; observations count from 1"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v2, dataset: assay, observation: 99}]' > out_beyond.yaml
+bad_case "named output beyond the observations" out_beyond.yaml "out_beyond.yaml:14: outputs: 'v2': observation: 99 is beyond the 14 observations"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v2, dataset: assay, when: 3}]' > out_key.yaml
+bad_case "named output with an unknown key" out_key.yaml "out_key.yaml:14: unknown key 'when' in outputs[1]"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: cost, dataset: assay, at: 1}]' > out_cost.yaml
+bad_case "named output called cost" out_cost.yaml "outputs: 'cost': 'cost' is the name of the study's cost output"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: {v: 1}' > out_map.yaml
+bad_case "outputs not a list" out_map.yaml "out_map.yaml:14"
+config "$GOOD_V" "$GOOD_K" "$EXPR" $'outputs:\n  - {name: v, dataset: assay, at: 1}\n  - {name: v, dataset: assay, at: 2}' > out_twice.yaml
+bad_case "named output twice" out_twice.yaml "out_twice.yaml:16: outputs: 'v': the name is used twice"
 
 # ---- an interrupted study resumed equals an uninterrupted one ---------------
 for method in sobol morris; do
@@ -132,6 +153,17 @@ run sensitivity good.yaml -o part --samples 128 --resume
 [ "$RC" -eq 2 ] || why "exit $RC, expected 2"
 grep -qF "the ledger is from another study: samples is '64' there and '128' now" "$T/stderr" || why "message"
 finish "resume refuses a ledger with other samples"
+run sensitivity good.yaml -o part --samples 64 --resume --points 5
+[ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+grep -qF "the ledger is from another study: outputs is 'cost,assay.mean,assay@[14 of 14 observations]' there and 'cost,assay.mean,assay@[5 of 14 observations]' now" "$T/stderr" || why "message"
+finish "resume refuses a ledger with other --points, naming the outputs"
+config "$GOOD_V" "$GOOD_K" "$EXPR" 'outputs: [{name: v_half, dataset: assay, at: 0.5}]' > named.yaml
+cp good.yaml good.bak && cp named.yaml good.yaml
+run sensitivity good.yaml -o part --samples 64 --resume
+[ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+grep -qF "outputs is 'cost,assay.mean,assay@[14 of 14 observations]' there and 'cost,assay.mean,v_half=assay(x=0.5),assay@[14 of 14 observations]' now" "$T/stderr" || why "message"
+finish "resume refuses a ledger of a config with other named outputs, naming them"
+cp good.bak good.yaml
 config "$GOOD_V" "$GOOD_K" "$EXPR + 0" "" > good.yaml
 run sensitivity good.yaml -o part --samples 64 --resume
 [ "$RC" -eq 2 ] || why "exit $RC, expected 2"
@@ -175,6 +207,19 @@ run sensitivity per_h.yaml -o hour --samples 64
 grep -q 'h-1 cm-2' per_h.yaml || why "the unit was not changed"
 diff <(sed '/^results/d' sec.txt) <(sed '/^results/d' "$T/stdout") >/dev/null || why "the verdicts differ"
 finish "a prior in h-1 cm-2 gives the study of the same prior in s-1 cm-2"
+
+# ---- a ledger of many outputs: 100 observations and two named outputs per line ----
+rm -rf sec part part.ledger
+run sensitivity per_s.yaml -o sec --samples 64 -q
+n_fields=$(grep -m1 $'^0\tok' sec/ledger.tsv | awk -F'\t' '{print NF - 2}')
+[ "$n_fields" = 104 ] || why "a ledger line holds $n_fields outputs, expected 104 (cost, mean, 2 named, 100 observations)"
+PHYTOCAL_STOP_AFTER=100 "$PHC" sensitivity per_s.yaml -o part --samples 64 -q >/dev/null 2>"$T/stderr"
+run sensitivity per_s.yaml -o part --samples 64 --resume -q
+[ "$RC" -eq 0 ] || why "resume: exit $RC"
+cmp -s sec/result.json part/result.json || why "result.json differs from the uninterrupted run's"
+grep -q '"series"' part/result.json || why "no series in result.json"
+[ -f part/balance_over_x.png ] || why "no plot against x"
+finish "104 outputs per evaluation: interrupted and resumed = uninterrupted (result.json identical)"
 
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

@@ -58,17 +58,18 @@ static phc_problem *ishigami_problem(void)
 static void test_evaluate(void)
 {
     phc_problem *pb = ishigami_problem();
-    CHECK(phc_study_outputs(pb) == 2);
+    CHECK(phc_study_outputs(pb) == 3); /* cost, mean, the prediction at the one observation */
     char name[64];
     phc_study_output_name(pb, 1, name, sizeof name);
     CHECK(strcmp(name, "dataset-1.mean") == 0); /* built in C without a name */
     phc_study_eval *w = phc_study_eval_new(pb);
     const double x[3] = {0.3, -1.2, 2.5};
-    double out[2];
+    double out[3];
     CHECK(phc_study_evaluate(w, x, out) == 0);
     const double f = sin(0.3) + 7 * pow(sin(-1.2), 2) + 0.1 * pow(2.5, 4) * sin(0.3);
     CHECK_NEAR(out[1], f, 0, 1e-14);
     CHECK_NEAR(out[0], 0.5 * f * f, 0, 1e-14);
+    CHECK(out[2] == out[1]); /* the one observation's prediction is the mean */
     phc_study_eval_free(w);
     phc_problem_free(pb);
 }
