@@ -42,6 +42,8 @@ static const key_spec KEYS[] = {
     {"growth", "max_length", K_NUM, OPT(max_length), 0, INF, 1, 1, "m", "L_max: length of a grown internode"},
     {"growth", "bud_fraction", K_NUM, OPT(bud_fraction), 0, 1, 1, 1, "", "sigma_0: size of a new internode / L_max"},
     {"growth", "growth_rate", K_NUM, OPT(growth_rate), 0, INF, 0, 1, "s-1", "r: d(sigma)/dt in full light (sec. 4.2)"},
+    {"growth", "apical_dominance", K_NUM, OPT(apical_dominance), 0, 1, 1, 0, "",
+     "a: a tip of branch order k grows at growth_rate*a^k (1: no dominance)"},
     {"growth", "radius", K_NUM, OPT(radius), 0, INF, 1, 1, "m", "radius of the main axis"},
     {"growth", "max_particles", K_SIZE, OPT(max_particles), 1, 1e8, 0, 0, "", "growth stops at this many"},
     {"branching", "probability", K_NUM, OPT(branch_probability), 0, 1, 0, 0, "",

@@ -13,8 +13,8 @@
  *   time_step: 0.25             # s
  *   frame_interval: 30          # s between written frames
  *   plant:     {position: [x, y, z], direction: [x, y, z]}      # m, any length
- *   growth:    {max_length, bud_fraction, growth_rate, radius, max_particles,
- *               apical_dominance}
+ *   growth:    {max_length, bud_fraction, growth_rate, apical_dominance, radius,
+ *               max_particles}
  *   branching: {probability, buds, variance, thickness_falloff, max_order}
  *   light:     {direction, extinction, cell, origin, size}
  *   tropisms:  {phototropism, surface_adaption, adaption_radius, contact_distance}
