@@ -641,6 +641,16 @@ int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
     return 0;
 }
 
+int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err)
+{
+    if (substeps > 0 && !(c->o.particles.maturity_age > 0))
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "climbing: dynamics need particles.maturity_age > 0 (it is %g s)",
+                             c->o.particles.maturity_age);
+    c->o.dynamics_substeps = substeps;
+    return 0;
+}
+
 void phc_climbing_get_stats(const phc_climbing *c, phc_climbing_stats *s) { *s = c->stats; }
 size_t phc_climbing_count(const phc_climbing *c) { return c ? c->n : 0; }
 size_t phc_climbing_parent(const phc_climbing *c, size_t i) { return c->parent[i]; }

@@ -156,6 +156,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err);
  * is turned or tilted while the plant grows. */
 int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err);
 
+/* Switches the dynamics on (substeps > 0) or off (0) from the next step,
+ * e.g. to grow a plant kinematically and then let it settle.  Error: substeps
+ * > 0 with particles.maturity_age = 0 (PHC_ERR_INVALID, nothing changed). */
+int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err);
+
 /* Counters since the seed. */
 typedef struct phc_climbing_stats {
     double time;            /* s */
