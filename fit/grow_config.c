@@ -36,7 +36,7 @@ static const key_spec KEYS[] = {
      "growth step; growth_rate*time_step < 1 - bud_fraction"},
     {NULL, "frame_interval", K_NUM, CFG(frame_interval), 0, INF, 1, 1, "s",
      "time between the frames written (frame 0 is the seed; the last frame is at duration)"},
-    {"plant", "position", K_VEC, CFG(position), -INF, INF, 1, 1, "m", "base of the seed particle; required"},
+    {"plant", "position", K_VEC, CFG(position), -INF, INF, 1, 1, "m", "base of the seed particle"},
     {"plant", "direction", K_VEC, CFG(direction), -INF, INF, 1, 1, "",
      "its growth direction (any non-zero length)"},
     {"growth", "max_length", K_NUM, OPT(max_length), 0, INF, 1, 1, "m", "L_max: length of a grown internode"},
