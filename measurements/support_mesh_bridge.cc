@@ -99,7 +99,17 @@ phc_support_mesh *phc_support_mesh_read(const char *path, phc_error *err)
         phc_error_set(err, PHC_ERR_IO, "%s: cannot open: %s", path, std::strerror(errno));
         return nullptr;
     }
+    // assimp 5's PLY reader loops forever on a header without end_header
+    // (found by phytocal grow's bad-input tests): refuse such a file first.
+    char head[65536];
+    const size_t got = std::fread(head, 1, sizeof head - 1, f);
     std::fclose(f);
+    head[got] = '\0';
+    if (got >= 3 && std::strncmp(head, "ply", 3) == 0 && !std::strstr(head, "\nend_header")) {
+        phc_error_set(err, PHC_ERR_INPUT,
+                      "%s: a PLY file whose header has no end_header line (within its first 64 KiB)", path);
+        return nullptr;
+    }
     phc_support_mesh *m = nullptr;
     try {
         Assimp::Importer importer;

@@ -43,6 +43,7 @@ phc_climbing_options phc_climbing_options_default(void)
     o.max_length = 0.02;
     o.bud_fraction = 0.25;
     o.growth_rate = 0.1;
+    o.apical_dominance = 1;
     o.radius = 0.002;
     o.max_particles = 20000;
     o.branch_probability = 0.3;
@@ -140,6 +141,8 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
     if (!(cond)) return bad(err, key, (double)(v), range)
     NEED(o->max_length > 0 && isfinite(o->max_length), "max_length", o->max_length, "(0, inf) m");
     NEED(o->bud_fraction > 0 && o->bud_fraction < 1, "bud_fraction", o->bud_fraction, "(0, 1)");
+    NEED(o->apical_dominance > 0 && o->apical_dominance <= 1, "apical_dominance", o->apical_dominance,
+         "(0, 1]");
     NEED(o->growth_rate >= 0 && isfinite(o->growth_rate), "growth_rate", o->growth_rate,
          "[0, inf) 1/s");
     NEED(o->radius > 0 && isfinite(o->radius), "radius", o->radius, "(0, inf) m");
@@ -602,7 +605,9 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         if (!c->apical[i])
             continue;
         tropisms(c, i, dt);
-        if (grow(c, i, o->growth_rate * c->light[i] * dt)) {
+        /* apical dominance (ours): a tip of order k grows at r·a^k */
+        const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
+        if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
             count(c);
             return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory at %zu particles",
                                  c->n);
@@ -633,6 +638,16 @@ int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
             return phc_error_set(err, PHC_ERR_INVALID, "climbing: gravity %c is not finite",
                                  "xyz"[k]);
     memcpy(c->o.particles.gravity, g, sizeof c->o.particles.gravity);
+    return 0;
+}
+
+int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err)
+{
+    if (substeps > 0 && !(c->o.particles.maturity_age > 0))
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "climbing: dynamics need particles.maturity_age > 0 (it is %g s)",
+                             c->o.particles.maturity_age);
+    c->o.dynamics_substeps = substeps;
     return 0;
 }
 

@@ -18,7 +18,8 @@
  *     each turning the current and the rest direction alike (eqs. 8–10);
  *     a tip within the contact distance that heads into the support loses
  *     the inward part of its direction (a collision rule of ours);
- *  3. apical growth (§4.2): dσ/dt = r·I (r the growth rate, s⁻¹).  When σ
+ *  3. apical growth (§4.2): dσ/dt = r·a^k·I (r the growth rate, s⁻¹; a^k
+ *     the apical dominance over a tip of branch order k, 1 by default).  When σ
  *     reaches 1 the particle stops growing and spawns a successor at its
  *     tip, same direction, order and radius, of size σ₀ (bud_fraction)
  *     plus the excess σ − 1 (no growth is lost: Σσ = n σ₀ + r∫I dt, and a
@@ -88,6 +89,12 @@ typedef struct phc_climbing_options {
     double max_length;          /* L_max, m, > 0: length of a grown particle; default 0.02 */
     double bud_fraction;        /* σ₀ ∈ (0, 1): size of a new particle / L_max; default 0.25 */
     double growth_rate;         /* r, s^-1, >= 0: dσ/dt in full light; default 0.1 */
+    double apical_dominance;    /* a ∈ (0, 1]: a tip of branch order k grows at r·a^k, so
+                                   laterals grow slower than the axis that bears them
+                                   (apical control as in Palubicki et al., "Self-organizing
+                                   tree models for image synthesis", SIGGRAPH 2009, §4;
+                                   the power law is ours, the climbing paper gives none);
+                                   default 1 (no dominance) */
     double radius;              /* m, > 0: radius of the main axis; default 0.002 */
     size_t max_particles;       /* growth stops when reached (>= 1); default 20000 */
     /* branching (§4.3, Fig. 5) */
@@ -148,6 +155,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err);
 /* Changes the gravity of the dynamics (m s^-2, finite), e.g. when the scene
  * is turned or tilted while the plant grows. */
 int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err);
+
+/* Switches the dynamics on (substeps > 0) or off (0) from the next step,
+ * e.g. to grow a plant kinematically and then let it settle.  Error: substeps
+ * > 0 with particles.maturity_age = 0 (PHC_ERR_INVALID, nothing changed). */
+int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err);
 
 /* Counters since the seed. */
 typedef struct phc_climbing_stats {

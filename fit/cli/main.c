@@ -2,6 +2,7 @@
  *
  *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal grow CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S] [--resume] ...
  *   phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]
  *   phytocal mcmc CONFIG.yaml [-o DIR] [--method dram|stretch] [--samples N] [--chains C] [--seed S] ...
@@ -27,6 +28,8 @@
 #include "fit/config_help.h"
 #include "fit/engine/fit.h"
 #include "fit/engine/provenance.h"
+#include "fit/grow.h"
+#include "fit/grow_config.h"
 #include "fit/mcmc_study.h"
 #include "fit/report.h"
 #include "fit/profile_study.h"
@@ -71,6 +74,22 @@ static const command_help commands[] = {
      "writes a run directory (default runs/<name>-simulation/) with <data set>_simulated.csv\n"
      "(x, observed, model) and <data set>_simulated.png, plus each kind's own outputs\n"
      "(fields, frames, plant files), so start values can be checked before a fit.\n"
+     "\n"
+     "options: -o DIR, --force, --quiet, --help as for fit."},
+    {"grow", "phytocal grow CONFIG.yaml [-o DIR] [--force] [--quiet]",
+     "Grows a climbing plant (Hadrich et al., CGF 2017; README: Climbing plants) from a\n"
+     "seed on a support mesh, as a grow config says (keys below), and writes a run\n"
+     "directory (default runs/<name>-grow/):\n"
+     "  frame_NNNN.vtk     the plant every frame_interval (ParaView: Tube filter on radius)\n"
+     "  growth.csv         per frame: particles, tips, laterals, anchored, height, length\n"
+     "  plant_side.png     the final plant seen along y (x-z) and along x (y-z:\n"
+     "  plant_front.png    plant_front.png), colour = branch order\n"
+     "  support.vtk        the support mesh\n"
+     "  result.json        the final plant: particles, laterals per order, height,\n"
+     "                     attached fraction, ...; and the provenance\n"
+     "  phytocal-run.json  manifest\n"
+     "and prints a summary.  A grow config is not a calibration config: it has no\n"
+     "parameters to fit and no data.\n"
      "\n"
      "options: -o DIR, --force, --quiet, --help as for fit."},
     {"sensitivity", "phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S]\n"
@@ -212,7 +231,12 @@ static const command_help *find_command(const char *name)
 
 static void print_command_help(const command_help *c, FILE *out)
 {
-    fprintf(out, "usage: %s\n\n%s\n\n%s", c->synopsis, c->text, exit_codes);
+    fprintf(out, "usage: %s\n\n%s\n\n", c->synopsis, c->text);
+    if (strcmp(c->name, "grow") == 0) {
+        phc_grow_config_help(out);
+        fputc('\n', out);
+    }
+    fprintf(out, "%s", exit_codes);
 }
 
 static int cmd_help(int argc, char **argv)
@@ -230,7 +254,7 @@ static int cmd_help(int argc, char **argv)
     phc_error_clear(&err);
     if (phc_config_write_help(stdout, strcmp(argv[0], "config") == 0 ? NULL : argv[0], &err) == PHC_OK)
         return EXIT_OK;
-    fprintf(stderr, "phytocal: %s; commands: fit, simulate, sensitivity, profile, mcmc, report, help, version\n", err.message);
+    fprintf(stderr, "phytocal: %s; commands: fit, simulate, grow, sensitivity, profile, mcmc, report, help, version\n", err.message);
     return EXIT_USAGE;
 }
 
@@ -487,6 +511,55 @@ static int cmd_simulate(int full_argc, char **full_argv, int argc, char **argv)
         printf("simulated %zu data set%s: %s/\n", pb->n_datasets, pb->n_datasets == 1 ? "" : "s", dir);
     phc_provenance_free(pv);
     phc_problem_free(pb);
+    return rc ? fail(&err) : EXIT_OK;
+}
+
+/* grow: one climbing plant from a grow config (grow.h). */
+static int cmd_grow(int full_argc, char **full_argv, int argc, char **argv)
+{
+    cli_options o;
+    if (parse_args("grow", argc, argv, &o, "ofq") != 0) {
+        fprintf(stderr, "usage: %s\n", find_command("grow")->synopsis);
+        return EXIT_USAGE;
+    }
+    phc_error err;
+    phc_error_clear(&err);
+    phc_grow_config *cfg = NULL;
+    if (phc_grow_config_load(o.input, &cfg, &err))
+        return fail(&err);
+    char dir[4096];
+    if (o.out_dir)
+        snprintf(dir, sizeof dir, "%s", o.out_dir);
+    else
+        snprintf(dir, sizeof dir, "runs/%s-grow", cfg->name);
+    for (size_t n = strlen(dir); n > 1 && dir[n - 1] == '/'; --n)
+        dir[n - 1] = '\0';
+    phc_grow_inputs in;
+    phc_grow_inputs_init(&in, cfg);
+    phc_provenance *pv = NULL;
+    if (phc_run_dir_check(dir, o.force, &in.pb, &err) ||
+        phc_provenance_begin(&in.pb, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, &pv, &err)) {
+        phc_grow_config_free(cfg);
+        return fail(&err);
+    }
+    phc_grow_summary s;
+    const int rc = phc_grow_write(cfg, pv, dir, o.force, &s, &err);
+    if (rc == PHC_OK && !o.quiet) {
+        printf("%s: grown for %g s in steps of %g s (seed %llu)\n", cfg->name, s.time, cfg->time_step,
+               (unsigned long long)cfg->options.seed);
+        printf("particles %zu (growing tips %zu), total length %.4g m, height %.4g m above the seed\n", s.particles,
+               s.apical, s.total_length, s.height);
+        printf("laterals %zu of %zu buds; per branch order:", s.laterals, s.bud_trials);
+        for (size_t k = 1; k <= s.max_order && k < 8; ++k)
+            printf(" %zu: %zu", k, s.laterals_per_order[k]);
+        printf("%s\n", s.max_order == 0 ? " none" : "");
+        printf("anchored %zu of %zu particles (attached fraction %.3f; made %zu, released %zu)\n", s.anchored,
+               s.particles, s.attached_fraction, s.anchors_made, s.anchors_released);
+        printf("results: %s/ (%zu frames, growth.csv, result.json, plant_side.png, plant_front.png)\n", dir,
+               s.frames);
+    }
+    phc_provenance_free(pv);
+    phc_grow_config_free(cfg);
     return rc ? fail(&err) : EXIT_OK;
 }
 
@@ -885,6 +958,8 @@ int main(int argc, char **argv)
         return cmd_fit(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "simulate") == 0)
         return cmd_simulate(argc, argv, argc - 2, argv + 2);
+    if (strcmp(cmd, "grow") == 0)
+        return cmd_grow(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "sensitivity") == 0)
         return cmd_sensitivity(argc, argv, argc - 2, argv + 2);
     if (strcmp(cmd, "profile") == 0)

@@ -1415,6 +1415,85 @@ fit_case "shape_series: viscosity without the water model" "$C/ss_wvisc.yaml" "s
 sed 's/^    water: plant/    water: plant\n    water_step: -1/' "$C/ss_wgood.yaml" >"$C/ss_wstep.yaml"
 fit_case "shape_series: negative water step" "$C/ss_wstep.yaml" "ss_wstep.yaml:12" "'water_step'" "positive"
 
+# ---- phytocal grow (climbing plants) -----------------------------------------
+# grow_case NAME CONFIG SUBSTRING...: `phytocal grow CONFIG -o OUT` must fail
+# with exit code 2, one line naming the file and line/key, and no output.
+grow_case() {
+    local name=$1 config=$2
+    shift 2
+    local out="$T/out_${name//[^A-Za-z0-9_]/_}"
+    WHY=""
+    run_phc grow "$config" -o "$out"
+    check_error_output 2 "$@"
+    check_no_output "$out"
+    report_case "$name"
+}
+printf 'v -0.5 0 0\nv 0.5 0 0\nv -0.5 0 1\nv 0.5 0 1\nf 1 3 2\nf 2 3 4\n' >"$C/gr_wall.obj"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nzero one two?\n' >"$C/gr_noheader.ply"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\nzero one two?\n' >"$C/gr_junk.ply"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' >"$C/gr_points.obj"
+gr_config() { # FILE MESH POSITION EXTRA_LINES
+    printf 'name: g\nsupport: %s\nduration: 2\nplant:\n  position: %s\n%s' "$2" "$3" "${4:-}" >"$C/$1"
+}
+gr_config gr_good.yaml gr_wall.obj '[0, 0.03, 0]'
+WHY=""
+run_phc grow "$C/gr_good.yaml" -o "$T/out_gr_good" --quiet
+[ "$RC" -eq 0 ] || add_why "exit code $RC, expected 0"
+for f in result.json growth.csv frame_0000.vtk plant_side.png plant_front.png support.vtk phytocal-run.json; do
+    [ -f "$T/out_gr_good/$f" ] || add_why "no $f written"
+done
+report_case "grow: control: a seed before a wall grows"
+run_phc grow "$C/gr_good.yaml" -o "$T/out_gr_good" --quiet
+WHY=""
+[ "$RC" -eq 2 ] || add_why "exit code $RC, expected 2 (the run directory exists)"
+run_phc grow "$C/gr_good.yaml" -o "$T/out_gr_good" --quiet --force
+[ "$RC" -eq 0 ] || add_why "with --force: exit code $RC, expected 0"
+report_case "grow: control: an earlier run is replaced only with --force"
+rm -rf "$T/out_gr_good"
+gr_config gr_noheader.yaml gr_noheader.ply '[0, 0.03, 0]'
+grow_case "grow: PLY mesh without end_header" "$C/gr_noheader.yaml" "gr_noheader.yaml:2" "support" "end_header"
+gr_config gr_junk.yaml gr_junk.ply '[0, 0.03, 0]'
+grow_case "grow: PLY mesh that does not parse" "$C/gr_junk.yaml" "gr_junk.yaml:2" "support" "assimp"
+gr_config gr_points.yaml gr_points.obj '[0, 0.03, 0]'
+grow_case "grow: OBJ mesh without triangles" "$C/gr_points.yaml" "gr_points.yaml:2" "no triangles"
+gr_config gr_nomesh.yaml gr_none.obj '[0, 0.03, 0]'
+grow_case "grow: missing mesh file" "$C/gr_nomesh.yaml" "gr_nomesh.yaml:2" "gr_none.obj"
+gr_config gr_inside.yaml gr_wall.obj '[0, -0.05, 0.3]'
+grow_case "grow: seed inside (behind) the support" "$C/gr_inside.yaml" "gr_inside.yaml:5" "plant.position" "behind"
+gr_config gr_bp.yaml gr_wall.obj '[0, 0.03, 0]' 'branching:
+  probability: 1.5
+'
+grow_case "grow: branching probability above 1" "$C/gr_bp.yaml" "gr_bp.yaml:7" "branching.probability" "[0, 1]"
+gr_config gr_bpneg.yaml gr_wall.obj '[0, 0.03, 0]' 'branching:
+  probability: -0.1
+'
+grow_case "grow: branching probability below 0" "$C/gr_bpneg.yaml" "gr_bpneg.yaml:7" "branching.probability"
+gr_config gr_var.yaml gr_wall.obj '[0, 0.03, 0]' 'branching:
+  variance: 1.2
+'
+grow_case "grow: direction variance over 1" "$C/gr_var.yaml" "gr_var.yaml:7" "branching.variance" "90 degrees"
+gr_config gr_ks.yaml gr_wall.obj '[0, 0.03, 0]' 'anchors:
+  strength: 2
+'
+grow_case "grow: anchor strength over 1" "$C/gr_ks.yaml" "gr_ks.yaml:7" "anchors.strength"
+gr_config gr_typo.yaml gr_wall.obj '[0, 0.03, 0]' 'branching:
+  probabilty: 0.5
+'
+grow_case "grow: misspelt key" "$C/gr_typo.yaml" "gr_typo.yaml:7" "did you mean 'probability'"
+gr_config gr_nopos.yaml gr_wall.obj '[0, 0.03, 0]'
+sed -i 's/position:/direction:/' "$C/gr_nopos.yaml"
+grow_case "grow: no seed position" "$C/gr_nopos.yaml" "gr_nopos.yaml:5" "position"
+gr_config gr_vec.yaml gr_wall.obj '[0, 0.03]'
+grow_case "grow: position of two numbers" "$C/gr_vec.yaml" "gr_vec.yaml:5" "three numbers"
+gr_config gr_dt.yaml gr_wall.obj '[0, 0.03, 0]' 'time_step: 8
+'
+grow_case "grow: time step too long for the growth rate" "$C/gr_dt.yaml" "gr_dt.yaml:6" "time_step"
+gr_config gr_rel.yaml gr_wall.obj '[0, 0.03, 0]' 'anchors:
+  attach_distance: 0.03
+'
+grow_case "grow: release distance not above attach distance" "$C/gr_rel.yaml" "gr_rel.yaml:7" "release_distance"
+# ---- end grow ----------------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

@@ -503,6 +503,59 @@ int main(void)
         phc_climbing_free(c);
     }
 
+    /* 8b. apical dominance: a tip of order k grows at r·a^k (full light).
+     * Over each step, per order k: Σσ_k grows by r·a^k·Δt per tip of
+     * order k, plus σ₀ per particle born (successors carry the excess). */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.seed = 5;
+        o.growth_rate = 0.2;
+        o.branch_probability = 1;
+        o.max_buds = 1;
+        o.max_order = 2;
+        o.apical_dominance = 0.5;
+        phc_climbing *c = phc_climbing_new(origin, up, &o, &err);
+        CHECK(c != NULL);
+        const double dt = 0.25;
+        double worst = 0, len[3] = {0, 0, 0};
+        for (int k = 0; c && k < 200; ++k) {
+            double sum0[3] = {0, 0, 0};
+            size_t tips[3] = {0, 0, 0}, n0[3] = {0, 0, 0}, n1[3] = {0, 0, 0};
+            const size_t n = phc_climbing_count(c);
+            for (size_t i = 0; i < n; ++i) {
+                const unsigned ord = phc_climbing_order(c, i);
+                sum0[ord] += phc_climbing_size(c, i);
+                n0[ord]++;
+                tips[ord] += (size_t)phc_climbing_is_apical(c, i);
+            }
+            CHECK(phc_climbing_step(c, dt, &err) == 0);
+            double sum1[3] = {0, 0, 0};
+            for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+                sum1[phc_climbing_order(c, i)] += phc_climbing_size(c, i);
+                n1[phc_climbing_order(c, i)]++;
+            }
+            for (int ord = 0; ord < 3; ++ord) {
+                const double want = o.growth_rate * pow(o.apical_dominance, ord) * dt * (double)tips[ord] +
+                                    o.bud_fraction * (double)(n1[ord] - n0[ord]);
+                worst = fmax(worst, fabs(sum1[ord] - sum0[ord] - want));
+            }
+        }
+        for (size_t i = 0; c && i < phc_climbing_count(c); ++i)
+            len[phc_climbing_order(c, i)] += phc_climbing_length(c, i);
+        size_t shoots[3] = {1, 0, 0};
+        for (size_t i = 0; c && i < phc_climbing_count(c); ++i)
+            shoots[phc_climbing_order(c, i)] += (size_t)phc_climbing_is_lateral(c, i);
+        printf("apical dominance a = 0.5: max |step growth of sum sigma per order - (r a^k dt tips + s0 born)| "
+               "= %.1e (bound 1e-12); mean shoot length by order 0, 1, 2: %.3f, %.3f, %.3f m\n",
+               worst, len[0] / (double)shoots[0], shoots[1] ? len[1] / (double)shoots[1] : 0.0,
+               shoots[2] ? len[2] / (double)shoots[2] : 0.0);
+        CHECK(worst < 1e-12);
+        CHECK(shoots[1] > 0 && shoots[2] > 0);
+        CHECK(len[0] / (double)shoots[0] > len[1] / (double)shoots[1]);
+        CHECK(len[1] / (double)shoots[1] > len[2] / (double)shoots[2]);
+        phc_climbing_free(c);
+    }
+
     /* 9. bad options */
     {
         /* the plant's generator: xoshiro256** seeded by splitmix64, against

@@ -1,0 +1,372 @@
+/* `phytocal grow`: see grow.h. */
+#include "fit/grow.h"
+
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/run_dir.h"
+#include "fit/shape_plots.h"
+#include "measurements/atomic_file.h"
+#include "measurements/plant_io.h"
+#include "measurements/support_mesh.h"
+
+void phc_grow_inputs_init(phc_grow_inputs *in, const phc_grow_config *c)
+{
+    memset(in, 0, sizeof *in);
+    in->pb.name = c->name;
+    in->pb.source = c->source;
+    in->seeds[0] = c->seed_text;
+    in->pb.seeds = in->seeds;
+    in->pb.n_seeds = 1;
+    in->pb.options.nls.num_threads = 1;
+    if (c->support) {
+        in->inputs[0] = c->support;
+        in->ds.inputs = in->inputs;
+        in->ds.n_inputs = 1;
+        in->ds.name = c->name;
+        in->dsp = &in->ds;
+        in->pb.datasets = &in->dsp;
+        in->pb.n_datasets = 1;
+    }
+}
+
+void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_grow_summary *s)
+{
+    const size_t frames = s->frames;
+    memset(s, 0, sizeof *s);
+    s->frames = frames;
+    phc_climbing_stats st;
+    phc_climbing_get_stats(c, &st);
+    s->time = st.time;
+    s->particles = st.particles;
+    s->apical = st.apical;
+    s->laterals = st.laterals;
+    s->bud_trials = st.bud_trials;
+    s->max_order = st.max_order;
+    s->anchored = st.anchored;
+    s->anchors_made = st.anchors_made;
+    s->anchors_released = st.anchors_released;
+    s->attached_fraction = st.particles ? (double)st.anchored / (double)st.particles : 0;
+    double top = seed_base[2];
+    for (size_t i = 0; i < st.particles; ++i) {
+        double b[3], t[3];
+        phc_climbing_segment(c, i, b, t);
+        top = fmax(top, fmax(b[2], t[2]));
+        s->total_length += phc_climbing_length(c, i);
+        if (phc_climbing_is_lateral(c, i)) {
+            const unsigned o = phc_climbing_order(c, i);
+            s->laterals_per_order[o < 8 ? o : 7]++;
+        }
+    }
+    s->height = top - seed_base[2];
+}
+
+phc_plant_graph *phc_grow_plant_graph(const phc_climbing *c, phc_error *err)
+{
+    const size_t n = phc_climbing_count(c);
+    phc_plant_graph *g = phc_plant_graph_new(n);
+    if (!g) {
+        phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        return NULL;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        phc_climbing_segment(c, i, g->head + 3 * i, g->tail + 3 * i);
+        g->radius[i] = phc_climbing_radius(c, i);
+        g->length[i] = phc_climbing_length(c, i);
+        const size_t p = phc_climbing_parent(c, i);
+        g->parent[i] = p == PHC_CLIMBING_NONE ? PHC_PLANT_NO_PARENT : p;
+        g->source_id[i] = (long)i;
+    }
+    g->fixed[0] = 1;
+    if (phc_plant_graph_finish(g, "climbing plant", err)) {
+        phc_plant_graph_free(g);
+        return NULL;
+    }
+    return g;
+}
+
+/* One frame: the plant as VTK with its per-segment fields. */
+static int write_frame(const phc_climbing *c, const char *path, double t, phc_error *err)
+{
+    phc_plant_graph *g = phc_grow_plant_graph(c, err);
+    if (!g)
+        return err->status;
+    const size_t n = g->n;
+    double *order = malloc(n * sizeof *order), *light = malloc(n * sizeof *light),
+           *anch = malloc(n * sizeof *anch);
+    int rc = PHC_OK;
+    if (!order || !light || !anch) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        double a[3];
+        order[i] = phc_climbing_order(c, i);
+        light[i] = phc_climbing_light_at(c, i);
+        anch[i] = phc_climbing_anchor(c, i, a);
+    }
+    char title[128];
+    snprintf(title, sizeof title, "phytocal grow: climbing plant at t = %g s", t);
+    const phc_plant_field fields[3] = {{"branch_order", order}, {"light", light}, {"anchored", anch}};
+    rc = phc_plant_io_write_vtk(path, g, title, fields, 3, err);
+done:
+    free(order);
+    free(light);
+    free(anch);
+    phc_plant_graph_free(g);
+    return rc;
+}
+
+/* The support mesh as legacy VTK polydata (triangles). */
+static int write_support_vtk(const phc_support_mesh *m, const char *path, phc_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+    const size_t nv = phc_support_mesh_vertex_count(m), nt = phc_support_mesh_triangle_count(m);
+    fprintf(f, "# vtk DataFile Version 3.0\nphytocal grow: support mesh\nASCII\nDATASET POLYDATA\n");
+    fprintf(f, "POINTS %zu double\n", nv);
+    for (size_t i = 0; i < nv; ++i) {
+        double v[3];
+        phc_support_mesh_vertex(m, i, v);
+        fprintf(f, "%.17g %.17g %.17g\n", v[0], v[1], v[2]);
+    }
+    fprintf(f, "POLYGONS %zu %zu\n", nt, 4 * nt);
+    for (size_t t = 0; t < nt; ++t) {
+        size_t idx[3];
+        phc_support_mesh_triangle(m, t, idx);
+        fprintf(f, "3 %zu %zu %zu\n", idx[0], idx[1], idx[2]);
+    }
+    if (fclose(f) != 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+    return PHC_OK;
+}
+
+/* Side (x-z) and front (y-z) views of the final plant. */
+static int write_views(const phc_climbing *c, const phc_support_mesh *m, const char *tmpdir, const char *name,
+                       phc_error *err)
+{
+    phc_plant_graph *g = phc_grow_plant_graph(c, err);
+    if (!g)
+        return err->status;
+    const size_t n = g->n, nv = m ? phc_support_mesh_vertex_count(m) : 0;
+    double *order = malloc(n * sizeof *order), *mk = malloc((nv ? 3 * nv : 1) * sizeof *mk);
+    int rc = PHC_OK;
+    if (!order || !mk) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    unsigned top = 0;
+    for (size_t i = 0; i < n; ++i) {
+        order[i] = phc_climbing_order(c, i);
+        top = order[i] > top ? (unsigned)order[i] : top;
+    }
+    for (size_t i = 0; i < nv; ++i)
+        phc_support_mesh_vertex(m, i, mk + 3 * i);
+    char title[256], path[4200];
+    phc_climbing_stats st;
+    phc_climbing_get_stats(c, &st);
+    snprintf(title, sizeof title, "%s: %zu particles after %g s", name, n, st.time);
+    phc_shape_panel p = {n, g->head, g->tail, g->radius, order, title, nv, nv ? mk : NULL, "support vertices"};
+    phc_shape_plot_options po = phc_shape_plot_options_default();
+    po.value_label = "branch order (0 = main axis)";
+    po.value_min = 0;
+    po.value_max = top > 0 ? top : 1;
+    po.max_line_width = 5;
+    const char *views[2] = {"plant_side.png", "plant_front.png"};
+    const char *titles[2] = {"side view (x-z)", "front view (y-z)"};
+    for (int v = 0; v < 2 && rc == PHC_OK; ++v) {
+        po.across_axis = v;
+        po.title = titles[v];
+        snprintf(path, sizeof path, "%s/%s", tmpdir, views[v]);
+        rc = phc_shape_plot(path, &p, 1, &po, err);
+    }
+done:
+    free(order);
+    free(mk);
+    phc_plant_graph_free(g);
+    return rc;
+}
+
+static json_t *summary_json(const phc_grow_summary *s)
+{
+    json_t *per = json_array();
+    for (size_t o = 1; o <= s->max_order && o < 8; ++o)
+        json_array_append_new(per, json_integer((json_int_t)s->laterals_per_order[o]));
+    return json_pack("{s:f, s:I, s:I, s:I, s:I, s:o, s:I, s:f, s:f, s:I, s:f, s:I, s:I}", "time_s", s->time,
+                     "particles", (json_int_t)s->particles, "growing_tips", (json_int_t)s->apical, "bud_trials",
+                     (json_int_t)s->bud_trials, "laterals", (json_int_t)s->laterals, "laterals_per_order", per,
+                     "max_order", (json_int_t)s->max_order, "height_m", s->height, "total_length_m", s->total_length,
+                     "anchored", (json_int_t)s->anchored, "attached_fraction", s->attached_fraction,
+                     "anchors_made", (json_int_t)s->anchors_made, "anchors_released",
+                     (json_int_t)s->anchors_released);
+}
+
+static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, const phc_provenance *pv,
+                        json_t *frames, const char *tmpdir, phc_error *err)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/result.json", tmpdir);
+    json_t *root = json_pack("{s:s, s:s, s:s?, s:I, s:f, s:f, s:f, s:o, s:O}", "command", "grow", "name", cfg->name,
+                             "support", cfg->support, "seed", (json_int_t)cfg->options.seed, "duration_s",
+                             cfg->duration, "time_step_s", cfg->time_step, "frame_interval_s", cfg->frame_interval,
+                             "plant", summary_json(s), "frames", frames);
+    if (!root)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (pv)
+        json_object_set_new(root, "provenance", phc_provenance_to_json(pv));
+    phc_atomic_file *af = NULL;
+    int rc = phc_atomic_file_open(path, &af, err);
+    if (rc == PHC_OK) {
+        if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0) {
+            phc_atomic_file_abort(af);
+            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+        } else {
+            rc = phc_atomic_file_commit(af, err);
+        }
+    }
+    json_decref(root);
+    return rc;
+}
+
+/* The light grid when the config gives none: the support's box (or, with
+ * no support, a 1 m box over the seed) widened by 0.25 m on every side. */
+static void default_light_grid(const phc_grow_config *cfg, const phc_support_mesh *m, phc_climbing_options *o)
+{
+    double lo[3], hi[3];
+    if (cfg->light_grid_given) {
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = o->light.origin[k];
+            hi[k] = lo[k] + cfg->light_size[k];
+        }
+    } else {
+        if (m) {
+            phc_support_mesh_bounds(m, lo, hi);
+        } else {
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = cfg->position[k] - 0.5;
+                hi[k] = cfg->position[k] + 0.5;
+            }
+            lo[2] = cfg->position[2];
+            hi[2] = cfg->position[2] + 1;
+        }
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fmin(lo[k], cfg->position[k]) - 0.25;
+            hi[k] = fmax(hi[k], cfg->position[k]) + 0.25;
+        }
+    }
+    for (int k = 0; k < 3; ++k) {
+        o->light.origin[k] = lo[k];
+        const double cells = ceil((hi[k] - lo[k]) / o->light.cell);
+        o->light.dims[k] = cells < 1 ? 1 : cells > 4096 ? 4096 : (size_t)cells;
+    }
+}
+
+int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *dir, int force,
+                   phc_grow_summary *summary, phc_error *err)
+{
+    phc_support_mesh *mesh = NULL;
+    phc_climbing *plant = NULL;
+    json_t *frames = NULL;
+    FILE *csv = NULL;
+    char tmpdir[4096] = "", path[4200];
+    int rc = PHC_OK;
+    phc_grow_inputs in;
+    phc_grow_summary s;
+    memset(&s, 0, sizeof s);
+    const size_t steps = (size_t)llround(cfg->duration / cfg->time_step);
+    const size_t per_frame = (size_t)fmax(1, llround(cfg->frame_interval / cfg->time_step));
+    if (cfg->support) {
+        phc_error e;
+        phc_error_clear(&e);
+        if (!(mesh = phc_support_mesh_read(cfg->support, &e)))
+            return phc_error_set(err, e.status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_ERR_INPUT, "%s:%zu: support: %s",
+                                 cfg->source, cfg->support_line, e.message);
+    }
+    phc_climbing_options o = cfg->options;
+    if (o.light.extinction > 0 || cfg->light_grid_given)
+        default_light_grid(cfg, mesh, &o);
+    if (mesh) {
+        o.closest = phc_support_mesh_closest;
+        o.closest_user = mesh;
+    }
+    {
+        phc_error e;
+        phc_error_clear(&e);
+        if (!(plant = phc_climbing_new(cfg->position, cfg->direction, &o, &e))) {
+            rc = phc_error_set(err, e.status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_ERR_INPUT, "%s:%zu: plant.position: %s",
+                               cfg->source, cfg->position_line, e.message);
+            goto done;
+        }
+    }
+    phc_grow_inputs_init(&in, cfg);
+    if ((rc = phc_run_dir_begin(dir, force, &in.pb, tmpdir, sizeof tmpdir, err))) {
+        tmpdir[0] = '\0';
+        goto done;
+    }
+    if (mesh) {
+        snprintf(path, sizeof path, "%s/support.vtk", tmpdir);
+        if ((rc = write_support_vtk(mesh, path, err)))
+            goto done;
+    }
+    snprintf(path, sizeof path, "%s/growth.csv", tmpdir);
+    if (!(csv = fopen(path, "w")) || !(frames = json_array())) {
+        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+        goto done;
+    }
+    fprintf(csv, "time_s,particles,growing_tips,laterals,anchored,attached_fraction,height_m,total_length_m,frame\n");
+    for (size_t k = 0;; ++k) {
+        if (k % per_frame == 0 || k == steps) {
+            char file[64];
+            snprintf(file, sizeof file, "frame_%04zu.vtk", s.frames);
+            snprintf(path, sizeof path, "%s/%s", tmpdir, file);
+            phc_grow_summarise(plant, cfg->position, &s);
+            if ((rc = write_frame(plant, path, s.time, err)))
+                goto done;
+            json_array_append_new(frames, json_pack("{s:f, s:s, s:I}", "time_s", s.time, "file", file, "particles",
+                                                    (json_int_t)s.particles));
+            fprintf(csv, "%.10g,%zu,%zu,%zu,%zu,%.10g,%.10g,%.10g,%s\n", s.time, s.particles, s.apical, s.laterals,
+                    s.anchored, s.attached_fraction, s.height, s.total_length, file);
+            s.frames++;
+        }
+        if (k == steps)
+            break;
+        phc_error e;
+        phc_error_clear(&e);
+        if (phc_climbing_step(plant, cfg->time_step, &e)) {
+            rc = phc_error_set(err, e.status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
+                               "%s: growth step at t = %g s failed: %s", cfg->source,
+                               (double)k * cfg->time_step, e.message);
+            goto done;
+        }
+    }
+    if (fclose(csv) != 0) {
+        csv = NULL;
+        rc = phc_error_set(err, PHC_ERR_IO, "%s/growth.csv: cannot write", tmpdir);
+        goto done;
+    }
+    csv = NULL;
+    phc_grow_summarise(plant, cfg->position, &s);
+    if ((rc = write_views(plant, mesh, tmpdir, cfg->name, err)))
+        goto done;
+    if (pv)
+        phc_provenance_end(pv);
+    if ((rc = write_result(cfg, &s, pv, frames, tmpdir, err)))
+        goto done;
+    if (summary)
+        *summary = s;
+    rc = phc_run_dir_commit(tmpdir, dir, pv, err);
+    tmpdir[0] = '\0';
+done:
+    if (csv)
+        fclose(csv);
+    if (rc && tmpdir[0])
+        phc_run_dir_discard(tmpdir);
+    json_decref(frames);
+    phc_climbing_free(plant);
+    phc_support_mesh_free(mesh);
+    return rc;
+}

@@ -1,0 +1,72 @@
+/* `phytocal grow`: grows one climbing plant from a grow config
+ * (fit/grow_config.h; model/climbing_growth.h, Hädrich et al., CGF 36(2)
+ * 2017) and writes a run directory:
+ *   frame_NNNN.vtk   legacy VTK polydata of the plant every frame_interval
+ *                    (radius; branch_order, light, anchored per segment)
+ *   growth.csv       per frame: time, particles, tips, laterals, anchored,
+ *                    attached fraction, height, total length
+ *   plant_side.png, plant_front.png   the final plant seen along y and along
+ *                    x (colour = branch order; support vertices as markers)
+ *   support.vtk      the support mesh (when there is one)
+ *   result.json      the final summary (below) and the provenance
+ *   phytocal-run.json  the manifest (fit/run_dir.h: --force rules)
+ *
+ * Why a command and not a data-set kind of `simulate`: a calibration
+ * problem (fit/engine/problem.h) is parameters plus data sets with
+ * observations, and every tool on it (fit, simulate's x/observed/model
+ * table, the report) needs observations; a plant grown from a seed has
+ * none, and its outputs are frames, not a curve. */
+#ifndef PHC_GROW_H
+#define PHC_GROW_H
+
+#include "fit/engine/dataset.h"
+#include "fit/engine/problem.h"
+#include "fit/engine/provenance.h"
+#include "fit/grow_config.h"
+#include "model/climbing_growth.h"
+#include "model/plant_graph.h"
+#include "model/status.h"
+
+/* Summary of a plant (also result.json's "plant"). */
+typedef struct phc_grow_summary {
+    double time;               /* s */
+    size_t particles, apical, laterals, bud_trials;
+    size_t laterals_per_order[8]; /* lateral shoots starting at order 1..7 (index = order; [0] unused) */
+    size_t max_order;
+    size_t anchored, anchors_made, anchors_released;
+    double attached_fraction;  /* anchored / particles */
+    double height;             /* m: highest segment end above the seed's base (z) */
+    double total_length;       /* m */
+    size_t frames;             /* frames written */
+} phc_grow_summary;
+
+void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_grow_summary *s);
+
+/* The plant's current shape as a finished plant graph (segment base =
+ * head, tip = tail; the seed particle fixed), for VTK files and plots. */
+phc_plant_graph *phc_grow_plant_graph(const phc_climbing *c, phc_error *err);
+
+/* A problem shell that only names the run's inputs (the config and the
+ * mesh) and its seed, so the run-directory checks and the provenance of
+ * fit/run_dir.h and fit/engine/provenance.h apply to grow runs too.
+ * Valid while the config lives; nothing to free. */
+typedef struct phc_grow_inputs {
+    phc_problem pb;
+    phc_dataset ds;
+    phc_dataset *dsp;
+    char *inputs[1];
+    char *seeds[1];
+} phc_grow_inputs;
+void phc_grow_inputs_init(phc_grow_inputs *in, const phc_grow_config *c);
+
+/* Grows the plant and writes the run directory DIR (force as in
+ * fit/run_dir.h); *summary (may be NULL) gets the final plant.  Errors,
+ * with the config's file and line: the mesh does not parse or has no
+ * triangles ("wall.yaml:3: support: wall.obj: ..."; PHC_ERR_INPUT), the seed
+ * lies inside a support (PHC_ERR_INPUT at plant.position's line), a growth
+ * step fails (its message and the time); DIR refused (PHC_ERR_EXISTS).
+ * pv (may be NULL) gets its end time when the plant is grown. */
+int phc_grow_write(const phc_grow_config *c, phc_provenance *pv, const char *dir, int force,
+                   phc_grow_summary *summary, phc_error *err);
+
+#endif /* PHC_GROW_H */
