@@ -33,6 +33,7 @@
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
 #include "fit/sensitivity_study.h"
+#include "fit/study_dist.h"
 #include "fit/simulate.h"
 #include "fit/version.h"
 #include "phc_git_commit.h"
@@ -501,9 +502,10 @@ static int parse_count(const char *opt, const char *text, unsigned long long max
     return 0;
 }
 
-static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+static int sensitivity_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_study_options so = phc_study_options_default();
+    so.dist = dist;
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     int n_rest = 0;
     if (!rest)
@@ -574,6 +576,12 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     if (load_for_run("sensitivity", full_argc, full_argv, n_rest, rest, "-sensitivity", &o, &pb, &pv, dir,
                      sizeof dir, &code)) {
         free(rest);
+        if (dist) { /* the other ranks may have loaded it: they must not wait for this one */
+            phc_error e;
+            phc_error_clear(&e);
+            phc_error_set(&e, code == EXIT_INPUT ? PHC_ERR_INPUT : PHC_ERR_INTERNAL, "the config did not load");
+            dist->agree(dist, e.status, &e);
+        }
         return code;
     }
     free(rest);
@@ -605,6 +613,28 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     }
     phc_study_summary_clear(&sum);
     return EXIT_OK;
+}
+
+/* Under mpirun or srun (study_dist.h) every rank runs the study: rank 0
+ * prints and writes, the workers print nothing (stdout and stderr go to
+ * /dev/null) and exit with rank 0's code. */
+static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+{
+    phc_dist *dist = NULL;
+    phc_error err;
+    phc_error_clear(&err);
+    if (phc_dist_open(&dist, &err)) {
+        fprintf(stderr, "phytocal sensitivity: %s\n", err.message);
+        return exit_code_for(err.status);
+    }
+    if (dist && dist->rank != 0 &&
+        (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))) {
+        /* cannot silence this worker: it still runs, and says so once */
+        fprintf(stderr, "phytocal sensitivity: rank %d: cannot redirect its output to /dev/null\n", dist->rank);
+    }
+    const int code = sensitivity_run(full_argc, full_argv, argc, argv, dist);
+    phc_dist_close(dist);
+    return code;
 }
 
 /* profile: profile likelihood of every free parameter (profile_study.h).
