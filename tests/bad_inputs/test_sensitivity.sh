@@ -3,7 +3,8 @@
 # nothing behind; an interrupted study resumed with --resume gives a
 # result.json identical byte for byte to an uninterrupted one and recomputes
 # nothing it finished; a ledger of another study is refused, saying what
-# differs; failed evaluations are retried, recorded and counted.
+# differs; failed evaluations are retried, recorded and counted; under
+# mpirun with one rank the study is refused (exit 2).
 #
 #   bash test_sensitivity.sh PATH/TO/phytocal
 #
@@ -175,6 +176,21 @@ run sensitivity per_h.yaml -o hour --samples 64
 grep -q 'h-1 cm-2' per_h.yaml || why "the unit was not changed"
 diff <(sed '/^results/d' sec.txt) <(sed '/^results/d' "$T/stdout") >/dev/null || why "the verdicts differ"
 finish "a prior in h-1 cm-2 gives the study of the same prior in s-1 cm-2"
+
+# ---- mpirun with one rank: a master-worker study is refused -------------------
+if command -v mpirun >/dev/null 2>&1; then
+    rm -rf out out.ledger
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun -np 1 "$PHC" sensitivity good.yaml \
+        -o out --samples 64 >"$T/stdout" 2>"$T/stderr"
+    RC=$?
+    [ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+    grep -qF "the MPI launcher started 1 rank: a master-worker study needs at least 2 ranks" "$T/stderr" ||
+        why "message"
+    [ ! -e out ] && [ ! -e out.ledger ] || why "left out/ or its ledger behind"
+    finish "mpirun -np 1: a master-worker study needs at least 2 ranks"
+else
+    echo "ok - mpirun -np 1 refused # SKIP mpirun not found"
+fi
 
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

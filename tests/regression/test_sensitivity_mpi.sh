@@ -80,6 +80,9 @@ for case in "sobol 2 128" "morris 3 40"; do
     n=$(grep -c '^estimating' "$T/stderr")
     [ "$n" = 1 ] || why "progress printed by $n ranks"
     [ ! -e many.ledger ] || why "the ledger stayed beside the finished run"
+    # the master records results as they arrive: rows out of order show that
+    # the workers evaluated some
+    grep '^[0-9]' many/ledger.tsv | cut -f1 | sort -n -C && why "the ledger is in row order: did a worker take part?"
     finish "$method with mpirun -np $np: result.json identical to one process, printed once"
 done
 
