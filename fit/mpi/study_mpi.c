@@ -197,6 +197,11 @@ int phc_mpi_module_open(int abi, phc_dist *d, phc_error *err)
     if (abi != PHC_DIST_ABI)
         return phc_error_set(err, PHC_ERR_INTERNAL, "the MPI module speaks interface %d, phytocal %d: install "
                              "phytocal_mpi.so of the same build", PHC_DIST_ABI, abi);
+    /* A rank waiting for a message polls; on a machine shared with other
+       work (or with more ranks than cores) it should give the core away
+       while it waits: Open MPI's mpi_yield_when_idle, unless the user set it
+       (environment or mpirun --mca). */
+    setenv("OMPI_MCA_mpi_yield_when_idle", "1", 0);
     int initialised = 0;
     MPI_Initialized(&initialised);
     if (!initialised && MPI_Init(NULL, NULL) != MPI_SUCCESS)
