@@ -214,8 +214,8 @@ int main(int argc, char **argv)
     printf("mpi2_time: %.2f s (mpirun -np 2, whole command, minimum of %d)\n", t2, reps);
     printf("one_process_fixed_time: %.2f s (the study resumed from its complete ledger: load, estimate, write)\n", f1);
     printf("mpi2_fixed_time: %.2f s (the same under mpirun -np 2: with MPI start-up)\n", f2);
-    printf("one_process_rate: %.0f evaluations/s (evaluations / (time - fixed time))\n", rows / (t1 - f1));
-    printf("mpi2_rate: %.0f evaluations/s\n", rows / (t2 - f2));
+    printf("one_process_evaluations_per_s: %.0f (evaluations / (time - fixed time))\n", rows / (t1 - f1));
+    printf("mpi2_evaluations_per_s: %.0f\n", rows / (t2 - f2));
     printf("mpi2_speedup: %.2f x (evaluation rate, 2 ranks / 1 process; target >= 1.8)\n",
            (t1 - f1) / (t2 - f2));
     printf("mpi2_command_speedup: %.2f x (whole commands)\n", t1 / t2);
