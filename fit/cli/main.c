@@ -95,7 +95,11 @@ static const command_help commands[] = {
      "  --resume           continue an interrupted study from DIR.ledger (its finished\n"
      "                     evaluations are not recomputed; a ledger of another config or\n"
      "                     design is refused, naming what differs)\n"
-     "  -o DIR, --force, --quiet as for fit."},
+     "  -o DIR, --force, --quiet as for fit.\n"
+     "\n"
+     "Under mpirun or srun (at least 2 ranks) the evaluations are spread over the ranks:\n"
+     "rank 0 hands them out, evaluates some itself, keeps the ledger, prints and writes;\n"
+     "the result is the one-process run's (README: \"On a cluster\")."},
     {"profile", "phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]",
      "Fits the configuration, then traces the profile likelihood of every free parameter:\n"
      "the parameter is fixed at steps away from the optimum (adaptive) while Ceres\n"
