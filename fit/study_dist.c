@@ -24,6 +24,19 @@ int phc_dist_launched(void)
     return 0;
 }
 
+int phc_dist_launched_rank(void)
+{
+    static const char *const vars[] = {"OMPI_COMM_WORLD_RANK", "PMIX_RANK", "PMI_RANK"};
+    for (size_t i = 0; i < sizeof vars / sizeof vars[0]; ++i) {
+        const char *v = getenv(vars[i]);
+        char *end = NULL;
+        const long r = v && *v ? strtol(v, &end, 10) : -1;
+        if (v && *v && *end == '\0' && r >= 0 && r <= 0x7fffffffL)
+            return (int)r;
+    }
+    return 0;
+}
+
 /* PATH of the module: the folder of the object that holds this function. */
 static int module_path(char *buf, size_t size, phc_error *err)
 {

@@ -71,6 +71,11 @@ typedef int (*phc_dist_module_open_fn)(int abi, phc_dist *d, phc_error *err);
 
 /* 1 when an MPI launcher started this process (the environment says so). */
 int phc_dist_launched(void);
+/* This process's rank as the launcher's environment gives it
+ * (OMPI_COMM_WORLD_RANK, PMIX_RANK or PMI_RANK), known before MPI is
+ * loaded: so that only rank 0 reports a module that cannot be loaded; 0
+ * when not launched or not said. */
+int phc_dist_launched_rank(void);
 
 /* Under an MPI launcher: loads phytocal_mpi.so, initialises MPI and sets
  * *out (free with phc_dist_close); otherwise *out = NULL (one process).

@@ -620,15 +620,25 @@ static int sensitivity_run(int full_argc, char **full_argv, int argc, char **arg
 }
 
 /* Under mpirun or srun (study_dist.h) every rank runs the study: rank 0
- * prints and writes, the workers print nothing (stdout and stderr go to
- * /dev/null) and exit with rank 0's code. */
+ * prints, writes and returns the exit code; the workers print nothing
+ * (stdout and stderr go to /dev/null) and exit 0. */
 static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
 {
     phc_dist *dist = NULL;
     phc_error err;
     phc_error_clear(&err);
     if (phc_dist_open(&dist, &err)) {
-        fprintf(stderr, "phytocal sensitivity: %s\n", err.message);
+        /* Usually every rank fails alike (no module, one rank): rank 0 says
+           so, and its exit ends the job.  Another rank waits 2 s for that,
+           then reports its own failure (rank 0 may be waiting for it in
+           MPI_Init) and exits, which ends the job too: no rank hangs. */
+        const int rank = phc_dist_launched_rank();
+        if (rank != 0) {
+            sleep(2);
+            fprintf(stderr, "phytocal sensitivity: rank %d: %s\n", rank, err.message);
+        } else {
+            fprintf(stderr, "phytocal sensitivity: %s\n", err.message);
+        }
         return exit_code_for(err.status);
     }
     if (dist && dist->rank != 0 &&
@@ -637,8 +647,13 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
         fprintf(stderr, "phytocal sensitivity: rank %d: cannot redirect its output to /dev/null\n", dist->rank);
     }
     const int code = sensitivity_run(full_argc, full_argv, argc, argv, dist);
+    /* a worker's own failures reach rank 0 (study_dist.h: agree), which
+       reports them; a worker exits 0, so that its exit cannot end the job
+       (mpirun stops every rank at the first non-zero exit) before rank 0
+       has printed */
+    const int worker = dist && dist->rank != 0;
     phc_dist_close(dist);
-    return code;
+    return worker ? EXIT_OK : code;
 }
 
 /* profile: profile likelihood of every free parameter (profile_study.h).
