@@ -180,8 +180,12 @@ finish "a prior in h-1 cm-2 gives the study of the same prior in s-1 cm-2"
 # ---- mpirun with one rank: a master-worker study is refused -------------------
 if command -v mpirun >/dev/null 2>&1; then
     rm -rf out out.ledger
-    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun -np 1 "$PHC" sensitivity good.yaml \
-        -o out --samples 64 >"$T/stdout" 2>"$T/stderr"
+    # In a sanitizer build, LeakSanitizer would report what MPI_Init
+    # allocates and MPI_Finalize leaves (Open MPI's components, unloaded by
+    # then, so no suppression can name them; none is phytocal's): leaks are
+    # not checked for this one command.
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" \
+        timeout 120 mpirun -np 1 "$PHC" sensitivity good.yaml -o out --samples 64 >"$T/stdout" 2>"$T/stderr"
     RC=$?
     [ "$RC" -eq 2 ] || why "exit $RC, expected 2"
     grep -qF "the MPI launcher started 1 rank: a master-worker study needs at least 2 ranks" "$T/stderr" ||
