@@ -103,6 +103,11 @@ static int run_master(phc_dist *d, size_t n_out, const size_t *rows, size_t n_ro
             MPI_Recv(in, (int)(MAX_BATCH * stride), MPI_DOUBLE, st.MPI_SOURCE, TAG_RESULT, MPI_COMM_WORLD,
                      MPI_STATUS_IGNORE);
             m.outstanding[st.MPI_SOURCE]--;
+            if (count <= 0 || (size_t)count % stride != 0) { /* every rank built the same study: cannot happen */
+                rc = phc_error_set(err, PHC_ERR_INTERNAL, "rank %d sent %d values, not rows of %zu", st.MPI_SOURCE,
+                                   count, stride);
+                break;
+            }
             for (size_t i = 0; i < (size_t)count / stride && rc == PHC_OK; ++i) {
                 const double *r = in + i * stride;
                 rc = record(ctx, (size_t)r[0], r[1] != 0, r + 2, err);
