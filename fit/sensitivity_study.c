@@ -17,6 +17,7 @@
 #include "fit/run_dir.h"
 #include "fit/run_ledger.h"
 #include "fit/sensitivity_plots.h"
+#include "fit/study_dist.h"
 #include "measurements/atomic_file.h"
 
 /* Verdict thresholds (Saltelli et al. 2008 use 0.05 as the usual cut for a
@@ -1062,6 +1063,61 @@ static int copy_file(const char *from, const char *to, phc_error *err)
     return phc_atomic_file_commit(af, err);
 }
 
+/* ---- the evaluation loop: one process, or distributed (study_dist.h) ----------------------- */
+
+typedef struct loop {
+    study *s;
+    phc_study_eval *w;
+    double *x, *u;
+    phc_run_ledger *ledger;
+    const char *ledger_path;
+    phc_study_summary *summary;
+    size_t found, report_every;
+} loop;
+
+/* Evaluates design row r into out; 1 when it failed twice. */
+static int eval_row(void *ctx, size_t r, double *out)
+{
+    loop *l = ctx;
+    if (l->s->saltelli)
+        phc_saltelli_design_point(l->s->saltelli, r, l->u);
+    else
+        phc_morris_design_point(l->s->morris, r, l->u);
+    point_values(l->s, l->u, l->x);
+    int failed = phc_study_evaluate(l->w, l->x, out);
+    if (failed) /* once more: a transient failure (none of today's models has one) gets a second chance */
+        failed = phc_study_evaluate(l->w, l->x, out);
+    return failed;
+}
+
+/* Records row r: the ledger, the outputs, progress; stops the study after
+ * stop_after new evaluations (while rows remain) or when cancelled. */
+static int record_row(void *ctx, size_t r, int failed, const double *out, phc_error *err)
+{
+    loop *l = ctx;
+    study *s = l->s;
+    const phc_study_options *o = s->o;
+    int rc = phc_run_ledger_append(l->ledger, r, failed, out, err);
+    if (rc)
+        return rc;
+    memcpy(s->y + r * s->n_out, out, s->n_out * sizeof *out);
+    s->state[r] = failed ? PHC_LEDGER_FAILED : PHC_LEDGER_OK;
+    const size_t done = l->found + ++l->summary->computed;
+    /* the count goes in the detail, not as steps: a log gets a line every
+       few seconds rather than one per evaluation (and is formatted only then) */
+    if (l->summary->computed % l->report_every == 0 || done == s->rows) {
+        char count[96];
+        snprintf(count, sizeof count, "%zu of %zu evaluations", done, s->rows);
+        if (phc_progress_report(o->progress, o->progress_data, "evaluating", 0, 0, -1, NAN, count))
+            return phc_error_set(err, PHC_ERR_INTERNAL, "cancelled; %s holds the finished evaluations: --resume "
+                                 "continues", l->ledger_path);
+    }
+    if (o->stop_after && l->summary->computed >= o->stop_after && done < s->rows)
+        return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new evaluations (stop_after); %s holds them: "
+                             "--resume continues", l->summary->computed, l->ledger_path);
+    return PHC_OK;
+}
+
 int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const phc_provenance *pv, const char *dir,
                   phc_study_summary *summary, phc_error *err)
 {
@@ -1077,6 +1133,8 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
     s.n_scalar = phc_study_scalar_outputs(pb);
     phc_run_ledger *ledger = NULL;
     phc_study_eval *w = NULL;
+    phc_dist *dist = o.dist;
+    int agreed = 0; /* with dist: every rank agrees once (study_dist.h), here or at done */
     double *x = NULL, *u = NULL, *out = NULL;
     char ledger_path[4200], tmpdir[4096] = "";
     int rc;
@@ -1135,46 +1193,36 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
         goto done;
     }
     snprintf(ledger_path, sizeof ledger_path, "%s.ledger", dir);
-    size_t found = 0;
+    summary->evaluations = s.rows;
+    loop lp = {&s, w, x, u, NULL, ledger_path, summary, 0, s.rows / 200 ? s.rows / 200 : 1};
+    if (dist && dist->rank != 0) { /* a worker: no ledger, no directory; evaluates what the master sends */
+        agreed = 1;
+        if ((rc = dist->agree(dist, PHC_OK, err)) == PHC_OK)
+            rc = dist->run(dist, s.n_out, NULL, 0, eval_row, NULL, &lp, err);
+        goto done;
+    }
     if ((rc = make_parents(ledger_path, err)) ||
         (rc = phc_run_ledger_open(ledger_path, (const char *const *)s.keys, (const char *const *)s.values, s.n_keys,
-                                  s.rows, s.n_out, o.resume, o.force, s.y, s.state, &found, &ledger, err)))
+                                  s.rows, s.n_out, o.resume, o.force, s.y, s.state, &lp.found, &ledger, err)))
         goto done;
-    summary->evaluations = s.rows;
-    summary->reused = found;
-    const size_t report_every = s.rows / 200 ? s.rows / 200 : 1;
-    for (size_t r = 0; r < s.rows; ++r) {
-        if (s.state[r] != PHC_LEDGER_PENDING)
-            continue;
-        if (o.stop_after && summary->computed >= o.stop_after) {
-            rc = phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new evaluations (stop_after); %s holds them: "
-                               "--resume continues", summary->computed, ledger_path);
+    lp.ledger = ledger;
+    summary->reused = lp.found;
+    if (dist) {
+        agreed = 1;
+        size_t *pending = malloc((s.rows - lp.found ? s.rows - lp.found : 1) * sizeof *pending), n_pending = 0;
+        rc = pending ? PHC_OK : phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t r = 0; pending && r < s.rows; ++r)
+            if (s.state[r] == PHC_LEDGER_PENDING)
+                pending[n_pending++] = r;
+        if ((rc = dist->agree(dist, rc, err)) == PHC_OK)
+            rc = dist->run(dist, s.n_out, pending, n_pending, eval_row, record_row, &lp, err);
+        free(pending);
+        if (rc)
             goto done;
-        }
-        if (s.saltelli)
-            phc_saltelli_design_point(s.saltelli, r, u);
-        else
-            phc_morris_design_point(s.morris, r, u);
-        point_values(&s, u, x);
-        int failed = phc_study_evaluate(w, x, out);
-        if (failed) /* once more: a transient failure (none of today's models has one) gets a second chance */
-            failed = phc_study_evaluate(w, x, out);
-        if ((rc = phc_run_ledger_append(ledger, r, failed, out, err)))
-            goto done;
-        memcpy(s.y + r * s.n_out, out, s.n_out * sizeof *out);
-        s.state[r] = failed ? PHC_LEDGER_FAILED : PHC_LEDGER_OK;
-        summary->computed++;
-        /* the count goes in the detail, not as steps: a log gets a line every
-           few seconds rather than one per evaluation (and is formatted only then) */
-        if (summary->computed % report_every == 0 || r + 1 == s.rows) {
-            char count[96];
-            snprintf(count, sizeof count, "%zu of %zu evaluations", found + summary->computed, s.rows);
-            if (phc_progress_report(o.progress, o.progress_data, "evaluating", 0, 0, -1, NAN, count)) {
-                rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled; %s holds the finished evaluations: --resume "
-                                   "continues", ledger_path);
+    } else {
+        for (size_t r = 0; r < s.rows; ++r)
+            if (s.state[r] == PHC_LEDGER_PENDING && (rc = record_row(&lp, r, eval_row(&lp, r, out), out, err)))
                 goto done;
-            }
-        }
     }
     if ((rc = phc_run_ledger_close(ledger, err))) {
         ledger = NULL;
@@ -1255,6 +1303,8 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
 discard:
     phc_run_dir_discard(tmpdir);
 done:
+    if (dist && !agreed) /* failed before the loop: the other ranks must not wait for this one */
+        dist->agree(dist, rc ? rc : phc_error_set(err, PHC_ERR_INTERNAL, "study ended before its loop"), err);
     if (ledger) {
         phc_error ignored;
         phc_run_ledger_close(ledger, &ignored);

@@ -60,6 +60,9 @@ typedef struct phc_study_options {
                               as an interrupted study would (0: never) */
     phc_progress_fn progress;
     void *progress_data;
+    struct phc_dist *dist; /* NULL: one process; else the processes of an MPI run (fit/study_dist.h,
+                              phc_dist_open): every rank calls phc_study_run, rank 0 (the master) records
+                              the results and writes DIR, the workers only evaluate rows and return */
 } phc_study_options;
 
 phc_study_options phc_study_options_default(void);

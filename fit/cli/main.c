@@ -36,6 +36,7 @@
 #include "fit/result_json.h"
 #include "fit/run_dir.h"
 #include "fit/sensitivity_study.h"
+#include "fit/study_dist.h"
 #include "fit/simulate.h"
 #include "fit/version.h"
 #include "phc_git_commit.h"
@@ -117,7 +118,11 @@ static const command_help commands[] = {
      "  --resume           continue an interrupted study from DIR.ledger (its finished\n"
      "                     evaluations are not recomputed; a ledger of another config or\n"
      "                     design is refused, naming what differs)\n"
-     "  -o DIR, --force, --quiet as for fit."},
+     "  -o DIR, --force, --quiet as for fit.\n"
+     "\n"
+     "Under mpirun or srun (at least 2 ranks) the evaluations are spread over the ranks:\n"
+     "rank 0 hands them out, evaluates some itself, keeps the ledger, prints and writes;\n"
+     "the result is the one-process run's (README: \"On a cluster\")."},
     {"profile", "phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]",
      "Fits the configuration, then traces the profile likelihood of every free parameter:\n"
      "the parameter is fixed at steps away from the optimum (adaptive) while Ceres\n"
@@ -578,10 +583,11 @@ static int parse_count(const char *opt, const char *text, unsigned long long max
     return 0;
 }
 
-static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+static int sensitivity_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_study_options so = phc_study_options_default();
     long long points = -1; /* --points: observations per data set with indices (-1: the default) */
+    so.dist = dist;
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
     int n_rest = 0;
     if (!rest)
@@ -657,6 +663,12 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     if (load_for_run("sensitivity", full_argc, full_argv, n_rest, rest, "-sensitivity", &o, &pb, &pv, dir,
                      sizeof dir, &code)) {
         free(rest);
+        if (dist) { /* the other ranks may have loaded it: they must not wait for this one */
+            phc_error e;
+            phc_error_clear(&e);
+            phc_error_set(&e, code == EXIT_INPUT ? PHC_ERR_INPUT : PHC_ERR_INTERNAL, "the config did not load");
+            dist->agree(dist, e.status, &e);
+        }
         return code;
     }
     free(rest);
@@ -690,6 +702,43 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     }
     phc_study_summary_clear(&sum);
     return EXIT_OK;
+}
+
+/* Under mpirun or srun (study_dist.h) every rank runs the study: rank 0
+ * prints, writes and returns the exit code; the workers print nothing
+ * (stdout and stderr go to /dev/null) and exit 0. */
+static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+{
+    phc_dist *dist = NULL;
+    phc_error err;
+    phc_error_clear(&err);
+    if (phc_dist_open(&dist, &err)) {
+        /* Usually every rank fails alike (no module, one rank): rank 0 says
+           so, and its exit ends the job.  Another rank waits 2 s for that,
+           then reports its own failure (rank 0 may be waiting for it in
+           MPI_Init) and exits, which ends the job too: no rank hangs. */
+        const int rank = phc_dist_launched_rank();
+        if (rank != 0) {
+            sleep(2);
+            fprintf(stderr, "phytocal sensitivity: rank %d: %s\n", rank, err.message);
+        } else {
+            fprintf(stderr, "phytocal sensitivity: %s\n", err.message);
+        }
+        return exit_code_for(err.status);
+    }
+    if (dist && dist->rank != 0 &&
+        (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))) {
+        /* cannot silence this worker: it still runs, and says so once */
+        fprintf(stderr, "phytocal sensitivity: rank %d: cannot redirect its output to /dev/null\n", dist->rank);
+    }
+    const int code = sensitivity_run(full_argc, full_argv, argc, argv, dist);
+    /* a worker's own failures reach rank 0 (study_dist.h: agree), which
+       reports them; a worker exits 0, so that its exit cannot end the job
+       (mpirun stops every rank at the first non-zero exit) before rank 0
+       has printed */
+    const int worker = dist && dist->rank != 0;
+    phc_dist_close(dist);
+    return worker ? EXIT_OK : code;
 }
 
 /* profile: profile likelihood of every free parameter (profile_study.h).

@@ -21,6 +21,8 @@
 #      run with LD_LIBRARY_PATH; same check
 #   7. a C++ program includes the umbrella header and links
 #   8. the installed phytocal command runs (RUNPATH $ORIGIN/../lib)
+#   9. the MPI module phytocal_mpi.so is installed beside the library, and
+#      the installed command loads it from there under mpirun -np 2
 # Prints "ok - <step>" / "not ok - <step>: <why>", then "N passed, M failed";
 # exits 1 if any step failed, 77 (skip) in a sanitizer build (a program
 # built without -fsanitize cannot load a sanitized library).
@@ -250,6 +252,21 @@ else
         why "the installed command loads '$loaded', not $SO"
 fi
 finish "installed phytocal --version runs with the installed library"
+
+# 9. the MPI module beside the installed library, found from there under mpirun
+if [ ! -f "$LIBDIR/phytocal_mpi.so" ]; then
+    why "no $LIBDIR/phytocal_mpi.so"
+elif command -v mpirun >/dev/null 2>&1 && [ -x "$P/bin/phytocal" ]; then
+    OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun -np 2 \
+        env -u LD_LIBRARY_PATH LD_DEBUG=libs "$P/bin/phytocal" sensitivity "$T/missing.yaml" >"$T/mpi.out" 2>&1
+    # the path as the loader wrote it (PREFIX/bin/../lib/...), resolved
+    n=0
+    for f in $(sed -n 's/.*calling init: \(.*phytocal_mpi\.so\)$/\1/p' "$T/mpi.out"); do
+        [ "$(readlink -f "$f")" = "$(readlink -f "$LIBDIR/phytocal_mpi.so")" ] && n=$((n + 1))
+    done
+    [ "$n" = 2 ] || why "mpirun -np 2 of the installed command loaded $LIBDIR/phytocal_mpi.so $n times, expected 2"
+fi
+finish "phytocal_mpi.so installed beside the library; the installed command loads it under mpirun"
 
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
