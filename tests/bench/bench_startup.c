@@ -1,7 +1,7 @@
 /* Start-up and small-fit benchmark (issue 16): what a user waits for when a
  * shell loop calls phytocal once per leaf or plant.
  *
- *   build/bench_bench_startup [RUNS]          (default 10)
+ *   build/bench_bench_startup [RUNS [OTHER_PHYTOCAL]]     (RUNS default 10)
  *
  * Runs, each RUNS times, as separate processes (posix_spawn, output to
  * /dev/null), and prints the best wall time and the best CPU time (user +
@@ -14,7 +14,9 @@
  *   scipy_curve_fit_end_to_end  /usr/bin/python3 tests/bench/startup_peer.py:
  *                             the same data and model with curve_fit and a
  *                             report (no plots), in one process
- * then the ratios peer / phytocal.  The phytocal command is the one beside
+ * then the ratios peer / phytocal.  With OTHER_PHYTOCAL (another build's
+ * command, e.g. one before the modules), its version and fit are timed in
+ * the same run too (other_phytocal_version, other_curve_fit_end_to_end).  The phytocal command is the one beside
  * this program (build/).  How busy other processes kept the machine is
  * printed too: on this shared 2-core machine wall times grow with it, CPU
  * times much less. */
@@ -78,7 +80,8 @@ static int time_command(char **argv, int out_slot, const char *tmp, int runs, ti
     char dir[4096];
     for (int i = 0; i < runs; ++i) {
         if (out_slot >= 0) {
-            snprintf(dir, sizeof dir, "%s/run%d", tmp, i);
+            static int serial; /* one new folder per run, over all commands */
+            snprintf(dir, sizeof dir, "%s/run%d", tmp, serial++);
             argv[out_slot] = dir;
             if (strstr(argv[0], "python") && mkdir(dir, 0700) != 0) {
                 perror(dir);
@@ -105,10 +108,10 @@ int main(int argc, char **argv)
 {
     const int runs = argc > 1 ? atoi(argv[1]) : 10;
     if (runs < 1) {
-        fprintf(stderr, "usage: bench_bench_startup [RUNS >= 1]\n");
+        fprintf(stderr, "usage: bench_bench_startup [RUNS >= 1 [OTHER_PHYTOCAL]]\n");
         return 1;
     }
-    char self[4096], phytocal[4096], yaml[4096], csv[4096], peer[4096];
+    char self[4096], phytocal[4200], yaml[4096], csv[4096], peer[4096];
     ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
     if (n <= 0) {
         perror("bench_startup: /proc/self/exe");
@@ -130,10 +133,15 @@ int main(int argc, char **argv)
     char *fit[] = {phytocal, "fit", yaml, "-o", NULL, NULL};
     char *import[] = {"/usr/bin/python3", "-c", "import scipy.optimize", NULL};
     char *scipy_fit[] = {"/usr/bin/python3", peer, csv, NULL, NULL};
-    timing tv, tf, ti, ts;
+    char *other = argc > 2 ? argv[2] : NULL;
+    char *other_version[] = {other, "version", NULL};
+    char *other_fit[] = {other, "fit", yaml, "-o", NULL, NULL};
+    timing tv, tf, ti, ts, ov = {0, 0}, of = {0, 0};
     const cpu_mark a = cpu_now();
     int rc = time_command(version, -1, NULL, runs, &tv) || time_command(fit, 4, tmp_ours, runs, &tf) ||
-             time_command(import, -1, NULL, runs, &ti) || time_command(scipy_fit, 3, tmp_peer, runs, &ts);
+             time_command(import, -1, NULL, runs, &ti) || time_command(scipy_fit, 3, tmp_peer, runs, &ts) ||
+             (other && (time_command(other_version, -1, NULL, runs, &ov) ||
+                        time_command(other_fit, 4, tmp_ours, runs, &of)));
     const cpu_mark b = cpu_now();
     char cleanup[8300];
     snprintf(cleanup, sizeof cleanup, "rm -rf '%s' '%s'", tmp_ours, tmp_peer);
@@ -147,6 +155,10 @@ int main(int argc, char **argv)
     print_timing("curve_fit_end_to_end", tf);
     print_timing("python_import_scipy", ti);
     print_timing("scipy_curve_fit_end_to_end", ts);
+    if (other) {
+        print_timing("other_phytocal_version", ov);
+        print_timing("other_curve_fit_end_to_end", of);
+    }
     printf("ratio_import_scipy_over_version: %.1f x (wall; CPU %.1f x)\n", ti.wall / tv.wall, ti.cpu / tv.cpu);
     printf("ratio_scipy_fit_over_ours: %.1f x (wall; CPU %.1f x; ours also draws 4 plots)\n", ts.wall / tf.wall,
            ts.cpu / tf.cpu);
