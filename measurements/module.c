@@ -52,9 +52,10 @@ const void *phc_module_table(phc_module *m, phc_error *err)
     }
     /* RTLD_LOCAL: the module's libraries (OpenCV, assimp, HDF5, their C++
        runtime pieces) stay out of the global scope, so they cannot bind a
-       program's own copies of the same libraries; RTLD_NOW: a missing symbol
+       program's own copies of the same libraries (unless the module asks
+       for RTLD_GLOBAL); RTLD_NOW: a missing symbol
        is reported here, not as a crash in the middle of a run. */
-    void *h = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    void *h = dlopen(path, RTLD_NOW | (m->global ? RTLD_GLOBAL : RTLD_LOCAL));
     if (!h) {
         phc_error_set(err, PHC_ERR_IO, "%s: cannot load the %s module (installed beside libphytocal; "
                       "PHYTOCAL_MODULE_DIR overrides the folder): %s", path, m->what, dlerror());

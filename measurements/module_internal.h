@@ -12,7 +12,8 @@
  * function pointers (one struct per module, measurements/<name>_module.h);
  * libphytocal's public functions forward to it.  Internal: not installed.
  *
- * The folder is the one libphytocal.so was loaded from (dladdr), or
+ * The same loader suits any module of phytocal (the MPI one, for example,
+ * with `global` set).  The folder is the one libphytocal.so was loaded from (dladdr), or
  * $PHYTOCAL_MODULE_DIR when set (tests; relocated installs).  Loading is
  * thread-safe; a failed load is retried at the next call. */
 #ifndef PHC_MODULE_INTERNAL_H
@@ -28,6 +29,9 @@ typedef struct phc_module {
     int abi;                          /* the table's version, checked by the entry */
     const char *what;                 /* "photos (OpenCV)": for the error message */
     _Atomic(const void *) table;      /* set once loaded */
+    int global;                       /* 1: RTLD_GLOBAL instead of RTLD_LOCAL, for a module
+                                         whose libraries dlopen components that need their
+                                         symbols (Open MPI's) */
 } phc_module;
 
 /* The module's table (loading it on the first call), or NULL with err set:
