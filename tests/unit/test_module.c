@@ -60,7 +60,7 @@ int main(void)
     char empty[] = "/tmp/phc_test_module_XXXXXX";
     CHECK(mkdtemp(empty) != NULL);
     setenv("PHYTOCAL_MODULE_DIR", empty, 1);
-    char want[4200];
+    char want[8400];
     phc_error err;
     double lut[3 * 256];
     int rc = phc_photo_viridis(lut, &err);
@@ -72,7 +72,7 @@ int main(void)
     CHECK(m == NULL && err.status == PHC_ERR_IO);
     snprintf(want, sizeof want, "%s/phytocal_mesh.so: cannot load the support meshes (assimp, CGAL) module", empty);
     CHECK_STR_CONTAINS(err.message, want);
-    phc_soil_nc_grid g = {2, 2, 2, 0.01, {0, 0, 0}, 0, 0, 0};
+    phc_soil_nc_grid g = {2, 2, 2, 0.01, {0, 0, 0}, 0, 0, 0, 0, 0};
     phc_soil_nc *nc = (phc_soil_nc *)&g; /* must be reset to NULL */
     snprintf(want, sizeof want, "%s/never.nc", empty);
     rc = phc_soil_nc_create(want, &g, "t", NULL, NULL, NULL, &nc, &err);
