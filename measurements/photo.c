@@ -14,7 +14,7 @@
 #include "measurements/photo_module_internal.h"
 
 static phc_module photo_module = {PHC_PHOTO_MODULE_FILE, PHC_PHOTO_MODULE_ENTRY, PHC_PHOTO_MODULE_ABI,
-                                  "photos (OpenCV)", NULL};
+                                  "photos (OpenCV)", NULL, 0};
 
 #define PHC_PHOTO_FORWARD(name, params, args)                                                  \
     int name params                                                                            \

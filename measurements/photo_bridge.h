@@ -14,7 +14,7 @@
  * These files (with photo_module_bridge.cc, the entry point) make the module
  * phytocal_photo.so, opened on first use; libphytocal's measurements/photo.c
  * holds images in memory and the option defaults, and forwards the rest
- * (measurements/module_internal.h). */
+ * (measurements/module_internal.h).
  *
  * Every extern "C" function catches every exception (PHOTO_CATCH below) and
  * turns it into a status and a one-line message; sizes are validated before

@@ -8,7 +8,7 @@
 #include "measurements/soil_netcdf_module_internal.h"
 
 static phc_module netcdf_module = {PHC_NETCDF_MODULE_FILE, PHC_NETCDF_MODULE_ENTRY, PHC_NETCDF_MODULE_ABI,
-                                   "NetCDF output (NetCDF-C, HDF5)", NULL};
+                                   "NetCDF output (NetCDF-C, HDF5)", NULL, 0};
 
 int phc_soil_nc_create(const char *path, const phc_soil_nc_grid *g, const char *title, const char *start_iso,
                        const double *capacity, const double *permeability, phc_soil_nc **out, phc_error *err)

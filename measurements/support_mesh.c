@@ -9,7 +9,7 @@
 #include "measurements/support_mesh_module_internal.h"
 
 static phc_module mesh_module = {PHC_MESH_MODULE_FILE, PHC_MESH_MODULE_ENTRY, PHC_MESH_MODULE_ABI,
-                                 "support meshes (assimp, CGAL)", NULL};
+                                 "support meshes (assimp, CGAL)", NULL, 0};
 
 static const phc_mesh_module_table *loaded(void)
 {

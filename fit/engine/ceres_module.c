@@ -12,7 +12,7 @@
 #include "measurements/module_internal.h"
 
 static phc_module ceres_module = {PHC_CERES_MODULE_FILE, PHC_CERES_MODULE_ENTRY, PHC_CERES_MODULE_ABI,
-                                  "Ceres Solver", NULL};
+                                  "Ceres Solver", NULL, 0};
 
 static const phc_ceres_module_table *loaded(void)
 {
