@@ -11,6 +11,10 @@
  *   photo_veins_bridge.cc     ridge (vein) maps and their scores
  *   photo_draw_bridge.cc      text and the viridis colour map
  * Colour arithmetic (sRGB transfer function, CIELAB, ΔE) is model/colour.h's.
+ * These files (with photo_module_bridge.cc, the entry point) make the module
+ * phytocal_photo.so, opened on first use; libphytocal's measurements/photo.c
+ * holds images in memory and the option defaults, and forwards the rest
+ * (measurements/module_internal.h).
  *
  * Every extern "C" function catches every exception (PHOTO_CATCH below) and
  * turns it into a status and a one-line message; sizes are validated before

@@ -207,32 +207,6 @@ static int encoder_for(const char *path, int bit_depth, std::string &ext, phc_er
 
 /* ---- images -------------------------------------------------------------------------- */
 
-extern "C" int phc_image_alloc(phc_image *img, size_t width, size_t height, phc_error *err)
-{
-    if (!img)
-        return phc_error_set(err, PHC_ERR_INVALID, "phc_image_alloc: no image");
-    std::memset(img, 0, sizeof *img);
-    if (!size_ok(width, height))
-        return phc_error_set(err, PHC_ERR_INVALID, "phc_image_alloc: invalid size %zux%zu", width,
-                             height);
-    img->data = (double *)std::calloc(3 * width * height, sizeof(double));
-    if (!img->data)
-        return phc_error_set(err, PHC_ERR_NOMEM, "phc_image_alloc: out of memory (%zux%zu)",
-                             width, height);
-    img->width = width;
-    img->height = height;
-    img->bit_depth = 8;
-    return PHC_OK;
-}
-
-extern "C" void phc_image_free(phc_image *img)
-{
-    if (!img)
-        return;
-    std::free(img->data);
-    std::memset(img, 0, sizeof *img);
-}
-
 /* 8- or 16-bit cv::Mat (OpenCV channel order, 1-4 channels) -> phc_image. */
 static int image_from_mat(const cv::Mat &m, const char *what, phc_image *out, phc_error *err)
 {

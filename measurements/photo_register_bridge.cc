@@ -47,16 +47,6 @@ extern "C" int phc_photo_correlation(const phc_image *a, const phc_image *b,
     PHOTO_CATCH(err, "phc_photo_correlation")
 }
 
-extern "C" phc_register_options phc_register_options_default(void)
-{
-    phc_register_options o;
-    o.motion = PHC_MOTION_AFFINE;
-    o.max_levels = 5;
-    o.iterations = 200;
-    o.epsilon = 1e-6;
-    return o;
-}
-
 /* The moving-image pixels ECC may use at one level: the caller's mask (or
  * all) without a 3-pixel frame.  OpenCV blurs (5x5) and differentiates
  * (3x3 Sobel) with reflected borders, so the values at an image's edge are

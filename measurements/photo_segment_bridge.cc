@@ -16,25 +16,6 @@
 
 using namespace phc_photo;
 
-extern "C" phc_segment_options phc_segment_options_default(void)
-{
-    phc_segment_options o;
-    o.min_area_fraction = 0.05;
-    o.grabcut = 1;
-    o.grabcut_iterations = 3;
-    o.downscale_to = 1200;
-    return o;
-}
-
-extern "C" void phc_segmentation_free(phc_segmentation *seg)
-{
-    if (!seg)
-        return;
-    std::free(seg->labels);
-    std::free(seg->leaf);
-    std::memset(seg, 0, sizeof *seg);
-}
-
 /* Background (paper) colour: per-channel median of a frame of border pixels
  * (1 % of the short side, at least 2 px), in the work image (CV_32FC3). */
 static cv::Vec3f background_colour(const cv::Mat &rgb)

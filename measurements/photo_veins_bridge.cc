@@ -13,16 +13,6 @@
 
 using namespace phc_photo;
 
-extern "C" phc_vein_options phc_vein_options_default(void)
-{
-    phc_vein_options o;
-    o.sigma_min = 1;
-    o.sigma_max = 4;
-    o.scales = 4;
-    o.dark_veins = -1;
-    return o;
-}
-
 /* Eigenvalues of the scale-normalised Hessian (σ² H, Lindeberg 1998) of
  * the blurred green channel at scale σ: the ridge response of one polarity,
  * lam_hi = max(larger eigenvalue, 0) for dark lines (valleys: the intensity

@@ -4,6 +4,7 @@
  * PHC_ERR_IO with the final path, what was being done and nc_strerror's
  * text, and jumps to the one cleanup path. */
 #include "measurements/soil_netcdf.h"
+#include "measurements/soil_netcdf_module_internal.h"
 
 #include <ctype.h>
 #include <math.h>
@@ -577,4 +578,16 @@ int phc_soil_nc_close(phc_soil_nc *nc, phc_error *err)
     free(nc->path);
     free(nc);
     return status;
+}
+
+/* ---- the module's entry point (soil_netcdf_module_internal.h) ------------ */
+
+/* This file is compiled into phytocal_netcdf.so, which libphytocal opens on
+ * the first soil_netcdf.h call (measurements/soil_netcdf_module.c). */
+static const phc_netcdf_module_table netcdf_module = {phc_soil_nc_create, phc_soil_nc_append, phc_soil_nc_frames,
+                                                       phc_soil_nc_close};
+
+const void *phc_netcdf_module_entry(int abi)
+{
+    return abi == PHC_NETCDF_MODULE_ABI ? &netcdf_module : NULL;
 }

@@ -3,7 +3,7 @@
 // measurements/support_mesh.h.  Every extern "C" function catches every
 // exception; none crosses into C.
 
-#include "measurements/support_mesh.h"
+#include "measurements/support_mesh_module_internal.h"
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -266,3 +266,16 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
 }
 
 }  // extern "C"
+
+/* The module's entry point (measurements/support_mesh_module_internal.h):
+ * this file is compiled into phytocal_mesh.so, which libphytocal opens on
+ * the first support_mesh.h call. */
+static const phc_mesh_module_table phc_mesh_module = {
+    phc_support_mesh_read,           phc_support_mesh_from_arrays, phc_support_mesh_free,
+    phc_support_mesh_triangle_count, phc_support_mesh_vertex_count, phc_support_mesh_bounds,
+    phc_support_mesh_vertex,         phc_support_mesh_triangle,    phc_support_mesh_closest};
+
+extern "C" const void *phc_mesh_module_entry(int abi)
+{
+    return abi == PHC_MESH_MODULE_ABI ? &phc_mesh_module : nullptr;
+}

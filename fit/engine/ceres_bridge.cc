@@ -4,7 +4,7 @@
 // code, and every size and index is validated before Ceres sees it (Ceres
 // CHECK failures abort the process).
 
-#include "fit/engine/ceres_bridge.h"
+#include "fit/engine/ceres_module_internal.h"
 
 #include <ceres/ceres.h>
 #include <ceres/dynamic_numeric_diff_cost_function.h>
@@ -299,20 +299,6 @@ struct phc_nls {
 static int internal_error(phc_error *err, const char *what)
 {
     return phc_error_set(err, PHC_ERR_INTERNAL, "Ceres bridge: %s", what);
-}
-
-extern "C" phc_nls_options phc_nls_options_default(void)
-{
-    phc_nls_options o;
-    o.max_iterations = 1000;
-    o.function_tolerance = 1e-15;
-    o.gradient_tolerance = 1e-15;
-    o.parameter_tolerance = 1e-15;
-    o.method = PHC_LEVENBERG_MARQUARDT;
-    o.num_threads = 1;
-    o.on_iteration = nullptr;
-    o.on_iteration_data = nullptr;
-    return o;
 }
 
 extern "C" phc_nls *phc_nls_new(size_t n_params)
@@ -657,7 +643,14 @@ extern "C" int phc_nls_evaluate(phc_nls *nls, const double *x, double *residuals
     }
 }
 
-extern "C" const char *phc_nls_version(void)
+/* The module's entry point (fit/engine/ceres_module_internal.h): this file
+ * is compiled into phytocal_ceres.so, which libphytocal opens on the first
+ * phc_nls_new. */
+static const phc_ceres_module_table phc_ceres_module = {
+    phc_nls_new,   phc_nls_free,  phc_nls_set_parameter, phc_nls_add_block, phc_nls_residual_count,
+    phc_nls_solve, phc_nls_evaluate};
+
+extern "C" const void *phc_ceres_module_entry(int abi)
 {
-    return CERES_VERSION_STRING;
+    return abi == PHC_CERES_MODULE_ABI ? &phc_ceres_module : nullptr;
 }

@@ -103,6 +103,11 @@ typedef struct phc_nls phc_nls;
 
 /* A problem with n_params parameters (all start at 0, unbounded, free, scale 1). */
 phc_nls *phc_nls_new(size_t n_params);
+/* Why phc_nls_new returned NULL: PHC_ERR_IO "PATH: cannot load the Ceres
+ * module ..." when Ceres (phytocal_ceres.so beside the library, opened on
+ * the first phc_nls_new) could not be loaded, else PHC_ERR_NOMEM "WHAT: out
+ * of memory". */
+int phc_nls_new_error(const char *what, phc_error *err);
 void phc_nls_free(phc_nls *nls); /* accepts NULL */
 
 /* Bounds may be -INFINITY / INFINITY.  Requires lower < upper (lower <= upper

@@ -116,7 +116,7 @@ static int refit_without(const phc_problem *pb, phc_dataset *ds, const phc_cv_pl
     fold f = {ds, plan->group, g};
     int rc = PHC_OK;
     if (!nls || !idx) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        rc = nls ? phc_error_set(err, PHC_ERR_NOMEM, "out of memory") : phc_nls_new_error("cross-validation", err);
         goto done;
     }
     for (size_t q = 0; q < ds->k; ++q) {

@@ -1162,7 +1162,9 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     phc_nls *nls = phc_nls_new(pb->n_params);
     phc_fit_result *res = calloc(1, sizeof *res);
     double *best = calloc(pb->n_params, sizeof *best);
-    if (!nls || !res || !best)
+    if (!nls)
+        rc = phc_nls_new_error("fit", err);
+    else if (!res || !best)
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     else if (!(rc = fit_solve(nls, pb, progress, user_data, best, res, err)) &&
              !(rc = fit_analyse(nls, pb, best, progress, user_data, res, err))) {

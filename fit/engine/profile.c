@@ -74,7 +74,7 @@ static int build_nls(phc_problem *pb, size_t fixed_j, phc_nls **out, phc_error *
     phc_nls *nls = phc_nls_new(pb->n_params);
     int rc = PHC_OK;
     if (!nls)
-        return phc_error_set(err, PHC_ERR_NOMEM, "profile: out of memory");
+        return phc_nls_new_error("profile", err);
     for (size_t i = 0; i < pb->n_params && rc == PHC_OK; ++i) {
         const phc_parameter *p = &pb->params[i];
         rc = phc_nls_set_parameter(nls, i, p->lower, p->upper, p->fixed || i == fixed_j, phc_problem_scale(pb, i),

@@ -23,6 +23,13 @@
 #   8. the installed phytocal command runs (RUNPATH $ORIGIN/../lib)
 #   9. the MPI module phytocal_mpi.so is installed beside the library, and
 #      the installed command loads it from there under mpirun -np 2
+#  10. the modules (phytocal_{ceres,photo,mesh,netcdf}.so) are installed
+#      beside the library; `phytocal version` loads none of them nor their
+#      libraries; the installed command's fit of the enzyme example loads the
+#      installed Ceres module; a program built with pkg-config writes and
+#      reads a PNG and queries a one-triangle mesh through the installed
+#      photo and mesh modules; with PHYTOCAL_MODULE_DIR naming an empty
+#      folder the same calls fail with PHC_ERR_IO naming the module and path
 # Prints "ok - <step>" / "not ok - <step>: <why>", then "N passed, M failed";
 # exits 1 if any step failed, 77 (skip) in a sanitizer build (a program
 # built without -fsanitize cannot load a sanitized library).
@@ -267,6 +274,104 @@ elif command -v mpirun >/dev/null 2>&1 && [ -x "$P/bin/phytocal" ]; then
     [ "$n" = 2 ] || why "mpirun -np 2 of the installed command loaded $LIBDIR/phytocal_mpi.so $n times, expected 2"
 fi
 finish "phytocal_mpi.so installed beside the library; the installed command loads it under mpirun"
+
+# 10. the modules: beside the library, loaded only when a call needs them
+for m in ceres photo mesh netcdf; do
+    [ -f "$LIBDIR/phytocal_$m.so" ] || why "no $LIBDIR/phytocal_$m.so"
+done
+if [ -x "$P/bin/phytocal" ]; then
+    env -u LD_LIBRARY_PATH LD_DEBUG=files "$P/bin/phytocal" version >/dev/null 2>"$T/version.ld"
+    heavy=$(grep -o 'file=[^ ]*\(phytocal_[a-z]*\|libopencv_[a-z]*\|libnetcdf\|libassimp\|libceres\|libhdf5\)[^ ]*' \
+            "$T/version.ld" | sort -u | tr '\n' ' ')
+    [ -z "$heavy" ] || why "phytocal version loaded $heavy"
+    grep -q 'file=.*libphytocal' "$T/version.ld" ||
+        why "LD_DEBUG=files shows no library load (is the loader's debug output available?)"
+    if ! (cd "$T" && env -u LD_LIBRARY_PATH LD_DEBUG=files "$P/bin/phytocal" fit \
+            "$SRC/measurements/examples/enzyme_kinetics/enzyme.yaml" -o "$T/enzyme" >"$T/fit.out" 2>"$T/fit.ld"); then
+        why "installed phytocal fit of the enzyme example failed [$(grep -v '^ *[0-9]*:' "$T/fit.ld" | tail -n 3 | tr '\n' '|')]"
+    else
+        # the command finds the library as bin/../lib (RUNPATH $ORIGIN/../lib)
+        ceres=$(sed -n 's/.*file=\([^ ]*phytocal_ceres\.so\) .*/\1/p' "$T/fit.ld" | head -n 1)
+        [ -n "$ceres" ] && [ "$(readlink -f "$ceres")" = "$(readlink -f "$LIBDIR/phytocal_ceres.so")" ] ||
+            why "the installed fit did not load $LIBDIR/phytocal_ceres.so (loaded: '${ceres}')"
+    fi
+fi
+cat >"$T/modules.c" <<'EOF'
+#include <phytocal/measurements/photo.h>
+#include <phytocal/measurements/support_mesh.h>
+#include <phytocal/phytocal.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+/* photo and mesh calls through the modules; argv[1] the PNG to write, argv[2]
+ * "missing" when PHYTOCAL_MODULE_DIR names an empty folder */
+int main(int argc, char **argv)
+{
+    phc_error err;
+    phc_error_clear(&err);
+    int missing = argc > 2 && strcmp(argv[2], "missing") == 0;
+    phc_image img, rd;
+    memset(&rd, 0, sizeof rd);
+    if (phc_image_alloc(&img, 4, 3, &err))
+        return printf("alloc: %s\n", err.message), 1;
+    for (size_t i = 0; i < 3 * 4 * 3; ++i)
+        img.data[i] = (double)(i % 11) / 10.0;
+    int rc = phc_photo_write_png(argv[1], &img, &err);
+    if (missing) {
+        printf("photo: %s: %s\n", phc_strerror(rc), err.message);
+        phc_support_mesh *m = phc_support_mesh_from_arrays((double[]){0, 0, 0, 1, 0, 0, 0, 1, 0}, 3,
+                                                           (size_t[]){0, 1, 2}, 1, "tri", &err);
+        printf("mesh: %s: %s\n", m ? "loaded" : phc_strerror(err.status), err.message);
+        return rc != PHC_ERR_IO || m != NULL;
+    }
+    if (rc || (rc = phc_photo_read(argv[1], &rd, &err)))
+        return printf("photo: %s\n", err.message), 1;
+    double worst = 0;
+    for (size_t i = 0; i < 3 * 4 * 3; ++i)
+        worst = fmax(worst, fabs(rd.data[i] - img.data[i]));
+    phc_support_mesh *m = phc_support_mesh_from_arrays((double[]){0, 0, 0, 1, 0, 0, 0, 1, 0}, 3,
+                                                       (size_t[]){0, 1, 2}, 1, "tri", &err);
+    double c[3] = {0}, n[3] = {0};
+    int q = m ? phc_support_mesh_closest(m, (double[]){0.25, 0.25, 2}, c, n) : -1;
+    printf("png round trip: %zux%zu, worst %.4f; closest (%.3f, %.3f, %.3f)\n", rd.width, rd.height,
+           worst, c[0], c[1], c[2]);
+    FILE *maps = fopen("/proc/self/maps", "r");
+    char line[4096];
+    while (maps && fgets(line, sizeof line, maps))
+        if (strstr(line, "phytocal_photo.so") || strstr(line, "phytocal_mesh.so"))
+            printf("mapped:%s", strrchr(line, ' ') + 1);
+    if (maps)
+        fclose(maps);
+    const int ok = q == 0 && worst <= 0.5 / 255 + 1e-12 && rd.width == 4 && rd.height == 3 &&
+                   fabs(c[0] - 0.25) + fabs(c[1] - 0.25) + fabs(c[2]) < 1e-12;
+    phc_support_mesh_free(m);
+    phc_image_free(&img);
+    phc_image_free(&rd);
+    return !ok;
+}
+EOF
+# shellcheck disable=SC2086
+if ! cc -std=c11 -Wall -Wextra "$T/modules.c" $flags -lm -o "$T/modules" >"$T/modules-build.log" 2>&1; then
+    why "cc modules.c \$(pkg-config ...) failed [$(tail_of "$T/modules-build.log")]"
+elif ! LD_LIBRARY_PATH="$LIBDIR" "$T/modules" "$T/small.png" >"$T/modules.out" 2>&1; then
+    why "photo/mesh through the installed modules failed [$(tail_of "$T/modules.out")]"
+else
+    for m in photo mesh; do
+        grep -q "^mapped:$(readlink -f "$LIBDIR/phytocal_$m.so")\$" "$T/modules.out" ||
+            why "the program did not map $LIBDIR/phytocal_$m.so [$(tail_of "$T/modules.out")]"
+    done
+    mkdir -p "$T/empty"
+    if ! PHYTOCAL_MODULE_DIR="$T/empty" LD_LIBRARY_PATH="$LIBDIR" "$T/modules" "$T/small2.png" missing \
+            >"$T/missing.out" 2>&1; then
+        why "with no modules the calls did not fail with PHC_ERR_IO [$(tail_of "$T/missing.out")]"
+    else
+        grep -q "^photo: .*: $T/empty/phytocal_photo.so: cannot load the photos (OpenCV) module" "$T/missing.out" ||
+            why "the missing photo module's message does not name it and its path: $(tail_of "$T/missing.out")"
+        grep -q "^mesh: .*: $T/empty/phytocal_mesh.so: cannot load the support meshes" "$T/missing.out" ||
+            why "the missing mesh module's message does not name it and its path: $(tail_of "$T/missing.out")"
+    fi
+fi
+finish "modules beside the library: version loads none, fit loads Ceres, photo and mesh calls theirs, a missing one is PHC_ERR_IO naming it"
 
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
