@@ -1,6 +1,7 @@
 /* The phytocal command (DESIGN.md §4).  The only place that prints.
  *
  *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal fit A.yaml B.yaml ... -o DIR | CONFIG.yaml --each COLUMN -o DIR   (batch)
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S] [--resume] ...
  *   phytocal profile CONFIG.yaml [-o DIR] [--points N] [--level L] [--force] [--quiet]
@@ -47,7 +48,9 @@ typedef struct command_help {
 } command_help;
 
 static const command_help commands[] = {
-    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]",
+    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]\n"
+            "  phytocal fit A.yaml B.yaml ... -o DIR [--force] [--quiet]\n"
+            "  phytocal fit CONFIG.yaml --each COLUMN -o DIR [--force] [--quiet]",
      "Fits the configuration's parameters to its data sets (Ceres Solver), then judges\n"
      "the residuals and parameters, and writes a run directory:\n"
      "  result.json        machine-readable result (README: result.json)\n"
@@ -66,7 +69,21 @@ static const command_help commands[] = {
      "  -h, --help         this text\n"
      "\n"
      "Progress goes to stderr: one updating line on a terminal (start k of n, solver\n"
-     "iteration and cost, elapsed time), plain lines otherwise."},
+     "iteration and cost, elapsed time), plain lines otherwise.\n"
+     "\n"
+     "Batch (many small fits in one process; -o DIR is required):\n"
+     "  A.yaml B.yaml ...  each config fitted into DIR/<config stem>/ (two configs with\n"
+     "                     the same stem are refused before anything is fitted)\n"
+     "  --each COLUMN      one fit per value of COLUMN in the config's table(s) (kinds\n"
+     "                     curve, pv_curve, weight_curve), each on its rows only, into\n"
+     "                     DIR/<value>/; bytes of the value other than letters, digits,\n"
+     "                     '-', '_', '.' (and a leading '.') are written %XX\n"
+     "Each fit's directory is a run directory as above; DIR holds them, summary.tsv and\n"
+     "summary.md (one row per fit: status, verdict, cost, R², parameters with standard\n"
+     "errors) and its own manifest, so --force and report --check treat DIR as one run.\n"
+     "A fit that fails to load or solve is named in the summary and the others are\n"
+     "still done.  Exit code: 0 when every fit converged, else the worst (highest) of\n"
+     "the fits' own codes (2 bad input, 3 not converged, 4 internal)."},
     {"simulate", "phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]",
      "Runs every data set's model at the configured start values, without fitting, and\n"
      "writes a run directory (default runs/<name>-simulation/) with <data set>_simulated.csv\n"
