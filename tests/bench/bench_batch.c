@@ -20,7 +20,7 @@
  * The split: `phytocal version` (start-up alone), and per fit the batch
  * call's time / N (the work a process per fit repeats besides start-up).
  *
- * Each timing is the minimum wall time of 3 rounds (the machine is shared;
+ * Each timing is the minimum wall time of 2 rounds (the machine is shared;
  * the load of other processes during the rounds is printed); child CPU time
  * (user + system, getrusage) beside it.  The phytocal binary is the one
  * beside this program (build/phytocal); python is /usr/bin/python3.
@@ -42,7 +42,7 @@
 #include "bench/bench_machine.h"
 #include "nist_problem.h"
 
-#define ROUNDS 3
+#define ROUNDS 2
 #define MAX_ARGS 64
 
 static const char *const NIST_CASES[] = {"Misra1a", "Chwirut2", "Chwirut1", "Lanczos3", "Gauss1",
