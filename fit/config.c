@@ -433,14 +433,22 @@ int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_
     }
     const size_t n = phc_table_rows(t);
     f->tables++;
-    if (!f->value) { /* collecting the groups */
+    /* collecting the groups: every value, and the table cut to the first
+     * group, since the rows of all groups together need not make one valid
+     * data set (a weight curve's times start again with each plant) */
+    const char *value = f->value;
+    if (!value) {
+        const size_t before = f->n_values;
         for (size_t r = 0; r < n; ++r)
             if (collect_value(f, phc_table_cell(t, r, (size_t)col))) {
                 phc_table_free(t);
                 return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             }
-        *out = t;
-        return PHC_OK;
+        if (n == 0) {
+            *out = t;
+            return PHC_OK;
+        }
+        value = before ? f->values[0] : phc_table_cell(t, 0, (size_t)col);
     }
     size_t *rows = malloc((n ? n : 1) * sizeof *rows), k = 0;
     if (!rows) {
@@ -448,10 +456,14 @@ int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     for (size_t r = 0; r < n; ++r)
-        if (strcmp(phc_table_cell(t, r, (size_t)col), f->value) == 0)
+        if (strcmp(phc_table_cell(t, r, (size_t)col), value) == 0)
             rows[k++] = r;
+    if (k == 0 && !f->value) /* the first group is not in this table: its own first */
+        for (size_t r = 0; r < n; ++r)
+            if (strcmp(phc_table_cell(t, r, (size_t)col), phc_table_cell(t, 0, (size_t)col)) == 0)
+                rows[k++] = r;
     if (k == 0)
-        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: --each %s: no row has the value '%s'", path, f->column, f->value);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: --each %s: no row has the value '%s'", path, f->column, value);
     else
         rc = phc_table_select_rows(t, rows, k, out, err);
     free(rows);

@@ -42,9 +42,10 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err);
  * column (and the columns it has).
  *
  * group_values: the distinct cells of COLUMN over the config's tables, in
- * order of first appearance (the config is loaded and validated whole, and
- * handed back in *whole when whole is not NULL); *values is malloc'd, free
- * with phc_config_group_values_free.
+ * order of first appearance; the config is loaded and validated with the
+ * first group's rows (all groups' rows together need not be one valid data
+ * set) and handed back in *whole when whole is not NULL; *values is
+ * malloc'd, free with phc_config_group_values_free.
  * load_group: the config with each table cut to the rows whose COLUMN cell
  * equals value (rows keep their file lines for messages); a table with no
  * such row is PHC_ERR_INPUT. */

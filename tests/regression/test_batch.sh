@@ -18,7 +18,10 @@
 #  3. two configs in one call (enzyme.yaml, pv_leaves.yaml): DIR/enzyme/ and
 #     DIR/pv_leaves/ equal to the single fits of the two configs;
 #  4. `phytocal report --check` passes on the batch directory and on a
-#     fit's directory inside it.
+#     fit's directory inside it;
+#  5. --each plant over a weight_curve table holding the seedling's balance
+#     twice (plants p1, p2, times starting at 0 for each): both rows equal
+#     the seedling example fitted alone.
 # Each case prints "ok - <case>" or "not ok - <case>: <why>"; exit 1 if any failed.
 set -u
 PHC=${1:-}
@@ -155,6 +158,23 @@ run fit "$EX/pressure_volume/pv_leaves.yaml" -o "$T/one_pv" -q
 cmp_row "$T/two/summary.tsv" enzyme "$T/one_enzyme/result.json"
 cmp_row "$T/two/summary.tsv" pv_leaves "$T/one_pv/result.json"
 finish "two configs: DIR/enzyme and DIR/pv_leaves equal to the single fits"
+
+# 5. --each over a weight_curve table: the seedling's balance twice, as plants p1 and p2
+#    (each plant's times start at 0 again: the rows of all plants together are no weight curve)
+mkdir -p "$T/wc"
+cp "$EX/weight_curve/seedling.yaml" "$EX/weight_curve/seedling.csv" "$T/wc/"
+{
+    grep '^#' "$EX/weight_curve/balance.csv"
+    echo "plant,$(grep -v '^#' "$EX/weight_curve/balance.csv" | head -1)"
+    for p in p1 p2; do grep -v '^#' "$EX/weight_curve/balance.csv" | tail -n +2 | sed "s/^/$p,/"; done
+} >"$T/wc/balance.csv"
+run fit "$T/wc/seedling.yaml" --each plant -o "$T/plants" -q
+[ "$RC" -eq 0 ] || why "exit $RC"
+run fit "$EX/weight_curve/seedling.yaml" -o "$T/seedling_alone" -q
+[ "$RC" -eq 0 ] || why "single seedling fit: exit $RC"
+cmp_row "$T/plants/summary.tsv" p1 "$T/seedling_alone/result.json"
+cmp_row "$T/plants/summary.tsv" p2 "$T/seedling_alone/result.json"
+finish "--each plant (weight_curve): each plant equal to the seedling fit alone"
 
 # 4. the manifests hold
 run report --check "$T/runs"
