@@ -373,11 +373,107 @@ static int parse_report(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_
     return PHC_OK;
 }
 
-/* Context for deciding which expression names are parameters. */
+/* Splitting the data sets' tables into groups (phc_config_load_group):
+ * value NULL collects the column's distinct values instead of selecting. */
+typedef struct row_filter {
+    const char *column, *value;
+    char **values; /* collected, in order of first appearance */
+    size_t n_values;
+    size_t tables; /* tables the filter was applied to */
+} row_filter;
+
+/* The loader's context for a kind: which expression names are parameters,
+ * and the row filter (phc_kind_read_table). */
 typedef struct binding_ctx {
     const phc_problem *pb;
     const phc_yaml_node *binding; /* the data set's `parameters:` mapping or NULL */
+    row_filter *rows;             /* NULL: every row */
 } binding_ctx;
+
+static int collect_value(row_filter *f, const char *v)
+{
+    for (size_t i = 0; i < f->n_values; ++i)
+        if (strcmp(f->values[i], v) == 0)
+            return 0;
+    char **grown = realloc(f->values, (f->n_values + 1) * sizeof *grown);
+    if (!grown)
+        return -1;
+    f->values = grown;
+    if (!(f->values[f->n_values] = strdup(v)))
+        return -1;
+    f->n_values++;
+    return 0;
+}
+
+int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_error *err)
+{
+    const binding_ctx *b = user_data;
+    phc_table *t = NULL;
+    int rc;
+    *out = NULL;
+    if ((rc = phc_table_read(path, &t, err)))
+        return rc;
+    row_filter *f = b ? b->rows : NULL;
+    if (!f) {
+        *out = t;
+        return PHC_OK;
+    }
+    const long col = phc_table_find(t, f->column);
+    if (col < 0) {
+        const size_t nc = phc_table_columns(t);
+        const char *names[64];
+        char list[512] = "";
+        for (size_t j = 0; j < nc; ++j) {
+            if (j < 64)
+                names[j] = phc_table_column_name(t, j);
+            const size_t used = strlen(list);
+            snprintf(list + used, sizeof list - used, "%s%s", j ? ", " : "", phc_table_column_name(t, j));
+        }
+        const char *near = phc_suggest(f->column, names, nc < 64 ? nc : 64);
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: --each: no column '%s'%s%s%s (columns: %s)", path, f->column,
+                           near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "", list);
+        phc_table_free(t);
+        return rc;
+    }
+    const size_t n = phc_table_rows(t);
+    f->tables++;
+    /* collecting the groups: every value, and the table cut to the first
+     * group, since the rows of all groups together need not make one valid
+     * data set (a weight curve's times start again with each plant) */
+    const char *value = f->value;
+    if (!value) {
+        const size_t before = f->n_values;
+        for (size_t r = 0; r < n; ++r)
+            if (collect_value(f, phc_table_cell(t, r, (size_t)col))) {
+                phc_table_free(t);
+                return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            }
+        if (n == 0) {
+            *out = t;
+            return PHC_OK;
+        }
+        value = before ? f->values[0] : phc_table_cell(t, 0, (size_t)col);
+    }
+    size_t *rows = malloc((n ? n : 1) * sizeof *rows), k = 0;
+    if (!rows) {
+        phc_table_free(t);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    for (size_t r = 0; r < n; ++r)
+        if (strcmp(phc_table_cell(t, r, (size_t)col), value) == 0)
+            rows[k++] = r;
+    if (k == 0 && !f->value) /* the first group is not in this table: its own first */
+        for (size_t r = 0; r < n; ++r)
+            if (strcmp(phc_table_cell(t, r, (size_t)col), phc_table_cell(t, 0, (size_t)col)) == 0)
+                rows[k++] = r;
+    if (k == 0)
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: --each %s: no row has the value '%s'", path, f->column, value);
+    else
+        rc = phc_table_select_rows(t, rows, k, out, err);
+    free(rows);
+    phc_table_free(t);
+    return rc;
+}
 
 static int is_parameter(const char *name, void *user_data)
 {
@@ -521,7 +617,7 @@ static int parse_loss(const phc_yaml_doc *doc, const phc_yaml_node *node, phc_da
 }
 
 static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, size_t index,
-                         const char *base_dir, phc_problem *pb, phc_error *err)
+                         const char *base_dir, phc_problem *pb, row_filter *rows, phc_error *err)
 {
     char ctx[96];
     snprintf(ctx, sizeof ctx, "data set %zu", index + 1);
@@ -564,7 +660,18 @@ static int parse_dataset(const phc_yaml_doc *doc, const phc_yaml_node *node, siz
     if (binding && (rc = expect_kind(doc, binding, PHC_YAML_MAPPING, "parameters of a data set", err)))
         return rc;
 
-    binding_ctx bctx = {pb, binding};
+    if (rows && !entry->each) {
+        char can[256] = "";
+        for (size_t i = 0; i < N_KINDS; ++i)
+            if (kinds[i]->each) {
+                const size_t used = strlen(can);
+                snprintf(can + used, sizeof can - used, "%s%s", used ? ", " : "", kinds[i]->config.name);
+            }
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "%s:%zu: %s: --each %s: kind '%s' cannot be split into groups of rows (kinds that "
+                             "can: %s)", doc->path, node->line, ctx, rows->column, kind, can);
+    }
+    binding_ctx bctx = {pb, binding, rows};
     phc_dataset *ds = NULL;
     if ((rc = entry->load_yaml(doc, node, base_dir, is_parameter, &bctx, &ds, err)))
         return rc;
@@ -735,7 +842,7 @@ static int parse_outputs(const phc_yaml_doc *doc, const phc_yaml_node *node, phc
     return PHC_OK;
 }
 
-int phc_config_load(const char *path, phc_problem **out, phc_error *err)
+static int load(const char *path, row_filter *rows, phc_problem **out, phc_error *err)
 {
     phc_yaml_doc *doc = NULL;
     phc_problem *pb = NULL;
@@ -796,7 +903,7 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
         goto fail;
     }
     for (size_t i = 0; i < datasets->count; ++i)
-        if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, err)))
+        if ((rc = parse_dataset(doc, datasets->items[i], i, base_dir, pb, rows, err)))
             goto fail;
     const phc_yaml_node *groups = phc_yaml_get(root, "groups");
     if (groups && (rc = parse_groups(doc, groups, pb, err)))
@@ -826,4 +933,48 @@ fail:
     free(dir_copy);
     free(stem);
     return rc;
+}
+
+int phc_config_load(const char *path, phc_problem **out, phc_error *err)
+{
+    return load(path, NULL, out, err);
+}
+
+int phc_config_group_values(const char *path, const char *column, char ***values, size_t *n, phc_problem **whole,
+                            phc_error *err)
+{
+    row_filter f = {column, NULL, NULL, 0, 0};
+    phc_problem *pb = NULL;
+    *values = NULL;
+    *n = 0;
+    if (whole)
+        *whole = NULL;
+    int rc = load(path, &f, &pb, err);
+    if (whole && !rc)
+        *whole = pb;
+    else
+        phc_problem_free(pb);
+    if (rc) {
+        phc_config_group_values_free(f.values, f.n_values);
+        return rc;
+    }
+    *values = f.values;
+    *n = f.n_values;
+    return PHC_OK;
+}
+
+void phc_config_group_values_free(char **values, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        free(values[i]);
+    free(values);
+}
+
+int phc_config_load_group(const char *path, const char *column, const char *value, phc_problem **out,
+                          phc_error *err)
+{
+    if (!column || !value)
+        return phc_error_set(err, PHC_ERR_INVALID, "phc_config_load_group: invalid argument");
+    row_filter f = {column, value, NULL, 0, 0};
+    return load(path, &f, out, err);
 }

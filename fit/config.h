@@ -34,6 +34,27 @@
 /* Loads and validates (phc_problem_validate) a configuration file. */
 int phc_config_load(const char *path, phc_problem **out, phc_error *err);
 
+/* Groups of rows (`phytocal fit --each COLUMN`): every data set's table is
+ * split by the text of its column COLUMN; only kinds whose table is one of
+ * rows can be split (phc_kind.each: curve, pv_curve, weight_curve), any
+ * other kind in the config is PHC_ERR_INPUT naming it and the kinds that
+ * can.  A table without the column is PHC_ERR_INPUT naming the file and the
+ * column (and the columns it has).
+ *
+ * group_values: the distinct cells of COLUMN over the config's tables, in
+ * order of first appearance; the config is loaded and validated with the
+ * first group's rows (all groups' rows together need not be one valid data
+ * set) and handed back in *whole when whole is not NULL; *values is
+ * malloc'd, free with phc_config_group_values_free.
+ * load_group: the config with each table cut to the rows whose COLUMN cell
+ * equals value (rows keep their file lines for messages); a table with no
+ * such row is PHC_ERR_INPUT. */
+int phc_config_group_values(const char *path, const char *column, char ***values, size_t *n, phc_problem **whole,
+                            phc_error *err);
+void phc_config_group_values_free(char **values, size_t n);
+int phc_config_load_group(const char *path, const char *column, const char *value, phc_problem **out,
+                          phc_error *err);
+
 /* A set of configuration keys: a data-set kind, or a block of the file. */
 typedef struct phc_config_section {
     const char *name;          /* the kind ("weight_curve") or block ("solver") */

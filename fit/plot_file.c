@@ -2,6 +2,9 @@
 #include "fit/plot_file.h"
 
 #include <plplot.h>
+#include <png.h>
+#include <setjmp.h>
+#include <zlib.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,4 +92,43 @@ double phc_plot_nice_step(double span, double target)
     const double p = pow(10.0, floor(log10(raw)));
     const double m = raw / p;
     return (m < 1.5 ? 1.0 : m < 3.5 ? 2.0 : m < 7.5 ? 5.0 : 10.0) * p;
+}
+
+int phc_plot_png_write(phc_atomic_file *af, const unsigned char *rgba, int w, int h, phc_error *err)
+{
+    FILE *f = phc_atomic_file_stream(af);
+    unsigned char *row = malloc((size_t)w * 3);
+    png_structp png = row ? png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, NULL, NULL) : NULL;
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    if (!info) {
+        png_destroy_write_struct(&png, NULL);
+        free(row);
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", phc_atomic_file_path(af));
+    }
+    if (setjmp(png_jmpbuf(png))) { /* libpng reports its errors by longjmp */
+        png_destroy_write_struct(&png, &info);
+        free(row);
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write the PNG", phc_atomic_file_path(af));
+    }
+    png_init_io(png, f);
+    png_set_compression_level(png, Z_BEST_SPEED);
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+    png_set_IHDR(png, info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_BASE, PNG_FILTER_TYPE_BASE);
+    png_write_info(png, info);
+    for (int y = 0; y < h; ++y) {
+        const unsigned char *src = rgba + (size_t)y * (size_t)w * 4;
+        for (int x = 0; x < w; ++x) {
+            row[3 * x] = src[4 * x];
+            row[3 * x + 1] = src[4 * x + 1];
+            row[3 * x + 2] = src[4 * x + 2];
+        }
+        png_write_row(png, row);
+    }
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    free(row);
+    if (fflush(f) != 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write the PNG", phc_atomic_file_path(af));
+    return PHC_OK;
 }

@@ -1,7 +1,8 @@
 /* The file side of a PLplot figure, shared by fit/plots.c,
- * fit/soil_plots.c and fit/growth_outputs.c: text escaping, the pngcairo
- * device check, the check that cairo wrote a complete PNG, and committing
- * the temporary output file (measurements/atomic_file.h). */
+ * fit/soil_plots.c and fit/growth_outputs.c: text escaping, the cairo
+ * device check, the PNG encoder of plots.c's memcairo pages, the check
+ * that a complete PNG was written, and committing the temporary output file
+ * (measurements/atomic_file.h). */
 #ifndef PHC_PLOT_FILE_H
 #define PHC_PLOT_FILE_H
 
@@ -20,6 +21,12 @@ int phc_plot_device_available(const char *name);
  * PHC_ERR_IO "PATH: PLplot did not write a complete PNG file (disk full?)"
  * or the commit's message. */
 int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err);
+/* Encodes an RGBA page (w x h, rows top to bottom, as PLplot's memcairo
+ * device leaves it) as an 8-bit RGB PNG into af's stream and flushes it.
+ * zlib level 1 with the Sub filter: plots are mostly flat colour, and this
+ * is several times faster than cairo's own PNG writer (default level, every
+ * filter tried per row) for files about as large.  PHC_ERR_IO / NOMEM. */
+int phc_plot_png_write(phc_atomic_file *af, const unsigned char *rgba, int w, int h, phc_error *err);
 /* 1 when file starts with the PNG signature and ends with the IEND chunk
  * (cairo reports no write errors through PLplot: a full disk shows as a
  * truncated file). */

@@ -1,4 +1,9 @@
-/* Diagnostic plots of a fit with PLplot's pngcairo driver: see plots.h.
+/* Diagnostic plots of a fit with PLplot's memcairo driver: see plots.h.
+ * PLplot draws with cairo into a page in memory (the same rendering as its
+ * pngcairo driver: the images are pixel for pixel those pngcairo made) and
+ * phc_plot_png_write encodes it, at zlib level 1, several times faster than
+ * cairo's PNG writer (which was most of a small fit's time in a batch:
+ * issue 16, README "Speed").
  *
  * How each call stays self-contained and safe:
  * - It makes its own PLplot stream (plmkstrm) and ends it (plend1), then
@@ -15,7 +20,8 @@
  *   and plbox reject empty windows).
  * - The PNG is written to a temporary file next to `path` (created by us
  *   first, measurements/atomic_file.h, so the directory is known to be
- *   writable), checked for the PNG signature and IEND chunk and renamed
+ *   writable; PLplot never opens a file), checked for the PNG signature
+ *   and IEND chunk and renamed
  *   into place (DESIGN.md §3).
  *
  * Caller text is plain text: PLplot's escape character '#' is doubled so a
@@ -245,6 +251,7 @@ typedef struct plot_ctx {
     PLINT old_stream;
     PLINT stream;        /* -1 when none was made */
     phc_atomic_file *af; /* the output file until committed, NULL when none */
+    unsigned char *pixels; /* PAGE_W x PAGE_H RGBA, PLplot's memcairo page */
     double page_fx, page_fy; /* one character height as a page fraction */
     double ch_fx, ch_fy;     /* ... and as a viewport fraction */
     double ylab_disp;        /* y label distance from the frame (chars) */
@@ -284,6 +291,7 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
 {
     ctx->stream = -1;
     ctx->af = NULL;
+    ctx->pixels = NULL;
     ctx->groups = groups;
     ctx->key_w = 0.0;
     plgstrm(&ctx->old_stream);
@@ -295,17 +303,24 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
             return rc;
     }
 
-    int dev = phc_plot_device_available("pngcairo");
+    int dev = phc_plot_device_available("memcairo");
     if (dev < 0)
         return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
     if (dev == 0)
         return phc_error_set(err, PHC_ERR_INTERNAL,
-                             "%s: PLplot has no 'pngcairo' device "
+                             "%s: PLplot has no 'memcairo' device "
                              "(install plplot-driver-cairo)", path);
 
     int status = phc_atomic_file_open(path, &ctx->af, err);
     if (status)
         return status;
+    /* the page: white, drawn on by memcairo, encoded by plot_end */
+    if (!(ctx->pixels = malloc((size_t)PAGE_W * PAGE_H * 4))) {
+        phc_atomic_file_abort(ctx->af);
+        ctx->af = NULL;
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path);
+    }
+    memset(ctx->pixels, 255, (size_t)PAGE_W * PAGE_H * 4);
 
     PLINT strm = -1;
     plmkstrm(&strm);
@@ -313,13 +328,15 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
         plsstrm(ctx->old_stream);
         phc_atomic_file_abort(ctx->af);
         ctx->af = NULL;
+        free(ctx->pixels);
+        ctx->pixels = NULL;
         return phc_error_set(err, PHC_ERR_INTERNAL,
                              "%s: no free PLplot stream", path);
     }
     ctx->stream = strm;
 
-    plsdev("pngcairo");
-    plsfnam(phc_atomic_file_temp_path(ctx->af));
+    plsdev("memcairo");
+    plsmema(PAGE_W, PAGE_H, ctx->pixels);
     plspage(0.0, 0.0, PAGE_W, PAGE_H, 0, 0);
     plsfam(0, 0, 0);
 
@@ -362,6 +379,10 @@ static int plot_end(plot_ctx *ctx, int status, phc_error *err)
         plsstrm(ctx->old_stream);
         ctx->stream = -1;
     }
+    if (status == PHC_OK && ctx->af && ctx->pixels)
+        status = phc_plot_png_write(ctx->af, ctx->pixels, PAGE_W, PAGE_H, err);
+    free(ctx->pixels);
+    ctx->pixels = NULL;
     status = phc_plot_file_finish(ctx->af, status, err);
     ctx->af = NULL;
     return status;

@@ -450,6 +450,54 @@ int phc_table_read(const char *path, phc_table **out, phc_error *err)
     return rc;
 }
 
+int phc_table_select_rows(const phc_table *t, const size_t *rows, size_t n_rows, phc_table **out, phc_error *err)
+{
+    if (out)
+        *out = NULL;
+    if (!t || !out || (n_rows && !rows))
+        return phc_error_set(err, PHC_ERR_INVALID, "phc_table_select_rows: invalid argument");
+    for (size_t r = 0; r < n_rows; ++r)
+        if (rows[r] >= t->nrows)
+            return phc_error_set(err, PHC_ERR_INVALID, "phc_table_select_rows: row %zu of %zu", rows[r], t->nrows);
+    /* one text buffer: the header names, then the selected cells */
+    size_t bytes = 0;
+    for (size_t j = 0; j < t->ncols; ++j)
+        bytes += strlen(t->names[j]) + 1;
+    for (size_t r = 0; r < n_rows; ++r)
+        for (size_t j = 0; j < t->ncols; ++j)
+            bytes += strlen(t->cells[rows[r] * t->ncols + j]) + 1;
+    phc_table *s = calloc(1, sizeof *s);
+    if (!s)
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", t->source);
+    s->source = malloc(strlen(t->source) + 1);
+    s->text = malloc(bytes ? bytes : 1);
+    s->names = malloc(((n_rows + 1) * t->ncols ? (n_rows + 1) * t->ncols : 1) * sizeof *s->names);
+    s->lines = malloc((n_rows ? n_rows : 1) * sizeof *s->lines);
+    if (!s->source || !s->text || !s->names || !s->lines) {
+        phc_table_free(s);
+        return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", t->source);
+    }
+    strcpy(s->source, t->source);
+    s->ncols = t->ncols;
+    s->nrows = n_rows;
+    s->header_line = t->header_line;
+    s->cells = s->names + t->ncols;
+    char *at = s->text;
+    for (size_t k = 0; k < (n_rows + 1) * t->ncols; ++k) {
+        const size_t r = k / t->ncols, j = k % t->ncols;
+        const char *src = r == 0 ? t->names[j] : t->cells[rows[r - 1] * t->ncols + j];
+        const size_t len = strlen(src) + 1;
+        memcpy(at, src, len);
+        s->names[k] = at;
+        at += len;
+    }
+    for (size_t r = 0; r < n_rows; ++r)
+        s->lines[r] = t->lines[rows[r]];
+    *out = s;
+    phc_error_clear(err);
+    return PHC_OK;
+}
+
 void phc_table_free(phc_table *t)
 {
     if (!t)

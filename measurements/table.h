@@ -49,6 +49,14 @@ int phc_table_from_columns(const char *name, size_t n_columns, const char *const
 
 void phc_table_free(phc_table *t); /* accepts NULL */
 
+/* A new table holding the rows rows[0..n_rows-1] of t (0-based, in the
+ * order given) under the same header and source name; each row keeps its
+ * source line, so messages about the subset still point into the file.
+ * Used to split one table into groups (phytocal fit --each). */
+int phc_table_select_rows(const phc_table *t, const size_t *rows, size_t n_rows, phc_table **out,
+                          phc_error *err);
+
+
 const char *phc_table_source(const phc_table *t);   /* path or name given */
 size_t phc_table_rows(const phc_table *t);
 size_t phc_table_columns(const phc_table *t);

@@ -1,6 +1,7 @@
 /* The phytocal command (DESIGN.md §4).  The only place that prints.
  *
  *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal fit A.yaml B.yaml ... -o DIR | CONFIG.yaml --each COLUMN -o DIR   (batch)
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal grow CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal sensitivity CONFIG.yaml [-o DIR] [--method morris|sobol] [--samples N] [--seed S] [--resume] ...
@@ -23,6 +24,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "fit/batch_summary.h"
 #include "fit/engine/ceres_bridge.h"
 #include "fit/config.h"
 #include "fit/config_help.h"
@@ -50,7 +52,9 @@ typedef struct command_help {
 } command_help;
 
 static const command_help commands[] = {
-    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]",
+    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]\n"
+            "  phytocal fit A.yaml B.yaml ... -o DIR [--force] [--quiet]\n"
+            "  phytocal fit CONFIG.yaml --each COLUMN -o DIR [--force] [--quiet]",
      "Fits the configuration's parameters to its data sets (Ceres Solver), then judges\n"
      "the residuals and parameters, and writes a run directory:\n"
      "  result.json        machine-readable result (README: result.json)\n"
@@ -69,7 +73,21 @@ static const command_help commands[] = {
      "  -h, --help         this text\n"
      "\n"
      "Progress goes to stderr: one updating line on a terminal (start k of n, solver\n"
-     "iteration and cost, elapsed time), plain lines otherwise."},
+     "iteration and cost, elapsed time), plain lines otherwise.\n"
+     "\n"
+     "Batch (many small fits in one process; -o DIR is required):\n"
+     "  A.yaml B.yaml ...  each config fitted into DIR/<config stem>/ (two configs with\n"
+     "                     the same stem are refused before anything is fitted)\n"
+     "  --each COLUMN      one fit per value of COLUMN in the config's table(s) (kinds\n"
+     "                     curve, pv_curve, weight_curve), each on its rows only, into\n"
+     "                     DIR/<value>/; bytes of the value other than letters, digits,\n"
+     "                     '-', '_', '.' (and a leading '.') are written %XX\n"
+     "Each fit's directory is a run directory as above; DIR holds them, summary.tsv and\n"
+     "summary.md (one row per fit: status, verdict, cost, R², parameters with standard\n"
+     "errors) and its own manifest, so --force and report --check treat DIR as one run.\n"
+     "A fit that fails to load or solve is named in the summary and the others are\n"
+     "still done.  Exit code: 0 when every fit converged, else the worst (highest) of\n"
+     "the fits' own codes (2 bad input, 3 not converged, 4 internal)."},
     {"simulate", "phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]",
      "Runs every data set's model at the configured start values, without fitting, and\n"
      "writes a run directory (default runs/<name>-simulation/) with <data set>_simulated.csv\n"
@@ -360,6 +378,7 @@ typedef struct progress_state {
     char last_stage[32];
     size_t last_step;
     int open_line; /* a terminal line is drawn and not yet ended */
+    const char *prefix; /* batch mode: "fit k/n NAME", or NULL */
 } progress_state;
 
 static double now_seconds(void)
@@ -375,7 +394,8 @@ static int progress_cb(const phc_progress *p, void *user_data)
     const double t = now_seconds(), elapsed = t - st->t0;
     const int new_step = strcmp(p->stage, st->last_stage) != 0 || p->step != st->last_step;
     char line[256];
-    int len = snprintf(line, sizeof line, "%s", p->stage);
+    int len = st->prefix ? snprintf(line, sizeof line, "%s: ", st->prefix) : 0;
+    len += snprintf(line + len, sizeof line - (size_t)len, "%s", p->stage);
     if (p->steps > 0)
         len += snprintf(line + len, sizeof line - (size_t)len, " %zu/%zu", p->step, p->steps);
     if (p->detail)
@@ -445,8 +465,13 @@ static int load_for_run(const char *cmd, int full_argc, char **full_argv, int ar
     return 0;
 }
 
+static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv);
+static int is_batch(int argc, char **argv);
+
 static int cmd_fit(int full_argc, char **full_argv, int argc, char **argv)
 {
+    if (is_batch(argc, argv))
+        return cmd_fit_batch(full_argc, full_argv, argc, argv);
     cli_options o;
     phc_problem *pb = NULL;
     phc_provenance *pv = NULL;
@@ -456,7 +481,7 @@ static int cmd_fit(int full_argc, char **full_argv, int argc, char **argv)
         return code;
     phc_error err;
     phc_error_clear(&err);
-    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     phc_progress_fn progress = o.quiet ? NULL : progress_cb;
     phc_fit_result *res = NULL;
     int rc = phc_fit_run(pb, progress, &prog, &res, &err);
@@ -494,6 +519,312 @@ static int cmd_fit(int full_argc, char **full_argv, int argc, char **argv)
     return EXIT_OK;
 }
 
+/* ---- batch: several configs, or one config's groups (--each) ------------------------- */
+
+/* The folder of one fit of a batch: the config's stem or the group's value,
+ * with every byte other than letters, digits, '-', '_' and '.' (and a
+ * leading '.') written as %XX, so that distinct values give distinct folders
+ * and none is a path ("a/b" -> a%2Fb, ".." -> %2E.).  Returns -1 (out
+ * untouched) for an empty value or a name longer than 100 bytes. */
+static int batch_dir_name(const char *value, char *out, size_t size)
+{
+    static const char hex[] = "0123456789ABCDEF";
+    size_t j = 0;
+    if (!value[0])
+        return -1;
+    char buf[128];
+    for (size_t i = 0; value[i]; ++i) {
+        const unsigned char c = (unsigned char)value[i];
+        const int plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                          c == '_' || (c == '.' && i > 0);
+        if (j + (plain ? 1 : 3) > 100)
+            return -1;
+        if (plain) {
+            buf[j++] = (char)c;
+        } else {
+            buf[j++] = '%';
+            buf[j++] = hex[c >> 4];
+            buf[j++] = hex[c & 15];
+        }
+    }
+    buf[j] = '\0';
+    snprintf(out, size, "%s", buf);
+    return 0;
+}
+
+static char *config_stem(const char *path)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    char *s = strdup(base);
+    char *dot = s ? strrchr(s, '.') : NULL;
+    if (dot && dot != s)
+        *dot = '\0';
+    return s;
+}
+
+/* 1 when `fit` is asked for a batch: --each, or more than one config. */
+static int is_batch(int argc, char **argv)
+{
+    int positional = 0;
+    for (int i = 0; i < argc; ++i) {
+        if (strcmp(argv[i], "--each") == 0)
+            return 1;
+        if (strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--output") == 0)
+            ++i;
+        else if (argv[i][0] != '-' || argv[i][1] == '\0')
+            ++positional;
+    }
+    return positional > 1;
+}
+
+typedef struct batch_job {
+    const char *config;  /* the config file */
+    char *group;         /* --each: the group's value */
+    char name[128];      /* its folder below DIR ("" when refused) */
+    phc_problem *pb;     /* several configs: loaded up front (NULL after an error) */
+    phc_error load_err;  /* the error that stopped it before fitting */
+    int load_rc;
+} batch_job;
+
+static int batch_row_text(char **field, const char *text)
+{
+    free(*field);
+    *field = text ? strdup(text) : NULL;
+    return text && !*field ? -1 : 0;
+}
+
+/* Fits one job into tmpdir/<name>/ and fills its row.  Returns the exit
+ * code `phytocal fit` alone would give it. */
+static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n, int full_argc, char **full_argv,
+                         const char *tmpdir, int quiet, phc_batch_row *row)
+{
+    phc_error err;
+    phc_error_clear(&err);
+    char prefix[160], subdir[8192];
+    snprintf(prefix, sizeof prefix, "fit %zu/%zu %s", k + 1, n, job->name[0] ? job->name : "?");
+    batch_row_text(&row->fit, job->group ? job->group : job->name);
+    batch_row_text(&row->group, job->group);
+    batch_row_text(&row->config, job->config);
+    phc_problem *pb = job->pb;
+    job->pb = NULL;
+    int rc = job->load_rc;
+    if (rc)
+        err = job->load_err;
+    else if (!pb)
+        rc = phc_config_load_group(job->config, column, job->group, &pb, &err);
+    phc_provenance *pv = NULL;
+    phc_fit_result *res = NULL;
+    const int tty = isatty(STDERR_FILENO);
+    progress_state prog = {tty, now_seconds(), 0, "", 0, 0, prefix};
+    phc_progress_fn progress = !quiet && tty ? progress_cb : NULL;
+    if (!quiet && !tty)
+        fprintf(stderr, "%s\n", prefix);
+    if (!rc)
+        rc = phc_provenance_begin(pb, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, &pv, &err);
+    if (!rc && (rc = phc_fit_run(pb, progress, &prog, &res, &err)))
+        batch_row_text(&row->status, "failed");
+    if (!rc) {
+        for (size_t d = 0; d < pb->n_datasets; ++d) {
+            pb->datasets[d]->progress = progress;
+            pb->datasets[d]->progress_data = &prog;
+        }
+        phc_progress_report(progress, &prog, "writing", 0, 0, -1, 0, job->name);
+        phc_provenance_end(pv);
+        res->provenance = pv;
+        pv = NULL;
+        snprintf(subdir, sizeof subdir, "%s/%s", tmpdir, job->name);
+        if (!(rc = phc_run_dir_write(res, pb, subdir, 0, &err)))
+            batch_row_text(&row->dir, job->name);
+    }
+    progress_end(&prog);
+    int code = exit_code_for(rc);
+    if (res && phc_batch_row_set_result(row, res) != PHC_OK)
+        code = EXIT_INTERNAL;
+    if (rc) {
+        if (!row->status)
+            batch_row_text(&row->status, "error");
+        batch_row_text(&row->message, err.message[0] ? err.message : phc_strerror(err.status));
+    } else if (res->summary.outcome != PHC_NLS_CONVERGED) {
+        batch_row_text(&row->status, phc_fit_status_name(res->summary.outcome));
+        batch_row_text(&row->message, "the fit did not converge; results written for inspection");
+        code = EXIT_FIT;
+    } else {
+        batch_row_text(&row->status, "converged");
+    }
+    row->exit_code = code;
+    if (!quiet) {
+        printf("%s: %s", row->fit, row->status);
+        if (row->has_result) {
+            printf(", %s, cost %.6g", row->verdict, row->cost);
+            for (size_t d = 0; d < row->n_datasets; ++d)
+                if (row->n_datasets == 1)
+                    printf(", R² %.6g", row->r2[d]);
+                else
+                    printf(", R² %s %.6g", row->dataset_names[d], row->r2[d]);
+        }
+        if (code)
+            printf(" (exit %d: %s)", code, row->message ? row->message : "");
+        putchar('\n');
+        fflush(stdout);
+    }
+    phc_fit_result_free(res);
+    phc_provenance_free(pv);
+    phc_problem_free(pb);
+    return code;
+}
+
+/* phytocal fit A.yaml B.yaml ... -o DIR  |  phytocal fit CONFIG.yaml --each COLUMN -o DIR */
+static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
+{
+    const char *out_dir = NULL, *column = NULL;
+    int force = 0, quiet = 0, n_configs = 0;
+    const char **configs = calloc((size_t)argc + 1, sizeof *configs);
+    if (!configs)
+        return EXIT_INTERNAL;
+    for (int i = 0; i < argc; ++i) {
+        const char *a = argv[i];
+        if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0 || strcmp(a, "--each") == 0) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "phytocal fit: %s needs %s\nusage: %s\n", a,
+                        a[2] == 'e' ? "a column name" : "a directory", find_command("fit")->synopsis);
+                free(configs);
+                return EXIT_USAGE;
+            }
+            *(a[2] == 'e' ? &column : &out_dir) = argv[++i];
+        } else if (strcmp(a, "--force") == 0) {
+            force = 1;
+        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+            quiet = 1;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            fprintf(stderr, "phytocal fit: unknown option '%s' (phytocal fit --help lists the options)\n", a);
+            free(configs);
+            return EXIT_USAGE;
+        } else {
+            configs[n_configs++] = a;
+        }
+    }
+    const char *why = n_configs == 0                ? "missing the configuration file"
+                      : column && n_configs > 1     ? "--each splits one configuration's tables: give one config"
+                      : !out_dir                    ? "a batch (several configs, or --each) needs -o DIR"
+                      : column && !column[0]        ? "--each needs a column name"
+                                                    : NULL;
+    if (why) {
+        fprintf(stderr, "phytocal fit: %s\nusage: %s\n", why, find_command("fit")->synopsis);
+        free(configs);
+        return EXIT_USAGE;
+    }
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", out_dir);
+    for (size_t n = strlen(dir); n > 1 && dir[n - 1] == '/'; --n)
+        dir[n - 1] = '\0';
+
+    phc_error err;
+    phc_error_clear(&err);
+    batch_job *jobs = NULL;
+    size_t n_jobs = 0;
+    int code = EXIT_OK;
+    if (column) {
+        char **values = NULL;
+        size_t n_values = 0;
+        phc_problem *whole = NULL;
+        if (phc_config_group_values(configs[0], column, &values, &n_values, &whole, &err)) {
+            free(configs);
+            return fail(&err);
+        }
+        /* DIR may not hold the config or its data (run_dir.h) */
+        const int rc = phc_run_dir_check(dir, force, whole, &err);
+        phc_problem_free(whole);
+        if (rc || !(jobs = calloc(n_values ? n_values : 1, sizeof *jobs))) {
+            phc_config_group_values_free(values, n_values);
+            free(configs);
+            return rc ? fail(&err) : EXIT_INTERNAL;
+        }
+        for (size_t g = 0; g < n_values; ++g) {
+            batch_job *j = &jobs[n_jobs++];
+            j->config = configs[0];
+            j->group = values[g];
+            values[g] = NULL;
+            if (batch_dir_name(j->group, j->name, sizeof j->name) != 0)
+                j->load_rc = phc_error_set(&j->load_err, PHC_ERR_INPUT,
+                                           "%s: --each %s: the group '%.60s' has no folder name: an empty cell, or "
+                                           "longer than 100 bytes once escaped",
+                                           configs[0], column, j->group);
+        }
+        phc_config_group_values_free(values, n_values);
+    } else {
+        if (!(jobs = calloc((size_t)n_configs, sizeof *jobs))) {
+            free(configs);
+            return EXIT_INTERNAL;
+        }
+        for (int c = 0; c < n_configs; ++c) {
+            batch_job *j = &jobs[n_jobs++];
+            j->config = configs[c];
+            char *stem = config_stem(configs[c]);
+            if (!stem || batch_dir_name(stem, j->name, sizeof j->name) != 0)
+                j->load_rc = phc_error_set(&j->load_err, PHC_ERR_INPUT, "%s: its stem '%s' makes no folder name",
+                                           configs[c], stem ? stem : "");
+            free(stem);
+            for (int b = 0; b < c && !j->load_rc; ++b)
+                if (jobs[b].name[0] && strcmp(jobs[b].name, j->name) == 0) {
+                    fprintf(stderr,
+                            "phytocal fit: %s and %s have the same stem '%s': both would be fitted into %s/%s/; "
+                            "rename one (nothing was fitted)\n", jobs[b].config, j->config, j->name, dir, j->name);
+                    code = EXIT_INPUT;
+                }
+        }
+        /* loaded up front: DIR may not hold any config or its data */
+        for (size_t c = 0; c < n_jobs && code == EXIT_OK; ++c) {
+            if (jobs[c].load_rc)
+                continue;
+            jobs[c].load_rc = phc_config_load(jobs[c].config, &jobs[c].pb, &jobs[c].load_err);
+            if (!jobs[c].load_rc && phc_run_dir_check(dir, force, jobs[c].pb, &err))
+                code = fail(&err);
+        }
+    }
+    char tmpdir[4096];
+    if (code == EXIT_OK && phc_run_dir_begin(dir, force, NULL, tmpdir, sizeof tmpdir, &err))
+        code = fail(&err);
+    phc_batch_row *rows = code == EXIT_OK ? calloc(n_jobs ? n_jobs : 1, sizeof *rows) : NULL;
+    if (code == EXIT_OK && !rows) {
+        phc_run_dir_discard(tmpdir);
+        code = EXIT_INTERNAL;
+    }
+    if (code == EXIT_OK) {
+        int worst = EXIT_OK;
+        size_t n_ok = 0;
+        for (size_t k = 0; k < n_jobs; ++k) {
+            const int c = batch_fit_one(&jobs[k], column, k, n_jobs, full_argc, full_argv, tmpdir, quiet, &rows[k]);
+            worst = c > worst ? c : worst;
+            n_ok += c == EXIT_OK;
+        }
+        if (phc_batch_summary_write(tmpdir, column, rows, n_jobs, &err)) {
+            phc_run_dir_discard(tmpdir);
+            code = fail(&err);
+        } else if (phc_run_dir_commit(tmpdir, dir, NULL, &err)) {
+            code = fail(&err);
+        } else {
+            code = worst;
+            if (!quiet)
+                printf("%zu of %zu fits converged; summary: %s/summary.tsv, %s/summary.md\n", n_ok, n_jobs, dir,
+                       dir);
+            if (n_ok < n_jobs)
+                fprintf(stderr, "phytocal: %zu of %zu fits did not succeed (exit %d, the worst; each is named in %s/"
+                        "summary.md)\n", n_jobs - n_ok, n_jobs, worst, dir);
+        }
+        for (size_t k = 0; k < n_jobs; ++k)
+            phc_batch_row_clear(&rows[k]);
+    }
+    free(rows);
+    for (size_t k = 0; k < n_jobs; ++k) {
+        free(jobs[k].group);
+        phc_problem_free(jobs[k].pb);
+    }
+    free(jobs);
+    free(configs);
+    return code;
+}
+
 /* simulate: each data set's model at the start values (simulate.h). */
 static int cmd_simulate(int full_argc, char **full_argv, int argc, char **argv)
 {
@@ -507,7 +838,7 @@ static int cmd_simulate(int full_argc, char **full_argv, int argc, char **argv)
         return code;
     phc_error err;
     phc_error_clear(&err);
-    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     if (!o.quiet)
         phc_progress_report(progress_cb, &prog, "simulating", 0, 0, -1, 0, dir);
     const int rc = phc_simulate_write(pb, pv, dir, o.force, &err);
@@ -679,7 +1010,7 @@ static int sensitivity_run(int full_argc, char **full_argv, int argc, char **arg
     so.force = o.force;
     if (points >= 0)
         pb->series_points = (size_t)points;
-    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     so.progress = o.quiet ? NULL : progress_cb;
     so.progress_data = &prog;
     phc_error err;
@@ -795,7 +1126,7 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
         return code;
     }
     free(rest);
-    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     po.force = o.force;
     po.progress = o.quiet ? NULL : progress_cb;
     po.progress_data = &prog;
@@ -895,7 +1226,7 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
     const char *stop = getenv("PHYTOCAL_STOP_AFTER"); /* test hook: stop after k chains, as a killed run would */
     if (stop && *stop)
         mo.stop_after = (size_t)strtoull(stop, NULL, 10);
-    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0};
+    progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     mo.progress = o.quiet ? NULL : progress_cb;
     mo.progress_data = &prog;
     phc_error err;

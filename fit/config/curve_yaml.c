@@ -48,7 +48,7 @@ static int curve_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, const 
     char *path = phc_join_path(base_dir, file);
     if (!path)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err))) {
+    if ((rc = phc_kind_read_table(user_data, path, &table, err))) {
         if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
             phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto done;
@@ -94,4 +94,5 @@ const phc_kind phc_curve_kind = {
                .help = curve_help},
     .ops = &phc_curve_ops,
     .load_yaml = curve_yaml,
+    .each = 1,
 };

@@ -151,7 +151,6 @@ static int pv_curve_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, con
                          phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
 {
     (void)is_parameter; /* the slots are fixed: kappa, chi0, e_min, e_max (per leaf with `each`) */
-    (void)user_data;
     const char *file = NULL;
     phc_pv_curve_options o = phc_pv_curve_options_default();
     const phc_origin origin = phc_yaml_origin(doc, node);
@@ -164,7 +163,7 @@ static int pv_curve_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, con
         return rc;
     if (!(path = phc_join_path(base_dir, file)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(path, &table, err))) {
+    if ((rc = phc_kind_read_table(user_data, path, &table, err))) {
         if (rc == PHC_ERR_IO) /* a file that cannot be read: which key named it */
             phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_key_line(node, "file"));
         goto done;
@@ -207,4 +206,5 @@ const phc_kind phc_pv_curve_kind = {
                .help = pv_curve_help},
     .ops = &phc_pv_curve_ops,
     .load_yaml = pv_curve_yaml,
+    .each = 1,
 };

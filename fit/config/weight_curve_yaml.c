@@ -480,7 +480,7 @@ static int read_table(wc_yaml *y, phc_error *err)
     int rc;
     if (!(y->path = phc_join_path(y->base_dir, y->file)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if ((rc = phc_table_read(y->path, &y->table, err)) && rc == PHC_ERR_IO) /* which key named it */
+    if ((rc = phc_kind_read_table(y->o.user_data, y->path, &y->table, err)) && rc == PHC_ERR_IO) /* which key named it */
         phc_error_prefix(err, rc, "%s:%zu: key 'file'", y->doc->path, phc_key_line(y->node, "file"));
     return rc;
 }
@@ -628,4 +628,5 @@ const phc_kind phc_weight_curve_kind = {
                .help = weight_curve_help},
     .ops = &phc_weight_curve_ops,
     .load_yaml = weight_curve_yaml,
+    .each = 1,
 };

@@ -587,6 +587,47 @@ static void test_locale(void)
     setlocale(LC_NUMERIC, "C");
 }
 
+/* phc_table_select_rows (the groups of `fit --each`): the chosen rows in the
+ * given order, the header and source kept, each row's file line kept (so a
+ * bad cell of the subset is reported at its line of the file), 0 rows
+ * allowed, an out-of-range row refused. */
+static void test_select_rows(void)
+{
+    phc_error err;
+    phc_table *t = NULL, *s = NULL;
+    const char *text = "# groups\nleaf,x\nA,1\nB,2\nA,oops\nB,4\n";
+    CHECK(phc_table_parse(text, strlen(text), "g.csv", &t, &err) == PHC_OK);
+    const size_t rows[] = {3, 1};
+    CHECK(phc_table_select_rows(t, rows, 2, &s, &err) == PHC_OK);
+    if (s) {
+        CHECK(phc_table_rows(s) == 2 && phc_table_columns(s) == 2);
+        CHECK(strcmp(phc_table_source(s), "g.csv") == 0);
+        CHECK(strcmp(phc_table_column_name(s, 0), "leaf") == 0 && strcmp(phc_table_column_name(s, 1), "x") == 0);
+        CHECK(strcmp(phc_table_cell(s, 0, 0), "B") == 0 && strcmp(phc_table_cell(s, 0, 1), "4") == 0);
+        CHECK(strcmp(phc_table_cell(s, 1, 0), "B") == 0 && strcmp(phc_table_cell(s, 1, 1), "2") == 0);
+        CHECK(phc_table_row_line(s, 0) == 6 && phc_table_row_line(s, 1) == 4);
+        double *v = NULL;
+        CHECK(phc_table_column_numbers(s, "x", &v, &err) == PHC_OK && v && v[0] == 4.0 && v[1] == 2.0);
+        free(v);
+    }
+    phc_table_free(s);
+    s = NULL;
+    const size_t group_a[] = {0, 2};
+    CHECK(phc_table_select_rows(t, group_a, 2, &s, &err) == PHC_OK);
+    double *v = NULL;
+    CHECK(s && phc_table_column_numbers(s, "x", &v, &err) == PHC_ERR_INPUT);
+    CHECK_STR_CONTAINS(err.message, "g.csv:5: column 'x'");
+    free(v);
+    phc_table_free(s);
+    s = NULL;
+    CHECK(phc_table_select_rows(t, NULL, 0, &s, &err) == PHC_OK && s && phc_table_rows(s) == 0);
+    phc_table_free(s);
+    s = NULL;
+    const size_t past[] = {4};
+    CHECK(phc_table_select_rows(t, past, 1, &s, &err) == PHC_ERR_INVALID && s == NULL);
+    phc_table_free(t);
+}
+
 int main(void)
 {
     if (!mkdtemp(tmp_dir)) {
@@ -603,6 +644,7 @@ int main(void)
     test_zero_rows();
     test_junk();
     test_locale();
+    test_select_rows();
     remove_files();
     return check_finish("test_table");
 }
