@@ -471,7 +471,8 @@ int phc_table_select_rows(const phc_table *t, const size_t *rows, size_t n_rows,
         return phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", t->source);
     s->source = malloc(strlen(t->source) + 1);
     s->text = malloc(bytes ? bytes : 1);
-    s->names = malloc(((n_rows + 1) * t->ncols ? (n_rows + 1) * t->ncols : 1) * sizeof *s->names);
+    const size_t n_names = (n_rows + 1) * t->ncols;
+    s->names = malloc((n_names ? n_names : 1) * sizeof *s->names);
     s->lines = malloc((n_rows ? n_rows : 1) * sizeof *s->lines);
     if (!s->source || !s->text || !s->names || !s->lines) {
         phc_table_free(s);
