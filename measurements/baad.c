@@ -1110,6 +1110,21 @@ static double value_of(const phc_baad_study *s, long k, size_t i)
     return k >= 0 && s->vars[k].numeric ? s->vars[k].num[i] : NAN;
 }
 
+/* The text read for variable k in row i, NULL when absent. */
+static const char *text_of(const phc_baad_study *s, long k, size_t i)
+{
+    return k >= 0 && s->vars[k].text ? s->vars[k].text[i] : NULL;
+}
+
+/* Variable k of row i is numeric and absent from the file (no text was
+ * read there), so a derived value may fill it.  A variable the study maps
+ * but never fills may have no arrays at all. */
+static int fillable(const phc_baad_study *s, long k, size_t i)
+{
+    return k >= 0 && s->vars[k].numeric && s->vars[k].num && isnan(s->vars[k].num[i]) &&
+           !(s->vars[k].text && s->vars[k].text[i]);
+}
+
 /* Step 5a: invalid sizes.  A value present in the file (text not NULL) must
  * be finite and positive. */
 static int flag_invalid(phc_baad_study *s)
@@ -1468,12 +1483,12 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
             phc_baad_row *r = &s->rows[i];
             size_t j;
             r->line = phc_table_row_line(s->data, i);
-            r->species = k_sp >= 0 ? s->vars[k_sp].text[i] : NULL;
-            r->growing_condition = k_gc >= 0 ? s->vars[k_gc].text[i] : NULL;
+            r->species = text_of(s, k_sp, i);
+            r->growing_condition = text_of(s, k_gc, i);
             r->age = value_of(s, k_age, i);
             if (isfinite(r->age))
                 s->counts.ages++;
-            if (k_dba >= 0 && isnan(s->vars[k_dba].num[i]) && !s->vars[k_dba].text[i] &&
+            if (fillable(s, k_dba, i) &&
                 isfinite(value_of(s, k_stba, i))) {
                 /* d.ba = 2 sqrt(a.stba / pi): the stem's cross-section at
                  * its base taken as a circle; m from m2 */
@@ -1482,7 +1497,7 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
                 r->d_ba_derived = 1;
                 s->counts.derived_diameters++;
             }
-            if (k_rt >= 0 && isnan(s->vars[k_rt].num[i]) && !s->vars[k_rt].text[i] &&
+            if (fillable(s, k_rt, i) &&
                 isfinite(value_of(s, k_rf, i)) && isfinite(value_of(s, k_rc, i))) {
                 s->vars[k_rt].num[i] = value_of(s, k_rf, i) + value_of(s, k_rc, i);
                 r->m_rt_derived = 1;
@@ -1496,7 +1511,7 @@ int phc_baad_read(const char *study_dir, phc_baad_study **out, phc_error *err)
             r->m_so = value_of(s, k_so, i);
             r->latitude = value_of(s, k_lat, i);
             r->longitude = value_of(s, k_lon, i);
-            if (k_so >= 0 && isnan(r->m_so) && !s->vars[k_so].text[i] &&
+            if (fillable(s, k_so, i) &&
                 isfinite(r->m_st) && isfinite(r->m_lf)) {
                 r->m_so = r->m_st + r->m_lf; /* BAAD's fillDerivedVariables */
                 r->m_so_derived = 1;
@@ -1648,7 +1663,7 @@ const char *phc_baad_text(const phc_baad_study *s, size_t i, const char *variabl
     if (!s || !variable || i >= s->n)
         return NULL;
     k = var_find(s, variable);
-    return k < 0 ? NULL : s->vars[k].text[i];
+    return text_of(s, k, i);
 }
 
 const char *phc_baad_unit(const phc_baad_study *s, const char *variable)
