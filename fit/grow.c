@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/json_file_internal.h"
 #include "fit/run_dir.h"
 #include "fit/shape_plots.h"
 #include "measurements/atomic_file.h"
@@ -218,16 +219,7 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if (pv)
         json_object_set_new(root, "provenance", phc_provenance_to_json(pv));
-    phc_atomic_file *af = NULL;
-    int rc = phc_atomic_file_open(path, &af, err);
-    if (rc == PHC_OK) {
-        if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0) {
-            phc_atomic_file_abort(af);
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
-        } else {
-            rc = phc_atomic_file_commit(af, err);
-        }
-    }
+    int rc = phc_json_file_write(root, path, err);
     json_decref(root);
     return rc;
 }

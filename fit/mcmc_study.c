@@ -18,6 +18,7 @@
 #include "fit/engine/mcmc_dram.h"
 #include "fit/engine/mcmc_stretch.h"
 #include "fit/engine/prior.h"
+#include "fit/json_file_internal.h"
 #include "fit/mcmc_plots.h"
 #include "fit/run_dir.h"
 #include "fit/run_ledger.h"
@@ -150,20 +151,6 @@ static int chain_done(void *data, size_t c, const phc_mcmc_chains *out, const si
     if (cl->stop_after && cl->computed >= cl->stop_after)
         return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new chains (stop_after); %s holds them: "
                              "--resume continues", cl->computed, cl->path);
-    return PHC_OK;
-}
-
-static int make_parents(const char *path, phc_error *err)
-{
-    char buf[4400];
-    snprintf(buf, sizeof buf, "%s", path);
-    for (char *c = buf + 1; *c; ++c)
-        if (*c == '/') {
-            *c = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return phc_error_set(err, PHC_ERR_IO, "%s: cannot create: %s", buf, strerror(errno));
-            *c = '/';
-        }
     return PHC_OK;
 }
 
@@ -408,7 +395,7 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         size_t found = 0;
         if (bad || !y || !state || !counts || !have.theta || !have.s2 || !have.log_post || !cl.row)
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        if (rc == PHC_OK && (rc = make_parents(ledger_path, err)) == PHC_OK)
+        if (rc == PHC_OK && (rc = phc_run_dir_make_parents(ledger_path, err)) == PHC_OK)
             rc = phc_run_ledger_open(ledger_path, keys, (const char *const *)ident, 6, C, cl.n_out, o.resume, o.force,
                                      y, state, &found, &cl.l, err);
         if (rc == PHC_OK) {
@@ -606,16 +593,7 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
                             json_pack("{s:I, s:o}", "every", (json_int_t)step, "draws", thin));
         json_object_set_new(root, "verdict", json_pack("{s:b, s:s}", "mixed", mixed, "text", verdict));
         snprintf(path, sizeof path, "%s/result.json", tmpdir);
-        phc_atomic_file *af = NULL;
-        rc = phc_atomic_file_open(path, &af, err);
-        if (rc == PHC_OK) {
-            if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0) {
-                phc_atomic_file_abort(af);
-                rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
-            } else {
-                rc = phc_atomic_file_commit(af, err);
-            }
-        }
+        rc = phc_json_file_write(root, path, err);
         json_decref(root);
     }
     /* report.md */

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "fit/engine/fit.h"
+#include "fit/json_file_internal.h"
 #include "fit/plot_file.h"
 #include "fit/profile_plots.h"
 #include "fit/run_dir.h"
@@ -165,16 +166,7 @@ static int write_json(const phc_problem *pb, const phc_fit_result *fr, const phc
         json_array_append_new(params, o);
     }
     json_object_set_new(root, "parameters", params);
-    phc_atomic_file *af = NULL;
-    int rc = phc_atomic_file_open(path, &af, err);
-    if (rc == PHC_OK) {
-        if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0) {
-            phc_atomic_file_abort(af);
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
-        } else {
-            rc = phc_atomic_file_commit(af, err);
-        }
-    }
+    int rc = phc_json_file_write(root, path, err);
     json_decref(root);
     return rc;
 }

@@ -1,6 +1,7 @@
 /* result.json writer and reader (jansson): see result_json.h. */
 #include "fit/result_json.h"
 #include "fit/engine/provenance.h"
+#include "fit/json_file_internal.h"
 #include "measurements/atomic_file.h"
 
 #include <jansson.h>
@@ -192,17 +193,7 @@ int phc_result_write_json(const phc_fit_result *res, const char *path, phc_error
     json_t *root = result_json(res);
     if (!root)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory building result.json");
-    phc_atomic_file *af = NULL;
-    int rc = phc_atomic_file_open(path, &af, err);
-    if (rc == PHC_OK) {
-        errno = 0;
-        if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0) {
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write: %s", path, strerror(errno ? errno : EIO));
-            phc_atomic_file_abort(af);
-        } else {
-            rc = phc_atomic_file_commit(af, err);
-        }
-    }
+    int rc = phc_json_file_write(root, path, err);
     json_decref(root);
     return rc;
 }

@@ -306,11 +306,11 @@ int phc_run_dir_check(const char *dir, int force, const phc_problem *pb, phc_err
     }
 }
 
-/* mkdir -p for the parent of dir. */
-static int make_parents(const char *dir, phc_error *err)
+int phc_run_dir_make_parents(const char *dir, phc_error *err)
 {
-    char buf[4096];
-    snprintf(buf, sizeof buf, "%s", dir);
+    char buf[4400];
+    if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf)
+        return phc_error_set(err, PHC_ERR_IO, "%.200s...: path too long", dir);
     for (char *p = buf + 1; *p; ++p) {
         if (*p != '/')
             continue;
@@ -339,7 +339,7 @@ int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *t
                       phc_error *err)
 {
     int rc;
-    if ((rc = phc_run_dir_check(dir, force, pb, err)) || (rc = make_parents(dir, err)))
+    if ((rc = phc_run_dir_check(dir, force, pb, err)) || (rc = phc_run_dir_make_parents(dir, err)))
         return rc;
     if ((size_t)snprintf(tmpdir, size, "%s.tmp-XXXXXX", dir) >= size)
         return phc_error_set(err, PHC_ERR_IO, "%s: output path too long", dir);

@@ -62,6 +62,10 @@ typedef struct phc_run_dir_item {
 int phc_run_dir_verify(const char *dir, phc_run_dir_item **items, size_t *n, phc_error *err);
 void phc_run_dir_verify_free(phc_run_dir_item *items, size_t n);
 
+/* mkdir -p of the folders that hold path (not path itself): a run
+ * directory's or a ledger's parents.  PHC_ERR_IO names the folder. */
+int phc_run_dir_make_parents(const char *path, phc_error *err);
+
 /* A file-name-safe copy of a data-set name: characters other than letters,
  * digits, '-', '_' and '.' become '_'. */
 void phc_run_dir_safe_name(const char *name, char *out, size_t size);

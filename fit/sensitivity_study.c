@@ -14,6 +14,7 @@
 #include "fit/engine/morris.h"
 #include "fit/engine/prior.h"
 #include "fit/engine/sobol_indices.h"
+#include "fit/json_file_internal.h"
 #include "fit/run_dir.h"
 #include "fit/run_ledger.h"
 #include "fit/sensitivity_plots.h"
@@ -518,27 +519,6 @@ static int study_identity(study *s, const phc_provenance *pv)
     return bad ? -1 : 0;
 }
 
-/* mkdir -p of the folder holding path. */
-static int make_parents(const char *path, phc_error *err)
-{
-    char buf[4400];
-    snprintf(buf, sizeof buf, "%s", path);
-    char *slash = strrchr(buf, '/');
-    if (!slash || slash == buf)
-        return PHC_OK;
-    *slash = '\0';
-    for (char *c = buf + 1; *c; ++c)
-        if (*c == '/') {
-            *c = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return phc_error_set(err, PHC_ERR_IO, "%s: cannot create: %s", buf, strerror(errno));
-            *c = '/';
-        }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return phc_error_set(err, PHC_ERR_IO, "%s: cannot create: %s", buf, strerror(errno));
-    return PHC_OK;
-}
-
 static json_t *jnum(double v)
 {
     return isfinite(v) ? json_real(v) : json_null();
@@ -788,16 +768,7 @@ static int write_json(const study *s, const phc_study_summary *sum, const char *
         free(where);
     }
     json_object_set_new(root, "verdict", verdict);
-    phc_atomic_file *af = NULL;
-    int rc = phc_atomic_file_open(path, &af, err);
-    if (rc == PHC_OK) {
-        if (json_dumpf(root, phc_atomic_file_stream(af), JSON_INDENT(2) | JSON_REAL_PRECISION(17)) != 0) {
-            phc_atomic_file_abort(af);
-            rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
-        } else {
-            rc = phc_atomic_file_commit(af, err);
-        }
-    }
+    int rc = phc_json_file_write(root, path, err);
     json_decref(root);
     return rc;
 }
@@ -1201,7 +1172,7 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
             rc = dist->run(dist, s.n_out, NULL, 0, eval_row, NULL, &lp, err);
         goto done;
     }
-    if ((rc = make_parents(ledger_path, err)) ||
+    if ((rc = phc_run_dir_make_parents(ledger_path, err)) ||
         (rc = phc_run_ledger_open(ledger_path, (const char *const *)s.keys, (const char *const *)s.values, s.n_keys,
                                   s.rows, s.n_out, o.resume, o.force, s.y, s.state, &lp.found, &ledger, err)))
         goto done;
