@@ -16,28 +16,12 @@ static const PLINT palette[COL_CHAIN0 + N_CHAIN_COLOURS][3] = {
     {31, 119, 180},  {255, 127, 14}, {44, 160, 44},   {214, 39, 40},   {148, 103, 189},
     {140, 86, 75},   {227, 119, 194}, {127, 127, 127}};
 
-/* Opens a PLplot stream writing to af's temporary file. */
-static int begin(const char *path, int w, int h, phc_atomic_file **af, PLINT *old, phc_error *err)
+/* Opens a PLplot stream writing to af's temporary file, in the palette. */
+static int begin(const char *path, int w, int h, phc_atomic_file **af, int *old, phc_error *err)
 {
-    const int dev = phc_plot_device_available("pngcairo");
-    if (dev <= 0)
-        return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,
-                             "%s: PLplot has no 'pngcairo' device (install plplot-driver-cairo)", path);
-    int rc = phc_atomic_file_open(path, af, err);
+    int rc = phc_plot_begin(path, w, h, af, old, err);
     if (rc)
         return rc;
-    PLINT strm = -1;
-    plgstrm(old);
-    plmkstrm(&strm);
-    if (strm < 0) {
-        plsstrm(*old);
-        phc_atomic_file_abort(*af);
-        return phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
-    }
-    plsdev("pngcairo");
-    plsfnam(phc_atomic_file_temp_path(*af));
-    plspage(0.0, 0.0, w, h, 0, 0);
-    plsfam(0, 0, 0);
     plscmap0n(16);
     for (int i = 0; i < COL_CHAIN0 + N_CHAIN_COLOURS; ++i)
         plscol0(i, palette[i][0], palette[i][1], palette[i][2]);
@@ -121,7 +105,7 @@ int phc_plot_mcmc_trace(const char *path, const char *title, size_t d, const cha
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     phc_atomic_file *af = NULL;
-    PLINT old = 0;
+    int old = 0;
     int h = (int)(170 * d + 130);
     h = h < 400 ? 400 : h;
     int rc = begin(path, 1100, h, &af, &old, err);
@@ -165,9 +149,7 @@ int phc_plot_mcmc_trace(const char *path, const char *title, size_t d, const cha
     plmtex("b", 3.2, 0.5, 0.5, xl);
     plvpor(0.12, 0.97, bottom, top);
     plmtex("t", 1.2, 0.5, 0.5, etitle);
-    plend1();
-    plsstrm(old);
-    rc = phc_plot_file_finish(af, PHC_OK, err);
+    rc = phc_plot_end(af, old, PHC_OK, err);
     free(etitle);
     free(xs);
     free(ys);
@@ -196,7 +178,7 @@ int phc_plot_mcmc_pairs(const char *path, const char *title, size_t d, const cha
         range(draws + j, m, d, &lo[j], &hi[j]);
     const int side = (int)(260 * d + 160);
     phc_atomic_file *af = NULL;
-    PLINT old = 0;
+    int old = 0;
     int rc = begin(path, side < 600 ? 600 : side, side < 600 ? 600 : side, &af, &old, err);
     if (rc)
         goto out;
@@ -257,9 +239,7 @@ int phc_plot_mcmc_pairs(const char *path, const char *title, size_t d, const cha
     plvpor(left, right, bottom, top);
     plcol0(COL_FG);
     plmtex("t", 1.2, 0.5, 0.5, etitle);
-    plend1();
-    plsstrm(old);
-    rc = phc_plot_file_finish(af, PHC_OK, err);
+    rc = phc_plot_end(af, old, PHC_OK, err);
 out:
     free(etitle);
     free(lo);

@@ -76,7 +76,6 @@ typedef struct posterior {
     phc_prior *prior;  /* d, in the user's unit; kind NONE with an open bound: flat improper */
     int *improper;     /* d */
     double *x;         /* n_params slot values */
-    double *out;
     phc_study_eval *w;
     size_t evaluations;
 } posterior;
@@ -98,9 +97,10 @@ static int post_eval(void *data, const double *theta, double *ss, double *log_pr
         q->x[q->col[c]] = slot;
     }
     q->evaluations++;
-    if (phc_study_evaluate(q->w, q->x, q->out) != 0)
+    double cost;
+    if (phc_study_cost(q->w, q->x, &cost) != 0)
         return 1;
-    *ss = 2 * q->out[0];
+    *ss = 2 * cost;
     *log_prior = lp;
     return 0;
 }
@@ -179,9 +179,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
     q.prior = calloc(np, sizeof *q.prior);
     q.improper = calloc(np, sizeof *q.improper);
     q.x = malloc(np * sizeof *q.x);
-    q.out = malloc(phc_study_outputs(pb) * sizeof *q.out);
     q.w = phc_study_eval_new(pb);
-    if (!q.col || !q.prior || !q.improper || !q.x || !q.out || !q.w) {
+    if (!q.col || !q.prior || !q.improper || !q.x || !q.w) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -682,7 +681,6 @@ done:
     free(q.prior);
     free(q.improper);
     free(q.x);
-    free(q.out);
     free(cov0);
     free(x0);
     free(opt);

@@ -72,6 +72,40 @@ int phc_plot_png_complete(const char *file)
     return ok;
 }
 
+int phc_plot_begin(const char *path, int w, int h, phc_atomic_file **af, int *old_stream, phc_error *err)
+{
+    *af = NULL;
+    const int dev = phc_plot_device_available("pngcairo");
+    if (dev <= 0)
+        return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,
+                             "%s: PLplot has no 'pngcairo' device (install plplot-driver-cairo)", path);
+    int rc = phc_atomic_file_open(path, af, err);
+    if (rc)
+        return rc;
+    PLINT old = 0, strm = -1;
+    plgstrm(&old);
+    plmkstrm(&strm);
+    if (strm < 0) {
+        plsstrm(old);
+        phc_atomic_file_abort(*af);
+        *af = NULL;
+        return phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
+    }
+    *old_stream = (int)old;
+    plsdev("pngcairo");
+    plsfnam(phc_atomic_file_temp_path(*af));
+    plspage(0.0, 0.0, w, h, 0, 0);
+    plsfam(0, 0, 0);
+    return PHC_OK;
+}
+
+int phc_plot_end(phc_atomic_file *af, int old_stream, int status, phc_error *err)
+{
+    plend1();
+    plsstrm(old_stream);
+    return phc_plot_file_finish(af, status, err);
+}
+
 int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err)
 {
     if (!af)

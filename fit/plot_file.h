@@ -21,6 +21,15 @@ int phc_plot_device_available(const char *name);
  * PHC_ERR_IO "PATH: PLplot did not write a complete PNG file (disk full?)"
  * or the commit's message. */
 int phc_plot_file_finish(phc_atomic_file *af, int status, phc_error *err);
+/* Starts a w x h px PNG for path: checks the pngcairo device, opens path's
+ * temporary file (*af) and a new PLplot stream writing it, remembering the
+ * caller's stream in *old_stream.  The caller then sets its colours, calls
+ * plinit() and draws.  PHC_ERR_INTERNAL (no device, no free stream) or the
+ * file's error; nothing is left open on failure. */
+int phc_plot_begin(const char *path, int w, int h, phc_atomic_file **af, int *old_stream, phc_error *err);
+/* Ends what phc_plot_begin started (plend1, back to *old_stream) and
+ * finishes the file as phc_plot_file_finish does with status. */
+int phc_plot_end(phc_atomic_file *af, int old_stream, int status, phc_error *err);
 /* Encodes an RGBA page (w x h, rows top to bottom, as PLplot's memcairo
  * device leaves it) as an 8-bit RGB PNG into af's stream and flushes it.
  * zlib level 1 with the Sub filter: plots are mostly flat colour, and this

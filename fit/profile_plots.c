@@ -46,10 +46,6 @@ int phc_plot_profile(const char *path, const phc_profile_plot *p, phc_error *err
     xhi += xpad;
     yhi += 0.30 * (yhi - ylo); /* headroom for the legend */
     ylo -= ypad;
-    const int dev = phc_plot_device_available("pngcairo");
-    if (dev <= 0)
-        return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,
-                             "%s: PLplot has no 'pngcairo' device (install plplot-driver-cairo)", path);
     char xlabel[512], title[512];
     snprintf(xlabel, sizeof xlabel, "%s%s%s%s", p->param, p->unit && *p->unit ? " (" : "",
              p->unit && *p->unit ? p->unit : "", p->unit && *p->unit ? ")" : "");
@@ -69,21 +65,9 @@ int phc_plot_profile(const char *path, const phc_profile_plot *p, phc_error *err
             ++m;
         }
     phc_atomic_file *af = NULL;
-    if ((rc = phc_atomic_file_open(path, &af, err)))
+    int old = 0;
+    if ((rc = phc_plot_begin(path, PAGE_W, PAGE_H, &af, &old, err)))
         goto done;
-    PLINT old = 0, strm = -1;
-    plgstrm(&old);
-    plmkstrm(&strm);
-    if (strm < 0) {
-        plsstrm(old);
-        phc_atomic_file_abort(af);
-        rc = phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
-        goto done;
-    }
-    plsdev("pngcairo");
-    plsfnam(phc_atomic_file_temp_path(af));
-    plspage(0.0, 0.0, PAGE_W, PAGE_H, 0, 0);
-    plsfam(0, 0, 0);
     static const PLINT rgb[COL_N][3] = {{255, 255, 255}, {0, 0, 0},   {221, 221, 221}, {31, 100, 190},
                                         {230, 97, 1},    {180, 0, 0}, {90, 90, 90}};
     plscmap0n(16);
@@ -148,9 +132,7 @@ int phc_plot_profile(const char *path, const phc_profile_plot *p, phc_error *err
     pllegend(&lwidth, &lheight, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
              PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, COL_BG, COL_FG, 1, 0, 0, 5,
              opt, 1.0, 1.0, 2.0, 0.0, tcol, texts, NULL, NULL, NULL, NULL, lcol, lsty, lw, scol, ssc, snum, syms);
-    plend1();
-    plsstrm(old);
-    rc = phc_plot_file_finish(af, PHC_OK, err);
+    rc = phc_plot_end(af, old, PHC_OK, err);
 done:
     free(ex);
     free(et);

@@ -36,10 +36,6 @@ int phc_plot_bars(const char *path, const char *title, const char *y_label, cons
     hi += 0.40 * (hi - lo); /* headroom: the legend sits above the tallest bar */
     if (lo < 0)
         lo -= pad;
-    const int dev = phc_plot_device_available("pngcairo");
-    if (dev <= 0)
-        return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,
-                             "%s: PLplot has no 'pngcairo' device (install plplot-driver-cairo)", path);
     char *etitle = phc_plot_escape(title), *ey = phc_plot_escape(y_label);
     char **enames = calloc(n_factors, sizeof *enames);
     char *elabel[2] = {NULL, NULL};
@@ -59,21 +55,9 @@ int phc_plot_bars(const char *path, const char *title, const char *y_label, cons
             goto done;
         }
     phc_atomic_file *af = NULL;
-    if ((rc = phc_atomic_file_open(path, &af, err)))
+    int old = 0;
+    if ((rc = phc_plot_begin(path, PAGE_W, PAGE_H, &af, &old, err)))
         goto done;
-    PLINT old = 0, strm = -1;
-    plgstrm(&old);
-    plmkstrm(&strm);
-    if (strm < 0) {
-        plsstrm(old);
-        phc_atomic_file_abort(af);
-        rc = phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
-        goto done;
-    }
-    plsdev("pngcairo");
-    plsfnam(phc_atomic_file_temp_path(af));
-    plspage(0.0, 0.0, PAGE_W, PAGE_H, 0, 0);
-    plsfam(0, 0, 0);
     static const PLINT rgb[COL_N][3] = {{255, 255, 255}, {0, 0, 0},      {221, 221, 221},
                                         {31, 100, 190},  {230, 97, 1},   {40, 40, 40}};
     plscmap0n(16);
@@ -148,9 +132,7 @@ int phc_plot_bars(const char *path, const char *title, const char *y_label, cons
              PL_POSITION_TOP | PL_POSITION_RIGHT | PL_POSITION_INSIDE, 0.02, 0.02, 0.1, COL_BG, COL_FG, 1, 0, 0,
              (PLINT)nl, opt, 1.0, 1.0, 2.0, 0.0, tcol, (const char *const *)texts, colours, fill_styles, fscale,
              lw, lcol, lsty, lw, NULL, NULL, NULL, NULL);
-    plend1();
-    plsstrm(old);
-    rc = phc_plot_file_finish(af, PHC_OK, err);
+    rc = phc_plot_end(af, old, PHC_OK, err);
 done:
     free(etitle);
     free(ey);
@@ -186,10 +168,6 @@ int phc_plot_index_lines(const char *path, const char *title, const char *x_labe
         x0 -= 0.5;
         x1 += 0.5;
     }
-    const int dev = phc_plot_device_available("pngcairo");
-    if (dev <= 0)
-        return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,
-                             "%s: PLplot has no 'pngcairo' device (install plplot-driver-cairo)", path);
     char *etitle = phc_plot_escape(title), *ex = phc_plot_escape(x_label);
     char *ey[2] = {NULL, NULL};
     char **enames = calloc(n_lines, sizeof *enames);
@@ -209,21 +187,9 @@ int phc_plot_index_lines(const char *path, const char *title, const char *x_labe
             goto done;
         }
     phc_atomic_file *af = NULL;
-    if ((rc = phc_atomic_file_open(path, &af, err)))
+    int old = 0;
+    if ((rc = phc_plot_begin(path, 1100, n_panels == 2 ? 900 : PAGE_H, &af, &old, err)))
         goto done;
-    PLINT old = 0, strm = -1;
-    plgstrm(&old);
-    plmkstrm(&strm);
-    if (strm < 0) {
-        plsstrm(old);
-        phc_atomic_file_abort(af);
-        rc = phc_error_set(err, PHC_ERR_INTERNAL, "%s: no free PLplot stream", path);
-        goto done;
-    }
-    plsdev("pngcairo");
-    plsfnam(phc_atomic_file_temp_path(af));
-    plspage(0.0, 0.0, 1100, n_panels == 2 ? 900 : PAGE_H, 0, 0);
-    plsfam(0, 0, 0);
     /* colour-blind-safe line colours (Okabe & Ito 2008), in 0 .. 15 with a
        translucent copy of each for its band at +8 */
     static const PLINT rgb[N_LINE_COLOURS][3] = {{0, 114, 178}, {213, 94, 0},   {0, 158, 115}, {204, 121, 167},
@@ -356,9 +322,7 @@ int phc_plot_index_lines(const char *path, const char *title, const char *x_labe
     plcol0(LCOL_FG);
     plschr(0.0, 0.9);
     plptex(0.5, 0.45, 1, 0, 0.5, etitle);
-    plend1();
-    plsstrm(old);
-    rc = phc_plot_file_finish(af, PHC_OK, err);
+    rc = phc_plot_end(af, old, PHC_OK, err);
 done:
     free(etitle);
     free(ex);

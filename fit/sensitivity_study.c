@@ -183,6 +183,42 @@ void phc_study_eval_free(phc_study_eval *w)
     free(w);
 }
 
+/* Data set d's predictions at x into w->yhat (its slots into w->p), its
+ * cost 1/2 sum r^2 into *cost and the sum of its predictions into *sum.
+ * Nonzero when the model cannot be evaluated there. */
+static int predict_dataset(phc_study_eval *w, size_t d, const double *x, double *cost, double *sum)
+{
+    phc_dataset *ds = w->pb->datasets[d];
+    for (size_t j = 0; j < ds->k; ++j)
+        w->p[j] = x[ds->param_index[j]];
+    if (ds->ops->predict(ds, w->p, w->yhat, NULL) != 0)
+        return 1;
+    double c = 0, s = 0;
+    for (size_t i = 0; i < ds->n; ++i) {
+        const double r = (ds->y[i] - w->yhat[i]) / (ds->sigma ? ds->sigma[i] : 1.0);
+        c += 0.5 * r * r;
+        s += w->yhat[i];
+    }
+    *cost = c;
+    *sum = s;
+    return 0;
+}
+
+int phc_study_cost(phc_study_eval *w, const double *x, double *cost)
+{
+    double total = 0;
+    for (size_t d = 0; d < w->pb->n_datasets; ++d) {
+        double c, s;
+        if (predict_dataset(w, d, x, &c, &s) != 0) {
+            *cost = NAN;
+            return 1;
+        }
+        total += c;
+    }
+    *cost = total;
+    return isfinite(total) ? 0 : 1;
+}
+
 int phc_study_evaluate(phc_study_eval *w, const double *x, double *out)
 {
     const phc_problem *pb = w->pb;
@@ -191,16 +227,9 @@ int phc_study_evaluate(phc_study_eval *w, const double *x, double *out)
     out[0] = 0;
     for (size_t d = 0; d < pb->n_datasets; ++d) {
         phc_dataset *ds = pb->datasets[d];
-        for (size_t j = 0; j < ds->k; ++j)
-            w->p[j] = x[ds->param_index[j]];
-        if (ds->ops->predict(ds, w->p, w->yhat, NULL) != 0)
+        double cost, sum;
+        if (predict_dataset(w, d, x, &cost, &sum) != 0)
             goto failed;
-        double cost = 0, sum = 0;
-        for (size_t i = 0; i < ds->n; ++i) {
-            const double r = (ds->y[i] - w->yhat[i]) / (ds->sigma ? ds->sigma[i] : 1.0);
-            cost += 0.5 * r * r;
-            sum += w->yhat[i];
-        }
         if (m == 2)
             out[1 + 2 * d] = cost;
         out[1 + m * d + (m - 1)] = ds->n ? sum / (double)ds->n : NAN;

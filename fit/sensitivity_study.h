@@ -110,5 +110,10 @@ void phc_study_eval_free(phc_study_eval *w);
  * (phc_study_outputs values).  0 on success; > 0 when a model could not be
  * evaluated there or gave a non-finite value (out then holds NAN). */
 int phc_study_evaluate(phc_study_eval *w, const double *x, double *out);
+/* The cost alone (output 0 of phc_study_evaluate, the same number) into
+ * *cost, without the other outputs' work (named outputs may solve the model
+ * again): what a sampler needs at every step.  0 on success; > 0 as above
+ * (*cost then NAN). */
+int phc_study_cost(phc_study_eval *w, const double *x, double *cost);
 
 #endif /* PHC_SENSITIVITY_STUDY_H */
