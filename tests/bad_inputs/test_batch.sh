@@ -6,45 +6,9 @@
 #   bash test_batch.sh PATH/TO/phytocal [SHARED_DATA_DIR]
 #
 # Each case prints "ok - <case>" or "not ok - <case>: <why>"; exit 1 if any failed.
-set -u
+source "$(dirname "${BASH_SOURCE[0]}")/../cli_cases.sh" "$@"
 export LC_ALL=C
-PHC=${1:-}
-if [ -z "$PHC" ]; then
-    echo "usage: bash test_batch.sh PATH/TO/phytocal" >&2
-    exit 2
-fi
-case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
-SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 EX="$SCRIPT_DIR/../../measurements/examples"
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/phc_batch_bad.XXXXXX") || exit 1
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 1
-
-PASSED=0
-FAILED=0
-WHY=""
-why() { WHY="${WHY:+$WHY; }$1"; }
-finish() {
-    if grep -q -e 'AddressSanitizer' -e 'runtime error' -e 'LeakSanitizer' "$T/stderr" 2>/dev/null; then
-        why "sanitizer report on stderr"
-    fi
-    if [ -z "$WHY" ]; then
-        PASSED=$((PASSED + 1))
-        echo "ok - $1"
-    else
-        FAILED=$((FAILED + 1))
-        echo "not ok - $1: $WHY [rc=$RC stderr: $(head -c 400 "$T/stderr" | tr '\n' '|')]"
-    fi
-    WHY=""
-}
-run() {
-    timeout 300 "$PHC" "$@" >"$T/stdout" 2>"$T/stderr"
-    RC=$?
-}
-want_rc() { [ "$RC" -eq "$1" ] || why "exit code $RC, expected $1"; }
-err_has() { grep -qF -- "$1" "$T/stderr" || why "stderr lacks '$1'"; }
-out_has() { grep -qF -- "$1" "$T/stdout" || why "stdout lacks '$1'"; }
 no_leftovers() {
     local left
     left=$(ls -d "$1".tmp-* "$1".old-* 2>/dev/null | head -3 | tr '\n' ' ')

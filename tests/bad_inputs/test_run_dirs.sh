@@ -8,44 +8,8 @@
 # is "N passed, M failed"; exit 1 if any failed.  Runs in the sanitizer build
 # too (label bad_inputs): any sanitizer report fails the case.
 
-set -u
-PHC=${1:-}
-if [ -z "$PHC" ]; then
-    echo "usage: bash test_run_dirs.sh PATH/TO/phytocal" >&2
-    exit 2
-fi
-case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
-SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$(dirname "${BASH_SOURCE[0]}")/../cli_cases.sh" "$@"
 EXAMPLE_DIR="$SCRIPT_DIR/../../measurements/examples/enzyme_kinetics"
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/phc_run_dirs.XXXXXX") || exit 1
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 1
-
-PASSED=0
-FAILED=0
-WHY=""
-why() { WHY="${WHY:+$WHY; }$1"; }
-finish() {
-    if grep -q -e 'AddressSanitizer' -e 'runtime error' -e 'LeakSanitizer' "$T/stderr" 2>/dev/null; then
-        why "sanitizer report on stderr"
-    fi
-    if [ -z "$WHY" ]; then
-        PASSED=$((PASSED + 1))
-        echo "ok - $1"
-    else
-        FAILED=$((FAILED + 1))
-        echo "not ok - $1: $WHY [rc=$RC stderr: $(head -c 400 "$T/stderr" | tr '\n' '|')]"
-    fi
-    WHY=""
-}
-run() {
-    timeout 300 "$PHC" "$@" >"$T/stdout" 2>"$T/stderr"
-    RC=$?
-}
-want_rc() { [ "$RC" -eq "$1" ] || why "exit code $RC, expected $1"; }
-err_has() { grep -qF -- "$1" "$T/stderr" || why "stderr lacks '$1'"; }
-out_has() { grep -qF -- "$1" "$T/stdout" || why "stdout lacks '$1'"; }
 exists() { [ -e "$1" ] || why "$1 is gone"; }
 no_leftovers() {
     local left

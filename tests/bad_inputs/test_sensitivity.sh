@@ -10,40 +10,9 @@
 #
 # Prints "ok - <case>" / "not ok - <case>: <why>", then "N passed, M failed".
 
-set -u
-PHC=${1:-}
-if [ -z "$PHC" ]; then
-    echo "usage: bash test_sensitivity.sh PATH/TO/phytocal" >&2
-    exit 2
-fi
-case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
-SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$(dirname "${BASH_SOURCE[0]}")/../cli_cases.sh" "$@"
 EXAMPLE_DIR="$SCRIPT_DIR/../../measurements/examples/enzyme_kinetics"
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/phc_sensitivity.XXXXXX") || exit 1
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 1
 cp "$EXAMPLE_DIR/enzyme.csv" .
-
-PASSED=0
-FAILED=0
-WHY=""
-RC=0
-why() { WHY="${WHY:+$WHY; }$1"; }
-finish() {
-    if grep -q -e 'AddressSanitizer' -e 'runtime error' -e 'LeakSanitizer' "$T/stderr" 2>/dev/null; then
-        why "sanitizer report on stderr"
-    fi
-    if [ -z "$WHY" ]; then
-        PASSED=$((PASSED + 1))
-        echo "ok - $1"
-    else
-        FAILED=$((FAILED + 1))
-        echo "not ok - $1: $WHY [rc=$RC stderr: $(head -c 400 "$T/stderr" | tr '\n' '|')]"
-    fi
-    WHY=""
-}
-run() { "$PHC" "$@" >"$T/stdout" 2>"$T/stderr"; RC=$?; }
 
 # config: $1 = vmax line, $2 = km line, $3 = expression, $4 = extra top-level text
 config() {

@@ -23,40 +23,10 @@
 #     twice (plants p1, p2, times starting at 0 for each): both rows equal
 #     the seedling example fitted alone.
 # Each case prints "ok - <case>" or "not ok - <case>: <why>"; exit 1 if any failed.
-set -u
-PHC=${1:-}
-if [ -z "$PHC" ]; then
-    echo "usage: bash test_batch.sh PATH/TO/phytocal" >&2
-    exit 2
-fi
-case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
-SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+source "$(dirname "${BASH_SOURCE[0]}")/../cli_cases.sh" "$@"
 EX="$SCRIPT_DIR/../../measurements/examples"
 PY=python3
 [ -x /usr/bin/python3 ] && PY=/usr/bin/python3
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/phc_batch.XXXXXX") || exit 1
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 1
-
-PASSED=0
-FAILED=0
-WHY=""
-why() { WHY="${WHY:+$WHY; }$1"; }
-finish() {
-    if [ -z "$WHY" ]; then
-        PASSED=$((PASSED + 1))
-        echo "ok - $1"
-    else
-        FAILED=$((FAILED + 1))
-        echo "not ok - $1: $WHY [rc=$RC stderr: $(head -c 400 "$T/stderr" | tr '\n' '|')]"
-    fi
-    WHY=""
-}
-run() {
-    timeout 600 "$PHC" "$@" >"$T/stdout" 2>"$T/stderr"
-    RC=$?
-}
 
 # compare SUMMARY ROW_FIT RESULT_JSON: every number of the row against result.json
 compare() {

@@ -11,45 +11,17 @@
 #
 # Prints "ok - <case>" / "not ok - <case>: <why>", then "N passed, M failed".
 
-set -u
-PHC=${1:-}
-if [ -z "$PHC" ]; then
-    echo "usage: bash test_sensitivity_mpi.sh PATH/TO/phytocal" >&2
-    exit 2
-fi
-case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
+source "$(dirname "${BASH_SOURCE[0]}")/../cli_cases.sh" "$@"
 if ! command -v mpirun >/dev/null 2>&1; then
     echo "skip: mpirun not found (Debian: openmpi-bin; scripts/setup installs it)"
     exit 77
 fi
-SCRIPT_DIR=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 SEED_DIR="$SCRIPT_DIR/../../measurements/examples/weight_curve"
-
-T=$(mktemp -d "${TMPDIR:-/tmp}/phc_sensitivity_mpi.XXXXXX") || exit 1
-trap 'rm -rf "$T"' EXIT
-cd "$T" || exit 1
 cp "$SEED_DIR/seedling.csv" "$SEED_DIR/balance.csv" "$SEED_DIR/seedling_sensitivity.yaml" .
-
 # Open MPI refuses root without these; --oversubscribe lets 2 or 3 ranks
 # start on a machine with fewer cores.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 MPIRUN=(timeout 300 mpirun --oversubscribe)
-
-PASSED=0
-FAILED=0
-WHY=""
-RC=0
-why() { WHY="${WHY:+$WHY; }$1"; }
-finish() {
-    if [ -z "$WHY" ]; then
-        PASSED=$((PASSED + 1))
-        echo "ok - $1"
-    else
-        FAILED=$((FAILED + 1))
-        echo "not ok - $1: $WHY [rc=$RC stderr: $(head -c 600 "$T/stderr" | tr '\n' '|')]"
-    fi
-    WHY=""
-}
 run() { "$@" >"$T/stdout" 2>"$T/stderr"; RC=$?; [ "$RC" -ne 124 ] || why "hung (killed after 300 s)"; }
 records() { grep '^[0-9]' "$1" | sort; }
 
