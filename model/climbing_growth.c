@@ -9,6 +9,7 @@
 #include "model/climbing_rng.h"
 #include "model/climbing_tropism.h"
 #include "model/plant_graph.h"
+#include "model/quaternion.h"
 
 static const double PI = 3.14159265358979323846;
 
@@ -442,25 +443,6 @@ static void rebuild_rest(phc_climbing *c)
     }
 }
 
-/* The shortest-arc rotation taking z to the unit d (as model/particles.c
- * builds its rest orientations, so current and rest agree when d = rest). */
-static void quat_from_z(const double d[3], double q[4])
-{
-    if (d[2] < -1 + 1e-12) {
-        q[0] = 0;
-        q[1] = 1;
-        q[2] = q[3] = 0;
-        return;
-    }
-    q[0] = 1 + d[2];
-    q[1] = -d[1];
-    q[2] = d[0];
-    q[3] = 0;
-    const double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-    for (int k = 0; k < 4; ++k)
-        q[k] /= l;
-}
-
 double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
 {
     if (!c->anchored[i])
@@ -498,7 +480,7 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         goto done;
     for (size_t i = 1; i < n; ++i) {
         double q[4];
-        quat_from_z(c->d + 3 * i, q);
+        phc_quat_from_z(c->d + 3 * i, q);
         if (phc_particles_set_position(p, i, c->x + 3 * i, err) ||
             phc_particles_set_orientation(p, i, q, err) ||
             phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age), err))

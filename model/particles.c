@@ -266,23 +266,6 @@ void phc_particles_free(phc_particles *p)
     free(p);
 }
 
-/* Rest orientation: the shortest-arc rotation taking the local z axis to
- * the unit direction d. */
-static void quat_from_z(const double d[3], double q[4])
-{
-    if (d[2] < -1 + 1e-12) {
-        q[0] = 0;
-        q[1] = 1;
-        q[2] = q[3] = 0;
-        return;
-    }
-    q[0] = 1 + d[2];
-    q[1] = -d[1];
-    q[2] = d[0];
-    q[3] = 0;
-    quat_normalize(q);
-}
-
 phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_options *options,
                                  phc_error *err)
 {
@@ -376,7 +359,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
         }
         for (int k = 0; k < 3; ++k)
             d[k] /= len;
-        quat_from_z(d, p->q0 + 4 * i);
+        phc_quat_from_z(d, p->q0 + 4 * i);
         memcpy(p->q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
         p->gq[4 * i] = 1;
         p->m[i] = o.density * PI * r * r * L;

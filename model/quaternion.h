@@ -45,6 +45,10 @@ void phc_quat_log(const double q[4], double v[3]);
  * (parallel transport of a frame along a bend).  For antiparallel a, b the
  * axis is any unit vector perpendicular to a. */
 void phc_quat_from_two_vectors(const double a[3], const double b[3], double out[4]);
+/* The shortest-arc rotation taking the local z axis to the unit direction
+ * d (the rest orientation of a particle or segment along d); z to -z turns
+ * about x. */
+void phc_quat_from_z(const double d[3], double q[4]);
 
 #ifdef __cplusplus
 }

@@ -38,6 +38,7 @@
 
 #include "fit/shape_plots.h"
 #include "measurements/plant_io.h"
+#include "fit/grow.h"
 #include "model/climbing_growth.h"
 #include "model/climbing_tropism.h"
 #include "model/plant_graph.h"
@@ -70,27 +71,19 @@ typedef struct result {
     double *head, *tail, *radius, *order, *light;
 } result;
 
+/* The plant as a graph (phc_grow_plant_graph, as `phytocal grow` writes
+ * it), with each segment's order and light kept in r for the pictures. */
 static phc_plant_graph *to_graph(const phc_climbing *c, result *r)
 {
-    const size_t n = phc_climbing_count(c);
-    phc_plant_graph *g = phc_plant_graph_new(n);
-    if (!g)
+    phc_error err;
+    phc_plant_graph *g = phc_grow_plant_graph(c, &err);
+    if (!g) {
+        fprintf(stderr, "%s\n", err.message);
         return NULL;
-    for (size_t i = 0; i < n; ++i) {
-        phc_climbing_segment(c, i, g->head + 3 * i, g->tail + 3 * i);
-        g->radius[i] = phc_climbing_radius(c, i);
-        g->length[i] = phc_climbing_length(c, i);
-        const size_t p = phc_climbing_parent(c, i);
-        g->parent[i] = p == PHC_CLIMBING_NONE ? PHC_PLANT_NO_PARENT : p;
+    }
+    for (size_t i = 0; i < g->n; ++i) {
         r->order[i] = phc_climbing_order(c, i);
         r->light[i] = phc_climbing_light_at(c, i);
-    }
-    g->fixed[0] = 1;
-    phc_error err;
-    if (phc_plant_graph_finish(g, "climbing plant", &err)) {
-        fprintf(stderr, "%s\n", err.message);
-        phc_plant_graph_free(g);
-        return NULL;
     }
     return g;
 }
