@@ -17,6 +17,7 @@
 #include "fit/engine/mcmc_diagnostics.h"
 #include "fit/engine/mcmc_dram.h"
 #include "fit/engine/mcmc_stretch.h"
+#include "fit/engine/parameter_units.h"
 #include "fit/engine/prior.h"
 #include "fit/json_file_internal.h"
 #include "fit/mcmc_plots.h"
@@ -191,16 +192,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
             continue;
         const size_t c = q.d++;
         q.col[c] = i;
-        double lo = p->lower, hi = p->upper;
-        if (p->unit_scale != 1.0 || p->unit_offset != 0.0) {
-            lo = (p->lower - p->unit_offset) / p->unit_scale;
-            hi = (p->upper - p->unit_offset) / p->unit_scale;
-            if (lo > hi) {
-                const double t = lo;
-                lo = hi;
-                hi = t;
-            }
-        }
+        double lo, hi;
+        phc_parameter_user_bounds(p, &lo, &hi);
         if (p->prior.kind == PHC_PRIOR_NONE && !(isfinite(lo) && isfinite(hi))) {
             q.prior[c].kind = PHC_PRIOR_NONE; /* flat, improper */
             q.prior[c].lower = lo;

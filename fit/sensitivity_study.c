@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "fit/engine/morris.h"
+#include "fit/engine/parameter_units.h"
 #include "fit/engine/prior.h"
 #include "fit/engine/sobol_indices.h"
 #include "fit/json_file_internal.h"
@@ -389,16 +390,8 @@ static int study_factors(study *s, phc_error *err)
             }
         }
         /* the prior is in the user's unit: so are the bounds it is truncated to */
-        double lo = p->lower, hi = p->upper;
-        if (p->unit_scale != 1.0 || p->unit_offset != 0.0) {
-            lo = (p->lower - p->unit_offset) / p->unit_scale;
-            hi = (p->upper - p->unit_offset) / p->unit_scale;
-            if (lo > hi) {
-                const double t = lo;
-                lo = hi;
-                hi = t;
-            }
-        }
+        double lo, hi;
+        phc_parameter_user_bounds(p, &lo, &hi);
         char what[600];
         param_place(pb, p, p->prior_line ? p->prior_line : p->config_line, what, sizeof what);
         if ((rc = phc_prior_resolve(&p->prior, lo, hi, what, &s->prior[c], err)))

@@ -107,3 +107,15 @@ int phc_problem_convert_units(phc_problem *pb, phc_error *err)
     phc_units_free(units);
     return rc;
 }
+
+void phc_parameter_user_bounds(const phc_parameter *p, double *lower, double *upper)
+{
+    double lo = phc_parameter_to_user(p, p->lower), hi = phc_parameter_to_user(p, p->upper);
+    if (lo > hi) {
+        const double t = lo;
+        lo = hi;
+        hi = t;
+    }
+    *lower = lo;
+    *upper = hi;
+}

@@ -25,5 +25,8 @@ int phc_problem_convert_units(phc_problem *pb, phc_error *err);
 /* A value of parameter p from its slots' unit into the user's (and back). */
 double phc_parameter_to_user(const phc_parameter *p, double slot_value);
 double phc_parameter_to_slot(const phc_parameter *p, double user_value);
+/* p's bounds in the user's unit, lower first (a negative scale swaps them;
+ * infinite bounds stay infinite): what a prior in that unit is truncated to. */
+void phc_parameter_user_bounds(const phc_parameter *p, double *lower, double *upper);
 
 #endif /* PHC_PARAMETER_UNITS_H */

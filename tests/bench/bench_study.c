@@ -49,6 +49,7 @@
 #include "bench_machine.h"
 #include "fit/config.h"
 #include "fit/engine/dataset.h"
+#include "fit/engine/parameter_units.h"
 #include "fit/engine/prior.h"
 #include "fit/engine/problem.h"
 #include "fit/engine/sobol_indices.h"
@@ -190,16 +191,8 @@ static int make_design(const phc_problem *pb, size_t n, design_points *out)
             if (grp >= 0)
                 gf[grp] = group_of[k];
         }
-        double lo = p->lower, hi = p->upper;
-        if (p->unit_scale != 1.0 || p->unit_offset != 0.0) {
-            lo = (p->lower - p->unit_offset) / p->unit_scale;
-            hi = (p->upper - p->unit_offset) / p->unit_scale;
-            if (lo > hi) {
-                const double t = lo;
-                lo = hi;
-                hi = t;
-            }
-        }
+        double lo, hi;
+        phc_parameter_user_bounds(p, &lo, &hi);
         if (phc_prior_resolve(&p->prior, lo, hi, p->name, &prior[k], &err))
             return -1;
         ++k;
