@@ -1,6 +1,7 @@
 /* Leaf colour from fluid (Silva et al. §3, eqs. 8-9) and colour arithmetic:
  * see colour.h. */
 #include "model/colour.h"
+#include "model/order_statistics.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -236,58 +237,6 @@ static int cmp_value_index(const void *pa, const void *pb)
  * u m): this is what makes matching a set to itself the identity.  The
  * result is clamped to [y_j, y_{j+1}], so it is monotone in pos and never
  * leaves the range of the data. */
-/* Hoare quickselect: rearranges a[lo..hi) so that a[k] is the value a sort
- * would put there, everything before it <= a[k] and everything after >=.
- * The median of three is moved to a[lo] and used as the pivot, so Hoare's
- * partition always splits into two non-empty parts (lo <= j < hi - 1). */
-static void quickselect(double *a, size_t lo, size_t hi, size_t k)
-{
-    while (hi - lo > 1) {
-        const size_t mid = lo + (hi - lo) / 2, last = hi - 1;
-        size_t med = (a[lo] < a[mid]) == (a[mid] < a[last]) ? mid
-                     : (a[mid] < a[lo]) == (a[lo] < a[last]) ? lo
-                                                              : last;
-        double t = a[lo];
-        a[lo] = a[med];
-        a[med] = t;
-        const double pivot = a[lo];
-        ptrdiff_t i = (ptrdiff_t)lo - 1, j = (ptrdiff_t)hi;
-        for (;;) {
-            do
-                ++i;
-            while (a[i] < pivot);
-            do
-                --j;
-            while (a[j] > pivot);
-            if (i >= j)
-                break;
-            t = a[i];
-            a[i] = a[j];
-            a[j] = t;
-        }
-        /* a[lo..j] <= pivot <= a[j+1..hi) */
-        if (k <= (size_t)j)
-            hi = (size_t)j + 1;
-        else
-            lo = (size_t)j + 1;
-    }
-}
-
-/* Puts the order statistics at the ascending distinct positions ks[0..nk)
- * (all in [lo, hi)) in place: select the middle one, then recurse on the
- * two sides with the positions that fall there. */
-static void multiselect(double *a, size_t lo, size_t hi, const size_t *ks, size_t nk)
-{
-    while (nk > 0 && hi - lo > 1) {
-        const size_t m = nk / 2, k = ks[m];
-        quickselect(a, lo, hi, k);
-        multiselect(a, lo, k, ks, m);
-        lo = k + 1;
-        ks += m + 1;
-        nk -= m + 1;
-    }
-}
-
 static double sorted_quantile(const double *y, size_t m, uint64_t num_plus, uint64_t num_minus,
                               uint64_t den)
 {
@@ -473,9 +422,9 @@ int phc_colour_quantiles(size_t n, const double *colours, int channel, size_t nq
     }
     const uint64_t den = 2 * (uint64_t)nq;
     /* Only the order statistics the quantiles read are needed: put those
-     * in place by a multi-selection (O(n log nq), against a full sort's
+     * in place in O(n) (model/order_statistics.h), against a full sort's
      * O(n log n) with a comparison callback: the calibration computes
-     * these for every photo at every trial point).  The values read are
+     * these for every photo at every trial point.  The values read are
      * the same as after a sort, so the result is too. */
     size_t *pos = malloc(2 * nq * sizeof *pos), np = 0;
     if (!pos) {
@@ -501,7 +450,7 @@ int phc_colour_quantiles(size_t n, const double *colours, int channel, size_t nq
         for (size_t i = 0; i < np; ++i)
             if (u == 0 || pos[i] > pos[u - 1])
                 pos[u++] = pos[i];
-        multiselect(scratch, 0, n, pos, u);
+        phc_order_statistics_select(scratch, n, pos, u);
         free(pos);
     }
     for (size_t k = 0; k < nq; ++k)
