@@ -376,30 +376,35 @@ static int predict_water(phc_dataset *ds, const double *p, double *yhat, double 
     return 0;
 }
 
-static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+/* Series s of predict() (no water model): its observations in order, the
+ * rod reset where the previous observation belongs to another series (as
+ * one pass over all observations would).  On failure *bad is the failing
+ * observation (yhat NAN there) and the status is returned. */
+static int predict_series(phc_dataset *ds, const double *p, size_t s, double *yhat, double *jac, size_t *bad)
 {
     shape_impl *m = ds->impl;
-    if (m->water)
-        return predict_water(ds, p, yhat, jac);
+    stalk *st = &m->stalks[s];
     double *grad = calloc(ds->k, sizeof *grad);
-    if (!grad)
-        return -1;
-    if (jac)
-        memset(jac, 0, ds->n * ds->k * sizeof *jac);
-    size_t prev = (size_t)-1;
+    if (!grad) {
+        for (size_t i = 0; i < ds->n; ++i)
+            if (m->stalk_of[i] == s) {
+                *bad = i;
+                break;
+            }
+        return PHC_ERR_NOMEM;
+    }
     int rc = 0;
     for (size_t i = 0; i < ds->n && !rc; ++i) {
-        stalk *st = &m->stalks[m->stalk_of[i]];
-        if (m->stalk_of[i] != prev) { /* a new series: from the rest shape */
-            if (m->dynamics != PHC_SHAPE_PARTICLES)
-                phc_rod_reset(st->rod);
-            prev = m->stalk_of[i];
-        }
+        if (m->stalk_of[i] != s)
+            continue;
+        if ((i == 0 || m->stalk_of[i - 1] != s) && m->dynamics != PHC_SHAPE_PARTICLES)
+            phc_rod_reset(st->rod); /* a new run of this series: from the rest shape */
         memset(grad, 0, ds->k * sizeof *grad);
         const double z = driver(ds, p, m->t[i], jac ? grad : NULL);
         double a;
         if ((rc = solve_angle(m, st, z, &a, NULL))) {
             yhat[i] = NAN; /* phc_dataset_check_start names this observation's line */
+            *bad = i;
             break;
         }
         yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
@@ -410,12 +415,16 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
         const double h = m->fd_step * z;
         double ap, am, da_dE;
         if (m->dynamics == PHC_SHAPE_PARTICLES && z + h > 1.0) {
-            if ((rc = solve_angle(m, st, z - h, &am, NULL)) || (rc = solve_angle(m, st, z - 2.0 * h, &ap, NULL)))
+            if ((rc = solve_angle(m, st, z - h, &am, NULL)) || (rc = solve_angle(m, st, z - 2.0 * h, &ap, NULL))) {
+                *bad = i;
                 break;
+            }
             da_dE = (3.0 * a - 4.0 * am + ap) / (2.0 * h);
         } else {
-            if ((rc = solve_angle(m, st, z + h, &ap, NULL)) || (rc = solve_angle(m, st, z - h, &am, NULL)))
+            if ((rc = solve_angle(m, st, z + h, &ap, NULL)) || (rc = solve_angle(m, st, z - h, &am, NULL))) {
+                *bad = i;
                 break;
+            }
             da_dE = (ap - am) / (2.0 * h);
         }
         double *row = jac + i * ds->k;
@@ -425,7 +434,36 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
             row[st->offset_slot] = 1.0;
     }
     free(grad);
-    return rc == PHC_ERR_NOMEM ? -1 : rc ? 1 : 0;
+    return rc;
+}
+
+static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    shape_impl *m = ds->impl;
+    if (m->water)
+        return predict_water(ds, p, yhat, jac);
+    if (jac)
+        memset(jac, 0, ds->n * ds->k * sizeof *jac);
+    /* The series are independent (a rod each), so with rods they are
+     * solved side by side; each walks its own observations in order with
+     * the same warm starts as one thread, so the result is the same to the
+     * bit.  Particles share the data set's step counter: one at a time. */
+    const int side_by_side = m->dynamics != PHC_SHAPE_PARTICLES && m->n_stalks > 1;
+    size_t first_bad = ds->n;
+    int bad_rc = 0;
+#pragma omp parallel for schedule(dynamic, 1) if (side_by_side)
+    for (size_t s = 0; s < m->n_stalks; ++s) {
+        size_t bad = ds->n;
+        const int rc = predict_series(ds, p, s, yhat, jac, &bad);
+        if (rc) {
+#pragma omp critical(phc_shape_series_first_bad)
+            if (bad < first_bad) {
+                first_bad = bad;
+                bad_rc = rc;
+            }
+        }
+    }
+    return bad_rc == PHC_ERR_NOMEM ? -1 : bad_rc ? 1 : 0;
 }
 
 /* A frame: the stalk's equilibrium at time t as a graph copy (head, tail

@@ -112,6 +112,12 @@ def block_matches(want, got):
     return match(0, 0)
 
 
+# A unit or real-data test program run without arguments writes no files, so
+# two blocks showing its output share one run (two README sections quote
+# the particle and shape-series tests).
+READ_ONLY_TEST = re.compile(r"^build/(unit_test|realdata_test)_[A-Za-z0-9_]+$")
+
+
 def scratch(build, shared):
     root = tempfile.mkdtemp(prefix="phc_readme.")
     work = os.path.join(root, "checkout")
@@ -140,6 +146,7 @@ def main():
     have_shared = bool(shared) and os.path.isdir(shared)
     passed = failed = skipped = 0
     root, work = scratch(build, shared)
+    ran = {}
     try:
         for line_no, lang, body, marker in parse(README):
             if lang:
@@ -164,10 +171,16 @@ def main():
                 print(f"ok - {name} # SKIP no shared data folder: {command}")
                 continue
             t0 = time.time()
-            proc = subprocess.run(["/bin/sh", "-c", command + (" 2>&1" if "stderr" in options else "")],
-                                  cwd=work, stdout=subprocess.PIPE,
-                                  stderr=None if "stderr" in options else subprocess.PIPE,
-                                  timeout=1800)
+            key = (command, "stderr" in options)
+            if key in ran:
+                proc = ran[key]  # a test program that writes nothing: its output again
+            else:
+                proc = subprocess.run(["/bin/sh", "-c", command + (" 2>&1" if "stderr" in options else "")],
+                                      cwd=work, stdout=subprocess.PIPE,
+                                      stderr=None if "stderr" in options else subprocess.PIPE,
+                                      timeout=1800)
+                if READ_ONLY_TEST.match(command):
+                    ran[key] = proc
             seconds = time.time() - t0
             got = proc.stdout.decode("utf-8", "replace").rstrip("\n").split("\n")
             got = [g.rstrip() for g in got]
