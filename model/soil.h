@@ -68,6 +68,13 @@
  * the previous state, and budget sums are reduced per z-plane in a fixed
  * order, so results are bit-identical for any thread count.
  *
+ * Time blocking: while only water moves (no nutrients, sink hook, absorbing
+ * face, tangent, and no rain or source acting), up to `block_steps`
+ * consecutive sub-steps of the same length (at most nz/8) are taken in one
+ * sweep over the grid (a wavefront in z), so the per-voxel constants
+ * stream from memory once per sweep.  The arithmetic is that of one
+ * sub-step at a time: the result is bit-identical for any block_steps.
+ *
  * Layout: voxel (i, j, k) is element i + nx (j + ny k); x east, y north,
  * z up; k = nz - 1 is the surface layer.  Voxel centres are at
  * origin + (index + 1/2) dx.
@@ -117,6 +124,7 @@ typedef struct phc_soil_params {
     double safety;                          /* fraction of the limit used when sub-stepping, 0.9 */
     size_t max_substeps;                    /* most sub-steps per step of dt; 0 (default) = no limit */
     phc_soil_gravity gravity;               /* gravity and nutrient face fluxes; default LAX_WENDROFF */
+    size_t block_steps;                     /* water-only sub-steps per sweep (time blocking); 0 (default) = 4, 1 = none */
 } phc_soil_params;
 
 /* The defaults listed above. */
