@@ -1025,13 +1025,17 @@ int phc_growth_step(phc_growth *g, double dt, phc_error *err)
         /* a long step: the soil at its stability limit (times the safety
            factor), not at params.dt, when that is longer */
         phc_soil *s = g->soil;
-        const double dt_soil = s->params.dt;
+        const double dt_soil = s->params.dt, absorb_dt = s->params.absorb_dt;
         if (g->o.long_step > 0 && dt >= g->o.long_step) {
             double coarse = s->params.safety * phc_soil_stable_dt(s, NULL);
-            if (isfinite(coarse) && coarse > dt_soil) s->params.dt = coarse;
+            if (isfinite(coarse) && coarse > dt_soil) {
+                s->params.dt = coarse;
+                if (!(absorb_dt > 0)) s->params.absorb_dt = dt_soil; /* the same loss per hour */
+            }
         }
         rc = phc_soil_run(s, s->t + 24.0 * dt, err);
         s->params.dt = dt_soil;
+        s->params.absorb_dt = absorb_dt;
         if (rc) return phc_error_prefix(err, rc, "growth at day %g", g->age);
     }
     g->age += dt;

@@ -484,6 +484,9 @@ static int check_impl(const phc_soil *s, int strict, phc_error *err)
     if (pr->gravity != PHC_SOIL_GRAVITY_LAX_WENDROFF && pr->gravity != PHC_SOIL_GRAVITY_UPWIND)
         return phc_error_set(err, PHC_ERR_INPUT, "soil: unknown gravity scheme %d (0 Lax-Wendroff, 1 upwind)",
                              (int)pr->gravity);
+    if (!(pr->absorb_dt >= 0) || !isfinite(pr->absorb_dt))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: absorb_dt must be finite and >= 0 h, found %g",
+                             pr->absorb_dt);
     if (!(pr->safety > 0 && pr->safety <= 1))
         return phc_error_set(err, PHC_ERR_INPUT, "soil: safety must be in (0, 1], found %g", pr->safety);
     size_t dims[3] = {s->nx, s->ny, s->nz};
@@ -985,7 +988,7 @@ static void prepare_damping(phc_soil *s, double h)
     size_t dims[3] = {s->nx, s->ny, s->nz};
     double *out[3] = {wk->damp_x, wk->damp_y, wk->damp_z};
     int W = s->params.absorb_width;
-    double e = h / s->params.dt;
+    double e = h / (s->params.absorb_dt > 0 ? s->params.absorb_dt : s->params.dt);
     for (int a = 0; a < 3; ++a)
         for (size_t i = 0; i < dims[a]; ++i) {
             double f = 1.0;

@@ -415,6 +415,35 @@ int main(void)
                month_water[q] / water - 1,
                (double)(C->shoot_nodes + C->root_nodes) / (double)(S.shoot_nodes + S.root_nodes) - 1, coarse_dt);
     }
+    /* two month steps from 10k nodes: the plant samples the soil at the
+       start of a step, so the soil step's effect reaches it in the second */
+    {
+        phc_growth_summary S2[2];
+        double W2[2];
+        size_t N2[2];
+        for (int v = 0; v < 2; ++v) {
+            long_step = v ? 0 : -1;
+            plant pl;
+            int dd = 0;
+            phc_error err;
+            if (plant_new(&pl) || grow_to(&pl, target[0], &dd))
+                return 1;
+            for (int k = 0; k < 2; ++k)
+                if (phc_growth_step(pl.g, 30.0, &err)) {
+                    printf("growth: %s\n", err.message);
+                    return 1;
+                }
+            phc_growth_summarize(pl.g, &S2[v]);
+            W2[v] = phc_soil_water_total(pl.s);
+            N2[v] = S2[v].shoot_nodes + S2[v].root_nodes;
+            plant_free(&pl);
+        }
+        printf("growth_two_months_soil_step_effect_10k: root mass %+.2e, shoot mass %+.2e, root length %+.2e, soil "
+               "water %+.2e, nodes %+.2e (relative, soil at %.3g h vs 1 h, after two 30-day steps from 10k nodes: "
+               "%zu vs %zu nodes)\n", S2[0].root_mass / S2[1].root_mass - 1, S2[0].shoot_mass / S2[1].shoot_mass - 1,
+               S2[0].root_length / S2[1].root_length - 1, W2[0] / W2[1] - 1, (double)N2[0] / (double)N2[1] - 1,
+               coarse_dt, N2[0], N2[1]);
+    }
     for (int q = 0; q < NT; ++q) {
         int bd = day[0][q].best <= day[1][q].best ? 0 : 1;
         double pd = paper(paper_day_10k, paper_day_60k, target[q]);

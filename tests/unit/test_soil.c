@@ -397,6 +397,42 @@ static void test_stability(void)
 
 /* ---- 6. absorbing boundaries and rain -------------------------------------- */
 
+/* absorb_dt: with nothing moving (f_diff = f_grav = 0), a voxel i layers
+ * from an absorbing face keeps w0 a(i)^(T / absorb_dt) after T hours, for
+ * any dt (the growth model's long steps lengthen dt and keep absorb_dt). */
+static void test_absorb_dt(void)
+{
+    const double dts[3] = {0.5, 1.0, 2.0 / 3.0};
+    double worst = 0;
+    for (int c = 0; c < 3; ++c) {
+        phc_soil *s = new_soil(1, 1, 12, 0.01);
+        for (size_t k = 0; k < 12; ++k)
+            s->w[k] = 1.0 + 0.1 * (double)k;
+        s->params.f_diff = 0;
+        s->params.f_grav = 0;
+        s->params.boundary[PHC_SOIL_ZMIN] = PHC_SOIL_ABSORB;
+        s->params.dt = dts[c];
+        s->params.absorb_dt = 2.0;
+        phc_error err;
+        must(phc_soil_run(s, 4.0, &err), &err, "absorb_dt run");
+        for (size_t k = 0; k < 12; ++k) {
+            double a = k < 5 ? 1.0 - exp(-(double)(k * k) / (0.2 * 25)) : 1.0;
+            double exact = (1.0 + 0.1 * (double)k) * pow(a, 4.0 / 2.0);
+            worst = fmax(worst, exact > 0 ? fabs(s->w[k] / exact - 1) : fabs(s->w[k]));
+        }
+        phc_soil_free(s);
+    }
+    phc_soil *s = new_soil(1, 1, 12, 0.01);
+    s->params.absorb_dt = -1;
+    phc_error err;
+    int rc = phc_soil_run(s, 1.0, &err);
+    printf("6b. absorb_dt 2 h, dt 0.5, 1 and 2/3 h, 4 h without transport: w = w0 a(i)^2 to %.1e (rel); "
+           "absorb_dt -1: rc %d \"%s\"\n", worst, rc, rc ? err.message : "");
+    CHECK(worst < 1e-14);
+    CHECK(rc == PHC_ERR_INPUT && strstr(err.message, "absorb_dt"));
+    phc_soil_free(s);
+}
+
 static void test_absorb_rain(void)
 {
     phc_error err;
@@ -898,6 +934,7 @@ int main(void)
     test_blocking();
     test_stability();
     test_absorb_rain();
+    test_absorb_dt();
     test_tangent();
     t_upwind = 1;
     printf("7b. the tangent again with the upwind gravity flux:\n");
