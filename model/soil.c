@@ -37,6 +37,7 @@ struct phc_soil_work {
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
+    int damp_xy_one;           /* 1 when every damp_x and damp_y factor is 1 */
     double *src_w;             /* per source: normalised weights over its voxels */
     size_t *src_idx, *src_first, src_total;
     int nutrients;             /* 1 when nutrients move */
@@ -999,6 +1000,11 @@ static void prepare_damping(phc_soil *s, double h)
                 f *= pow(absorb_factor(s->params.absorb_form, W, (int)from_max), e);
             out[a][i] = f;
         }
+    wk->damp_xy_one = 1;
+    for (size_t i = 0; i < s->nx; ++i)
+        wk->damp_xy_one &= wk->damp_x[i] == 1.0;
+    for (size_t j = 0; j < s->ny; ++j)
+        wk->damp_xy_one &= wk->damp_y[j] == 1.0;
 }
 
 static int any_absorb(const phc_soil *s)
@@ -1019,7 +1025,9 @@ static double damp(phc_soil *s, double *f, double *g)
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         double part = 0, fz = wk->damp_z[k];
-        for (size_t j = 0; j < ny; ++j) {
+        /* a plane whose every factor is 1 (an absorbing bottom only: all
+           but its W planes) has nothing to damp */
+        for (size_t j = 0; j < ny && !(fz == 1.0 && wk->damp_xy_one); ++j) {
             double fyz = fz * wk->damp_y[j];
             for (size_t i = 0; i < nx; ++i) {
                 double fac = fyz * wk->damp_x[i];
