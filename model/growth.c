@@ -215,6 +215,7 @@ phc_growth_options phc_growth_options_default(void)
     o.mode = PHC_GROWTH_EXPECTED;
     o.seed = 1;
     o.uptake = PHC_GROWTH_UPTAKE_PHYSICAL;
+    o.long_step = 7.0;
     return o;
 }
 
@@ -380,6 +381,9 @@ int phc_growth_new(const phc_growth_params *p, const phc_growth_options *o, phc_
     for (int k = 0; k < 3; k++)
         if (!isfinite(opt.base[k]))
             return phc_error_set(err, PHC_ERR_INPUT, "the plant's seed position is not finite");
+    if (!(opt.long_step >= 0) || !isfinite(opt.long_step))
+        return phc_error_set(err, PHC_ERR_INPUT, "growth options: long_step must be finite and >= 0 d, found %g",
+                             opt.long_step);
     if (soil) {
         double lo[3], hi[3];
         for (int k = 0; k < 3; k++) lo[k] = soil->origin[k];
@@ -1018,7 +1022,20 @@ int phc_growth_step(phc_growth *g, double dt, phc_error *err)
             memset(g->sink_rate, 0, g->soil->n * sizeof *g->sink_rate);
             g->n_sink_voxels = 0;
         }
-        rc = phc_soil_run(g->soil, g->soil->t + 24.0 * dt, err);
+        /* a long step: the soil at its stability limit (times the safety
+           factor), not at params.dt, when that is longer */
+        phc_soil *s = g->soil;
+        const double dt_soil = s->params.dt, absorb_dt = s->params.absorb_dt;
+        if (g->o.long_step > 0 && dt >= g->o.long_step) {
+            double coarse = s->params.safety * phc_soil_stable_dt(s, NULL);
+            if (isfinite(coarse) && coarse > dt_soil) {
+                s->params.dt = coarse;
+                if (!(absorb_dt > 0)) s->params.absorb_dt = dt_soil; /* the same loss per hour */
+            }
+        }
+        rc = phc_soil_run(s, s->t + 24.0 * dt, err);
+        s->params.dt = dt_soil;
+        s->params.absorb_dt = absorb_dt;
         if (rc) return phc_error_prefix(err, rc, "growth at day %g", g->age);
     }
     g->age += dt;

@@ -214,6 +214,9 @@ typedef struct phc_growth_options {
     phc_growth_uptake uptake;   /* default PHYSICAL */
     double base[3];             /* m, seed position in the soil frame; default (0, 0, 0) */
     size_t max_nodes;           /* refuse to grow past this many nodes; 0 = 10 million */
+    double long_step;           /* d: a step this long or longer runs its soil at soil.params.safety x
+                                   the soil's stability limit when that exceeds soil.params.dt
+                                   (phc_growth_step); 0 = never; default 7 */
 } phc_growth_options;
 phc_growth_options phc_growth_options_default(void);
 
@@ -279,6 +282,10 @@ int phc_growth_new(const phc_growth_params *p, const phc_growth_options *o, phc_
 void phc_growth_free(phc_growth *g); /* removes its sink hook; accepts NULL */
 
 /* Advances dt days (> 0): the steps above, then the soil for 24 dt hours.
+ * With dt >= options.long_step the soil's step is, for this call only,
+ * params.safety (0.9) x its stability limit (phc_soil_stable_dt) when that
+ * is longer than params.dt: a month-long step is then 5-7x faster on the
+ * bench plant (README, Speed, "The growth model", for what it changes).
  * PHC_ERR_DOMAIN when max_nodes would be exceeded or the soil fails. */
 int phc_growth_step(phc_growth *g, double dt, phc_error *err);
 

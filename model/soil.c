@@ -3,6 +3,9 @@
 
 #include <ctype.h>
 #include <math.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,17 +19,25 @@
 #define PHC_SOIL_PARALLEL_MIN 2048
 #endif
 
+/* Water-only sub-steps one sweep over the grid takes when nothing else
+ * acts between them (params.block_steps = 0). */
+#ifndef PHC_SOIL_BLOCK_STEPS
+#define PHC_SOIL_BLOCK_STEPS 4
+#endif
+
 struct phc_soil_work {
     double *w_new, *v_new;     /* next state */
     double *ic;                /* 1 / c */
     double *kx, *ky, *kz;      /* face permeability (harmonic mean) to the +x, +y, +z
                                   neighbour (wrapped); 0 across closed box faces */
     double *sink_w, *sink_v;   /* sink hook buffers */
-    double *lw, *gw;           /* transport_water's per-voxel w/c and f_grav p w */
+    double *ring;              /* transport_water's plane rings, ring_per_thread each */
+    size_t ring_per_thread, ring_threads;
     double *plane;             /* nz partial sums */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
+    int damp_xy_one;           /* 1 when every damp_x and damp_y factor is 1 */
     double *src_w;             /* per source: normalised weights over its voxels */
     size_t *src_idx, *src_first, src_total;
     int nutrients;             /* 1 when nutrients move */
@@ -67,8 +78,7 @@ static void work_free(phc_soil_work *wk)
     free(wk->kz);
     free(wk->sink_w);
     free(wk->sink_v);
-    free(wk->lw);
-    free(wk->gw);
+    free(wk->ring);
     free(wk->plane);
     free(wk->top);
     free(wk->damp_x);
@@ -111,14 +121,12 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->kx = malloc(n * sizeof(double));
     wk->ky = malloc(n * sizeof(double));
     wk->kz = malloc(n * sizeof(double));
-    wk->lw = malloc(n * sizeof(double));
-    wk->gw = malloc(n * sizeof(double));
     wk->plane = malloc(nz * sizeof(double));
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
-    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->lw || !wk->gw || !wk->plane ||
+    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane ||
         !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
@@ -477,6 +485,9 @@ static int check_impl(const phc_soil *s, int strict, phc_error *err)
     if (pr->gravity != PHC_SOIL_GRAVITY_LAX_WENDROFF && pr->gravity != PHC_SOIL_GRAVITY_UPWIND)
         return phc_error_set(err, PHC_ERR_INPUT, "soil: unknown gravity scheme %d (0 Lax-Wendroff, 1 upwind)",
                              (int)pr->gravity);
+    if (!(pr->absorb_dt >= 0) || !isfinite(pr->absorb_dt))
+        return phc_error_set(err, PHC_ERR_INPUT, "soil: absorb_dt must be finite and >= 0 h, found %g",
+                             pr->absorb_dt);
     if (!(pr->safety > 0 && pr->safety <= 1))
         return phc_error_set(err, PHC_ERR_INPUT, "soil: safety must be in (0, 1], found %g", pr->safety);
     size_t dims[3] = {s->nx, s->ny, s->nz};
@@ -649,106 +660,193 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
     f[7] = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
 }
 
-/* The water update of voxel q, voxel_faces' terms summed as transport()
- * sums them, from the voxels' fill l = w/c and gravity flux g = f_grav p w
- * computed once per sub-step (wk->lw, wk->gw) instead of once for each of a
- * voxel's 7 stencil entries: the same products, the same sums in the same
- * order, so the same numbers to the last bit. */
-static inline double water_voxel_pre(const double *restrict w, const double *restrict l,
-                                     const double *restrict g, const double *restrict kx,
-                                     const double *restrict ky, const double *restrict kz, size_t q,
-                                     size_t qe, size_t qw, size_t qn, size_t qs, size_t qu, size_t qd,
-                                     double cd, double cg, double lw, int up)
+/* The water update of voxel r of a z-plane, voxel_faces' terms summed as
+ * transport() sums them, from the fill l = w/c and gravity flux
+ * g = f_grav p w of the plane below (ld, gd), the plane itself (lc, gc) and
+ * the plane above (lu, gu), computed once per plane and sub-step instead of
+ * once for each of a voxel's 7 stencil entries: the same products, the
+ * same sums in the same order, so the same numbers to the last bit.  kx,
+ * ky, kzc are the plane's face permeabilities, kzd those of the plane
+ * below; re, rw, rn, rs the in-plane neighbours (wrapped). */
+static inline double water_voxel_pre(const double *restrict wc, const double *restrict ld,
+                                     const double *restrict lc, const double *restrict lu,
+                                     const double *restrict gd, const double *restrict gc,
+                                     const double *restrict gu, const double *restrict kx,
+                                     const double *restrict ky, const double *restrict kzc,
+                                     const double *restrict kzd, size_t r, size_t re, size_t rw,
+                                     size_t rn, size_t rs, double cd, double cg, double lw, int up)
 {
-    const double l0 = l[q];
-    const double f0 = kx[q] * (l[qe] - l0), f1 = kx[qw] * (l[qw] - l0);
-    const double f2 = ky[q] * (l[qn] - l0), f3 = ky[qs] * (l[qs] - l0);
-    const double f4 = kz[q] * (l[qu] - l0), f5 = kz[qd] * (l[qd] - l0);
-    const double q0 = g[q], qU = g[qu], qD = g[qd];
-    const double f6 = kz[q] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kz[q]) * (q0 - qU) : 0;
-    const double f7 = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
-    return w[q] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
+    const double l0 = lc[r];
+    const double f0 = kx[r] * (lc[re] - l0), f1 = kx[rw] * (lc[rw] - l0);
+    const double f2 = ky[r] * (lc[rn] - l0), f3 = ky[rs] * (lc[rs] - l0);
+    const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
+    const double q0 = gc[r], qU = gu[r], qD = gd[r];
+    const double f6 = kzc[r] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kzc[r]) * (q0 - qU) : 0;
+    const double f7 = kzd[r] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kzd[r]) * (qD - q0) : 0;
+    return wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
 }
 
-/* wk->lw and wk->gw of the z-plane k (voxel_faces' l and q). */
-static inline void fill_plane(const phc_soil *s, size_t k)
+/* One z-plane of a water-only sub-step into `out`: the x-interior of every
+ * row has no wrap-around and no branches, so the compiler vectorises it;
+ * the two ends of the row are done apart.  The build targets baseline
+ * x86-64 (SSE2, 2 doubles per instruction): on x86-64 an AVX2 copy (4
+ * doubles) is compiled beside it and chosen at load time by the CPU (GCC
+ * function multiversioning).  AVX2 does not imply FMA and the C11 build
+ * does not contract a * b + c, so both copies round every operation
+ * alike: the same numbers to the last bit. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
+__attribute__((target_clones("avx2", "default")))
+#endif
+static void water_plane(size_t nx, size_t ny, const double *restrict wc, const double *restrict ld,
+                        const double *restrict lc, const double *restrict lu, const double *restrict gd,
+                        const double *restrict gc, const double *restrict gu, const double *restrict kx,
+                        const double *restrict ky, const double *restrict kzc, const double *restrict kzd,
+                        double *restrict out, double cd, double cg, double lw, int up)
 {
-    const phc_soil_work *wk = s->work;
-    const size_t plane = s->nx * s->ny;
-    const double *restrict w = s->w, *restrict ic = wk->ic, *restrict p = s->p;
-    double *restrict l = wk->lw, *restrict g = wk->gw;
-    const double a = s->params.f_grav;
-    for (size_t q = plane * k; q < plane * (k + 1); ++q) {
+    const size_t plane = nx * ny;
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+        const size_t row = nx * j;
+        {
+            const size_t r = row;
+            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, nx > 1 ? r + 1 : r,
+                                     r + nx - 1, r + jn, r - js, cd, cg, lw, up);
+        }
+#pragma omp simd
+        for (size_t i = 1; i < nx - 1; ++i) {
+            const size_t r = row + i;
+            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, r + 1, r - 1, r + jn,
+                                     r - js, cd, cg, lw, up);
+        }
+        if (nx > 1) {
+            const size_t r = row + nx - 1;
+            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, row, r - 1, r + jn,
+                                     r - js, cd, cg, lw, up);
+        }
+    }
+}
+
+/* A plane's fill l = w/c (as w times 1/c) and gravity flux g = f_grav p w. */
+static inline void fill_plane(size_t m, const double *restrict w, const double *restrict ic,
+                              const double *restrict p, double a, double *restrict l, double *restrict g)
+{
+    for (size_t q = 0; q < m; ++q) {
         l[q] = w[q] * ic[q];
         g[q] = a * p[q] * w[q];
     }
 }
 
-/* Water only (no nutrients move), the z-plane k: the x-interior of every
- * row has no wrap-around and no branches, so the compiler vectorises it;
- * the two ends of the row are done apart. */
-static inline void transport_water_plane(const phc_soil *s, double h, size_t k)
+/* The z-plane of unwrapped index k (k < 0 or >= nz wrap around). */
+static size_t wrap_plane(long k, long nz)
+{
+    return (size_t)(((k % nz) + nz) % nz);
+}
+
+/* T water-only sub-steps of h (time blocking, a wavefront in z): the planes
+ * [k0, k1) of w_new from w.  Sub-step t's plane k needs sub-step t-1's
+ * planes k-1, k and k+1, so the planes are swept once: at plane m, the fill
+ * of w's plane m, then sub-step t's plane m - t for t = 1..T.  Sub-step t
+ * runs over [k0 - (T - t), k1 + (T - t)): the planes next to the chunk are
+ * recomputed by the thread that needs them, with the same arithmetic, so
+ * the result does not depend on the chunks (nor the thread count).  Each
+ * intermediate sub-step keeps 3 planes of w, l and g in `ring` (T x 3 x 3
+ * planes); the face permeabilities, 1/c and p stream from memory once per
+ * T sub-steps instead of once per sub-step.  (Outside the box the planes
+ * wrap around as the one-step stencil does: across a closed z face the
+ * face permeability is 0 and the wrapped values are multiplied by it.) */
+static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1, double *ring)
 {
     const phc_soil_work *wk = s->work;
-    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny, n = s->n;
-    const double *restrict w = s->w, *restrict l = wk->lw, *restrict g = wk->gw;
-    const double *restrict kx = wk->kx, *restrict ky = wk->ky, *restrict kz = wk->kz;
-    double *restrict wn = wk->w_new;
+    const size_t nx = s->nx, ny = s->ny, P = nx * ny;
+    const long nz = (long)s->nz, base = k0 - (long)T;
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
-    const size_t kup = k + 1 < nz ? plane : plane - n, kdn = k > 0 ? plane : plane - n;
-    for (size_t j = 0; j < ny; ++j) {
-        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
-        const size_t row = nx * (j + ny * k);
+#define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * P)
+    for (long m = base; m < k1 + (long)T; ++m) {
+        const size_t km = wrap_plane(m, nz) * P;
+        fill_plane(P, s->w + km, wk->ic + km, s->p + km, a, RING(0, m, 1), RING(0, m, 2));
+        for (size_t t = 1; t <= T; ++t) {
+            const long k = m - (long)t;
+            if (k < k0 - (long)(T - t))
+                break; /* and so for every later t */
+            const size_t kk = wrap_plane(k, nz) * P, kd = wrap_plane(k - 1, nz) * P;
+            const double *wc = t == 1 ? s->w + kk : RING(t - 1, k, 0);
+            double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
+            water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
+                        RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
+                        wk->ky + kk, wk->kz + kk, wk->kz + kd, out, cd, cg, lw, up);
+            if (t < T)
+                fill_plane(P, out, wk->ic + kk, s->p + kk, a, RING(t, k, 1), RING(t, k, 2));
+        }
+    }
+#undef RING
+}
+
+/* Water only (no nutrients move), T sub-steps of h in one sweep; each
+ * thread takes a contiguous range of z-planes (static, so the planes a
+ * thread writes are the ones it first touched).  A small grid does not
+ * enter an OpenMP region at all (an `if` clause still calls into libgomp
+ * on every sub-step: a tenth of a small pot's run time, more inside
+ * another parallel region, as when a root:shoot Jacobian grows its plants
+ * in parallel). */
+static void transport_water(phc_soil *s, double h, size_t T)
+{
+    phc_soil_work *wk = s->work;
+    const long nz = (long)s->nz;
+    if (s->n >= PHC_SOIL_PARALLEL_MIN && wk->ring_threads > 1) {
+#pragma omp parallel num_threads((int)wk->ring_threads)
         {
-            const size_t q = row;
-            wn[q] = water_voxel_pre(w, l, g, kx, ky, kz, q, nx > 1 ? q + 1 : q, q + nx - 1, q + jn,
-                                    q - js, q + kup, q - kdn, cd, cg, lw, up);
+#ifdef _OPENMP
+            const long nth = omp_get_num_threads(), id = omp_get_thread_num();
+#else
+            const long nth = 1, id = 0;
+#endif
+            const long k0 = nz * id / nth, k1 = nz * (id + 1) / nth;
+            if (k1 > k0)
+                sweep_chunk(s, h, T, k0, k1, wk->ring + (size_t)id * wk->ring_per_thread);
         }
-#pragma omp simd
-        for (size_t i = 1; i < nx - 1; ++i) {
-            const size_t q = row + i;
-            wn[q] = water_voxel_pre(w, l, g, kx, ky, kz, q, q + 1, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, cd, cg, lw, up);
-        }
-        if (nx > 1) {
-            const size_t q = row + nx - 1;
-            wn[q] = water_voxel_pre(w, l, g, kx, ky, kz, q, row, q - 1, q + jn, q - js, q + kup,
-                                    q - kdn, cd, cg, lw, up);
-        }
+    } else {
+        sweep_chunk(s, h, T, 0, nz, wk->ring);
     }
 }
 
-/* Water only, every plane.  A small grid does not enter an OpenMP region
- * at all (an `if` clause still calls into libgomp on every sub-step: a
- * tenth of a small pot's run time, more inside another parallel region,
- * as when a root:shoot Jacobian grows its plants in parallel). */
-static void transport_water(phc_soil *s, double h)
+/* The sub-steps one sweep may take: params.block_steps (0: the default),
+ * at most nz / 8 (the planes each thread recomputes next to its range
+ * grow with it) and at least 1. */
+static size_t block_levels(const phc_soil *s)
 {
-    if (s->n >= PHC_SOIL_PARALLEL_MIN) {
-#pragma omp parallel
-        {
-#pragma omp for schedule(static)
-            for (size_t k = 0; k < s->nz; ++k)
-                fill_plane(s, k);
-#pragma omp for schedule(static)
-            for (size_t k = 0; k < s->nz; ++k)
-                transport_water_plane(s, h, k);
-        }
-    } else {
-        for (size_t k = 0; k < s->nz; ++k)
-            fill_plane(s, k);
-        for (size_t k = 0; k < s->nz; ++k)
-            transport_water_plane(s, h, k);
-    }
+    size_t T = s->params.block_steps ? s->params.block_steps : PHC_SOIL_BLOCK_STEPS;
+    if (T > s->nz / 8)
+        T = s->nz / 8;
+    return T ? T : 1;
+}
+
+/* The rings of transport_water for T sub-steps per sweep and the threads
+ * a run may use; PHC_ERR_NOMEM. */
+static int prepare_ring(phc_soil *s, size_t T)
+{
+    phc_soil_work *wk = s->work;
+    size_t threads = 1;
+#ifdef _OPENMP
+    if (s->n >= PHC_SOIL_PARALLEL_MIN && !omp_in_parallel())
+        threads = (size_t)omp_get_max_threads();
+#endif
+    const size_t per = T * 9 * s->nx * s->ny;
+    if (wk->ring && wk->ring_per_thread >= per && wk->ring_threads == threads)
+        return PHC_OK;
+    free(wk->ring);
+    wk->ring = malloc(threads * per * sizeof(double));
+    wk->ring_threads = wk->ring ? threads : 0;
+    wk->ring_per_thread = per;
+    return wk->ring ? PHC_OK : PHC_ERR_NOMEM;
 }
 
 /* Transport over one sub-step h: w_new (and v_new) from w (and v). */
 static void transport(phc_soil *s, double h)
 {
     if (!s->work->nutrients) {
-        transport_water(s, h); /* v is left as it is: run_impl does not swap it */
+        transport_water(s, h, 1); /* v is left as it is: run_impl does not swap it */
         return;
     }
     phc_soil_work *wk = s->work;
@@ -891,7 +989,7 @@ static void prepare_damping(phc_soil *s, double h)
     size_t dims[3] = {s->nx, s->ny, s->nz};
     double *out[3] = {wk->damp_x, wk->damp_y, wk->damp_z};
     int W = s->params.absorb_width;
-    double e = h / s->params.dt;
+    double e = h / (s->params.absorb_dt > 0 ? s->params.absorb_dt : s->params.dt);
     for (int a = 0; a < 3; ++a)
         for (size_t i = 0; i < dims[a]; ++i) {
             double f = 1.0;
@@ -902,6 +1000,11 @@ static void prepare_damping(phc_soil *s, double h)
                 f *= pow(absorb_factor(s->params.absorb_form, W, (int)from_max), e);
             out[a][i] = f;
         }
+    wk->damp_xy_one = 1;
+    for (size_t i = 0; i < s->nx; ++i)
+        wk->damp_xy_one &= wk->damp_x[i] == 1.0;
+    for (size_t j = 0; j < s->ny; ++j)
+        wk->damp_xy_one &= wk->damp_y[j] == 1.0;
 }
 
 static int any_absorb(const phc_soil *s)
@@ -922,7 +1025,9 @@ static double damp(phc_soil *s, double *f, double *g)
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         double part = 0, fz = wk->damp_z[k];
-        for (size_t j = 0; j < ny; ++j) {
+        /* a plane whose every factor is 1 (an absorbing bottom only: all
+           but its W planes) has nothing to damp */
+        for (size_t j = 0; j < ny && !(fz == 1.0 && wk->damp_xy_one); ++j) {
             double fyz = fz * wk->damp_y[j];
             for (size_t i = 0; i < nx; ++i) {
                 double fac = fyz * wk->damp_x[i];
@@ -1049,6 +1154,39 @@ static void tangent_step(phc_soil *s, double h, const phc_soil_tangent *tan, siz
 
 /* ---- running --------------------------------------------------------------- */
 
+/* The step of phc_soil_run that starts at t: its length *h (params.dt, the
+ * last one shortened to land on t_end) and its sub-steps *nsub.  Returns 0
+ * when t_end is reached, -1 when the step exceeds the stability limit and
+ * sub-stepping is off, 1 otherwise. */
+static int plan_step(const phc_soil *s, double t, double t_end, double eps, double limit, double *h,
+                     size_t *nsub)
+{
+    if (!(t_end - t > eps))
+        return 0;
+    const double dt = s->params.dt;
+    *h = t_end - t < dt ? t_end - t : dt;
+    *nsub = 1;
+    if (*h > limit) {
+        if (!s->params.substep)
+            return -1;
+        *nsub = (size_t)ceil(*h / (s->params.safety * limit));
+    }
+    return 1;
+}
+
+/* Whether rain or a source changes w during the sub-step [t, t + h) (as
+ * sources_and_sinks tests them). */
+static int sources_act(const phc_soil *s, double t, double h)
+{
+    for (size_t r = 0; r < s->n_rain; ++r)
+        if (s->rain[r].rate > 0 && overlap(t, t + h, s->rain[r].start, s->rain[r].end) > 0)
+            return 1;
+    for (size_t q = 0; q < s->n_sources; ++q)
+        if (overlap(t, t + h, s->sources[q].start, s->sources[q].end) > 0)
+            return 1;
+    return 0;
+}
+
 static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_error *err)
 {
     int rc;
@@ -1088,11 +1226,20 @@ static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_
     }
     const int absorb = any_absorb(s);
     phc_soil_work *wk = s->work;
-    while (t_end - s->t > eps) {
-        double h = t_end - s->t < dt ? t_end - s->t : dt;
-        size_t nsub = 1;
-        if (h > limit) {
-            if (!s->params.substep) {
+    /* several sub-steps per sweep only when nothing but transport acts */
+    const size_t fuse_max = (!tan && !wk->nutrients && !absorb && !s->sink) ? block_levels(s) : 1;
+    if (prepare_ring(s, fuse_max)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    double h = 0, hs = 0;
+    size_t nsub = 0, sub = 0; /* the current step's sub-steps, and those done */
+    for (;;) {
+        if (sub == nsub) {
+            int pl = plan_step(s, s->t, t_end, eps, limit, &h, &nsub);
+            if (pl == 0)
+                break;
+            if (pl < 0) {
                 size_t i = at % s->nx, j = (at / s->nx) % s->ny, k = at / (s->nx * s->ny);
                 rc = phc_error_set(err, PHC_ERR_INPUT,
                                    "soil: the time step dt = %g h exceeds the stability limit %g h set by voxel "
@@ -1100,50 +1247,88 @@ static int run_impl(phc_soil *s, double t_end, const phc_soil_tangent *tan, phc_
                                    h, limit, i, j, k, s->p[at], s->c[at]);
                 goto done;
             }
-            nsub = (size_t)ceil(h / (s->params.safety * limit));
+            hs = h / (double)nsub;
+            sub = 0;
+            if (absorb)
+                prepare_damping(s, hs);
         }
-        double hs = h / (double)nsub;
-        if (absorb)
-            prepare_damping(s, hs);
-        for (size_t sub = 0; sub < nsub; ++sub) {
-            double t0 = s->t;
-            if (tan)
-                for (size_t m = 0; m < tan->m; ++m)
-                    tangent_step(s, hs, tan, m, tmp[m]);
-            transport(s, hs);
-            if ((rc = sources_and_sinks(s, t0, hs, &s->budget))) {
-                rc = phc_error_set(err, rc, rc == PHC_ERR_NOMEM ? "out of memory"
-                                                                : "soil: the sink hook stopped the run at t = %g h",
-                                   t0);
-                goto done;
+        double t0 = s->t;
+        /* the sub-steps of the same length h ahead with no rain or source
+           acting, up to fuse_max, across steps of dt: one sweep takes them */
+        size_t F = 1;
+        if (fuse_max > 1 && !sources_act(s, t0, hs)) {
+            double t = t0 + hs;
+            size_t sb = sub + 1, ns = nsub;
+            while (F < fuse_max) {
+                if (sb == ns) {
+                    double h2;
+                    if (plan_step(s, t, t_end, eps, limit, &h2, &ns) != 1 || h2 / (double)ns != hs)
+                        break;
+                    sb = 0;
+                }
+                if (sources_act(s, t, hs))
+                    break;
+                ++F;
+                t = t + hs;
+                ++sb;
             }
-            if (absorb) {
-                double vol = s->dx * s->dx * s->dx;
-                s->budget.water_absorbed += damp(s, wk->w_new, NULL) * vol;
-                s->budget.nutrient_absorbed += damp(s, wk->nutrients ? wk->v_new : s->v, NULL) * vol;
-                if (tan)
-                    for (size_t m = 0; m < tan->m; ++m)
-                        damp(s, tmp[m], NULL);
-            }
+        }
+        if (F > 1) {
+            transport_water(s, hs, F);
             double *swap = s->w;
             s->w = wk->w_new;
             wk->w_new = swap;
-            if (wk->nutrients) {
-                swap = s->v;
-                s->v = wk->v_new;
-                wk->v_new = swap;
-            }
-            if (tan)
-                for (size_t m = 0; m < tan->m; ++m) {
-                    swap = tan->sw[m];
-                    tan->sw[m] = tmp[m];
-                    tmp[m] = swap;
+            for (size_t f = 0; f < F; ++f) {
+                s->t = s->t + hs;
+                if (++sub == nsub) {
+                    s->budget.steps++;
+                    s->budget.substeps += nsub;
+                    if (f + 1 < F) {
+                        plan_step(s, s->t, t_end, eps, limit, &h, &nsub);
+                        sub = 0;
+                    }
                 }
-            ++swaps;
-            s->t = t0 + hs;
+            }
+            continue;
         }
-        s->budget.steps++;
-        s->budget.substeps += nsub;
+        if (tan)
+            for (size_t m = 0; m < tan->m; ++m)
+                tangent_step(s, hs, tan, m, tmp[m]);
+        transport(s, hs);
+        if ((rc = sources_and_sinks(s, t0, hs, &s->budget))) {
+            rc = phc_error_set(err, rc, rc == PHC_ERR_NOMEM ? "out of memory"
+                                                            : "soil: the sink hook stopped the run at t = %g h",
+                               t0);
+            goto done;
+        }
+        if (absorb) {
+            double vol = s->dx * s->dx * s->dx;
+            s->budget.water_absorbed += damp(s, wk->w_new, NULL) * vol;
+            s->budget.nutrient_absorbed += damp(s, wk->nutrients ? wk->v_new : s->v, NULL) * vol;
+            if (tan)
+                for (size_t m = 0; m < tan->m; ++m)
+                    damp(s, tmp[m], NULL);
+        }
+        double *swap = s->w;
+        s->w = wk->w_new;
+        wk->w_new = swap;
+        if (wk->nutrients) {
+            swap = s->v;
+            s->v = wk->v_new;
+            wk->v_new = swap;
+        }
+        if (tan)
+            for (size_t m = 0; m < tan->m; ++m) {
+                swap = tan->sw[m];
+                tan->sw[m] = tmp[m];
+                tmp[m] = swap;
+            }
+        ++swaps;
+        s->t = t0 + hs;
+        if (++sub == nsub) {
+            s->budget.steps++;
+            s->budget.substeps += nsub;
+        }
     }
     s->t = t_end;
     s->budget.water_stored = phc_soil_water_total(s);

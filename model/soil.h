@@ -50,7 +50,9 @@
  *                         authors' SoilModel.cpp (W = 5)
  *   PHC_SOIL_ABSORB_PAPER a(i) = 1 - exp(-i / (0.2 W^2)), as printed in eq. 31
  * The authors damp once per step of dt; we damp by a(i)^(h/dt) per sub-step
- * h, so the loss per hour does not depend on sub-stepping.  The code form is
+ * h, so the loss per hour does not depend on sub-stepping (params.absorb_dt,
+ * when > 0, stands for dt here: a caller that lengthens dt for a while, as
+ * the growth model's long steps do, keeps the loss per hour).  The code form is
  * the default because the paper's figures were made with it.  Absorbing
  * layers damp water and nutrients alike (the authors' code damps water only).
  *
@@ -67,6 +69,13 @@
  * Threads: the voxel loops run with OpenMP; every voxel's update reads only
  * the previous state, and budget sums are reduced per z-plane in a fixed
  * order, so results are bit-identical for any thread count.
+ *
+ * Time blocking: while only water moves (no nutrients, sink hook, absorbing
+ * face, tangent, and no rain or source acting), up to `block_steps`
+ * consecutive sub-steps of the same length (at most nz/8) are taken in one
+ * sweep over the grid (a wavefront in z), so the per-voxel constants
+ * stream from memory once per sweep.  The arithmetic is that of one
+ * sub-step at a time: the result is bit-identical for any block_steps.
  *
  * Layout: voxel (i, j, k) is element i + nx (j + ny k); x east, y north,
  * z up; k = nz - 1 is the surface layer.  Voxel centres are at
@@ -117,6 +126,8 @@ typedef struct phc_soil_params {
     double safety;                          /* fraction of the limit used when sub-stepping, 0.9 */
     size_t max_substeps;                    /* most sub-steps per step of dt; 0 (default) = no limit */
     phc_soil_gravity gravity;               /* gravity and nutrient face fluxes; default LAX_WENDROFF */
+    size_t block_steps;                     /* water-only sub-steps per sweep (time blocking); 0 (default) = 4, 1 = none */
+    double absorb_dt;                       /* h, the step the absorbing factors a(i) apply per; 0 (default) = dt */
 } phc_soil_params;
 
 /* The defaults listed above. */

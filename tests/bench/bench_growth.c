@@ -35,8 +35,15 @@
  *          median.  A 30-day step elongates every tip by 30 days' worth at
  *          once, so the plant grows a lot during the step: the nodes after
  *          the step are printed, and the per-node month cost uses them.
- *   soil:  phc_soil_run over 24 h / 720 h on an identical soil without a
- *          plant: the part of a step that does not depend on the nodes.
+ *          The month step runs the soil at 0.9 x its stability limit (9.7
+ *          h), the growth option long_step's default for steps of >= 7 d.
+ *   soil:  phc_soil_run over 24 h (at 1 h) / 720 h (at the month step's
+ *          soil dt) on an identical soil without a plant: the part of a
+ *          step that does not depend on the nodes.
+ *   1 h soil: the month step again with long_step = 0 (the soil at its dt
+ *          of 1 h, as before long_step), 1 thread, and the relative
+ *          change the coarse soil step makes in root and shoot mass, root
+ *          length, nodes and the soil's water after the step.
  * Each at 1 thread and at 2 threads (omp_set_num_threads; the soil's voxel
  * loops are OpenMP, the plant's passes are serial).  The headline numbers
  * (without a _1t/_2t suffix) are the better of the two thread counts.
@@ -74,7 +81,8 @@ static double paper(double v10, double v60, size_t n)
     return v10 + (v60 - v10) * ((double)n - 10000.0) / 50000.0;
 }
 
-static double soil_dt = 1.0; /* h; the month step is also timed at 0.9 x the stability limit */
+static double soil_dt = 1.0; /* h, the soil's params.dt */
+static double long_step = -1; /* d, the growth option long_step; < 0: its default (7 d) */
 
 static phc_soil *make_soil(void)
 {
@@ -144,6 +152,8 @@ static int plant_new(plant *pl)
     o.seed = 7;
     o.max_nodes = 100000000;
     o.base[0] = 1.6, o.base[1] = 1.6, o.base[2] = 2.4;
+    if (long_step >= 0)
+        o.long_step = long_step;
     if (phc_growth_new(&p, &o, pl->s, &pl->g, &err)) {
         printf("growth: %s\n", err.message);
         plant_free(pl);
@@ -221,14 +231,29 @@ int main(void)
            "bottom ABSORB, soil dt = 1 h\n");
     printf("growth_threads_available: %d\n", omp_get_num_procs());
 
+    double coarse_dt;
+    {
+        phc_soil *s0 = make_soil();
+        if (!s0)
+            return 1;
+        coarse_dt = s0->params.safety * phc_soil_stable_dt(s0, NULL);
+        phc_soil_free(s0);
+    }
+    printf("growth_long_step: %.4g d (default: steps this long run the soil at %.3g h, 0.9 x its stability "
+           "limit, instead of its dt of %.3g h)\n", phc_growth_options_default().long_step, coarse_dt, soil_dt);
+    phc_growth_summary month_sum[NT];
+    double month_water[NT];
     for (int th = 0; th < 2; ++th) {
         omp_set_num_threads(threads[th]);
         soil_day[th] = soil_only(24.0);
+        soil_dt = coarse_dt; /* what a month step runs */
         soil_month[th] = soil_only(720.0);
+        soil_dt = 1.0;
         printf("soil_only_s_per_day_%dt: %.4g s (best of %d; median %.4g; other load %.2f CPUs)\n", threads[th],
                soil_day[th].best, REPEAT, soil_day[th].median, soil_day[th].other);
-        printf("soil_only_s_per_month_%dt: %.4g s (best of %d; median %.4g; other load %.2f CPUs)\n",
-               threads[th], soil_month[th].best, REPEAT, soil_month[th].median, soil_month[th].other);
+        printf("soil_only_s_per_month_%dt: %.4g s (soil dt %.3g h as in a month step; best of %d; median %.4g; "
+               "other load %.2f CPUs)\n", threads[th], soil_month[th].best, coarse_dt, REPEAT, soil_month[th].median,
+               soil_month[th].other);
 
         /* day steps: one plant grown through all targets */
         plant pl;
@@ -290,6 +315,10 @@ int main(void)
                     return 1;
                 }
                 r->n1 = nodes_of(pl.g);
+                if (th == 0) {
+                    phc_growth_summarize(pl.g, &month_sum[q]);
+                    month_water[q] = phc_soil_water_total(pl.s);
+                }
                 plant_free(&pl);
             }
             r->other = other;
@@ -341,21 +370,18 @@ int main(void)
         printf("growth_us_per_node_month_%s: %.4g us (step minus soil-only %.4g s, over the nodes after the step)\n",
                tname[q], us_month[q], soil_month[bm].best);
     }
-    /* the month step with the soil at 0.9 x its stability limit (1 thread) */
+    /* the month step with the soil at its own dt of 1 h (long_step = 0, the
+       behaviour before long_step), 1 thread: time and what the coarse soil
+       step changes in the plant and the soil */
     omp_set_num_threads(1);
-    {
-        phc_soil *s0 = make_soil();
-        if (!s0)
-            return 1;
-        soil_dt = 0.9 * phc_soil_stable_dt(s0, NULL);
-        phc_soil_free(s0);
-    }
-    timing sm_coarse = soil_only(720.0);
-    printf("soil_only_s_per_month_coarse_dt: %.4g s (soil dt = %.3g h = 0.9 x the stability limit; best of %d)\n",
-           sm_coarse.best, soil_dt, REPEAT);
+    long_step = 0;
+    timing sm_fine = soil_only(720.0);
+    printf("soil_only_s_per_month_1h_soil_dt: %.4g s (soil dt 1 h; best of %d)\n", sm_fine.best, REPEAT);
     for (int q = 0; q < NT; ++q) {
         double t[REPEAT_MONTH];
         size_t n0 = 0, n1 = 0;
+        phc_growth_summary S;
+        double water = NAN;
         for (int k = 0; k < REPEAT_MONTH; ++k) {
             plant pl;
             int dd = 0;
@@ -371,15 +397,52 @@ int main(void)
                 return 1;
             }
             n1 = nodes_of(pl.g);
+            phc_growth_summarize(pl.g, &S);
+            water = phc_soil_water_total(pl.s);
             plant_free(&pl);
         }
         double best = t[0];
         for (int k = 1; k < REPEAT_MONTH; ++k)
             best = fmin(best, t[k]);
         double pm = paper(paper_month_10k, paper_month_60k, target[q]);
-        printf("growth_s_per_month_coarse_soil_dt_%s: %.4g s (nodes %zu -> %zu; soil dt %.3g h; 1 thread; best of %d, "
-               "median %.4g; %.1f x the paper's %.3g s)\n", tname[q], best, n0, n1, soil_dt, REPEAT_MONTH,
+        printf("growth_s_per_month_1h_soil_dt_%s: %.4g s (nodes %zu -> %zu; soil dt 1 h, long_step 0; 1 thread; "
+               "best of %d, median %.4g; %.1f x the paper's %.3g s)\n", tname[q], best, n0, n1, REPEAT_MONTH,
                median(t, REPEAT_MONTH), pm / best, pm);
+        const phc_growth_summary *C = &month_sum[q];
+        printf("growth_month_soil_step_effect_%s: root mass %+.2e, shoot mass %+.2e, root length %+.2e, soil water "
+               "%+.2e, nodes %+.2e (relative, soil at %.3g h vs 1 h, after the 30-day step)\n", tname[q],
+               C->root_mass / S.root_mass - 1, C->shoot_mass / S.shoot_mass - 1, C->root_length / S.root_length - 1,
+               month_water[q] / water - 1,
+               (double)(C->shoot_nodes + C->root_nodes) / (double)(S.shoot_nodes + S.root_nodes) - 1, coarse_dt);
+    }
+    /* two month steps from 10k nodes: the plant samples the soil at the
+       start of a step, so the soil step's effect reaches it in the second */
+    {
+        phc_growth_summary S2[2];
+        double W2[2];
+        size_t N2[2];
+        for (int v = 0; v < 2; ++v) {
+            long_step = v ? 0 : -1;
+            plant pl;
+            int dd = 0;
+            phc_error err;
+            if (plant_new(&pl) || grow_to(&pl, target[0], &dd))
+                return 1;
+            for (int k = 0; k < 2; ++k)
+                if (phc_growth_step(pl.g, 30.0, &err)) {
+                    printf("growth: %s\n", err.message);
+                    return 1;
+                }
+            phc_growth_summarize(pl.g, &S2[v]);
+            W2[v] = phc_soil_water_total(pl.s);
+            N2[v] = S2[v].shoot_nodes + S2[v].root_nodes;
+            plant_free(&pl);
+        }
+        printf("growth_two_months_soil_step_effect_10k: root mass %+.2e, shoot mass %+.2e, root length %+.2e, soil "
+               "water %+.2e, nodes %+.2e (relative, soil at %.3g h vs 1 h, after two 30-day steps from 10k nodes: "
+               "%zu vs %zu nodes)\n", S2[0].root_mass / S2[1].root_mass - 1, S2[0].shoot_mass / S2[1].shoot_mass - 1,
+               S2[0].root_length / S2[1].root_length - 1, W2[0] / W2[1] - 1, (double)N2[0] / (double)N2[1] - 1,
+               coarse_dt, N2[0], N2[1]);
     }
     for (int q = 0; q < NT; ++q) {
         int bd = day[0][q].best <= day[1][q].best ? 0 : 1;

@@ -740,6 +740,70 @@ static void test_nutrients(void)
     CHECK(tips[1] > tips[0]);
 }
 
+/* Long steps (options.long_step, default 7 d): an 8-day step runs the soil
+ * at 0.9 x its stability limit instead of its dt of 1 h (fewer soil
+ * sub-steps), restores dt and absorb_dt afterwards, keeps the absorbing
+ * layer's loss per hour (absorb_dt), and changes the soil water and the
+ * plant after a further day by little against long_step = 0 (the 1 h soil
+ * step); a 6-day step is not a long step; a negative long_step is refused. */
+static void test_long_step(void)
+{
+    phc_growth_summary S[2];
+    double water[2], absorbed[2];
+    size_t sub[2], sub6 = 0;
+    double lim = 0, dt_after[2], adt_after[2];
+    for (int v = 0; v < 2; ++v) {
+        phc_growth_options o = opts_at_surface();
+        if (v) o.long_step = 0;
+        phc_growth_params p = preset("oak");
+        phc_soil *s = test_soil(0.5, 0.0015, 0, 0);
+        for (size_t k = 0; k < s->n; ++k) s->c[k] = 100, s->w[k] = 50;
+        s->params.dt = 1;
+        s->params.boundary[PHC_SOIL_ZMIN] = PHC_SOIL_ABSORB;
+        phc_soil_rain r = {.start = 0, .end = 1e9, .rate = 0.0075 * 0.3};
+        phc_error err;
+        must(phc_soil_set_rain(s, &r, 1, &err), &err, "rain");
+        lim = phc_soil_stable_dt(s, NULL);
+        phc_growth *g;
+        must(phc_growth_new(&p, &o, s, &g, &err), &err, "new");
+        for (int d = 0; d < 20; ++d) must(phc_growth_step(g, 1.0, &err), &err, "step");
+        size_t before = s->budget.substeps;
+        must(phc_growth_step(g, 6.0, &err), &err, "6-day step");
+        if (!v) sub6 = s->budget.substeps - before;
+        must(phc_growth_step(g, 8.0, &err), &err, "8-day step");
+        sub[v] = s->budget.substeps - before;
+        dt_after[v] = s->params.dt;
+        adt_after[v] = s->params.absorb_dt;
+        must(phc_growth_step(g, 1.0, &err), &err, "step");
+        phc_growth_summarize(g, &S[v]);
+        water[v] = phc_soil_water_total(s);
+        absorbed[v] = s->budget.water_absorbed;
+        phc_growth_free(g);
+        phc_soil_free(s);
+    }
+    double dw = fabs(water[0] / water[1] - 1), da = fabs(absorbed[0] / absorbed[1] - 1);
+    double dr = fabs(S[0].root_mass / S[1].root_mass - 1), ds = fabs(S[0].shoot_mass / S[1].shoot_mass - 1);
+    double dl = fabs(S[0].root_length / S[1].root_length - 1);
+    printf("  long steps (oak, 20 + 6 + 8 + 1 d, soil c 100, p 0.0015 m/h, limit %.3g h): soil sub-steps of the "
+           "6 + 8 days %zu (6-day step: %zu, 8-day step: %zu) vs %zu with long_step 0; dt after %g h, absorb_dt after %g; "
+           "relative change: soil water %.2e, absorbed %.2e, root mass %.2e, shoot mass %.2e, root length %.2e\n",
+           lim, sub[0], sub6, sub[0] - sub6, sub[1], dt_after[0], adt_after[0], dw, da, dr, ds, dl);
+    CHECK(sub6 == 144 && sub[1] == 336);
+    CHECK(sub[0] - sub6 == (size_t)ceil(192.0 / (0.9 * lim)));
+    CHECK(dt_after[0] == 1 && adt_after[0] == 0 && dt_after[1] == 1);
+    CHECK(dw < 0.01);
+    CHECK(da < 0.05);
+    CHECK(dr < 1e-3 && ds < 1e-3 && dl < 1e-3);
+    phc_growth_options o = opts_at_surface();
+    o.long_step = -1;
+    phc_growth_params p = preset("oak");
+    phc_growth *g = NULL;
+    phc_error err;
+    int rc = phc_growth_new(&p, &o, NULL, &g, &err);
+    printf("  long_step -1: rc %d \"%s\"\n", rc, rc ? err.message : "");
+    CHECK(rc == PHC_ERR_INPUT && strstr(err.message, "long_step") && !g);
+}
+
 /* Eq. 24 scales the branching probability by (1 + nutrient_branching v):
  * in a uniform soil with v = 5, nutrient_branching = 1 and root_branching
  * rb must give the plant of nutrient_branching = 0 and 6 rb, for any step
@@ -942,7 +1006,7 @@ int main(void)
         {"determinism", test_determinism}, {"pipe+geometry", test_pipe_and_geometry},
         {"limits", test_limits},       {"uptake", test_uptake},
         {"exports", test_exports},     {"nutrients", test_nutrients},
-        {"nutrient scaling", test_nutrient_scaling},
+        {"nutrient scaling", test_nutrient_scaling}, {"long steps", test_long_step},
         {"nutrient allocation", test_nutrient_allocation}, {"pot walls", test_pot_walls},
         {"smoothness", test_smoothness}, {"modes", test_modes},
     };

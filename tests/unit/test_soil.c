@@ -1,6 +1,8 @@
 /* Unit tests of the soil water and nutrient model (model/soil.h): exact
  * solutions and limits of the finite-volume discretisation documented in
- * soil.h.  One line per check with the measured numbers. */
+ * soil.h.  One line per check with the measured numbers.  4b: time
+ * blocking (several sub-steps per sweep) gives the numbers of one sub-step
+ * per sweep, bit for bit, for 1-3 threads. */
 #include "check.h"
 
 #include <omp.h>
@@ -235,6 +237,85 @@ static void test_threads(void)
         phc_soil_free(s[r]);
 }
 
+/* ---- 4b. time blocking: bit-identical to one sub-step per sweep ------------- */
+
+/* A water-only soil (no nutrients) of nx x ny x nz voxels: two layers,
+ * rocks, w from noise. */
+static phc_soil *water_soil(size_t nx, size_t ny, size_t nz)
+{
+    phc_soil *s = new_soil(nx, ny, nz, 0.01);
+    phc_error err;
+    phc_soil_layer L[2] = {{.thickness = 0.01 * (double)(nz / 2), .c = 5, .p = 0.05, .d = 1, .fill = 0.3},
+                           {.thickness = 0, .c = 10, .p = 0.02, .d = 2, .fill = 0.6}};
+    must(phc_soil_set_layers(s, L, 2, &err), &err, "layers");
+    phc_soil_add_rocks(s, 42, 0.03, 0.15);
+    for (size_t q = 0; q < s->n; ++q)
+        s->w[q] *= 0.5 + phc_soil_noise(11, 0.025, (q % nx + 0.5) * 0.01, (q / nx % ny + 0.5) * 0.01,
+                                        (q / (nx * ny) + 0.5) * 0.01);
+    s->params.f_diff = 1;
+    s->params.f_grav = 1;
+    return s;
+}
+
+static void test_blocking(void)
+{
+    /* cases: sizes (nz 40: 4 sub-steps per sweep; 16: 2; 9: 1), faces,
+       gravity scheme, sub-stepping with a shortened last step, and rain
+       over part of the run (sweeps stop at its start and resume after) */
+    static const struct { size_t nx, ny, nz; int periodic, upwind, substep, rain; } C[] = {
+        {24, 20, 40, 0, 0, 0, 0}, {24, 20, 40, 1, 0, 0, 0}, {24, 20, 40, 0, 1, 0, 0},
+        {24, 20, 40, 0, 0, 1, 1}, {33, 17, 16, 1, 1, 1, 0}, {40, 30, 9, 0, 0, 0, 1}};
+    const int threads[4] = {1, 1, 2, 3};
+    const size_t block[4] = {1, 0, 0, 3};
+    int saved = omp_get_max_threads();
+    for (size_t c = 0; c < sizeof C / sizeof C[0]; ++c) {
+        phc_soil *s[4];
+        for (int r = 0; r < 4; ++r) {
+            omp_set_num_threads(threads[r]);
+            s[r] = water_soil(C[c].nx, C[c].ny, C[c].nz);
+            phc_soil *x = s[r];
+            if (C[c].periodic)
+                for (int f = 0; f < PHC_SOIL_FACES; f += 1)
+                    if (f != PHC_SOIL_YMIN && f != PHC_SOIL_YMAX)
+                        x->params.boundary[f] = PHC_SOIL_PERIODIC;
+            x->params.gravity = C[c].upwind ? PHC_SOIL_GRAVITY_UPWIND : PHC_SOIL_GRAVITY_LAX_WENDROFF;
+            double lim = phc_soil_stable_dt(x, NULL);
+            x->params.dt = C[c].substep ? 2.5 * lim : 0.5 * lim;
+            x->params.substep = C[c].substep;
+            x->params.block_steps = block[r];
+            phc_error err;
+            if (C[c].rain) {
+                phc_soil_rain rn = {.start = 20 * x->params.dt, .end = 23.5 * x->params.dt, .rate = 1e-4};
+                must(phc_soil_set_rain(x, &rn, 1, &err), &err, "rain");
+            }
+            phc_soil_budget_reset(x);
+            must(phc_soil_run(x, 61.3 * x->params.dt, &err), &err, "blocking run");
+        }
+        for (int r = 1; r < 4; ++r) {
+            const phc_soil_budget *a = &s[0]->budget, *b = &s[r]->budget;
+            int same_w = !memcmp(s[0]->w, s[r]->w, s[0]->n * sizeof(double));
+            int same_b = a->water_stored == b->water_stored && a->water_in == b->water_in &&
+                         a->water_closing == b->water_closing && a->steps == b->steps &&
+                         a->substeps == b->substeps && s[0]->t == s[r]->t;
+            double dmax = 0;
+            for (size_t q = 0; q < s[0]->n; ++q)
+                dmax = fmax(dmax, fabs(s[0]->w[q] - s[r]->w[q]));
+            printf("4b. blocking %zux%zux%zu%s%s%s%s: block_steps %zu, %d thread%s vs 1 sub-step per sweep, 1 "
+                   "thread: w bit-identical %s (max |dw| %.1e), budget and t %s (%zu steps, %zu sub-steps, water "
+                   "in %.3e m^3)\n", C[c].nx, C[c].ny, C[c].nz, C[c].periodic ? ", x z periodic" : "",
+                   C[c].upwind ? ", upwind" : "", C[c].substep ? ", sub-stepped" : "", C[c].rain ? ", rain" : "",
+                   block[r], threads[r], threads[r] > 1 ? "s" : "", same_w ? "yes" : "NO", dmax,
+                   same_b ? "yes" : "NO", b->steps, b->substeps, b->water_in);
+            CHECK(same_w);
+            CHECK(same_b);
+        }
+        CHECK(!C[c].rain || s[0]->budget.water_in > 0);
+        for (int r = 0; r < 4; ++r)
+            phc_soil_free(s[r]);
+    }
+    omp_set_num_threads(saved);
+}
+
 /* ---- 5. stability ----------------------------------------------------------- */
 
 /* 8x8x8 pure diffusion (f_grav = 0), two layers of permeability, rocks,
@@ -315,6 +396,42 @@ static void test_stability(void)
 }
 
 /* ---- 6. absorbing boundaries and rain -------------------------------------- */
+
+/* absorb_dt: with nothing moving (f_diff = f_grav = 0), a voxel i layers
+ * from an absorbing face keeps w0 a(i)^(T / absorb_dt) after T hours, for
+ * any dt (the growth model's long steps lengthen dt and keep absorb_dt). */
+static void test_absorb_dt(void)
+{
+    const double dts[3] = {0.5, 1.0, 2.0 / 3.0};
+    double worst = 0;
+    for (int c = 0; c < 3; ++c) {
+        phc_soil *s = new_soil(1, 1, 12, 0.01);
+        for (size_t k = 0; k < 12; ++k)
+            s->w[k] = 1.0 + 0.1 * (double)k;
+        s->params.f_diff = 0;
+        s->params.f_grav = 0;
+        s->params.boundary[PHC_SOIL_ZMIN] = PHC_SOIL_ABSORB;
+        s->params.dt = dts[c];
+        s->params.absorb_dt = 2.0;
+        phc_error err;
+        must(phc_soil_run(s, 4.0, &err), &err, "absorb_dt run");
+        for (size_t k = 0; k < 12; ++k) {
+            double a = k < 5 ? 1.0 - exp(-(double)(k * k) / (0.2 * 25)) : 1.0;
+            double exact = (1.0 + 0.1 * (double)k) * pow(a, 4.0 / 2.0);
+            worst = fmax(worst, exact > 0 ? fabs(s->w[k] / exact - 1) : fabs(s->w[k]));
+        }
+        phc_soil_free(s);
+    }
+    phc_soil *s = new_soil(1, 1, 12, 0.01);
+    s->params.absorb_dt = -1;
+    phc_error err;
+    int rc = phc_soil_run(s, 1.0, &err);
+    printf("6b. absorb_dt 2 h, dt 0.5, 1 and 2/3 h, 4 h without transport: w = w0 a(i)^2 to %.1e (rel); "
+           "absorb_dt -1: rc %d \"%s\"\n", worst, rc, rc ? err.message : "");
+    CHECK(worst < 1e-14);
+    CHECK(rc == PHC_ERR_INPUT && strstr(err.message, "absorb_dt"));
+    phc_soil_free(s);
+}
 
 static void test_absorb_rain(void)
 {
@@ -814,8 +931,10 @@ int main(void)
     test_gravity_pulse();
     test_conservation();
     test_threads();
+    test_blocking();
     test_stability();
     test_absorb_rain();
+    test_absorb_dt();
     test_tangent();
     t_upwind = 1;
     printf("7b. the tangent again with the upwind gravity flux:\n");
