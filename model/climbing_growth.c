@@ -40,7 +40,10 @@ struct phc_climbing {
     unsigned char *has_child;/* n scratch */
     double *target;          /* n scratch: pipe-model target areas, m^2 */
     double *sx, *sv, *sI;    /* 6n, 2n, 2n scratch: light points, volumes, light */
-    unsigned char *opaque;   /* light-grid cells blocked by supports, NULL: none */
+    unsigned char *opaque;   /* light-grid cells holding occluders, NULL: none */
+    double *occ_v;           /* occluding triangles' vertices, m (3 per vertex) */
+    size_t *occ_t;           /* and their indices (3 per triangle) */
+    size_t occ_nv, occ_nt;
     size_t opaque_cells;
     size_t leaves;
 };
@@ -127,6 +130,8 @@ void phc_climbing_free(phc_climbing *c)
     free(c->sv);
     free(c->sI);
     free(c->opaque);
+    free(c->occ_v);
+    free(c->occ_t);
     free(c);
 }
 
@@ -650,7 +655,8 @@ static void light_step(phc_climbing *c, size_t n0)
             memcpy(c->sx + 3 * m, c->leaf_c + 3 * i, 3 * sizeof *c->sx);
             c->sv[m++] = leaf_vol;
         }
-    phc_climbing_light_shaded(&o->light, c->opaque, c->sx, c->sv, m, c->phi, c->sI);
+    const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
+    phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi, c->sI);
     memcpy(c->light, c->sI, n0 * sizeof *c->light);
     m = n0;
     for (size_t i = 0; i < n0; ++i)
@@ -724,6 +730,19 @@ int phc_climbing_set_shadow_triangles(phc_climbing *c, const double *vertices, s
             return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu light cells",
                                  cells);
     }
+    double *nv_ = realloc(c->occ_v, 3 * (c->occ_nv + nv) * sizeof *nv_);
+    if (nv_)
+        c->occ_v = nv_;
+    size_t *nt_ = nv_ ? realloc(c->occ_t, 3 * (c->occ_nt + nt) * sizeof *nt_) : NULL;
+    if (!nv_ || !nt_)
+        return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu shadow triangles",
+                             nt);
+    c->occ_t = nt_;
+    memcpy(c->occ_v + 3 * c->occ_nv, vertices, 3 * nv * sizeof *vertices);
+    for (size_t t = 0; t < 3 * nt; ++t)
+        c->occ_t[3 * c->occ_nt + t] = c->occ_nv + triangles[t];
+    c->occ_nv += nv;
+    c->occ_nt += nt;
     for (size_t t = 0; t < nt; ++t) {
         const size_t *v = triangles + 3 * t;
         c->opaque_cells += phc_climbing_light_mark_triangle(

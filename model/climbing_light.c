@@ -61,10 +61,52 @@ size_t phc_climbing_light_mark_triangle(const phc_climbing_light_grid *g, const 
     return marked;
 }
 
-void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const unsigned char *opaque,
+int phc_climbing_ray_hits_triangle(const double x[3], const double l[3], double t_min,
+                                   const double a[3], const double b[3], const double c[3])
+{
+    double e1[3], e2[3], s[3];
+    for (int k = 0; k < 3; ++k) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        s[k] = x[k] - a[k];
+    }
+    const double p[3] = {l[1] * e2[2] - l[2] * e2[1], l[2] * e2[0] - l[0] * e2[2],
+                         l[0] * e2[1] - l[1] * e2[0]};
+    const double det = e1[0] * p[0] + e1[1] * p[1] + e1[2] * p[2];
+    if (det == 0)
+        return 0;
+    const double inv = 1 / det;
+    const double u = (s[0] * p[0] + s[1] * p[1] + s[2] * p[2]) * inv;
+    if (u < 0 || u > 1)
+        return 0;
+    const double q[3] = {s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2],
+                         s[0] * e1[1] - s[1] * e1[0]};
+    const double v = (l[0] * q[0] + l[1] * q[1] + l[2] * q[2]) * inv;
+    if (v < 0 || u + v > 1)
+        return 0;
+    const double t = (e2[0] * q[0] + e2[1] * q[1] + e2[2] * q[2]) * inv;
+    return t > t_min;
+}
+
+/* 1 when the ray from x toward the light crosses an occluding triangle. */
+static int occluded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
+                    const double x[3])
+{
+    const double t_min = 1e-9 * g->cell;
+    for (size_t t = 0; t < occ->nt; ++t) {
+        const size_t *v = occ->triangles + 3 * t;
+        if (phc_climbing_ray_hits_triangle(x, g->direction, t_min, occ->vertices + 3 * v[0],
+                                           occ->vertices + 3 * v[1], occ->vertices + 3 * v[2]))
+            return 1;
+    }
+    return 0;
+}
+
+void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
                                const double *x, const double *vol, size_t n, double *phi,
                                double *light)
 {
+    const unsigned char *opaque = occ && occ->nt ? occ->mask : NULL;
     const double a = g->ambient;
     const int absorb = g->extinction > 0;
     if (!absorb && !opaque) {
@@ -86,21 +128,30 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const unsigned 
     const size_t kmax = g->dims[0] + g->dims[1] + g->dims[2];
     for (size_t i = 0; i < n; ++i) {
         double depth = 0;
-        int blocked = 0;
-        if (cell_of(g, x + 3 * i) == (size_t)-1) { /* outside the grid: full light */
+        int blocked = 0, tested = 0;
+        const size_t own = cell_of(g, x + 3 * i);
+        if (own == (size_t)-1) { /* outside the grid: full light */
             light[i] = 1;
             continue;
         }
-        for (size_t k = 1; k <= kmax; ++k) {
+        /* an occluder in the point's own cell may lie between it and the light */
+        if (opaque && opaque[own]) {
+            tested = 1;
+            blocked = occluded(g, occ, x + 3 * i);
+        }
+        for (size_t k = 1; k <= kmax && !blocked; ++k) {
             double p[3];
             for (int d = 0; d < 3; ++d)
                 p[d] = x[3 * i + d] + (double)k * g->cell * g->direction[d];
             const size_t c = cell_of(g, p);
             if (c == (size_t)-1)
                 break;
-            if (opaque && opaque[c]) {
-                blocked = 1;
-                break;
+            if (opaque && opaque[c] && !tested) {
+                tested = 1; /* one exact test per ray */
+                if (occluded(g, occ, x + 3 * i)) {
+                    blocked = 1;
+                    break;
+                }
             }
             if (absorb)
                 depth += phi[c] * g->cell;

@@ -16,16 +16,17 @@
  * Supports cast shadows (ours; the paper's light grid holds occlusion from
  * the plant and the scene alike): a support mesh's triangles are rasterised
  * into an opaque mask over the same cells (phc_climbing_light_mark_triangle).
- * A ray that meets an opaque cell at k ≥ 1 is blocked: the direct light is
- * 0.  A diffuse share a (ambient ∈ [0, 1], sky light reaching every point)
- * gives
+ * When the point's own cell or a cell the march meets is masked, the ray x + t ℓ (t > 0) is
+ * tested exactly against every occluding triangle (Möller & Trumbore, "Fast,
+ * minimum storage ray/triangle intersection", J. Graphics Tools 2(1) 1997);
+ * a hit blocks the direct light.  The exact test keeps a shoot lying on a
+ * wall lit when the light runs along the wall (its ray passes the wall's
+ * cells without crossing a face), and a masked cell only costs the test.
+ * A diffuse share a (ambient ∈ [0, 1], sky light reaching every point) gives
  *   I(x) = a + (1 − a)·T(x),  T = 0 when blocked, else exp(−λ Σ φ h),
- * so a shoot behind a wall grows at the rate r·a.  a = 0 and no mask is the
- * pure Beer–Lambert law above, bit for bit.  The march samples the ray
- * every h, so a wall one cell thick across an axis is never stepped over
- * (a ray's coordinate along that axis advances by at most h per sample);
- * a slanted wall rasterises to a staircase of cells that a ray can cross
- * between samples only at a corner the triangle cuts. */
+ * so a shoot behind a wall grows at the rate r·a.  a = 0 and no occluders
+ * is the pure Beer–Lambert law above, bit for bit.  A face is an occluder
+ * from both sides. */
 #ifndef PHC_CLIMBING_LIGHT_H
 #define PHC_CLIMBING_LIGHT_H
 
@@ -61,10 +62,25 @@ size_t phc_climbing_light_mark_triangle(const phc_climbing_light_grid *g, const 
                                         const double b[3], const double c[3],
                                         unsigned char *opaque);
 
-/* phc_climbing_light with an opaque mask (NULL: none) and the ambient share
- * a: I = a + (1 − a)·T as above.  With no mask and a = 0 it equals
+/* Occluding triangles: nt × 3 indices into nv × 3 vertices (m), and their
+ * mask over the grid's cells (phc_climbing_light_mark_triangle of each). */
+typedef struct phc_climbing_occluders {
+    const double *vertices;
+    size_t nv;
+    const size_t *triangles;
+    size_t nt;
+    const unsigned char *mask;
+} phc_climbing_occluders;
+
+/* 1 when the ray x + t ℓ, t in (t_min, inf), crosses the triangle (a, b,
+ * c) (m), else 0 (Möller–Trumbore; a ray in the triangle's plane misses). */
+int phc_climbing_ray_hits_triangle(const double x[3], const double l[3], double t_min,
+                                   const double a[3], const double b[3], const double c[3]);
+
+/* phc_climbing_light with occluders (NULL: none) and the ambient share a:
+ * I = a + (1 − a)·T as above.  With no occluders and a = 0 it equals
  * phc_climbing_light. */
-void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const unsigned char *opaque,
+void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
                                const double *x, const double *vol, size_t n, double *phi,
                                double *light);
 

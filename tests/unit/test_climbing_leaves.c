@@ -102,7 +102,8 @@ int main(void)
         marked += phc_climbing_light_mark_triangle(&g, v, v + 6, v + 9, mask);
         const double x[6] = {0.05, 0.05, 0.05, 0.05, 0.05, 0.35}, vol[2] = {0, 0};
         double phi[4], I[2];
-        phc_climbing_light_shaded(&g, mask, x, vol, 2, phi, I);
+        const phc_climbing_occluders occ = {v, 4, t, 2, mask};
+        phc_climbing_light_shaded(&g, &occ, x, vol, 2, phi, I);
         printf("shadow: 1x1x4 grid, wall in cell 2: %zu cell marked (%d %d %d %d); I below = %.17g "
                "(ambient 0.3), above = %.17g\n",
                marked, mask[0], mask[1], mask[2], mask[3], I[0], I[1]);
@@ -110,9 +111,41 @@ int main(void)
         CHECK(I[0] == 0.3);
         CHECK(I[1] == 1);
         g.ambient = 0;
-        phc_climbing_light_shaded(&g, mask, x, vol, 2, phi, I);
+        phc_climbing_light_shaded(&g, &occ, x, vol, 2, phi, I);
         printf("shadow: ambient 0: I below = %g (opaque wall: no direct light)\n", I[0]);
         CHECK(I[0] == 0);
+        /* a point 3 mm beside a vertical wall x = 0.1 inside the wall's cells,
+           light along the wall: lit; light across it from behind: shadowed */
+        {
+            phc_climbing_light_grid w = g;
+            w.dims[0] = 4;
+            w.dims[2] = 4;
+            w.ambient = 0;
+            unsigned char wm[16] = {0};
+            const double wv[12] = {0.1, -1, -1, 0.1, 2, -1, 0.1, 2, 2, 0.1, -1, 2};
+            const size_t wt[6] = {0, 1, 2, 0, 2, 3};
+            phc_climbing_light_mark_triangle(&w, wv, wv + 3, wv + 6, wm);
+            phc_climbing_light_mark_triangle(&w, wv, wv + 6, wv + 9, wm);
+            const phc_climbing_occluders wo = {wv, 4, wt, 2, wm};
+            const double px[3] = {0.103, 0.05, 0.05}, pv[1] = {0};
+            double along, across, front;
+            phc_climbing_light_shaded(&w, &wo, px, pv, 1, phi, &along);
+            w.direction[0] = -1; /* light from -x: the wall is between */
+            w.direction[2] = 0;
+            phc_climbing_light_shaded(&w, &wo, px, pv, 1, phi, &across);
+            w.direction[0] = 1; /* light from +x: the wall is behind */
+            phc_climbing_light_shaded(&w, &wo, px, pv, 1, phi, &front);
+            printf("shadow: point 3 mm off a wall: light along the wall I = %g, from behind the "
+                   "wall I = %g, from its front I = %g\n",
+                   along, across, front);
+            CHECK(along == 1 && across == 0 && front == 1);
+            const double o0[3] = {0, 0, 0}, l[3] = {0, 0, 1}, a[3] = {-1, -1, 1}, b[3] = {1, -1, 1},
+                         cc[3] = {0, 1, 1};
+            CHECK(phc_climbing_ray_hits_triangle(o0, l, 0, a, b, cc) == 1);
+            CHECK(phc_climbing_ray_hits_triangle(o0, l, 1.5, a, b, cc) == 0);
+            const double lx[3] = {1, 0, 0};
+            CHECK(phc_climbing_ray_hits_triangle(o0, lx, 0, a, b, cc) == 0);
+        }
         /* no mask, a = 0: the plain law, bit for bit */
         g.extinction = 40;
         const double xs[9] = {0.05, 0.05, 0.05, 0.05, 0.05, 0.15, 0.05, 0.05, 0.38};
