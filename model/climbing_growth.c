@@ -436,6 +436,44 @@ static void tropisms(phc_climbing *c, size_t i, double dt)
         c->x[3 * i + k] = b[k] + h * d[k];
 }
 
+/* keep_outside (ours): turns apical i out when its tip or its centre is
+ * behind the face of its closest support point. */
+static void keep_outside(phc_climbing *c, size_t i)
+{
+    const phc_climbing_options *o = &c->o;
+    if (!o->keep_outside || !o->closest)
+        return;
+    double tip[3], cp[3], nf[3], b[3];
+    seg_tip(c, i, 0, tip);
+    /* the tip, then the centre (a segment that cuts a convex edge has both
+       ends outside and its middle inside) */
+    int behind = 0;
+    for (int pass = 0; pass < 2 && !behind; ++pass) {
+        const double *p = pass ? c->x + 3 * i : tip;
+        if (o->closest(o->closest_user, p, cp, nf))
+            return;
+        const double r[3] = {p[0] - cp[0], p[1] - cp[1], p[2] - cp[2]};
+        behind = dot(r, nf) < 0;
+    }
+    if (!behind)
+        return;
+    double *d = c->d + 3 * i;
+    const double dn = dot(d, nf);
+    double t[3] = {d[0] - dn * nf[0], d[1] - dn * nf[1], d[2] - dn * nf[2]};
+    if (unit(t, t) == 0)
+        for (int k = 0; k < 3; ++k)
+            t[k] += nf[k];
+    else
+        memcpy(t, nf, sizeof t);
+    if (unit(t, t))
+        return;
+    seg_base(c, i, 0, b);
+    phc_climbing_turn(d, c->dr + 3 * i, t, 1);
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        c->x[3 * i + k] = b[k] + h * d[k];
+}
+
 /* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
  * Returns 0 or -1 (out of memory). */
 static int grow(phc_climbing *c, size_t i, double dsig)
@@ -491,6 +529,7 @@ static int grow(phc_climbing *c, size_t i, double dsig)
         if (k == PHC_CLIMBING_NONE)
             return -1;
         memcpy(c->dr + 3 * k, ldr, sizeof ldr);
+        keep_outside(c, k);
         c->stats.laterals++;
         if (order + 1 > c->stats.max_order)
             c->stats.max_order = order + 1;
@@ -795,6 +834,10 @@ int phc_climbing_leaf_quad(const phc_climbing *c, size_t i, double corners[12])
 }
 
 size_t phc_climbing_leaf_count(const phc_climbing *c) { return c->leaves; }
+void phc_climbing_light_direction(const phc_climbing *c, double l[3])
+{
+    memcpy(l, c->o.light.direction, 3 * sizeof *l);
+}
 unsigned phc_climbing_node_index(const phc_climbing *c, size_t i) { return c->node_k[i]; }
 double phc_climbing_primary_radius(const phc_climbing *c, size_t i) { return c->r0[i]; }
 
@@ -821,6 +864,7 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         if (!c->apical[i])
             continue;
         tropisms(c, i, dt);
+        keep_outside(c, i);
         /* apical dominance (ours): a tip of order k grows at r·a^k */
         const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
         if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
@@ -829,6 +873,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
                                  c->n);
         }
     }
+    /* keep_outside (ours) once more on the grown tips, the new ones included */
+    if (o->keep_outside)
+        for (size_t i = 0; i < c->n; ++i)
+            if (c->apical[i])
+                keep_outside(c, i);
     /* 9. secondary growth */
     if (o->cambium_rate > 0)
         cambium(c, dt);

@@ -154,6 +154,13 @@ typedef struct phc_climbing_options {
     double cambium_rate;        /* κ, s^-1, >= 0: 0 = no secondary growth (default) */
     double leaf_pipe_area;      /* a_L, m², >= 0: cross-section one leaf adds below it;
                                    default 0 */
+    /* supports: keep the tips outside (ours) */
+    int keep_outside;           /* 1: a growing tip whose end or centre lies behind the face
+                                   of its closest support point (outward normal n) is turned,
+                                   about its base, to the unit bisector of its tangential
+                                   part and n (45° off the face, outward), so the shoot
+                                   does not grow through a wall at an edge or corner; new
+                                   laterals are checked at birth.  0 (default): off */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -248,6 +255,8 @@ double phc_climbing_leaf_light(const phc_climbing *c, size_t i);
 int phc_climbing_leaf_quad(const phc_climbing *c, size_t i, double corners[12]);
 /* Leaves on the plant. */
 size_t phc_climbing_leaf_count(const phc_climbing *c);
+/* The unit light direction ℓ in use. */
+void phc_climbing_light_direction(const phc_climbing *c, double l[3]);
 /* Node index of i along its shoot (0 for a shoot's first particle). */
 unsigned phc_climbing_node_index(const phc_climbing *c, size_t i);
 /* The primary radius r0 (m) i was born with (phc_climbing_radius is the

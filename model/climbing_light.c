@@ -92,7 +92,9 @@ int phc_climbing_ray_hits_triangle(const double x[3], const double l[3], double 
 static int occluded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
                     const double x[3])
 {
-    const double t_min = 1e-9 * g->cell;
+    /* a skin of h/50: a shoot pressed onto a face (its centre a hair behind
+       it after a tropism step) is not shadowed by the face it lies on */
+    const double t_min = 0.02 * g->cell;
     for (size_t t = 0; t < occ->nt; ++t) {
         const size_t *v = occ->triangles + 3 * t;
         if (phc_climbing_ray_hits_triangle(x, g->direction, t_min, occ->vertices + 3 * v[0],

@@ -26,7 +26,9 @@
  *   I(x) = a + (1 − a)·T(x),  T = 0 when blocked, else exp(−λ Σ φ h),
  * so a shoot behind a wall grows at the rate r·a.  a = 0 and no occluders
  * is the pure Beer–Lambert law above, bit for bit.  A face is an occluder
- * from both sides. */
+ * from both sides; hits closer than h/50 along the ray do not count (ours:
+ * a shoot pressed onto a wall, its centre a hair behind the face after a
+ * tropism step, is not shadowed by the wall it lies on). */
 #ifndef PHC_CLIMBING_LIGHT_H
 #define PHC_CLIMBING_LIGHT_H
 
