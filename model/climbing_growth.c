@@ -731,6 +731,22 @@ static void leaves_update(phc_climbing *c)
         seg_tip(c, i, 0, tip);
         double *p = c->leaf_p + 3 * i;
         phc_climbing_leaf_petiole(d, (double)(c->node_k[i] / o->leaf_step), alpha, p);
+        /* a petiole that points into a support within a blade's reach is
+           mirrored in the support's face (ours: blades stay in front of the
+           wall the shoot climbs on), then made ⊥ the stem again */
+        double cp[3], nf[3];
+        if (o->closest && o->closest(o->closest_user, tip, cp, nf) == 0) {
+            const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
+            const double pn = dot(p, nf);
+            if (sqrt(dot(r, r)) < o->leaf_size && pn < 0) {
+                for (int k = 0; k < 3; ++k)
+                    p[k] -= 2 * pn * nf[k];
+                const double pd = dot(p, d);
+                double q[3] = {p[0] - pd * d[0], p[1] - pd * d[1], p[2] - pd * d[2]};
+                if (unit(q, q) == 0)
+                    memcpy(p, q, sizeof q);
+            }
+        }
         for (int k = 0; k < 3; ++k)
             c->leaf_c[3 * i + k] = tip[k] + 0.5 * o->leaf_size * p[k];
         phc_climbing_leaf_normal(d, o->light.direction, o->leaf_response, c->leaf_light[i], tmax,

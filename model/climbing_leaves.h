@@ -15,6 +15,11 @@
  *  - The petiole direction p = cos(mα) e1 + sin(mα) e2 (⊥ d); the blade is
  *    a square of side s (leaf size, m) whose centre lies at the node plus
  *    p·s/2.
+ *    Near a support (model/climbing_growth.c, ours): a petiole that points
+ *    into the face of the closest support point of its node, within a
+ *    blade's reach, is mirrored in that face (and made ⊥ d again), so the
+ *    blades of a vine on a wall stay in front of it; the divergence angle
+ *    then holds only away from supports.
  *  - Orientation: the blade's default normal is n0 = d (the blade spread
  *    across the stem).  In light I ∈ [0, 1] it turns toward the light
  *    direction ℓ: n = unit((1 − w) n0 + w ℓ), w = ω·I (ω ∈ [0, 1] the

@@ -8,6 +8,7 @@
  *     triangle (assimp's OBJ importer does not share them) and the bounding
  *     box written (to 1e-7 m: assimp holds single-precision floats), and
  *     every tube vertex lies at its segment's radius from the axis.
+ *     Every blade centre of the vine lies in front of the wall.
  *  2. A grow config with leaves:, cambium: and light.ambient /
  *     supports_cast_shadows is read into the options; `phytocal help grow`'s
  *     table lists the keys. */
@@ -54,6 +55,19 @@ int main(void)
         }
         for (int k = 0; c && k < 200; ++k)
             phc_climbing_step(c, 0.5, &err);
+        /* blades of a vine on a wall stay in front of it (petioles mirrored) */
+        double min_leaf_y = INFINITY, min_stem_y = INFINITY;
+        for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+            double ctr[3], x[3];
+            phc_climbing_position(c, i, x);
+            min_stem_y = fmin(min_stem_y, x[1]);
+            if (phc_climbing_leaf(c, i, ctr, NULL, NULL))
+                min_leaf_y = fmin(min_leaf_y, ctr[1]);
+        }
+        printf("obj: vine on the wall y = 0: smallest y of a blade centre %.3g m, of a particle centre "
+               "%.3g m\n",
+               min_leaf_y, min_stem_y);
+        CHECK(min_leaf_y >= 0);
         snprintf(path, sizeof path, "%s/plant.obj", dir);
         phc_grow_obj_counts k;
         memset(&k, 0, sizeof k);
