@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/grow_mesh.h"
 #include "fit/json_file_internal.h"
 #include "fit/run_dir.h"
 #include "fit/shape_plots.h"
@@ -63,6 +64,19 @@ void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_gr
         }
     }
     s->height = top - seed_base[2];
+    /* leaves and secondary growth */
+    double ell[3];
+    phc_climbing_light_direction(c, ell);
+    double sum_cos = 0;
+    for (size_t i = 0; i < st.particles; ++i) {
+        double nrm[3];
+        s->max_radius = fmax(s->max_radius, phc_climbing_radius(c, i));
+        if (phc_climbing_leaf(c, i, NULL, nrm, NULL)) {
+            s->leaves++;
+            sum_cos += nrm[0] * ell[0] + nrm[1] * ell[1] + nrm[2] * ell[2];
+        }
+    }
+    s->mean_leaf_cos = s->leaves ? sum_cos / (double)s->leaves : 0;
 }
 
 phc_plant_graph *phc_grow_plant_graph(const phc_climbing *c, phc_error *err)
@@ -121,6 +135,45 @@ done:
     return rc;
 }
 
+/* The leaves of one frame as legacy VTK polydata: one quad per blade, with
+ * its light and its normal's cosine to the light direction as cell data. */
+static int write_leaves_vtk(const phc_climbing *c, const double light_dir[3], const char *path, double t,
+                            phc_error *err)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+    const double ll = sqrt(light_dir[0] * light_dir[0] + light_dir[1] * light_dir[1] + light_dir[2] * light_dir[2]);
+    const size_t n = phc_climbing_count(c), nl = phc_climbing_leaf_count(c);
+    fprintf(f, "# vtk DataFile Version 3.0\nphytocal grow: leaves at t = %g s\nASCII\nDATASET POLYDATA\n", t);
+    fprintf(f, "POINTS %zu double\n", 4 * nl);
+    for (size_t i = 0; i < n; ++i) {
+        double q[12];
+        if (phc_climbing_leaf_quad(c, i, q))
+            for (int j = 0; j < 4; ++j)
+                fprintf(f, "%.17g %.17g %.17g\n", q[3 * j], q[3 * j + 1], q[3 * j + 2]);
+    }
+    fprintf(f, "POLYGONS %zu %zu\n", nl, 5 * nl);
+    for (size_t j = 0; j < nl; ++j)
+        fprintf(f, "4 %zu %zu %zu %zu\n", 4 * j, 4 * j + 1, 4 * j + 2, 4 * j + 3);
+    if (nl) {
+        fprintf(f, "CELL_DATA %zu\nSCALARS light double 1\nLOOKUP_TABLE default\n", nl);
+        for (size_t i = 0; i < n; ++i)
+            if (phc_climbing_leaf(c, i, NULL, NULL, NULL))
+                fprintf(f, "%.10g\n", phc_climbing_leaf_light(c, i));
+        fprintf(f, "SCALARS cos_normal_light double 1\nLOOKUP_TABLE default\n");
+        for (size_t i = 0; i < n; ++i) {
+            double nrm[3];
+            if (phc_climbing_leaf(c, i, NULL, nrm, NULL))
+                fprintf(f, "%.10g\n", (nrm[0] * light_dir[0] + nrm[1] * light_dir[1] + nrm[2] * light_dir[2]) / ll);
+        }
+    }
+    const int bad = ferror(f);
+    if (fclose(f) != 0 || bad)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write", path);
+    return PHC_OK;
+}
+
 /* The support mesh as legacy VTK polydata (triangles). */
 static int write_support_vtk(const phc_support_mesh *m, const char *path, phc_error *err)
 {
@@ -153,17 +206,38 @@ static int write_views(const phc_climbing *c, const phc_support_mesh *m, const c
     phc_plant_graph *g = phc_grow_plant_graph(c, err);
     if (!g)
         return err->status;
-    const size_t n = g->n, nv = m ? phc_support_mesh_vertex_count(m) : 0;
-    double *order = malloc(n * sizeof *order), *mk = malloc((nv ? 3 * nv : 1) * sizeof *mk);
+    const size_t n = g->n, nv = m ? phc_support_mesh_vertex_count(m) : 0, nl = phc_climbing_leaf_count(c);
+    const size_t ns = n + nl;
+    double *order = malloc(ns * sizeof *order), *mk = malloc((nv ? 3 * nv : 1) * sizeof *mk);
+    double *head = malloc(3 * ns * sizeof *head), *tail = malloc(3 * ns * sizeof *tail),
+           *rad = malloc(ns * sizeof *rad);
     int rc = PHC_OK;
-    if (!order || !mk) {
+    if (!order || !mk || !head || !tail || !rad) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
     unsigned top = 0;
+    double rmax = 0;
     for (size_t i = 0; i < n; ++i) {
         order[i] = phc_climbing_order(c, i);
         top = order[i] > top ? (unsigned)order[i] : top;
+        rmax = fmax(rmax, g->radius[i]);
+    }
+    memcpy(head, g->head, 3 * n * sizeof *head);
+    memcpy(tail, g->tail, 3 * n * sizeof *tail);
+    memcpy(rad, g->radius, n * sizeof *rad);
+    /* leaves: a stroke across each blade (its midline along the petiole),
+       as wide as the thickest stem, coloured one past the highest order */
+    for (size_t i = 0, j = n; i < n; ++i) {
+        double q[12];
+        if (!phc_climbing_leaf_quad(c, i, q))
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            head[3 * j + k] = 0.5 * (q[k] + q[9 + k]);
+            tail[3 * j + k] = 0.5 * (q[3 + k] + q[6 + k]);
+        }
+        rad[j] = rmax;
+        order[j++] = top + 1;
     }
     for (size_t i = 0; i < nv; ++i)
         phc_support_mesh_vertex(m, i, mk + 3 * i);
@@ -171,11 +245,14 @@ static int write_views(const phc_climbing *c, const phc_support_mesh *m, const c
     phc_climbing_stats st;
     phc_climbing_get_stats(c, &st);
     snprintf(title, sizeof title, "%s: %zu particles after %g s", name, n, st.time);
-    phc_shape_panel p = {n, g->head, g->tail, g->radius, order, title, nv, nv ? mk : NULL, "support vertices"};
+    phc_shape_panel p = {ns, head, tail, rad, order, title, nv, nv ? mk : NULL, "support vertices"};
     phc_shape_plot_options po = phc_shape_plot_options_default();
-    po.value_label = "branch order (0 = main axis)";
+    char vlabel[96];
+    if (nl)
+        snprintf(vlabel, sizeof vlabel, "branch order (0 = main axis; %u = leaves)", top + 1);
+    po.value_label = nl ? vlabel : "branch order (0 = main axis)";
     po.value_min = 0;
-    po.value_max = top > 0 ? top : 1;
+    po.value_max = nl ? top + 1 : top > 0 ? top : 1;
     po.max_line_width = 5;
     const char *views[2] = {"plant_side.png", "plant_front.png"};
     const char *titles[2] = {"side view (x-z)", "front view (y-z)"};
@@ -188,6 +265,9 @@ static int write_views(const phc_climbing *c, const phc_support_mesh *m, const c
 done:
     free(order);
     free(mk);
+    free(head);
+    free(tail);
+    free(rad);
     phc_plant_graph_free(g);
     return rc;
 }
@@ -206,6 +286,17 @@ static json_t *summary_json(const phc_grow_summary *s)
                      (json_int_t)s->anchors_released);
 }
 
+static json_t *summary_json_full(const phc_grow_summary *s)
+{
+    json_t *o = summary_json(s);
+    if (o) {
+        json_object_set_new(o, "leaves", json_integer((json_int_t)s->leaves));
+        json_object_set_new(o, "mean_cos_leaf_normal_light", json_real(s->mean_leaf_cos));
+        json_object_set_new(o, "max_radius_m", json_real(s->max_radius));
+    }
+    return o;
+}
+
 static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, const phc_provenance *pv,
                         json_t *frames, const char *tmpdir, phc_error *err)
 {
@@ -214,7 +305,7 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
     json_t *root = json_pack("{s:s, s:s, s:s?, s:I, s:f, s:f, s:f, s:o, s:O}", "command", "grow", "name", cfg->name,
                              "support", cfg->support, "seed", (json_int_t)cfg->options.seed, "duration_s",
                              cfg->duration, "time_step_s", cfg->time_step, "frame_interval_s", cfg->frame_interval,
-                             "plant", summary_json(s), "frames", frames);
+                             "plant", summary_json_full(s), "frames", frames);
     if (!root)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if (pv)
@@ -279,7 +370,7 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
                                  cfg->source, cfg->support_line, e.message);
     }
     phc_climbing_options o = cfg->options;
-    if (o.light.extinction > 0 || cfg->light_grid_given)
+    if (o.light.extinction > 0 || cfg->light_grid_given || (mesh && cfg->shadows))
         default_light_grid(cfg, mesh, &o);
     if (mesh) {
         o.closest = phc_support_mesh_closest;
@@ -291,6 +382,29 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
         if (!(plant = phc_climbing_new(cfg->position, cfg->direction, &o, &e))) {
             rc = phc_error_set(err, e.status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_ERR_INPUT, "%s:%zu: plant.position: %s",
                                cfg->source, cfg->position_line, e.message);
+            goto done;
+        }
+    }
+    if (mesh && cfg->shadows) { /* the support blocks the direct light */
+        const size_t nv = phc_support_mesh_vertex_count(mesh), nt = phc_support_mesh_triangle_count(mesh);
+        double *v = malloc(3 * nv * sizeof *v);
+        size_t *t = malloc(3 * nt * sizeof *t);
+        phc_error e;
+        phc_error_clear(&e);
+        int src = !v || !t;
+        for (size_t i = 0; !src && i < nv; ++i)
+            phc_support_mesh_vertex(mesh, i, v + 3 * i);
+        for (size_t i = 0; !src && i < nt; ++i)
+            phc_support_mesh_triangle(mesh, i, t + 3 * i);
+        if (src)
+            phc_error_set(&e, PHC_ERR_NOMEM, "out of memory");
+        else
+            src = phc_climbing_set_shadow_triangles(plant, v, nv, t, nt, &e);
+        free(v);
+        free(t);
+        if (src) {
+            rc = phc_error_set(err, e.status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_ERR_INPUT,
+                               "%s:%zu: support: %s", cfg->source, cfg->support_line, e.message);
             goto done;
         }
     }
@@ -318,6 +432,13 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
             phc_grow_summarise(plant, cfg->position, &s);
             if ((rc = write_frame(plant, path, s.time, err)))
                 goto done;
+            if (o.leaf_step > 0) {
+                char lfile[64];
+                snprintf(lfile, sizeof lfile, "leaves_%04zu.vtk", s.frames);
+                snprintf(path, sizeof path, "%s/%s", tmpdir, lfile);
+                if ((rc = write_leaves_vtk(plant, o.light.direction, path, s.time, err)))
+                    goto done;
+            }
             json_array_append_new(frames, json_pack("{s:f, s:s, s:I}", "time_s", s.time, "file", file, "particles",
                                                     (json_int_t)s.particles));
             fprintf(csv, "%.10g,%zu,%zu,%zu,%zu,%.10g,%.10g,%.10g,%s\n", s.time, s.particles, s.apical, s.laterals,
@@ -343,6 +464,9 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
     csv = NULL;
     phc_grow_summarise(plant, cfg->position, &s);
     if ((rc = write_views(plant, mesh, tmpdir, cfg->name, err)))
+        goto done;
+    snprintf(path, sizeof path, "%s/plant.obj", tmpdir);
+    if ((rc = phc_grow_write_obj(plant, mesh, 8, path, NULL, err)))
         goto done;
     if (pv)
         phc_provenance_end(pv);

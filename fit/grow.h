@@ -3,10 +3,16 @@
  * 2017) and writes a run directory:
  *   frame_NNNN.vtk   legacy VTK polydata of the plant every frame_interval
  *                    (radius; branch_order, light, anchored per segment)
+ *   leaves_NNNN.vtk  the leaves at the same times (one quad per blade; light
+ *                    and cos(normal, light direction) per blade), when
+ *                    leaves.step > 0
+ *   plant.obj        the final plant as a mesh (fit/grow_mesh.h: stems as
+ *                    tubes, leaves as squares, the support)
  *   growth.csv       per frame: time, particles, tips, laterals, anchored,
  *                    attached fraction, height, total length
  *   plant_side.png, plant_front.png   the final plant seen along y and along
- *                    x (colour = branch order; support vertices as markers)
+ *                    x (colour = branch order, leaves one colour past it;
+ *                    support vertices as markers)
  *   support.vtk      the support mesh (when there is one)
  *   result.json      the final summary (below) and the provenance
  *   phytocal-run.json  the manifest (fit/run_dir.h: --force rules)
@@ -38,6 +44,9 @@ typedef struct phc_grow_summary {
     double height;             /* m: highest segment end above the seed's base (z) */
     double total_length;       /* m */
     size_t frames;             /* frames written */
+    size_t leaves;             /* leaves on the plant */
+    double mean_leaf_cos;      /* mean cosine between leaf normals and the light direction */
+    double max_radius;         /* m: thickest particle (after secondary growth) */
 } phc_grow_summary;
 
 void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_grow_summary *s);

@@ -11,7 +11,7 @@
 #include "fit/config/yaml_keys.h"
 #include "measurements/yaml_doc.h"
 
-typedef enum key_type { K_NUM, K_SIZE, K_UINT, K_U64, K_VEC } key_type;
+typedef enum key_type { K_NUM, K_SIZE, K_UINT, K_U64, K_VEC, K_BOOL } key_type;
 
 /* One key: where it goes (offset into phc_grow_config), its range
  * [lo, hi] (open ends where said), unit and meaning. */
@@ -62,6 +62,25 @@ static const key_spec KEYS[] = {
     {"light", "origin", K_VEC, OPT(light.origin), -INF, INF, 1, 1, "m",
      "lowest corner of the light grid (with size; default: the support's box widened by 0.25 m)"},
     {"light", "size", K_VEC, CFG(light_size), 0, INF, 1, 1, "m", "extent of the light grid (with origin)"},
+    {"light", "ambient", K_NUM, OPT(light.ambient), 0, 1, 0, 0, "",
+     "a: diffuse share of the light that reaches shadowed points too (I = a + (1-a) T)"},
+    {"light", "supports_cast_shadows", K_BOOL, CFG(shadows), 0, 1, 0, 0, "",
+     "the support mesh blocks the direct light (exact ray/triangle test)"},
+    {"leaves", "step", K_UINT, OPT(leaf_step), 0, 1000, 0, 0, "",
+     "every step-th node of a shoot bears a leaf (0: no leaves)"},
+    {"leaves", "angle", K_NUM, OPT(leaf_angle_deg), 0, 360, 0, 0, "deg",
+     "alpha: divergence angle between successive leaves (137.5: golden angle)"},
+    {"leaves", "size", K_NUM, OPT(leaf_size), 0, INF, 1, 1, "m", "s: side of the square blade"},
+    {"leaves", "thickness", K_NUM, OPT(leaf_thickness), 0, INF, 0, 1, "m",
+     "a leaf shades the light grid as a volume s^2*thickness (0: leaves cast no shade)"},
+    {"leaves", "response", K_NUM, OPT(leaf_response), 0, 1, 0, 0, "",
+     "omega: a blade in light I turns by omega*I toward the light direction"},
+    {"leaves", "max_angle", K_NUM, OPT(leaf_max_angle_deg), 0, 180, 0, 0, "deg",
+     "largest turn of a blade from its default normal (the stem direction)"},
+    {"cambium", "rate", K_NUM, OPT(cambium_rate), 0, INF, 0, 1, "s-1",
+     "kappa: radii relax toward the pipe model's at this rate (0: no secondary growth)"},
+    {"cambium", "leaf_area", K_NUM, OPT(leaf_pipe_area), 0, INF, 0, 1, "m2",
+     "a_L: cross-section each leaf adds to the stem below it"},
     {"tropisms", "phototropism", K_NUM, OPT(phototropism), 0, INF, 0, 1, "s-1",
      "eta: turning rate of tips toward the light (eq. 7)"},
     {"tropisms", "surface_adaption", K_NUM, OPT(surface_adaption), 0, INF, 0, 1, "s-1",
@@ -70,6 +89,8 @@ static const key_spec KEYS[] = {
      "supports farther from a tip do not attract it"},
     {"tropisms", "contact_distance", K_NUM, OPT(contact_distance), 0, INF, 0, 1, "m",
      "within it a tip crawls along the support"},
+    {"tropisms", "keep_outside", K_BOOL, OPT(keep_outside), 0, 1, 0, 0, "",
+     "a tip behind its closest support face turns out of it (no growth through a wall's edges)"},
     {"anchors", "attach_distance", K_NUM, OPT(attach_distance), 0, INF, 0, 1, "m",
      "a particle this close to a support anchors (eq. 5; 0: no anchors)"},
     {"anchors", "release_distance", K_NUM, OPT(release_distance), 0, INF, 1, 1, "m",
@@ -88,14 +109,19 @@ static const key_spec KEYS[] = {
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 
-static const char *const SECTIONS[] = {"plant", "growth", "branching", "light", "tropisms", "anchors", "dynamics", NULL};
+static const char *const SECTIONS[] = {"plant", "growth", "branching", "light", "tropisms", "anchors", "dynamics",
+                                       "leaves", "cambium", NULL};
 static const char *const TOP_KEYS[] = {"name",   "support", "seed",      "duration", "time_step", "frame_interval",
                                        "plant",  "growth",  "branching", "light",    "tropisms",  "anchors",
-                                       "dynamics", NULL};
+                                       "dynamics", "leaves", "cambium", NULL};
 
 static void range_text(const key_spec *k, char *buf, size_t size)
 {
     char lo[24], hi[24];
+    if (k->type == K_BOOL) {
+        snprintf(buf, size, "true or false");
+        return;
+    }
     if (isinf(k->lo))
         snprintf(lo, sizeof lo, "-inf");
     else
@@ -148,6 +174,13 @@ static int read_key(const phc_yaml_doc *doc, const phc_yaml_node *map, const key
         memcpy(field, x, sizeof x);
         return PHC_OK;
     }
+    if (k->type == K_BOOL) {
+        int b;
+        if ((rc = phc_yaml_boolean(doc, v, name, &b, err)))
+            return rc;
+        *(int *)field = b;
+        return PHC_OK;
+    }
     double x;
     if (k->type == K_NUM) {
         if ((rc = phc_yaml_number(doc, v, name, &x, err)))
@@ -167,7 +200,8 @@ static int read_key(const phc_yaml_doc *doc, const phc_yaml_node *map, const key
     case K_SIZE: *(size_t *)field = (size_t)x; break;
     case K_UINT: *(unsigned *)field = (unsigned)x; break;
     case K_U64: *(uint64_t *)field = (uint64_t)x; break;
-    case K_VEC: break;
+    case K_VEC:
+    case K_BOOL: break;
     }
     return PHC_OK;
 }
@@ -240,6 +274,7 @@ int phc_grow_config_load(const char *path, phc_grow_config **out, phc_error *err
     c->duration = 60;
     c->time_step = 0.25;
     c->frame_interval = 10;
+    c->shadows = 1;
     /* name */
     const char *name = NULL;
     if ((rc = phc_yaml_map_string(doc, root, "name", 0, "grow config", &name, err)))
@@ -376,6 +411,7 @@ void phc_grow_config_help(FILE *out)
     d.duration = 60;
     d.time_step = 0.25;
     d.frame_interval = 10;
+    d.shadows = 1;
     fprintf(out, "keys of a grow config (all optional but plant.position):\n"
                  "  name                      run name (default: the config file's name)\n"
                  "  support                   support mesh, OBJ or PLY, relative to the config (default: none)\n");
@@ -390,6 +426,7 @@ void phc_grow_config_help(FILE *out)
         case K_SIZE: snprintf(def, sizeof def, "%zu", *(const size_t *)field); break;
         case K_UINT: snprintf(def, sizeof def, "%u", *(const unsigned *)field); break;
         case K_U64: snprintf(def, sizeof def, "%llu", (unsigned long long)*(const uint64_t *)field); break;
+        case K_BOOL: snprintf(def, sizeof def, "%s", *(const int *)field ? "true" : "false"); break;
         case K_VEC: {
             const double *v = (const double *)field;
             snprintf(def, sizeof def, "[%g, %g, %g]", v[0], v[1], v[2]);

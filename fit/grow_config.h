@@ -16,10 +16,12 @@
  *   growth:    {max_length, bud_fraction, growth_rate, apical_dominance, radius,
  *               max_particles}
  *   branching: {probability, buds, variance, thickness_falloff, max_order}
- *   light:     {direction, extinction, cell, origin, size}
- *   tropisms:  {phototropism, surface_adaption, adaption_radius, contact_distance}
+ *   light:     {direction, extinction, cell, origin, size, ambient, supports_cast_shadows}
+ *   tropisms:  {phototropism, surface_adaption, adaption_radius, contact_distance, keep_outside}
  *   anchors:   {attach_distance, release_distance, strength, time}
  *   dynamics:  {substeps, maturity_age, min_stiffness, gravity, iterations, damping}
+ *   leaves:    {step, angle, size, thickness, response, max_angle}   (model/climbing_leaves.h)
+ *   cambium:   {rate, leaf_area}                                     (model/climbing_cambium.h)
  *
  * Every key is optional except plant.position; the defaults are
  * phc_climbing_options_default()'s.  Every number is checked against its
@@ -48,6 +50,7 @@ typedef struct phc_grow_config {
     double frame_interval; /* s, > 0 */
     int light_grid_given;  /* light.origin and light.size were given */
     double light_size[3];  /* m, when given */
+    int shadows;           /* light.supports_cast_shadows: 1 (default) or 0 */
     phc_climbing_options options; /* closest/closest_user left NULL */
 } phc_grow_config;
 

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model/climbing_cambium.h"
+#include "model/climbing_leaves.h"
 #include "model/climbing_rng.h"
 #include "model/climbing_tropism.h"
 #include "model/plant_graph.h"
@@ -29,6 +31,21 @@ struct phc_climbing {
     double *vol;             /* n scratch: particle volumes, m^3 */
     double *phi;             /* light grid scratch */
     phc_climbing_stats stats;
+    /* leaves, secondary growth, shadows of the supports */
+    unsigned *node_k;        /* n: node index along the shoot */
+    unsigned char *has_leaf; /* n */
+    double *leaf_c, *leaf_n, *leaf_p; /* 3n: blade centre (m), normal, petiole */
+    double *leaf_light;      /* n: I at the blade, last step */
+    double *r0;              /* n: primary radius, m */
+    unsigned char *has_child;/* n scratch */
+    double *target;          /* n scratch: pipe-model target areas, m^2 */
+    double *sx, *sv, *sI;    /* 6n, 2n, 2n scratch: light points, volumes, light */
+    unsigned char *opaque;   /* light-grid cells holding occluders, NULL: none */
+    double *occ_v;           /* occluding triangles' vertices, m (3 per vertex) */
+    size_t *occ_t;           /* and their indices (3 per triangle) */
+    size_t occ_nv, occ_nt;
+    size_t opaque_cells;
+    size_t leaves;
 };
 
 static double dot(const double a[3], const double b[3])
@@ -68,6 +85,14 @@ phc_climbing_options phc_climbing_options_default(void)
     o.min_stiffness = 0.1;
     o.particles = phc_particles_options_default();
     o.particles.maturity_age = 50;
+    o.leaf_step = 0;
+    o.leaf_angle_deg = 137.5;
+    o.leaf_size = 0.03;
+    o.leaf_thickness = 3e-4;
+    o.leaf_response = 1;
+    o.leaf_max_angle_deg = 80;
+    o.cambium_rate = 0;
+    o.leaf_pipe_area = 0;
     return o;
 }
 
@@ -92,6 +117,21 @@ void phc_climbing_free(phc_climbing *c)
     free(c->anchor_t0);
     free(c->vol);
     free(c->phi);
+    free(c->node_k);
+    free(c->has_leaf);
+    free(c->leaf_c);
+    free(c->leaf_n);
+    free(c->leaf_p);
+    free(c->leaf_light);
+    free(c->r0);
+    free(c->has_child);
+    free(c->target);
+    free(c->sx);
+    free(c->sv);
+    free(c->sI);
+    free(c->opaque);
+    free(c->occ_v);
+    free(c->occ_t);
     free(c);
 }
 
@@ -126,6 +166,18 @@ static int reserve(phc_climbing *c, size_t want)
     GROW(anchor_at, 3);
     GROW(anchor_t0, 1);
     GROW(vol, 1);
+    GROW(node_k, 1);
+    GROW(has_leaf, 1);
+    GROW(leaf_c, 3);
+    GROW(leaf_n, 3);
+    GROW(leaf_p, 3);
+    GROW(leaf_light, 1);
+    GROW(r0, 1);
+    GROW(has_child, 1);
+    GROW(target, 1);
+    GROW(sx, 6);
+    GROW(sv, 2);
+    GROW(sI, 2);
 #undef GROW
     c->cap = cap;
     return 0;
@@ -183,6 +235,20 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
          o->particles.maturity_age, "(0, inf) s when dynamics_substeps > 0");
     NEED(o->anchor_time > 0 && isfinite(o->anchor_time), "anchor_time", o->anchor_time,
          "(0, inf) s");
+    NEED(o->light.ambient >= 0 && o->light.ambient <= 1, "light.ambient", o->light.ambient,
+         "[0, 1]");
+    NEED(isfinite(o->leaf_angle_deg), "leaf_angle_deg", o->leaf_angle_deg, "finite degrees");
+    NEED(o->leaf_size > 0 && isfinite(o->leaf_size), "leaf_size", o->leaf_size, "(0, inf) m");
+    NEED(o->leaf_thickness >= 0 && isfinite(o->leaf_thickness), "leaf_thickness",
+         o->leaf_thickness, "[0, inf) m");
+    NEED(o->leaf_response >= 0 && o->leaf_response <= 1, "leaf_response", o->leaf_response,
+         "[0, 1]");
+    NEED(o->leaf_max_angle_deg >= 0 && o->leaf_max_angle_deg <= 180, "leaf_max_angle_deg",
+         o->leaf_max_angle_deg, "[0, 180] degrees");
+    NEED(o->cambium_rate >= 0 && isfinite(o->cambium_rate), "cambium_rate", o->cambium_rate,
+         "[0, inf) 1/s");
+    NEED(o->leaf_pipe_area >= 0 && isfinite(o->leaf_pipe_area), "leaf_pipe_area",
+         o->leaf_pipe_area, "[0, inf) m^2");
 #undef NEED
     return 0;
 }
@@ -216,6 +282,10 @@ static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int l
     c->age[i] = 0;
     c->light[i] = 1;
     c->anchor_t0[i] = 0;
+    c->node_k[i] = 0;
+    c->has_leaf[i] = 0;
+    c->leaf_light[i] = 0;
+    c->r0[i] = radius;
     const double h = 0.5 * sigma * c->o.max_length;
     for (int k = 0; k < 3; ++k) {
         c->d[3 * i + k] = c->dr[3 * i + k] = dir[k];
@@ -366,6 +436,44 @@ static void tropisms(phc_climbing *c, size_t i, double dt)
         c->x[3 * i + k] = b[k] + h * d[k];
 }
 
+/* keep_outside (ours): turns apical i out when its tip or its centre is
+ * behind the face of its closest support point. */
+static void keep_outside(phc_climbing *c, size_t i)
+{
+    const phc_climbing_options *o = &c->o;
+    if (!o->keep_outside || !o->closest)
+        return;
+    double tip[3], cp[3], nf[3], b[3];
+    seg_tip(c, i, 0, tip);
+    /* the tip, then the centre (a segment that cuts a convex edge has both
+       ends outside and its middle inside) */
+    int behind = 0;
+    for (int pass = 0; pass < 2 && !behind; ++pass) {
+        const double *p = pass ? c->x + 3 * i : tip;
+        if (o->closest(o->closest_user, p, cp, nf))
+            return;
+        const double r[3] = {p[0] - cp[0], p[1] - cp[1], p[2] - cp[2]};
+        behind = dot(r, nf) < 0;
+    }
+    if (!behind)
+        return;
+    double *d = c->d + 3 * i;
+    const double dn = dot(d, nf);
+    double t[3] = {d[0] - dn * nf[0], d[1] - dn * nf[1], d[2] - dn * nf[2]};
+    if (unit(t, t) == 0)
+        for (int k = 0; k < 3; ++k)
+            t[k] += nf[k];
+    else
+        memcpy(t, nf, sizeof t);
+    if (unit(t, t))
+        return;
+    seg_base(c, i, 0, b);
+    phc_climbing_turn(d, c->dr + 3 * i, t, 1);
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        c->x[3 * i + k] = b[k] + h * d[k];
+}
+
 /* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
  * Returns 0 or -1 (out of memory). */
 static int grow(phc_climbing *c, size_t i, double dsig)
@@ -403,6 +511,7 @@ static int grow(phc_climbing *c, size_t i, double dsig)
     if (j == PHC_CLIMBING_NONE)
         return -1;
     memcpy(c->dr + 3 * j, dirr, sizeof dirr);
+    c->node_k[j] = c->node_k[i] + 1;
     if (order >= o->max_order)
         return 0;
     for (unsigned bud = 0; bud < o->max_buds && c->n < o->max_particles; ++bud) {
@@ -420,6 +529,7 @@ static int grow(phc_climbing *c, size_t i, double dsig)
         if (k == PHC_CLIMBING_NONE)
             return -1;
         memcpy(c->dr + 3 * k, ldr, sizeof ldr);
+        keep_outside(c, k);
         c->stats.laterals++;
         if (order + 1 > c->stats.max_order)
             c->stats.max_order = order + 1;
@@ -449,6 +559,13 @@ double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
         return 0;
     const double ramp = fmin(1, (c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
     return c->o.anchor_strength * c->sigma[i] * ramp;
+}
+
+/* Step 9's stiffening: (r/r0)^4, 1 without secondary growth. */
+static double thickness_factor(const phc_climbing *c, size_t i)
+{
+    const double q = c->radius[i] / c->r0[i];
+    return q == 1 ? 1 : q * q * q * q;
 }
 
 /* Step 6: the particles' dynamics on the grown shape. */
@@ -483,7 +600,7 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         phc_quat_from_z(c->d + 3 * i, q);
         if (phc_particles_set_position(p, i, c->x + 3 * i, err) ||
             phc_particles_set_orientation(p, i, q, err) ||
-            phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age), err))
+            phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
             goto done;
         if (c->anchored[i]) {
             const double k = phc_climbing_anchor_strength(c, i);
@@ -559,6 +676,187 @@ static void count(phc_climbing *c)
     c->stats.anchored = anchored;
 }
 
+/* Step 1: light at the particles and the leaves (model/climbing_light.h);
+ * leaves add their volumes s²·thickness to the grid. */
+static void light_step(phc_climbing *c, size_t n0)
+{
+    const phc_climbing_options *o = &c->o;
+    size_t m = 0;
+    for (size_t i = 0; i < n0; ++i) {
+        const double L = c->sigma[i] * o->max_length;
+        c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
+        memcpy(c->sx + 3 * m, c->x + 3 * i, 3 * sizeof *c->sx);
+        c->sv[m++] = c->vol[i];
+    }
+    const double leaf_vol = o->leaf_size * o->leaf_size * o->leaf_thickness;
+    for (size_t i = 0; i < n0; ++i)
+        if (c->has_leaf[i]) {
+            memcpy(c->sx + 3 * m, c->leaf_c + 3 * i, 3 * sizeof *c->sx);
+            c->sv[m++] = leaf_vol;
+        }
+    const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
+    phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi, c->sI);
+    memcpy(c->light, c->sI, n0 * sizeof *c->light);
+    m = n0;
+    for (size_t i = 0; i < n0; ++i)
+        if (c->has_leaf[i])
+            c->leaf_light[i] = c->sI[m++];
+}
+
+/* Step 9: secondary growth by the pipe model. */
+static void cambium(phc_climbing *c, double dt)
+{
+    phc_climbing_pipe_targets(c->n, c->parent, c->radius, c->r0, c->has_leaf,
+                              c->o.leaf_pipe_area, c->has_child, c->target);
+    for (size_t i = 0; i < c->n; ++i)
+        c->radius[i] = phc_climbing_cambium_step(c->radius[i], c->target[i], c->o.cambium_rate, dt);
+}
+
+/* Step 8: new leaves at grown nodes; every blade placed and oriented. */
+static void leaves_update(phc_climbing *c)
+{
+    const phc_climbing_options *o = &c->o;
+    const double alpha = o->leaf_angle_deg * PI / 180, tmax = o->leaf_max_angle_deg * PI / 180;
+    size_t count_leaves = 0;
+    for (size_t i = 0; i < c->n; ++i) {
+        if (!c->has_leaf[i]) {
+            if (c->apical[i] || c->node_k[i] % o->leaf_step != 0)
+                continue;
+            c->has_leaf[i] = 1; /* its first light: the stem's at the node */
+            c->leaf_light[i] = c->light[i];
+        }
+        ++count_leaves;
+        double tip[3];
+        const double *d = c->d + 3 * i;
+        seg_tip(c, i, 0, tip);
+        double *p = c->leaf_p + 3 * i;
+        phc_climbing_leaf_petiole(d, (double)(c->node_k[i] / o->leaf_step), alpha, p);
+        /* a petiole that points into a support within a blade's reach is
+           mirrored in the support's face (ours: blades stay in front of the
+           wall the shoot climbs on), then made ⊥ the stem again */
+        double cp[3], nf[3];
+        if (o->closest && o->closest(o->closest_user, tip, cp, nf) == 0) {
+            const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
+            const double pn = dot(p, nf);
+            if (sqrt(dot(r, r)) < o->leaf_size && pn < 0) {
+                for (int k = 0; k < 3; ++k)
+                    p[k] -= 2 * pn * nf[k];
+                const double pd = dot(p, d);
+                double q[3] = {p[0] - pd * d[0], p[1] - pd * d[1], p[2] - pd * d[2]};
+                if (unit(q, q) == 0)
+                    memcpy(p, q, sizeof q);
+            }
+        }
+        for (int k = 0; k < 3; ++k)
+            c->leaf_c[3 * i + k] = tip[k] + 0.5 * o->leaf_size * p[k];
+        phc_climbing_leaf_normal(d, o->light.direction, o->leaf_response, c->leaf_light[i], tmax,
+                                 c->leaf_n + 3 * i);
+    }
+    c->leaves = count_leaves;
+}
+
+int phc_climbing_set_shadow_triangles(phc_climbing *c, const double *vertices, size_t nv,
+                                      const size_t *triangles, size_t nt, phc_error *err)
+{
+    const size_t cells = phc_climbing_light_cells(&c->o.light);
+    for (size_t t = 0; t < nt; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const size_t v = triangles[3 * t + k];
+            if (v >= nv)
+                return phc_error_set(err, PHC_ERR_INVALID,
+                                     "climbing: shadow triangle %zu: vertex index %zu >= %zu "
+                                     "vertices",
+                                     t, v, nv);
+            for (int j = 0; j < 3; ++j)
+                if (!isfinite(vertices[3 * v + j]))
+                    return phc_error_set(err, PHC_ERR_INVALID,
+                                         "climbing: shadow triangle %zu: vertex %zu is not finite",
+                                         t, v);
+        }
+    if (!c->opaque) {
+        c->opaque = calloc(cells, 1);
+        if (!c->opaque)
+            return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu light cells",
+                                 cells);
+    }
+    if (!c->phi) {
+        c->phi = malloc(cells * sizeof *c->phi);
+        if (!c->phi)
+            return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu light cells",
+                                 cells);
+    }
+    double *nv_ = realloc(c->occ_v, 3 * (c->occ_nv + nv) * sizeof *nv_);
+    if (nv_)
+        c->occ_v = nv_;
+    size_t *nt_ = nv_ ? realloc(c->occ_t, 3 * (c->occ_nt + nt) * sizeof *nt_) : NULL;
+    if (!nv_ || !nt_)
+        return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu shadow triangles",
+                             nt);
+    c->occ_t = nt_;
+    memcpy(c->occ_v + 3 * c->occ_nv, vertices, 3 * nv * sizeof *vertices);
+    for (size_t t = 0; t < 3 * nt; ++t)
+        c->occ_t[3 * c->occ_nt + t] = c->occ_nv + triangles[t];
+    c->occ_nv += nv;
+    c->occ_nt += nt;
+    for (size_t t = 0; t < nt; ++t) {
+        const size_t *v = triangles + 3 * t;
+        c->opaque_cells += phc_climbing_light_mark_triangle(
+            &c->o.light, vertices + 3 * v[0], vertices + 3 * v[1], vertices + 3 * v[2], c->opaque);
+    }
+    return 0;
+}
+
+size_t phc_climbing_opaque_cells(const phc_climbing *c) { return c->opaque_cells; }
+
+int phc_climbing_leaf(const phc_climbing *c, size_t i, double centre[3], double normal[3],
+                      double petiole[3])
+{
+    if (!c->has_leaf[i])
+        return 0;
+    if (centre)
+        memcpy(centre, c->leaf_c + 3 * i, 3 * sizeof *centre);
+    if (normal)
+        memcpy(normal, c->leaf_n + 3 * i, 3 * sizeof *normal);
+    if (petiole)
+        memcpy(petiole, c->leaf_p + 3 * i, 3 * sizeof *petiole);
+    return 1;
+}
+
+double phc_climbing_leaf_light(const phc_climbing *c, size_t i)
+{
+    return c->has_leaf[i] ? c->leaf_light[i] : 0;
+}
+
+int phc_climbing_leaf_quad(const phc_climbing *c, size_t i, double corners[12])
+{
+    if (!c->has_leaf[i])
+        return 0;
+    const double *n = c->leaf_n + 3 * i, *p = c->leaf_p + 3 * i, *x = c->leaf_c + 3 * i;
+    /* blade axes: u = petiole made ⊥ n, v = n × u */
+    const double pn = dot(p, n);
+    double u[3] = {p[0] - pn * n[0], p[1] - pn * n[1], p[2] - pn * n[2]};
+    if (unit(u, u)) { /* petiole along the normal: any u ⊥ n */
+        double e2[3];
+        phc_climbing_leaf_frame(n, u, e2);
+    }
+    const double v[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2],
+                         n[0] * u[1] - n[1] * u[0]};
+    const double h = 0.5 * c->o.leaf_size;
+    static const double su[4] = {-1, 1, 1, -1}, sv[4] = {-1, -1, 1, 1};
+    for (int q = 0; q < 4; ++q)
+        for (int k = 0; k < 3; ++k)
+            corners[3 * q + k] = x[k] + h * (su[q] * u[k] + sv[q] * v[k]);
+    return 1;
+}
+
+size_t phc_climbing_leaf_count(const phc_climbing *c) { return c->leaves; }
+void phc_climbing_light_direction(const phc_climbing *c, double l[3])
+{
+    memcpy(l, c->o.light.direction, 3 * sizeof *l);
+}
+unsigned phc_climbing_node_index(const phc_climbing *c, size_t i) { return c->node_k[i]; }
+double phc_climbing_primary_radius(const phc_climbing *c, size_t i) { return c->r0[i]; }
+
 int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
 {
     const phc_climbing_options *o = &c->o;
@@ -575,18 +873,14 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     for (size_t i = 0; i < n0; ++i)
         c->age[i] += dt;
     /* 1. light */
-    if (o->light.extinction > 0) {
-        for (size_t i = 0; i < n0; ++i) {
-            const double L = c->sigma[i] * o->max_length;
-            c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
-        }
-        phc_climbing_light(&o->light, c->x, c->vol, n0, c->phi, c->light);
-    }
+    if (o->light.extinction > 0 || c->opaque)
+        light_step(c, n0);
     /* 2.–4. tropisms, growth, branching of the tips present at the start */
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])
             continue;
         tropisms(c, i, dt);
+        keep_outside(c, i);
         /* apical dominance (ours): a tip of order k grows at r·a^k */
         const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
         if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
@@ -595,6 +889,14 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
                                  c->n);
         }
     }
+    /* keep_outside (ours) once more on the grown tips, the new ones included */
+    if (o->keep_outside)
+        for (size_t i = 0; i < c->n; ++i)
+            if (c->apical[i])
+                keep_outside(c, i);
+    /* 9. secondary growth */
+    if (o->cambium_rate > 0)
+        cambium(c, dt);
     /* 5. rest shape */
     rebuild_rest(c);
     /* 6. dynamics, or kinematic: current = rest */
@@ -609,6 +911,9 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     }
     /* 7. anchors */
     anchors(c);
+    /* 8. leaves */
+    if (o->leaf_step > 0)
+        leaves_update(c);
     count(c);
     return 0;
 }

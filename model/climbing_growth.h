@@ -51,6 +51,20 @@
  *     weakly and lets its elongation win; an anchor is released when the
  *     particle is farther than release_distance from it.
  *
+ *  8. leaves (model/climbing_leaves.h): every leaf_step-th node of a shoot
+ *     bears a leaf when its particle is grown (σ = 1); each step its blade
+ *     is placed at its node along the phyllotactic petiole and turned toward
+ *     the light it received in step 1 (leaves are light-grid points too, and
+ *     shade it as volumes s²·leaf_thickness).
+ *  9. secondary growth (model/climbing_cambium.h), after step 4 when
+ *     cambium_rate > 0: every radius relaxes toward the pipe model's
+ *     √(Σ children's areas + leaf share)/π); the dynamics see the thicker
+ *     particle as stiffer: its age is passed as max(t_l, s_min·t_m)·(r/r0)⁴
+ *     (bending stiffness E·πr⁴/4 grows as r⁴; the mapping onto the
+ *     particles' age law is ours), r0 its primary radius.
+ * Supports may cast shadows (phc_climbing_set_shadow_triangles: the mesh
+ * rasterised into the light grid's opaque mask, model/climbing_light.h).
+ *
  * Random numbers: model/climbing_rng.h, state in the plant; the same seed
  * and options give the same plant, bit for bit.
  *
@@ -126,6 +140,27 @@ typedef struct phc_climbing_options {
     /* supports */
     phc_climbing_closest_fn closest; /* NULL: no supports */
     void *closest_user;
+    /* leaves (§4.3; model/climbing_leaves.h) */
+    unsigned leaf_step;         /* every leaf_step-th node of a shoot bears a leaf (its
+                                   first node, 0, included); 0: no leaves (default) */
+    double leaf_angle_deg;      /* α, degrees, finite: divergence angle; default 137.5 */
+    double leaf_size;           /* s, m, > 0: side of the square blade; default 0.03 */
+    double leaf_thickness;      /* m, >= 0: a leaf shades the light grid as a volume
+                                   s²·thickness (Beer–Lambert, like the stems); default 3e-4 */
+    double leaf_response;       /* ω ∈ [0, 1]: how far a lit blade turns toward ℓ; default 1 */
+    double leaf_max_angle_deg;  /* θ_max ∈ [0, 180]: largest turn from the default normal;
+                                   default 80 */
+    /* secondary growth (pipe model; model/climbing_cambium.h) */
+    double cambium_rate;        /* κ, s^-1, >= 0: 0 = no secondary growth (default) */
+    double leaf_pipe_area;      /* a_L, m², >= 0: cross-section one leaf adds below it;
+                                   default 0 */
+    /* supports: keep the tips outside (ours) */
+    int keep_outside;           /* 1: a growing tip whose end or centre lies behind the face
+                                   of its closest support point (outward normal n) is turned,
+                                   about its base, to the unit bisector of its tangential
+                                   part and n (45° off the face, outward), so the shoot
+                                   does not grow through a wall at an edge or corner; new
+                                   laterals are checked at birth.  0 (default): off */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -198,6 +233,35 @@ void phc_climbing_segment(const phc_climbing *c, size_t i, double base[3], doubl
 int phc_climbing_anchor(const phc_climbing *c, size_t i, double a[3]);
 /* The anchor's strength now (eq. 5), 0 when not anchored. */
 double phc_climbing_anchor_strength(const phc_climbing *c, size_t i);
+
+/* Rasterises the triangles (nt × 3 vertex indices into vertices, nv × 3,
+ * m) into the light grid's opaque mask: from the next step they block the
+ * direct light (model/climbing_light.h).  May be called more than once
+ * (masks add up).  Errors: an index >= nv or a non-finite vertex
+ * (PHC_ERR_INVALID naming the triangle); out of memory. */
+int phc_climbing_set_shadow_triangles(phc_climbing *c, const double *vertices, size_t nv,
+                                      const size_t *triangles, size_t nt, phc_error *err);
+/* Opaque cells of the light grid (0 without shadows). */
+size_t phc_climbing_opaque_cells(const phc_climbing *c);
+
+/* Leaves: 1 when particle i bears one, with its blade's centre (m), unit
+ * normal and unit petiole direction (any of them may be NULL); else 0. */
+int phc_climbing_leaf(const phc_climbing *c, size_t i, double centre[3], double normal[3],
+                      double petiole[3]);
+/* The light I its leaf received in the last step (0 without a leaf). */
+double phc_climbing_leaf_light(const phc_climbing *c, size_t i);
+/* The four corners (m, counter-clockwise seen from the normal's side) of
+ * i's blade, a square of side leaf_size; 0 without a leaf. */
+int phc_climbing_leaf_quad(const phc_climbing *c, size_t i, double corners[12]);
+/* Leaves on the plant. */
+size_t phc_climbing_leaf_count(const phc_climbing *c);
+/* The unit light direction ℓ in use. */
+void phc_climbing_light_direction(const phc_climbing *c, double l[3]);
+/* Node index of i along its shoot (0 for a shoot's first particle). */
+unsigned phc_climbing_node_index(const phc_climbing *c, size_t i);
+/* The primary radius r0 (m) i was born with (phc_climbing_radius is the
+ * radius now, after secondary growth). */
+double phc_climbing_primary_radius(const phc_climbing *c, size_t i);
 
 #ifdef __cplusplus
 }

@@ -891,8 +891,13 @@ static int cmd_grow(int full_argc, char **full_argv, int argc, char **argv)
         printf("%s\n", s.max_order == 0 ? " none" : "");
         printf("anchored %zu of %zu particles (attached fraction %.3f; made %zu, released %zu)\n", s.anchored,
                s.particles, s.attached_fraction, s.anchors_made, s.anchors_released);
-        printf("results: %s/ (%zu frames, growth.csv, result.json, plant_side.png, plant_front.png)\n", dir,
-               s.frames);
+        if (s.leaves)
+            printf("leaves %zu, mean cos(leaf normal, light direction) %.3f\n", s.leaves, s.mean_leaf_cos);
+        if (cfg->options.cambium_rate > 0)
+            printf("secondary growth: thickest radius %.4g mm (primary %.4g mm)\n", 1e3 * s.max_radius,
+                   1e3 * cfg->options.radius);
+        printf("results: %s/ (%zu frames, growth.csv, result.json, plant_side.png, plant_front.png, plant.obj)\n",
+               dir, s.frames);
     }
     phc_provenance_free(pv);
     phc_grow_config_free(cfg);

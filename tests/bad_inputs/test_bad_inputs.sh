@@ -1499,6 +1499,30 @@ gr_config gr_rel.yaml gr_wall.obj '[0, 0.03, 0]' 'anchors:
   attach_distance: 0.03
 '
 grow_case "grow: release distance not above attach distance" "$C/gr_rel.yaml" "gr_rel.yaml:7" "release_distance"
+gr_config gr_leafang.yaml gr_wall.obj '[0, 0.03, 0]' 'leaves:
+  angle: 400
+'
+grow_case "grow: leaf divergence angle over 360 degrees" "$C/gr_leafang.yaml" "gr_leafang.yaml:7" "leaves.angle" "[0, 360]"
+gr_config gr_leafsize.yaml gr_wall.obj '[0, 0.03, 0]' 'leaves:
+  size: 0
+'
+grow_case "grow: leaf size zero" "$C/gr_leafsize.yaml" "gr_leafsize.yaml:7" "leaves.size" "(0, inf)"
+gr_config gr_leafstep.yaml gr_wall.obj '[0, 0.03, 0]' 'leaves:
+  step: 1.5
+'
+grow_case "grow: leaf step not an integer" "$C/gr_leafstep.yaml" "gr_leafstep.yaml:7" "leaves.step"
+gr_config gr_camb.yaml gr_wall.obj '[0, 0.03, 0]' 'cambium:
+  rate: -1
+'
+grow_case "grow: negative cambium rate" "$C/gr_camb.yaml" "gr_camb.yaml:7" "cambium.rate"
+gr_config gr_shadow.yaml gr_wall.obj '[0, 0.03, 0]' 'light:
+  supports_cast_shadows: maybe
+'
+grow_case "grow: shadows neither true nor false" "$C/gr_shadow.yaml" "gr_shadow.yaml:7" "supports_cast_shadows"
+gr_config gr_amb.yaml gr_wall.obj '[0, 0.03, 0]' 'light:
+  ambient: 1.5
+'
+grow_case "grow: ambient light share over 1" "$C/gr_amb.yaml" "gr_amb.yaml:7" "light.ambient" "[0, 1]"
 # ---- end grow ----------------------------------------------------------------
 
 # ----------------------------------------------------------------------------
