@@ -1,6 +1,6 @@
 /* The LAPACKE and CBLAS functions libphytocal calls (model/water.c,
- * water_balance.c, particles.c, rod.c; fit/engine/fit.c, uncertainty.c,
- * sensitivity.c), forwarded to liblapacke and OpenBLAS opened on first use
+ * water_balance.c, particles.c, rod.c; the fit analysis uses
+ * model/jacobi_svd instead), forwarded to liblapacke and OpenBLAS opened on first use
  * (measurements/lazy_library_internal.h): a run that solves no eigen- or
  * singular-value problem never loads them (nor the reference LAPACK,
  * gfortran and quadmath behind them).  Prototypes: lapacke.h and
@@ -10,10 +10,6 @@
 
 #include "measurements/lazy_library_internal.h"
 
-PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dgelsd,
-                 (int layout, lapack_int m, lapack_int n, lapack_int nrhs, double *a, lapack_int lda, double *b,
-                  lapack_int ldb, double *s, double rcond, lapack_int *rank),
-                 (layout, m, n, nrhs, a, lda, b, ldb, s, rcond, rank))
 PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dgesvd,
                  (int layout, char jobu, char jobvt, lapack_int m, lapack_int n, double *a, lapack_int lda,
                   double *s, double *u, lapack_int ldu, double *vt, lapack_int ldvt, double *superb),
@@ -21,9 +17,6 @@ PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dgesvd,
 PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dstedc,
                  (int layout, char compz, lapack_int n, double *d, double *e, double *z, lapack_int ldz),
                  (layout, compz, n, d, e, z, ldz))
-PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dsyev,
-                 (int layout, char jobz, char uplo, lapack_int n, double *a, lapack_int lda, double *w),
-                 (layout, jobz, uplo, n, a, lda, w))
 PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dsyevd,
                  (int layout, char jobz, char uplo, lapack_int n, double *a, lapack_int lda, double *w),
                  (layout, jobz, uplo, n, a, lda, w))

@@ -28,8 +28,8 @@ int phc_jacobi_svd(double *A, size_t m, size_t n, double *s, double *V)
                     beta += aq * aq;
                     gamma += ap * aq;
                 }
-                /* columns orthogonal to working precision (Demmel & Veselic
-                   eq. 4.2: |a_p . a_q| <= tol |a_p| |a_q|, with tol = sqrt(m)
+                /* columns orthogonal to working precision (the relative
+                   test |a_p . a_q| <= tol |a_p| |a_q|, with tol = sqrt(m)
                    eps as LAPACK's dgesvj: the computed dot product of two
                    m-vectors itself carries that much rounding, so a smaller
                    tol can rotate forever), or one of them zero to working
