@@ -89,6 +89,9 @@ int phc_growth_plot_side(const char *path, const phc_growth *const *plants,
     if (!isfinite(x0)) return phc_error_set(err, PHC_ERR_INVALID, "growth side view: empty plants");
     double padx = 0.05 * (x1 - x0 + 0.02), padz = 0.05 * (z1 - z0 + 0.02);
     x0 -= padx; x1 += padx; z0 -= padz; z1 += padz;
+    const int lib = phc_plot_library_open(path, err);
+    if (lib)
+        return lib;
     int dev = phc_plot_device_available("pngcairo");
     if (dev <= 0)
         return dev < 0 ? phc_error_set(err, PHC_ERR_NOMEM, "%s: out of memory", path)

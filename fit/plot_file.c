@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "measurements/lazy_library_internal.h"
+
 /* Copy of s with PLplot's escape character doubled; "" for NULL. */
 char *phc_plot_escape(const char *s)
 {
@@ -29,6 +31,11 @@ char *phc_plot_escape(const char *s)
     }
     *p = '\0';
     return out;
+}
+
+int phc_plot_library_open(const char *path, phc_error *err)
+{
+    return phc_lazy_library_open(&phc_lazy_plplot, path, err);
 }
 
 int phc_plot_device_available(const char *name)
@@ -75,6 +82,9 @@ int phc_plot_png_complete(const char *file)
 int phc_plot_begin(const char *path, int w, int h, phc_atomic_file **af, int *old_stream, phc_error *err)
 {
     *af = NULL;
+    const int lib = phc_plot_library_open(path, err);
+    if (lib)
+        return lib;
     const int dev = phc_plot_device_available("pngcairo");
     if (dev <= 0)
         return phc_error_set(err, dev < 0 ? PHC_ERR_NOMEM : PHC_ERR_INTERNAL,

@@ -12,8 +12,15 @@
 /* s with PLplot's escape character '#' doubled (malloc'd; NULL when out of
  * memory; NULL s gives ""). */
 char *phc_plot_escape(const char *s);
-/* 1 when PLplot has the device `name`, 0 when not, -1 when it cannot tell. */
+/* 1 when PLplot has the device `name`, 0 when not, -1 when it cannot tell.
+ * Opens PLplot (measurements/lazy_library_internal.h): call phc_plot_library_open
+ * first where a failure can be reported. */
 int phc_plot_device_available(const char *name);
+/* Opens PLplot if not yet open (libphytocal loads it on the first plot, not
+ * at start-up): PHC_OK or PHC_ERR_IO "PATH: cannot load the plotting
+ * (PLplot) library libplplot.so.N: <dlerror>".  Every plot calls it before
+ * its first PLplot call. */
+int phc_plot_library_open(const char *path, phc_error *err);
 /* The PNG goes to the temporary file of a phc_atomic_file (PLplot writes it
  * by name: plsfnam(phc_atomic_file_temp_path(af))).  Finishing it: when
  * status is PHC_OK and the file is a complete PNG, commits it to its path;

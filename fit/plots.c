@@ -294,6 +294,9 @@ static int plot_begin(plot_ctx *ctx, const char *path, size_t groups, phc_error 
     ctx->pixels = NULL;
     ctx->groups = groups;
     ctx->key_w = 0.0;
+    const int lib = phc_plot_library_open(path, err); /* PLplot: opened on the first plot */
+    if (lib)
+        return lib;
     plgstrm(&ctx->old_stream);
 
     double lut[3 * 256] = {0};

@@ -218,6 +218,9 @@ int phc_shape_plot(const char *path, const phc_shape_panel *panels, size_t count
     const int page_h = o.page_height > 0 ? o.page_height : (int)(520 * rows + 120);
     frame f = common_frame(panels, count, &o);
     f.chr = cols * rows > 2 ? 0.8 * CHAR_SCALE : CHAR_SCALE; /* smaller letters in grids */
+    const int lib = phc_plot_library_open(path, err);
+    if (lib)
+        return lib;
     char *bar_label = phc_plot_escape(o.value_label ? o.value_label : "value");
     char *title = phc_plot_escape(o.title ? o.title : "");
     if (!bar_label || !title) {

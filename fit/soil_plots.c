@@ -155,6 +155,9 @@ int phc_plot_soil_slice(const char *path, const char *title,
     if (!isfinite(nodata))
         nodata = -HUGE_VAL;
 
+    const int lib = phc_plot_library_open(path, err);
+    if (lib)
+        return lib;
     char *t_title = phc_plot_escape(title), *t_bar = phc_plot_escape(colorbar_label);
     char sub[160];
     double pos = ((double)index + 0.5) * dx;

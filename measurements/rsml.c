@@ -15,6 +15,7 @@
 
 #include "measurements/atomic_file.h"
 #include "measurements/c_number.h"
+#include "measurements/lazy_library_internal.h"
 
 /* ---- the in-memory document ---------------------------------------------- */
 
@@ -751,6 +752,9 @@ int phc_rsml_read_with(const char *path, const phc_rsml_read_options *options, p
         return phc_error_set(err, PHC_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     fclose(probe);
 
+    int lib = phc_lazy_library_open(&phc_lazy_xml, path, err); /* libxml2, opened on first use */
+    if (lib)
+        return lib;
     xmlInitParser();
     ctxt = xmlNewParserCtxt();
     if (!ctxt) {
@@ -1048,6 +1052,8 @@ int phc_rsml_write(const phc_rsml *r, const char *path, phc_error *err)
         *last = i;
     }
 
+    if ((rc = phc_lazy_library_open(&phc_lazy_xml, path, err))) /* libxml2, opened on first use */
+        goto fail;
     if ((rc = phc_atomic_file_open(path, &af, err)))
         goto fail;
     f = phc_atomic_file_stream(af);

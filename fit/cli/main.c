@@ -1324,6 +1324,14 @@ int main(int argc, char **argv)
     /* GSL's default error handler aborts; the library checks its inputs and
      * reports errors itself. */
     gsl_set_error_handler_off();
+    /* OpenBLAS (loaded with the Ceres module's SuiteSparse, or for the water
+     * model's eigenproblems) starts a worker per core when it loads, and each
+     * spins about 2^28 cycles waiting for work: 50-60 ms of CPU in a small
+     * fit that never calls a threaded BLAS routine (README "Speed").  One
+     * thread unless the user chose otherwise; phytocal's own parallel loops
+     * use OpenMP, which this does not touch. */
+    if (!getenv("OPENBLAS_NUM_THREADS") && !getenv("GOTO_NUM_THREADS") && !getenv("OMP_NUM_THREADS"))
+        setenv("OPENBLAS_NUM_THREADS", "1", 0);
     if (argc < 2) {
         usage(stderr);
         fprintf(stderr, "(phytocal --help explains the commands, exit codes and data-set kinds)\n");

@@ -4,7 +4,6 @@
 #include "fit/engine/provenance.h"
 
 #include <gsl/gsl_cdf.h>
-#include <lapacke.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -15,6 +14,7 @@
 #include "fit/engine/multistart.h"
 #include "fit/engine/residual_checks.h"
 #include "fit/engine/uncertainty.h"
+#include "model/jacobi_svd.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -658,7 +658,7 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
     if (nf == 0 || m < nf)
         return PHC_OK;
     double *r = malloc(m * sizeof *r), *J = malloc(m * np * sizeof *J), *A = malloc(m * nf * sizeof *A);
-    double *b = malloc(m * sizeof *b), *sv = malloc(nf * sizeof *sv), *trial = malloc(np * sizeof *trial);
+    double *b = malloc(m * sizeof *b), *sv = malloc((3 * nf + nf * nf) * sizeof *sv), *trial = malloc(np * sizeof *trial);
     double *colscale = malloc(nf * sizeof *colscale);
     size_t *fi = malloc(nf * sizeof *fi);
     int rc = PHC_OK;
@@ -692,16 +692,17 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
         }
         for (size_t i = 0; i < m; ++i)
             b[i] = -r[i];
-        lapack_int rank = 0;
-        if (LAPACKE_dgelsd(LAPACK_ROW_MAJOR, (lapack_int)m, (lapack_int)nf, 1, A, (lapack_int)nf, b, 1, sv,
-                           1e-13, &rank) != 0 || (size_t)rank < nf)
+        /* sv: 2 nf of work space, the step (nf), V (nf x nf) */
+        double *step_f = sv + 2 * nf, *V = sv + 3 * nf;
+        size_t rank = 0;
+        if (phc_jacobi_lstsq(A, m, nf, b, 1e-13, V, sv, step_f, &rank) != 0 || rank < nf)
             break; /* rank-deficient: leave it to the covariance analysis */
         double step = 0;
         memcpy(trial, x, np * sizeof *x);
         int inside = 1;
         for (size_t f = 0; f < nf; ++f) {
             const size_t i = fi[f];
-            const double d = b[f] / colscale[f];
+            const double d = step_f[f] / colscale[f];
             trial[i] = x[i] + d;
             step = fmax(step, fabs(d) / (fabs(x[i]) + phc_problem_scale(pb, i) * 1e-300 + 1e-300));
             inside &= trial[i] >= pb->params[i].lower && trial[i] <= pb->params[i].upper;

@@ -2,10 +2,11 @@
 #include "fit/engine/sensitivity.h"
 
 #include <float.h>
-#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "model/jacobi_svd.h"
 
 void phc_sensitivity_clear(phc_sensitivity *s)
 {
@@ -31,21 +32,24 @@ static int by_gamma_desc(const void *a, const void *b)
     return (ga < gb) - (ga > gb);
 }
 
-/* gamma of one subset from the Gram matrix G = Sn'Sn of all columns. */
+/* gamma of one subset from the Gram matrix G = Sn'Sn of all columns: its
+ * k x k block is symmetric positive semi-definite, so its eigenvalues are
+ * its singular values (model/jacobi_svd.h: no LAPACK, no allocation). */
 static double subset_gamma(const double *G, size_t n, const size_t *idx, size_t k)
 {
-    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], w[PHC_COLLIN_MAX_SIZE];
+    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], V[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE],
+        w[PHC_COLLIN_MAX_SIZE];
     for (size_t a = 0; a < k; ++a)
         for (size_t b = 0; b < k; ++b)
             A[a * k + b] = G[idx[a] * n + idx[b]];
-    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'N', 'U', (lapack_int)k, A, (lapack_int)k, w) != 0)
+    if (phc_jacobi_svd(A, k, k, w, V) != 0)
         return NAN;
-    /* Singular to working precision counts as singular: dsyev's eigenvalues
+    /* Singular to working precision counts as singular: the eigenvalues
      * carry an absolute error of a few k eps lambda_max, so two proportional
-     * columns (y = a b x) give lambda_min ~ +-1e-16 and gamma ~ 1e8 rather
-     * than inf, depending on rounding. */
-    const double lmin = w[0];
-    return lmin > 4.0 * (double)k * DBL_EPSILON * w[k - 1] ? 1.0 / sqrt(lmin) : INFINITY;
+     * columns (y = a b x) give lambda_min ~ 1e-16 and gamma ~ 1e8 rather
+     * than inf, depending on rounding.  w is in descending order. */
+    const double lmin = w[k - 1];
+    return lmin > 4.0 * (double)k * DBL_EPSILON * w[0] ? 1.0 / sqrt(lmin) : INFINITY;
 }
 
 int phc_sensitivity_compute(const double *S, size_t m, size_t n, size_t max_sets,

@@ -1,11 +1,12 @@
 /* Covariance at the optimum: see uncertainty.h. */
 #include "fit/engine/uncertainty.h"
 
-#include <lapacke.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "model/jacobi_svd.h"
 
 /* |J_j| * scale_j: how much the residuals move for a relative change of p_j. */
 static double column_effect(const double *J, size_t m, size_t ld, size_t j, const double *scale)
@@ -33,19 +34,19 @@ int phc_covariance_compute(const double *J, size_t m, size_t n, double s2, doubl
     memset(out, 0, sizeof *out);
     if (!J || n == 0 || m == 0)
         return phc_error_set(err, PHC_ERR_INVALID, "covariance: empty Jacobian");
-    const size_t mm = m > n ? m : n; /* pad rows so that LAPACK sees m >= n */
+    const size_t mm = m > n ? m : n; /* rows padded with zeros when m < n */
     double *A = calloc(mm * n, sizeof *A);
     double *D = calloc(n, sizeof *D);
     double *S = calloc(n, sizeof *S);
     double *VT = calloc(n * n, sizeof *VT);
-    double *superb = calloc(n, sizeof *superb);
+    double *V = calloc(n * n, sizeof *V);
     out->n = n;
     out->cov = calloc(n * n, sizeof *out->cov);
     out->stderr_ = calloc(n, sizeof *out->stderr_);
     out->correlation = calloc(n * n, sizeof *out->correlation);
     out->null_vectors = calloc(n * n, sizeof *out->null_vectors);
     int rc = PHC_OK;
-    if (!A || !D || !S || !VT || !superb || !out->cov || !out->stderr_ || !out->correlation ||
+    if (!A || !D || !S || !VT || !V || !out->cov || !out->stderr_ || !out->correlation ||
         !out->null_vectors) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "covariance: out of memory");
         goto fail;
@@ -69,12 +70,15 @@ int phc_covariance_compute(const double *J, size_t m, size_t n, double s2, doubl
     for (size_t i = 0; i < m; ++i)
         for (size_t j = 0; j < n; ++j)
             A[i * n + j] = D[j] > 0 ? J[i * n + j] / D[j] : 0.0;
-    lapack_int info = LAPACKE_dgesvd(LAPACK_ROW_MAJOR, 'N', 'A', (lapack_int)mm, (lapack_int)n, A,
-                                     (lapack_int)n, S, NULL, 1, VT, (lapack_int)n, superb);
-    if (info != 0) {
-        rc = phc_error_set(err, PHC_ERR_NUMERIC, "covariance: SVD did not converge (LAPACK info %d)", (int)info);
+    /* the SVD by one-sided Jacobi (model/jacobi_svd.h: no LAPACK to load);
+       VT[k][a] = V[a][k], the k-th right singular vector */
+    if (phc_jacobi_svd(A, mm, n, S, V)) {
+        rc = phc_error_set(err, PHC_ERR_NUMERIC, "covariance: SVD did not converge (Jacobi, 60 sweeps)");
         goto fail;
     }
+    for (size_t k = 0; k < n; ++k)
+        for (size_t a = 0; a < n; ++a)
+            VT[k * n + a] = V[a * n + k];
     const double smax = S[0];
     size_t rank = 0;
     for (size_t k = 0; k < n; ++k)
@@ -114,7 +118,7 @@ fail:
     free(D);
     free(S);
     free(VT);
-    free(superb);
+    free(V);
     if (rc)
         phc_covariance_clear(out);
     return rc;

@@ -281,7 +281,7 @@ for m in ceres photo mesh netcdf; do
 done
 if [ -x "$P/bin/phytocal" ]; then
     env -u LD_LIBRARY_PATH LD_DEBUG=files "$P/bin/phytocal" version >/dev/null 2>"$T/version.ld"
-    heavy=$(grep -o 'file=[^ ]*\(phytocal_[a-z]*\|libopencv_[a-z]*\|libnetcdf\|libassimp\|libceres\|libhdf5\)[^ ]*' \
+    heavy=$(grep -o 'file=[^ ]*\(phytocal_[a-z]*\|libopencv_[a-z]*\|libnetcdf\|libassimp\|libceres\|libhdf5\|libplplot\|liblapacke\|libopenblas\|libxml2\)[^ ]*' \
             "$T/version.ld" | sort -u | tr '\n' ' ')
     [ -z "$heavy" ] || why "phytocal version loaded $heavy"
     grep -q 'file=.*libphytocal' "$T/version.ld" ||
@@ -294,6 +294,12 @@ if [ -x "$P/bin/phytocal" ]; then
         ceres=$(sed -n 's/.*file=\([^ ]*phytocal_ceres\.so\) .*/\1/p' "$T/fit.ld" | head -n 1)
         [ -n "$ceres" ] && [ "$(readlink -f "$ceres")" = "$(readlink -f "$LIBDIR/phytocal_ceres.so")" ] ||
             why "the installed fit did not load $LIBDIR/phytocal_ceres.so (loaded: '${ceres}')"
+        # PLplot (the plots): opened by the library when the fit draws
+        # (measurements/lazy_library.c); the analysis needs no LAPACKE
+        # (model/jacobi_svd.h), so a curve fit does not load it (OpenBLAS
+        # comes with the Ceres module's SuiteSparse)
+        grep -q "file=[^ ]*libplplot\.so" "$T/fit.ld" || why "the installed fit did not load libplplot"
+        ! grep -q "file=[^ ]*liblapacke" "$T/fit.ld" || why "the installed curve fit loaded liblapacke"
     fi
 fi
 cat >"$T/modules.c" <<'EOF'
@@ -371,7 +377,7 @@ else
             why "the missing mesh module's message does not name it and its path: $(tail_of "$T/missing.out")"
     fi
 fi
-finish "modules beside the library: version loads none, fit loads Ceres, photo and mesh calls theirs, a missing one is PHC_ERR_IO naming it"
+finish "modules beside the library: version loads none (nor PLplot, LAPACKE, OpenBLAS, libxml2), fit loads Ceres and PLplot (not LAPACKE), photo and mesh calls theirs, a missing one is PHC_ERR_IO naming it"
 
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]
