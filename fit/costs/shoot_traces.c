@@ -564,6 +564,31 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
             goto fail_ds;
         }
     }
+    /* the traced plant is one draw of the process and the model value a mean over K:
+     * each sigma is widened by the seed-to-seed spread sd at the start options,
+     * sigma^2 = sigma_given^2 + (1 + 1/K) sd^2 */
+    {
+        double *p0 = malloc(im->k * sizeof *p0), *y0 = malloc(n * sizeof *y0), *sd0 = malloc(n * sizeof *sd0);
+        if (!p0 || !y0 || !sd0) {
+            free(p0); free(y0); free(sd0);
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_ds;
+        }
+        for (size_t j = 0; j < im->k; ++j) p0[j] = *slot_ref(&im->o.plant, im->slot[j]);
+        int r = phc_shoot_traces_model(ds, p0, y0, sd0);
+        for (i = 0; !r && i < n; ++i) {
+            const double v = isfinite(sd0[i]) ? sd0[i] : 0;
+            ds->sigma[i] = sqrt(ds->sigma[i] * ds->sigma[i] + (1 + 1.0 / (double)o->seeds) * v * v);
+        }
+        free(p0); free(y0); free(sd0);
+        if (r) {
+            rc = phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_INPUT,
+                               "shoot_traces: the model plant cannot be grown at the start options (or it "
+                               "makes no lateral while the traces have some)");
+            goto fail_ds;
+        }
+        im->plants = 0;
+    }
     ds->x_label = strdup("time (s)");
     ds->y_label = strdup("statistic (its unit)");
     ds->derivatives = PHC_DERIV_ANALYTIC;

@@ -18,7 +18,10 @@
  *
  * σ per statistic: lengths and height max(σ_rel·value, σ_len) (defaults
  * 0.1 and 0.01 m), attached fraction and light cosine 0.05, counts
- * sqrt(max(1, count)) (Poisson), angles 5°.
+ * sqrt(max(1, count)) (Poisson), angles 5°; then widened by the spread of
+ * the statistic between the K model plants at the start options (the grow
+ * config's values): σ² = σ_given² + (1 + 1/K)·sd², because the traced plant
+ * is one draw of the random process and the model value a mean over K.
  *
  * Slots (the grow config's values are the start of the ones not fitted):
  * branch_probability, direction_variance, phototropism (s-1),
