@@ -393,7 +393,7 @@ static int st_report_section(phc_dataset *ds, const double *p, char **markdown, 
         fprintf(f, "| %g | %s | %.4g | %.4g | %.3g | %.3g |\n", im->times[im->tindex[i]], stat_names[im->stat[i]],
                 ds->y[i], y[i], sd[i], ds->sigma ? ds->sigma[i] : 1.0);
     fprintf(f, "\nIdentifiability from the statistics (this data set's Jacobian at the fitted values, "
-               "sigma as given, not rescaled): rank %zu of %zu, condition number %.3g.\n\n",
+               "the data set's sigma, not rescaled by the fit's residual variance): rank %zu of %zu, condition number %.3g.\n\n",
             id.rank, ds->k, id.condition);
     fprintf(f, "| parameter | estimate | 95%% interval | sensitivity | most collinear with | identifiable | why |\n"
                "|---|---:|---|---:|---|---|---|\n");
