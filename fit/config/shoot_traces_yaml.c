@@ -31,7 +31,9 @@ static const phc_key_help shoot_traces_help[] = {
     {"sigma", "{relative, length, fraction, cosine, angle}: lengths and height have sigma "
               "max(relative * value, length) (default 0.1, 0.01 m), attached fraction and light "
               "cosine `fraction` and `cosine` (0.05), angles `angle` degrees (5); shoot counts "
-              "sqrt(max(1, count))."},
+              "sqrt(max(1, count)); then each is widened by the statistic's spread sd between the K "
+              "model plants at the grow config's values: sigma^2 + (1 + 1/K) sd^2. Default: "
+              "those values."},
     {"fd_step", "Relative step of the central differences, in (0, 1). Default: 0.05."},
     {NULL, NULL}};
 
