@@ -28,6 +28,7 @@ static const phc_kind *const kinds[] = {
     &phc_pv_curve_kind,
     &phc_root_shoot_kind,
     &phc_shape_series_kind,
+    &phc_shoot_traces_kind,
     &phc_soil_probe_kind,
     &phc_weight_curve_kind,
 };

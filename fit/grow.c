@@ -317,7 +317,7 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
 
 /* The light grid when the config gives none: the support's box (or, with
  * no support, a 1 m box over the seed) widened by 0.25 m on every side. */
-static void default_light_grid(const phc_grow_config *cfg, const phc_support_mesh *m, phc_climbing_options *o)
+void phc_grow_light_grid(const phc_grow_config *cfg, const phc_support_mesh *m, phc_climbing_options *o)
 {
     double lo[3], hi[3];
     if (cfg->light_grid_given) {
@@ -371,7 +371,7 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
     }
     phc_climbing_options o = cfg->options;
     if (o.light.extinction > 0 || cfg->light_grid_given || (mesh && cfg->shadows))
-        default_light_grid(cfg, mesh, &o);
+        phc_grow_light_grid(cfg, mesh, &o);
     if (mesh) {
         o.closest = phc_support_mesh_closest;
         o.closest_user = mesh;

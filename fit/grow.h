@@ -49,6 +49,12 @@ typedef struct phc_grow_summary {
     double max_radius;         /* m: thickest particle (after secondary growth) */
 } phc_grow_summary;
 
+/* Fills o's light grid (origin and dims) when the config gives none: the
+ * support's box (or, with no support, a 1 m box over the seed) widened by
+ * 0.25 m on every side; with light.origin and light.size given, their box. */
+struct phc_support_mesh;
+void phc_grow_light_grid(const phc_grow_config *cfg, const struct phc_support_mesh *m, phc_climbing_options *o);
+
 void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_grow_summary *s);
 
 /* The plant's current shape as a finished plant graph (segment base =

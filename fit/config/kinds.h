@@ -12,6 +12,7 @@ extern const phc_kind phc_leaf_photos_kind;
 extern const phc_kind phc_pv_curve_kind;
 extern const phc_kind phc_root_shoot_kind;
 extern const phc_kind phc_shape_series_kind;
+extern const phc_kind phc_shoot_traces_kind;
 extern const phc_kind phc_soil_probe_kind;
 extern const phc_kind phc_weight_curve_kind;
 

@@ -1525,6 +1525,33 @@ gr_config gr_amb.yaml gr_wall.obj '[0, 0.03, 0]' 'light:
 grow_case "grow: ambient light share over 1" "$C/gr_amb.yaml" "gr_amb.yaml:7" "light.ambient" "[0, 1]"
 # ---- end grow ----------------------------------------------------------------
 
+# ---- shoot_traces (traced shoots of a climbing plant) ------------------------
+gr_config st_plant.yaml gr_wall.obj '[0, 0.03, 0]'
+st_config() { # FILE TRACES [EXTRA_LINES]
+    printf 'name: st\nparameters:\n  branch_probability: {value: 0.3, lower: 0, upper: 1}\ndatasets:\n  - kind: shoot_traces\n    file: %s\n    plant: st_plant.yaml\n    seeds: 2\n%s' "$2" "${3:-}" >"$C/$1"
+}
+printf 'time,shoot,x,y,z,parent\n0,a,0,0.03,0,\n1,a,0,0.03,0.01,\n1,b,0,0.03,0.005,c\n2,b,0.01,0.03,0.01,c\n' >"$C/st_parent.csv"
+st_config st_parent.yaml st_parent.csv
+fit_case "shoot_traces: unknown parent shoot" "$C/st_parent.yaml" "st_parent.csv:4" "column 'parent'" "'c'"
+printf 'time,shoot,x,y,z\n0,a,0,0.03,0\n2,a,0,0.03,0.01\n1,a,0,0.03,0.02\n' >"$C/st_back.csv"
+st_config st_back.yaml st_back.csv
+fit_case "shoot_traces: time going backwards within a shoot" "$C/st_back.yaml" "st_back.csv:4" "column 'time'" "backwards"
+printf 'time,shoot,x,y,z\n0,a,0,0.03,0\n1,a,0,n/a,0.01\n' >"$C/st_text.csv"
+st_config st_text.yaml st_text.csv
+fit_case "shoot_traces: non-numeric cell" "$C/st_text.yaml" "st_text.csv:3" "column 'y'" "n/a"
+printf 'time,shoot,x,y,z\n0,a,0,0.03,0\n1,a,0,0.03,0.01\n1,b,0,0.03,0.01\n' >"$C/st_one.csv"
+st_config st_one.yaml st_one.csv
+fit_case "shoot_traces: a shoot with one point" "$C/st_one.yaml" "st_one.csv:4" "at least 2"
+printf 'time,shoot,x,y,z\n0,a,0,0.03,0\n1,a,0,0.03,0.01\n' >"$C/st_ok.csv"
+st_config st_late.yaml st_ok.csv '    times: [0.5, 3]
+'
+fit_case "shoot_traces: observation time after the traces" "$C/st_late.yaml" "st_late.yaml:5" "3 s"
+st_config st_seeds.yaml st_ok.csv '    seeds: 0
+'
+sed -i '0,/    seeds: 2/{/    seeds: 2/d}' "$C/st_seeds.yaml"
+fit_case "shoot_traces: zero seeds" "$C/st_seeds.yaml" "st_seeds.yaml:8" "'seeds'"
+# ---- end shoot_traces --------------------------------------------------------
+
 # ----------------------------------------------------------------------------
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

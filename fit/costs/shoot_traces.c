@@ -1,0 +1,707 @@
+/* `shoot_traces` data sets: see shoot_traces.h. */
+#include "fit/costs/shoot_traces.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fit/engine/problem.h"
+#include "model/climbing_statistics.h"
+
+enum { ST_TOTAL, ST_MAIN, ST_HEIGHT, ST_ATTACHED, ST_COSINE, ST_COUNT1, ST_ANGLE_MEAN = ST_COUNT1 + 7, ST_ANGLE_SD,
+       ST_N };
+
+static const char *const stat_names[ST_N] = {
+    "total_length (m)", "main_length (m)", "height (m)", "attached_fraction", "light_cosine",
+    "shoots order 1", "shoots order 2", "shoots order 3", "shoots order 4", "shoots order 5",
+    "shoots order 6", "shoots order 7", "angle_mean (deg)", "angle_sd (deg)"};
+
+static const char *const slot_names[] = {"branch_probability", "direction_variance", "phototropism",
+                                         "surface_adaption", "growth_rate", "apical_dominance",
+                                         "thickness_falloff", "min_stiffness", "anchor_strength"};
+static const char *const slot_units[] = {"1", "1", "s-1", "s-1", "s-1", "1", "1", "1", "1"};
+#define N_SLOTS (sizeof slot_names / sizeof slot_names[0])
+
+static double *slot_ref(phc_climbing_options *o, size_t s)
+{
+    switch (s) {
+    case 0: return &o->branch_probability;
+    case 1: return &o->direction_variance;
+    case 2: return &o->phototropism;
+    case 3: return &o->surface_adaption;
+    case 4: return &o->growth_rate;
+    case 5: return &o->apical_dominance;
+    case 6: return &o->thickness_falloff;
+    case 7: return &o->min_stiffness;
+    default: return &o->anchor_strength;
+    }
+}
+
+typedef struct st_impl {
+    phc_shoot_traces *traces;
+    phc_shoot_traces_options o;   /* times point into `times` below */
+    double *times;
+    size_t n_times;
+    size_t *steps;                /* round(t_j / Δt) */
+    int *stat;                    /* n: statistic of each observation */
+    size_t *tindex;               /* n: time index of each observation */
+    size_t slot[N_SLOTS];         /* data-set slot j -> slot_names index */
+    size_t k;
+    unsigned long plants;         /* plants grown */
+} st_impl;
+
+phc_shoot_traces_options phc_shoot_traces_options_default(void)
+{
+    phc_shoot_traces_options o;
+    memset(&o, 0, sizeof o);
+    o.plant = phc_climbing_options_default();
+    o.direction[2] = 1;
+    o.time_step = 0.25;
+    o.seeds = 8;
+    o.first_seed = o.plant.seed;
+    o.sigma_rel = 0.1;
+    o.sigma_length = 0.01;
+    o.sigma_fraction = 0.05;
+    o.sigma_cosine = 0.05;
+    o.sigma_angle = 5;
+    o.fd_step = 0.05;
+    return o;
+}
+
+static void st_free(void *p)
+{
+    st_impl *im = p;
+    if (!im) return;
+    phc_shoot_traces_free(im->traces);
+    if (im->o.support_free) im->o.support_free(im->o.support_owner);
+    free(im->times);
+    free(im->steps);
+    free(im->stat);
+    free(im->tindex);
+    free(im);
+}
+
+static double stat_value(const phc_climbing_summary *s, int id)
+{
+    switch (id) {
+    case ST_TOTAL: return s->total_length;
+    case ST_MAIN: return s->main_length;
+    case ST_HEIGHT: return s->height;
+    case ST_ATTACHED: return s->attached_fraction;
+    case ST_COSINE: return s->light_cosine;
+    case ST_ANGLE_MEAN: return s->angle_mean;
+    case ST_ANGLE_SD: return s->angle_sd;
+    default: return s->shoots[id - ST_COUNT1 + 1];
+    }
+}
+
+static phc_climbing_stat_options stat_options(const phc_shoot_traces_options *o)
+{
+    phc_climbing_stat_options so;
+    memset(&so, 0, sizeof so);
+    memcpy(so.origin, o->position, sizeof so.origin);
+    memcpy(so.light, o->plant.light.direction, sizeof so.light);
+    so.attach_distance = o->plant.attach_distance;
+    so.closest = o->plant.closest;
+    so.closest_user = o->plant.closest_user;
+    return so;
+}
+
+/* Grows one plant with options po and seed, summarising it after steps[j]
+ * steps (j < nt) into s[j].  0, 1 (outside the model's domain), -1 memory. */
+static int grow_one(const phc_shoot_traces_options *o, const phc_climbing_options *po, uint64_t seed,
+                    const size_t *steps, size_t nt, phc_climbing_summary *s)
+{
+    phc_climbing_options co = *po;
+    co.seed = seed;
+    phc_error e;
+    phc_error_clear(&e);
+    if (!(co.growth_rate * o->time_step < 1 - co.bud_fraction)) return 1;
+    phc_climbing *c = phc_climbing_new(o->position, o->direction, &co, &e);
+    if (!c) return e.status == PHC_ERR_NOMEM ? -1 : 1;
+    const phc_climbing_stat_options so = stat_options(o);
+    phc_shoot_segment *seg = NULL;
+    size_t cap = 0, done = 0;
+    int rc = 0;
+    for (size_t j = 0; j < nt && !rc; ++j) {
+        for (; done < steps[j] && !rc; ++done)
+            if (phc_climbing_step(c, o->time_step, &e)) rc = e.status == PHC_ERR_NOMEM ? -1 : 1;
+        if (rc) break;
+        const size_t n = phc_climbing_count(c);
+        if (n > cap) {
+            phc_shoot_segment *g = realloc(seg, n * sizeof *g);
+            if (!g) { rc = -1; break; }
+            seg = g;
+            cap = n;
+        }
+        phc_climbing_segments(c, seg);
+        if (phc_climbing_summarize_segments(seg, n, &so, &s[j], &e)) rc = 1;
+    }
+    free(seg);
+    phc_climbing_free(c);
+    return rc;
+}
+
+/* Averages over the K seeds at slot values p: y (n) and sd (n or NULL). */
+int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd)
+{
+    st_impl *im = ds->impl;
+    const size_t K = im->o.seeds, nt = im->n_times;
+    phc_climbing_options po = im->o.plant;
+    for (size_t j = 0; j < im->k; ++j) *slot_ref(&po, im->slot[j]) = p[j];
+    phc_climbing_summary *s = malloc(K * nt * sizeof *s), *one = malloc(K * sizeof *one), mean;
+    if (!s || !one) { free(s); free(one); return -1; }
+    int rc = 0;
+    for (size_t a = 0; a < K && !rc; ++a) {
+        rc = grow_one(&im->o, &po, im->o.first_seed + a, im->steps, nt, s + a * nt);
+        im->plants++;
+    }
+    for (size_t i = 0; !rc && i < ds->n; ++i) {
+        const size_t j = im->tindex[i];
+        for (size_t a = 0; a < K; ++a) one[a] = s[a * nt + j];
+        phc_climbing_summary_mean(one, K, &mean);
+        y[i] = stat_value(&mean, im->stat[i]);
+        if (!isfinite(y[i])) rc = 1; /* no lateral at all: no angle */
+        if (sd) {
+            double m = 0, v = 0;
+            for (size_t a = 0; a < K; ++a) m += stat_value(&one[a], im->stat[i]);
+            m /= (double)K;
+            size_t q = 0;
+            for (size_t a = 0; a < K; ++a) {
+                const double d = stat_value(&one[a], im->stat[i]);
+                if (isfinite(d)) { v += (d - m) * (d - m); q++; }
+            }
+            sd[i] = q > 1 ? sqrt(v / (double)(q - 1)) : NAN;
+        }
+    }
+    free(s);
+    free(one);
+    return rc;
+}
+
+static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    st_impl *im = ds->impl;
+    int rc = phc_shoot_traces_model(ds, p, yhat, NULL);
+    if (rc || !jac) return rc;
+    const size_t k = ds->k, n = ds->n;
+    double *q = malloc(k * sizeof *q), *yp = malloc(n * sizeof *yp), *ym = malloc(n * sizeof *ym);
+    if (!q || !yp || !ym) { free(q); free(yp); free(ym); return -1; }
+    for (size_t j = 0; j < k && !rc; ++j) {
+        double scale = fabs(p[j]) > 0 ? fabs(p[j]) : 1;
+        if (ds->problem && ds->param_index) {
+            const phc_parameter *pa = &ds->problem->params[ds->param_index[j]];
+            if (pa->scale > 0 && !(fabs(p[j]) > 0)) scale = pa->scale;
+        }
+        const double h = im->o.fd_step * scale;
+        memcpy(q, p, k * sizeof *q);
+        q[j] = p[j] + h;
+        const int rp = phc_shoot_traces_model(ds, q, yp, NULL);
+        q[j] = p[j] - h;
+        const int rm = phc_shoot_traces_model(ds, q, ym, NULL);
+        if (rp < 0 || rm < 0) { rc = -1; break; }
+        for (size_t i = 0; i < n; ++i) {
+            if (!rp && !rm) jac[i * k + j] = (yp[i] - ym[i]) / (2 * h);
+            else if (!rp) jac[i * k + j] = (yp[i] - yhat[i]) / h;
+            else if (!rm) jac[i * k + j] = (yhat[i] - ym[i]) / h;
+            else jac[i * k + j] = 0;
+        }
+        if (rp && rm) rc = 1;
+    }
+    free(q);
+    free(yp);
+    free(ym);
+    return rc;
+}
+
+/* Symmetric eigen-decomposition by cyclic Jacobi rotations (k small):
+ * a (k x k) is destroyed, w the eigenvalues, v (k x k, columns) the vectors. */
+static void jacobi_eigen(double *a, size_t k, double *w, double *v)
+{
+    for (size_t i = 0; i < k; ++i)
+        for (size_t j = 0; j < k; ++j) v[i * k + j] = i == j;
+    for (int sweep = 0; sweep < 100; ++sweep) {
+        double off = 0;
+        for (size_t i = 0; i < k; ++i)
+            for (size_t j = i + 1; j < k; ++j) off += a[i * k + j] * a[i * k + j];
+        if (off < 1e-30) break;
+        for (size_t pq = 0; pq < k; ++pq)
+            for (size_t r = pq + 1; r < k; ++r) {
+                const double apq = a[pq * k + r];
+                if (fabs(apq) < 1e-300) continue;
+                const double th = (a[r * k + r] - a[pq * k + pq]) / (2 * apq);
+                const double t = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
+                const double c = 1 / sqrt(t * t + 1), s = t * c;
+                for (size_t i = 0; i < k; ++i) {
+                    const double aip = a[i * k + pq], aiq = a[i * k + r];
+                    a[i * k + pq] = c * aip - s * aiq;
+                    a[i * k + r] = s * aip + c * aiq;
+                }
+                for (size_t i = 0; i < k; ++i) {
+                    const double api = a[pq * k + i], aqi = a[r * k + i];
+                    a[pq * k + i] = c * api - s * aqi;
+                    a[r * k + i] = s * api + c * aqi;
+                }
+                for (size_t i = 0; i < k; ++i) {
+                    const double vip = v[i * k + pq], viq = v[i * k + r];
+                    v[i * k + pq] = c * vip - s * viq;
+                    v[i * k + r] = s * vip + c * viq;
+                }
+            }
+    }
+    for (size_t i = 0; i < k; ++i) w[i] = a[i * k + i];
+}
+
+int phc_shoot_traces_identifiability(phc_dataset *ds, const double *p, phc_shoot_traces_ident *out, phc_error *err)
+{
+    const size_t k = ds->k, n = ds->n;
+    memset(out, 0, sizeof *out);
+    double *y = malloc(n * sizeof *y), *J = malloc(n * k * sizeof *J), *A = calloc(k * k, sizeof *A),
+           *w = malloc(k * sizeof *w), *V = malloc(k * k * sizeof *V);
+    int rc = PHC_OK;
+    if (!y || !J || !A || !w || !V) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    int r = st_predict(ds, p, y, J);
+    if (r) {
+        rc = phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
+                           "data set '%s': the model failed at the fitted values", ds->name);
+        goto done;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double s = ds->sigma ? ds->sigma[i] : 1;
+        for (size_t j = 0; j < k; ++j) J[i * k + j] /= s;
+    }
+    for (size_t a = 0; a < k; ++a)
+        for (size_t b = 0; b < k; ++b) {
+            double sum = 0;
+            for (size_t i = 0; i < n; ++i) sum += J[i * k + a] * J[i * k + b];
+            A[a * k + b] = sum;
+        }
+    for (size_t a = 0; a < k && a < PHC_SHOOT_TRACES_MAX_SLOTS; ++a) {
+        out->sensitivity[a] = sqrt(A[a * k + a]);
+        out->value[a] = p[a];
+    }
+    /* correlations from the normal matrix: the largest |corr| of each slot with another */
+    double *C = malloc(k * k * sizeof *C);
+    if (!C) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto done; }
+    memcpy(C, A, k * k * sizeof *C);
+    jacobi_eigen(C, k, w, V);
+    double wmax = 0;
+    for (size_t a = 0; a < k; ++a) wmax = fmax(wmax, w[a]);
+    out->rank = 0;
+    for (size_t a = 0; a < k; ++a)
+        if (w[a] > 1e-8 * wmax && w[a] > 0) out->rank++;
+    out->condition = 0;
+    double wmin = INFINITY;
+    for (size_t a = 0; a < k; ++a) wmin = fmin(wmin, w[a]);
+    out->condition = wmin > 0 ? wmax / wmin : INFINITY;
+    /* covariance = pseudo-inverse over the kept eigenvalues */
+    for (size_t a = 0; a < k && a < PHC_SHOOT_TRACES_MAX_SLOTS; ++a) {
+        double var = 0;
+        int null_part = 0;
+        for (size_t e = 0; e < k; ++e) {
+            if (w[e] > 1e-8 * wmax && w[e] > 0) var += V[a * k + e] * V[a * k + e] / w[e];
+            else if (fabs(V[a * k + e]) > 0.1) null_part = 1;
+        }
+        out->sd[a] = null_part ? INFINITY : sqrt(var);
+        out->partner[a] = (size_t)-1;
+        out->max_corr[a] = 0;
+    }
+    free(C);
+    /* the correlation of the slots' estimates, from the inverse when full rank, else of
+     * the sensitivities' columns (cosine of J's columns) */
+    for (size_t a = 0; a < k && a < PHC_SHOOT_TRACES_MAX_SLOTS; ++a)
+        for (size_t b = 0; b < k; ++b) {
+            if (a == b) continue;
+            const double d = sqrt(A[a * k + a] * A[b * k + b]);
+            const double c = d > 0 ? A[a * k + b] / d : 0;
+            if (fabs(c) > fabs(out->max_corr[a])) {
+                out->max_corr[a] = c;
+                out->partner[a] = b;
+            }
+        }
+done:
+    free(y);
+    free(J);
+    free(A);
+    free(w);
+    free(V);
+    return rc;
+}
+
+/* Verdicts: yes when the slot moves the statistics, is not in a null
+ * direction, its column is not nearly parallel (|cos| > 0.95) to another's
+ * and its 95% interval (± 1.96 sd) is narrower than ± its value. */
+static void ident_verdicts(const phc_dataset *ds, phc_shoot_traces_ident *id)
+{
+    double smax = 0;
+    for (size_t a = 0; a < ds->k; ++a) smax = fmax(smax, id->sensitivity[a] * fmax(fabs(id->value[a]), 1e-12));
+    for (size_t a = 0; a < ds->k && a < PHC_SHOOT_TRACES_MAX_SLOTS; ++a) {
+        id->identifiable[a] = 0;
+        if (!(id->sensitivity[a] > 0) || id->sensitivity[a] * fmax(fabs(id->value[a]), 1e-12) < 1e-6 * smax)
+            snprintf(id->why[a], sizeof id->why[a], "the statistics do not change with it");
+        else if (!isfinite(id->sd[a]))
+            snprintf(id->why[a], sizeof id->why[a], "in a null direction (rank %zu of %zu)", id->rank, ds->k);
+        else if (fabs(id->max_corr[a]) > 0.95 && id->partner[a] != (size_t)-1)
+            snprintf(id->why[a], sizeof id->why[a], "collinear with %s (cosine %.3f)",
+                     ds->slot_names[id->partner[a]], id->max_corr[a]);
+        else if (1.96 * id->sd[a] >= fabs(id->value[a]))
+            snprintf(id->why[a], sizeof id->why[a], "95%% interval wider than +/- its value");
+        else {
+            id->identifiable[a] = 1;
+            snprintf(id->why[a], sizeof id->why[a], "interval +/- %.0f%% of its value",
+                     100 * 1.96 * id->sd[a] / fabs(id->value[a]));
+        }
+    }
+}
+
+static int st_report_section(phc_dataset *ds, const double *p, char **markdown, phc_error *err)
+{
+    st_impl *im = ds->impl;
+    const unsigned long before = im->plants;
+    const size_t n = ds->n;
+    double *y = malloc(n * sizeof *y), *sd = malloc(n * sizeof *sd);
+    if (!y || !sd) { free(y); free(sd); return phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); }
+    int r = phc_shoot_traces_model(ds, p, y, sd);
+    if (r) {
+        free(y); free(sd);
+        return phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
+                             "data set '%s': the model failed at the fitted values", ds->name);
+    }
+    phc_shoot_traces_ident id;
+    int rc = phc_shoot_traces_identifiability(ds, p, &id, err);
+    if (rc) { free(y); free(sd); return rc; }
+    ident_verdicts(ds, &id);
+    char *out = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&out, &len);
+    if (!f) { free(y); free(sd); return phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); }
+    fprintf(f, "Traces: `%s`, %zu shoots, %zu points, up to %g s.\n\n", im->traces->source,
+            im->traces->n_shoots, im->traces->n_points, im->traces->t_end);
+    fprintf(f, "Model: the climbing plant (Hädrich et al. 2017) grown with %zu seeds (%llu .. %llu, the same "
+               "at every parameter value) in steps of %g s; statistics averaged over the seeds. "
+               "Derivatives: central differences, step %g of each value. %lu plants grown before this "
+               "report.\n\n",
+            im->o.seeds, (unsigned long long)im->o.first_seed,
+            (unsigned long long)(im->o.first_seed + im->o.seeds - 1), im->o.time_step, im->o.fd_step, before);
+    fprintf(f, "| time (s) | statistic | traced | model (mean of seeds) | seed sd | sigma |\n"
+               "|---:|---|---:|---:|---:|---:|\n");
+    for (size_t i = 0; i < n; ++i)
+        fprintf(f, "| %g | %s | %.4g | %.4g | %.3g | %.3g |\n", im->times[im->tindex[i]], stat_names[im->stat[i]],
+                ds->y[i], y[i], sd[i], ds->sigma ? ds->sigma[i] : 1.0);
+    fprintf(f, "\nIdentifiability from the statistics (this data set's Jacobian at the fitted values, "
+               "the data set's sigma, not rescaled by the fit's residual variance): rank %zu of %zu, condition number %.3g.\n\n",
+            id.rank, ds->k, id.condition);
+    fprintf(f, "| parameter | estimate | 95%% interval | sensitivity | most collinear with | identifiable | why |\n"
+               "|---|---:|---|---:|---|---|---|\n");
+    for (size_t a = 0; a < ds->k && a < PHC_SHOOT_TRACES_MAX_SLOTS; ++a) {
+        char iv[64], co[96];
+        if (isfinite(id.sd[a]))
+            snprintf(iv, sizeof iv, "[%.4g, %.4g]", p[a] - 1.96 * id.sd[a], p[a] + 1.96 * id.sd[a]);
+        else
+            snprintf(iv, sizeof iv, "unbounded");
+        if (id.partner[a] != (size_t)-1)
+            snprintf(co, sizeof co, "%s (%.3f)", ds->slot_names[id.partner[a]], id.max_corr[a]);
+        else
+            snprintf(co, sizeof co, "-");
+        fprintf(f, "| %s | %.4g | %s | %.3g | %s | %s | %s |\n", ds->slot_names[a], p[a], iv, id.sensitivity[a], co,
+                id.identifiable[a] ? "yes" : "no", id.why[a]);
+    }
+    fputc('\n', f);
+    fclose(f);
+    free(y);
+    free(sd);
+    *markdown = out;
+    return PHC_OK;
+}
+
+static void st_series_name(const phc_dataset *ds, size_t g, char *buf, size_t size)
+{
+    (void)ds;
+    snprintf(buf, size, "%s", g < ST_N ? stat_names[g] : "?");
+}
+
+static int st_name_series2(phc_dataset *ds, phc_error *err)
+{
+    return phc_dataset_name_series(ds, "statistic", ST_N, st_series_name, err);
+}
+
+const phc_dataset_ops phc_shoot_traces_ops = {
+    .kind = "shoot_traces",
+    .predict = st_predict,
+    .free_impl = st_free,
+    .report_section = st_report_section,
+    .name_series = st_name_series2,
+};
+
+static double sigma_for(const phc_shoot_traces_options *o, int stat, double v)
+{
+    switch (stat) {
+    case ST_TOTAL: case ST_MAIN: case ST_HEIGHT: return fmax(o->sigma_rel * fabs(v), o->sigma_length);
+    case ST_ATTACHED: return o->sigma_fraction;
+    case ST_COSINE: return o->sigma_cosine;
+    case ST_ANGLE_MEAN: case ST_ANGLE_SD: return o->sigma_angle;
+    default: return sqrt(fmax(1, v));
+    }
+}
+
+int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_options *o, phc_dataset **out,
+                         phc_error *err)
+{
+    *out = NULL;
+    st_impl *im = calloc(1, sizeof *im);
+    phc_dataset *ds = NULL;
+    phc_shoot_segment *seg = NULL;
+    int rc = PHC_OK;
+    if (!im) {
+        phc_shoot_traces_free(traces);
+        if (o->support_free) o->support_free(o->support_owner);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    im->traces = traces;
+    im->o = *o;
+    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->sigma_rel >= 0) ||
+        !(o->sigma_length > 0) || !(o->sigma_fraction > 0) || !(o->sigma_cosine > 0) || !(o->sigma_angle > 0)) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1) and every sigma > 0");
+        goto fail;
+    }
+    /* times */
+    im->n_times = o->times ? o->n_times : 4;
+    im->times = malloc(im->n_times * sizeof *im->times);
+    im->steps = malloc(im->n_times * sizeof *im->steps);
+    if (!im->times || !im->steps) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
+    for (size_t j = 0; j < im->n_times; ++j) {
+        im->times[j] = o->times ? o->times[j] : traces->t_end * (double)(j + 1) / 4.0;
+        if (!(im->times[j] > 0) || (j && !(im->times[j] > im->times[j - 1])) ||
+            im->times[j] > traces->t_end * (1 + 1e-12)) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "shoot_traces: observation time %g s: times must be > 0, increasing and at most "
+                               "the traces' last time (%g s)",
+                               im->times[j], traces->t_end);
+            goto fail;
+        }
+        im->steps[j] = (size_t)llround(im->times[j] / o->time_step);
+    }
+    /* slots */
+    for (size_t s = 0; s < N_SLOTS; ++s)
+        if (o->is_parameter ? o->is_parameter(slot_names[s], o->user_data) : s == 0) im->slot[im->k++] = s;
+    if (!im->k) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "shoot_traces: no parameter to fit: name one of branch_probability, direction_variance, "
+                           "phototropism, surface_adaption, growth_rate, apical_dominance, thickness_falloff, "
+                           "min_stiffness, anchor_strength");
+        goto fail;
+    }
+    /* the traced statistics */
+    const phc_climbing_stat_options so = stat_options(o);
+    phc_climbing_summary *ts = calloc(im->n_times, sizeof *ts);
+    if (!ts) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
+    for (size_t j = 0; j < im->n_times && !rc; ++j) {
+        size_t ns = 0;
+        free(seg);
+        seg = NULL;
+        if (!(rc = phc_shoot_traces_segments(traces, im->times[j], &seg, &ns, err)))
+            rc = phc_climbing_summarize_segments(seg, ns, &so, &ts[j], err);
+    }
+    if (rc) { free(ts); goto fail; }
+    unsigned max_order = o->plant.max_order < 7 ? o->plant.max_order : 7;
+    const phc_climbing_summary *last = &ts[im->n_times - 1];
+    const int angles = last->angle_n >= 2;
+    const size_t n = 5 * im->n_times + max_order + (angles ? 2 : 0);
+    im->stat = malloc(n * sizeof *im->stat);
+    im->tindex = malloc(n * sizeof *im->tindex);
+    if (!im->stat || !im->tindex || !(ds = phc_dataset_new(&phc_shoot_traces_ops, im->k))) {
+        free(ts);
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail;
+    }
+    ds->impl = im;
+    ds->n = n;
+    ds->x = malloc(n * sizeof *ds->x);
+    ds->y = malloc(n * sizeof *ds->y);
+    ds->sigma = malloc(n * sizeof *ds->sigma);
+    ds->series = malloc(n * sizeof *ds->series);
+    if (!ds->x || !ds->y || !ds->sigma || !ds->series) {
+        free(ts);
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_ds;
+    }
+    size_t i = 0;
+    for (size_t j = 0; j < im->n_times; ++j)
+        for (int s = ST_TOTAL; s <= ST_COSINE; ++s) {
+            im->stat[i] = s;
+            im->tindex[i++] = j;
+        }
+    for (unsigned q = 1; q <= max_order; ++q) {
+        im->stat[i] = ST_COUNT1 + (int)q - 1;
+        im->tindex[i++] = im->n_times - 1;
+    }
+    if (angles) {
+        im->stat[i] = ST_ANGLE_MEAN;
+        im->tindex[i++] = im->n_times - 1;
+        im->stat[i] = ST_ANGLE_SD;
+        im->tindex[i++] = im->n_times - 1;
+    }
+    for (i = 0; i < n; ++i) {
+        ds->x[i] = im->times[im->tindex[i]];
+        ds->y[i] = stat_value(&ts[im->tindex[i]], im->stat[i]);
+        ds->sigma[i] = sigma_for(o, im->stat[i], ds->y[i]);
+        ds->series[i] = (size_t)im->stat[i];
+    }
+    free(ts);
+    free(seg);
+    for (size_t j = 0; j < im->k; ++j) {
+        if (!(ds->slot_names[j] = strdup(slot_names[im->slot[j]]))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_ds;
+        }
+        if ((rc = phc_dataset_declare_unit(ds, slot_names[im->slot[j]], slot_units[im->slot[j]]))) {
+            rc = phc_error_set(err, rc, "out of memory");
+            goto fail_ds;
+        }
+    }
+    /* the traced plant is one draw of the process and the model value a mean over K:
+     * each sigma is widened by the seed-to-seed spread sd at the start options,
+     * sigma^2 = sigma_given^2 + (1 + 1/K) sd^2 */
+    {
+        double *p0 = malloc(im->k * sizeof *p0), *y0 = malloc(n * sizeof *y0), *sd0 = malloc(n * sizeof *sd0);
+        if (!p0 || !y0 || !sd0) {
+            free(p0); free(y0); free(sd0);
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail_ds;
+        }
+        for (size_t j = 0; j < im->k; ++j) p0[j] = *slot_ref(&im->o.plant, im->slot[j]);
+        int r = phc_shoot_traces_model(ds, p0, y0, sd0);
+        for (i = 0; !r && i < n; ++i) {
+            const double v = isfinite(sd0[i]) ? sd0[i] : 0;
+            ds->sigma[i] = sqrt(ds->sigma[i] * ds->sigma[i] + (1 + 1.0 / (double)o->seeds) * v * v);
+        }
+        free(p0); free(y0); free(sd0);
+        if (r) {
+            rc = phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_INPUT,
+                               "shoot_traces: the model plant cannot be grown at the start options (or it "
+                               "makes no lateral while the traces have some)");
+            goto fail_ds;
+        }
+        im->plants = 0;
+    }
+    ds->x_label = strdup("time (s)");
+    ds->y_label = strdup("statistic (its unit)");
+    ds->derivatives = PHC_DERIV_ANALYTIC;
+    ds->model_tolerance = 1e-3;
+    if (!ds->x_label || !ds->y_label || (rc = phc_dataset_add_input(ds, traces->source))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_ds;
+    }
+    *out = ds;
+    return PHC_OK;
+fail_ds:
+    phc_dataset_free(ds); /* frees im */
+    return rc;
+fail:
+    free(seg);
+    st_free(im);
+    return rc;
+}
+
+/* phc_shoot_traces_from_model: see the header. */
+typedef struct rows {
+    size_t n, cap;
+    double *t, *x, *y, *z;
+    char **shoot, **parent;
+} rows;
+
+static int rows_push(rows *r, double t, const double p[3], const char *shoot, const char *parent)
+{
+    if (r->n == r->cap) {
+        size_t cap = r->cap ? 2 * r->cap : 256;
+        double *a = realloc(r->t, cap * sizeof *a); if (a) r->t = a;
+        double *b = realloc(r->x, cap * sizeof *b); if (b) r->x = b;
+        double *c = realloc(r->y, cap * sizeof *c); if (c) r->y = c;
+        double *d = realloc(r->z, cap * sizeof *d); if (d) r->z = d;
+        char **e = realloc(r->shoot, cap * sizeof *e); if (e) r->shoot = e;
+        char **f = realloc(r->parent, cap * sizeof *f); if (f) r->parent = f;
+        if (!a || !b || !c || !d || !e || !f) return -1;
+        r->cap = cap;
+    }
+    r->t[r->n] = t;
+    r->x[r->n] = p[0];
+    r->y[r->n] = p[1];
+    r->z[r->n] = p[2];
+    r->shoot[r->n] = strdup(shoot);
+    r->parent[r->n] = strdup(parent);
+    if (!r->shoot[r->n] || !r->parent[r->n]) return -1;
+    r->n++;
+    return 0;
+}
+
+int phc_shoot_traces_from_model(const phc_shoot_traces_options *o, const double *times, size_t n_times,
+                                phc_shoot_traces **out, phc_error *err)
+{
+    *out = NULL;
+    phc_climbing *c = phc_climbing_new(o->position, o->direction, &o->plant, err);
+    if (!c) return err ? err->status : PHC_ERR_INVALID;
+    rows r = {0};
+    size_t *shoot_of = NULL, *joints = NULL, cap = 0, done = 0;
+    int rc = PHC_OK;
+    for (size_t j = 0; j < n_times && !rc; ++j) {
+        const size_t steps = (size_t)llround(times[j] / o->time_step);
+        for (; done < steps && !rc; ++done) rc = phc_climbing_step(c, o->time_step, err);
+        if (rc) break;
+        const size_t n = phc_climbing_count(c);
+        if (n > cap) {
+            size_t *a = realloc(shoot_of, n * sizeof *a);
+            if (a) shoot_of = a;
+            size_t *b = realloc(joints, n * sizeof *b);
+            if (b) joints = b;
+            if (!a || !b) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); break; }
+            for (size_t i = cap; i < n; ++i) joints[i] = 0;
+            cap = n;
+        }
+        /* shoots: a particle starts one when it has no parent or is a lateral; joints[s]
+         * counts the completed joints written for shoot s (its start particle's index) */
+        for (size_t i = 0; i < n && !rc; ++i) {
+            const size_t p = phc_climbing_parent(c, i);
+            shoot_of[i] = (p == PHC_CLIMBING_NONE || phc_climbing_is_lateral(c, i)) ? i : shoot_of[p];
+        }
+        for (size_t i = 0; i < n && !rc; ++i) {
+            const size_t s = shoot_of[i];
+            char name[32], parent[32] = "";
+            snprintf(name, sizeof name, "s%zu", s);
+            if (s != 0) snprintf(parent, sizeof parent, "s%zu", shoot_of[phc_climbing_parent(c, s)]);
+            /* the position of i in its shoot's chain: particles of one shoot in index order */
+            size_t pos = 0;
+            for (size_t q = s; q < i; ++q) pos += shoot_of[q] == s;
+            double base[3], tip[3];
+            phc_climbing_segment(c, i, base, tip);
+            if (pos == 0 && joints[s] == 0) {
+                if (rows_push(&r, times[j], base, name, parent)) rc = -1;
+                joints[s] = 1;
+            }
+            const int apical = phc_climbing_is_apical(c, i);
+            if (!rc && !apical && joints[s] == pos + 1) {
+                if (rows_push(&r, times[j], tip, name, parent)) rc = -1;
+                joints[s] = pos + 2;
+            } else if (!rc && apical) {
+                if (rows_push(&r, times[j], tip, name, parent)) rc = -1;
+            }
+        }
+        if (rc < 0) rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    /* a shoot born at the last time has its base and tip only: at least 2 points */
+    if (!rc) rc = phc_shoot_traces_from_rows("model traces", r.n, r.t, (const char *const *)r.shoot, r.x, r.y, r.z,
+                                             (const char *const *)r.parent, out, err);
+    for (size_t i = 0; i < r.n; ++i) {
+        free(r.shoot[i]);
+        free(r.parent[i]);
+    }
+    free(r.t); free(r.x); free(r.y); free(r.z); free(r.shoot); free(r.parent);
+    free(shoot_of);
+    free(joints);
+    phc_climbing_free(c);
+    return rc;
+}

@@ -1,0 +1,112 @@
+/* `shoot_traces` data sets: traced shoots of a climbing plant
+ * (measurements/shoot_traces.h) against the climbing-plant growth model
+ * (model/climbing_growth.h; Hädrich et al., CGF 36(2) 2017), compared by
+ * summary statistics (model/climbing_statistics.h) averaged over K seeds.
+ *
+ * Observations: at each observation time t_j (s) the traced plant's
+ * total_length, main_length, height, attached_fraction and light_cosine;
+ * at the last time also the lateral-shoot count of every branch order
+ * 1 .. max_order and, when the traces hold at least 2 laterals, the
+ * branching angle's mean and standard deviation.
+ * Model: the plant grown from the grow config's seed, support and light
+ * (fit/grow_config.h) with each of the seeds first_seed .. first_seed+K-1
+ * (common random numbers: the same K seeds at every parameter value), the
+ * statistics of each at t_j (after round(t_j/Δt) steps), averaged
+ * (phc_climbing_summary_mean: the angles pooled over all laterals).
+ * Residual: (model − traced)/σ per statistic (the dataset's convention is
+ * (traced − model)/σ; the sign does not matter to the fit).
+ *
+ * σ per statistic: lengths and height max(σ_rel·value, σ_len) (defaults
+ * 0.1 and 0.01 m), attached fraction and light cosine 0.05, counts
+ * sqrt(max(1, count)) (Poisson), angles 5°; then widened by the spread of
+ * the statistic between the K model plants at the start options (the grow
+ * config's values): σ² = σ_given² + (1 + 1/K)·sd², because the traced plant
+ * is one draw of the random process and the model value a mean over K.
+ *
+ * Slots (the grow config's values are the start of the ones not fitted):
+ * branch_probability, direction_variance, phototropism (s-1),
+ * surface_adaption (s-1), growth_rate (s-1), apical_dominance,
+ * thickness_falloff, min_stiffness, anchor_strength.
+ *
+ * Derivatives: central differences with a relative step fd_step (default
+ * 0.05 of the value, or 0.05 of the slot's scale when the value is 0): the
+ * averaged statistics are piecewise constant in BP, V, η, ... with fixed
+ * seeds (a bud flips at a threshold of its uniform draw), so steps of 1e-6
+ * would see zero or a jump; a step of 5% spans many flips over K plants and
+ * gives the slope of the trend.  A step that leaves the model's domain
+ * (BP + h > 1) falls back to the one-sided difference. */
+#ifndef PHC_COSTS_SHOOT_TRACES_H
+#define PHC_COSTS_SHOOT_TRACES_H
+
+#include <stdint.h>
+
+#include "fit/engine/dataset.h"
+#include "measurements/shoot_traces.h"
+#include "model/climbing_growth.h"
+#include "model/status.h"
+
+typedef struct phc_shoot_traces_options {
+    phc_climbing_options plant;  /* the growth options (closest/closest_user: the support) */
+    double position[3];          /* m: the seed's base */
+    double direction[3];         /* its growth direction */
+    double time_step;            /* s, > 0 */
+    size_t seeds;                /* K >= 1; default 8 */
+    uint64_t first_seed;         /* default: plant.seed */
+    const double *times;         /* observation times, s, increasing, > 0, <= the traces' end;
+                                    NULL: 4 evenly spaced up to the traces' last time */
+    size_t n_times;
+    double sigma_rel, sigma_length; /* default 0.1, 0.01 m */
+    double sigma_fraction, sigma_cosine, sigma_angle; /* default 0.05, 0.05, 5° */
+    double fd_step;              /* relative, default 0.05 */
+    phc_is_parameter_fn is_parameter; /* which slots are fitted (NULL: branch_probability) */
+    void *user_data;
+    void *support_owner;         /* freed with support_free when the data set is freed */
+    void (*support_free)(void *);
+} phc_shoot_traces_options;
+
+phc_shoot_traces_options phc_shoot_traces_options_default(void);
+
+/* Builds the data set; takes the traces (freed with the data set, also on
+ * error) and the support owner.  Errors (PHC_ERR_INPUT): bad options,
+ * observation times after the traces' end, no slot to fit. */
+int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_options *o, phc_dataset **out,
+                         phc_error *err);
+
+/* The averaged statistics of the model at slot values p at the data set's
+ * observation times, in its observation order (n values), and their
+ * seed-to-seed standard deviation (sd, n values, may be NULL).  0, > 0
+ * (outside the model's domain), < 0 (memory). */
+int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd);
+
+/* Traces of a plant grown by the model (for regression tests and
+ * examples): the tip of every particle, written when the particle is born
+ * and at every time of `times`, as traces (shoot = the particle chain of
+ * one apex from its lateral start; parent the shoot it leaves). */
+int phc_shoot_traces_from_model(const phc_shoot_traces_options *o, const double *times, size_t n_times,
+                                phc_shoot_traces **out, phc_error *err);
+
+/* Local identifiability at slot values p, from the data set's own
+ * central-difference Jacobian J of the weighted residuals (σ as given, not
+ * rescaled by the fit's residual variance): the normal matrix JᵀJ, its
+ * eigenvalues (rank: those above 1e-8 of the largest), each slot's
+ * standard deviation from the pseudo-inverse (INFINITY when the slot has a
+ * part > 0.1 in a null direction), its sensitivity |J_j| and the largest
+ * cosine between its column and another's (collinearity). */
+#define PHC_SHOOT_TRACES_MAX_SLOTS 9
+typedef struct phc_shoot_traces_ident {
+    size_t rank;
+    double condition;                               /* largest / smallest eigenvalue */
+    double value[PHC_SHOOT_TRACES_MAX_SLOTS];
+    double sd[PHC_SHOOT_TRACES_MAX_SLOTS];          /* slot units */
+    double sensitivity[PHC_SHOOT_TRACES_MAX_SLOTS]; /* |column of J|, per slot unit */
+    double max_corr[PHC_SHOOT_TRACES_MAX_SLOTS];    /* cosine with `partner`'s column */
+    size_t partner[PHC_SHOOT_TRACES_MAX_SLOTS];     /* slot, or (size_t)-1 */
+    int identifiable[PHC_SHOOT_TRACES_MAX_SLOTS];   /* 1 yes, 0 no (reason in why) */
+    char why[PHC_SHOOT_TRACES_MAX_SLOTS][96];
+} phc_shoot_traces_ident;
+int phc_shoot_traces_identifiability(phc_dataset *ds, const double *p, phc_shoot_traces_ident *out,
+                                     phc_error *err);
+
+extern const phc_dataset_ops phc_shoot_traces_ops;
+
+#endif /* PHC_COSTS_SHOOT_TRACES_H */

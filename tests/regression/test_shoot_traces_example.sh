@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The climbing-plant traces example (README "Fitting growth to traced shoots"):
+#  1. tests/climbing/shoot_traces_generator.py (seed 2024, defaults) writes
+#     exactly the committed measurements/examples/climbing/traces.csv;
+#  2. `phytocal fit traces.yaml` converges and its report has the
+#     identifiability table, with growth_rate and surface_adaption identifiable.
+#   bash test_shoot_traces_example.sh PATH/TO/phytocal
+set -u
+PHC=${1:?usage: test_shoot_traces_example.sh PATH/TO/phytocal}
+case "$PHC" in /*) ;; *) PHC="$PWD/$PHC" ;; esac
+SRC=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+T=$(mktemp -d "${TMPDIR:-/tmp}/phc_traces.XXXXXX") || exit 1
+trap 'rm -rf "$T"' EXIT
+FAILED=0
+if /usr/bin/python3 "$SRC/tests/climbing/shoot_traces_generator.py" "$T/traces.csv" &&
+   cmp -s "$T/traces.csv" "$SRC/measurements/examples/climbing/traces.csv"; then
+    echo "ok - the generator writes the committed traces"
+else
+    echo "not ok - the generator's traces differ from measurements/examples/climbing/traces.csv"
+    FAILED=1
+fi
+"$PHC" fit "$SRC/measurements/examples/climbing/traces.yaml" -o "$T/run" >"$T/stdout" 2>"$T/stderr"
+RC=$?
+R="$T/run/report.md"
+if [ "$RC" -eq 0 ] && grep -q "converged after" "$T/stdout" &&
+   grep -q "^| growth_rate | .* | yes | " "$R" && grep -q "^| surface_adaption | .* | yes | " "$R" &&
+   grep -q "^Identifiability from the statistics" "$R"; then
+    echo "ok - the example fit converges; growth_rate and surface_adaption identifiable"
+else
+    echo "not ok - the example fit (exit $RC): $(head -c 400 "$T/stderr")"
+    grep "^| [a-z_]* | " "$R" 2>/dev/null | tail -5
+    FAILED=1
+fi
+exit $FAILED
