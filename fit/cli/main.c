@@ -914,6 +914,18 @@ static int parse_count(const char *opt, const char *text, unsigned long long max
     return 0;
 }
 
+/* A config that did not load on this rank: the other ranks may have loaded
+ * it and must not wait for this one (study_dist.h: one agree per study). */
+static void dist_load_failed(phc_dist *dist, int code)
+{
+    if (!dist)
+        return;
+    phc_error e;
+    phc_error_clear(&e);
+    phc_error_set(&e, code == EXIT_INPUT ? PHC_ERR_INPUT : PHC_ERR_INTERNAL, "the config did not load");
+    dist->agree(dist, e.status, &e);
+}
+
 static int sensitivity_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_study_options so = phc_study_options_default();
@@ -994,12 +1006,7 @@ static int sensitivity_run(int full_argc, char **full_argv, int argc, char **arg
     if (load_for_run("sensitivity", full_argc, full_argv, n_rest, rest, "-sensitivity", &o, &pb, &pv, dir,
                      sizeof dir, &code)) {
         free(rest);
-        if (dist) { /* the other ranks may have loaded it: they must not wait for this one */
-            phc_error e;
-            phc_error_clear(&e);
-            phc_error_set(&e, code == EXIT_INPUT ? PHC_ERR_INPUT : PHC_ERR_INTERNAL, "the config did not load");
-            dist->agree(dist, e.status, &e);
-        }
+        dist_load_failed(dist, code);
         return code;
     }
     free(rest);
@@ -1037,8 +1044,12 @@ static int sensitivity_run(int full_argc, char **full_argv, int argc, char **arg
 
 /* Under mpirun or srun (study_dist.h) every rank runs the study: rank 0
  * prints, writes and returns the exit code; the workers print nothing
- * (stdout and stderr go to /dev/null) and exit 0. */
-static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+ * (stdout and stderr go to /dev/null) and exit 0.  Used by sensitivity,
+ * profile and mcmc. */
+typedef int (*dist_command_fn)(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist);
+
+static int run_on_ranks(const char *name, dist_command_fn fn, int full_argc, char **full_argv, int argc,
+                        char **argv)
 {
     phc_dist *dist = NULL;
     phc_error err;
@@ -1051,18 +1062,18 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
         const int rank = phc_dist_launched_rank();
         if (rank != 0) {
             sleep(2);
-            fprintf(stderr, "phytocal sensitivity: rank %d: %s\n", rank, err.message);
+            fprintf(stderr, "phytocal %s: rank %d: %s\n", name, rank, err.message);
         } else {
-            fprintf(stderr, "phytocal sensitivity: %s\n", err.message);
+            fprintf(stderr, "phytocal %s: %s\n", name, err.message);
         }
         return exit_code_for(err.status);
     }
     if (dist && dist->rank != 0 &&
         (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))) {
         /* cannot silence this worker: it still runs, and says so once */
-        fprintf(stderr, "phytocal sensitivity: rank %d: cannot redirect its output to /dev/null\n", dist->rank);
+        fprintf(stderr, "phytocal %s: rank %d: cannot redirect its output to /dev/null\n", name, dist->rank);
     }
-    const int code = sensitivity_run(full_argc, full_argv, argc, argv, dist);
+    const int code = fn(full_argc, full_argv, argc, argv, dist);
     /* a worker's own failures reach rank 0 (study_dist.h: agree), which
        reports them; a worker exits 0, so that its exit cannot end the job
        (mpirun stops every rank at the first non-zero exit) before rank 0
@@ -1072,10 +1083,15 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     return worker ? EXIT_OK : code;
 }
 
+static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+{
+    return run_on_ranks("sensitivity", sensitivity_run, full_argc, full_argv, argc, argv);
+}
+
 /* profile: profile likelihood of every free parameter (profile_study.h).
  * --points and --level are taken out first; the rest goes through
  * load_for_run. */
-static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
+static int profile_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_profile_study_options po = phc_profile_study_options_default();
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
@@ -1123,11 +1139,13 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
     if (load_for_run("profile", full_argc, full_argv, n_rest, rest, "-profile", &o, &pb, &pv, dir, sizeof dir,
                      &code)) {
         free(rest);
+        dist_load_failed(dist, code);
         return code;
     }
     free(rest);
     progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     po.force = o.force;
+    po.dist = dist;
     po.progress = o.quiet ? NULL : progress_cb;
     po.progress_data = &prog;
     phc_error err;
@@ -1154,6 +1172,11 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
         return EXIT_FIT;
     }
     return EXIT_OK;
+}
+
+static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
+{
+    return run_on_ranks("profile", profile_run, full_argc, full_argv, argc, argv);
 }
 
 /* mcmc: posterior sampling (mcmc_study.h).  Its own options first, the rest through load_for_run. */
