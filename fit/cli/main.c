@@ -1180,7 +1180,7 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
 }
 
 /* mcmc: posterior sampling (mcmc_study.h).  Its own options first, the rest through load_for_run. */
-static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
+static int mcmc_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_mcmc_options mo = phc_mcmc_options_default();
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
@@ -1242,10 +1242,12 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
     int code;
     if (load_for_run("mcmc", full_argc, full_argv, n_rest, rest, "-mcmc", &o, &pb, &pv, dir, sizeof dir, &code)) {
         free(rest);
+        dist_load_failed(dist, code);
         return code;
     }
     free(rest);
     mo.force = o.force;
+    mo.dist = dist;
     const char *stop = getenv("PHYTOCAL_STOP_AFTER"); /* test hook: stop after k chains, as a killed run would */
     if (stop && *stop)
         mo.stop_after = (size_t)strtoull(stop, NULL, 10);
@@ -1266,6 +1268,11 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
                dir);
     phc_mcmc_run_summary_clear(&sum);
     return EXIT_OK;
+}
+
+static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
+{
+    return run_on_ranks("mcmc", mcmc_run, full_argc, full_argv, argc, argv);
 }
 
 /* report --check DIR: the run's inputs and outputs against its manifest. */
