@@ -64,7 +64,9 @@ typedef struct phc_mcmc_options {
        rank 0 records each in DIR.ledger as it arrives and writes DIR,
        identical to one process's; --resume works as in one process.  The
        stretch ensemble is not shared out: rank 0 runs it alone while the
-       other ranks wait.  The workers return PHC_OK with an empty summary. */
+       other ranks wait (its random stream depends on each proposal's
+       density: README, On a cluster).  The workers return PHC_OK with an
+       empty summary. */
     struct phc_dist *dist;
 } phc_mcmc_options;
 
