@@ -154,7 +154,10 @@ static const command_help commands[] = {
      "options:\n"
      "  --points N         target steps per side before the threshold (default 12, >= 3)\n"
      "  --level L          confidence level, 0 < L < 1 (default 0.95)\n"
-     "  -o DIR, --force, --quiet as for fit."},
+     "  -o DIR, --force, --quiet as for fit.\n"
+     "\n"
+     "Under mpirun or srun (at least 2 ranks) the parameters' profiles are spread over the\n"
+     "ranks; rank 0 prints and writes the one-process run's result (README: \"On a cluster\")."},
     {"mcmc", "phytocal mcmc CONFIG.yaml [-o DIR] [--method dram|stretch] [--samples N] [--chains C] [--seed S]\n"
              "                     [--resume] [--force] [--quiet]",
      "Bayesian posterior of the free parameters by MCMC: Gaussian likelihood of the\n"
@@ -177,7 +180,11 @@ static const command_help commands[] = {
      "  --resume           dram: continue an interrupted run from DIR.ledger (the chains it\n"
      "                     holds are not rerun; a ledger of another config or setting is\n"
      "                     refused, naming what differs)\n"
-     "  -o DIR, --force, --quiet as for fit."},
+     "  -o DIR, --force, --quiet as for fit.\n"
+     "\n"
+     "Under mpirun or srun (at least 2 ranks) DRAM's chains are spread over the ranks (rank\n"
+     "0 keeps the ledger, prints and writes); the stretch ensemble runs on rank 0 alone.\n"
+     "The result is the one-process run's (README: \"On a cluster\")."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",
      "Prints the summary of an earlier fit from its result.json; with --level L the\n"
