@@ -285,7 +285,6 @@ fail:
     if (l->f)
         fclose(l->f);
     free(l->pending);
-    free(l->pending);
     free(l->path);
     free(l);
     return rc;
