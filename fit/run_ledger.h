@@ -1,7 +1,7 @@
 /* The run ledger of a long study: an append-only text file with one line
- * per finished model evaluation, flushed as each result arrives, so that an
- * interrupted study continues (`--resume`) without recomputing anything it
- * finished.
+ * per finished model evaluation, written in small batches as results
+ * arrive (below), so that an interrupted study continues (`--resume`)
+ * without recomputing anything the ledger holds.
  *
  * Format (tab-separated, one record per line):
  *   # phytocal run ledger 1
