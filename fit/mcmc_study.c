@@ -24,6 +24,7 @@
 #include "fit/run_dir.h"
 #include "fit/run_ledger.h"
 #include "fit/sensitivity_study.h"
+#include "fit/study_dist.h"
 #include "measurements/atomic_file.h"
 
 /* Verdict thresholds (Vehtari et al. 2021, Bayesian Analysis 16:667: R-hat
@@ -155,6 +156,129 @@ static int chain_done(void *data, size_t c, const phc_mcmc_chains *out, const si
     return PHC_OK;
 }
 
+/* ---- DRAM's chains on MPI ranks (fit/study_dist.h) ------------------------------------ */
+
+/* DRAM is sequential within a chain (each step adapts the proposal from the
+ * chain's past), so under MPI the chains, not the steps, go to the ranks:
+ * one chain per message, run by phc_dram_run with every other chain marked
+ * as present (its own seeded generator makes it the chain a single process
+ * runs), sent back as the ledger's row (counts, draws, error variances, log
+ * posterior densities) plus the number of model evaluations it took.  The
+ * master records each chain as it arrives: into the ledger (resume works as
+ * in one process) and into the chains the run directory is written from. */
+typedef struct dram_dist {
+    const phc_mcmc_target *t;
+    const double *x0, *cov0;
+    const phc_dram_options *dop;
+    size_t C, n, d, n_out;  /* n_out: the ledger row, 4 + n (d + 2); one more value travels */
+    posterior *q;
+    unsigned char *only;    /* C: every chain present but the one being run */
+    phc_mcmc_chains blank;  /* the absent chains' draws (zeros, never read back) */
+    size_t *blank_counts;   /* 4 C zeros */
+    double *row;            /* the running chain's row */
+    chain_ledger *cl;       /* master: the ledger */
+    unsigned char *state;   /* master: C, 1 once a chain is held */
+    phc_mcmc_chains *have;  /* master: the chains held */
+    size_t *counts;         /* master: 4 C */
+} dram_dist;
+
+static int dd_chain_done(void *data, size_t c, const phc_mcmc_chains *out, const size_t counts[4], phc_error *err)
+{
+    (void)err;
+    dram_dist *dd = data;
+    const size_t n = dd->n, d = dd->d;
+    double *v = dd->row;
+    for (int k = 0; k < 4; ++k)
+        *v++ = (double)counts[k];
+    memcpy(v, out->theta + c * n * d, n * d * sizeof *v);
+    memcpy(v + n * d, out->s2 + c * n, n * sizeof *v);
+    memcpy(v + n * (d + 1), out->log_post + c * n, n * sizeof *v);
+    return PHC_OK;
+}
+
+static int dd_eval(void *ctx, size_t c, double *out)
+{
+    dram_dist *dd = ctx;
+    memset(dd->only, 1, dd->C);
+    dd->only[c] = 0;
+    phc_dram_options dop = *dd->dop;
+    dop.have = dd->only;
+    dop.have_draws = &dd->blank;
+    dop.have_counts = dd->blank_counts;
+    dop.chain_done = dd_chain_done;
+    dop.chain_data = dd;
+    dd->row = out;
+    const size_t before = dd->q->evaluations;
+    phc_mcmc_chains ch;
+    memset(&ch, 0, sizeof ch);
+    phc_error e;
+    phc_error_clear(&e);
+    const int rc = phc_dram_run(dd->t, dd->x0, dd->cov0, &dop, &ch, &e);
+    phc_mcmc_chains_clear(&ch);
+    out[dd->n_out] = (double)(dd->q->evaluations - before);
+    dd->q->evaluations = before; /* counted once, when the master records the chain */
+    return rc != PHC_OK;
+}
+
+static int dd_record(void *ctx, size_t c, int failed, const double *in, phc_error *err)
+{
+    dram_dist *dd = ctx;
+    const size_t n = dd->n, d = dd->d;
+    if (failed)
+        return phc_error_set(err, PHC_ERR_INVALID, "DRAM: chain %zu failed on its rank (its start outside the "
+                             "support, or out of memory)", c + 1);
+    dd->q->evaluations += (size_t)in[dd->n_out];
+    for (int k = 0; k < 4; ++k)
+        dd->counts[4 * c + k] = (size_t)in[k];
+    memcpy(dd->have->theta + c * n * d, in + 4, n * d * sizeof *in);
+    memcpy(dd->have->s2 + c * n, in + 4 + n * d, n * sizeof *in);
+    memcpy(dd->have->log_post + c * n, in + 4 + n * (d + 1), n * sizeof *in);
+    dd->state[c] = 1;
+    chain_ledger *cl = dd->cl;
+    int rc = phc_run_ledger_append(cl->l, c, 0, in, err);
+    if (rc)
+        return rc;
+    cl->computed++;
+    if (cl->stop_after && cl->computed >= cl->stop_after)
+        return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new chains (stop_after); %s holds them: "
+                             "--resume continues", cl->computed, cl->path);
+    return PHC_OK;
+}
+
+/* Every rank: agrees on rc (the master's ledger), then runs the chains the
+ * master lacks (state[c] == 0) on the ranks.  The master then holds every
+ * chain in state/have/counts. */
+static int dram_on_ranks(phc_dist *dist, int rc, dram_dist *dd, phc_error *err)
+{
+    const size_t C = dd->C;
+    size_t *rows = malloc(C * sizeof *rows), n_rows = 0;
+    dd->only = malloc(C);
+    dd->blank.theta = calloc(C * dd->n * dd->d, sizeof *dd->blank.theta);
+    dd->blank.s2 = calloc(C * dd->n, sizeof *dd->blank.s2);
+    dd->blank.log_post = calloc(C * dd->n, sizeof *dd->blank.log_post);
+    dd->blank_counts = calloc(4 * C, sizeof *dd->blank_counts);
+    if (rc == PHC_OK && (!rows || !dd->only || !dd->blank.theta || !dd->blank.s2 || !dd->blank.log_post ||
+                         !dd->blank_counts))
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "rank %d: out of memory for the chains", dist->rank);
+    if ((rc = dist->agree(dist, rc, err)) == PHC_OK) {
+        if (dist->rank == 0) {
+            for (size_t c = 0; c < C; ++c)
+                if (!dd->state[c])
+                    rows[n_rows++] = c;
+            rc = dist->run(dist, dd->n_out + 1, rows, n_rows, dd_eval, dd_record, dd, err);
+        } else {
+            rc = dist->run(dist, dd->n_out + 1, NULL, 0, dd_eval, NULL, dd, err);
+        }
+    }
+    free(rows);
+    free(dd->only);
+    free(dd->blank.theta);
+    free(dd->blank.s2);
+    free(dd->blank.log_post);
+    free(dd->blank_counts);
+    return rc;
+}
+
 int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_provenance *pv, const char *dir,
                  phc_mcmc_run_summary *summary, phc_error *err)
 {
@@ -173,6 +297,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
     gsl_rng *rng = NULL;
     char tmpdir[4096] = "", ledger_path[4200] = "";
     int rc = PHC_OK, have_ledger = 0;
+    int agreed = 0; /* under MPI every rank agrees once (study_dist.h), at the sampler or at done */
+    const int worker = opts->dist && opts->dist->rank != 0;
     size_t reused_chains = 0;
     /* the free parameters and their priors */
     const size_t np = pb->n_params ? pb->n_params : 1;
@@ -387,10 +513,10 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         size_t found = 0;
         if (bad || !y || !state || !counts || !have.theta || !have.s2 || !have.log_post || !cl.row)
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        if (rc == PHC_OK && (rc = phc_run_dir_make_parents(ledger_path, err)) == PHC_OK)
+        if (rc == PHC_OK && !worker && (rc = phc_run_dir_make_parents(ledger_path, err)) == PHC_OK)
             rc = phc_run_ledger_open(ledger_path, keys, (const char *const *)ident, 6, C, cl.n_out, o.resume, o.force,
                                      y, state, &found, &cl.l, err);
-        if (rc == PHC_OK) {
+        if (rc == PHC_OK && !worker) {
             for (size_t c = 0; c < C; ++c) {
                 state[c] = state[c] == PHC_LEDGER_OK;
                 if (!state[c])
@@ -403,6 +529,16 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
                 memcpy(have.log_post + c * o.samples, v + 4 + o.samples * (d + 1), o.samples * sizeof *v);
             }
             reused_chains = found;
+        }
+        if (o.dist) { /* the chains on the ranks; the master then holds them all */
+            if (worker && rc == PHC_OK)
+                memset(state, 0, C);
+            dram_dist dd = {&t, x0, cov0, &dop, C, o.samples, d, cl.n_out, &q, NULL, {0}, NULL, NULL,
+                            &cl,   state, &have, counts};
+            rc = dram_on_ranks(o.dist, rc, &dd, err);
+            agreed = 1;
+        }
+        if (rc == PHC_OK && !worker) {
             dop.have = state;
             dop.have_draws = &have;
             dop.have_counts = counts;
@@ -427,6 +563,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         free(cl.row);
         if (rc == PHC_OK)
             have_ledger = 1;
+        if (worker) /* its chains went to the master, which writes DIR */
+            goto done;
     } else if (o.resume) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "--resume: only --method dram resumes (its chains are independent); "
                            "the stretch ensemble moves every walker together");
@@ -437,6 +575,13 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         sop.seed = o.seed;
         sop.progress = o.progress ? relay : NULL;
         sop.progress_data = &pr;
+        if (o.dist) {
+            /* not shared out yet: the master runs the ensemble alone (mcmc_study.h) */
+            rc = o.dist->agree(o.dist, PHC_OK, err);
+            agreed = 1;
+            if (worker || rc)
+                goto done;
+        }
         rc = phc_stretch_run(&t, x0, &sop, &ch, err);
     }
     if (rc)
@@ -665,6 +810,8 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
     if (rc == PHC_OK && have_ledger)
         unlink(ledger_path); /* the run directory holds the result */
 done:
+    if (o.dist && !agreed) /* failed before sampling: the other ranks must not wait for this one */
+        o.dist->agree(o.dist, rc ? rc : phc_error_set(err, PHC_ERR_INTERNAL, "mcmc ended before sampling"), err);
     if (rc)
         phc_mcmc_run_summary_clear(summary);
     phc_fit_result_free(res);

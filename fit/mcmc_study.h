@@ -57,6 +57,17 @@ typedef struct phc_mcmc_options {
     size_t stop_after;   /* for tests: stop after this many chains, as a killed run would (0: never) */
     phc_progress_fn progress;
     void *progress_data;
+    /* NULL: one process.  Else the processes of an MPI run
+       (fit/study_dist.h, phc_dist_open): every rank calls phc_mcmc_run and
+       fits the same start.  DRAM: the chains are shared out (one chain per
+       message; a chain is sequential, each has its own seeded generator),
+       rank 0 records each in DIR.ledger as it arrives and writes DIR,
+       identical to one process's; --resume works as in one process.  The
+       stretch ensemble is not shared out: rank 0 runs it alone while the
+       other ranks wait (its random stream depends on each proposal's
+       density: README, On a cluster).  The workers return PHC_OK with an
+       empty summary. */
+    struct phc_dist *dist;
 } phc_mcmc_options;
 
 phc_mcmc_options phc_mcmc_options_default(void);

@@ -13,6 +13,7 @@
 #include "fit/plot_file.h"
 #include "fit/profile_plots.h"
 #include "fit/run_dir.h"
+#include "fit/study_dist.h"
 #include "measurements/atomic_file.h"
 
 phc_profile_study_options phc_profile_study_options_default(void)
@@ -251,25 +252,27 @@ int phc_profile_study_run(phc_problem *pb, const phc_profile_study_options *o, p
                           const char *dir, phc_profile_summary *summary, phc_error *err)
 {
     memset(summary, 0, sizeof *summary);
-    if (o->points < 3)
-        return phc_error_set(err, PHC_ERR_INPUT, "--points: %zu is too few; a profile needs at least 3 per side",
-                             o->points);
-    if (!(o->level > 0.0 && o->level < 1.0))
-        return phc_error_set(err, PHC_ERR_INPUT, "--level: %g is not between 0 and 1", o->level);
-    size_t n_free = 0;
-    for (size_t i = 0; i < pb->n_params; ++i)
-        n_free += !pb->params[i].fixed;
-    if (n_free == 0)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s: no free parameter to profile (every parameter is fixed)",
-                             pb->source ? pb->source : pb->name);
     phc_fit_result *fr = NULL;
     phc_profile_result *pr = NULL;
     row *rows = NULL;
     double *x0 = NULL, *step = NULL;
     char *report = NULL;
-    int rc = phc_fit_run(pb, o->progress, o->progress_data, &fr, err);
+    int rc = PHC_OK, before = 1; /* before phc_profile_run: under MPI this layer agrees on a failure */
+    size_t n_free = 0;
+    for (size_t i = 0; i < pb->n_params; ++i)
+        n_free += !pb->params[i].fixed;
+    if (o->points < 3)
+        rc = phc_error_set(err, PHC_ERR_INPUT, "--points: %zu is too few; a profile needs at least 3 per side",
+                           o->points);
+    else if (!(o->level > 0.0 && o->level < 1.0))
+        rc = phc_error_set(err, PHC_ERR_INPUT, "--level: %g is not between 0 and 1", o->level);
+    else if (n_free == 0)
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s: no free parameter to profile (every parameter is fixed)",
+                           pb->source ? pb->source : pb->name);
+    else
+        rc = phc_fit_run(pb, o->progress, o->progress_data, &fr, err);
     if (rc)
-        return rc;
+        goto done;
     summary->fit_converged = fr->summary.outcome == PHC_NLS_CONVERGED;
     x0 = malloc(pb->n_params * sizeof *x0);
     step = malloc(pb->n_params * sizeof *step);
@@ -287,7 +290,11 @@ int phc_profile_study_run(phc_problem *pb, const phc_profile_study_options *o, p
     po.points = o->points;
     po.progress = o->progress;
     po.progress_data = o->progress_data;
+    po.dist = o->dist;
+    before = 0; /* phc_profile_run agrees, also when it fails */
     if ((rc = phc_profile_run(pb, x0, step, &po, &pr, err)))
+        goto done;
+    if (o->dist && o->dist->rank != 0) /* a worker: its profiles went to the master, which writes DIR */
         goto done;
     rows = calloc(pr->n_profiles, sizeof *rows);
     if (!rows) {
@@ -365,6 +372,8 @@ int phc_profile_study_run(phc_problem *pb, const phc_profile_study_options *o, p
 discard:
     phc_run_dir_discard(tmpdir);
 done:
+    if (o->dist && before) /* failed before the profiles: the other ranks must not wait for this one */
+        o->dist->agree(o->dist, rc, err);
     if (rows)
         for (size_t k = 0; pr && k < pr->n_profiles; ++k)
             free(rows[k].theta);

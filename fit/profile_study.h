@@ -38,6 +38,12 @@ typedef struct phc_profile_study_options {
     int force;      /* replace DIR (run_dir.h) */
     phc_progress_fn progress;
     void *progress_data;
+    /* NULL: one process; else the processes of an MPI run
+       (fit/study_dist.h, phc_dist_open): every rank calls
+       phc_profile_study_run; each fits, then the profiles are shared out
+       (profile.h) and rank 0 alone writes DIR, identical to one process's
+       (the workers return PHC_OK with an empty summary). */
+    struct phc_dist *dist;
 } phc_profile_study_options;
 
 phc_profile_study_options phc_profile_study_options_default(void);

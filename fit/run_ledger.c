@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -16,9 +17,43 @@ struct phc_run_ledger {
     FILE *f;
     char *path;
     size_t rows, n_out;
-    char *line; /* buffer of one record */
-    size_t line_size;
+    size_t line_size; /* longest record */
+    char *pending;  /* records formatted, not yet written (phc_run_ledger.h: batches) */
+    size_t pending_bytes, pending_records, pending_cap;
+    double last_write; /* CLOCK_MONOTONIC seconds of the last write(2) */
 };
+
+/* A batch goes out when it holds this many records or bytes, or when this
+ * long has passed since the last write: what a SIGKILL can lose. */
+#define BATCH_RECORDS 64
+#define BATCH_BYTES 65536
+#define BATCH_SECONDS 0.05
+
+static double monotonic_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Writes the pending records in one write(2) (more when the system writes
+ * part of it). */
+static int write_pending(phc_run_ledger *l, phc_error *err)
+{
+    for (size_t done = 0; done < l->pending_bytes;) {
+        const ssize_t w = write(fileno(l->f), l->pending + done, l->pending_bytes - done);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path,
+                                 w < 0 ? strerror(errno) : "nothing written");
+        done += (size_t)w;
+    }
+    l->pending_bytes = 0;
+    l->pending_records = 0;
+    l->last_write = monotonic_seconds();
+    return PHC_OK;
+}
 
 /* The first 16 hex digits of SHA-256(text[0..n-1]). */
 static void checksum(const char *text, size_t n, char hex[17])
@@ -237,16 +272,19 @@ int phc_run_ledger_open(const char *path, const char *const *keys, const char *c
         }
     }
     l->line_size = 96 + 26 * n_out; /* row, state, n_out x (tab, %.17g), " #", 16 hex digits, newline */
-    if (!(l->line = malloc(l->line_size))) {
+    /* a batch: up to BATCH_BYTES, then one more record */
+    l->pending_cap = BATCH_BYTES + l->line_size;
+    if (!(l->pending = malloc(l->pending_cap))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail;
     }
+    l->last_write = monotonic_seconds();
     *out = l;
     return PHC_OK;
 fail:
     if (l->f)
         fclose(l->f);
-    free(l->line);
+    free(l->pending);
     free(l->path);
     free(l);
     return rc;
@@ -256,30 +294,29 @@ int phc_run_ledger_append(phc_run_ledger *l, size_t row, int failed, const doubl
 {
     if (row >= l->rows)
         return phc_error_set(err, PHC_ERR_INVALID, "ledger: row %zu of %zu", row, l->rows);
-    size_t n = (size_t)snprintf(l->line, l->line_size, "%zu\t%s", row, failed ? "failed" : "ok");
+    /* formatted straight into the batch: it has room for one more record
+       (pending_bytes < BATCH_BYTES after every append) */
+    char *line = l->pending + l->pending_bytes;
+    size_t n = (size_t)snprintf(line, l->line_size, "%zu\t%s", row, failed ? "failed" : "ok");
     for (size_t j = 0; j < l->n_out; ++j) {
         const double v = failed ? NAN : y[j];
-        n += (size_t)snprintf(l->line + n, l->line_size - n, "\t%.17g", v);
+        n += (size_t)snprintf(line + n, l->line_size - n, "\t%.17g", v);
     }
-    char hex[17];
-    checksum(l->line, n, hex);
-    /* the record and its checksum in one write(2): flushed to the operating
-       system as it is written (the header went through the stream, flushed;
-       nothing else is buffered there) */
     if (n + 20 > l->line_size)
         return phc_error_set(err, PHC_ERR_INTERNAL, "%s: ledger record of %zu bytes", l->path, n);
-    memcpy(l->line + n, " #", 2);
-    memcpy(l->line + n + 2, hex, 16);
-    l->line[n + 18] = '\n';
-    const size_t total = n + 19;
-    for (size_t done = 0; done < total;) {
-        const ssize_t w = write(fileno(l->f), l->line + done, total - done);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0)
-            return phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path, w < 0 ? strerror(errno) : "nothing written");
-        done += (size_t)w;
-    }
+    char hex[17];
+    checksum(line, n, hex);
+    memcpy(line + n, " #", 2);
+    memcpy(line + n + 2, hex, 16);
+    line[n + 18] = '\n';
+    /* the batch goes to the operating system in one write(2) when it is
+       full or BATCH_SECONDS after the last write (the header went through
+       the stream, flushed; nothing else is buffered there) */
+    l->pending_bytes += n + 19;
+    l->pending_records++;
+    if (l->pending_records >= BATCH_RECORDS || l->pending_bytes >= BATCH_BYTES ||
+        monotonic_seconds() - l->last_write >= BATCH_SECONDS)
+        return write_pending(l, err);
     return PHC_OK;
 }
 
@@ -288,9 +325,11 @@ int phc_run_ledger_close(phc_run_ledger *l, phc_error *err)
     if (!l)
         return PHC_OK;
     int rc = PHC_OK;
-    if (l->f && fclose(l->f) != 0)
+    if (l->f && l->pending_bytes)
+        rc = write_pending(l, err);
+    if (l->f && fclose(l->f) != 0 && rc == PHC_OK)
         rc = phc_error_set(err, PHC_ERR_IO, "%s: write error: %s", l->path, strerror(errno));
-    free(l->line);
+    free(l->pending);
     free(l->path);
     free(l);
     return rc;

@@ -1,7 +1,7 @@
 /* The run ledger of a long study: an append-only text file with one line
- * per finished model evaluation, flushed as each result arrives, so that an
- * interrupted study continues (`--resume`) without recomputing anything it
- * finished.
+ * per finished model evaluation, written in small batches as results
+ * arrive (below), so that an interrupted study continues (`--resume`)
+ * without recomputing anything the ledger holds.
  *
  * Format (tab-separated, one record per line):
  *   # phytocal run ledger 1
@@ -14,10 +14,16 @@
  *                          line before " #"
  * A last line without its newline (the process died while writing it) is
  * cut off on resume; any other line that does not parse or whose checksum
- * does not match is an error naming the file and line.  Lines are flushed to
- * the operating system per result (fflush; not fsync: a process that is
- * killed loses nothing, a machine that loses power may lose the last
- * lines, which are then recomputed). */
+ * does not match is an error naming the file and line.  Records go to the
+ * operating system in batches, one write(2) each: a batch is written when
+ * it holds 64 records or 64 KiB, when a record arrives 50 ms or more after
+ * the last write (so a study whose evaluations take 50 ms or more writes
+ * every record as it comes), and at phc_run_ledger_close (also when a study
+ * stops on an error or is cancelled).  A process that is killed (SIGKILL)
+ * loses at most the records of the batch not yet written: at most 63
+ * records, all appended less than 50 ms after the last write; they are
+ * recomputed on --resume.  Not fsync: a machine that loses power may lose
+ * the last lines too. */
 #ifndef PHC_RUN_LEDGER_H
 #define PHC_RUN_LEDGER_H
 

@@ -154,7 +154,10 @@ static const command_help commands[] = {
      "options:\n"
      "  --points N         target steps per side before the threshold (default 12, >= 3)\n"
      "  --level L          confidence level, 0 < L < 1 (default 0.95)\n"
-     "  -o DIR, --force, --quiet as for fit."},
+     "  -o DIR, --force, --quiet as for fit.\n"
+     "\n"
+     "Under mpirun or srun (at least 2 ranks) the parameters' profiles are spread over the\n"
+     "ranks; rank 0 prints and writes the one-process run's result (README: \"On a cluster\")."},
     {"mcmc", "phytocal mcmc CONFIG.yaml [-o DIR] [--method dram|stretch] [--samples N] [--chains C] [--seed S]\n"
              "                     [--resume] [--force] [--quiet]",
      "Bayesian posterior of the free parameters by MCMC: Gaussian likelihood of the\n"
@@ -177,7 +180,11 @@ static const command_help commands[] = {
      "  --resume           dram: continue an interrupted run from DIR.ledger (the chains it\n"
      "                     holds are not rerun; a ledger of another config or setting is\n"
      "                     refused, naming what differs)\n"
-     "  -o DIR, --force, --quiet as for fit."},
+     "  -o DIR, --force, --quiet as for fit.\n"
+     "\n"
+     "Under mpirun or srun (at least 2 ranks) DRAM's chains are spread over the ranks (rank\n"
+     "0 keeps the ledger, prints and writes); the stretch ensemble runs on rank 0 alone.\n"
+     "The result is the one-process run's (README: \"On a cluster\")."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",
      "Prints the summary of an earlier fit from its result.json; with --level L the\n"
@@ -919,6 +926,18 @@ static int parse_count(const char *opt, const char *text, unsigned long long max
     return 0;
 }
 
+/* A config that did not load on this rank: the other ranks may have loaded
+ * it and must not wait for this one (study_dist.h: one agree per study). */
+static void dist_load_failed(phc_dist *dist, int code)
+{
+    if (!dist)
+        return;
+    phc_error e;
+    phc_error_clear(&e);
+    phc_error_set(&e, code == EXIT_INPUT ? PHC_ERR_INPUT : PHC_ERR_INTERNAL, "the config did not load");
+    dist->agree(dist, e.status, &e);
+}
+
 static int sensitivity_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_study_options so = phc_study_options_default();
@@ -999,12 +1018,7 @@ static int sensitivity_run(int full_argc, char **full_argv, int argc, char **arg
     if (load_for_run("sensitivity", full_argc, full_argv, n_rest, rest, "-sensitivity", &o, &pb, &pv, dir,
                      sizeof dir, &code)) {
         free(rest);
-        if (dist) { /* the other ranks may have loaded it: they must not wait for this one */
-            phc_error e;
-            phc_error_clear(&e);
-            phc_error_set(&e, code == EXIT_INPUT ? PHC_ERR_INPUT : PHC_ERR_INTERNAL, "the config did not load");
-            dist->agree(dist, e.status, &e);
-        }
+        dist_load_failed(dist, code);
         return code;
     }
     free(rest);
@@ -1042,8 +1056,12 @@ static int sensitivity_run(int full_argc, char **full_argv, int argc, char **arg
 
 /* Under mpirun or srun (study_dist.h) every rank runs the study: rank 0
  * prints, writes and returns the exit code; the workers print nothing
- * (stdout and stderr go to /dev/null) and exit 0. */
-static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+ * (stdout and stderr go to /dev/null) and exit 0.  Used by sensitivity,
+ * profile and mcmc. */
+typedef int (*dist_command_fn)(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist);
+
+static int run_on_ranks(const char *name, dist_command_fn fn, int full_argc, char **full_argv, int argc,
+                        char **argv)
 {
     phc_dist *dist = NULL;
     phc_error err;
@@ -1056,18 +1074,18 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
         const int rank = phc_dist_launched_rank();
         if (rank != 0) {
             sleep(2);
-            fprintf(stderr, "phytocal sensitivity: rank %d: %s\n", rank, err.message);
+            fprintf(stderr, "phytocal %s: rank %d: %s\n", name, rank, err.message);
         } else {
-            fprintf(stderr, "phytocal sensitivity: %s\n", err.message);
+            fprintf(stderr, "phytocal %s: %s\n", name, err.message);
         }
         return exit_code_for(err.status);
     }
     if (dist && dist->rank != 0 &&
         (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))) {
         /* cannot silence this worker: it still runs, and says so once */
-        fprintf(stderr, "phytocal sensitivity: rank %d: cannot redirect its output to /dev/null\n", dist->rank);
+        fprintf(stderr, "phytocal %s: rank %d: cannot redirect its output to /dev/null\n", name, dist->rank);
     }
-    const int code = sensitivity_run(full_argc, full_argv, argc, argv, dist);
+    const int code = fn(full_argc, full_argv, argc, argv, dist);
     /* a worker's own failures reach rank 0 (study_dist.h: agree), which
        reports them; a worker exits 0, so that its exit cannot end the job
        (mpirun stops every rank at the first non-zero exit) before rank 0
@@ -1077,10 +1095,15 @@ static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **arg
     return worker ? EXIT_OK : code;
 }
 
+static int cmd_sensitivity(int full_argc, char **full_argv, int argc, char **argv)
+{
+    return run_on_ranks("sensitivity", sensitivity_run, full_argc, full_argv, argc, argv);
+}
+
 /* profile: profile likelihood of every free parameter (profile_study.h).
  * --points and --level are taken out first; the rest goes through
  * load_for_run. */
-static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
+static int profile_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_profile_study_options po = phc_profile_study_options_default();
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
@@ -1128,11 +1151,13 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
     if (load_for_run("profile", full_argc, full_argv, n_rest, rest, "-profile", &o, &pb, &pv, dir, sizeof dir,
                      &code)) {
         free(rest);
+        dist_load_failed(dist, code);
         return code;
     }
     free(rest);
     progress_state prog = {isatty(STDERR_FILENO), now_seconds(), 0, "", 0, 0, NULL};
     po.force = o.force;
+    po.dist = dist;
     po.progress = o.quiet ? NULL : progress_cb;
     po.progress_data = &prog;
     phc_error err;
@@ -1161,8 +1186,13 @@ static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
     return EXIT_OK;
 }
 
+static int cmd_profile(int full_argc, char **full_argv, int argc, char **argv)
+{
+    return run_on_ranks("profile", profile_run, full_argc, full_argv, argc, argv);
+}
+
 /* mcmc: posterior sampling (mcmc_study.h).  Its own options first, the rest through load_for_run. */
-static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
+static int mcmc_run(int full_argc, char **full_argv, int argc, char **argv, phc_dist *dist)
 {
     phc_mcmc_options mo = phc_mcmc_options_default();
     char **rest = calloc((size_t)argc + 1, sizeof *rest);
@@ -1224,10 +1254,12 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
     int code;
     if (load_for_run("mcmc", full_argc, full_argv, n_rest, rest, "-mcmc", &o, &pb, &pv, dir, sizeof dir, &code)) {
         free(rest);
+        dist_load_failed(dist, code);
         return code;
     }
     free(rest);
     mo.force = o.force;
+    mo.dist = dist;
     const char *stop = getenv("PHYTOCAL_STOP_AFTER"); /* test hook: stop after k chains, as a killed run would */
     if (stop && *stop)
         mo.stop_after = (size_t)strtoull(stop, NULL, 10);
@@ -1248,6 +1280,11 @@ static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
                dir);
     phc_mcmc_run_summary_clear(&sum);
     return EXIT_OK;
+}
+
+static int cmd_mcmc(int full_argc, char **full_argv, int argc, char **argv)
+{
+    return run_on_ranks("mcmc", mcmc_run, full_argc, full_argv, argc, argv);
 }
 
 /* report --check DIR: the run's inputs and outputs against its manifest. */

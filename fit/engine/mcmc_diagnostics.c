@@ -1,11 +1,61 @@
 /* MCMC diagnostics: see mcmc_diagnostics.h. */
 #include "fit/engine/mcmc_diagnostics.h"
 
+#include <gsl/gsl_fft_halfcomplex.h>
+#include <gsl/gsl_fft_real.h>
 #include <gsl/gsl_sort.h>
 #include <gsl/gsl_statistics_double.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The chains' autocorrelation averaged over the chains that moved:
+ * rho[k] = mean over chains of sum_t (x_t - m)(x_{t+k} - m) / sum_t (x_t - m)^2,
+ * k = 0 .. n - 1, by the Wiener-Khinchin theorem: the sums for every lag at
+ * once are the inverse FFT of |FFT(x - m)|^2 with x zero-padded to a power
+ * of two L >= 2 n (no wrap-around), O(L log L) per chain where the sums lag
+ * by lag cost O(n) each (GSL's radix-2 real FFT, halfcomplex layout).
+ * Returns the number of chains used (0: none moved), -1 out of memory. */
+static long mean_autocorr(const double *x, size_t chains, size_t n, double *rho)
+{
+    size_t L = 1;
+    while (L < 2 * n)
+        L <<= 1;
+    double *f = malloc(L * sizeof *f);
+    if (!f)
+        return -1;
+    memset(rho, 0, n * sizeof *rho);
+    long used = 0;
+    for (size_t ch = 0; ch < chains; ++ch) {
+        const double *v = x + ch * n;
+        double s = 0;
+        for (size_t t = 0; t < n; ++t)
+            s += v[t];
+        const double mean = s / (double)n;
+        for (size_t t = 0; t < n; ++t)
+            f[t] = v[t] - mean;
+        memset(f + n, 0, (L - n) * sizeof *f);
+        gsl_fft_real_radix2_transform(f, 1, L);
+        /* halfcomplex: f[0] and f[L/2] real, f[k] + i f[L-k] for 0 < k < L/2 */
+        f[0] *= f[0];
+        f[L / 2] *= f[L / 2];
+        for (size_t k = 1; k < L / 2; ++k) {
+            f[k] = f[k] * f[k] + f[L - k] * f[L - k];
+            f[L - k] = 0;
+        }
+        gsl_fft_halfcomplex_radix2_inverse(f, 1, L);
+        if (!(f[0] > 0))
+            continue; /* a chain that never moved: no autocorrelation to average */
+        for (size_t k = 0; k < n; ++k)
+            rho[k] += f[k] / f[0];
+        ++used;
+    }
+    free(f);
+    if (used)
+        for (size_t k = 0; k < n; ++k)
+            rho[k] /= (double)used;
+    return used;
+}
 
 double phc_mcmc_autocorr_time(const double *x, size_t chains, size_t n, double c, size_t *window, int *reliable)
 {
@@ -15,51 +65,27 @@ double phc_mcmc_autocorr_time(const double *x, size_t chains, size_t n, double c
         *reliable = 0;
     if (n < 2 || chains == 0)
         return NAN;
-    double *mean = malloc(chains * sizeof *mean), *var = malloc(chains * sizeof *var);
-    if (!mean || !var) {
-        free(mean);
-        free(var);
+    double *rho = malloc(n * sizeof *rho);
+    const long used = rho ? mean_autocorr(x, chains, n, rho) : -1;
+    free(used > 0 ? NULL : rho);
+    if (used < 0)
         return NAN;
-    }
-    for (size_t ch = 0; ch < chains; ++ch) {
-        const double *v = x + ch * n;
-        double s = 0;
-        for (size_t t = 0; t < n; ++t)
-            s += v[t];
-        mean[ch] = s / (double)n;
-        double q = 0;
-        for (size_t t = 0; t < n; ++t)
-            q += (v[t] - mean[ch]) * (v[t] - mean[ch]);
-        var[ch] = q;
+    if (used == 0) { /* no chain moved */
+        if (window)
+            *window = 1;
+        return NAN;
     }
     double tau = 1; /* rho(0) = 1 */
     size_t m;
     int found = 0;
     for (m = 1; m < n; ++m) {
-        double rho = 0;
-        size_t used = 0;
-        for (size_t ch = 0; ch < chains; ++ch) {
-            if (!(var[ch] > 0))
-                continue; /* a chain that never moved: no autocorrelation to average */
-            const double *v = x + ch * n;
-            double s = 0;
-            for (size_t t = 0; t + m < n; ++t)
-                s += (v[t] - mean[ch]) * (v[t + m] - mean[ch]);
-            rho += s / var[ch];
-            ++used;
-        }
-        if (!used) {
-            tau = NAN;
-            break;
-        }
-        tau += 2 * rho / (double)used;
+        tau += 2 * rho[m];
         if ((double)m >= c * tau) {
             found = 1;
             break;
         }
     }
-    free(mean);
-    free(var);
+    free(rho);
     if (window)
         *window = m < n ? m : n - 1;
     if (reliable)

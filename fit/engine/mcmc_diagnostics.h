@@ -8,7 +8,9 @@
  *      tau(M) = 1 + 2 sum_{k=1..M} rho(k),
  *    at the smallest window M >= c tau(M) (c = 5); when no lag below n
  *    satisfies it, the last one (emcee likewise) and `reliable` = 0;
- *    emcee's rule: the estimate is trusted when n >= 50 tau;
+ *    emcee's rule: the estimate is trusted when n >= 50 tau; the sums for
+ *    every lag come from one FFT per chain (Wiener-Khinchin, zero-padded
+ *    to a power of two >= 2 n, GSL), O(n log n) instead of O(n M);
  *  - effective sample size ESS = chains n / tau;
  *  - split-R-hat (Gelman et al. 2013, BDA3 §11.4, eq. 11.3-11.4): each chain
  *    cut in halves, m = 2 chains sequences of n' = floor(n/2);

@@ -11,6 +11,7 @@
 
 #include "fit/engine/ceres_bridge.h"
 #include "fit/engine/dataset.h"
+#include "fit/study_dist.h"
 
 phc_profile_options phc_profile_options_default(void)
 {
@@ -276,30 +277,224 @@ static int store_points(const point_list *l, phc_profile *prof)
     return PHC_OK;
 }
 
+static void profile_clear(phc_profile *p)
+{
+    free(p->theta);
+    free(p->delta);
+    free(p->others);
+    memset(p, 0, sizeof *p);
+}
+
+/* The profile of parameter j (the k-th free one) into prof, from the
+ * optimum res->best (its cost and threshold set): depends on nothing else,
+ * so that the profiles can be traced in any order, on any process. */
+static int profile_one(phc_problem *pb, const phc_profile_options *opt, const phc_nls_options *nls_opt,
+                       const phc_profile_result *res, const double *initial_step, size_t j, size_t k,
+                       phc_profile *prof, double *scratch, phc_error *err)
+{
+    const size_t n_free = res->n_free, n_obs = res->n_obs;
+    int rc;
+    memset(prof, 0, sizeof *prof);
+    prof->param = j;
+    prof->min_delta = 0.0;
+    point_list pts = {0, 0, pb->n_params, NULL, NULL, NULL};
+    tracer tr = {pb, NULL, opt, *nls_opt, j, k, n_free, res->best_cost, res->threshold, &pts, prof, scratch};
+    if ((rc = build_nls(pb, j, &tr.nls, err)))
+        return rc;
+    double h0 = 0.1 * phc_problem_scale(pb, j);
+    /* from the Wald standard error: about `points` steps to the threshold */
+    if (initial_step && isfinite(initial_step[j]) && initial_step[j] > 0.0) {
+        /* near the optimum delta = s2 (theta - theta_hat)^2 / (2 se^2), with s2 the
+           variance factor: the threshold is sqrt(2 thr / s2) se away */
+        const double s2 = res->absolute_sigma ? 1.0 : 2.0 * res->best_cost / (double)(n_obs - n_free);
+        h0 = initial_step[j] * sqrt(2.0 * res->threshold / (s2 > 0.0 ? s2 : 1.0)) / (double)opt->points;
+    }
+    if ((rc = push_point(&pts, res->best[j], 0.0, res->best)) == PHC_OK)
+        rc = trace_side(&tr, res->best, h0, -1, &prof->lo, &prof->lo_end);
+    if (rc == PHC_OK)
+        rc = trace_side(&tr, res->best, h0, +1, &prof->hi, &prof->hi_end);
+    phc_nls_free(tr.nls);
+    if (rc == PHC_OK)
+        rc = store_points(&pts, prof);
+    free(pts.theta);
+    free(pts.delta);
+    free(pts.x);
+    if (rc) {
+        profile_clear(prof);
+        return phc_error_set(err, rc, "profile of '%s': out of memory", pb->params[j].name);
+    }
+    double max_delta = 0.0;
+    for (size_t i = 0; i < prof->n; ++i)
+        if (prof->delta[i] > max_delta)
+            max_delta = prof->delta[i];
+    prof->flat = prof->lo_end != PHC_PROFILE_CROSSED && prof->hi_end != PHC_PROFILE_CROSSED &&
+                 max_delta < opt->flat_fraction * res->threshold;
+    return PHC_OK;
+}
+
+/* ---- the profiles shared out over processes (fit/study_dist.h) ------------------------- */
+
+/* A profile travels as one row of doubles: 8 numbers (n, lo, hi, lo_end,
+ * hi_end, inner_fits, failed_fits, min_delta), then theta, delta and the
+ * others (n_params each) of at most `cap` points.  A side pushes at most one
+ * point per step and 40 in its crossing's refinement, so
+ * cap = 1 + 2 (max_steps + 40) holds every profile.  Doubles carry every
+ * value bit for bit (counts are exact below 2^53). */
+enum { HEAD = 8, REFINE_POINTS = 40 };
+
+typedef struct dist_ctx {
+    phc_problem *pb;
+    const phc_profile_options *opt;
+    const phc_nls_options *nls_opt;
+    phc_profile_result *res;
+    const double *initial_step;
+    const size_t *param_of; /* k -> j */
+    size_t cap;
+    double *scratch;
+} dist_ctx;
+
+static size_t dist_cap(const phc_profile_options *opt)
+{
+    const size_t max_steps = opt->max_steps ? opt->max_steps : 8 * opt->points + 40;
+    return 1 + 2 * (max_steps + REFINE_POINTS);
+}
+
+static int dist_eval(void *vctx, size_t k, double *out)
+{
+    dist_ctx *c = vctx;
+    const size_t np = c->pb->n_params;
+    phc_profile p;
+    phc_error e;
+    phc_error_clear(&e);
+    out[0] = NAN;
+    if (profile_one(c->pb, c->opt, c->nls_opt, c->res, c->initial_step, c->param_of[k], k, &p, c->scratch, &e) !=
+            PHC_OK ||
+        p.n > c->cap) {
+        profile_clear(&p);
+        return 1;
+    }
+    const double head[HEAD] = {(double)p.n,           p.lo, p.hi, (double)p.lo_end, (double)p.hi_end,
+                               (double)p.inner_fits, (double)p.failed_fits, p.min_delta};
+    memcpy(out, head, sizeof head);
+    memcpy(out + HEAD, p.theta, p.n * sizeof *p.theta);
+    memcpy(out + HEAD + c->cap, p.delta, p.n * sizeof *p.delta);
+    memcpy(out + HEAD + 2 * c->cap, p.others, p.n * np * sizeof *p.others);
+    profile_clear(&p); /* flat: the master recomputes it from the points */
+    return 0;
+}
+
+static int dist_record(void *vctx, size_t k, int failed, const double *in, phc_error *err)
+{
+    dist_ctx *c = vctx;
+    const size_t np = c->pb->n_params, j = c->param_of[k];
+    if (failed)
+        return phc_error_set(err, PHC_ERR_NOMEM, "profile of '%s': out of memory, or more than %zu points",
+                             c->pb->params[j].name, c->cap);
+    phc_profile *p = &c->res->profiles[k];
+    const size_t n = (size_t)in[0];
+    p->param = j;
+    p->n = n;
+    p->lo = in[1];
+    p->hi = in[2];
+    p->lo_end = (phc_profile_end)(int)in[3];
+    p->hi_end = (phc_profile_end)(int)in[4];
+    p->inner_fits = (size_t)in[5];
+    p->failed_fits = (size_t)in[6];
+    p->min_delta = in[7];
+    p->theta = malloc((n ? n : 1) * sizeof *p->theta);
+    p->delta = malloc((n ? n : 1) * sizeof *p->delta);
+    p->others = malloc((n ? n : 1) * np * sizeof *p->others);
+    if (!p->theta || !p->delta || !p->others)
+        return phc_error_set(err, PHC_ERR_NOMEM, "profile of '%s': out of memory", c->pb->params[j].name);
+    memcpy(p->theta, in + HEAD, n * sizeof *p->theta);
+    memcpy(p->delta, in + HEAD + c->cap, n * sizeof *p->delta);
+    memcpy(p->others, in + HEAD + 2 * c->cap, n * np * sizeof *p->others);
+    double max_delta = 0.0;
+    for (size_t i = 0; i < n; ++i)
+        if (p->delta[i] > max_delta)
+            max_delta = p->delta[i];
+    p->flat = p->lo_end != PHC_PROFILE_CROSSED && p->hi_end != PHC_PROFILE_CROSSED &&
+              max_delta < c->opt->flat_fraction * c->res->threshold;
+    return PHC_OK;
+}
+
+/* Every rank has polished the same optimum; the master hands out one
+ * parameter's profile per message and traces profiles itself between
+ * results; the workers leave with res->n_profiles = 0. */
+static int distribute(phc_problem *pb, const phc_profile_options *opt, const phc_nls_options *nls_opt,
+                      phc_profile_result *res, const double *initial_step, size_t n_free, phc_error *err)
+{
+    phc_dist *d = opt->dist;
+    const size_t np = pb->n_params, cap = dist_cap(opt);
+    size_t *param_of = malloc(n_free * sizeof *param_of), *rows = malloc(n_free * sizeof *rows);
+    double *scratch = malloc(np * sizeof *scratch);
+    int rc = !param_of || !rows || !scratch ? phc_error_set(err, PHC_ERR_NOMEM, "profile: out of memory") : PHC_OK;
+    if (rc == PHC_OK)
+        for (size_t j = 0, k = 0; j < np; ++j)
+            if (!pb->params[j].fixed) {
+                param_of[k] = j;
+                rows[k] = k;
+                ++k;
+            }
+    dist_ctx c = {pb, opt, nls_opt, res, initial_step, param_of, cap, scratch};
+    if ((rc = d->agree(d, rc, err)) == PHC_OK) {
+        if (d->rank == 0) {
+            res->n_profiles = n_free; /* recorded as they arrive; freed with res when the run fails */
+            rc = d->run(d, HEAD + cap * (2 + np), rows, n_free, dist_eval, dist_record, &c, err);
+        } else {
+            rc = d->run(d, HEAD + cap * (2 + np), NULL, 0, dist_eval, NULL, &c, err);
+        }
+    }
+    free(param_of);
+    free(rows);
+    free(scratch);
+    return rc;
+}
+
+/* An error before the profiles: under MPI the other ranks learn it (the one
+ * agree() of study_dist.h's protocol) instead of waiting for this rank. */
+static int agree_failure(const phc_profile_options *opt, int rc, phc_error *err)
+{
+    if (opt->dist)
+        opt->dist->agree(opt->dist, rc, err);
+    return rc;
+}
+
 int phc_profile_run(phc_problem *pb, const double *x0, const double *initial_step,
                     const phc_profile_options *opt, phc_profile_result **out, phc_error *err)
 {
     *out = NULL;
+    int rc = PHC_OK, agreed = 0; /* with opt->dist, every rank agrees once (study_dist.h) */
     if (!(opt->level > 0.0 && opt->level < 1.0))
-        return phc_error_set(err, PHC_ERR_INPUT, "profile: level must be between 0 and 1, found %g", opt->level);
+        return agree_failure(
+            opt, phc_error_set(err, PHC_ERR_INPUT, "profile: level must be between 0 and 1, found %g", opt->level),
+            err);
     if (opt->points < 3)
-        return phc_error_set(err, PHC_ERR_INPUT, "profile: points must be at least 3, found %zu", opt->points);
+        return agree_failure(
+            opt, phc_error_set(err, PHC_ERR_INPUT, "profile: points must be at least 3, found %zu", opt->points),
+            err);
     size_t n_free = 0, n_obs = 0;
     for (size_t i = 0; i < pb->n_params; ++i)
         n_free += !pb->params[i].fixed;
     for (size_t d = 0; d < pb->n_datasets; ++d)
         n_obs += pb->datasets[d]->n;
     if (n_free == 0)
-        return phc_error_set(err, PHC_ERR_INPUT, "%s: no free parameter to profile (every parameter is fixed)",
-                             pb->source ? pb->source : pb->name);
+        return agree_failure(opt,
+                             phc_error_set(err, PHC_ERR_INPUT,
+                                           "%s: no free parameter to profile (every parameter is fixed)",
+                                           pb->source ? pb->source : pb->name),
+                             err);
     if (!pb->options.absolute_sigma && n_obs <= n_free)
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "%s: %zu observations for %zu free parameters leave no degrees of freedom to estimate "
-                             "the noise; a profile needs n > p (or absolute sigmas)",
-                             pb->source ? pb->source : pb->name, n_obs, n_free);
+        return agree_failure(opt,
+                             phc_error_set(err, PHC_ERR_INPUT,
+                                           "%s: %zu observations for %zu free parameters leave no degrees of "
+                                           "freedom to estimate the noise; a profile needs n > p (or absolute "
+                                           "sigmas)",
+                                           pb->source ? pb->source : pb->name, n_obs, n_free),
+                             err);
     phc_profile_result *res = calloc(1, sizeof *res);
     if (!res)
-        return phc_error_set(err, PHC_ERR_NOMEM, "profile: out of memory");
+        return agree_failure(opt, phc_error_set(err, PHC_ERR_NOMEM, "profile: out of memory"), err);
     res->n_params = pb->n_params;
     res->n_obs = n_obs;
     res->n_free = n_free;
@@ -308,7 +503,6 @@ int phc_profile_run(phc_problem *pb, const double *x0, const double *initial_ste
     res->best = malloc(pb->n_params * sizeof *res->best);
     res->profiles = calloc(n_free, sizeof *res->profiles);
     double *scratch = malloc(pb->n_params * sizeof *scratch);
-    int rc = PHC_OK;
     if (!res->best || !res->profiles || !scratch) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "profile: out of memory");
         goto done;
@@ -336,53 +530,24 @@ int phc_profile_run(phc_problem *pb, const double *x0, const double *initial_ste
         res->best_cost = sum.final_cost;
     }
     res->threshold = phc_profile_threshold(opt->level, res->absolute_sigma, res->best_cost, n_obs, n_free);
+    if (opt->dist) { /* every rank: the same set-up, then the profiles shared out (study_dist.h) */
+        rc = distribute(pb, opt, &nls_opt, res, initial_step, n_free, err);
+        agreed = 1;
+        goto done;
+    }
     size_t k = 0;
     for (size_t j = 0; j < pb->n_params && rc == PHC_OK; ++j) {
         if (pb->params[j].fixed)
             continue;
-        phc_profile *prof = &res->profiles[k];
-        prof->param = j;
-        prof->min_delta = 0.0;
-        point_list pts = {0, 0, pb->n_params, NULL, NULL, NULL};
-        tracer tr = {pb, NULL, opt, nls_opt, j, k, n_free, res->best_cost, res->threshold, &pts, prof, scratch};
-        if ((rc = build_nls(pb, j, &tr.nls, err)))
+        if ((rc = profile_one(pb, opt, &nls_opt, res, initial_step, j, k, &res->profiles[k], scratch, err)))
             break;
-        double h0 = initial_step && isfinite(initial_step[j]) && initial_step[j] > 0.0
-                        ? initial_step[j]
-                        : 0.1 * phc_problem_scale(pb, j);
-        /* from the Wald standard error: about `points` steps to the threshold */
-        if (initial_step && isfinite(initial_step[j]) && initial_step[j] > 0.0)
-        {
-            /* near the optimum delta = s2 (theta - theta_hat)^2 / (2 se^2), with s2 the
-               variance factor: the threshold is sqrt(2 thr / s2) se away */
-            const double s2 = res->absolute_sigma ? 1.0 : 2.0 * res->best_cost / (double)(n_obs - n_free);
-            h0 = initial_step[j] * sqrt(2.0 * res->threshold / (s2 > 0.0 ? s2 : 1.0)) / (double)opt->points;
-        }
-        if ((rc = push_point(&pts, res->best[j], 0.0, res->best)) == PHC_OK)
-            rc = trace_side(&tr, res->best, h0, -1, &prof->lo, &prof->lo_end);
-        if (rc == PHC_OK)
-            rc = trace_side(&tr, res->best, h0, +1, &prof->hi, &prof->hi_end);
-        phc_nls_free(tr.nls);
-        if (rc == PHC_OK)
-            rc = store_points(&pts, prof);
-        free(pts.theta);
-        free(pts.delta);
-        free(pts.x);
-        if (rc) {
-            phc_error_set(err, rc, "profile of '%s': out of memory", pb->params[j].name);
-            break;
-        }
-        double max_delta = 0.0;
-        for (size_t i = 0; i < prof->n; ++i)
-            if (prof->delta[i] > max_delta)
-                max_delta = prof->delta[i];
-        prof->flat = prof->lo_end != PHC_PROFILE_CROSSED && prof->hi_end != PHC_PROFILE_CROSSED &&
-                     max_delta < opt->flat_fraction * res->threshold;
         ++k;
     }
     res->n_profiles = k;
 done:
     free(scratch);
+    if (opt->dist && !agreed) /* failed before the profiles: the other ranks must not wait for this one */
+        opt->dist->agree(opt->dist, rc, err);
     if (rc) {
         phc_profile_result_free(res);
         return rc;

@@ -45,6 +45,15 @@ typedef struct phc_profile_options {
                             threshold everywhere is flat (0.01) */
     phc_progress_fn progress;
     void *progress_data;
+    /* NULL: one process.  Else the processes of an MPI run
+       (fit/study_dist.h): every rank calls phc_profile_run with the same
+       problem and x0, polishes the same optimum, then the free parameters'
+       profiles are shared out (one per message; each is traced from the
+       optimum alone, so the order does not matter) and the master (rank 0)
+       receives them bit for bit: its result equals one process's.  A
+       worker's result has n_profiles = 0.  Every rank calls agree() once,
+       also when the set-up fails. */
+    struct phc_dist *dist;
 } phc_profile_options;
 
 phc_profile_options phc_profile_options_default(void);

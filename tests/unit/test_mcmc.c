@@ -98,6 +98,68 @@ static void compare(const char *what, const phc_mcmc_chains *c, const double *me
 }
 
 /* The quantiles of phc_mcmc_summarise against a full sort. */
+/* The FFT autocorrelation (mcmc_diagnostics.c) against the sums lag by
+ * lag, on AR(1) chains of odd and power-of-two lengths and with one chain
+ * that never moved (left out of the average): tau and the window equal the
+ * direct computation's to rounding. */
+static double direct_tau(const double *x, size_t chains, size_t n, double c, size_t *window)
+{
+    double tau = 1;
+    size_t m;
+    for (m = 1; m < n; ++m) {
+        double rho = 0;
+        size_t used = 0;
+        for (size_t ch = 0; ch < chains; ++ch) {
+            const double *v = x + ch * n;
+            double mean = 0, var = 0, s = 0;
+            for (size_t t = 0; t < n; ++t)
+                mean += v[t];
+            mean /= (double)n;
+            for (size_t t = 0; t < n; ++t)
+                var += (v[t] - mean) * (v[t] - mean);
+            if (!(var > 0))
+                continue;
+            for (size_t t = 0; t + m < n; ++t)
+                s += (v[t] - mean) * (v[t + m] - mean);
+            rho += s / var;
+            ++used;
+        }
+        tau += 2 * rho / (double)used;
+        if ((double)m >= c * tau)
+            break;
+    }
+    *window = m < n ? m : n - 1;
+    return tau;
+}
+
+static void test_autocorr_fft_equals_direct(void)
+{
+    gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(r, 11);
+    const size_t sizes[3] = {777, 1024, 3001};
+    const double phis[3] = {0.5, 0.9, 0.97};
+    for (int k = 0; k < 3; ++k) {
+        const size_t chains = 5, n = sizes[k];
+        double *x = malloc(chains * n * sizeof *x);
+        for (size_t c = 0; c < chains; ++c) {
+            double v = 0;
+            for (size_t t = 0; t < n; ++t) {
+                v = phis[k] * v + gsl_ran_ugaussian(r);
+                x[c * n + t] = c == 2 ? 1.5 : 100 + v; /* chain 3 never moved */
+            }
+        }
+        size_t w_fft, w_dir;
+        const double t_fft = phc_mcmc_autocorr_time(x, chains, n, 5, &w_fft, NULL);
+        const double t_dir = direct_tau(x, chains, n, 5, &w_dir);
+        printf("autocorrelation by FFT, n = %zu, phi = %.2f: tau %.15g (direct sums %.15g, rel. diff %.2e), window "
+               "%zu (%zu)\n", n, phis[k], t_fft, t_dir, fabs(t_fft - t_dir) / t_dir, w_fft, w_dir);
+        CHECK(fabs(t_fft - t_dir) <= 1e-10 * t_dir);
+        CHECK(w_fft == w_dir);
+        free(x);
+    }
+    gsl_rng_free(r);
+}
+
 static void test_quantiles_by_selection(void)
 {
     gsl_rng *r = gsl_rng_alloc(gsl_rng_mt19937);
@@ -138,6 +200,7 @@ static void test_quantiles_by_selection(void)
 int main(void)
 {
     test_quantiles_by_selection();
+    test_autocorr_fft_equals_direct();
     phc_error err;
     /* ---- AR(1): tau = (1 + phi) / (1 - phi) */
     {
