@@ -79,6 +79,7 @@ PHC_LAZY_FORWARD_VOID(L, c_plscol0, (PLINT icol0, PLINT r, PLINT g, PLINT b), (i
 PHC_LAZY_FORWARD_VOID(L, c_plscol0a, (PLINT icol0, PLINT r, PLINT g, PLINT b, PLFLT alpha),
                       (icol0, r, g, b, alpha))
 PHC_LAZY_FORWARD_VOID(L, c_plsdev, (PLCHAR_VECTOR devname), (devname))
+PHC_LAZY_FORWARD(L, PLINT, c_plsetopt, (PLCHAR_VECTOR opt, PLCHAR_VECTOR optarg), (opt, optarg))
 PHC_LAZY_FORWARD_VOID(L, c_plsfam, (PLINT fam, PLINT num, PLINT bmax), (fam, num, bmax))
 PHC_LAZY_FORWARD_VOID(L, c_plsfnam, (PLCHAR_VECTOR fnam), (fnam))
 PHC_LAZY_FORWARD_VOID(L, c_plslabelfunc, (PLLABEL_FUNC_callback label_func, PLPointer label_data),
