@@ -134,6 +134,20 @@ typedef struct chain_ledger {
     const char *path;
 } chain_ledger;
 
+/* Chain c's ledger row (its counts, samples, s2 and log posterior) appended;
+ * PHC_ERR_INTERNAL once stop_after new chains are written. */
+static int chain_record(chain_ledger *cl, size_t c, const double *row, phc_error *err)
+{
+    int rc = phc_run_ledger_append(cl->l, c, 0, row, err);
+    if (rc)
+        return rc;
+    cl->computed++;
+    if (cl->stop_after && cl->computed >= cl->stop_after)
+        return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new chains (stop_after); %s holds them: "
+                             "--resume continues", cl->computed, cl->path);
+    return PHC_OK;
+}
+
 static int chain_done(void *data, size_t c, const phc_mcmc_chains *out, const size_t counts[4], phc_error *err)
 {
     chain_ledger *cl = data;
@@ -146,14 +160,7 @@ static int chain_done(void *data, size_t c, const phc_mcmc_chains *out, const si
     memcpy(v, out->s2 + c * n, n * sizeof *v);
     v += n;
     memcpy(v, out->log_post + c * n, n * sizeof *v);
-    int rc = phc_run_ledger_append(cl->l, c, 0, cl->row, err);
-    if (rc)
-        return rc;
-    cl->computed++;
-    if (cl->stop_after && cl->computed >= cl->stop_after)
-        return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new chains (stop_after); %s holds them: "
-                             "--resume continues", cl->computed, cl->path);
-    return PHC_OK;
+    return chain_record(cl, c, cl->row, err);
 }
 
 /* ---- DRAM's chains on MPI ranks (fit/study_dist.h) ------------------------------------ */
@@ -234,15 +241,7 @@ static int dd_record(void *ctx, size_t c, int failed, const double *in, phc_erro
     memcpy(dd->have->s2 + c * n, in + 4 + n * d, n * sizeof *in);
     memcpy(dd->have->log_post + c * n, in + 4 + n * (d + 1), n * sizeof *in);
     dd->state[c] = 1;
-    chain_ledger *cl = dd->cl;
-    int rc = phc_run_ledger_append(cl->l, c, 0, in, err);
-    if (rc)
-        return rc;
-    cl->computed++;
-    if (cl->stop_after && cl->computed >= cl->stop_after)
-        return phc_error_set(err, PHC_ERR_INTERNAL, "stopped after %zu new chains (stop_after); %s holds them: "
-                             "--resume continues", cl->computed, cl->path);
-    return PHC_OK;
+    return chain_record(dd->cl, c, in, err);
 }
 
 /* Every rank: agrees on rc (the master's ledger), then runs the chains the

@@ -8,6 +8,7 @@
 
 #include "fit/engine/problem.h"
 #include "model/climbing_statistics.h"
+#include "model/jacobi_svd.h"
 
 enum { ST_TOTAL, ST_MAIN, ST_HEIGHT, ST_ATTACHED, ST_COSINE, ST_COUNT1, ST_ANGLE_MEAN = ST_COUNT1 + 7, ST_ANGLE_SD,
        ST_N };
@@ -215,44 +216,6 @@ static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
     return rc;
 }
 
-/* Symmetric eigen-decomposition by cyclic Jacobi rotations (k small):
- * a (k x k) is destroyed, w the eigenvalues, v (k x k, columns) the vectors. */
-static void jacobi_eigen(double *a, size_t k, double *w, double *v)
-{
-    for (size_t i = 0; i < k; ++i)
-        for (size_t j = 0; j < k; ++j) v[i * k + j] = i == j;
-    for (int sweep = 0; sweep < 100; ++sweep) {
-        double off = 0;
-        for (size_t i = 0; i < k; ++i)
-            for (size_t j = i + 1; j < k; ++j) off += a[i * k + j] * a[i * k + j];
-        if (off < 1e-30) break;
-        for (size_t pq = 0; pq < k; ++pq)
-            for (size_t r = pq + 1; r < k; ++r) {
-                const double apq = a[pq * k + r];
-                if (fabs(apq) < 1e-300) continue;
-                const double th = (a[r * k + r] - a[pq * k + pq]) / (2 * apq);
-                const double t = (th >= 0 ? 1 : -1) / (fabs(th) + sqrt(th * th + 1));
-                const double c = 1 / sqrt(t * t + 1), s = t * c;
-                for (size_t i = 0; i < k; ++i) {
-                    const double aip = a[i * k + pq], aiq = a[i * k + r];
-                    a[i * k + pq] = c * aip - s * aiq;
-                    a[i * k + r] = s * aip + c * aiq;
-                }
-                for (size_t i = 0; i < k; ++i) {
-                    const double api = a[pq * k + i], aqi = a[r * k + i];
-                    a[pq * k + i] = c * api - s * aqi;
-                    a[r * k + i] = s * api + c * aqi;
-                }
-                for (size_t i = 0; i < k; ++i) {
-                    const double vip = v[i * k + pq], viq = v[i * k + r];
-                    v[i * k + pq] = c * vip - s * viq;
-                    v[i * k + r] = s * vip + c * viq;
-                }
-            }
-    }
-    for (size_t i = 0; i < k; ++i) w[i] = a[i * k + i];
-}
-
 int phc_shoot_traces_identifiability(phc_dataset *ds, const double *p, phc_shoot_traces_ident *out, phc_error *err)
 {
     const size_t k = ds->k, n = ds->n;
@@ -285,10 +248,19 @@ int phc_shoot_traces_identifiability(phc_dataset *ds, const double *p, phc_shoot
         out->value[a] = p[a];
     }
     /* correlations from the normal matrix: the largest |corr| of each slot with another */
-    double *C = malloc(k * k * sizeof *C);
+    /* eigenvalues of J'J as the squared singular values of J (one-sided
+     * Jacobi, model/jacobi_svd.h: no squaring of the condition number) */
+    double *C = malloc(n * k * sizeof *C);
     if (!C) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto done; }
-    memcpy(C, A, k * k * sizeof *C);
-    jacobi_eigen(C, k, w, V);
+    memcpy(C, J, n * k * sizeof *C);
+    if (phc_jacobi_svd(C, n, k, w, V)) {
+        free(C);
+        rc = phc_error_set(err, PHC_ERR_DOMAIN, "data set '%s': the sensitivities' decomposition did not converge",
+                           ds->name);
+        goto done;
+    }
+    for (size_t a = 0; a < k; ++a)
+        w[a] *= w[a];
     double wmax = 0;
     for (size_t a = 0; a < k; ++a) wmax = fmax(wmax, w[a]);
     out->rank = 0;
