@@ -33,13 +33,19 @@ struct phc_particles {
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
     size_t *child_start, *child; /* children from the graph */
     double *gq;              /* 4n: last rotation of each group (warm start) */
-    double *gsum;            /* 3n: goal accumulator */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
-    /* scratch for one group */
-    size_t cap;
-    size_t *mem;
-    double *mu, *goal;
+    size_t *child_index;     /* n: position of i among its parent's children */
+    double *ell0;            /* 9n: D_j R̄_jᵀ / 5 (kg-free ellipsoid term, m²) */
+    double *Rq;              /* 9n: R(q_j) of the orientations being matched */
+    /* Group slots: group k owns slots goff[k] .. goff[k+1]−1: slot 0 = k,
+     * slot 1 = its parent, slot 2 + c = its c-th child; a slot whose link
+     * is broken has μ = 0.  Each group writes only its own slots, so the
+     * groups can be matched in parallel and the blend gathers them in a
+     * fixed order (the same sums for any thread count). */
+    size_t *goff;            /* n + 1 */
+    size_t *mem;             /* slots: member particle */
+    double *mu, *goal;       /* slots: μ_jk (kg); 3·slots: goal (m) */
     size_t polar_total, polar_fallbacks; /* counters of the current step */
 };
 
@@ -146,12 +152,21 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     }
     quat_normalize(q);
     /* Müller et al. 2016, eq. 7: ω = Σ_c r_c × a_c / (|Σ_c r_c · a_c| + ε)
-     * over the columns c of R and A; q ← exp(ω) q until |ω| is negligible. */
+     * over the columns c of R and A; q ← exp(ω) q.  With B = A Rᵀ,
+     * Σ_c r_c × a_c = g = axial(B − Bᵀ) is the gradient of tr(Rᵀ A) along a
+     * left turn exp([ω]×) R, and the Hessian is −T, T = tr(B) I − sym(B)
+     * (second-order expansion of exp).  Müller's step replaces T by tr(B) I,
+     * which converges only linearly, at the rate 1 − (σ2 + σ3)/tr S, when
+     * A is rod-like (σ1 ≫ σ2, σ3: the turn about the rod axis is weakly
+     * determined); ours takes the Newton step ω = T⁻¹ g whenever T is
+     * positive definite (near the maximum it is), Müller's step otherwise,
+     * and stops after a Newton step shorter than 1e-9 rad (the next one
+     * would be below rounding: quadratic convergence). */
     double R[9];
     int converged = 0;
     for (int it = 0; it < 100; ++it) {
         phc_quat_to_matrix(q, R);
-        double om[3] = {0, 0, 0}, dot = 0;
+        double om[3] = {0, 0, 0}, dot = 0, B[9];
         for (int c = 0; c < 3; ++c) {
             const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
             const double a0 = a[c], a1 = a[3 + c], a2 = a[6 + c];
@@ -160,9 +175,43 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
             om[2] += r0 * a1 - r1 * a0;
             dot += r0 * a0 + r1 * a1 + r2 * a2;
         }
-        const double sc = 1.0 / (fabs(dot) + 1e-12);
-        for (int k = 0; k < 3; ++k)
-            om[k] *= sc;
+        /* T = tr(B) I − sym(B), B = A Rᵀ (rows of A against rows of R) */
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+                B[3 * i + j] = a[3 * i] * R[3 * j] + a[3 * i + 1] * R[3 * j + 1] +
+                               a[3 * i + 2] * R[3 * j + 2];
+        const double T00 = dot - B[0], T11 = dot - B[4], T22 = dot - B[8];
+        const double T01 = -0.5 * (B[1] + B[3]), T02 = -0.5 * (B[2] + B[6]),
+                     T12 = -0.5 * (B[5] + B[7]);
+        /* Cholesky of T; pivots must stay above 1e-10 (|a|_F = 1). */
+        int newton = 0;
+        double nw[3];
+        const double piv_min = 1e-10;
+        if (T00 > piv_min) {
+            const double l00 = sqrt(T00), l10 = T01 / l00, l20 = T02 / l00;
+            const double d1 = T11 - l10 * l10;
+            if (d1 > piv_min) {
+                const double l11 = sqrt(d1), l21 = (T12 - l20 * l10) / l11;
+                const double d2 = T22 - l20 * l20 - l21 * l21;
+                if (d2 > piv_min) {
+                    const double l22 = sqrt(d2);
+                    const double y0 = om[0] / l00, y1 = (om[1] - l10 * y0) / l11,
+                                 y2 = (om[2] - l20 * y0 - l21 * y1) / l22;
+                    nw[2] = y2 / l22;
+                    nw[1] = (y1 - l21 * nw[2]) / l11;
+                    nw[0] = (y0 - l10 * nw[1] - l20 * nw[2]) / l00;
+                    /* trust the quadratic model only for turns below 1 rad */
+                    newton = nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2] < 1.0;
+                }
+            }
+        }
+        if (newton) {
+            memcpy(om, nw, sizeof nw);
+        } else {
+            const double sc = 1.0 / (fabs(dot) + 1e-12);
+            for (int k = 0; k < 3; ++k)
+                om[k] *= sc;
+        }
         const double wn = sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
         if (wn < 1e-14) {
             converged = 1;
@@ -173,6 +222,10 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
         quat_mul(dq, q, t);
         memcpy(q, t, sizeof t);
         quat_normalize(q);
+        if (newton && wn < 1e-9) {
+            converged = 1;
+            break;
+        }
     }
     if (converged) {
         /* Certificate: at a maximum of tr(Rᵀa) over rotations, S = Rᵀa is
@@ -257,9 +310,12 @@ void phc_particles_free(phc_particles *p)
     free(p->child_start);
     free(p->child);
     free(p->gq);
-    free(p->gsum);
     free(p->stress);
     free(p->source_id);
+    free(p->child_index);
+    free(p->ell0);
+    free(p->Rq);
+    free(p->goff);
     free(p->mem);
     free(p->mu);
     free(p->goal);
@@ -280,18 +336,12 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
         return NULL;
     }
     const size_t n = g->n;
-    size_t maxdeg = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const size_t deg = g->child_start[i + 1] - g->child_start[i] + 2;
-        if (deg > maxdeg)
-            maxdeg = deg;
-    }
     phc_particles *p = calloc(1, sizeof *p);
     if (!p)
         goto nomem;
     p->n = n;
     p->o = o;
-    p->cap = maxdeg;
+    const size_t slots = n + 2 * n; /* Σ_k (2 + children(k)) = 2n + (n − roots) */
 #define ALLOC(field, count) \
     if (!(p->field = calloc((count), sizeof *p->field))) goto nomem
     ALLOC(x, 3 * n);
@@ -317,12 +367,15 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(child_start, n + 1);
     ALLOC(child, n > 1 ? n - 1 : 1);
     ALLOC(gq, 4 * n);
-    ALLOC(gsum, 3 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
-    ALLOC(mem, maxdeg);
-    ALLOC(mu, maxdeg);
-    ALLOC(goal, 3 * maxdeg);
+    ALLOC(child_index, n);
+    ALLOC(ell0, 9 * n);
+    ALLOC(Rq, 9 * n);
+    ALLOC(goff, n + 1);
+    ALLOC(mem, slots);
+    ALLOC(mu, slots);
+    ALLOC(goal, 3 * slots);
 #undef ALLOC
     memcpy(p->child_start, g->child_start, (n + 1) * sizeof *p->child_start);
     if (n > 1)
@@ -375,6 +428,18 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
             memcpy(p->anchor_at + 3 * i, p->x0 + 3 * i, 3 * sizeof(double));
             memcpy(p->anchor_q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
         }
+    }
+    for (size_t k = 0; k < n; ++k) {
+        p->goff[k + 1] = p->goff[k] + 2 + (p->child_start[k + 1] - p->child_start[k]);
+        for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c)
+            p->child_index[p->child[c]] = c - p->child_start[k];
+        /* ell0 = D R̄ᵀ / 5, D = diag(r², r², (L/2)²): the rest half of the
+         * ellipsoid moment R D R̄ᵀ / 5 (Müller & Chentanez eq. 10) */
+        double R0[9];
+        phc_quat_to_matrix(p->q0 + 4 * k, R0);
+        for (int t = 0; t < 3; ++t)
+            for (int c = 0; c < 3; ++c)
+                p->ell0[9 * k + 3 * t + c] = 0.2 * p->ax[3 * k + t] * p->ax[3 * k + t] * R0[3 * c + t];
     }
     memcpy(p->xp, p->x, 3 * n * sizeof(double));
     memcpy(p->qp, p->q, 4 * n * sizeof(double));
@@ -484,6 +549,10 @@ int phc_particles_set_orientation(phc_particles *p, size_t i, const double q[4],
         p->q[4 * i + k] = p->qp[4 * i + k] = q[k] / r;
     for (int k = 0; k < 3; ++k)
         p->w[3 * i + k] = 0;
+    /* warm start of its group's rotation: the particle's own turn from
+     * rest, q q̄⁻¹ (the group turns with its owner) */
+    const double q0i[4] = {p->q0[4 * i], -p->q0[4 * i + 1], -p->q0[4 * i + 2], -p->q0[4 * i + 3]};
+    quat_mul(p->q + 4 * i, q0i, p->gq + 4 * i);
     return PHC_OK;
 }
 
@@ -589,37 +658,45 @@ static double weight_sum(const phc_particles *p, size_t i)
     return W;
 }
 
-/* Members of group k and their blend weights ω_jk (in p->mu, still to be
- * multiplied by the masses). */
-static size_t group_members(const phc_particles *p, size_t k)
+/* Fills the slots of group k with their members and blend weights ω_jk
+ * (in p->mu, still to be multiplied by the masses; 0 for a broken link). */
+static void group_members(const phc_particles *p, size_t k)
 {
-    size_t n = 0;
-    p->mem[n] = k;
-    p->mu[n++] = 1.0 / weight_sum(p, k);
-    if (p->linked[k]) {
-        const size_t pa = p->parent[k];
-        p->mem[n] = pa;
-        p->mu[n++] = 1.0 / weight_sum(p, pa);
-    }
+    const size_t o = p->goff[k];
+    p->mem[o] = k;
+    p->mu[o] = 1.0 / weight_sum(p, k);
+    p->mem[o + 1] = p->linked[k] ? p->parent[k] : k;
+    p->mu[o + 1] = p->linked[k] ? 1.0 / weight_sum(p, p->parent[k]) : 0.0;
     for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c) {
-        const size_t ch = p->child[c];
-        if (p->linked[ch]) {
-            p->mem[n] = ch;
-            p->mu[n++] = p->o.parent_weight / weight_sum(p, ch);
-        }
+        const size_t ch = p->child[c], sl = o + 2 + (c - p->child_start[k]);
+        p->mem[sl] = ch;
+        p->mu[sl] = p->linked[ch] ? p->o.parent_weight / weight_sum(p, ch) : 0.0;
     }
-    return n;
 }
 
-/* Shape matching of group k against positions X (3n) and orientations Q
- * (4n): fills p->mem, p->mu (= μ_jk), p->goal and R (row-major), returns
- * the member count; *stress gets σ_k.  Negative on a numerical failure. */
-static long match_group(phc_particles *p, size_t k, const double *X, const double *Q,
-                        double R[9], double *stress)
+/* R(q_j) of every particle into p->Rq. */
+static void orientation_matrices(phc_particles *p, const double *Q)
 {
-    const size_t n = group_members(p, k);
+    const long n = (long)p->n;
+#pragma omp parallel for schedule(static)
+    for (long j = 0; j < n; ++j)
+        phc_quat_to_matrix(Q + 4 * j, p->Rq + 9 * j);
+}
+
+/* Shape matching of group k against positions X (3n), the orientations
+ * whose matrices are in p->Rq: fills group k's slots (p->mem, p->mu = μ_jk,
+ * p->goal) and R (row-major); *stress gets σ_k.  Touches only group k's
+ * slots and rotation, so distinct groups may run concurrently.  Returns 0,
+ * or −1 when the moment matrix is not finite. */
+static int match_group(phc_particles *p, size_t k, const double *X, double R[9],
+                       double *stress, size_t *polar_total, size_t *polar_fallbacks)
+{
+    group_members(p, k);
+    const size_t o = p->goff[k], e = p->goff[k + 1];
     double M = 0, c[3] = {0, 0, 0}, c0[3] = {0, 0, 0};
-    for (size_t a = 0; a < n; ++a) {
+    for (size_t a = o; a < e; ++a) {
+        if (p->mu[a] == 0)
+            continue;
         const size_t j = p->mem[a];
         p->mu[a] *= p->m[j];
         M += p->mu[a];
@@ -633,36 +710,37 @@ static long match_group(phc_particles *p, size_t k, const double *X, const doubl
         c0[d] /= M;
     }
     /* A = Σ μ (x − c)(x̄ − c̄)ᵀ + Σ (μ/5) R_j D_j R̄_jᵀ (Müller & Chentanez
-     * eq. 9 with the ellipsoid moment of eq. 10). */
+     * eq. 9 with the ellipsoid moment of eq. 10; D R̄ᵀ/5 is p->ell0). */
     double A[9] = {0};
-    for (size_t a = 0; a < n; ++a) {
+    for (size_t a = o; a < e; ++a) {
+        if (p->mu[a] == 0)
+            continue;
         const size_t j = p->mem[a];
-        double dx[3], d0[3], Rj[9], R0[9];
+        const double *Rj = p->Rq + 9 * j, *E = p->ell0 + 9 * j;
+        double dx[3], d0[3];
         for (int d = 0; d < 3; ++d) {
             dx[d] = X[3 * j + d] - c[d];
             d0[d] = p->x0[3 * j + d] - c0[d];
         }
-        phc_quat_to_matrix(Q + 4 * j, Rj);
-        phc_quat_to_matrix(p->q0 + 4 * j, R0);
-        const double *e = p->ax + 3 * j;
-        const double D[3] = {e[0] * e[0], e[1] * e[1], e[2] * e[2]};
+        const double mu = p->mu[a];
         for (int r = 0; r < 3; ++r)
-            for (int s = 0; s < 3; ++s) {
-                double ell = 0;
-                for (int t = 0; t < 3; ++t)
-                    ell += Rj[3 * r + t] * D[t] * R0[3 * s + t];
-                A[3 * r + s] += p->mu[a] * (dx[r] * d0[s] + 0.2 * ell);
-            }
+            for (int s = 0; s < 3; ++s)
+                A[3 * r + s] += mu * (dx[r] * d0[s] + Rj[3 * r] * E[s] + Rj[3 * r + 1] * E[3 + s] +
+                                      Rj[3 * r + 2] * E[6 + s]);
     }
     double *gq = p->gq + 4 * k;
     const int how = phc_particles_polar_rotation(A, gq);
     if (how < 0)
         return -1;
-    ++p->polar_total;
-    p->polar_fallbacks += how == 1;
+    ++*polar_total;
+    *polar_fallbacks += how == 1;
     phc_quat_to_matrix(gq, R);
     double num = 0, den = 0;
-    for (size_t a = 0; a < n; ++a) {
+    size_t members = 0;
+    for (size_t a = o; a < e; ++a) {
+        if (p->mu[a] == 0)
+            continue;
+        ++members;
         const size_t j = p->mem[a];
         double d0[3], rd[3];
         for (int d = 0; d < 3; ++d)
@@ -670,14 +748,14 @@ static long match_group(phc_particles *p, size_t k, const double *X, const doubl
         mat_vec(R, d0, rd);
         for (int d = 0; d < 3; ++d) {
             p->goal[3 * a + d] = rd[d] + c[d];
-            const double e = X[3 * j + d] - p->goal[3 * a + d];
-            num += p->mu[a] * e * e;
+            const double ed = X[3 * j + d] - p->goal[3 * a + d];
+            num += p->mu[a] * ed * ed;
             den += p->mu[a] * d0[d] * d0[d];
         }
     }
     if (stress)
-        *stress = den > 0 ? sqrt(num / den) : 0.0;
-    return (long)n;
+        *stress = members > 1 && den > 0 ? sqrt(num / den) : 0.0; /* one particle: 0 */
+    return 0;
 }
 
 size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, size_t *member,
@@ -689,21 +767,35 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, s
     double gq_keep[4];
     memcpy(gq_keep, pm->gq + 4 * k, sizeof gq_keep);
     double Rl[9], st;
-    const long n = match_group(pm, k, p->x, p->q, Rl, &st);
+    size_t tot = 0, fb = 0;
+    const size_t o = p->goff[k], e = p->goff[k + 1];
+    group_members(pm, k);
+    for (size_t a = o; a < e; ++a) /* the members' orientation matrices */
+        phc_quat_to_matrix(p->q + 4 * p->mem[a], pm->Rq + 9 * p->mem[a]);
+    const int rc = match_group(pm, k, p->x, Rl, &st, &tot, &fb);
     memcpy(pm->gq + 4 * k, gq_keep, sizeof gq_keep);
-    if (n < 0 || (size_t)n > cap)
+    if (rc < 0)
         return 0;
-    for (long a = 0; a < n; ++a) {
+    size_t n = 0;
+    for (size_t a = o; a < e; ++a)
+        n += p->mu[a] != 0;
+    if (n > cap)
+        return 0;
+    n = 0;
+    for (size_t a = o; a < e; ++a) {
+        if (p->mu[a] == 0)
+            continue;
         if (member)
-            member[a] = p->mem[a];
+            member[n] = p->mem[a];
         if (goal)
-            memcpy(goal + 3 * a, p->goal + 3 * a, 3 * sizeof(double));
+            memcpy(goal + 3 * n, p->goal + 3 * a, 3 * sizeof(double));
+        ++n;
     }
     if (R)
         memcpy(R, Rl, sizeof Rl);
     if (stress)
         *stress = st;
-    return (size_t)n;
+    return n;
 }
 
 double phc_particles_stiffness(const phc_particles *p, size_t i)
@@ -721,27 +813,49 @@ double phc_particles_stiffness(const phc_particles *p, size_t i)
 
 static int project(phc_particles *p, phc_error *err)
 {
-    const size_t n = p->n;
-    memset(p->gsum, 0, 3 * n * sizeof(double));
-    for (size_t k = 0; k < n; ++k) {
+    const long n = (long)p->n;
+    orientation_matrices(p, p->qp);
+    long bad = -1;
+    size_t tot = 0, fb = 0;
+#pragma omp parallel for schedule(static) reduction(+ : tot, fb) reduction(max : bad)
+    for (long k = 0; k < n; ++k) {
         double R[9];
-        const long m = match_group(p, k, p->xp, p->qp, R, NULL);
-        if (m < 0)
-            return phc_error_set(err, PHC_ERR_NUMERIC,
-                                 "particles: particle %zu (segment %ld): the moment matrix of its "
-                                 "group is not finite",
-                                 k, p->source_id[k]);
-        for (long a = 0; a < m; ++a) {
-            const size_t j = p->mem[a];
-            const double omega = p->mu[a] / p->m[j]; /* ω_jk */
-            for (int d = 0; d < 3; ++d)
-                p->gsum[3 * j + d] += omega * p->goal[3 * a + d];
-        }
+        if (match_group(p, (size_t)k, p->xp, R, NULL, &tot, &fb) < 0 && k > bad)
+            bad = k;
     }
-    for (size_t i = 0; i < n; ++i) {
+    p->polar_total += tot;
+    p->polar_fallbacks += fb;
+    if (bad >= 0)
+        return phc_error_set(err, PHC_ERR_NUMERIC,
+                             "particles: particle %ld (segment %ld): the moment matrix of its "
+                             "group is not finite",
+                             bad, p->source_id[bad]);
+#pragma omp parallel for schedule(static)
+    for (long ii = 0; ii < n; ++ii) {
+        const size_t i = (size_t)ii;
+        /* x_g,i = Σ_k ω_ik g_i^k over i's own group, its parent's group and
+         * its children's groups, always in this order (ω = μ / m) */
+        double gs[3];
+        const size_t own = p->goff[i];
+        const double mi = p->m[i];
+        for (int d = 0; d < 3; ++d)
+            gs[d] = p->mu[own] / mi * p->goal[3 * own + d];
+        if (p->linked[i]) {
+            const size_t sl = p->goff[p->parent[i]] + 2 + p->child_index[i];
+            for (int d = 0; d < 3; ++d)
+                gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
+        }
+        for (size_t c = p->child_start[i]; c < p->child_start[i + 1]; ++c) {
+            const size_t ch = p->child[c];
+            if (!p->linked[ch])
+                continue;
+            const size_t sl = p->goff[ch] + 1;
+            for (int d = 0; d < 3; ++d)
+                gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
+        }
         const double s = phc_particles_stiffness(p, i);
         for (int d = 0; d < 3; ++d) /* x' = x_p + s (x_g − x_p) */
-            p->xp[3 * i + d] += s * (p->gsum[3 * i + d] - p->xp[3 * i + d]);
+            p->xp[3 * i + d] += s * (gs[d] - p->xp[3 * i + d]);
         /* q_i = R_i q̄_i: own group's rotation applied to the rest pose. */
         quat_mul(p->gq + 4 * i, p->q0 + 4 * i, p->qp + 4 * i);
         quat_normalize(p->qp + 4 * i);
@@ -828,16 +942,30 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         p->age[i] += dt;
     }
     /* Stress of every group on the new state (§4.3), and breaking. */
+    orientation_matrices(p, p->q);
+    long bad = -1;
+    size_t tot = 0, fb = 0;
+    {
+        const long nn = (long)n;
+#pragma omp parallel for schedule(static) reduction(+ : tot, fb) reduction(max : bad)
+        for (long k = 0; k < nn; ++k) {
+            double R[9], st = 0;
+            if (match_group(p, (size_t)k, p->x, R, &st, &tot, &fb) < 0 && k > bad)
+                bad = k;
+            p->stress[k] = st;
+        }
+    }
+    p->polar_total += tot;
+    p->polar_fallbacks += fb;
+    if (bad >= 0)
+        return phc_error_set(err, PHC_ERR_NUMERIC,
+                             "particles: particle %ld (segment %ld): the moment matrix of its "
+                             "group is not finite",
+                             bad, p->source_id[bad]);
     double smax = 0, bmax = -1;
     size_t gmax = PHC_PARTICLES_NONE, bk = PHC_PARTICLES_NONE;
     for (size_t k = 0; k < n; ++k) {
-        double R[9], st;
-        if (match_group(p, k, p->x, p->q, R, &st) < 0)
-            return phc_error_set(err, PHC_ERR_NUMERIC,
-                                 "particles: particle %zu (segment %ld): the moment matrix of its "
-                                 "group is not finite",
-                                 k, p->source_id[k]);
-        p->stress[k] = st;
+        const double st = p->stress[k];
         if (st > smax || gmax == PHC_PARTICLES_NONE) {
             smax = st;
             gmax = k;
