@@ -6,9 +6,23 @@
 
 #include <lapacke.h>
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* Fewer particles than this run their group loops on one thread: a fork
+ * and join of the OpenMP team costs more than a small plant's whole
+ * projection (a 20-particle stalk stepped thousands of times in a shape
+ * fit was 80x slower with the loops always parallel). */
+#ifndef PHC_PARTICLES_PARALLEL_MIN
+#define PHC_PARTICLES_PARALLEL_MIN 1024
+#endif
+
+/* Whether a loop over n particles or groups forks a team: only for large
+ * plants and outside any enclosing OpenMP region (a nested region, even one
+ * serialised by an `if` clause, costs futex calls on every entry). */
+static int team(long n) { return n >= PHC_PARTICLES_PARALLEL_MIN && omp_get_level() == 0; }
 
 /* pi to double precision (M_PI is not ISO C). */
 static const double PI = 3.14159265358979323846;
@@ -678,6 +692,11 @@ static void group_members(const phc_particles *p, size_t k)
 static void orientation_matrices(phc_particles *p, const double *Q)
 {
     const long n = (long)p->n;
+    if (!team(n)) {
+        for (long j = 0; j < n; ++j)
+            phc_quat_to_matrix(Q + 4 * j, p->Rq + 9 * j);
+        return;
+    }
 #pragma omp parallel for schedule(static)
     for (long j = 0; j < n; ++j)
         phc_quat_to_matrix(Q + 4 * j, p->Rq + 9 * j);
@@ -811,17 +830,31 @@ double phc_particles_stiffness(const phc_particles *p, size_t i)
 
 /* ---- the time step ------------------------------------------------------ */
 
-static int project(phc_particles *p, phc_error *err)
+/* Group k matched against X; with `stress`, σ_k into p->stress[k]. */
+static void match_one(phc_particles *p, long k, const double *X, int stress, size_t *tot,
+                      size_t *fb, long *bad)
+{
+    double R[9], st = 0;
+    if (match_group(p, (size_t)k, X, R, stress ? &st : NULL, tot, fb) < 0 && k > *bad)
+        *bad = k;
+    if (stress)
+        p->stress[k] = st;
+}
+
+/* Every group matched against X (3n), side by side for large plants;
+ * counts the polar decompositions and their SVD fallbacks. */
+static int match_all(phc_particles *p, const double *X, int stress, phc_error *err)
 {
     const long n = (long)p->n;
-    orientation_matrices(p, p->qp);
     long bad = -1;
     size_t tot = 0, fb = 0;
+    if (!team(n)) {
+        for (long k = 0; k < n; ++k)
+            match_one(p, k, X, stress, &tot, &fb, &bad);
+    } else {
 #pragma omp parallel for schedule(static) reduction(+ : tot, fb) reduction(max : bad)
-    for (long k = 0; k < n; ++k) {
-        double R[9];
-        if (match_group(p, (size_t)k, p->xp, R, NULL, &tot, &fb) < 0 && k > bad)
-            bad = k;
+        for (long k = 0; k < n; ++k)
+            match_one(p, k, X, stress, &tot, &fb, &bad);
     }
     p->polar_total += tot;
     p->polar_fallbacks += fb;
@@ -830,44 +863,65 @@ static int project(phc_particles *p, phc_error *err)
                              "particles: particle %ld (segment %ld): the moment matrix of its "
                              "group is not finite",
                              bad, p->source_id[bad]);
-#pragma omp parallel for schedule(static)
-    for (long ii = 0; ii < n; ++ii) {
-        const size_t i = (size_t)ii;
-        /* x_g,i = Σ_k ω_ik g_i^k over i's own group, its parent's group and
-         * its children's groups, always in this order (ω = μ / m) */
-        double gs[3];
-        const size_t own = p->goff[i];
-        const double mi = p->m[i];
-        for (int d = 0; d < 3; ++d)
-            gs[d] = p->mu[own] / mi * p->goal[3 * own + d];
-        if (p->linked[i]) {
-            const size_t sl = p->goff[p->parent[i]] + 2 + p->child_index[i];
-            for (int d = 0; d < 3; ++d)
-                gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
-        }
-        for (size_t c = p->child_start[i]; c < p->child_start[i + 1]; ++c) {
-            const size_t ch = p->child[c];
-            if (!p->linked[ch])
-                continue;
-            const size_t sl = p->goff[ch] + 1;
-            for (int d = 0; d < 3; ++d)
-                gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
-        }
-        const double s = phc_particles_stiffness(p, i);
-        for (int d = 0; d < 3; ++d) /* x' = x_p + s (x_g − x_p) */
-            p->xp[3 * i + d] += s * (gs[d] - p->xp[3 * i + d]);
-        /* q_i = R_i q̄_i: own group's rotation applied to the rest pose. */
-        quat_mul(p->gq + 4 * i, p->q0 + 4 * i, p->qp + 4 * i);
-        quat_normalize(p->qp + 4 * i);
-        if (p->anchored[i]) { /* eq. 5 */
-            const double ka = p->anchor_k[i];
-            for (int d = 0; d < 3; ++d)
-                p->xp[3 * i + d] += ka * (p->anchor_at[3 * i + d] - p->xp[3 * i + d]);
-            if (p->hold_q[i])
-                memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
-        }
-    }
     return PHC_OK;
+}
+
+static void blend(phc_particles *p, size_t i);
+
+static int project(phc_particles *p, phc_error *err)
+{
+    const long n = (long)p->n;
+    orientation_matrices(p, p->qp);
+    if (match_all(p, p->xp, 0, err))
+        return -1;
+    if (!team(n)) {
+        for (long i = 0; i < n; ++i)
+            blend(p, (size_t)i);
+        return PHC_OK;
+    }
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i)
+        blend(p, (size_t)i);
+    return PHC_OK;
+}
+
+/* Particle i's new predicted state: the blend of its groups' goals, its
+ * own group's rotation, and its anchor.  Touches only particle i. */
+static void blend(phc_particles *p, size_t i)
+{
+    /* x_g,i = Σ_k ω_ik g_i^k over i's own group, its parent's group and
+     * its children's groups, always in this order (ω = μ / m) */
+    double gs[3];
+    const size_t own = p->goff[i];
+    const double mi = p->m[i];
+    for (int d = 0; d < 3; ++d)
+        gs[d] = p->mu[own] / mi * p->goal[3 * own + d];
+    if (p->linked[i]) {
+        const size_t sl = p->goff[p->parent[i]] + 2 + p->child_index[i];
+        for (int d = 0; d < 3; ++d)
+            gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
+    }
+    for (size_t c = p->child_start[i]; c < p->child_start[i + 1]; ++c) {
+        const size_t ch = p->child[c];
+        if (!p->linked[ch])
+            continue;
+        const size_t sl = p->goff[ch] + 1;
+        for (int d = 0; d < 3; ++d)
+            gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
+    }
+    const double s = phc_particles_stiffness(p, i);
+    for (int d = 0; d < 3; ++d) /* x' = x_p + s (x_g − x_p) */
+        p->xp[3 * i + d] += s * (gs[d] - p->xp[3 * i + d]);
+    /* q_i = R_i q̄_i: own group's rotation applied to the rest pose. */
+    quat_mul(p->gq + 4 * i, p->q0 + 4 * i, p->qp + 4 * i);
+    quat_normalize(p->qp + 4 * i);
+    if (p->anchored[i]) { /* eq. 5 */
+        const double ka = p->anchor_k[i];
+        for (int d = 0; d < 3; ++d)
+            p->xp[3 * i + d] += ka * (p->anchor_at[3 * i + d] - p->xp[3 * i + d]);
+        if (p->hold_q[i])
+            memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
+    }
 }
 
 int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report, phc_error *err)
@@ -943,25 +997,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     }
     /* Stress of every group on the new state (§4.3), and breaking. */
     orientation_matrices(p, p->q);
-    long bad = -1;
-    size_t tot = 0, fb = 0;
-    {
-        const long nn = (long)n;
-#pragma omp parallel for schedule(static) reduction(+ : tot, fb) reduction(max : bad)
-        for (long k = 0; k < nn; ++k) {
-            double R[9], st = 0;
-            if (match_group(p, (size_t)k, p->x, R, &st, &tot, &fb) < 0 && k > bad)
-                bad = k;
-            p->stress[k] = st;
-        }
-    }
-    p->polar_total += tot;
-    p->polar_fallbacks += fb;
-    if (bad >= 0)
-        return phc_error_set(err, PHC_ERR_NUMERIC,
-                             "particles: particle %ld (segment %ld): the moment matrix of its "
-                             "group is not finite",
-                             bad, p->source_id[bad]);
+    if (match_all(p, p->x, 1, err))
+        return -1;
     double smax = 0, bmax = -1;
     size_t gmax = PHC_PARTICLES_NONE, bk = PHC_PARTICLES_NONE;
     for (size_t k = 0; k < n; ++k) {

@@ -240,10 +240,11 @@ static void test_polar_rodlike(void)
 }
 
 /* The projection matches the groups in parallel and blends in a fixed
- * order: one and two OpenMP threads give bit-identical states. */
+ * order: one and two OpenMP threads give bit-identical states (1500
+ * segments: above PHC_PARTICLES_PARALLEL_MIN, so the loops do run in parallel). */
 static void test_threads(void)
 {
-    phc_plant_graph *g = phc_plant_graph_random(300, 11);
+    phc_plant_graph *g = phc_plant_graph_random(1500, 11);
     phc_error err;
     double *x[2] = {NULL, NULL};
     size_t polar[2] = {0, 0}, fallbacks[2] = {0, 0};
