@@ -2,6 +2,13 @@
 """The README's output blocks are what the commands print now (issue 13).
 
     python3 check_readme.py README.md BUILD_DIR SHARED_DATA_DIR [--only LINE]
+        [--commands REGEX | --other-than REGEX]
+
+--only LINE checks the one block whose first line is LINE; --commands REGEX
+checks only the blocks whose command starts with a match of REGEX (and fails
+when there is none: a block removed from the README), --other-than
+REGEX all the others.  CMake registers one test per benchmark this way and
+one for the rest, so ctest runs them side by side.
 
 Every fenced block without a language tag must be preceded (blank lines
 allowed) by one of two HTML comments, invisible on a rendered page:
@@ -33,6 +40,7 @@ Prints "ok - ..." / "not ok - ..." per block with a diff, then
 """
 import difflib
 import os
+import resource
 import re
 import shutil
 import subprocess
@@ -118,6 +126,12 @@ def block_matches(want, got):
 READ_ONLY_TEST = re.compile(r"^build/(unit_test|realdata_test)_[A-Za-z0-9_]+$")
 
 
+def children_cpu():
+    """CPU seconds (user + system) of the commands run so far."""
+    ru = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return ru.ru_utime + ru.ru_stime
+
+
 def scratch(build, shared):
     root = tempfile.mkdtemp(prefix="phc_readme.")
     work = os.path.join(root, "checkout")
@@ -133,11 +147,23 @@ def scratch(build, shared):
 
 def main():
     global README
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    only = None
-    if "--only" in sys.argv:
-        only = int(sys.argv[sys.argv.index("--only") + 1])
-        args = [a for a in args if a != str(only)]
+    argv = sys.argv[1:]
+    only = select = exclude = None
+    for flag in ("--only", "--commands", "--other-than"):
+        if flag in argv:
+            k = argv.index(flag)
+            if k + 1 >= len(argv):
+                print(f"{flag} needs a value")
+                return 2
+            value = argv[k + 1]
+            del argv[k:k + 2]
+            if flag == "--only":
+                only = int(value)
+            elif flag == "--commands":
+                select = re.compile(value)
+            else:
+                exclude = re.compile(value)
+    args = [a for a in argv if not a.startswith("--")]
     if len(args) < 2:
         print(__doc__)
         return 2
@@ -162,6 +188,10 @@ def main():
             if marker[0] == "not output":
                 continue
             command, *options = [p.strip() for p in marker[1].split("|")]
+            if select is not None and not select.match(command):
+                continue
+            if exclude is not None and exclude.match(command):
+                continue
             want_exit = 0
             for o in options:
                 if o.startswith("exit="):
@@ -171,6 +201,7 @@ def main():
                 print(f"ok - {name} # SKIP no shared data folder: {command}")
                 continue
             t0 = time.time()
+            c0 = children_cpu()
             key = (command, "stderr" in options)
             if key in ran:
                 proc = ran[key]  # a test program that writes nothing: its output again
@@ -182,6 +213,7 @@ def main():
                 if READ_ONLY_TEST.match(command):
                     ran[key] = proc
             seconds = time.time() - t0
+            cpu = children_cpu() - c0
             got = proc.stdout.decode("utf-8", "replace").rstrip("\n").split("\n")
             got = [g.rstrip() for g in got]
             want = [w.rstrip() for w in body if not w.startswith("$ ")]
@@ -198,12 +230,15 @@ def main():
                 problems.append("output differs:\n" + diff)
             if problems:
                 failed += 1
-                print(f"not ok - {name}: {command} ({seconds:.1f} s)\n  " + "\n  ".join(problems))
+                print(f"not ok - {name}: {command} ({seconds:.1f} s, CPU {cpu:.1f} s)\n  " + "\n  ".join(problems))
             else:
                 passed += 1
-                print(f"ok - {name}: {command} ({seconds:.1f} s)")
+                print(f"ok - {name}: {command} ({seconds:.1f} s, CPU {cpu:.1f} s)")
     finally:
         shutil.rmtree(root, ignore_errors=True)
+    if select is not None and passed + failed + skipped == 0:
+        failed += 1
+        print(f"not ok - no output block of a command matching {select.pattern!r} in {README}")
     print(f"{passed} passed, {failed} failed, {skipped} skipped")
     return 1 if failed else 0
 
