@@ -67,6 +67,8 @@
 #define NT 4
 #define REPEAT 5
 #define REPEAT_MONTH 3
+/* the repeats of this run (bench_repeats: 1 under PHC_BENCH_QUICK=1) */
+static int repeat = REPEAT, repeat_month = REPEAT_MONTH;
 #define TARGET_SPEEDUP 10.0
 #define MAX_DAYS 400
 
@@ -197,7 +199,7 @@ static timing soil_only(double hours)
     timing r = {INFINITY, NAN, 0, 0, 0};
     double t[REPEAT];
     cpu_mark a = cpu_now();
-    for (int k = 0; k < REPEAT; ++k) {
+    for (int k = 0; k < repeat; ++k) {
         phc_soil *s = make_soil();
         phc_error err;
         if (!s)
@@ -211,15 +213,17 @@ static timing soil_only(double hours)
     }
     r.other = other_load(a, cpu_now());
     r.best = t[0];
-    for (int k = 1; k < REPEAT; ++k)
+    for (int k = 1; k < repeat; ++k)
         r.best = fmin(r.best, t[k]);
-    r.median = median(t, REPEAT);
+    r.median = median(t, repeat);
     return r;
 }
 
 int main(void)
 {
     double t_start = now();
+    repeat = bench_repeats(REPEAT);
+    repeat_month = bench_repeats(REPEAT_MONTH);
     int threads[2] = {1, 2};
     timing day[2][NT], month[2][NT], soil_day[2], soil_month[2];
     double grow_s[NT];
@@ -250,9 +254,9 @@ int main(void)
         soil_month[th] = soil_only(720.0);
         soil_dt = 1.0;
         printf("soil_only_s_per_day_%dt: %.4g s (best of %d; median %.4g; other load %.2f CPUs)\n", threads[th],
-               soil_day[th].best, REPEAT, soil_day[th].median, soil_day[th].other);
+               soil_day[th].best, repeat, soil_day[th].median, soil_day[th].other);
         printf("soil_only_s_per_month_%dt: %.4g s (soil dt %.3g h as in a month step; best of %d; median %.4g; "
-               "other load %.2f CPUs)\n", threads[th], soil_month[th].best, coarse_dt, REPEAT, soil_month[th].median,
+               "other load %.2f CPUs)\n", threads[th], soil_month[th].best, coarse_dt, repeat, soil_month[th].median,
                soil_month[th].other);
 
         /* day steps: one plant grown through all targets */
@@ -272,7 +276,7 @@ int main(void)
             double t[REPEAT];
             r->n0 = nodes_of(pl.g);
             cpu_mark a = cpu_now();
-            for (int k = 0; k < REPEAT; ++k) {
+            for (int k = 0; k < repeat; ++k) {
                 phc_error err;
                 double t0 = now();
                 int rc = phc_growth_step(pl.g, 1.0, &err);
@@ -286,9 +290,9 @@ int main(void)
             r->other = other_load(a, cpu_now());
             r->n1 = nodes_of(pl.g);
             r->best = t[0];
-            for (int k = 1; k < REPEAT; ++k)
+            for (int k = 1; k < repeat; ++k)
                 r->best = fmin(r->best, t[k]);
-            r->median = median(t, REPEAT);
+            r->median = median(t, repeat);
         }
         plant_free(&pl);
 
@@ -297,7 +301,7 @@ int main(void)
             timing *r = &month[th][q];
             double t[REPEAT_MONTH];
             double other = 0;
-            for (int k = 0; k < REPEAT_MONTH; ++k) {
+            for (int k = 0; k < repeat_month; ++k) {
                 if (plant_new(&pl))
                     return 1;
                 int dd = 0;
@@ -323,19 +327,19 @@ int main(void)
             }
             r->other = other;
             r->best = t[0];
-            for (int k = 1; k < REPEAT_MONTH; ++k)
+            for (int k = 1; k < repeat_month; ++k)
                 r->best = fmin(r->best, t[k]);
-            r->median = median(t, REPEAT_MONTH);
+            r->median = median(t, repeat_month);
         }
 
         for (int q = 0; q < NT; ++q) {
             const timing *r = &day[th][q], *m = &month[th][q];
             printf("growth_s_per_day_%s_%dt: %.4g s (nodes %zu -> %zu over %d steps; best of %d, median %.4g; "
-                   "other load %.2f CPUs)\n", tname[q], threads[th], r->best, r->n0, r->n1, REPEAT, REPEAT,
+                   "other load %.2f CPUs)\n", tname[q], threads[th], r->best, r->n0, r->n1, repeat, repeat,
                    r->median, r->other);
             printf("growth_s_per_month_%s_%dt: %.4g s (nodes %zu -> %zu in the 30-day step; best of %d, median "
                    "%.4g; other load up to %.2f CPUs)\n", tname[q], threads[th], m->best, m->n0, m->n1,
-                   REPEAT_MONTH, m->median, m->other);
+                   repeat_month, m->median, m->other);
         }
     }
 
@@ -353,9 +357,9 @@ int main(void)
                                                     "interpolated linearly in nodes between Table 3's 10k and 60k";
         double sd = pd / r->best, sm = pm / m->best;
         printf("growth_s_per_day_%s: %.4g s (nodes %zu; %d thread%s; best of %d, median %.4g)\n", tname[q], r->best,
-               r->n0, threads[bd], bd ? "s" : "", REPEAT, r->median);
+               r->n0, threads[bd], bd ? "s" : "", repeat, r->median);
         printf("growth_s_per_month_%s: %.4g s (nodes %zu -> %zu during the step; %d thread%s; best of %d, median "
-               "%.4g)\n", tname[q], m->best, m->n0, m->n1, threads[bm], bm ? "s" : "", REPEAT_MONTH, m->median);
+               "%.4g)\n", tname[q], m->best, m->n0, m->n1, threads[bm], bm ? "s" : "", repeat_month, m->median);
         printf("paper_s_per_day_%s: %.4g s (%s)\n", tname[q], pd, how);
         printf("paper_s_per_month_%s: %.4g s (%s)\n", tname[q], pm, how);
         printf("growth_speedup_vs_paper_day_%s: %.0f x\n", tname[q], sd);
@@ -376,13 +380,13 @@ int main(void)
     omp_set_num_threads(1);
     long_step = 0;
     timing sm_fine = soil_only(720.0);
-    printf("soil_only_s_per_month_1h_soil_dt: %.4g s (soil dt 1 h; best of %d)\n", sm_fine.best, REPEAT);
+    printf("soil_only_s_per_month_1h_soil_dt: %.4g s (soil dt 1 h; best of %d)\n", sm_fine.best, repeat);
     for (int q = 0; q < NT; ++q) {
         double t[REPEAT_MONTH];
         size_t n0 = 0, n1 = 0;
         phc_growth_summary S;
         double water = NAN;
-        for (int k = 0; k < REPEAT_MONTH; ++k) {
+        for (int k = 0; k < repeat_month; ++k) {
             plant pl;
             int dd = 0;
             phc_error err;
@@ -402,12 +406,12 @@ int main(void)
             plant_free(&pl);
         }
         double best = t[0];
-        for (int k = 1; k < REPEAT_MONTH; ++k)
+        for (int k = 1; k < repeat_month; ++k)
             best = fmin(best, t[k]);
         double pm = paper(paper_month_10k, paper_month_60k, target[q]);
         printf("growth_s_per_month_1h_soil_dt_%s: %.4g s (nodes %zu -> %zu; soil dt 1 h, long_step 0; 1 thread; "
-               "best of %d, median %.4g; %.1f x the paper's %.3g s)\n", tname[q], best, n0, n1, REPEAT_MONTH,
-               median(t, REPEAT_MONTH), pm / best, pm);
+               "best of %d, median %.4g; %.1f x the paper's %.3g s)\n", tname[q], best, n0, n1, repeat_month,
+               median(t, repeat_month), pm / best, pm);
         const phc_growth_summary *C = &month_sum[q];
         printf("growth_month_soil_step_effect_%s: root mass %+.2e, shoot mass %+.2e, root length %+.2e, soil water "
                "%+.2e, nodes %+.2e (relative, soil at %.3g h vs 1 h, after the 30-day step)\n", tname[q],

@@ -6,6 +6,8 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
@@ -48,6 +50,17 @@ static inline double other_load(cpu_mark a, cpu_mark b)
 {
     double x = ((b.machine - a.machine) - (b.self - a.self)) / (b.wall - a.wall);
     return x < 0 ? 0 : x;
+}
+
+/* How many times to repeat a timing a benchmark takes the best or median
+ * of: `full`, or 1 when PHC_BENCH_QUICK=1.  The README check
+ * (tests/readme/check_readme.py) sets it: it compares a benchmark's keys and
+ * its model values, which do not depend on the repeats, and masks every
+ * measured value, so one repetition checks the same. */
+static inline int bench_repeats(int full)
+{
+    const char *q = getenv("PHC_BENCH_QUICK");
+    return q && strcmp(q, "1") == 0 ? 1 : full;
 }
 
 static inline int cmp_double(const void *a, const void *b)

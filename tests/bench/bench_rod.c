@@ -124,7 +124,7 @@ static void newton_parts(phc_rod *rod, const char *tag)
     if (reps < 3)
         reps = 3;
     double best[5] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY}, cpu[5] = {0}, load = 0.0;
-    for (int r = 0; r < REPEAT; ++r) {
+    for (int r = 0; r < bench_repeats(REPEAT); ++r) {
         double t[5] = {0, 0, 0, 0, 0}, c[5] = {0, 0, 0, 0, 0};
         cpu_mark m0 = cpu_now();
         for (int k = 0; k < reps; ++k) {
@@ -171,7 +171,7 @@ static void newton_parts(phc_rod *rod, const char *tag)
     printf("newton_us_per_segment_iteration_%s: %.3f us (assembly %.3f + factorisation and solve "
            "in one sweep %.3f; apart: factorisation %.3f, solve %.3f; best of %d timings of %d "
            "iterations; thread CPU %.3f us; other load %.2f CPUs)\n",
-           tag, best[3] * s, best[0] * s, best[4] * s, best[1] * s, best[2] * s, REPEAT, reps,
+           tag, best[3] * s, best[0] * s, best[4] * s, best[1] * s, best[2] * s, bench_repeats(REPEAT), reps,
            cpu[3] * s, load);
 }
 
@@ -435,7 +435,7 @@ static int run_plant000(void)
     phc_rod_set_options(rod, &o, &err);
 
     /* (b) */
-    const double t_direct = static_from_rest(rod, "plant000", REPEAT);
+    const double t_direct = static_from_rest(rod, "plant000", bench_repeats(REPEAT));
     if (!isfinite(t_direct))
         return 1;
     const double e_direct = tail_error(rod, ref);
@@ -473,7 +473,7 @@ static int run_tree(size_t n)
         return 1;
     }
     newton_parts(rod, tag);
-    static_from_rest(rod, tag, 3);
+    static_from_rest(rod, tag, bench_repeats(3));
     phc_rod_free(rod);
     phc_plant_graph_free(g);
     return 0;

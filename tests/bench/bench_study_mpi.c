@@ -10,7 +10,8 @@
  * It also checks that both runs wrote the same result.json, byte for byte.
  *
  *   build/bench_bench_study_mpi [N [R]]     (N base samples, default 1024;
- *                                            R runs, default 3)
+ *                                            R runs, default 3, 1 under
+ *                                            PHC_BENCH_QUICK=1)
  * Prints `name: value unit` lines.  Needs mpirun (Debian: openmpi-bin). */
 #include <errno.h>
 #include <stdio.h>
@@ -142,7 +143,7 @@ static int same_file(const char *a, const char *b)
 int main(int argc, char **argv)
 {
     const char *samples = argc > 1 ? argv[1] : "1024";
-    const int reps = argc > 2 ? atoi(argv[2]) : 3;
+    const int reps = argc > 2 ? atoi(argv[2]) : bench_repeats(3);
     const long n_base = strtol(samples, NULL, 10);
     if (n_base < 8 || reps < 1) {
         fprintf(stderr, "usage: bench_bench_study_mpi [N >= 8 [R >= 1]]\n");

@@ -34,6 +34,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "bench_machine.h"
 #include "fit/costs/weight_curve.h"
 #include "fit/costs/weight_table.h"
 #include "fit/engine/fit.h"
@@ -87,19 +88,13 @@
 #define START_DELTA 3e-3
 #define START_W0 6.0
 
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 /* BDF6 time per segment per step (ns) over `steps` steps of 10 s, the
  * minimum of REPEAT runs; the start (5 steps) is not counted. */
 static double bdf6_ns(const phc_water_system *s, size_t steps)
 {
     double best = INFINITY;
-    for (int r = 0; r < REPEAT; ++r) {
+    for (int r = 0; r < bench_repeats(REPEAT); ++r) {
         phc_water_bdf6 *b = NULL;
         phc_error err;
         if (phc_water_bdf6_new(s, 10.0, 0, &b, &err))
@@ -317,7 +312,8 @@ static int run_peer(const char *tree_path, const char *csv)
         return -1;
     }
     char cmd[2048];
-    int len = snprintf(cmd, sizeof cmd, PEER_PY " '" PEER_SCRIPT "' '" PLANT000 "' --repeat 3");
+    int len = snprintf(cmd, sizeof cmd, PEER_PY " '" PEER_SCRIPT "' '" PLANT000 "' --repeat %d",
+                       bench_repeats(3));
     if (tree_path)
         len += snprintf(cmd + len, sizeof cmd - (size_t)len, " --tree100k '%s'", tree_path);
     if (csv)
@@ -391,12 +387,12 @@ int main(void)
         bdf6_p = bdf6_ns(s, 1000);
         printf("bdf6_ns_per_segment_step_plant000: %.2f ns\n", bdf6_p);
         phc_water_exact *e = NULL, *w = NULL;
-        full_s = exact_setup(s, PHC_WATER_EXACT_FULL, 3, &e);
-        wonly_s = exact_setup(s, PHC_WATER_EXACT_TOTAL_ONLY, 3, &w);
+        full_s = exact_setup(s, PHC_WATER_EXACT_FULL, bench_repeats(3), &e);
+        wonly_s = exact_setup(s, PHC_WATER_EXACT_TOTAL_ONLY, bench_repeats(3), &w);
         printf("exact_setup_full_plant000: %.3f s\n", full_s);
         printf("exact_setup_w_only_plant000: %.3f s\n", wonly_s);
         eval_us = INFINITY;
-        for (int r = 0; r < REPEAT; ++r) {
+        for (int r = 0; r < bench_repeats(REPEAT); ++r) {
             volatile double acc = 0;
             double t3 = now();
             for (int i = 0; i < 1000; ++i)
@@ -433,7 +429,7 @@ int main(void)
             for (int v = 0; v < 2; ++v) {
                 const char *sfx = v ? "_tol1e-8" : "";
                 double fs = INFINITY, ss = INFINITY;
-                for (int r = 0; r < 3; ++r) {
+                for (int r = 0; r < bench_repeats(3); ++r) {
                     phc_fit_result *res = NULL;
                     double f0 = now();
                     phc_problem *pb = fit_problem(csv, v ? 1e-8 : 0.0, &err);
