@@ -38,6 +38,8 @@ static void root_clear(phc_rsml_root *root)
     free(root->label);
     free(root->xyz);
     free(root->diameter);
+    free(root->time);
+    free(root->time_line);
     memset(root, 0, sizeof *root);
 }
 
@@ -491,9 +493,12 @@ static int read_polyline(reader *rd, const xmlNode *polyline, const char *root_n
     return PHC_OK;
 }
 
-/* Reads a <function name="diameter"> into root->diameter. */
-static int read_diameter(reader *rd, const xmlNode *function, const char *root_name,
-                         phc_rsml_root *root)
+/* Reads the samples of a per-point function `what` (domain polyline, one
+ * <sample> per polyline point) into *values (and each sample's line into
+ * *lines when lines != NULL); nonneg: samples must be >= 0. */
+static int read_samples(reader *rd, const xmlNode *function, const char *root_name,
+                        const char *what, int nonneg, size_t n_points, double **values,
+                        size_t **lines)
 {
     const xmlNode *c;
     int nomem = 0;
@@ -503,26 +508,28 @@ static int read_diameter(reader *rd, const xmlNode *function, const char *root_n
         return nomem_error(rd);
     if (domain && strcmp(domain, "polyline")) {
         int rc = phc_error_set(rd->err, PHC_ERR_INPUT,
-                               "%s:%ld: root %s: diameter function on domain '%s': only "
+                               "%s:%ld: root %s: %s function on domain '%s': only "
                                "domain 'polyline' is supported",
-                               rd->path, line_of(function), root_name, domain);
+                               rd->path, line_of(function), root_name, what, domain);
         free(domain);
         return rc;
     }
     free(domain);
-    if (root->diameter)
+    if (*values)
         return phc_error_set(rd->err, PHC_ERR_INPUT,
-                             "%s:%ld: root %s has a second diameter function", rd->path,
-                             line_of(function), root_name);
-    if (n != root->n_points)
+                             "%s:%ld: root %s has a second %s function", rd->path,
+                             line_of(function), root_name, what);
+    if (n != n_points)
         return phc_error_set(rd->err, PHC_ERR_INPUT,
-                             "%s:%ld: root %s: diameter function has %zu samples, expected one "
+                             "%s:%ld: root %s: %s function has %zu samples, expected one "
                              "per polyline point (%zu)",
-                             rd->path, line_of(function), root_name, n, root->n_points);
+                             rd->path, line_of(function), root_name, what, n, n_points);
     if (n == 0)
         return PHC_OK;
-    root->diameter = malloc(n * sizeof *root->diameter);
-    if (!root->diameter)
+    *values = malloc(n * sizeof **values);
+    if (!*values)
+        return nomem_error(rd);
+    if (lines && !(*lines = malloc(n * sizeof **lines)))
         return nomem_error(rd);
     for (c = function->children; c; c = c->next) {
         char *s;
@@ -534,16 +541,19 @@ static int read_diameter(reader *rd, const xmlNode *function, const char *root_n
             s = text_of(c, &nomem);
         if (nomem)
             return nomem_error(rd);
-        if (parse_finite(s, &v) || v < 0.0) {
+        if (parse_finite(s, &v) || (nonneg && v < 0.0)) {
             int rc = phc_error_set(rd->err, PHC_ERR_INPUT,
-                                   "%s:%ld: root %s: diameter sample %zu: expected a finite "
-                                   "number >= 0, found '%s'",
-                                   rd->path, line_of(c), root_name, i + 1, s);
+                                   "%s:%ld: root %s: %s sample %zu: expected a finite "
+                                   "number%s, found '%s'",
+                                   rd->path, line_of(c), root_name, what, i + 1,
+                                   nonneg ? " >= 0" : "", s);
             free(s);
             return rc;
         }
         free(s);
-        root->diameter[i++] = v;
+        if (lines)
+            (*lines)[i] = (size_t)line_of(c);
+        (*values)[i++] = v;
     }
     return PHC_OK;
 }
@@ -602,7 +612,7 @@ static int read_root(reader *rd, const xmlNode *node, size_t plant, size_t paren
             continue;
         for (f = c->children; f; f = f->next) {
             char *name;
-            int is_diameter;
+            int is_diameter, is_time;
             if (!is_element(f, "function"))
                 continue;
             name = attribute(f, "name", &nomem);
@@ -611,9 +621,17 @@ static int read_root(reader *rd, const xmlNode *node, size_t plant, size_t paren
                 goto fail;
             }
             is_diameter = name && !strcmp(name, "diameter");
+            is_time = name && !strcmp(name, "time");
             free(name);
-            if (is_diameter && (rc = read_diameter(rd, f, root_name, &root)))
+            if (is_diameter && (rc = read_samples(rd, f, root_name, "diameter", 1, root.n_points,
+                                                  &root.diameter, NULL)))
                 goto fail;
+            if (is_time) {
+                root.time_function_line = (size_t)line_of(f);
+                if ((rc = read_samples(rd, f, root_name, "time", 0, root.n_points, &root.time,
+                                       &root.time_line)))
+                    goto fail;
+            }
         }
     }
 

@@ -10,8 +10,9 @@
  *     </scene></rsml>
  *
  * What is kept: the metadata unit, resolution and software, the plants and
- * their ids, every root's id, label, parent, polyline and its diameter
- * function.  Other properties, functions and annotations are not kept.
+ * their ids, every root's id, label, parent, polyline and its diameter and
+ * time functions (time: per-point time stamps of traced shoots,
+ * measurements/shoot_traces.h).  Other properties, functions and annotations are not kept.
  *
  * Reading accepts what the published tools write: element names are matched
  * on their local name (any namespace prefix); root ids come from `id` or
@@ -53,6 +54,11 @@ typedef struct phc_rsml_root {
     double *diameter;    /* n_points or NULL: the <function name="diameter"> values on the polyline
                             (domain polyline), file units, >= 0; else NULL */
     size_t source_line;  /* line of the <root> element in the file (0 when built in memory) */
+    double *time;        /* n_points or NULL: the <function name="time"> (domain polyline) values,
+                            one per point, finite (traced shoots: seconds; read only, not
+                            written by phc_rsml_write) */
+    size_t *time_line;   /* n_points or NULL: the line of each time <sample> */
+    size_t time_function_line; /* line of that <function>, 0 without one */
 } phc_rsml_root;
 
 typedef struct phc_rsml {

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "measurements/rsml.h"
 #include "measurements/table.h"
 
 void phc_shoot_traces_free(phc_shoot_traces *tr)
@@ -191,9 +192,121 @@ int phc_shoot_traces_from_rows(const char *name, size_t n, const double *t, cons
     return rc;
 }
 
+/* Metres per RSML <unit> (the lengths RSML files use), 0 when unknown. */
+static double metres_per_unit(const char *u)
+{
+    static const struct { const char *name; double m; } units[] = {
+        {"m", 1},         {"meter", 1},     {"metre", 1},     {"meters", 1}, {"metres", 1},
+        {"cm", 0.01},     {"mm", 0.001},    {"um", 1e-6},     {"µm", 1e-6},  {"micron", 1e-6},
+        {"inch", 0.0254}, {"in", 0.0254},   {"inches", 0.0254}};
+    for (size_t k = 0; k < sizeof units / sizeof units[0]; ++k)
+        if (!strcmp(u, units[k].name)) return units[k].m;
+    return 0;
+}
+
+static int ends_with_rsml(const char *path)
+{
+    const size_t n = strlen(path);
+    if (n < 5) return 0;
+    const char *e = path + n - 5;
+    return e[0] == '.' && (e[1] | 32) == 'r' && (e[2] | 32) == 's' && (e[3] | 32) == 'm' && (e[4] | 32) == 'l';
+}
+
+/* Traced shoots from RSML (see shoot_traces.h): every <root> polyline is a
+ * shoot, its parent the root it is nested in, each point's time its sample
+ * of the function named "time". */
+static int read_rsml(const char *path, phc_shoot_traces **out, phc_error *err)
+{
+    phc_rsml *doc = NULL;
+    int rc = phc_rsml_read(path, &doc, err);
+    if (rc) return rc;
+    size_t n = 0;
+    for (size_t r = 0; r < doc->n_roots; ++r) n += doc->roots[r].n_points;
+    double *t = malloc((n ? n : 1) * sizeof *t), *x = malloc((n ? n : 1) * sizeof *x),
+           *y = malloc((n ? n : 1) * sizeof *y), *z = malloc((n ? n : 1) * sizeof *z);
+    const char **shoot = malloc((n ? n : 1) * sizeof *shoot), **parent = malloc((n ? n : 1) * sizeof *parent);
+    size_t *line = malloc((n ? n : 1) * sizeof *line);
+    char **names = calloc(doc->n_roots ? doc->n_roots : 1, sizeof *names);
+    if (!t || !x || !y || !z || !shoot || !parent || !line || !names) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    /* every root must carry its time before anything else is said */
+    for (size_t r = 0; r < doc->n_roots; ++r) {
+        const phc_rsml_root *root = &doc->roots[r];
+        if (!root->time) {
+            rc = phc_error_set(err, PHC_ERR_INPUT,
+                               "%s:%zu: root '%s': no per-point function named 'time' (traced shoots need "
+                               "<functions><function name=\"time\" domain=\"polyline\"> with one <sample> "
+                               "per point, in s)",
+                               path, root->source_line, root->id ? root->id : root->label ? root->label : "?");
+            goto done;
+        }
+    }
+    const char *unit = doc->unit ? doc->unit : "m";
+    const double per = metres_per_unit(unit);
+    if (!(per > 0)) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s: metadata <unit> '%s' is not a length (traced shoots need m, cm, mm, um or "
+                           "inch: coordinates / resolution are in that unit)",
+                           path, unit);
+        goto done;
+    }
+    const double scale = per / doc->resolution;
+    size_t i = 0;
+    for (size_t r = 0; r < doc->n_roots; ++r) {
+        const phc_rsml_root *root = &doc->roots[r];
+        char buf[32];
+        snprintf(buf, sizeof buf, "root%zu", r + 1);
+        const char *nm = root->id ? root->id : buf;
+        for (size_t q = 0; q < r; ++q)
+            if (!strcmp(names[q], nm)) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: root '%s': the id is used by the root at line %zu too (a shoot's "
+                                   "id must be unique)",
+                                   path, root->source_line, nm, doc->roots[q].source_line);
+                goto done;
+            }
+        if (!(names[r] = dup_text(nm))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        for (size_t j = 0; j < root->n_points; ++j, ++i) {
+            if (j > 0 && root->time[j] < root->time[j - 1]) {
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "%s:%zu: root '%s': time goes backwards along the shoot: sample %zu is %g s, "
+                                   "after %g s (points run from the base, traced in time order)",
+                                   path, root->time_line[j], nm, j + 1, root->time[j], root->time[j - 1]);
+                goto done;
+            }
+            t[i] = root->time[j];
+            x[i] = root->xyz[3 * j] * scale;
+            y[i] = root->xyz[3 * j + 1] * scale;
+            z[i] = root->xyz[3 * j + 2] * scale;
+            shoot[i] = names[r];
+            parent[i] = root->parent == PHC_RSML_NO_PARENT ? "" : names[root->parent];
+            line[i] = root->time_line[j];
+        }
+    }
+    rc = build(path, n, line, t, shoot, x, y, z, parent, out, err);
+done:
+    for (size_t r = 0; names && r < doc->n_roots; ++r) free(names[r]);
+    free(names);
+    free(t);
+    free(x);
+    free(y);
+    free(z);
+    free(shoot);
+    free(parent);
+    free(line);
+    phc_rsml_free(doc);
+    return rc;
+}
+
 int phc_shoot_traces_read(const char *path, phc_shoot_traces **out, phc_error *err)
 {
     *out = NULL;
+    if (ends_with_rsml(path)) return read_rsml(path, out, err);
     phc_table *tab = NULL;
     int rc = phc_table_read(path, &tab, err);
     if (rc) return rc;

@@ -18,6 +18,22 @@
  * A shoot's polyline at time t is its points with time <= t, joined in
  * order; a lateral's first point is its branch point on the parent.
  *
+ * RSML (a file whose name ends in .rsml; Lobet et al. 2015, read by
+ * measurements/rsml.h): every <root> polyline is a shoot named by its id
+ * (root<k> without one), base first; its parent is the <root> it is nested
+ * in (laterals nest in their parent shoot, so a parent is always known);
+ * each point's time (s) is its <sample> of the root's per-point function
+ * named "time" (<functions><function name="time" domain="polyline">, one
+ * sample per point).  RSML 1.0 itself has no per-point time (its metadata
+ * <time-sequence> numbers whole files of a series), so the function is our
+ * convention.  Coordinates are converted to m by the metadata: coordinate /
+ * <resolution> is in <unit> (m, cm, mm, um or inch).  Errors, naming the
+ * file and the line of the element: a root without a time function (the
+ * first such root is named, before any other check), a time sample count
+ * other than the point count, time going backwards along a root, a unit
+ * that is not a length (e.g. "pixel"), two roots with one id; then the
+ * table's checks below (a shoot with fewer than 2 points ...).
+ *
  * Errors (PHC_ERR_INPUT, "FILE:LINE: column 'NAME': ..."): a missing
  * column, a non-numeric or non-finite cell, an empty shoot name, time going
  * backwards within a shoot, a parent that is not a shoot of the table, a

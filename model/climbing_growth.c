@@ -8,6 +8,7 @@
 
 #include "model/climbing_cambium.h"
 #include "model/climbing_leaves.h"
+#include "model/climbing_light_field.h"
 #include "model/climbing_rng.h"
 #include "model/climbing_tropism.h"
 #include "model/plant_graph.h"
@@ -46,6 +47,8 @@ struct phc_climbing {
     size_t occ_nv, occ_nt;
     size_t opaque_cells;
     size_t leaves;
+    phc_climbing_light_field field; /* seek_light: where the light is */
+    int field_ready;         /* 1 once the field holds a step's light */
 };
 
 static double dot(const double a[3], const double b[3])
@@ -74,6 +77,9 @@ phc_climbing_options phc_climbing_options_default(void)
     o.light.extinction = 0;
     o.light.direction[2] = 1;
     o.phototropism = 0;
+    o.seek_light = 0;
+    o.light_spread_deg = 30;
+    o.light_gradient_threshold = 1e-3;
     o.surface_adaption = 0;
     o.adaption_radius = 0.1;
     o.contact_distance = 0.004;
@@ -126,6 +132,7 @@ void phc_climbing_free(phc_climbing *c)
     free(c->r0);
     free(c->has_child);
     free(c->target);
+    phc_climbing_light_field_free(&c->field);
     free(c->sx);
     free(c->sv);
     free(c->sI);
@@ -217,6 +224,10 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
     NEED(ll > 0 && isfinite(ll), "|light.direction|", ll, "(0, inf)");
     NEED(o->phototropism >= 0 && isfinite(o->phototropism), "phototropism", o->phototropism,
          "[0, inf) 1/s");
+    NEED(o->light_spread_deg >= 0 && o->light_spread_deg <= 89, "light_spread_deg",
+         o->light_spread_deg, "[0, 89] degrees");
+    NEED(o->light_gradient_threshold >= 0 && isfinite(o->light_gradient_threshold),
+         "light_gradient_threshold", o->light_gradient_threshold, "[0, inf)");
     NEED(o->surface_adaption >= 0 && isfinite(o->surface_adaption), "surface_adaption",
          o->surface_adaption, "[0, inf) 1/s");
     NEED(o->adaption_radius >= 0 && isfinite(o->adaption_radius), "adaption_radius",
@@ -342,6 +353,9 @@ phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
         if (!c->phi)
             goto nomem;
     }
+    if (o.seek_light && o.phototropism > 0 &&
+        phc_climbing_light_field_init(&c->field, &c->o.light, o.light_spread_deg))
+        goto nomem;
     if (add_particle(c, PHC_CLIMBING_NONE, 0, 0, o.bud_fraction, o.radius, base, dir, base) ==
         PHC_CLIMBING_NONE)
         goto nomem;
@@ -402,8 +416,16 @@ static void tropisms(phc_climbing *c, size_t i, double dt)
     double b[3];
     seg_base(c, i, 0, b);
     double *d = c->d + 3 * i, *dr = c->dr + 3 * i;
-    if (o->phototropism > 0) /* eq. 7 */
-        phc_climbing_turn(d, dr, o->light.direction, o->phototropism * dt);
+    if (o->phototropism > 0) { /* eq. 7 */
+        double t[3];
+        memcpy(t, o->light.direction, sizeof t);
+        if (c->field_ready) { /* toward where the light is */
+            double tip[3];
+            seg_tip(c, i, 0, tip);
+            phc_climbing_light_field_target(&c->field, tip, o->light_gradient_threshold, t);
+        }
+        phc_climbing_turn(d, dr, t, o->phototropism * dt);
+    }
     if (o->closest && (o->surface_adaption > 0 || o->contact_distance > 0)) { /* eq. 6 */
         double tip[3], cp[3], nf[3], t[3];
         seg_tip(c, i, 0, tip);
@@ -678,7 +700,7 @@ static void count(phc_climbing *c)
 
 /* Step 1: light at the particles and the leaves (model/climbing_light.h);
  * leaves add their volumes s²·thickness to the grid. */
-static void light_step(phc_climbing *c, size_t n0)
+static int light_step(phc_climbing *c, size_t n0)
 {
     const phc_climbing_options *o = &c->o;
     size_t m = 0;
@@ -697,10 +719,19 @@ static void light_step(phc_climbing *c, size_t n0)
     const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
     phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi, c->sI);
     memcpy(c->light, c->sI, n0 * sizeof *c->light);
+    const size_t points = m;
     m = n0;
     for (size_t i = 0; i < n0; ++i)
         if (c->has_leaf[i])
             c->leaf_light[i] = c->sI[m++];
+    /* seek_light: the light field from the same shading points */
+    if (c->field.value) {
+        if (phc_climbing_light_field_update(&c->field, c->opaque ? &occ : NULL, c->sx, c->sv,
+                                            points))
+            return -1;
+        c->field_ready = 1;
+    }
+    return 0;
 }
 
 /* Step 9: secondary growth by the pipe model. */
@@ -873,8 +904,8 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     for (size_t i = 0; i < n0; ++i)
         c->age[i] += dt;
     /* 1. light */
-    if (o->light.extinction > 0 || c->opaque)
-        light_step(c, n0);
+    if ((o->light.extinction > 0 || c->opaque) && light_step(c, n0))
+        return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for the light field");
     /* 2.–4. tropisms, growth, branching of the tips present at the start */
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])

@@ -62,6 +62,9 @@
  *     particle as stiffer: its age is passed as max(t_l, s_min·t_m)·(r/r0)⁴
  *     (bending stiffness E·πr⁴/4 grows as r⁴; the mapping onto the
  *     particles' age law is ours), r0 its primary radius.
+ * With seek_light, step 1 also builds the light field of
+ * model/climbing_light_field.h (only when the light varies: extinction > 0
+ * or shadows), and step 2's phototropism turns toward its gradient.
  * Supports may cast shadows (phc_climbing_set_shadow_triangles: the mesh
  * rasterised into the light grid's opaque mask, model/climbing_light.h).
  *
@@ -124,6 +127,19 @@ typedef struct phc_climbing_options {
     double surface_adaption;    /* τ, s^-1, >= 0; default 0 */
     double adaption_radius;     /* m: supports farther from a tip do not attract; default 0.1 */
     double contact_distance;    /* m: within it a tip crawls along the support; default 0.004 */
+    /* phototropism toward where the light is (model/climbing_light_field.h) */
+    int seek_light;             /* 1: eq. 7's target is the gradient of the light field at
+                                   the tip, ∇F/|∇F| (the direction of most light, −∇O),
+                                   falling back to ℓ where |∇F|·h < light_gradient_threshold,
+                                   so a shoot in a wall's shade turns toward a gap.  0
+                                   (default): the fixed direction ℓ — the old model bit for
+                                   bit, and no field to compute (it costs 1 + 6 ray marches
+                                   per grid cell and step) */
+    double light_spread_deg;    /* ψ ∈ [0, 89] degrees: the field's sky is ℓ and six
+                                   directions ψ from it (a penumbra of width ≈ 2H tan ψ at
+                                   depth H below an edge); default 30 */
+    double light_gradient_threshold; /* >= 0: smallest change of light over one cell that
+                                   counts as a direction; default 1e-3 */
     /* anchors (eq. 5) */
     double attach_distance;     /* m, >= 0 (0: no anchors); default 0.005 */
     double release_distance;    /* m, > attach_distance; default 0.02 */

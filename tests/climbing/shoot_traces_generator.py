@@ -23,7 +23,13 @@ The apex positions are written every `--interval` seconds, plus each node
 when it is laid down; columns time (s), shoot, x, y, z (m), parent.  The
 numbers are synthetic: they are NOT measurements of a real plant.
 
-Usage: shoot_traces_generator.py OUT.csv [--seed N] [--duration S] ...
+With `--rsml OUT.rsml` the same traces are also written as RSML 1.0
+(Lobet et al. 2015; unit m, resolution 1): one <root> per shoot, laterals
+nested in their parent, the points of a shoot in the CSV's order with the
+same digits, and each point's time as a per-point function named "time"
+(domain polyline, s), the convention measurements/shoot_traces.h reads.
+
+Usage: shoot_traces_generator.py OUT.csv [--rsml OUT.rsml] [--seed N] [--duration S] ...
 """
 import argparse
 import math
@@ -70,6 +76,7 @@ def closest_on_wall(p):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("out")
+    ap.add_argument("--rsml", help="also write the traces as RSML to this file")
     ap.add_argument("--seed", type=int, default=2024)
     ap.add_argument("--duration", type=float, default=120.0)
     ap.add_argument("--dt", type=float, default=0.25)
@@ -134,9 +141,57 @@ def main():
         for r in rows:
             count[r[1]] = count.get(r[1], 0) + 1
         kept = {n for n, c in count.items() if c >= 2}
+        written = []
         for tt, name, x, parent in rows:
             if name in kept and (parent == "" or parent in kept):
                 f.write("%g,%s,%.6f,%.6f,%.6f,%s\n" % (tt, name, x[0], x[1], x[2], parent))
+                written.append((tt, name, x, parent))
+    if args.rsml:
+        write_rsml(args.rsml, written, args.seed)
+
+
+def write_rsml(path, rows, seed):
+    """The rows (time, shoot, x, parent) as RSML: shoots nested by parent."""
+    order, points, parent_of = [], {}, {}
+    for tt, name, x, parent in rows:
+        if name not in points:
+            order.append(name)
+            points[name] = []
+            parent_of[name] = parent
+        points[name].append((tt, x))
+    children = {n: [c for c in order if parent_of[c] == n] for n in order}
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           '<!-- SYNTHETIC traces written by tests/climbing/shoot_traces_generator.py (seed %d): '
+           'not measurements of a real plant -->' % seed,
+           '<rsml>', '  <metadata>', '    <version>1</version>', '    <unit>m</unit>',
+           '    <resolution>1</resolution>', '    <software>shoot_traces_generator.py</software>',
+           '  </metadata>', '  <scene>', '    <plant id="1">']
+
+    def root(name, depth):
+        pad = "  " * depth
+        out.append('%s<root id="%s">' % (pad, name))
+        out.append('%s  <geometry>' % pad)
+        out.append('%s    <polyline>' % pad)
+        for tt, x in points[name]:
+            out.append('%s      <point x="%.6f" y="%.6f" z="%.6f"/>' % (pad, x[0], x[1], x[2]))
+        out.append('%s    </polyline>' % pad)
+        out.append('%s  </geometry>' % pad)
+        out.append('%s  <functions>' % pad)
+        out.append('%s    <function name="time" domain="polyline">' % pad)
+        for tt, x in points[name]:
+            out.append('%s      <sample>%g</sample>' % (pad, tt))
+        out.append('%s    </function>' % pad)
+        out.append('%s  </functions>' % pad)
+        for c in children[name]:
+            root(c, depth + 1)
+        out.append('%s</root>' % pad)
+
+    for n in order:
+        if parent_of[n] == "":
+            root(n, 3)
+    out += ['    </plant>', '  </scene>', '</rsml>']
+    with open(path, "w") as f:
+        f.write("\n".join(out) + "\n")
 
 
 if __name__ == "__main__":
