@@ -44,9 +44,9 @@ static void remove_files(void)
 {
     int i;
     for (i = 0; i < n_tmp_files; ++i) {
-        char tmp[300];
+        char tmp[sizeof tmp_files[0] + 8];
         remove(tmp_files[i]);
-        snprintf(tmp, sizeof tmp, "%s.tmp", tmp_files[i]);
+        snprintf(tmp, sizeof tmp, "%.255s.tmp", tmp_files[i]);
         remove(tmp);
     }
     rmdir(tmp_dir);
