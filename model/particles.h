@@ -114,6 +114,37 @@ void phc_particles_free(phc_particles *p); /* accepts NULL */
 
 size_t phc_particles_count(const phc_particles *p);
 
+/* Growing a system in place (climbing plants: one system for the whole
+ * growth, so that the groups' rotations warm-start the polar
+ * decompositions and velocities carry over from frame to frame).
+ *
+ * phc_particles_append adds a particle for the segment head → tail (m) of
+ * radius r (m) as a child of `parent` (linked; PHC_PARTICLES_NONE: a new
+ * root), at rest: current = rest, zero velocities, age 0, no anchor, the
+ * options' stiffness, mass ρπr²L.  Its index (the old count) goes to
+ * *index (may be NULL).  The children and group slots are rebuilt once at
+ * the next step (O(n), no allocation); the arrays grow by doubling.
+ * Errors: parent out of range, a bad segment (as phc_particles_new), out
+ * of memory (the system is unchanged and still valid). */
+int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
+                         const double tail[3], double radius, size_t *index, phc_error *err);
+/* New rest state of particle i from its segment head → tail (m) and radius
+ * (m): rest centre, rest orientation, radii and mass ρπr²L (replacing a
+ * mass set by phc_particles_set_mass).  The current state, velocities,
+ * age, anchor and its group's rotation (the polar warm start) are kept. */
+int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], const double tail[3],
+                           double radius, phc_error *err);
+/* Moves particle i to x (m) turned to the unit quaternion q (normalised
+ * here) WITHOUT touching its velocities (a kinematic displacement, e.g. a
+ * growing tip whose centre moves along its axis); phc_particles_set_position
+ * and _set_orientation zero them instead. */
+int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
+                        phc_error *err);
+
+/* Gravity of a system from the next step (m s^-2, finite; e.g. a scene
+ * turned while a persistent system lives on). */
+int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *err);
+
 /* Setters; each validates and names the particle in its message. */
 int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
                            phc_error *err);
