@@ -665,6 +665,7 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
     if (!c->sys) {
         if (!(c->sys = dynamics_new(c, err)))
             return -1;
+        phc_particles_measure_stress(c->sys, 0); /* nothing reads it here */
         known = n;
         for (size_t i = 0; i < n; ++i)
             seen_now(c, i, c->sys_seen + SEEN * i);

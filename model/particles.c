@@ -31,6 +31,7 @@ struct phc_particles {
     size_t n;
     size_t cap;              /* particles the arrays hold (>= n) */
     int layout_dirty;        /* 1 after an append: children and slots to rebuild */
+    int no_stress;           /* 1: skip the stress pass when nothing breaks */
     phc_particles_options o;
     double *x, *v, *xp;      /* 3n: position, velocity, predicted position (m, m/s) */
     double *x0;              /* 3n: rest position (m) */
@@ -697,6 +698,12 @@ int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *er
     return PHC_OK;
 }
 
+void phc_particles_measure_stress(phc_particles *p, int on)
+{
+    if (p)
+        p->no_stress = !on;
+}
+
 int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
                         phc_error *err)
 {
@@ -1250,6 +1257,13 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         p->age[i] += dt;
     }
     /* Stress of every group on the new state (§4.3), and breaking. */
+    if (p->no_stress && !(p->o.break_threshold > 0)) {
+        if (report) {
+            report->polar_total = p->polar_total;
+            report->polar_fallbacks = p->polar_fallbacks;
+        }
+        return PHC_OK;
+    }
     orientation_matrices(p, p->q);
     if (match_all(p, p->x, 1, err))
         return -1;

@@ -145,6 +145,12 @@ int phc_particles_place(phc_particles *p, size_t i, const double x[3], const dou
  * turned while a persistent system lives on). */
 int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *err);
 
+/* on = 0: a step without breaking (break_threshold <= 0) skips the stress
+ * pass after it (one shape matching of every group of five with the
+ * default 4 iterations): phc_particles_stress keeps the last measured
+ * values and the report's max_stress stays 0 (group NONE).  Default on. */
+void phc_particles_measure_stress(phc_particles *p, int on);
+
 /* Setters; each validates and names the particle in its message. */
 int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
                            phc_error *err);
