@@ -52,6 +52,8 @@ struct phc_climbing {
     phc_particles *sys;
     double *sys_seen;
     size_t sys_seen_cap;
+    size_t pushed;           /* collisions of the last step (option collide) */
+    double depth;            /* smallest δ − r before the pushes, m */
 };
 
 static double dot(const double a[3], const double b[3])
@@ -675,6 +677,7 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
     phc_particles *p = c->sys;
     if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
         return -1;
+    phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
     for (size_t i = 0; i < n; ++i) {
         double now[SEEN], head[3], tail[3], q[4];
         seen_now(c, i, now);
@@ -717,6 +720,30 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
     return 0;
 }
 
+/* Kinematic collisions (option collide): current centres pushed out of
+ * the supports (the seed's left alone). */
+static void collide_kinematic(phc_climbing *c)
+{
+    c->pushed = 0;
+    c->depth = INFINITY;
+    if (!c->o.collide || !c->o.closest)
+        return;
+    for (size_t i = 1; i < c->n; ++i) {
+        double d;
+        c->pushed += (size_t)phc_particles_push_out(c->o.closest, c->o.closest_user,
+                                                    c->radius[i], c->x + 3 * i, &d);
+        c->depth = fmin(c->depth, d - c->radius[i]);
+    }
+}
+
+void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth)
+{
+    if (pushed)
+        *pushed = c->pushed;
+    if (depth)
+        *depth = c->depth;
+}
+
 static int dynamics(phc_climbing *c, double dt, phc_error *err)
 {
     const size_t n = c->n;
@@ -724,9 +751,17 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         goto fail;
     phc_particles *p = c->sys;
     const double h = dt / (double)c->o.dynamics_substeps;
-    for (size_t s = 0; s < c->o.dynamics_substeps; ++s)
+    c->pushed = 0;
+    c->depth = INFINITY;
+    for (size_t s = 0; s < c->o.dynamics_substeps; ++s) {
         if (phc_particles_step(p, h, NULL, err))
             goto fail;
+        size_t pushed;
+        double depth;
+        phc_particles_collisions(p, &pushed, &depth);
+        c->pushed += pushed;
+        c->depth = fmin(c->depth, depth);
+    }
     for (size_t i = 1; i < n; ++i) {
         double q[4], R[9];
         phc_particles_position(p, i, c->x + 3 * i);
@@ -1025,6 +1060,7 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     } else {
         memcpy(c->x, c->xr, 3 * c->n * sizeof *c->x);
         memcpy(c->d, c->dr, 3 * c->n * sizeof *c->d);
+        collide_kinematic(c);
     }
     /* 7. anchors */
     anchors(c);

@@ -161,6 +161,13 @@ typedef struct phc_climbing_options {
                                    part and n (45° off the face, outward), so the shoot
                                    does not grow through a wall at an edge or corner; new
                                    laterals are checked at birth.  0 (default): off */
+    int collide;                /* 1: collisions of every particle with the supports (ours;
+                                   model/particles.h phc_particles_set_collider): a particle
+                                   whose centre lies closer than its radius to the supports, or
+                                   behind a face, is pushed out to its radius along the surface
+                                   normal, inside each dynamics step (before the velocities) or,
+                                   kinematic, after current = rest; the seed particle is left
+                                   alone.  0 (default): off */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -195,6 +202,11 @@ int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
  * e.g. to grow a plant kinematically and then let it settle.  Error: substeps
  * > 0 with particles.maturity_age = 0 (PHC_ERR_INVALID, nothing changed). */
 int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err);
+
+/* Collisions of the last step (option collide): particles pushed out and
+ * the smallest δ − r (m) before the pushes (+INFINITY when none measured;
+ * δ: signed distance of a centre to the supports, model/particles.h). */
+void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth);
 
 /* Counters since the seed. */
 typedef struct phc_climbing_stats {

@@ -32,6 +32,10 @@ struct phc_particles {
     size_t cap;              /* particles the arrays hold (>= n) */
     int layout_dirty;        /* 1 after an append: children and slots to rebuild */
     int no_stress;           /* 1: skip the stress pass when nothing breaks */
+    phc_particles_closest_fn collide; /* supports, NULL: none */
+    void *collide_user;
+    size_t pushed;           /* particles pushed out in the last step */
+    double depth;            /* smallest δ − r before the pushes, m */
     phc_particles_options o;
     double *x, *v, *xp;      /* 3n: position, velocity, predicted position (m, m/s) */
     double *x0;              /* 3n: rest position (m) */
@@ -698,6 +702,62 @@ int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *er
     return PHC_OK;
 }
 
+void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, void *user)
+{
+    if (!p)
+        return;
+    p->collide = fn;
+    p->collide_user = user;
+}
+
+int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
+                           double *delta)
+{
+    double c[3], nf[3];
+    if (delta)
+        *delta = INFINITY;
+    if (!fn || fn(user, x, c, nf))
+        return 0;
+    const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+    const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    const int front = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0;
+    const double d = front ? dist : -dist;
+    if (delta)
+        *delta = d;
+    if (!(d < r))
+        return 0;
+    for (int k = 0; k < 3; ++k)
+        x[k] = c[k] + r * (front && dist > 0 ? e[k] / dist : nf[k]);
+    return 1;
+}
+
+void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth)
+{
+    if (pushed)
+        *pushed = p ? p->pushed : 0;
+    if (depth)
+        *depth = p ? p->depth : INFINITY;
+}
+
+/* The collision pass on the predicted positions (see particles.h). */
+static void collide(phc_particles *p)
+{
+    p->pushed = 0;
+    p->depth = INFINITY;
+    if (!p->collide)
+        return;
+    for (size_t i = 0; i < p->n; ++i) {
+        if (p->hold_q[i])
+            continue;
+        double d;
+        const double r = p->ax[3 * i];
+        p->pushed += (size_t)phc_particles_push_out(p->collide, p->collide_user, r,
+                                                    p->xp + 3 * i, &d);
+        if (d - r < p->depth)
+            p->depth = d - r;
+    }
+}
+
 void phc_particles_measure_stress(phc_particles *p, int on)
 {
     if (p)
@@ -1229,6 +1289,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         if (rc)
             return rc;
     }
+    collide(p);
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d)
             if (!isfinite(p->xp[3 * i + d]) || !isfinite(p->qp[4 * i + d]))

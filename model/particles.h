@@ -151,6 +151,31 @@ int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *er
  * values and the report's max_stress stays 0 (group NONE).  Default on. */
 void phc_particles_measure_stress(phc_particles *p, int on);
 
+/* Collisions with supports (ours; the climbing paper's particles only
+ * attach to them).  fn gives the closest support point c (m) to x and the
+ * unit outward face normal n there (0; nonzero: no support).  With a
+ * collider set, every step ends its projection with one collision pass
+ * over the predicted positions x_p, before the velocities are derived
+ * from them (position-based dynamics: the inward velocity goes too):
+ * the particle's signed distance is δ = |x_p − c| when (x_p − c)·n >= 0
+ * (in front of the face) and −|x_p − c| otherwise; when δ < r (the
+ * particle's radius) it is moved to c + r·u, u = (x_p − c)/|x_p − c| in
+ * front (the surface normal at c, also round an edge or a corner), u = n
+ * behind or on the face.  Particles whose orientation is held (clamped)
+ * are left alone.  The callback is called once per particle and step,
+ * from one thread, in index order.  fn = NULL: no collisions (default). */
+typedef int (*phc_particles_closest_fn)(void *user, const double x[3], double c[3], double n[3]);
+void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, void *user);
+/* The push of the collision pass on one point x (m) for a particle of
+ * radius r (m): returns 1 and moves x when δ < r, else 0 (also without a
+ * support).  *delta (may be NULL) gets δ before the move (m; +INFINITY
+ * without a support). */
+int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
+                           double *delta);
+/* Collisions of the last step: particles pushed out and the smallest δ − r
+ * (m) seen before the pushes (+INFINITY when none was measured). */
+void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth);
+
 /* Setters; each validates and names the particle in its message. */
 int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
                            phc_error *err);
