@@ -53,7 +53,8 @@
  *
  * Time step (position-based dynamics): predict v += Δt (g + f/m),
  * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
- * from the current x_p (Jacobi), blend, stiffness, anchors}; update
+ * from the current x_p (Jacobi), blend, stiffness, anchors}; with a
+ * collider, one collision pass (phc_particles_set_collider); update
  * v = (x_p − x)/Δt, ω from q_p q⁻¹, both times (1 − damping); age += Δt.
  *
  * Breaking (climbing §4.3; our definition of the stress): after the step,
@@ -248,7 +249,9 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
  * (row-major): the proper rotation R maximising tr(Rᵀ A).  q (w,x,y,z) is
  * the start on entry (e.g. the last step's rotation) and the result on
  * return.  Müller et al. 2016 ("A robust method to extract the rotational
- * part of deformations") iteration; its stationary point is certified a
+ * part of deformations") iteration, with a Newton step where tr(B)I −
+ * sym(B) is positive definite (cut to 1 rad when longer) and at most 16 of
+ * Müller's own steps (then the SVD); its stationary point is certified a
  * maximum (tr(S)·I − S positive semidefinite, S = RᵀA, checked by its
  * principal minors), otherwise LAPACK
  * dgesvd gives R = U diag(1, 1, det(UVᵀ)) Vᵀ.  Returns 0 with the
