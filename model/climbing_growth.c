@@ -49,6 +49,14 @@ struct phc_climbing {
     size_t leaves;
     phc_climbing_light_field field; /* seek_light: where the light is */
     int field_ready;         /* 1 once the field holds a step's light */
+    /* dynamics (step 6): one particle system kept across the steps, and
+     * per particle what was last handed to it or read from it (14 doubles:
+     * rest centre, rest direction, radius, σ, current centre, direction) */
+    phc_particles *sys;
+    double *sys_seen;
+    size_t sys_seen_cap;
+    size_t pushed;           /* collisions of the last step (option collide) */
+    double depth;            /* smallest δ − r before the pushes, m */
 };
 
 static double dot(const double a[3], const double b[3])
@@ -139,6 +147,8 @@ void phc_climbing_free(phc_climbing *c)
     free(c->opaque);
     free(c->occ_v);
     free(c->occ_t);
+    phc_particles_free(c->sys);
+    free(c->sys_seen);
     free(c);
 }
 
@@ -590,50 +600,190 @@ static double thickness_factor(const phc_climbing *c, size_t i)
     return q == 1 ? 1 : q * q * q * q;
 }
 
-/* Step 6: the particles' dynamics on the grown shape. */
-static int dynamics(phc_climbing *c, double dt, phc_error *err)
+/* Step 6: the particles' dynamics on the grown shape.
+ *
+ * One phc_particles system lives across the steps (c->sys): it is made
+ * from the rest shape at the first dynamic step; afterwards each step
+ * hands it only what changed: the rest segment of a particle whose rest
+ * centre, rest direction, radius or size changed (phc_particles_set_rest),
+ * the current centre and direction of a particle the growth code moved (a
+ * growing or turned tip: phc_particles_place, velocities kept), the new
+ * particles (phc_particles_append, at their current place, at rest), the
+ * ages and the anchors.  Velocities and the groups' rotations therefore
+ * carry over from one step to the next. */
+
+#define SEEN 14 /* doubles per particle in c->sys_seen */
+
+/* What particle i's rest and current state are now, in c->sys_seen's
+ * layout. */
+static void seen_now(const phc_climbing *c, size_t i, double out[SEEN])
+{
+    memcpy(out, c->xr + 3 * i, 3 * sizeof(double));
+    memcpy(out + 3, c->dr + 3 * i, 3 * sizeof(double));
+    out[6] = c->radius[i];
+    out[7] = c->sigma[i];
+    memcpy(out + 8, c->x + 3 * i, 3 * sizeof(double));
+    memcpy(out + 11, c->d + 3 * i, 3 * sizeof(double));
+}
+
+static void rest_segment(const phc_climbing *c, size_t i, double head[3], double tail[3])
+{
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k) {
+        head[k] = c->xr[3 * i + k] - h * c->dr[3 * i + k];
+        tail[k] = c->xr[3 * i + k] + h * c->dr[3 * i + k];
+    }
+}
+
+/* The first dynamic step: the system from the rest shape, given the
+ * current centres and directions (at rest). */
+static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
 {
     const size_t n = c->n;
     phc_plant_graph *g = phc_plant_graph_new(n);
     phc_particles *p = NULL;
-    int rc = -1;
     if (!g) {
         phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu particles", n);
-        return -1;
+        return NULL;
     }
     for (size_t i = 0; i < n; ++i) {
-        const double h = seg_half(c, i);
-        for (int k = 0; k < 3; ++k) {
-            g->head[3 * i + k] = c->xr[3 * i + k] - h * c->dr[3 * i + k];
-            g->tail[3 * i + k] = c->xr[3 * i + k] + h * c->dr[3 * i + k];
-        }
+        rest_segment(c, i, g->head + 3 * i, g->tail + 3 * i);
         g->radius[i] = c->radius[i];
-        g->length[i] = 2 * h;
+        g->length[i] = 2 * seg_half(c, i);
         g->parent[i] = c->parent[i] == PHC_CLIMBING_NONE ? PHC_PLANT_NO_PARENT : c->parent[i];
     }
     g->fixed[0] = 1; /* the seed is in the ground */
-    if (phc_plant_graph_finish(g, "climbing", err))
-        goto done;
-    p = phc_particles_new(g, &c->o.particles, err);
+    if (phc_plant_graph_finish(g, "climbing", err) == 0)
+        p = phc_particles_new(g, &c->o.particles, err);
+    phc_plant_graph_free(g);
     if (!p)
-        goto done;
+        return NULL;
     for (size_t i = 1; i < n; ++i) {
         double q[4];
         phc_quat_from_z(c->d + 3 * i, q);
         if (phc_particles_set_position(p, i, c->x + 3 * i, err) ||
-            phc_particles_set_orientation(p, i, q, err) ||
-            phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
-            goto done;
-        if (c->anchored[i]) {
-            const double k = phc_climbing_anchor_strength(c, i);
-            if (k > 0 && phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err))
-                goto done;
+            phc_particles_set_orientation(p, i, q, err)) {
+            phc_particles_free(p);
+            return NULL;
         }
     }
+    return p;
+}
+
+/* Hands the grown plant to c->sys (made at the first call). */
+static int dynamics_sync(phc_climbing *c, phc_error *err)
+{
+    const size_t n = c->n;
+    if (n > c->sys_seen_cap) { /* amortised: doubling */
+        size_t cap = c->sys_seen_cap ? c->sys_seen_cap : 64;
+        while (cap < n)
+            cap *= 2;
+        double *t = realloc(c->sys_seen, SEEN * cap * sizeof *t);
+        if (!t)
+            return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu particles",
+                                 n);
+        c->sys_seen = t;
+        c->sys_seen_cap = cap;
+    }
+    size_t known = 0;
+    if (!c->sys) {
+        if (!(c->sys = dynamics_new(c, err)))
+            return -1;
+        phc_particles_measure_stress(c->sys, 0); /* nothing reads it here */
+        known = n;
+        for (size_t i = 0; i < n; ++i)
+            seen_now(c, i, c->sys_seen + SEEN * i);
+    } else {
+        known = phc_particles_count(c->sys);
+    }
+    phc_particles *p = c->sys;
+    if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
+        return -1;
+    phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
+    for (size_t i = 0; i < n; ++i) {
+        double now[SEEN], head[3], tail[3], q[4];
+        seen_now(c, i, now);
+        double *was = c->sys_seen + SEEN * i;
+        if (i >= known) { /* new: at its current place, at rest */
+            rest_segment(c, i, head, tail);
+            phc_quat_from_z(c->d + 3 * i, q);
+            if (phc_particles_append(p, c->parent[i], head, tail, c->radius[i], NULL, err) ||
+                phc_particles_set_position(p, i, c->x + 3 * i, err) ||
+                phc_particles_set_orientation(p, i, q, err))
+                return -1;
+        } else {
+            if (memcmp(now, was, 8 * sizeof(double)) != 0) { /* rest changed */
+                rest_segment(c, i, head, tail);
+                if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
+                    return -1;
+            }
+            if (i > 0 && memcmp(now + 8, was + 8, 6 * sizeof(double)) != 0) { /* moved */
+                phc_quat_from_z(c->d + 3 * i, q);
+                if (phc_particles_place(p, i, c->x + 3 * i, q, err))
+                    return -1;
+            }
+        }
+        memcpy(was, now, sizeof now);
+        if (i == 0) { /* the seed: clamped at its rest place and orientation */
+            phc_quat_from_z(c->dr, q);
+            if (phc_particles_set_position(p, 0, c->xr, err) ||
+                phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
+                phc_particles_anchor(p, 0, c->xr, 1, 1, err))
+                return -1;
+            continue;
+        }
+        if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
+            return -1;
+        const double k = c->anchored[i] ? phc_climbing_anchor_strength(c, i) : 0;
+        if (k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
+                  : phc_particles_release(p, i, err))
+            return -1;
+    }
+    return 0;
+}
+
+/* Kinematic collisions (option collide): current centres pushed out of
+ * the supports (the seed's left alone). */
+static void collide_kinematic(phc_climbing *c)
+{
+    c->pushed = 0;
+    c->depth = INFINITY;
+    if (!c->o.collide || !c->o.closest)
+        return;
+    for (size_t i = 1; i < c->n; ++i) {
+        double d;
+        c->pushed += (size_t)phc_particles_push_out(c->o.closest, c->o.closest_user,
+                                                    c->radius[i], c->x + 3 * i, &d);
+        c->depth = fmin(c->depth, d - c->radius[i]);
+    }
+}
+
+void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth)
+{
+    if (pushed)
+        *pushed = c->pushed;
+    if (depth)
+        *depth = c->depth;
+}
+
+static int dynamics(phc_climbing *c, double dt, phc_error *err)
+{
+    const size_t n = c->n;
+    if (dynamics_sync(c, err))
+        goto fail;
+    phc_particles *p = c->sys;
     const double h = dt / (double)c->o.dynamics_substeps;
-    for (size_t s = 0; s < c->o.dynamics_substeps; ++s)
+    c->pushed = 0;
+    c->depth = INFINITY;
+    for (size_t s = 0; s < c->o.dynamics_substeps; ++s) {
         if (phc_particles_step(p, h, NULL, err))
-            goto done;
+            goto fail;
+        size_t pushed;
+        double depth;
+        phc_particles_collisions(p, &pushed, &depth);
+        c->pushed += pushed;
+        c->depth = fmin(c->depth, depth);
+    }
     for (size_t i = 1; i < n; ++i) {
         double q[4], R[9];
         phc_particles_position(p, i, c->x + 3 * i);
@@ -645,12 +795,14 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         R[8] = 1 - 2 * (a * a + b * b);
         const double dz[3] = {R[2], R[5], R[8]};
         unit(dz, c->d + 3 * i);
+        memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
+        memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
     }
-    rc = 0;
-done:
-    phc_particles_free(p);
-    phc_plant_graph_free(g);
-    return rc;
+    return 0;
+fail: /* the next dynamic step starts a fresh system from the plant */
+    phc_particles_free(c->sys);
+    c->sys = NULL;
+    return -1;
 }
 
 /* Step 7: anchors (eq. 5). */
@@ -939,6 +1091,7 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     } else {
         memcpy(c->x, c->xr, 3 * c->n * sizeof *c->x);
         memcpy(c->d, c->dr, 3 * c->n * sizeof *c->d);
+        collide_kinematic(c);
     }
     /* 7. anchors */
     anchors(c);
@@ -966,6 +1119,10 @@ int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_err
                              "climbing: dynamics need particles.maturity_age > 0 (it is %g s)",
                              c->o.particles.maturity_age);
     c->o.dynamics_substeps = substeps;
+    if (substeps == 0) { /* kinematic from now on: a later dynamic step starts afresh */
+        phc_particles_free(c->sys);
+        c->sys = NULL;
+    }
     return 0;
 }
 

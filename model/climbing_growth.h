@@ -35,14 +35,20 @@
  *  5. the rest shape is rebuilt from the rest directions (each rest centre
  *     at its parent's rest tip plus L_i/2 along its direction; the seed's
  *     base is fixed);
- *  6. dynamics, when dynamics_substeps > 0: a phc_particles system is made
- *     from the rest shape, given the current centres, directions, ages and
- *     anchors, stepped dynamics_substeps times by Δt/substeps (stiffness
- *     s = max(s_min, min(1, t_l/t_m)) from the particles' maturity age t_m,
- *     passed to model/particles as the age max(t_l, s_min·t_m); the seed
- *     particle is clamped), and the current centres and directions are read
- *     back.  Velocities are not carried from one growth step to the next
- *     (each starts at rest: quasi-static growth, our simplification).  With
+ *  6. dynamics, when dynamics_substeps > 0: one phc_particles system lives
+ *     across the steps (made from the rest shape at the first dynamic
+ *     step); each step hands it the new particles (appended at their
+ *     current place, at rest), the rest segments that changed, the current
+ *     place of particles the growth moved (velocities kept), the ages and
+ *     the anchors; it is stepped dynamics_substeps times by Δt/substeps
+ *     (stiffness s = max(s_min, min(1, t_l/t_m)) from the particles'
+ *     maturity age t_m, passed to model/particles as the age
+ *     max(t_l, s_min·t_m); the seed particle is clamped), and the current
+ *     centres and directions are read back.  Velocities and the groups'
+ *     rotations carry over from one growth step to the next.  Switching
+ *     the dynamics off, or a failed dynamics step, drops the system (the
+ *     next dynamic step starts afresh, at rest).  With collide, every
+ *     particle is pushed out of the supports (see the option).  With
  *     dynamics_substeps = 0 the plant is kinematic: current = rest.
  *  7. anchors (eq. 5): a particle without an anchor whose closest support
  *     point lies within attach_distance is anchored there; its strength
@@ -177,6 +183,13 @@ typedef struct phc_climbing_options {
                                    part and n (45° off the face, outward), so the shoot
                                    does not grow through a wall at an edge or corner; new
                                    laterals are checked at birth.  0 (default): off */
+    int collide;                /* 1: collisions of every particle with the supports (ours;
+                                   model/particles.h phc_particles_set_collider): a particle
+                                   whose centre lies closer than its radius to the supports, or
+                                   behind a face, is pushed out to its radius along the surface
+                                   normal, inside each dynamics step (before the velocities) or,
+                                   kinematic, after current = rest; the seed particle is left
+                                   alone.  0 (default): off */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -211,6 +224,11 @@ int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
  * e.g. to grow a plant kinematically and then let it settle.  Error: substeps
  * > 0 with particles.maturity_age = 0 (PHC_ERR_INVALID, nothing changed). */
 int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err);
+
+/* Collisions of the last step (option collide): particles pushed out and
+ * the smallest δ − r (m) before the pushes (+INFINITY when none measured;
+ * δ: signed distance of a centre to the supports, model/particles.h). */
+void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth);
 
 /* Counters since the seed. */
 typedef struct phc_climbing_stats {

@@ -29,6 +29,13 @@ static const double PI = 3.14159265358979323846;
 
 struct phc_particles {
     size_t n;
+    size_t cap;              /* particles the arrays hold (>= n) */
+    int layout_dirty;        /* 1 after an append: children and slots to rebuild */
+    int no_stress;           /* 1: skip the stress pass when nothing breaks */
+    phc_particles_closest_fn collide; /* supports, NULL: none */
+    void *collide_user;
+    size_t pushed;           /* particles pushed out in the last step */
+    double depth;            /* smallest δ − r before the pushes, m */
     phc_particles_options o;
     double *x, *v, *xp;      /* 3n: position, velocity, predicted position (m, m/s) */
     double *x0;              /* 3n: rest position (m) */
@@ -45,7 +52,7 @@ struct phc_particles {
     double *anchor_q;        /* 4n */
     size_t *parent;          /* n: parent from the graph */
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
-    size_t *child_start, *child; /* children from the graph */
+    size_t *child_start, *child; /* children (CSR, in index order) */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
@@ -177,7 +184,7 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
      * and stops after a Newton step shorter than 1e-9 rad (the next one
      * would be below rounding: quadratic convergence). */
     double R[9];
-    int converged = 0;
+    int converged = 0, slow = 0;
     for (int it = 0; it < 100; ++it) {
         phc_quat_to_matrix(q, R);
         double om[3] = {0, 0, 0}, dot = 0, B[9];
@@ -214,13 +221,25 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
                     nw[2] = y2 / l22;
                     nw[1] = (y1 - l21 * nw[2]) / l11;
                     nw[0] = (y0 - l10 * nw[1] - l20 * nw[2]) / l00;
-                    /* trust the quadratic model only for turns below 1 rad */
-                    newton = nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2] < 1.0;
+                    /* trust the quadratic model only for turns below 1 rad:
+                     * a longer Newton step (T positive definite, so still an
+                     * ascent direction) is cut to 1 rad */
+                    const double n2 = nw[0] * nw[0] + nw[1] * nw[1] + nw[2] * nw[2];
+                    if (n2 > 1.0) {
+                        const double sc = 1.0 / sqrt(n2);
+                        for (int k = 0; k < 3; ++k)
+                            nw[k] *= sc;
+                    }
+                    newton = 1;
                 }
             }
         }
         if (newton) {
             memcpy(om, nw, sizeof nw);
+        } else if (++slow > 16) {
+            /* Müller's step far from the maximum of a rod-like A crawls
+             * (hundreds of steps); the SVD below is cheaper than that */
+            break;
         } else {
             const double sc = 1.0 / (fabs(dot) + 1e-12);
             for (int k = 0; k < 3; ++k)
@@ -354,8 +373,9 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     if (!p)
         goto nomem;
     p->n = n;
+    p->cap = n;
     p->o = o;
-    const size_t slots = n + 2 * n; /* Σ_k (2 + children(k)) = 2n + (n − roots) */
+    const size_t slots = 3 * n; /* Σ_k (2 + children(k)) = 2n + (n − roots) <= 3n */
 #define ALLOC(field, count) \
     if (!(p->field = calloc((count), sizeof *p->field))) goto nomem
     ALLOC(x, 3 * n);
@@ -379,7 +399,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(parent, n);
     ALLOC(linked, n);
     ALLOC(child_start, n + 1);
-    ALLOC(child, n > 1 ? n - 1 : 1);
+    ALLOC(child, n);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
@@ -466,6 +486,303 @@ fail:
 }
 
 size_t phc_particles_count(const phc_particles *p) { return p ? p->n : 0; }
+
+/* ---- growing the system in place ----------------------------------------- */
+
+/* Grows every per-particle array to hold `want` particles (amortised
+ * doubling); the contents are kept.  0, or -1 when out of memory (the
+ * arrays that did grow keep their contents; the system stays valid). */
+static int reserve(phc_particles *p, size_t want)
+{
+    if (want <= p->cap)
+        return 0;
+    size_t cap = p->cap ? 2 * p->cap : 16;
+    while (cap < want)
+        cap *= 2;
+#define GROW(field, per) \
+    do { \
+        void *t_ = realloc(p->field, (per) * cap * sizeof *p->field); \
+        if (!t_) \
+            return -1; \
+        p->field = t_; \
+    } while (0)
+    GROW(x, 3);
+    GROW(v, 3);
+    GROW(xp, 3);
+    GROW(x0, 3);
+    GROW(q, 4);
+    GROW(qp, 4);
+    GROW(q0, 4);
+    GROW(w, 3);
+    GROW(m, 1);
+    GROW(ax, 3);
+    GROW(age, 1);
+    GROW(s, 1);
+    GROW(f, 3);
+    GROW(anchored, 1);
+    GROW(hold_q, 1);
+    GROW(anchor_at, 3);
+    GROW(anchor_k, 1);
+    GROW(anchor_q, 4);
+    GROW(parent, 1);
+    GROW(linked, 1);
+    GROW(child, 1);
+    GROW(gq, 4);
+    GROW(stress, 1);
+    GROW(source_id, 1);
+    GROW(child_index, 1);
+    GROW(ell0, 9);
+    GROW(Rq, 9);
+    GROW(mem, 3);
+    GROW(mu, 3);
+    GROW(goal, 9);
+#undef GROW
+    void *t = realloc(p->child_start, (cap + 1) * sizeof *p->child_start);
+    if (!t)
+        return -1;
+    p->child_start = t;
+    t = realloc(p->goff, (cap + 1) * sizeof *p->goff);
+    if (!t)
+        return -1;
+    p->goff = t;
+    p->cap = cap;
+    return 0;
+}
+
+/* Children (CSR, each parent's children in index order, as
+ * phc_plant_graph_finish orders them), each child's index among its
+ * parent's children, and the group slot offsets, from p->parent.  O(n),
+ * no allocation. */
+static void relayout(phc_particles *p)
+{
+    const size_t n = p->n;
+    memset(p->child_start, 0, (n + 1) * sizeof *p->child_start);
+    memset(p->child_index, 0, n * sizeof *p->child_index);
+    for (size_t i = 0; i < n; ++i)
+        if (p->parent[i] != PHC_PLANT_NO_PARENT)
+            ++p->child_start[p->parent[i] + 1];
+    for (size_t i = 0; i < n; ++i)
+        p->child_start[i + 1] += p->child_start[i];
+    /* fill: child_index counts the children placed so far under each parent */
+    for (size_t i = 0; i < n; ++i)
+        if (p->parent[i] != PHC_PLANT_NO_PARENT) {
+            const size_t u = p->parent[i];
+            const size_t c = p->child_start[u] + p->child_index[u];
+            p->child[c] = i;
+            ++p->child_index[u];
+        }
+    /* child_index was used as a fill counter above; now the real one */
+    for (size_t k = 0; k < n; ++k) {
+        p->goff[k + 1] = p->goff[k] + 2 + (p->child_start[k + 1] - p->child_start[k]);
+        for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c)
+            p->child_index[p->child[c]] = c - p->child_start[k];
+    }
+    p->layout_dirty = 0;
+}
+
+/* Rest state of particle i from its segment head → tail (m) and radius r
+ * (m): rest centre, rest orientation (z along the segment), radii, mass
+ * ρπr²L and the rest half of the ellipsoid moment.  The checks are the
+ * caller's. */
+static void rest_from_segment(phc_particles *p, size_t i, const double head[3],
+                              const double tail[3], double r, double L)
+{
+    double d[3];
+    for (int k = 0; k < 3; ++k) {
+        p->x0[3 * i + k] = 0.5 * (head[k] + tail[k]);
+        d[k] = (tail[k] - head[k]) / L;
+    }
+    phc_quat_from_z(d, p->q0 + 4 * i);
+    p->m[i] = p->o.density * PI * r * r * L;
+    p->ax[3 * i] = p->ax[3 * i + 1] = r;
+    p->ax[3 * i + 2] = 0.5 * L;
+    double R0[9];
+    phc_quat_to_matrix(p->q0 + 4 * i, R0);
+    for (int t = 0; t < 3; ++t)
+        for (int c = 0; c < 3; ++c)
+            p->ell0[9 * i + 3 * t + c] = 0.2 * p->ax[3 * i + t] * p->ax[3 * i + t] * R0[3 * c + t];
+}
+
+/* Checks a segment for particle i (or the one to be appended); its length
+ * into *L. */
+static int check_segment(const phc_particles *p, size_t i, const double head[3],
+                         const double tail[3], double r, double *L, phc_error *err)
+{
+    const long id = i < p->n ? p->source_id[i] : (long)i;
+    if (!head || !tail)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: particle %zu: segment: NULL", i);
+    if (!(r > 0) || !isfinite(r))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): radius must be positive and "
+                             "finite, found r = %g m",
+                             i, id, r);
+    double len = 0;
+    for (int k = 0; k < 3; ++k) {
+        if (!isfinite(head[k]) || !isfinite(tail[k]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "particles: particle %zu (segment %ld): coordinate %c is not "
+                                 "finite",
+                                 i, id, "xyz"[k]);
+        len += (tail[k] - head[k]) * (tail[k] - head[k]);
+    }
+    len = sqrt(len);
+    if (!(len > 0) || !isfinite(len))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): head and tail coincide", i,
+                             id);
+    *L = len;
+    return PHC_OK;
+}
+
+int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
+                         const double tail[3], double radius, size_t *index, phc_error *err)
+{
+    if (!p)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: append: no particle system");
+    if (parent != PHC_PARTICLES_NONE && parent >= p->n)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: append: parent %zu does not exist (%zu particles)",
+                             parent, p->n);
+    double L;
+    if (check_segment(p, p->n, head, tail, radius, &L, err))
+        return err ? err->status : PHC_ERR_INPUT;
+    if (reserve(p, p->n + 1))
+        return phc_error_set(err, PHC_ERR_NOMEM, "particles: out of memory for %zu particles",
+                             p->n + 1);
+    const size_t i = p->n++;
+    rest_from_segment(p, i, head, tail, radius, L);
+    memcpy(p->x + 3 * i, p->x0 + 3 * i, 3 * sizeof(double));
+    memcpy(p->xp + 3 * i, p->x0 + 3 * i, 3 * sizeof(double));
+    memcpy(p->q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
+    memcpy(p->qp + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
+    for (int k = 0; k < 3; ++k)
+        p->v[3 * i + k] = p->w[3 * i + k] = p->f[3 * i + k] = p->anchor_at[3 * i + k] = 0;
+    p->age[i] = 0;
+    p->s[i] = p->o.stiffness;
+    p->anchored[i] = p->hold_q[i] = 0;
+    p->anchor_k[i] = 0;
+    memcpy(p->anchor_q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
+    p->parent[i] = parent == PHC_PARTICLES_NONE ? PHC_PLANT_NO_PARENT : parent;
+    p->linked[i] = parent != PHC_PARTICLES_NONE;
+    p->child_index[i] = 0;
+    p->gq[4 * i] = 1; /* at rest: its group has not turned */
+    p->gq[4 * i + 1] = p->gq[4 * i + 2] = p->gq[4 * i + 3] = 0;
+    p->stress[i] = 0;
+    p->source_id[i] = (long)i;
+    p->layout_dirty = 1;
+    if (index)
+        *index = i;
+    return PHC_OK;
+}
+
+int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], const double tail[3],
+                           double radius, phc_error *err)
+{
+    if (!p || i >= p->n)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: rest: particle %zu does not exist (%zu particles)", i,
+                             p ? p->n : 0);
+    double L;
+    if (check_segment(p, i, head, tail, radius, &L, err))
+        return err ? err->status : PHC_ERR_INPUT;
+    rest_from_segment(p, i, head, tail, radius, L);
+    return PHC_OK;
+}
+
+int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *err)
+{
+    if (!p || !g)
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: gravity: NULL argument");
+    for (int k = 0; k < 3; ++k)
+        if (!isfinite(g[k]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "particles: gravity %c must be finite, found %g m s-2", "xyz"[k],
+                                 g[k]);
+    memcpy(p->o.gravity, g, 3 * sizeof(double));
+    return PHC_OK;
+}
+
+void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, void *user)
+{
+    if (!p)
+        return;
+    p->collide = fn;
+    p->collide_user = user;
+}
+
+int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
+                           double *delta)
+{
+    double c[3], nf[3];
+    if (delta)
+        *delta = INFINITY;
+    if (!fn || fn(user, x, c, nf))
+        return 0;
+    const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
+    const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    const int front = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0;
+    const double d = front ? dist : -dist;
+    if (delta)
+        *delta = d;
+    if (!(d < r))
+        return 0;
+    for (int k = 0; k < 3; ++k)
+        x[k] = c[k] + r * (front && dist > 0 ? e[k] / dist : nf[k]);
+    return 1;
+}
+
+void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth)
+{
+    if (pushed)
+        *pushed = p ? p->pushed : 0;
+    if (depth)
+        *depth = p ? p->depth : INFINITY;
+}
+
+/* The collision pass on the predicted positions (see particles.h). */
+static void collide(phc_particles *p)
+{
+    p->pushed = 0;
+    p->depth = INFINITY;
+    if (!p->collide)
+        return;
+    for (size_t i = 0; i < p->n; ++i) {
+        if (p->hold_q[i])
+            continue;
+        double d;
+        const double r = p->ax[3 * i];
+        p->pushed += (size_t)phc_particles_push_out(p->collide, p->collide_user, r,
+                                                    p->xp + 3 * i, &d);
+        if (d - r < p->depth)
+            p->depth = d - r;
+    }
+}
+
+void phc_particles_measure_stress(phc_particles *p, int on)
+{
+    if (p)
+        p->no_stress = !on;
+}
+
+int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
+                        phc_error *err)
+{
+    if (!p || i >= p->n)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: place: particle %zu does not exist (%zu particles)", i,
+                             p ? p->n : 0);
+    const double r = q ? sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) : 0;
+    if (!x || !q || !isfinite(x[0] + x[1] + x[2]) || !isfinite(r) || !(r > 0))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): place: position and "
+                             "orientation must be finite (and the quaternion non-zero)",
+                             i, p->source_id[i]);
+    memcpy(p->x + 3 * i, x, 3 * sizeof(double));
+    memcpy(p->xp + 3 * i, x, 3 * sizeof(double));
+    for (int k = 0; k < 4; ++k)
+        p->q[4 * i + k] = p->qp[4 * i + k] = q[k] / r;
+    return PHC_OK;
+}
 
 /* ---- setters ------------------------------------------------------------ */
 
@@ -783,6 +1100,8 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, s
     if (!p || k >= p->n)
         return 0;
     phc_particles *pm = (phc_particles *)p; /* scratch only; state unchanged */
+    if (pm->layout_dirty)
+        relayout(pm); /* derived from the parents: not a change of state */
     double gq_keep[4];
     memcpy(gq_keep, pm->gq + 4 * k, sizeof gq_keep);
     double Rl[9], st;
@@ -941,6 +1260,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         return phc_error_set(err, PHC_ERR_INPUT,
                              "particles: step: time step must be positive and finite, found %g s",
                              dt);
+    if (p->layout_dirty)
+        relayout(p);
     const size_t n = p->n;
     p->polar_total = p->polar_fallbacks = 0;
     for (size_t i = 0; i < n; ++i)
@@ -968,6 +1289,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         if (rc)
             return rc;
     }
+    collide(p);
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d)
             if (!isfinite(p->xp[3 * i + d]) || !isfinite(p->qp[4 * i + d]))
@@ -996,6 +1318,13 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         p->age[i] += dt;
     }
     /* Stress of every group on the new state (§4.3), and breaking. */
+    if (p->no_stress && !(p->o.break_threshold > 0)) {
+        if (report) {
+            report->polar_total = p->polar_total;
+            report->polar_fallbacks = p->polar_fallbacks;
+        }
+        return PHC_OK;
+    }
     orientation_matrices(p, p->q);
     if (match_all(p, p->x, 1, err))
         return -1;

@@ -53,7 +53,8 @@
  *
  * Time step (position-based dynamics): predict v += Δt (g + f/m),
  * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
- * from the current x_p (Jacobi), blend, stiffness, anchors}; update
+ * from the current x_p (Jacobi), blend, stiffness, anchors}; with a
+ * collider, one collision pass (phc_particles_set_collider); update
  * v = (x_p − x)/Δt, ω from q_p q⁻¹, both times (1 − damping); age += Δt.
  *
  * Breaking (climbing §4.3; our definition of the stress): after the step,
@@ -113,6 +114,68 @@ phc_particles *phc_particles_new(const phc_plant_graph *g,
 void phc_particles_free(phc_particles *p); /* accepts NULL */
 
 size_t phc_particles_count(const phc_particles *p);
+
+/* Growing a system in place (climbing plants: one system for the whole
+ * growth, so that the groups' rotations warm-start the polar
+ * decompositions and velocities carry over from frame to frame).
+ *
+ * phc_particles_append adds a particle for the segment head → tail (m) of
+ * radius r (m) as a child of `parent` (linked; PHC_PARTICLES_NONE: a new
+ * root), at rest: current = rest, zero velocities, age 0, no anchor, the
+ * options' stiffness, mass ρπr²L.  Its index (the old count) goes to
+ * *index (may be NULL).  The children and group slots are rebuilt once at
+ * the next step (O(n), no allocation); the arrays grow by doubling.
+ * Errors: parent out of range, a bad segment (as phc_particles_new), out
+ * of memory (the system is unchanged and still valid). */
+int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
+                         const double tail[3], double radius, size_t *index, phc_error *err);
+/* New rest state of particle i from its segment head → tail (m) and radius
+ * (m): rest centre, rest orientation, radii and mass ρπr²L (replacing a
+ * mass set by phc_particles_set_mass).  The current state, velocities,
+ * age, anchor and its group's rotation (the polar warm start) are kept. */
+int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], const double tail[3],
+                           double radius, phc_error *err);
+/* Moves particle i to x (m) turned to the unit quaternion q (normalised
+ * here) WITHOUT touching its velocities (a kinematic displacement, e.g. a
+ * growing tip whose centre moves along its axis); phc_particles_set_position
+ * and _set_orientation zero them instead. */
+int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
+                        phc_error *err);
+
+/* Gravity of a system from the next step (m s^-2, finite; e.g. a scene
+ * turned while a persistent system lives on). */
+int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *err);
+
+/* on = 0: a step without breaking (break_threshold <= 0) skips the stress
+ * pass after it (one shape matching of every group of five with the
+ * default 4 iterations): phc_particles_stress keeps the last measured
+ * values and the report's max_stress stays 0 (group NONE).  Default on. */
+void phc_particles_measure_stress(phc_particles *p, int on);
+
+/* Collisions with supports (ours; the climbing paper's particles only
+ * attach to them).  fn gives the closest support point c (m) to x and the
+ * unit outward face normal n there (0; nonzero: no support).  With a
+ * collider set, every step ends its projection with one collision pass
+ * over the predicted positions x_p, before the velocities are derived
+ * from them (position-based dynamics: the inward velocity goes too):
+ * the particle's signed distance is δ = |x_p − c| when (x_p − c)·n >= 0
+ * (in front of the face) and −|x_p − c| otherwise; when δ < r (the
+ * particle's radius) it is moved to c + r·u, u = (x_p − c)/|x_p − c| in
+ * front (the surface normal at c, also round an edge or a corner), u = n
+ * behind or on the face.  Particles whose orientation is held (clamped)
+ * are left alone.  The callback is called once per particle and step,
+ * from one thread, in index order.  fn = NULL: no collisions (default). */
+typedef int (*phc_particles_closest_fn)(void *user, const double x[3], double c[3], double n[3]);
+void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, void *user);
+/* The push of the collision pass on one point x (m) for a particle of
+ * radius r (m): returns 1 and moves x when δ < r, else 0 (also without a
+ * support).  *delta (may be NULL) gets δ before the move (m; +INFINITY
+ * without a support). */
+int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
+                           double *delta);
+/* Collisions of the last step: particles pushed out and the smallest δ − r
+ * (m) seen before the pushes (+INFINITY when none was measured). */
+void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth);
 
 /* Setters; each validates and names the particle in its message. */
 int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
@@ -186,7 +249,9 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
  * (row-major): the proper rotation R maximising tr(Rᵀ A).  q (w,x,y,z) is
  * the start on entry (e.g. the last step's rotation) and the result on
  * return.  Müller et al. 2016 ("A robust method to extract the rotational
- * part of deformations") iteration; its stationary point is certified a
+ * part of deformations") iteration, with a Newton step where tr(B)I −
+ * sym(B) is positive definite (cut to 1 rad when longer) and at most 16 of
+ * Müller's own steps (then the SVD); its stationary point is certified a
  * maximum (tr(S)·I − S positive semidefinite, S = RᵀA, checked by its
  * principal minors), otherwise LAPACK
  * dgesvd gives R = U diag(1, 1, det(UVᵀ)) Vᵀ.  Returns 0 with the

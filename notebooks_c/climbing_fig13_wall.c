@@ -26,6 +26,9 @@
  *     straight line clips a convex edge (a segment–triangle test against
  *     every triangle: a 2 cm internode rounding the window's sill cuts its
  *     corner although its centre is outside);
+ *   - collisions (option collide, every particle pushed out of the
+ *     supports to its radius): the smallest signed distance of a centre
+ *     minus its radius, over all particles, is >= -1e-12 m;
  *   - the ledge shades: leaves within 30 cm under it get less light on
  *     average than the others.
  *
@@ -56,6 +59,76 @@ static int crosses(const double b[3], const double t[3], const double p[3], cons
 {
     const double d[3] = {t[0] - b[0], t[1] - b[1], t[2] - b[2]}, e[3] = {-d[0], -d[1], -d[2]};
     return phc_climbing_ray_hits_triangle(b, d, 0, p, q, r) && phc_climbing_ray_hits_triangle(t, e, 0, p, q, r);
+}
+
+/* The plant of the figure: options o, the wall casting shadows, `steps`
+ * steps of dt seconds; NULL (message printed) on failure. */
+static phc_climbing *grow_wall(const phc_climbing_options *o, phc_support_mesh *wall, const double seed[3],
+                               const double up[3], size_t steps, double dt)
+{
+    phc_error err;
+    phc_climbing *c = phc_climbing_new(seed, up, o, &err);
+    if (!c) {
+        fprintf(stderr, "%s\n", err.message);
+        return NULL;
+    }
+    const size_t nv = phc_support_mesh_vertex_count(wall), nt = phc_support_mesh_triangle_count(wall);
+    double *v = malloc(3 * nv * sizeof *v);
+    size_t *t = malloc(3 * nt * sizeof *t);
+    int bad = !v || !t;
+    for (size_t i = 0; !bad && i < nv; ++i)
+        phc_support_mesh_vertex(wall, i, v + 3 * i);
+    for (size_t i = 0; !bad && i < nt; ++i)
+        phc_support_mesh_triangle(wall, i, t + 3 * i);
+    if (!bad && phc_climbing_set_shadow_triangles(c, v, nv, t, nt, &err)) {
+        fprintf(stderr, "%s\n", err.message);
+        bad = 1;
+    }
+    free(v);
+    free(t);
+    for (size_t k = 0; !bad && k < steps; ++k)
+        if (phc_climbing_step(c, dt, &err)) {
+            fprintf(stderr, "%s\n", err.message);
+            bad = 1;
+        }
+    if (bad) {
+        phc_climbing_free(c);
+        return NULL;
+    }
+    return c;
+}
+
+/* Over all particles: the smallest signed distance δ − r (δ = ±|x − c| to
+ * the closest support point c, − behind its face; r the radius, m) and
+ * the segments whose straight line crosses a triangle of the wall. */
+static double smallest_depth(const phc_climbing *c, phc_support_mesh *wall, size_t *crossing)
+{
+    double m = INFINITY;
+    *crossing = 0;
+    const size_t ntri = phc_support_mesh_triangle_count(wall);
+    for (size_t i = 0; i < phc_climbing_count(c); ++i) {
+        double x[3], cp[3], nf[3], b[3], t[3];
+        phc_climbing_position(c, i, x);
+        if (phc_support_mesh_closest(wall, x, cp, nf) == 0) {
+            const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+            const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            const double delta = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist;
+            m = fmin(m, delta - phc_climbing_radius(c, i));
+        }
+        phc_climbing_segment(c, i, b, t);
+        int clips = 0;
+        for (size_t k = 0; k < ntri && !clips; ++k) {
+            size_t id[3];
+            double p0[3], p1[3], p2[3];
+            phc_support_mesh_triangle(wall, k, id);
+            phc_support_mesh_vertex(wall, id[0], p0);
+            phc_support_mesh_vertex(wall, id[1], p1);
+            phc_support_mesh_vertex(wall, id[2], p2);
+            clips = crosses(b, t, p0, p1, p2);
+        }
+        *crossing += (size_t)clips;
+    }
+    return m;
 }
 
 int main(int argc, char **argv)
@@ -102,34 +175,10 @@ int main(int argc, char **argv)
     o.closest_user = wall;
     const double seed[3] = {-0.1, 0.02, 0}, up[3] = {0, 0, 1};
     const double duration = 240, dt = 0.25;
-    phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
-    if (!c) {
-        fprintf(stderr, "%s\n", err.message);
-        return 1;
-    }
-    {
-        const size_t nv = phc_support_mesh_vertex_count(wall), nt = phc_support_mesh_triangle_count(wall);
-        double *v = malloc(3 * nv * sizeof *v);
-        size_t *t = malloc(3 * nt * sizeof *t);
-        if (!v || !t)
-            return 1;
-        for (size_t i = 0; i < nv; ++i)
-            phc_support_mesh_vertex(wall, i, v + 3 * i);
-        for (size_t i = 0; i < nt; ++i)
-            phc_support_mesh_triangle(wall, i, t + 3 * i);
-        if (phc_climbing_set_shadow_triangles(c, v, nv, t, nt, &err)) {
-            fprintf(stderr, "%s\n", err.message);
-            return 1;
-        }
-        free(v);
-        free(t);
-    }
     const size_t steps = (size_t)llround(duration / dt);
-    for (size_t k = 0; k < steps; ++k)
-        if (phc_climbing_step(c, dt, &err)) {
-            fprintf(stderr, "%s\n", err.message);
-            return 1;
-        }
+    phc_climbing *c = grow_wall(&o, wall, seed, up, steps, dt);
+    if (!c)
+        return 1;
 
     /* the checks' numbers */
     const size_t n = phc_climbing_count(c), nl = phc_climbing_leaf_count(c);
@@ -156,6 +205,7 @@ int main(int argc, char **argv)
         if (phc_support_mesh_closest(wall, x, cp, nf) == 0) {
             const double sd = (x[0] - cp[0]) * nf[0] + (x[1] - cp[1]) * nf[1] + (x[2] - cp[2]) * nf[2];
             min_sd = fmin(min_sd, sd);
+
         }
         top = fmax(top, x[2]);
         /* a stem covers the cells along its axis, sampled every 2 mm */
@@ -283,7 +333,25 @@ int main(int argc, char **argv)
            crossing, n);
     printf("check: the ledge shades, mean leaf light under it %.3f (%zu leaves) < elsewhere %.3f (%zu): %s\n", lu,
            n_under, le, n_else, c5 ? "pass" : "FAIL");
-    const int ok = c1 && c2 && c3 && c4 && c5;
+    /* the same plant with collisions (option collide): every particle
+       pushed out of the wall to its radius */
+    size_t cross0 = 0, cross1 = 0, pushed_last = 0;
+    const double min_depth = smallest_depth(c, wall, &cross0);
+    phc_climbing_options oc1 = o;
+    oc1.collide = 1;
+    phc_climbing *cwall = grow_wall(&oc1, wall, seed, up, steps, dt);
+    if (!cwall)
+        return 1;
+    const double min_depth1 = smallest_depth(cwall, wall, &cross1);
+    phc_climbing_collisions(cwall, &pushed_last, NULL);
+    const int c6 = min_depth1 >= -1e-12;
+    printf("  smallest signed distance of a centre minus its radius, all particles: %.3g m (%zu segments clip)\n",
+           min_depth, cross0);
+    printf("check: the same seed with collisions (option collide): %zu particles, smallest signed distance minus "
+           "radius %.3g m >= -1e-12 m: %s (%zu pushed out in the last step; %zu segments clip)\n",
+           phc_climbing_count(cwall), min_depth1, c6 ? "pass" : "FAIL", pushed_last, cross1);
+    phc_climbing_free(cwall);
+    const int ok = c1 && c2 && c3 && c4 && c5 && c6;
 
     char md[1024], mdtmp[1024];
     FILE *f = nb_open_md(out, "climbing_fig13_wall.md", md, mdtmp, sizeof md);
@@ -300,9 +368,9 @@ int main(int argc, char **argv)
             "![front](climbing_fig13_wall_front.png)\n\n![side](climbing_fig13_wall_side.png)\n\n"
             "| quantity | value |\n|---|---|\n| particles | %zu |\n| leaves | %zu |\n"
             "| mean cos(leaf normal, light) | %.3f |\n| attached fraction | %.3f |\n| covered area (m²) | %.3f |\n"
-            "| smallest signed distance to the wall (m) | %.3g |\n| segments clipping a convex edge | %zu |\n| leaf light under the ledge / elsewhere | %.3f / %.3f |\n\n"
+            "| smallest signed distance to the wall (m) | %.3g |\n| smallest signed distance − radius (m) | %.3g |\n| segments clipping a convex edge | %zu |\n| leaf light under the ledge / elsewhere | %.3f / %.3f |\n\n"
             "**Checks**: %s.  The mesh `climbing_fig13_wall.obj` opens in any viewer.\n",
-            duration, n, nl, mean_cos, attached, area, min_sd, crossing, lu, le,
+            duration, n, nl, mean_cos, attached, area, min_sd, min_depth, crossing, lu, le,
             ok ? "all pass" : "**some FAIL** (see the program's output)");
     if (nb_close_md(f, md, mdtmp) != 0) {
         fprintf(stderr, "%s: cannot write the page\n", md);

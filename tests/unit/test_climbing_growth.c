@@ -28,6 +28,8 @@
  *  8. Dynamics (model/particles.h) under gravity, 0.01 s dynamics steps:
  *     the young shoot sags below its rest shape, its links stretch less
  *     than 25%, the seed particle stays.
+ *  8b. One particle system across the steps: 1 vs 2 OpenMP threads and the
+ *     same seed twice give the same > 1024-particle plant bit for bit.
  *  9. The generator against reference outputs; a seed behind a support
  *     face and bad options are refused naming the option. */
 #include "model/climbing_growth.h"
@@ -37,6 +39,7 @@
 #include "measurements/support_mesh.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -69,6 +72,37 @@ static size_t apical_tip(const phc_climbing *c)
         if (phc_climbing_is_apical(c, i))
             return i;
     return PHC_CLIMBING_NONE;
+}
+
+/* An axis-aligned box [-0.05, 0.05] x [-0.05, 0.05] x [-1, 0.2] m as a
+ * support: the exact closest point on its surface and the outward normal
+ * of the face it lies on (outside: the clamped point; inside: the nearest
+ * face). */
+static int box_closest(void *user, const double x[3], double c[3], double n[3])
+{
+    (void)user;
+    const double lo[3] = {-0.05, -0.05, -1}, hi[3] = {0.05, 0.05, 0.2};
+    int inside = 1;
+    for (int k = 0; k < 3; ++k) {
+        c[k] = fmin(hi[k], fmax(lo[k], x[k]));
+        inside &= x[k] > lo[k] && x[k] < hi[k];
+    }
+    double best = INFINITY;
+    int bk = 2, side = 1;
+    for (int k = 0; k < 3; ++k) /* the face nearest to c */
+        for (int sd = -1; sd <= 1; sd += 2) {
+            const double d = sd > 0 ? hi[k] - c[k] : c[k] - lo[k];
+            if (d < best) {
+                best = d;
+                bk = k;
+                side = sd;
+            }
+        }
+    if (inside)
+        c[bk] = side > 0 ? hi[bk] : lo[bk];
+    n[0] = n[1] = n[2] = 0;
+    n[bk] = side;
+    return 0;
 }
 
 int main(void)
@@ -604,5 +638,119 @@ int main(void)
         CHECK_STR_CONTAINS(err.message, "growth_rate * dt");
         phc_climbing_free(c);
     }
+    /* 8b. One particle system kept across the steps (model/particles.h
+       grown in place): a branching plant of > 1024 particles (the
+       particles' group loops then run in parallel), grown kinematically,
+       then 6 dynamic steps; 1 and 2 OpenMP threads, and the same seed
+       twice, give the same plant bit for bit. */
+    {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.seed = 5;
+        o.growth_rate = 0.2;
+        o.branch_probability = 0.9;
+        o.max_buds = 2;
+        o.direction_variance = 0.8;
+        o.max_order = 6;
+        o.particles.maturity_age = 20;
+        o.min_stiffness = 0.3;
+        const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
+        const int keep = omp_get_max_threads();
+        double *xs[3] = {NULL, NULL, NULL};
+        size_t ns[3] = {0, 0, 0};
+        for (int run = 0; run < 3; ++run) {
+            omp_set_num_threads(run == 1 ? 2 : 1);
+            phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
+            CHECK(c != NULL);
+            if (!c)
+                break;
+            while (phc_climbing_count(c) < 1100)
+                if (phc_climbing_step(c, 0.25, &err))
+                    break;
+            CHECK(phc_climbing_set_dynamics_substeps(c, 2, &err) == 0);
+            for (int k = 0; k < 6; ++k)
+                CHECK(phc_climbing_step(c, 0.25, &err) == 0);
+            ns[run] = phc_climbing_count(c);
+            xs[run] = malloc(6 * ns[run] * sizeof(double));
+            for (size_t i = 0; xs[run] && i < ns[run]; ++i) {
+                phc_climbing_position(c, i, xs[run] + 6 * i);
+                phc_climbing_direction(c, i, xs[run] + 6 * i + 3);
+            }
+            phc_climbing_free(c);
+        }
+        omp_set_num_threads(keep);
+        size_t differ_threads = 0, differ_again = 0;
+        CHECK(ns[0] == ns[1] && ns[0] == ns[2] && ns[0] >= 1100);
+        if (xs[0] && xs[1] && xs[2] && ns[0] == ns[1] && ns[0] == ns[2])
+            for (size_t k = 0; k < 6 * ns[0]; ++k) {
+                differ_threads += xs[0][k] != xs[1][k];
+                differ_again += xs[0][k] != xs[2][k];
+            }
+        printf("persistent dynamics: %zu particles after 6 dynamic steps; 1 vs 2 threads: %zu of "
+               "%zu coordinates differ; the same seed again: %zu differ\n",
+               ns[0], differ_threads, 6 * ns[0], differ_again);
+        CHECK(differ_threads == 0);
+        CHECK(differ_again == 0);
+        for (int run = 0; run < 3; ++run)
+            free(xs[run]);
+    }
+
+    /* 8c. Collisions with supports (option collide): a shoot grown up the
+       side y = 0.05 of a box and over its top edge (z = 0.2), kinematic
+       and with dynamics; with collisions no particle centre ends closer
+       than its radius to the box (tolerance 1e-12 m), without them the
+       internodes rounding the edge cut into it. */
+    for (int dyn = 0; dyn < 2; ++dyn) {
+        double worst[2] = {0, 0};
+        size_t pushed_total[2] = {0, 0}, count_end[2] = {0, 0};
+        for (int on = 0; on < 2; ++on) {
+            phc_climbing_options o = phc_climbing_options_default();
+            o.branch_probability = 0;
+            o.growth_rate = 0.2;
+            o.radius = 0.003;
+            o.surface_adaption = 0.5;
+            o.closest = box_closest;
+            o.collide = on;
+            if (dyn) {
+                o.dynamics_substeps = 10;
+                o.particles.maturity_age = 20;
+                o.min_stiffness = 0.3;
+            }
+            const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
+            phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
+            CHECK(c != NULL);
+            if (!c)
+                continue;
+            for (int k = 0; k < 120; ++k) {
+                CHECK(phc_climbing_step(c, 0.25, &err) == 0);
+                size_t pushed;
+                phc_climbing_collisions(c, &pushed, NULL);
+                pushed_total[on] += pushed;
+            }
+            /* the smallest δ − r over the particles at the end */
+            double w = INFINITY;
+            for (size_t i = 1; i < phc_climbing_count(c); ++i) {
+                double x[3], cp[3], nf[3];
+                phc_climbing_position(c, i, x);
+                box_closest(NULL, x, cp, nf);
+                const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+                const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+                const double delta = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist;
+                w = fmin(w, delta - phc_climbing_radius(c, i));
+            }
+            worst[on] = w;
+            count_end[on] = phc_climbing_count(c);
+            double tipx[3];
+            phc_climbing_position(c, phc_climbing_count(c) - 1, tipx);
+            printf("collisions %s, %s: %zu particles, tip centre (%.3f, %.3f, %.3f) m, smallest "
+                   "signed distance - radius %.3g m, pushes over the run %zu\n",
+                   dyn ? "dynamic" : "kinematic", on ? "on" : "off", count_end[on], tipx[0],
+                   tipx[1], tipx[2], w, pushed_total[on]);
+            phc_climbing_free(c);
+        }
+        CHECK(worst[1] >= -1e-12);
+        CHECK(worst[0] < -1e-4); /* without them a particle does cut in */
+        CHECK(pushed_total[1] > 0 && pushed_total[0] == 0);
+    }
+
     return check_finish("test_climbing_growth");
 }

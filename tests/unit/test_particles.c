@@ -914,6 +914,114 @@ static void test_bad_input(void)
     phc_plant_graph_free(g);
 }
 
+
+/* Growing a system in place (phc_particles_append, _set_rest, _place): a
+ * chain appended particle by particle steps like the same chain made from
+ * its graph; handing a particle its own rest segment and place changes
+ * nothing (velocities and warm starts kept, bit for bit), while
+ * set_position (which zeroes the velocity) does. */
+static void test_grow_in_place(void)
+{
+    const double o3[3] = {0, 0, 0}, ex[3] = {1, 0, 0};
+    const size_t n = 6;
+    const double h = 0.03125, r = 0.002; /* h = 2^-5: h·i exact, so L = |tail - head| = h */
+    phc_error err;
+    phc_particles_options opt = phc_particles_options_default();
+    opt.stiffness = 0.5;
+    phc_plant_graph *g = chain(n, o3, ex, h, r, 1), *g1 = chain(1, o3, ex, h, r, 1);
+    phc_particles *a = phc_particles_new(g, &opt, &err), *b = phc_particles_new(g1, &opt, &err);
+    CHECK(a != NULL && b != NULL);
+    if (!a || !b)
+        return;
+    for (size_t i = 1; i < n; ++i) {
+        const double hd[3] = {h * (double)i, 0, 0}, tl[3] = {h * (double)(i + 1), 0, 0};
+        size_t idx = 0;
+        CHECK(phc_particles_append(b, i - 1, hd, tl, r, &idx, &err) == PHC_OK);
+        CHECK(idx == i);
+    }
+    CHECK(phc_particles_count(b) == n);
+    for (int s = 0; s < 30; ++s) {
+        CHECK(phc_particles_step(a, 0.01, NULL, &err) == PHC_OK);
+        CHECK(phc_particles_step(b, 0.01, NULL, &err) == PHC_OK);
+    }
+    double dmax = 0, sag = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double xa[3], xb[3];
+        phc_particles_position(a, i, xa);
+        phc_particles_position(b, i, xb);
+        dmax = fmax(dmax, maxdiff(xa, xb, 3));
+        sag = fmin(sag, xa[2]);
+    }
+    printf("grow in place: 6-particle chain appended one by one vs made from its graph, 30 steps "
+           "under gravity: max |x_appended - x_graph| = %.3g m (lowest centre %.4f m)\n",
+           dmax, sag);
+    CHECK(dmax < 1e-12);
+    CHECK(sag < -1e-3); /* it did move */
+    /* same rest and same place: nothing changes; set_position: it does */
+    phc_particles *c = phc_particles_new(g, &opt, &err), *d = phc_particles_new(g, &opt, &err),
+                  *e = phc_particles_new(g, &opt, &err);
+    CHECK(c && d && e);
+    if (!c || !d || !e)
+        return;
+    for (int s = 0; s < 10; ++s) {
+        phc_particles_step(c, 0.01, NULL, &err);
+        phc_particles_step(d, 0.01, NULL, &err);
+        phc_particles_step(e, 0.01, NULL, &err);
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double hd[3] = {h * (double)i, 0, 0}, tl[3] = {h * (double)(i + 1), 0, 0};
+        double x[3], q[4];
+        phc_particles_position(d, i, x);
+        phc_particles_orientation(d, i, q);
+        CHECK(phc_particles_set_rest(d, i, hd, tl, r, &err) == PHC_OK);
+        CHECK(phc_particles_place(d, i, x, q, &err) == PHC_OK);
+        if (i > 0)
+            CHECK(phc_particles_set_position(e, i, x, &err) == PHC_OK);
+    }
+    for (int s = 0; s < 10; ++s) {
+        phc_particles_step(c, 0.01, NULL, &err);
+        phc_particles_step(d, 0.01, NULL, &err);
+        phc_particles_step(e, 0.01, NULL, &err);
+    }
+    size_t differ_d = 0;
+    double de = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double xc[3], xd[3], xe[3], qc[4], qd[4];
+        phc_particles_position(c, i, xc);
+        phc_particles_position(d, i, xd);
+        phc_particles_position(e, i, xe);
+        phc_particles_orientation(c, i, qc);
+        phc_particles_orientation(d, i, qd);
+        for (int k = 0; k < 3; ++k)
+            differ_d += xc[k] != xd[k];
+        for (int k = 0; k < 4; ++k)
+            differ_d += qc[k] != qd[k];
+        de = fmax(de, maxdiff(xc, xe, 3));
+    }
+    printf("grow in place: same rest segment and place handed back: %zu of %zu coordinates "
+           "differ; velocities zeroed by set_position instead: max |dx| = %.3g m after 10 steps\n",
+           differ_d, 7 * n, de);
+    CHECK(differ_d == 0);
+    CHECK(de > 1e-6);
+    /* bad input */
+    const double hd[3] = {0, 0, 0}, tl[3] = {0, 0, 0}, tl2[3] = {0, 0, 0.01};
+    CHECK(phc_particles_append(b, 99, hd, tl2, r, NULL, &err) != PHC_OK);
+    CHECK_STR_CONTAINS(err.message, "parent 99 does not exist");
+    CHECK(phc_particles_append(b, 0, hd, tl, r, NULL, &err) != PHC_OK);
+    CHECK_STR_CONTAINS(err.message, "particle 6 (segment 6): head and tail coincide");
+    CHECK(phc_particles_set_rest(b, 2, hd, tl2, -1, &err) != PHC_OK);
+    CHECK_STR_CONTAINS(err.message, "particle 2 (segment 2): radius must be positive");
+    CHECK(phc_particles_count(b) == n);
+    printf("grow in place, bad input: %s\n", err.message);
+    phc_particles_free(a);
+    phc_particles_free(b);
+    phc_particles_free(c);
+    phc_particles_free(d);
+    phc_particles_free(e);
+    phc_plant_graph_free(g);
+    phc_plant_graph_free(g1);
+}
+
 int main(void)
 {
     test_polar();
@@ -926,5 +1034,6 @@ int main(void)
     test_breaking();
     test_anchor_age_fall();
     test_bad_input();
+    test_grow_in_place();
     return check_finish("test_particles");
 }
