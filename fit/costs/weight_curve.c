@@ -34,6 +34,12 @@ typedef struct wc_impl {
     double step;               /* BDF6 step, s (0 = the model's choice) */
     phc_water_system *sys;     /* built for sys_mu; rebuilt when μ changes */
     double sys_mu;
+    phc_water_bdf6 *bdf6;      /* the last BDF6 run of the plant alone with a constant loss,
+                                  kept for its δ and step: the solver's repeated points, the
+                                  analysis, the plot and the report read it instead of
+                                  integrating again (same numbers, bit for bit) */
+    double bdf6_delta, bdf6_h;
+    int bdf6_sens;             /* PHC_WATER_SENS_* it carries */
     double viscosity;          /* mPa·s when not a slot */
     double dry_measured;       /* g, or NAN */
     int slot[N_SLOT_KINDS];    /* slot index of each quantity, -1 when fixed */
@@ -67,6 +73,7 @@ static void wc_free(void *p)
     if (!w)
         return;
     phc_plant_graph_free(w->graph);
+    phc_water_bdf6_free(w->bdf6);
     phc_water_system_free(w->sys);
     free(w->t_model);
     free(w->t_unique);
@@ -94,6 +101,8 @@ static int water_system(wc_impl *w, double delta, double mu)
     phc_error err;
     phc_error_clear(&err);
     if (!w->sys || w->sys_mu != mu) {
+        phc_water_bdf6_free(w->bdf6); /* it points into the system */
+        w->bdf6 = NULL;
         phc_water_system_free(w->sys);
         w->sys = NULL;
         phc_water_params p = w->params;
@@ -108,6 +117,54 @@ static int water_system(wc_impl *w, double delta, double mu)
     if (phc_water_system_set_loss_rate(w->sys, delta, &err))
         return 1; /* a trial point outside the model's domain: reject the step */
     return 0;
+}
+
+/* The plant alone by BDF6 with step h (s) at m times t (s, >= 0, the last
+ * > 0): u (W for W0 = 1) and, when du is given, its rows (width nw) with
+ * d/dδ, d/dW0 and, when μ is a parameter, d/dμ (else NAN).  Reuses the kept
+ * integrator when δ and h are the same and it carries the sensitivities
+ * asked for (advancing it when t goes further); otherwise integrates anew.
+ * The values are those of phc_water_system_total_curve bit for bit (the
+ * same steps; theta does not depend on the sensitivities carried; at the
+ * steps' nodes the dense output is the stored total exactly). */
+static int bdf6_curve(wc_impl *w, double delta, double h, const double *t, size_t m, double *u,
+                      double *du, size_t nw, phc_error *err)
+{
+    const int want = !du ? PHC_WATER_SENS_NONE
+                         : w->slot[SLOT_MU] >= 0 ? PHC_WATER_SENS_ALL : PHC_WATER_SENS_DELTA;
+    const int usable = w->bdf6 && w->bdf6_delta == delta && w->bdf6_h == h &&
+                       (want == PHC_WATER_SENS_NONE || w->bdf6_sens == want ||
+                        w->bdf6_sens == PHC_WATER_SENS_ALL);
+    int rc = 0;
+    if (!usable) {
+        phc_water_bdf6_free(w->bdf6);
+        w->bdf6 = NULL;
+        if ((rc = phc_water_bdf6_new(w->sys, h, want, &w->bdf6, err)))
+            return rc;
+        w->bdf6_delta = delta;
+        w->bdf6_h = h;
+        w->bdf6_sens = want;
+    }
+    if ((rc = phc_water_bdf6_advance(w->bdf6, t[m - 1], err))) /* no step when covered */
+        goto fail;
+    for (size_t i = 0; i < m; ++i) {
+        double d[3];
+        if ((rc = phc_water_bdf6_total(w->bdf6, t[i], u + i, du ? d : NULL, err)))
+            goto fail;
+        if (du) {
+            double *row = du + i * nw;
+            for (size_t c = 0; c < nw; ++c)
+                row[c] = 0;
+            row[PHC_WB_DELTA] = d[0];
+            row[PHC_WB_W0] = d[1];
+            row[PHC_WB_MU] = want == PHC_WATER_SENS_ALL ? d[2] : NAN;
+        }
+    }
+    return PHC_OK;
+fail:
+    phc_water_bdf6_free(w->bdf6);
+    w->bdf6 = NULL;
+    return rc;
 }
 
 /* The unit response u(t) = W(t)/W(0) of the water model (plant, and pot
@@ -125,8 +182,13 @@ static int unit_response(wc_impl *w, const double *p, double delta, double mu, d
     phc_error_clear(&err);
     if (!w->drv.pot && !phc_weight_drivers_time_varying(&w->drv)) {
         /* the plant alone with a constant loss: model/water.h (du m x 3) */
-        rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err);
-        if (!rc && du) /* spread to the balance's columns, back to front */
+        double h = 0;
+        const size_t nw = PHC_WB_COEF + w->n_coef;
+        if (m > 0 && t[m - 1] > 0 && isfinite(t[m - 1]) &&
+            phc_water_system_curve_method(w->sys, w->method, w->step, t[m - 1], &h) == PHC_WATER_BDF6)
+            rc = bdf6_curve(w, delta, h, t, m, u, du, nw, &err);
+        else if (!(rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err)) && du)
+            /* spread to the balance's columns, back to front */
             for (size_t i = m; i-- > 0;) {
                 double d0 = du[3 * i], d1 = du[3 * i + 1], d2 = du[3 * i + 2];
                 double *row = du + i * (PHC_WB_COEF + w->n_coef);
