@@ -459,7 +459,7 @@ int main(void)
                         printf("fit_load_time_plant000: %.3f s\n", f1 - f0);
                     const phc_param_result *d = param(res, "delta"),
                                            *w0 = param(res, "initial_water");
-                    if (r == 2) {
+                    if (r == bench_repeats(3) - 1) { /* the last repeat */
                         printf("fit%s_outcome: %s (%zu start%s, %d iterations, %d residual and %d "
                                "Jacobian evaluations)\n",
                                sfx, phc_fit_status_name(res->summary.outcome), res->starts,
