@@ -572,7 +572,7 @@ struct phc_water_bdf6 {
     double *l, *u, *ipiv;
     /* ring of the last 6 states (theta, and s_delta, s_mu with sensitivities) */
     double *ring;       /* 6 * nv * n */
-    size_t nv;          /* 1 or 3 */
+    size_t nv;          /* 1, 2 (theta, s_delta) or 3 (theta, s_delta, s_mu) */
     double *rhs, *tmp;  /* nv * n, n */
     double *acc;        /* n, zero between steps: children's terms in the fused step */
     size_t steps;       /* current state is at t = steps * h */
@@ -603,15 +603,18 @@ static void augmented_solve(phc_water_bdf6 *b, double *x)
     if (b->sens) {
         const phc_water_system *s = b->s;
         double c = b->c;
-        double *sd = x + n, *sm = x + 2 * n;
+        double *sd = x + n;
         for (size_t k = 0; k < n; ++k)
             sd[k] -= c * s->area[k] * x[k];        /* dS/d delta = -D_a */
-        diffusion_apply(s, x, b->tmp);             /* dS/d mu = (p/mu) R D^-1 */
-        double f = c * s->mu_power / s->mu;
-        for (size_t k = 0; k < n; ++k)
-            sm[k] += f * b->tmp[k];
         tree_solve(b, sd);
-        tree_solve(b, sm);
+        if (b->nv == 3) {
+            double *sm = x + 2 * n;
+            diffusion_apply(s, x, b->tmp);         /* dS/d mu = (p/mu) R D^-1 */
+            double f = c * s->mu_power / s->mu;
+            for (size_t k = 0; k < n; ++k)
+                sm[k] += f * b->tmp[k];
+            tree_solve(b, sm);
+        }
     }
 }
 
@@ -694,8 +697,15 @@ int phc_water_bdf6_new(const phc_water_system *s, double h, int sensitivities,
     b->s = s;
     b->n = n;
     b->h = h;
+    if (sensitivities != PHC_WATER_SENS_NONE && sensitivities != PHC_WATER_SENS_ALL &&
+        sensitivities != PHC_WATER_SENS_DELTA) {
+        free(b);
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "water BDF6: sensitivities must be 0 (none), 1 (delta and mu) or 2 "
+                             "(delta only), found %d", sensitivities);
+    }
     b->sens = sensitivities ? 1 : 0;
-    b->nv = b->sens ? 3 : 1;
+    b->nv = sensitivities == PHC_WATER_SENS_ALL ? 3 : sensitivities == PHC_WATER_SENS_DELTA ? 2 : 1;
     size_t len = b->nv * n;
     b->l = calloc(n, sizeof *b->l);
     b->u = calloc(n, sizeof *b->u);
@@ -916,12 +926,25 @@ int phc_water_bdf6_total(const phc_water_bdf6 *b, double t, double *W, double *d
     if (dW) {
         dW[0] = acc[1];
         dW[1] = acc[0] / b->s->w0;
-        dW[2] = acc[2];
+        dW[2] = b->nv == 3 ? acc[2] : NAN; /* d/d mu: PHC_WATER_SENS_ALL only */
     }
     return PHC_OK;
 }
 
 /* ------------------------------------------------------------------------ */
+
+phc_water_method phc_water_system_curve_method(const phc_water_system *s, phc_water_method method,
+                                               double step_or_0, double tmax, double *h)
+{
+    if (h)
+        *h = step_or_0 > 0.0 ? step_or_0 : tmax / 1000.0;
+    if (method == PHC_WATER_AUTO)
+        method = (s->n <= PHC_WATER_AUTO_EXACT_MAX &&
+                  phc_water_system_stiffness(s) * tmax <= 1e7)
+                     ? PHC_WATER_EXACT
+                     : PHC_WATER_BDF6;
+    return method;
+}
 
 int phc_water_system_total_curve(const phc_water_system *s, phc_water_method method,
                                  double step_or_0, const double *t, size_t m, double *W,
@@ -955,11 +978,8 @@ int phc_water_system_total_curve(const phc_water_system *s, phc_water_method met
         }
         return PHC_OK;
     }
-    if (method == PHC_WATER_AUTO)
-        method = (s->n <= PHC_WATER_AUTO_EXACT_MAX &&
-                  phc_water_system_stiffness(s) * tmax <= 1e7)
-                     ? PHC_WATER_EXACT
-                     : PHC_WATER_BDF6;
+    double h = 0.0;
+    method = phc_water_system_curve_method(s, method, step_or_0, tmax, &h);
     int rc;
     if (method == PHC_WATER_EXACT) {
         phc_water_exact *e = NULL;
@@ -977,7 +997,6 @@ int phc_water_system_total_curve(const phc_water_system *s, phc_water_method met
     }
     if (method != PHC_WATER_BDF6)
         return phc_error_set(err, PHC_ERR_INVALID, "water curve: unknown method %d", (int)method);
-    double h = step_or_0 > 0.0 ? step_or_0 : tmax / 1000.0;
     phc_water_bdf6 *b = NULL;
     rc = phc_water_bdf6_new(s, h, dW != NULL, &b, err);
     if (rc)

@@ -163,12 +163,20 @@ int phc_water_exact_sensitivity(const phc_water_exact *e, double t, double *dW,
 /* ---- BDF6 (paper eq. 8) ------------------------------------------------ */
 typedef struct phc_water_bdf6 phc_water_bdf6;
 
+/* Sensitivities integrated alongside theta (staggered, same factorisation
+ * of I - alpha h S: one more back substitution per step and vector). */
+enum {
+    PHC_WATER_SENS_NONE = 0,
+    PHC_WATER_SENS_ALL = 1,   /* d theta / d delta and d theta / d mu */
+    PHC_WATER_SENS_DELTA = 2  /* d theta / d delta only (mu fixed: 2/3 of the work of ALL) */
+};
+
 /* Creates an integrator with fixed step h (s) from theta(0) and computes
  * the start (theta at h..5h) by extrapolated implicit Euler (harmonic
  * sequence 1..8, Aitken-Neville; Deuflhard) on sub-steps, which reaches
- * ~1e-10 relative accuracy; with sensitivities, d theta / d delta and
- * d theta / d mu are integrated alongside (staggered, same factorisation).
- * Memory O(n) plus one double (three with sensitivities) per step taken. */
+ * ~1e-10 relative accuracy; sensitivities: PHC_WATER_SENS_* above.  theta
+ * does not depend on the choice (the same operations, bit for bit).
+ * Memory O(n) plus one double (two, three with sensitivities) per step. */
 int phc_water_bdf6_new(const phc_water_system *s, double h, int sensitivities,
                        phc_water_bdf6 **out, phc_error *err);
 void phc_water_bdf6_free(phc_water_bdf6 *b);
@@ -191,7 +199,7 @@ int phc_water_bdf6_state_at(const phc_water_bdf6 *b, double t, double *theta, do
                             phc_error *err);
 /* W at t (s) within [0, time()] by 6th-order Lagrange interpolation of the
  * stored step totals; dW (3, may be NULL; needs sensitivities) as in
- * phc_water_exact_sensitivity. */
+ * phc_water_exact_sensitivity (dW[2] = NAN with PHC_WATER_SENS_DELTA). */
 int phc_water_bdf6_total(const phc_water_bdf6 *b, double t, double *W, double *dW,
                          phc_error *err);
 
@@ -203,6 +211,10 @@ int phc_water_bdf6_total(const phc_water_bdf6 *b, double t, double *W, double *d
 int phc_water_system_total_curve(const phc_water_system *s, phc_water_method method,
                                  double step_or_0, const double *t, size_t m, double *W,
                                  double *dW, phc_error *err);
+/* The evaluator phc_water_system_total_curve uses for `method` up to tmax
+ * (s): EXACT or BDF6 (AUTO resolved), and its BDF6 step (s) in *h. */
+phc_water_method phc_water_system_curve_method(const phc_water_system *s, phc_water_method method,
+                                               double step_or_0, double tmax, double *h);
 int phc_water_total_curve(const phc_plant_graph *g, const phc_water_params *p,
                           phc_water_method method, double step_or_0, const double *t,
                           size_t m, double *W, double *dW, phc_error *err);

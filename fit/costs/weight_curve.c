@@ -34,6 +34,14 @@ typedef struct wc_impl {
     double step;               /* BDF6 step, s (0 = the model's choice) */
     phc_water_system *sys;     /* built for sys_mu; rebuilt when μ changes */
     double sys_mu;
+    phc_water_bdf6 *bdf6[2];   /* the last two BDF6 runs of the plant alone with a constant
+                                  loss, kept for their δ and step: the solver's repeated
+                                  points, the polish, the analysis, the plot and the report
+                                  read them instead of integrating again (same numbers, bit
+                                  for bit); bdf6_last: the more recent */
+    double bdf6_delta[2], bdf6_h[2];
+    int bdf6_sens[2];          /* PHC_WATER_SENS_* each carries */
+    int bdf6_last;
     double viscosity;          /* mPa·s when not a slot */
     double dry_measured;       /* g, or NAN */
     int slot[N_SLOT_KINDS];    /* slot index of each quantity, -1 when fixed */
@@ -67,6 +75,8 @@ static void wc_free(void *p)
     if (!w)
         return;
     phc_plant_graph_free(w->graph);
+    phc_water_bdf6_free(w->bdf6[0]);
+    phc_water_bdf6_free(w->bdf6[1]);
     phc_water_system_free(w->sys);
     free(w->t_model);
     free(w->t_unique);
@@ -94,6 +104,10 @@ static int water_system(wc_impl *w, double delta, double mu)
     phc_error err;
     phc_error_clear(&err);
     if (!w->sys || w->sys_mu != mu) {
+        for (int c = 0; c < 2; ++c) { /* they point into the system */
+            phc_water_bdf6_free(w->bdf6[c]);
+            w->bdf6[c] = NULL;
+        }
         phc_water_system_free(w->sys);
         w->sys = NULL;
         phc_water_params p = w->params;
@@ -108,6 +122,63 @@ static int water_system(wc_impl *w, double delta, double mu)
     if (phc_water_system_set_loss_rate(w->sys, delta, &err))
         return 1; /* a trial point outside the model's domain: reject the step */
     return 0;
+}
+
+/* The plant alone by BDF6 with step h (s) at m times t (s, >= 0, the last
+ * > 0): u (W for W0 = 1) and, when du is given, its rows (width nw) with
+ * d/dδ, d/dW0 and, when μ is a parameter, d/dμ (else NAN).  Reuses a kept
+ * integrator when δ and h are the same and it carries the sensitivities
+ * asked for (advancing it when t goes further); otherwise integrates anew.
+ * The values are those of phc_water_system_total_curve bit for bit (the
+ * same steps; theta does not depend on the sensitivities carried; at the
+ * steps' nodes the dense output is the stored total exactly). */
+static int bdf6_curve(wc_impl *w, double delta, double h, const double *t, size_t m, double *u,
+                      double *du, size_t nw, phc_error *err)
+{
+    const int want = !du ? PHC_WATER_SENS_NONE
+                         : w->slot[SLOT_MU] >= 0 ? PHC_WATER_SENS_ALL : PHC_WATER_SENS_DELTA;
+    int c = -1;
+    for (int q = 0; q < 2 && c < 0; ++q) {
+        const int k = q ? 1 - w->bdf6_last : w->bdf6_last; /* the more recent first */
+        if (w->bdf6[k] && w->bdf6_delta[k] == delta && w->bdf6_h[k] == h &&
+            (want == PHC_WATER_SENS_NONE || w->bdf6_sens[k] == want ||
+             w->bdf6_sens[k] == PHC_WATER_SENS_ALL))
+            c = k;
+    }
+    int rc = 0;
+    if (c < 0) { /* replace the older run */
+        c = 1 - w->bdf6_last;
+        phc_water_bdf6_free(w->bdf6[c]);
+        w->bdf6[c] = NULL;
+        if ((rc = phc_water_bdf6_new(w->sys, h, want, &w->bdf6[c], err)))
+            return rc;
+        w->bdf6_delta[c] = delta;
+        w->bdf6_h[c] = h;
+        w->bdf6_sens[c] = want;
+    }
+    w->bdf6_last = c;
+    phc_water_bdf6 *b = w->bdf6[c];
+    /* the system's loss is δ now (water_system), as when b was made */
+    if ((rc = phc_water_bdf6_advance(b, t[m - 1], err))) /* no step when covered */
+        goto fail;
+    for (size_t i = 0; i < m; ++i) {
+        double d[3];
+        if ((rc = phc_water_bdf6_total(b, t[i], u + i, du ? d : NULL, err)))
+            goto fail;
+        if (du) {
+            double *row = du + i * nw;
+            for (size_t k = 0; k < nw; ++k)
+                row[k] = 0;
+            row[PHC_WB_DELTA] = d[0];
+            row[PHC_WB_W0] = d[1];
+            row[PHC_WB_MU] = want == PHC_WATER_SENS_ALL ? d[2] : NAN;
+        }
+    }
+    return PHC_OK;
+fail:
+    phc_water_bdf6_free(b);
+    w->bdf6[c] = NULL;
+    return rc;
 }
 
 /* The unit response u(t) = W(t)/W(0) of the water model (plant, and pot
@@ -125,8 +196,13 @@ static int unit_response(wc_impl *w, const double *p, double delta, double mu, d
     phc_error_clear(&err);
     if (!w->drv.pot && !phc_weight_drivers_time_varying(&w->drv)) {
         /* the plant alone with a constant loss: model/water.h (du m x 3) */
-        rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err);
-        if (!rc && du) /* spread to the balance's columns, back to front */
+        double h = 0;
+        const size_t nw = PHC_WB_COEF + w->n_coef;
+        if (m > 0 && t[m - 1] > 0 && isfinite(t[m - 1]) &&
+            phc_water_system_curve_method(w->sys, w->method, w->step, t[m - 1], &h) == PHC_WATER_BDF6)
+            rc = bdf6_curve(w, delta, h, t, m, u, du, nw, &err);
+        else if (!(rc = phc_water_system_total_curve(w->sys, w->method, w->step, t, m, u, du, &err)) && du)
+            /* spread to the balance's columns, back to front */
             for (size_t i = m; i-- > 0;) {
                 double d0 = du[3 * i], d1 = du[3 * i + 1], d2 = du[3 * i + 2];
                 double *row = du + i * (PHC_WB_COEF + w->n_coef);

@@ -587,16 +587,22 @@ extern "C" int phc_nls_evaluate(phc_nls *nls, const double *x, double *residuals
             std::vector<double> xb(k), r(b.m), jac(jacobian ? b.m * k : 0);
             for (size_t j = 0; j < k; ++j)
                 xb[j] = x[b.index[j]];
-            if (!call_block(b, xb.data(), r.data(), nullptr, nullptr))
-                return phc_error_set(err, PHC_ERR_DOMAIN,
-                                     "residual block %zu cannot be evaluated at these parameters",
+            // Analytic blocks give the residuals and the Jacobian in one call, as
+            // Ceres asks for them while solving (one model run instead of two: a
+            // water fit's analysis and polish evaluate each point once).
+            const bool one_call = jacobian && b.derivs == PHC_DERIV_ANALYTIC;
+            if (one_call ? !call_block(b, xb.data(), r.data(), jac.data(), nullptr)
+                         : !call_block(b, xb.data(), r.data(), nullptr, nullptr)) {
+                if (!one_call || !call_block(b, xb.data(), r.data(), nullptr, nullptr))
+                    return phc_error_set(err, PHC_ERR_DOMAIN,
+                                         "residual block %zu cannot be evaluated at these parameters",
+                                         static_cast<size_t>(&b - nls->blocks.data()));
+                return phc_error_set(err, PHC_ERR_DOMAIN, "Jacobian of block %zu cannot be evaluated",
                                      static_cast<size_t>(&b - nls->blocks.data()));
+            }
             if (jacobian) {
-                if (b.derivs == PHC_DERIV_ANALYTIC) {
-                    std::vector<double> r2(b.m);
-                    if (!call_block(b, xb.data(), r2.data(), jac.data(), nullptr))
-                        return phc_error_set(err, PHC_ERR_DOMAIN, "Jacobian of block %zu cannot be evaluated",
-                                             static_cast<size_t>(&b - nls->blocks.data()));
+                if (one_call) {
+                    // filled above
                 } else {
                     std::unique_ptr<ceres::CostFunction> c = make_block_cost(b, nls->params, nullptr);
                     std::vector<double> u(k), r2(b.m), cols(b.m * k);

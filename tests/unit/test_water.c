@@ -441,6 +441,68 @@ static void test_dense_state(void)
     phc_plant_graph_free(g);
 }
 
+/* PHC_WATER_SENS_DELTA (d/d delta only, what a fit with mu fixed needs):
+ * theta and W bit for bit those of an integrator without sensitivities and
+ * of one with both, dW/d delta bit for bit that of PHC_WATER_SENS_ALL, d/d mu
+ * NAN; dW/d delta against central differences of the same BDF6 (printed);
+ * an unknown flag refused. */
+static void test_sensitivity_delta_only(void)
+{
+    phc_plant_graph *g = phc_plant_graph_random(200, 7);
+    const double delta = 1e-2, W0 = 2.0, h = 5.0, t_end = 1000.0;
+    phc_water_system *s = slow_system(g, PHC_WATER_REFERENCE, delta, W0, NULL);
+    phc_error err;
+    phc_water_bdf6 *b[3] = {NULL, NULL, NULL};
+    const int kinds[3] = {PHC_WATER_SENS_NONE, PHC_WATER_SENS_ALL, PHC_WATER_SENS_DELTA};
+    for (int k = 0; k < 3; ++k) {
+        CHECK(phc_water_bdf6_new(s, h, kinds[k], &b[k], &err) == 0);
+        CHECK(phc_water_bdf6_advance(b[k], t_end, &err) == 0);
+    }
+    int same_W = 1, same_d = 1, mu_nan = 1;
+    for (double t = 0; t <= t_end; t += 7.5) { /* nodes and between them */
+        double W[3], dA[3], dD[3];
+        CHECK(phc_water_bdf6_total(b[0], t, &W[0], NULL, &err) == 0);
+        CHECK(phc_water_bdf6_total(b[1], t, &W[1], dA, &err) == 0);
+        CHECK(phc_water_bdf6_total(b[2], t, &W[2], dD, &err) == 0);
+        same_W &= W[0] == W[1] && W[0] == W[2];
+        same_d &= dA[0] == dD[0] && dA[1] == dD[1];
+        mu_nan &= isnan(dD[2]) && isfinite(dA[2]);
+    }
+    double th0[200], th2[200];
+    phc_water_bdf6_state(b[0], th0, NULL);
+    phc_water_bdf6_state(b[2], th2, NULL);
+    for (int i = 0; i < 200; ++i)
+        same_W &= th0[i] == th2[i];
+    CHECK(same_W);
+    CHECK(same_d);
+    CHECK(mu_nan);
+    /* central differences of the discrete solution (same step) */
+    double W, dW[3], Wpm[2];
+    CHECK(phc_water_bdf6_total(b[2], t_end, &W, dW, &err) == 0);
+    const double hd = 1e-4 * delta;
+    for (int sg = 0; sg < 2; ++sg) {
+        phc_water_system_set_loss_rate(s, delta + (sg ? -hd : hd), &err);
+        phc_water_bdf6 *c = NULL;
+        CHECK(phc_water_bdf6_new(s, h, PHC_WATER_SENS_NONE, &c, &err) == 0);
+        CHECK(phc_water_bdf6_advance(c, t_end, &err) == 0);
+        CHECK(phc_water_bdf6_total(c, t_end, &Wpm[sg], NULL, &err) == 0);
+        phc_water_bdf6_free(c);
+    }
+    const double fd = (Wpm[0] - Wpm[1]) / (2 * hd);
+    printf("sensitivity delta only (random 200, h 5 s, t %g s): dW/ddelta %.10e, central "
+           "difference %.10e, relative difference %.2e; theta, W and dW/ddelta bit for bit those "
+           "of the other integrators: %s\n",
+           t_end, dW[0], fd, fabs(dW[0] - fd) / fabs(fd), same_W && same_d ? "yes" : "NO");
+    CHECK(fabs(dW[0] - fd) < 1e-6 * fabs(fd));
+    phc_water_bdf6 *bad = NULL;
+    CHECK(phc_water_bdf6_new(s, h, 3, &bad, &err) == PHC_ERR_INVALID && bad == NULL);
+    printf("refused: %s\n", err.message);
+    for (int k = 0; k < 3; ++k)
+        phc_water_bdf6_free(b[k]);
+    phc_water_system_free(s);
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_conservation();
@@ -449,6 +511,7 @@ int main(void)
     test_bdf6_order();
     test_sensitivities();
     test_dense_state();
+    test_sensitivity_delta_only();
     test_cut_edge();
     test_errors();
     return check_finish("test_water");

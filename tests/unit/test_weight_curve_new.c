@@ -14,6 +14,9 @@
  * 3. a light schedule from C: with night_factor at 1 the model is the
  *    constant-loss one; on a calendar the local clock of each weighing
  *    follows the time zone;
+ * 5. the BDF6 runs a data set keeps (the last two δ): the values and the
+ *    Jacobian at a point evaluated again, after other points, are those of
+ *    a fresh data set bit for bit, and W those of phc_water_total_curve;
  * 4. without an origin the messages name the kind ("weight_curve: ..."),
  *    with one they name the config file and the key's line; the weighings'
  *    own places are "weighings:LINE" (or the table's name and line). */
@@ -428,11 +431,82 @@ static void test_messages(void)
     phc_plant_graph_free(bare);
 }
 
+/* 5. Kept BDF6 runs: a data set evaluated at p1 (with the Jacobian), p2,
+ * p1 (residuals only: kept run), p3, p4 (p1 evicted), p1 with the Jacobian
+ * (integrated anew) gives at p1 exactly what a fresh data set gives, and
+ * the water of phc_water_total_curve (BDF6, the same step) bit for bit. */
+static void test_kept_runs(void)
+{
+    phc_plant_graph *g = small_plant(1);
+    CHECK(g != NULL);
+    if (!g)
+        return;
+    double t_s[49], mass[49], W[49];
+    for (int i = 0; i < 49; ++i)
+        t_s[i] = 1800.0 * i;
+    CHECK(water(g, W0, t_s, 49, W) == 0);
+    for (int i = 0; i < 49; ++i)
+        mass[i] = DRY + W[i];
+    phc_weighings w = phc_weighings_default();
+    w.n = 49;
+    w.t = t_s;
+    w.mass = mass;
+    phc_weight_curve_options o = phc_weight_curve_options_default();
+    o.sigma = 0.001;
+    o.method = PHC_WATER_BDF6;
+    phc_dataset *ds = NULL, *fresh = NULL;
+    phc_error err;
+    CHECK(phc_weight_curve_new(g, &w, &o, &ds, &err) == PHC_OK);
+    CHECK(phc_weight_curve_new(g, &w, &o, &fresh, &err) == PHC_OK);
+    if (!ds || !fresh) {
+        phc_dataset_free(ds);
+        phc_dataset_free(fresh);
+        phc_plant_graph_free(g);
+        return;
+    }
+    CHECK(ds->k == 3);
+    const double p1[3] = {DELTA, W0, DRY}, p2[3] = {1.1 * DELTA, W0, DRY}, p3[3] = {0.9 * DELTA, 1.2, DRY},
+                 p4[3] = {2 * DELTA, W0, DRY};
+    double y1[49], J1[49 * 3], y[49], J[49 * 3], yf[49], Jf[49 * 3];
+    CHECK(ds->ops->predict(ds, p1, y1, J1) == 0);
+    CHECK(ds->ops->predict(ds, p2, y, NULL) == 0);
+    CHECK(ds->ops->predict(ds, p1, y, NULL) == 0);
+    int same = memcmp(y, y1, sizeof y) == 0;
+    CHECK(ds->ops->predict(ds, p3, y, J) == 0);
+    CHECK(ds->ops->predict(ds, p4, y, NULL) == 0);
+    CHECK(ds->ops->predict(ds, p1, y, J) == 0);
+    same &= memcmp(y, y1, sizeof y) == 0 && memcmp(J, J1, sizeof J) == 0;
+    CHECK(fresh->ops->predict(fresh, p1, yf, Jf) == 0);
+    same &= memcmp(yf, y1, sizeof y) == 0 && memcmp(Jf, J1, sizeof J) == 0;
+    CHECK(fresh->ops->predict(fresh, p1, yf, NULL) == 0);
+    same &= memcmp(yf, y1, sizeof y) == 0;
+    CHECK(same);
+    /* the model's own curve (BDF6, step t_max / 1000 as the data set) for
+     * W0 = 1 g and no dry mass: the data set's unit response itself */
+    phc_water_params wp = phc_water_params_default();
+    wp.loss_rate = DELTA;
+    wp.initial_water = 1.0;
+    const double p0[3] = {DELTA, 1.0, 0.0};
+    CHECK(ds->ops->predict(ds, p0, y, NULL) == 0);
+    CHECK(phc_water_total_curve(g, &wp, PHC_WATER_BDF6, 0, t_s, 49, W, NULL, &err) == PHC_OK);
+    double worst = 0;
+    for (int i = 0; i < 49; ++i)
+        worst = fmax(worst, fabs(y[i] - W[i]));
+    printf("kept BDF6 runs: values and Jacobian at p1 after p2, p3, p4 identical to a fresh data "
+           "set: %s; largest difference to phc_water_total_curve (W0 1 g) %.3g g\n",
+           same ? "yes" : "NO", worst);
+    CHECK(worst == 0);
+    phc_dataset_free(ds);
+    phc_dataset_free(fresh);
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_arrays();
     test_table();
     test_day();
+    test_kept_runs();
     test_messages();
     return check_finish("test_weight_curve_new");
 }
