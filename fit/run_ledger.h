@@ -4,14 +4,22 @@
  * without recomputing anything the ledger holds.
  *
  * Format (tab-separated, one record per line):
- *   # phytocal run ledger 1
+ *   # phytocal run ledger 2
  *   @ KEY VALUE            the study's identity (config SHA-256, method,
  *   ...                    samples, seed, design, parameters and their
  *   @ end                  priors, outputs): resume refuses any difference
  *   ROW STATE V1 .. VK #C  ROW = design row, STATE = ok | failed, the K
- *                          outputs as %.17g (nan when failed), C = the first
- *                          16 hex digits of the SHA-256 (nettle) of the
- *                          line before " #"
+ *                          outputs each as the 16 lower-case hex digits of
+ *                          its IEEE-754 binary64 bit pattern, most
+ *                          significant first (exact; NaN when failed),
+ *                          C = the 8 hex digits of the CRC-32C (Castagnoli,
+ *                          as iSCSI) of the line before " #"
+ * The CRC detects torn and altered lines (any burst of up to 32 bits, all
+ * but 2^-32 of other changes); it is no defence against deliberate
+ * tampering, which the ledger never promised.  Format 1 (earlier phytocal:
+ * outputs as %.17g, C = the first 16 hex digits of the line's SHA-256) is
+ * still read, and a resumed format-1 ledger is appended to in format 1; a
+ * newer format is refused with its number.
  * A last line without its newline (the process died while writing it) is
  * cut off on resume; any other line that does not parse or whose checksum
  * does not match is an error naming the file and line.  Records go to the

@@ -201,6 +201,62 @@ static void estimate(const phc_saltelli_design *d, const double *y, const size_t
             s2[i * f + j] = j <= i ? NAN : var > 0 ? a2[i * f + j] / (double)m / var - s1[i] - s1[j] : NAN;
 }
 
+/* estimate (above, without second order) for G resamples at once:
+ * idx[q][0..m-1] for q < G.  Each resample's sums are taken exactly as
+ * estimate takes them (same terms, same order, same expressions), so the
+ * results are the same bits; the G resamples' sums are independent chains
+ * that the processor overlaps, where estimate's first two passes are one
+ * chain of additions each, waiting on the last.  res: G x 2f values. */
+enum { GROUP = 4 };
+
+static void estimate_group(const phc_saltelli_design *d, const double *y, const size_t *const idx[GROUP], size_t m,
+                           double *res, double *acc)
+{
+    const size_t f = d->f, bl = d->block;
+    const size_t *i0 = idx[0], *i1 = idx[1], *i2 = idx[2], *i3 = idx[3];
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    for (size_t t = 0; t < m; ++t) {
+        s0 += y[i0[t] * bl] + y[i0[t] * bl + 1];
+        s1 += y[i1[t] * bl] + y[i1[t] * bl + 1];
+        s2 += y[i2[t] * bl] + y[i2[t] * bl + 1];
+        s3 += y[i3[t] * bl] + y[i3[t] * bl + 1];
+    }
+    const double m0 = s0 / (double)(2 * m), m1 = s1 / (double)(2 * m), m2 = s2 / (double)(2 * m),
+                 m3 = s3 / (double)(2 * m);
+    double v0 = 0, v1 = 0, v2 = 0, v3 = 0;
+    for (size_t t = 0; t < m; ++t) {
+        const double a0 = y[i0[t] * bl] - m0, b0 = y[i0[t] * bl + 1] - m0;
+        const double a1 = y[i1[t] * bl] - m1, b1 = y[i1[t] * bl + 1] - m1;
+        const double a2 = y[i2[t] * bl] - m2, b2 = y[i2[t] * bl + 1] - m2;
+        const double a3 = y[i3[t] * bl] - m3, b3 = y[i3[t] * bl + 1] - m3;
+        v0 += a0 * a0 + b0 * b0;
+        v1 += a1 * a1 + b1 * b1;
+        v2 += a2 * a2 + b2 * b2;
+        v3 += a3 * a3 + b3 * b3;
+    }
+    const double mean[GROUP] = {m0, m1, m2, m3};
+    const double var[GROUP] = {v0 / (double)(2 * m), v1 / (double)(2 * m), v2 / (double)(2 * m),
+                               v3 / (double)(2 * m)};
+    double *a1 = acc, *at = acc + GROUP * f; /* [q f + i] */
+    memset(acc, 0, 2 * GROUP * f * sizeof *acc);
+    for (size_t t = 0; t < m; ++t)
+        for (size_t q = 0; q < GROUP; ++q) {
+            const double *yb = y + idx[q][t] * bl;
+            const double fa = yb[0] - mean[q], fb = yb[1] - mean[q];
+            double *a1q = a1 + q * f, *atq = at + q * f;
+            for (size_t i = 0; i < f; ++i) {
+                const double fab = yb[2 + i] - mean[q];
+                a1q[i] += fb * (fab - fa);
+                atq[i] += (fa - fab) * (fa - fab);
+            }
+        }
+    for (size_t q = 0; q < GROUP; ++q)
+        for (size_t i = 0; i < f; ++i) {
+            res[q * 2 * f + i] = var[q] > 0 ? a1[q * f + i] / (double)m / var[q] : NAN;
+            res[q * 2 * f + f + i] = var[q] > 0 ? at[q * f + i] / (2.0 * (double)m) / var[q] : NAN;
+        }
+}
+
 /* Percentile interval of the R values v (sorted here) at coverage level. */
 static void percentile(double *v, size_t r, double level, double *lo, double *hi)
 {
@@ -233,9 +289,9 @@ static int estimate_outputs(const phc_saltelli_design *d, const double *cols, si
 {
     const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, nf2 = d->o.second_order ? f * f : 0;
     const size_t M = n * bl, per = 2 * f + nf2;
-    size_t *draw = malloc(n * sizeof *draw);
+    size_t *draw = malloc(GROUP * n * sizeof *draw);
     double *boot = malloc(n_out * R * per * sizeof *boot), *tmp = malloc((R > 1 ? R : 1) * sizeof *tmp);
-    double *acc = malloc((2 * f + f * f) * sizeof *acc);
+    double *acc = malloc((2 * f + f * f + 2 * GROUP * f) * sizeof *acc), *res = malloc(GROUP * 2 * f * sizeof *res);
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     int rc = PHC_OK;
     for (size_t c = 0; c < n_out; ++c) {
@@ -248,7 +304,7 @@ static int estimate_outputs(const phc_saltelli_design *d, const double *cols, si
         if (!out->s1 || !out->st || (nf2 && !out->s2))
             rc = PHC_ERR_NOMEM;
     }
-    if (rc || !draw || !boot || !tmp || !acc || !rng) {
+    if (rc || !draw || !boot || !tmp || !acc || !res || !rng) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -285,13 +341,25 @@ static int estimate_outputs(const phc_saltelli_design *d, const double *cols, si
     /* bootstrap: a fixed stream per estimate, so results do not depend on
        which outputs were estimated before or together */
     gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL);
-    for (size_t r = 0; r < R; ++r) {
-        for (size_t t = 0; t < m; ++t)
-            draw[t] = used[gsl_rng_uniform_int(rng, m)];
+    for (size_t r = 0; r < R;) {
+        /* GROUP resamples at a time (drawn in turn, as one at a time would
+           draw them) when there are that many left and no second order */
+        const size_t g = !nf2 && R - r >= GROUP ? GROUP : 1;
+        for (size_t q = 0; q < g; ++q)
+            for (size_t t = 0; t < m; ++t)
+                draw[q * n + t] = used[gsl_rng_uniform_int(rng, m)];
         for (size_t c = 0; c < n_out; ++c) {
-            double *b = boot + (c * R + r) * per;
-            estimate(d, cols + c * M, draw, m, b, b + f, nf2 ? b + 2 * f : NULL, acc);
+            if (g == GROUP) {
+                const size_t *const idx[GROUP] = {draw, draw + n, draw + 2 * n, draw + 3 * n};
+                estimate_group(d, cols + c * M, idx, m, res, acc);
+                for (size_t q = 0; q < GROUP; ++q)
+                    memcpy(boot + (c * R + r + q) * per, res + q * 2 * f, 2 * f * sizeof *res);
+            } else {
+                double *b = boot + (c * R + r) * per;
+                estimate(d, cols + c * M, draw, m, b, b + f, nf2 ? b + 2 * f : NULL, acc);
+            }
         }
+        r += g;
     }
     for (size_t c = 0; c < n_out; ++c) {
         phc_sobol_indices *out = &outs[c];
@@ -323,6 +391,7 @@ done:
     free(boot);
     free(tmp);
     free(acc);
+    free(res);
     if (rc)
         for (size_t c = 0; c < n_out; ++c)
             phc_sobol_indices_clear(&outs[c]);
@@ -420,6 +489,65 @@ static void estimate_aggregate(const phc_saltelli_design *d, const double *y, si
         *var_out = var_sum;
 }
 
+/* estimate_aggregate for GROUP resamples idx[q][0..m-1] at once (the same
+ * sums in the same order for each: the same bits); res: GROUP x 2f values
+ * (s1, st of each resample), num: scratch of 2 GROUP f values. */
+static void estimate_aggregate_group(const phc_saltelli_design *d, const double *y, size_t T,
+                                     const size_t *const idx[GROUP], size_t m, double *res, double *num)
+{
+    const size_t f = d->f, bl = d->block, M = d->n * d->block;
+    const size_t *i0 = idx[0], *i1 = idx[1], *i2 = idx[2], *i3 = idx[3];
+    double var_sum[GROUP] = {0, 0, 0, 0};
+    double *num1 = num, *numt = num + GROUP * f; /* [q f + i] */
+    memset(num, 0, 2 * GROUP * f * sizeof *num);
+    for (size_t t = 0; t < T; ++t) {
+        const double *yt = y + t * M;
+        double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+        for (size_t q = 0; q < m; ++q) {
+            s0 += yt[i0[q] * bl] + yt[i0[q] * bl + 1];
+            s1 += yt[i1[q] * bl] + yt[i1[q] * bl + 1];
+            s2 += yt[i2[q] * bl] + yt[i2[q] * bl + 1];
+            s3 += yt[i3[q] * bl] + yt[i3[q] * bl + 1];
+        }
+        const double mean[GROUP] = {s0 / (double)(2 * m), s1 / (double)(2 * m), s2 / (double)(2 * m),
+                                    s3 / (double)(2 * m)};
+        double v0 = 0, v1 = 0, v2 = 0, v3 = 0;
+        for (size_t q = 0; q < m; ++q) {
+            const double a0 = yt[i0[q] * bl] - mean[0], b0 = yt[i0[q] * bl + 1] - mean[0];
+            const double a1 = yt[i1[q] * bl] - mean[1], b1 = yt[i1[q] * bl + 1] - mean[1];
+            const double a2 = yt[i2[q] * bl] - mean[2], b2 = yt[i2[q] * bl + 1] - mean[2];
+            const double a3 = yt[i3[q] * bl] - mean[3], b3 = yt[i3[q] * bl + 1] - mean[3];
+            v0 += a0 * a0 + b0 * b0;
+            v1 += a1 * a1 + b1 * b1;
+            v2 += a2 * a2 + b2 * b2;
+            v3 += a3 * a3 + b3 * b3;
+        }
+        var_sum[0] += v0 / (double)(2 * m);
+        var_sum[1] += v1 / (double)(2 * m);
+        var_sum[2] += v2 / (double)(2 * m);
+        var_sum[3] += v3 / (double)(2 * m);
+        for (size_t i = 0; i < f; ++i) {
+            double a1[GROUP] = {0, 0, 0, 0}, at[GROUP] = {0, 0, 0, 0};
+            for (size_t q = 0; q < m; ++q)
+                for (size_t g = 0; g < GROUP; ++g) {
+                    const double *yb = yt + idx[g][q] * bl;
+                    const double fa = yb[0] - mean[g], fb = yb[1] - mean[g], fab = yb[2 + i] - mean[g];
+                    a1[g] += fb * (fab - fa);
+                    at[g] += (fa - fab) * (fa - fab);
+                }
+            for (size_t g = 0; g < GROUP; ++g) {
+                num1[g * f + i] += a1[g] / (double)m;
+                numt[g * f + i] += at[g] / (2.0 * (double)m);
+            }
+        }
+    }
+    for (size_t g = 0; g < GROUP; ++g)
+        for (size_t i = 0; i < f; ++i) {
+            res[g * 2 * f + i] = var_sum[g] > 0 ? num1[g * f + i] / var_sum[g] : NAN;
+            res[g * 2 * f + f + i] = var_sum[g] > 0 ? numt[g * f + i] / var_sum[g] : NAN;
+        }
+}
+
 int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const double *y, size_t n_outputs,
                                          phc_sobol_indices *out, phc_error *err)
 {
@@ -427,9 +555,9 @@ int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const dou
     const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, M = d->n * d->block;
     if (n_outputs == 0)
         return phc_error_set(err, PHC_ERR_INVALID, "aggregated indices of no output");
-    size_t *used = malloc(n * sizeof *used), *draw = malloc(n * sizeof *draw);
+    size_t *used = malloc(n * sizeof *used), *draw = malloc(GROUP * n * sizeof *draw);
     double *boot = malloc(R * 2 * f * sizeof *boot), *tmp = malloc(R * sizeof *tmp);
-    double *num = malloc(2 * f * sizeof *num);
+    double *num = malloc(2 * GROUP * f * sizeof *num);
     out->n_factors = f;
     out->s1 = malloc(3 * f * sizeof *out->s1);
     out->st = malloc(3 * f * sizeof *out->st);
@@ -471,10 +599,18 @@ int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const dou
     }
     estimate_aggregate(d, y, n_outputs, used, m, out->s1, out->st, num, num + f, &out->variance);
     gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL); /* the resamples of phc_sobol_indices_estimate */
-    for (size_t r = 0; r < R; ++r) {
-        for (size_t q = 0; q < m; ++q)
-            draw[q] = used[gsl_rng_uniform_int(rng, m)];
-        estimate_aggregate(d, y, n_outputs, draw, m, boot + r * 2 * f, boot + r * 2 * f + f, num, num + f, NULL);
+    for (size_t r = 0; r < R;) { /* GROUP resamples at a time while that many are left (same draws, same bits) */
+        const size_t g = R - r >= GROUP ? GROUP : 1;
+        for (size_t k = 0; k < g; ++k)
+            for (size_t q = 0; q < m; ++q)
+                draw[k * n + q] = used[gsl_rng_uniform_int(rng, m)];
+        if (g == GROUP) {
+            const size_t *const idx[GROUP] = {draw, draw + n, draw + 2 * n, draw + 3 * n};
+            estimate_aggregate_group(d, y, n_outputs, idx, m, boot + r * 2 * f, num);
+        } else {
+            estimate_aggregate(d, y, n_outputs, draw, m, boot + r * 2 * f, boot + r * 2 * f + f, num, num + f, NULL);
+        }
+        r += g;
     }
     for (size_t i = 0; i < 2 * f; ++i) {
         size_t cnt = 0;

@@ -8,7 +8,10 @@
  *                                as doubles (a row index is exact below
  *                                2^53; the outputs travel bit for bit)
  *   TAG_STOP   master -> worker  one uint64: the master's status (0: done)
- * The master keeps each worker two batches ahead; a worker sends results
+ * The master keeps each worker two batches ahead, batches shrinking towards
+ * the end (guided: at most the rows left over 4 x ranks, at least 1), so
+ * that the workers' queues are short when the master runs out of rows and
+ * waits for them; a worker sends results
  * with MPI_Isend from two alternating buffers, so it never waits for the
  * master to look.  Messages between two ranks are not overtaken (MPI), so a
  * worker evaluates every batch sent before its stop, and the master
@@ -17,8 +20,8 @@
 #include <mpi.h>
 #include <limits.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "fit/study_dist.h"
@@ -55,7 +58,7 @@ static int mpi_agree(phc_dist *d, int rc, phc_error *err)
 
 typedef struct master {
     const size_t *rows;
-    size_t n_rows, next, batch;
+    size_t n_rows, next, batch, ranks;
     int *outstanding; /* per rank: batches sent, results not yet received */
     uint64_t *work;   /* one batch of row indices */
 } master;
@@ -63,8 +66,11 @@ typedef struct master {
 /* Sends worker w the next batch of rows (none when every row is handed out). */
 static void send_batch(master *m, int w)
 {
+    /* guided: smaller batches as the rows run out */
+    size_t size = (m->n_rows - m->next) / (AHEAD * 2 * m->ranks);
+    size = size < 1 ? 1 : size > m->batch ? m->batch : size;
     size_t k = 0;
-    while (k < m->batch && m->next < m->n_rows)
+    while (k < size && m->next < m->n_rows)
         m->work[k++] = (uint64_t)m->rows[m->next++];
     if (k == 0)
         return;
@@ -77,7 +83,12 @@ static int run_master(phc_dist *d, size_t n_out, const size_t *rows, size_t n_ro
                       int *outstanding, phc_error *err)
 {
     const size_t stride = 2 + n_out;
-    master m = {rows, n_rows, 0, 0, outstanding, work};
+    master m = {rows, n_rows, 0, 0, (size_t)d->size, outstanding, work};
+    /* PHC_STUDY_MPI_TIMES=1: the master's time receiving results and waiting
+       for the workers after its last row, on stderr */
+    const int times = getenv("PHC_STUDY_MPI_TIMES") != NULL;
+    double t_recv = 0, t_wait = 0, t_loop = MPI_Wtime();
+    size_t own_rows = 0;
     /* batches small enough that the last ones end together (about 1/128 of a
        process's share each), large enough that messages cost nothing beside
        a model evaluation */
@@ -94,14 +105,18 @@ static int run_master(phc_dist *d, size_t n_out, const size_t *rows, size_t n_ro
         if (m.next < n_rows) {
             MPI_Iprobe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &arrived, &st);
         } else { /* nothing left to evaluate here: wait for the workers */
+            const double t0 = MPI_Wtime();
             MPI_Probe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &st);
+            t_wait += MPI_Wtime() - t0;
             arrived = 1;
         }
         if (arrived) {
             int count = 0;
             MPI_Get_count(&st, MPI_DOUBLE, &count);
+            const double t0 = MPI_Wtime();
             MPI_Recv(in, (int)(MAX_BATCH * stride), MPI_DOUBLE, st.MPI_SOURCE, TAG_RESULT, MPI_COMM_WORLD,
                      MPI_STATUS_IGNORE);
+            t_recv += MPI_Wtime() - t0;
             m.outstanding[st.MPI_SOURCE]--;
             if (count <= 0 || (size_t)count % stride != 0) { /* every rank built the same study: cannot happen */
                 rc = phc_error_set(err, PHC_ERR_INTERNAL, "rank %d sent %d values, not rows of %zu", st.MPI_SOURCE,
@@ -121,7 +136,12 @@ static int run_master(phc_dist *d, size_t n_out, const size_t *rows, size_t n_ro
         const int failed = eval(ctx, row, own);
         rc = record(ctx, row, failed, own, err);
         ++recorded;
+        ++own_rows;
     }
+    if (times)
+        fprintf(stderr, "rank 0: %zu of %zu rows evaluated here; %.3f s receiving results, %.3f s waiting for the "
+                "workers after the last row was handed out, of %.3f s (batches of up to %zu rows)\n", own_rows,
+                n_rows, t_recv, t_wait, MPI_Wtime() - t_loop, m.batch);
     /* stop every worker, then take in what they still had in flight */
     const uint64_t status = (uint64_t)rc;
     for (int w = 1; w < d->size; ++w)

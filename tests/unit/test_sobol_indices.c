@@ -326,8 +326,61 @@ static void test_outputs_batched(void)
     }
 }
 
+/* The bootstrap takes first-order resamples four at a time
+ * (estimate_group), second-order ones one at a time (estimate): the S1 and
+ * ST of a second-order design, whose A, B and A_B^i rows are the
+ * first-order design's, must be the same bits, intervals included, and so
+ * must the aggregate of that one output; R = 1003 leaves three resamples
+ * to the one-at-a-time paths. */
+static void test_grouped_resamples(void)
+{
+    const size_t R[2] = {1000, 1003};
+    for (int k = 0; k < 2; ++k) {
+        phc_saltelli_options o = phc_saltelli_options_default();
+        o.n = 256;
+        o.bootstrap = R[k];
+        phc_error err;
+        phc_saltelli_design *d1 = NULL, *d2 = NULL;
+        CHECK(phc_saltelli_design_new(3, NULL, 3, &o, &d1, &err) == PHC_OK);
+        o.second_order = 1;
+        CHECK(phc_saltelli_design_new(3, NULL, 3, &o, &d2, &err) == PHC_OK);
+        double *y1 = malloc(o.n * 5 * sizeof *y1), *y2 = malloc(o.n * 8 * sizeof *y2), u1[3], u2[3];
+        int same_points = 1;
+        for (size_t r = 0; r < o.n * 8; ++r) {
+            phc_saltelli_design_point(d2, r, u2);
+            y2[r] = ishigami(u2, 3);
+            if (r % 8 < 5) {
+                phc_saltelli_design_point(d1, r / 8 * 5 + r % 8, u1);
+                same_points &= memcmp(u1, u2, sizeof u1) == 0;
+                y1[r / 8 * 5 + r % 8] = y2[r];
+            }
+        }
+        CHECK(same_points);
+        phc_sobol_indices a, b;
+        CHECK(phc_sobol_indices_estimate(d1, y1, &a, &err) == PHC_OK);
+        CHECK(phc_sobol_indices_estimate(d2, y2, &b, &err) == PHC_OK);
+        const int same = same_bits(a.s1, b.s1, 9) && same_bits(a.st, b.st, 9);
+        CHECK(same);
+        /* the aggregate of one output (its own resamples four at a time)
+           is that output's indices: the same sums */
+        phc_sobol_indices g;
+        CHECK(phc_sobol_indices_estimate_aggregate(d1, y1, 1, &g, &err) == PHC_OK);
+        CHECK(same_bits(a.s1, g.s1, 9) && same_bits(a.st, g.st, 9));
+        phc_sobol_indices_clear(&g);
+        printf("R = %zu: S1 and ST with their intervals, resamples four at a time and one at a time: %s (S1[0] "
+               "interval [%.6f, %.6f])\n", R[k], same ? "equal bit for bit" : "NOT equal", a.s1_lo[0], a.s1_hi[0]);
+        phc_sobol_indices_clear(&a);
+        phc_sobol_indices_clear(&b);
+        free(y1);
+        free(y2);
+        phc_saltelli_design_free(d1);
+        phc_saltelli_design_free(d2);
+    }
+}
+
 int main(void)
 {
+    test_grouped_resamples();
     test_ishigami();
     test_groups();
     test_gfunction();
