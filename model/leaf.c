@@ -39,7 +39,8 @@
  * solved exactly as if alone.
  *
  * Factorisations are cached for h == params.dt (slot 0) and for the last
- * other h (slot 1, e.g. the remainder step of phc_leaf_advance).
+ * other h (slot 1, e.g. the remainder step of phc_leaf_advance), and kept
+ * when only s_O, s_I or dt change (they do not enter the matrix).
  *
  * No I/O, no globals. */
 #include "model/leaf.h"
@@ -301,9 +302,13 @@ int phc_leaf_set_params(phc_leaf *leaf, phc_leaf_params params, phc_error *err)
     int rc = check_params(params, err);
     if (rc)
         return rc;
+    /* the factorisations depend on h and s_beta only (eq. 6's conductances):
+       a change of s_O, s_I or dt keeps them (slot 0 is keyed by its h) */
+    if (params.beta_scale != leaf->p.beta_scale) {
+        leaf->fac[0].h = 0; /* refactorised on the next use */
+        leaf->fac[1].h = 0;
+    }
     leaf->p = params;
-    leaf->fac[0].h = 0; /* refactorised on the next use */
-    leaf->fac[1].h = 0;
     return PHC_OK;
 }
 

@@ -495,21 +495,30 @@ int phc_leaf_setup_colours(phc_leaf_setup *s, phc_colour_transfer tf, double *la
     const size_t n = s->w * s->h;
     const double *y = phc_leaf_fluid(s->leaf);
     int rc;
-    /* eq. 9: blend in the matching space */
-    phc_colour_blend(n, s->original, s->matched, y, tf, s->blend);
-    if (lab) {
-        phc_colour_convert(n, s->blend, s->space, PHC_COLOUR_LAB, lab);
-        for (size_t i = 0; i < n; ++i)
-            if (!s->mask[i])
+    if (srgb && (rc = phc_image_alloc(srgb, s->w, s->h, err)))
+        return rc;
+    /* eq. 9: blend in the matching space, then convert, run by run of leaf
+     * pixels: pixels off the leaf get 0 (Lab) or white paper (sRGB) and
+     * their blend is never looked at (s->blend keeps old values there) */
+    for (size_t i = 0; i < n;) {
+        if (!s->mask[i]) {
+            if (lab)
                 lab[3 * i] = lab[3 * i + 1] = lab[3 * i + 2] = 0;
-    }
-    if (srgb) {
-        if ((rc = phc_image_alloc(srgb, s->w, s->h, err)))
-            return rc;
-        phc_colour_convert(n, s->blend, s->space, PHC_COLOUR_RGB, srgb->data);
-        for (size_t i = 0; i < n; ++i)
-            if (!s->mask[i])
-                srgb->data[3 * i] = srgb->data[3 * i + 1] = srgb->data[3 * i + 2] = 1; /* white paper */
+            if (srgb)
+                srgb->data[3 * i] = srgb->data[3 * i + 1] = srgb->data[3 * i + 2] = 1;
+            ++i;
+            continue;
+        }
+        size_t j = i + 1;
+        while (j < n && s->mask[j])
+            ++j;
+        const size_t o = 3 * i;
+        phc_colour_blend(j - i, s->original + o, s->matched + o, y + i, tf, s->blend + o);
+        if (lab)
+            phc_colour_convert(j - i, s->blend + o, s->space, PHC_COLOUR_LAB, lab + o);
+        if (srgb)
+            phc_colour_convert(j - i, s->blend + o, s->space, PHC_COLOUR_RGB, srgb->data + o);
+        i = j;
     }
     return PHC_OK;
 }
