@@ -110,6 +110,9 @@ typedef struct phc_leaf_setup {
     phc_colour_space space;
     phc_leaf *leaf;            /* the fluid model */
     double *blend;             /* 3 w h scratch */
+    double *lab_original, *lab_matched; /* 3 w h CIELAB of original and matched
+                                  when `space` is sRGB (else NULL): a pixel
+                                  with g = 1 or 0 (eq. 9) shows exactly these */
 } phc_leaf_setup;
 
 /* Builds the set-up from a fresh and a reference leaf.  Map files are grey
