@@ -527,19 +527,24 @@ int phc_leaf_setup_colours(phc_leaf_setup *s, phc_colour_transfer tf, double *la
         while (j < n && s->mask[j])
             ++j;
         const size_t o = 3 * i;
-        phc_colour_blend(j - i, s->original + o, s->matched + o, y + i, tf, s->blend + o);
+        if (srgb || !lab || !s->lab_original)
+            phc_colour_blend(j - i, s->original + o, s->matched + o, y + i, tf, s->blend + o);
         if (lab && s->lab_original) {
             /* g = 1 blends to original, g = 0 to matched, to the bit (g x
                + (1 - g) z with a factor 0 adds a zero): their Lab is the
-               one computed at set-up; the pixels in between are converted */
+               one computed at set-up; the pixels in between are blended
+               (when not done above) and converted */
             for (size_t k = i; k < j; ++k) {
                 const double g = phc_colour_transfer_weight(tf, y[k], NULL, NULL, NULL);
                 if (g == 1.0)
                     memcpy(lab + 3 * k, s->lab_original + 3 * k, 3 * sizeof *lab);
                 else if (g == 0.0)
                     memcpy(lab + 3 * k, s->lab_matched + 3 * k, 3 * sizeof *lab);
-                else
+                else {
+                    if (!srgb)
+                        phc_colour_blend(1, s->original + 3 * k, s->matched + 3 * k, y + k, tf, s->blend + 3 * k);
                     phc_colour_srgb_to_lab(s->blend + 3 * k, lab + 3 * k);
+                }
             }
         } else if (lab)
             phc_colour_convert(j - i, s->blend + o, s->space, PHC_COLOUR_LAB, lab + o);
