@@ -18,13 +18,37 @@
 
 using namespace phc_photo;
 
-/* Linear-light copy (IEC 61966-2-1 decoding) of a phc_image, CV_64FC3. */
+/* Linear-light copy (IEC 61966-2-1 decoding) of a phc_image, CV_64FC3.
+ * An 8-bit photo holds only the 256 values k/255: their decodings are
+ * tabulated once per call (the values k * (1/255) and k / 255, which differ
+ * in the last bit for some k), and a component equal to its table key
+ * takes the tabulated value, the very double phc_colour_srgb_decode returns
+ * (a pow per component otherwise; anything else, e.g. a 16-bit photo, still
+ * calls it). */
 static cv::Mat linear_copy(const phc_image *img)
 {
+    struct table {
+        double key[2][256], val[2][256];
+    } t;
+    for (int k = 0; k < 256; ++k) {
+        t.key[0][k] = (double)k * (1.0 / 255.0);
+        t.key[1][k] = (double)k / 255.0;
+        for (int v = 0; v < 2; ++v)
+            t.val[v][k] = phc_colour_srgb_decode(t.key[v][k]);
+    }
     cv::Mat lin = mat_of(img).clone();
-    lin.forEach<cv::Vec3d>([](cv::Vec3d &p, const int *) {
-        for (int c = 0; c < 3; ++c)
-            p[c] = phc_colour_srgb_decode(std::max(0.0, p[c]));
+    lin.forEach<cv::Vec3d>([&t](cv::Vec3d &p, const int *) {
+        for (int c = 0; c < 3; ++c) {
+            const double x = std::max(0.0, p[c]);
+            const double r = x * 255.0 + 0.5;
+            const int k = r < 256.0 ? (int)r : 0;
+            if (x == t.key[0][k])
+                p[c] = t.val[0][k];
+            else if (x == t.key[1][k])
+                p[c] = t.val[1][k];
+            else
+                p[c] = phc_colour_srgb_decode(x);
+        }
     });
     return lin;
 }

@@ -38,8 +38,12 @@
  * range), but always with a factor 0, so it never contributes: each run is
  * solved exactly as if alone.
  *
- * Factorisations are cached for h == params.dt (slot 0) and for the last
- * other h (slot 1, e.g. the remainder step of phc_leaf_advance).
+ * Factorisations are cached for h == params.dt (slot 0) and for up to
+ * OTHER_SLOTS other h (the remainder steps of phc_leaf_advance: a fit to
+ * photos at many stage times has one per interval, the same at every
+ * evaluation), as many as fit in OTHER_BYTES (one for a 1024² leaf, 16 for
+ * a 96² one), replaced round-robin; they are kept when only s_O, s_I or dt
+ * change (those do not enter the matrix).
  *
  * No I/O, no globals. */
 #include "model/leaf.h"
@@ -63,6 +67,11 @@
 #define PHC_LEAF_PARALLEL_MIN 16384
 #endif
 
+/* Cache of factorisations for steps h != dt: at most this many, and at
+ * most this many bytes (about 32 bytes per pixel each). */
+#define OTHER_SLOTS 16
+#define OTHER_BYTES ((size_t)64 << 20)
+
 typedef struct leaf_factors {
     double h;        /* step length [time unit]; 0 = not computed */
     double *rc, *bc; /* columns: r, b at element x + W y */
@@ -82,7 +91,8 @@ struct phc_leaf {
     size_t *run_first, *run_lo, *run_hi;
     size_t nblocks;          /* row blocks of ROW_BLOCK rows */
     size_t *blk_lo, *blk_hi; /* x range of each block's runs ([0, 0) if none) */
-    leaf_factors fac[2];     /* [0]: h == params.dt; [1]: the last other h */
+    leaf_factors fac[1 + OTHER_SLOTS]; /* [0]: h == params.dt; [1..n_other]: other h */
+    size_t n_other, next_other;        /* slots in use for other h; the next to replace */
     double *buf;             /* a zero row (W), then per-thread row buffers (W ROW_BLOCK) */
     size_t buf_slots;
 };
@@ -143,8 +153,8 @@ void phc_leaf_free(phc_leaf *leaf)
     free(leaf->run_hi);
     free(leaf->blk_lo);
     free(leaf->blk_hi);
-    factors_free(&leaf->fac[0]);
-    factors_free(&leaf->fac[1]);
+    for (size_t k = 0; k < 1 + OTHER_SLOTS; ++k)
+        factors_free(&leaf->fac[k]);
     free(leaf->buf);
     free(leaf);
 }
@@ -273,6 +283,10 @@ int phc_leaf_new(size_t width, size_t height, const unsigned char *mask, const d
             L->beta_max = L->beta[i];
     if (build_runs(L))
         goto nomem;
+    /* factorisation slots for other h: as many as fit in OTHER_BYTES, >= 1 */
+    const size_t slot_bytes = (2 * n + 2 * L->nblocks * L->w * ROW_BLOCK) * sizeof(double);
+    L->n_other = OTHER_BYTES / slot_bytes;
+    L->n_other = L->n_other < 1 ? 1 : L->n_other > OTHER_SLOTS ? OTHER_SLOTS : L->n_other;
     phc_leaf_reset(L, 1.0);
     *out = L;
     return PHC_OK;
@@ -301,9 +315,13 @@ int phc_leaf_set_params(phc_leaf *leaf, phc_leaf_params params, phc_error *err)
     int rc = check_params(params, err);
     if (rc)
         return rc;
+    /* the factorisations depend on h and s_beta only (eq. 6's conductances):
+       a change of s_O, s_I or dt keeps them (slot 0 is keyed by its h) */
+    if (params.beta_scale != leaf->p.beta_scale) {
+        for (size_t k = 0; k < 1 + OTHER_SLOTS; ++k)
+            leaf->fac[k].h = 0; /* refactorised on the next use */
+    }
     leaf->p = params;
-    leaf->fac[0].h = 0; /* refactorised on the next use */
-    leaf->fac[1].h = 0;
     return PHC_OK;
 }
 
@@ -459,7 +477,15 @@ static const leaf_factors *factors_for(phc_leaf *L, double h, int *rc)
         *rc = PHC_ERR_DOMAIN;
         return NULL;
     }
-    leaf_factors *f = &L->fac[h == L->p.dt ? 0 : 1];
+    leaf_factors *f = &L->fac[0];
+    if (h != L->p.dt) {
+        /* another h: a slot that holds it, else the next one round-robin */
+        for (size_t k = 1; k <= L->n_other; ++k)
+            if (L->fac[k].h == h && L->fac[k].rc)
+                return &L->fac[k];
+        f = &L->fac[1 + L->next_other];
+        L->next_other = (L->next_other + 1) % L->n_other;
+    }
     if (f->h == h && f->rc)
         return f;
     if (!f->rc) {

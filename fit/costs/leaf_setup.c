@@ -214,6 +214,8 @@ void phc_leaf_setup_free(phc_leaf_setup *s)
     free(s->stomata);
     free(s->inflow);
     free(s->blend);
+    free(s->lab_original);
+    free(s->lab_matched);
     phc_leaf_free(s->leaf);
     free(s);
 }
@@ -474,6 +476,18 @@ int phc_leaf_setup_new(const phc_leaf_photo *fresh, const phc_leaf_photo *refere
     if ((rc = match_colours(s, &ref, ref_mask, err)) || (rc = venation_map(s, fresh, opt, err)) ||
         (rc = stomata_inflow_maps(s, fresh, opt, err)))
         goto fail;
+    if (s->space != PHC_COLOUR_LAB) {
+        /* the colours of pixels wholly original or matched, converted once
+           here instead of at every evaluation (phc_leaf_setup_colours) */
+        s->lab_original = malloc(3 * n * sizeof *s->lab_original);
+        s->lab_matched = malloc(3 * n * sizeof *s->lab_matched);
+        if (!s->lab_original || !s->lab_matched) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto fail;
+        }
+        phc_colour_convert(n, s->original, s->space, PHC_COLOUR_LAB, s->lab_original);
+        phc_colour_convert(n, s->matched, s->space, PHC_COLOUR_LAB, s->lab_matched);
+    }
     phc_leaf_params lp = phc_leaf_params_default();
     lp.dt = opt->dt;
     if ((rc = phc_leaf_new(w, h, s->mask, s->beta, s->stomata, s->inflow, lp, &s->leaf, err)))
@@ -495,21 +509,48 @@ int phc_leaf_setup_colours(phc_leaf_setup *s, phc_colour_transfer tf, double *la
     const size_t n = s->w * s->h;
     const double *y = phc_leaf_fluid(s->leaf);
     int rc;
-    /* eq. 9: blend in the matching space */
-    phc_colour_blend(n, s->original, s->matched, y, tf, s->blend);
-    if (lab) {
-        phc_colour_convert(n, s->blend, s->space, PHC_COLOUR_LAB, lab);
-        for (size_t i = 0; i < n; ++i)
-            if (!s->mask[i])
+    if (srgb && (rc = phc_image_alloc(srgb, s->w, s->h, err)))
+        return rc;
+    /* eq. 9: blend in the matching space, then convert, run by run of leaf
+     * pixels: pixels off the leaf get 0 (Lab) or white paper (sRGB) and
+     * their blend is never looked at (s->blend keeps old values there) */
+    for (size_t i = 0; i < n;) {
+        if (!s->mask[i]) {
+            if (lab)
                 lab[3 * i] = lab[3 * i + 1] = lab[3 * i + 2] = 0;
-    }
-    if (srgb) {
-        if ((rc = phc_image_alloc(srgb, s->w, s->h, err)))
-            return rc;
-        phc_colour_convert(n, s->blend, s->space, PHC_COLOUR_RGB, srgb->data);
-        for (size_t i = 0; i < n; ++i)
-            if (!s->mask[i])
-                srgb->data[3 * i] = srgb->data[3 * i + 1] = srgb->data[3 * i + 2] = 1; /* white paper */
+            if (srgb)
+                srgb->data[3 * i] = srgb->data[3 * i + 1] = srgb->data[3 * i + 2] = 1;
+            ++i;
+            continue;
+        }
+        size_t j = i + 1;
+        while (j < n && s->mask[j])
+            ++j;
+        const size_t o = 3 * i;
+        if (srgb || !lab || !s->lab_original)
+            phc_colour_blend(j - i, s->original + o, s->matched + o, y + i, tf, s->blend + o);
+        if (lab && s->lab_original) {
+            /* g = 1 blends to original, g = 0 to matched, to the bit (g x
+               + (1 - g) z with a factor 0 adds a zero): their Lab is the
+               one computed at set-up; the pixels in between are blended
+               (when not done above) and converted */
+            for (size_t k = i; k < j; ++k) {
+                const double g = phc_colour_transfer_weight(tf, y[k], NULL, NULL, NULL);
+                if (g == 1.0)
+                    memcpy(lab + 3 * k, s->lab_original + 3 * k, 3 * sizeof *lab);
+                else if (g == 0.0)
+                    memcpy(lab + 3 * k, s->lab_matched + 3 * k, 3 * sizeof *lab);
+                else {
+                    if (!srgb)
+                        phc_colour_blend(1, s->original + 3 * k, s->matched + 3 * k, y + k, tf, s->blend + 3 * k);
+                    phc_colour_srgb_to_lab(s->blend + 3 * k, lab + 3 * k);
+                }
+            }
+        } else if (lab)
+            phc_colour_convert(j - i, s->blend + o, s->space, PHC_COLOUR_LAB, lab + o);
+        if (srgb)
+            phc_colour_convert(j - i, s->blend + o, s->space, PHC_COLOUR_RGB, srgb->data + o);
+        i = j;
     }
     return PHC_OK;
 }

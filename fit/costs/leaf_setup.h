@@ -109,7 +109,11 @@ typedef struct phc_leaf_setup {
     double *beta, *stomata, *inflow; /* w h maps given to the model */
     phc_colour_space space;
     phc_leaf *leaf;            /* the fluid model */
-    double *blend;             /* 3 w h scratch */
+    double *blend;             /* 3 w h scratch (blend of the last call; where
+                                  the Lab copies are used, maybe stale) */
+    double *lab_original, *lab_matched; /* 3 w h CIELAB of original and matched
+                                  when `space` is sRGB (else NULL): a pixel
+                                  with g = 1 or 0 (eq. 9) shows exactly these */
 } phc_leaf_setup;
 
 /* Builds the set-up from a fresh and a reference leaf.  Map files are grey

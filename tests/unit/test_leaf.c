@@ -651,11 +651,63 @@ static void test_caches_and_advance(void)
             CHECK(memcmp(phc_leaf_fluid(A), phc_leaf_fluid(C), n * 8) == 0);
             phc_leaf_params g = phc_leaf_get_params(A);
             CHECK(g.beta_scale == 11 && g.stomata_scale == 0.3 && g.inflow_scale == 0.05 && g.dt == dt);
+            /* s_O, s_I and dt changed, s_beta not: the factors are kept
+               (they depend on h and s_beta only), the steps still equal a
+               fresh leaf's to the bit, for h = the old dt, the new dt and
+               another h; then s_beta changes again: refactorised */
+            const phc_leaf_params ps[3] = {params(11, 0.7, 0.2, dt), params(11, 0.05, 0.4, h2),
+                                           params(2.5, 0.05, 0.4, h2)};
+            for (int k = 0; k < 3; ++k) {
+                phc_leaf *D = make(W, H, m, b, O, I, ps[k]);
+                CHECK(D != NULL);
+                if (!D)
+                    continue;
+                CHECK(phc_leaf_set_fluid(D, phc_leaf_fluid(A), &err) == 0);
+                CHECK(phc_leaf_set_params(A, ps[k], &err) == 0);
+                const double hk[3] = {dt, h2, 0.029};
+                for (int s = 0; s < 3; ++s) {
+                    CHECK(phc_leaf_step(A, hk[s]) == 0);
+                    CHECK(phc_leaf_step(D, hk[s]) == 0);
+                }
+                CHECK(memcmp(phc_leaf_fluid(A), phc_leaf_fluid(D), n * 8) == 0);
+                phc_leaf_free(D);
+            }
             phc_leaf_free(C);
         }
     }
     phc_leaf_free(A);
     phc_leaf_free(B);
+
+    /* many different h (more than the cache's slots, each twice, then in
+       reverse): every step equals a fresh leaf's step with that h as its dt */
+    A = make(W, H, m, b, O, I, params(5, 0.2, 0.1, dt));
+    CHECK(A != NULL);
+    if (A) {
+        double *ref = malloc(n * 8);
+        CHECK(phc_leaf_set_fluid(A, y0, &err) == 0);
+        memcpy(ref, y0, n * 8);
+        for (size_t i = 0; i < n; ++i)
+            ref[i] = m[i] ? ref[i] : 0.0;
+        int same = 1;
+        for (int s = 0; s < 60; ++s) {
+            const int k = s < 40 ? s % 20 : 59 - s;
+            const double h = k == 7 ? dt : 0.003 * (k + 1);
+            phc_leaf *R = make(W, H, m, b, O, I, params(5, 0.2, 0.1, h));
+            if (!R) {
+                same = 0;
+                break;
+            }
+            CHECK(phc_leaf_set_fluid(R, ref, &err) == 0);
+            CHECK(phc_leaf_step(R, h) == 0);
+            CHECK(phc_leaf_step(A, h) == 0);
+            memcpy(ref, phc_leaf_fluid(R), n * 8);
+            same &= memcmp(ref, phc_leaf_fluid(A), n * 8) == 0;
+            phc_leaf_free(R);
+        }
+        CHECK(same);
+        free(ref);
+        phc_leaf_free(A);
+    }
 
     /* advance(t) is continuous at t = k dt */
     const double tiny = 1e-9;

@@ -128,6 +128,37 @@ static void test_fit(void)
     CHECK(phc_leaf_set_params(su->leaf, lp, &err) == PHC_OK);
     for (int d = 0; d < 3; ++d)
         CHECK(aged_photo(su, 2.0 * (d + 1), tf, &fresh, &days[d]) == 0);
+    /* the Lab colours equal eq. 9's blend converted pixel by pixel, to the
+       bit, although pixels with g = 0 or 1 copy a Lab computed at set-up */
+    CHECK(su->space == PHC_COLOUR_RGB && su->lab_original && su->lab_matched);
+    {
+        const size_t n = su->w * su->h;
+        double *lab = malloc(3 * n * sizeof *lab);
+        size_t n_end = 0, n_mid = 0, n_bad = 0;
+        for (int d = 0; lab && d < 4; ++d) {
+            phc_leaf_reset(su->leaf, 1.0);
+            CHECK(phc_leaf_advance(su->leaf, 1.5 * d) == 0);
+            CHECK(phc_leaf_setup_colours(su, tf, lab, NULL, &err) == PHC_OK);
+            const double *y = phc_leaf_fluid(su->leaf);
+            for (size_t i = 0; i < n; ++i) {
+                double want[3] = {0, 0, 0};
+                if (su->mask[i]) {
+                    double rgb[3];
+                    const double g = phc_colour_transfer_weight(tf, y[i], NULL, NULL, NULL);
+                    phc_colour_blend(1, su->original + 3 * i, su->matched + 3 * i, y + i, tf, rgb);
+                    phc_colour_srgb_to_lab(rgb, want);
+                    if (g == 0.0 || g == 1.0)
+                        ++n_end;
+                    else
+                        ++n_mid;
+                }
+                n_bad += memcmp(want, lab + 3 * i, sizeof want) != 0;
+            }
+        }
+        printf("setup_colours: %zu leaf pixels at g = 0 or 1, %zu in between, %zu differ\n", n_end, n_mid, n_bad);
+        CHECK(lab && n_end > 0 && n_mid > 0 && n_bad == 0);
+        free(lab);
+    }
     phc_leaf_setup_free(su);
     phc_leaf_photo_free(&fresh);
     phc_leaf_photo_free(&ref);
