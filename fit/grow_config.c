@@ -113,6 +113,9 @@ static const key_spec KEYS[] = {
     {"dynamics", "iterations", K_SIZE, OPT(particles.iterations), 1, 1000, 0, 0, "",
      "shape-matching projections per substep"},
     {"dynamics", "damping", K_NUM, OPT(particles.damping), 0, 1, 0, 1, "", "fraction of velocity removed per substep"},
+    {"dynamics", "collide", K_BOOL, OPT(collide), 0, 1, 0, 0, "",
+     "every particle (but the seed's) is pushed out of the support to its radius along the surface normal, "
+     "in each dynamics substep or, kinematic, after each growth step (no effect without a support)"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 
