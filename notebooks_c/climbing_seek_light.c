@@ -149,8 +149,10 @@ int main(int argc, char **argv)
     /* side view x–z: both shoots, the plate's two parts, the gap's centre */
     const double pl_x[2][2] = {{-0.45, GAP_X0}, {GAP_X1, 0.5}}, pl_z[2] = {PLATE_Z, PLATE_Z};
     const double gc_x[1] = {0.5 * (GAP_X0 + GAP_X1)}, gc_z[1] = {PLATE_Z};
+    char fixed_label[96];
+    snprintf(fixed_label, sizeof fixed_label, "fixed light direction (eq. 7; on to z = %.2f m)", sh[0].z[sh[0].n]);
     nb_series ser[6] = {
-        {sh[0].x, sh[0].z, sh[0].n + 1, "fixed light direction (eq. 7; goes on to z = 1.6 m)", NB_BLUE, 1, 0, 3},
+        {sh[0].x, sh[0].z, sh[0].n + 1, fixed_label, NB_BLUE, 1, 0, 3},
         {sh[1].x, sh[1].z, sh[1].n + 1, "seek_light (gradient of the light field)", NB_GREEN, 0, 0, 3},
         {pl_x[0], pl_z, 2, "opaque plate (shades only)", NB_BLACK, 0, 0, 7},
         {pl_x[1], pl_z, 2, NULL, NB_BLACK, 0, 0, 7},
