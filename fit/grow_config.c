@@ -113,6 +113,12 @@ static const key_spec KEYS[] = {
     {"dynamics", "iterations", K_SIZE, OPT(particles.iterations), 1, 1000, 0, 0, "",
      "shape-matching projections per substep"},
     {"dynamics", "damping", K_NUM, OPT(particles.damping), 0, 1, 0, 1, "", "fraction of velocity removed per substep"},
+    {"dynamics", "collide", K_BOOL, OPT(collide), 0, 1, 0, 0, "",
+     "every particle (but the seed's) is pushed out of the support to its radius along the surface normal, "
+     "in each dynamics substep or, kinematic, after each growth step (no effect without a support)"},
+    {"dynamics", "collide_ends", K_BOOL, OPT(collide_ends), 0, 1, 0, 0, "",
+     "with collide, kinematic plants (substeps 0) only: each segment's two ends are pushed out too and its centre and "
+     "direction rebuilt from them (whole segments out of the support)"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 

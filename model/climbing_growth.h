@@ -190,6 +190,15 @@ typedef struct phc_climbing_options {
                                    normal, inside each dynamics step (before the velocities) or,
                                    kinematic, after current = rest; the seed particle is left
                                    alone.  0 (default): off */
+    int collide_ends;           /* with collide, kinematic plants only (ours): after the centre
+                                   push, the segment's two ends x ∓ (L/2)d are pushed out to the
+                                   radius as well, and the centre and direction are rebuilt from
+                                   the pushed ends (centre their midpoint, direction base → tip,
+                                   length kept), up to 16 rounds per particle, the centre pushed
+                                   again after each; a straight internode rounding a convex edge
+                                   then cuts less of its corner.  The current shape's segments
+                                   need not join (as with the centre push alone).  Ignored with
+                                   dynamics.  0 (default): off */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);

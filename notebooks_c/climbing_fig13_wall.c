@@ -29,6 +29,10 @@
  *   - collisions (option collide, every particle pushed out of the
  *     supports to its radius): the smallest signed distance of a centre
  *     minus its radius, over all particles, is >= -1e-12 m;
+ *   - whole segments (option collide_ends: the segments' two ends pushed
+ *     out too): the smallest signed distance of a segment end minus its
+ *     radius (seed excluded) is larger than with the centre push alone,
+ *     and the centres stay out (>= -1e-12 m);
  *   - the ledge shades: leaves within 30 cm under it get less light on
  *     average than the others.
  *
@@ -127,6 +131,28 @@ static double smallest_depth(const phc_climbing *c, phc_support_mesh *wall, size
             clips = crosses(b, t, p0, p1, p2);
         }
         *crossing += (size_t)clips;
+    }
+    return m;
+}
+
+/* Over all particles but the seed's (collisions leave it alone): the
+ * smallest signed distance δ − r of a segment's two ends (m). */
+static double smallest_end_depth(const phc_climbing *c, phc_support_mesh *wall)
+{
+    double m = INFINITY;
+    for (size_t i = 1; i < phc_climbing_count(c); ++i) {
+        double ends[6];
+        phc_climbing_segment(c, i, ends, ends + 3);
+        for (int j = 0; j < 2; ++j) {
+            const double *x = ends + 3 * j;
+            double cp[3], nf[3];
+            if (phc_support_mesh_closest(wall, x, cp, nf))
+                continue;
+            const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+            const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            const double delta = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist;
+            m = fmin(m, delta - phc_climbing_radius(c, i));
+        }
     }
     return m;
 }
@@ -350,8 +376,25 @@ int main(int argc, char **argv)
     printf("check: the same seed with collisions (option collide): %zu particles, smallest signed distance minus "
            "radius %.3g m >= -1e-12 m: %s (%zu pushed out in the last step; %zu segments clip)\n",
            phc_climbing_count(cwall), min_depth1, c6 ? "pass" : "FAIL", pushed_last, cross1);
+    /* and with the segments' ends pushed out too (option collide_ends) */
+    const double ends_before = smallest_end_depth(cwall, wall);
     phc_climbing_free(cwall);
-    const int ok = c1 && c2 && c3 && c4 && c5 && c6;
+    phc_climbing_options oc2 = oc1;
+    oc2.collide_ends = 1;
+    phc_climbing *cends = grow_wall(&oc2, wall, seed, up, steps, dt);
+    if (!cends)
+        return 1;
+    size_t cross2 = 0;
+    const double min_depth2 = smallest_depth(cends, wall, &cross2), ends_after = smallest_end_depth(cends, wall);
+    printf("  smallest signed distance of a segment end minus its radius (seed excluded): centres pushed %.3g m, "
+           "centres and ends pushed (option collide_ends) %.3g m\n",
+           ends_before, ends_after);
+    const int c7 = ends_after > ends_before && min_depth2 >= -1e-12;
+    printf("check: with collide_ends (%zu particles) the ends keep farther out, %.3g m > %.3g m, and the centres stay "
+           "out, %.3g m >= -1e-12 m: %s (%zu segments clip)\n",
+           phc_climbing_count(cends), ends_after, ends_before, min_depth2, c7 ? "pass" : "FAIL", cross2);
+    phc_climbing_free(cends);
+    const int ok = c1 && c2 && c3 && c4 && c5 && c6 && c7;
 
     char md[1024], mdtmp[1024];
     FILE *f = nb_open_md(out, "climbing_fig13_wall.md", md, mdtmp, sizeof md);

@@ -1523,6 +1523,14 @@ gr_config gr_amb.yaml gr_wall.obj '[0, 0.03, 0]' 'light:
   ambient: 1.5
 '
 grow_case "grow: ambient light share over 1" "$C/gr_amb.yaml" "gr_amb.yaml:7" "light.ambient" "[0, 1]"
+gr_config gr_collide.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  collide: sometimes
+'
+grow_case "grow: collide neither true nor false" "$C/gr_collide.yaml" "gr_collide.yaml:7" "dynamics.collide" "expected a boolean"
+gr_config gr_collide_ends.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  collide_ends: 2
+'
+grow_case "grow: collide_ends neither true nor false" "$C/gr_collide_ends.yaml" "gr_collide_ends.yaml:7" "dynamics.collide_ends" "expected a boolean"
 # ---- end grow ----------------------------------------------------------------
 
 # ---- shoot_traces (traced shoots of a climbing plant) ------------------------
