@@ -300,6 +300,106 @@ static size_t usable(const phc_saltelli_design *d, const double *y, size_t ys, s
     return m;
 }
 
+/* ---- the bootstrap's random base samples, drawn fast --------------------------------
+ * The resamples draw m R indices with gsl_rng_uniform_int on GSL's
+ * gsl_rng_mt19937; through GSL each costs a call through the generator's
+ * function pointer and a 64-bit division.  `draws` makes the same numbers:
+ * the Mersenne Twister (Matsumoto & Nishimura 1998, ACM TOMACS 8, 3) run on
+ * a copy of the seeded GSL state, 624 words at a time, and GSL's
+ * k = x / scale (scale = (2^32 - 1) / m, rejected while k >= m) taken in
+ * double precision, exact here: with x = k scale + r, 0 <= r < scale, the
+ * quotient lies at least 1/scale below k + 1 and (k + 1) scale <= 2^33 < 2^53,
+ * so the rounded quotient stays below k + 1 and its floor is k.  The copy is
+ * checked against GSL's own draws (1300 numbers, across a refill of the
+ * state) when made; if they differ (another GSL's layout), GSL draws. */
+enum { MT_N = 624, MT_M = 397 };
+
+typedef struct draws {
+    gsl_rng *rng;           /* seeded; used itself when !fast */
+    int fast;               /* the copy below matches GSL's numbers */
+    uint32_t mt[MT_N];
+    size_t mti;
+} draws;
+
+static void mt_refill(uint32_t *mt)
+{
+    size_t kk;
+    for (kk = 0; kk < MT_N - MT_M; ++kk) {
+        const uint32_t y = (mt[kk] & 0x80000000u) | (mt[kk + 1] & 0x7fffffffu);
+        mt[kk] = mt[kk + MT_M] ^ (y >> 1) ^ ((y & 1u) ? 0x9908b0dfu : 0u);
+    }
+    for (; kk < MT_N - 1; ++kk) {
+        const uint32_t y = (mt[kk] & 0x80000000u) | (mt[kk + 1] & 0x7fffffffu);
+        mt[kk] = mt[kk + MT_M - MT_N] ^ (y >> 1) ^ ((y & 1u) ? 0x9908b0dfu : 0u);
+    }
+    const uint32_t y = (mt[MT_N - 1] & 0x80000000u) | (mt[0] & 0x7fffffffu);
+    mt[MT_N - 1] = mt[MT_M - 1] ^ (y >> 1) ^ ((y & 1u) ? 0x9908b0dfu : 0u);
+}
+
+static inline uint32_t mt_next(draws *g)
+{
+    if (g->mti >= MT_N) {
+        mt_refill(g->mt);
+        g->mti = 0;
+    }
+    uint32_t k = g->mt[g->mti++];
+    k ^= k >> 11;
+    k ^= (k << 7) & 0x9d2c5680u;
+    k ^= (k << 15) & 0xefc60000u;
+    k ^= k >> 18;
+    return k;
+}
+
+/* Seeds GSL's generator with seed and copies its state (GSL's mt_state_t:
+ * 624 unsigned longs, then the int position), checked as said above. */
+static int draws_init(draws *g, unsigned long seed)
+{
+    memset(g, 0, sizeof *g);
+    if (!(g->rng = gsl_rng_alloc(gsl_rng_mt19937)))
+        return -1;
+    gsl_rng_set(g->rng, seed);
+    if (gsl_rng_size(g->rng) < MT_N * sizeof(unsigned long) + sizeof(int) || gsl_rng_max(g->rng) != 0xffffffffUL ||
+        gsl_rng_min(g->rng) != 0)
+        return 0;
+    const unsigned long *st = gsl_rng_state(g->rng);
+    int mti;
+    memcpy(&mti, st + MT_N, sizeof mti);
+    if (mti < 0 || mti > MT_N)
+        return 0;
+    for (size_t i = 0; i < MT_N; ++i)
+        g->mt[i] = (uint32_t)st[i];
+    g->mti = (size_t)mti;
+    gsl_rng *check = gsl_rng_clone(g->rng);
+    if (!check)
+        return -1;
+    draws copy = *g;
+    int same = 1;
+    for (int i = 0; i < 1300 && same; ++i)
+        same = mt_next(&copy) == (uint32_t)gsl_rng_get(check);
+    gsl_rng_free(check);
+    g->fast = same;
+    return 0;
+}
+
+/* count x m draws of used[gsl_rng_uniform_int(rng, m)], in GSL's order. */
+static void draws_take(draws *g, const size_t *used, size_t m, size_t count, uint32_t *out)
+{
+    if (!g->fast || m > 0xffffffffUL) {
+        for (size_t i = 0; i < count * m; ++i)
+            out[i] = (uint32_t)used[gsl_rng_uniform_int(g->rng, m)];
+        return;
+    }
+    const uint32_t scale = (uint32_t)(0xffffffffUL / m);
+    const double ds = (double)scale;
+    for (size_t i = 0; i < count * m; ++i) {
+        uint32_t k;
+        do
+            k = (uint32_t)((double)mt_next(g) / ds);
+        while (k >= m);
+        out[i] = (uint32_t)used[k];
+    }
+}
+
 /* Values per resample and output in the raw bootstrap sums: the summed
  * squares (divisor 2m still to apply), f first-order and f total numerators. */
 #define RAW_PER(f) (1 + 2 * (f))
@@ -320,19 +420,19 @@ static int bootstrap_raw(const phc_saltelli_design *d, const double *rows, size_
     const size_t threads = (size_t)omp_get_max_threads(), kper = KERNEL_OUTPUTS * (2 + 2 * f);
     uint32_t *draw = malloc(CHUNK * m * sizeof *draw);
     v4d *scratch = aligned_alloc(sizeof(v4d), threads * kper * sizeof *scratch); /* vectors: their alignment */
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
-    if (!draw || !scratch || !rng) {
+    draws *gen = malloc(sizeof *gen);
+    /* a fixed stream: results do not depend on other outputs */
+    if (!draw || !scratch || !gen || draws_init(gen, d->o.seed ^ 0x5deece66dUL)) {
         free(draw);
         free(scratch);
-        gsl_rng_free(rng);
+        if (gen)
+            gsl_rng_free(gen->rng);
+        free(gen);
         return -1;
     }
-    gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL); /* a fixed stream: results do not depend on other outputs */
     for (size_t r0 = 0; r0 < R; r0 += CHUNK) {
         const size_t nr = R - r0 < CHUNK ? R - r0 : CHUNK, ng = (nr + GROUP - 1) / GROUP;
-        for (size_t q = 0; q < nr; ++q)
-            for (size_t t = 0; t < m; ++t)
-                draw[q * m + t] = (uint32_t)used[gsl_rng_uniform_int(rng, m)];
+        draws_take(gen, used, m, nr, draw);
         for (size_t q = nr; q < ng * GROUP; ++q) /* the last group's spare lanes */
             memcpy(draw + q * m, draw, m * sizeof *draw);
 #pragma omp parallel for schedule(static) if (ng > 1)
@@ -355,7 +455,8 @@ static int bootstrap_raw(const phc_saltelli_design *d, const double *rows, size_
     }
     free(draw);
     free(scratch);
-    gsl_rng_free(rng);
+    gsl_rng_free(gen->rng);
+    free(gen);
     return 0;
 }
 
