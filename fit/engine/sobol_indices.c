@@ -274,8 +274,9 @@ static void group_sums(size_t f, size_t bl, const double *y, size_t rs, size_t c
 /* Outputs per kernel call: their accumulators stay in the L1 cache. */
 enum { KERNEL_OUTPUTS = 8 };
 
-/* Resamples drawn per round before the threads share them out (GROUP each). */
-enum { CHUNK = 64 };
+/* Indices drawn per round before the threads share the round's resamples
+ * out (at most 16 MB; fewer rounds, fewer waits at their ends). */
+enum { DRAWS_PER_ROUND = 1 << 22 };
 
 /* Percentile interval of the R values v (sorted here) at coverage level. */
 static void percentile(double *v, size_t r, double level, double *lo, double *hi)
@@ -408,7 +409,7 @@ static void draws_take(draws *g, const size_t *used, size_t m, size_t count, uin
  * (the generator seeded with the design's seed, drawn in turn, resample by
  * resample, as the estimators always drew them) for nc outputs (value of
  * output c at design row r: rows[r rs + c cs]); raw[(c R + r) RAW_PER(f) ..].
- * CHUNK resamples are drawn, then shared out to the threads GROUP at a time;
+ * A round's resamples are drawn, then shared out to the threads GROUP at a time;
  * each resample's sums land in their own place and are taken the same way
  * by any thread, so the results do not depend on the number of threads.
  * The last R mod GROUP resamples go through the kernel with their lanes
@@ -418,7 +419,10 @@ static int bootstrap_raw(const phc_saltelli_design *d, const double *rows, size_
 {
     const size_t f = d->f, bl = d->block, R = d->o.bootstrap, rp = RAW_PER(f);
     const size_t threads = (size_t)omp_get_max_threads(), kper = KERNEL_OUTPUTS * (2 + 2 * f);
-    uint32_t *draw = malloc(CHUNK * m * sizeof *draw);
+    /* resamples per round: a multiple of GROUP, all R if they fit */
+    size_t chunk = DRAWS_PER_ROUND / m / GROUP * GROUP, r_up = (R + GROUP - 1) / GROUP * GROUP;
+    chunk = chunk < GROUP ? GROUP : chunk > r_up ? r_up : chunk;
+    uint32_t *draw = malloc(chunk * m * sizeof *draw);
     v4d *scratch = aligned_alloc(sizeof(v4d), threads * kper * sizeof *scratch); /* vectors: their alignment */
     draws *gen = malloc(sizeof *gen);
     /* a fixed stream: results do not depend on other outputs */
@@ -430,13 +434,13 @@ static int bootstrap_raw(const phc_saltelli_design *d, const double *rows, size_
         free(gen);
         return -1;
     }
-    for (size_t r0 = 0; r0 < R; r0 += CHUNK) {
-        const size_t nr = R - r0 < CHUNK ? R - r0 : CHUNK, ng = (nr + GROUP - 1) / GROUP;
+    for (size_t r0 = 0; r0 < R; r0 += chunk) {
+        const size_t nr = R - r0 < chunk ? R - r0 : chunk, ng = (nr + GROUP - 1) / GROUP;
         draws_take(gen, used, m, nr, draw);
         for (size_t q = nr; q < ng * GROUP; ++q) /* the last group's spare lanes */
             memcpy(draw + q * m, draw, m * sizeof *draw);
-#pragma omp parallel for schedule(static) if (ng > 1)
-        for (long g = 0; g < (long)ng; ++g) {
+#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
+        for (long g = 0; g < (long)ng; ++g) { /* dynamic: a thread slowed by other processes takes fewer */
             v4d *sums = scratch + (size_t)omp_get_thread_num() * kper;
             const size_t rg = r0 + (size_t)g * GROUP, lanes = R - rg < GROUP ? R - rg : GROUP;
             for (size_t c0 = 0; c0 < nc; c0 += KERNEL_OUTPUTS) {

@@ -722,6 +722,24 @@ static void versus_numpy(const phc_problem *pb, const overhead_result *ours, con
             }
         }
     }
+    /* the series outputs ishigami@1..3: series[0].indices.<factor>.S1[t], ST[t] */
+    json_t *sidx = json_object_get(json_array_get(json_object_get(res, "series"), 0), "indices");
+    for (size_t t = 0; sidx && t < 3; ++t) {
+        const char *fn[3] = {"a", "b", "c"}, *what[2] = {"S1", "ST"};
+        int found = 0;
+        for (int i = 0; i < 3; ++i)
+            for (int w = 0; w < 2; ++w) {
+                json_t *arr = json_object_get(json_object_get(sidx, fn[i]), what[w]);
+                char key[64];
+                snprintf(key, sizeof key, "numpy_%s_y@%zu_%d", what[w], t + 1, i + 1);
+                if (t >= json_array_size(arr))
+                    continue;
+                found = 1;
+                const double dlt = fabs(json_real_value(json_array_get(arr, t)) - peer_value(text, key));
+                worst = !(dlt <= worst) ? dlt : worst;
+            }
+        compared += found;
+    }
     json_decref(res);
     const double ours_s = ours->run_us * 1e-6 * (double)ours->evaluations, w_np = peer_value(text, "numpy_saltelli_wall");
     printf("numpy_saltelli_time: %.4f s (N = %d, %.0f evaluations, model + estimators + 1000 bootstrap resamples for "
