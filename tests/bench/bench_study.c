@@ -127,7 +127,7 @@ typedef struct stage_clock {
 static double predict_seconds_now(void);
 static size_t predict_calls_now(void);
 
-/* Reads the clock only when a stage begins (a thread CPU clock read is a
+/* Reads the clock only when a stage begins (a process CPU clock read is a
  * system call here, about 1.5 us: not once per evaluation). */
 static int on_progress(const phc_progress *p, void *data)
 {
@@ -921,7 +921,7 @@ int main(void)
     }
     print_loadavg("start");
     calibrate_clock();
-    printf("bench_clock_pair_ns: %.0f ns (two reads of the thread CPU clock, taken off the paired overhead)\n",
+    printf("bench_clock_pair_ns: %.0f ns (two reads of the process CPU clock, taken off the paired overhead)\n",
            1e9 * clock_pair);
     overhead_result ishi, wc;
     char ishi_dir[256] = "", wc_dir[256] = "";
