@@ -1236,8 +1236,34 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    if (s.saltelli) /* all outputs at once: they share the bootstrap resamples */
-        rc = phc_sobol_indices_estimate_outputs(s.saltelli, s.y, s.n_out, s.sobol, err);
+    /* Sobol: all outputs at once, and per data set the summary of its series
+       over x (aggregated indices), all on the same bootstrap resamples */
+    if (s.saltelli && !(s.summary = calloc(pb->n_datasets ? pb->n_datasets : 1, sizeof *s.summary)))
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (s.saltelli && rc == PHC_OK) {
+        size_t *first = malloc((pb->n_datasets ? pb->n_datasets : 1) * 2 * sizeof *first), n_agg = 0;
+        if (!first) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        } else {
+            size_t *count = first + (pb->n_datasets ? pb->n_datasets : 1);
+            for (size_t d = 0; d < pb->n_datasets; ++d)
+                if (phc_study_series_points(pb, d)) {
+                    first[n_agg] = s.series_first[d];
+                    count[n_agg++] = phc_study_series_points(pb, d);
+                }
+            phc_sobol_indices *agg = calloc(n_agg ? n_agg : 1, sizeof *agg);
+            if (!agg)
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            else
+                rc = phc_sobol_indices_estimate_study(s.saltelli, s.y, s.n_out, s.sobol, n_agg, first, count, agg,
+                                                      err);
+            for (size_t d = 0, a = 0; d < pb->n_datasets && agg; ++d)
+                if (phc_study_series_points(pb, d))
+                    s.summary[d] = agg[a++]; /* the arrays move to the summary */
+            free(agg);
+            free(first);
+        }
+    }
     for (size_t j = 0; j < s.n_out && rc == PHC_OK && !s.saltelli; ++j) {
         for (size_t r = 0; r < s.rows; ++r)
             col[r] = s.y[r * s.n_out + j];
@@ -1246,30 +1272,6 @@ int phc_study_run(const phc_problem *pb, const phc_study_options *opts, const ph
     free(col);
     if (rc)
         goto done;
-    /* Sobol: per data set, the summary of its series over x */
-    if (s.saltelli) {
-        if (!(s.summary = calloc(pb->n_datasets ? pb->n_datasets : 1, sizeof *s.summary))) {
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto done;
-        }
-        for (size_t d = 0; d < pb->n_datasets && rc == PHC_OK; ++d) {
-            const size_t T = phc_study_series_points(pb, d);
-            if (T == 0)
-                continue;
-            double *cols = malloc(T * s.rows * sizeof *cols);
-            if (!cols) {
-                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-                break;
-            }
-            for (size_t t = 0; t < T; ++t)
-                for (size_t r = 0; r < s.rows; ++r)
-                    cols[t * s.rows + r] = s.y[r * s.n_out + s.series_first[d] + t];
-            rc = phc_sobol_indices_estimate_aggregate(s.saltelli, cols, T, &s.summary[d], err);
-            free(cols);
-        }
-        if (rc)
-            goto done;
-    }
     if (!(summary->verdict = verdict_text(&s))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;

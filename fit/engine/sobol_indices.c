@@ -6,6 +6,8 @@
 #include <gsl/gsl_sort.h>
 #include <gsl/gsl_statistics_double.h>
 #include <math.h>
+#include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -201,61 +203,80 @@ static void estimate(const phc_saltelli_design *d, const double *y, const size_t
             s2[i * f + j] = j <= i ? NAN : var > 0 ? a2[i * f + j] / (double)m / var - s1[i] - s1[j] : NAN;
 }
 
-/* estimate (above, without second order) for G resamples at once:
- * idx[q][0..m-1] for q < G.  Each resample's sums are taken exactly as
- * estimate takes them (same terms, same order, same expressions), so the
- * results are the same bits; the G resamples' sums are independent chains
- * that the processor overlaps, where estimate's first two passes are one
- * chain of additions each, waiting on the last.  res: G x 2f values. */
-enum { GROUP = 4 };
+enum { GROUP = 4 }; /* resamples per kernel call (the lanes of a vector) */
 
-static void estimate_group(const phc_saltelli_design *d, const double *y, const size_t *const idx[GROUP], size_t m,
-                           double *res, double *acc)
+/* ---- the bootstrap kernel: GROUP resamples x several outputs per pass ----------------
+ * The raw sums of estimate (without second order) and estimate_aggregate,
+ * whose sums per output are the same, for GROUP resamples of nc outputs at once, the
+ * GROUP resamples in the lanes of one vector (GCC's vector extension; SSE2
+ * splits it in two, the AVX2 clone does it in one).  Lane q's sums are taken
+ * term by term as estimate takes resample q's (the same terms, the same
+ * order, the same expressions; vector lanes round as the scalar operations
+ * do, and no clone has FMA to contract them), so the results are the same
+ * bits.  The outputs of one base sample lie together when rs > cs (a study's
+ * row-major y), so one index fetches them all instead of one per output.
+ * Value of output c at design row r: y[r rs + c cs].  idx: GROUP x m base
+ * samples (resample q at idx + q m).  sums: nc x (2 + 2f) vectors per
+ * output c: the mean, the summed squares (divisor still to apply), the f
+ * first-order and the f total numerators. */
+typedef double v4d __attribute__((vector_size(GROUP * sizeof(double))));
+
+#define PHC_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+
+PHC_KERNEL_CLONES
+static void group_sums(size_t f, size_t bl, const double *y, size_t rs, size_t cs, size_t nc, const uint32_t *idx,
+                       size_t m, v4d *sums)
 {
-    const size_t f = d->f, bl = d->block;
-    const size_t *i0 = idx[0], *i1 = idx[1], *i2 = idx[2], *i3 = idx[3];
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    const size_t per = 2 + 2 * f, ab = bl * rs;
+    const uint32_t *i0 = idx, *i1 = idx + m, *i2 = idx + 2 * m, *i3 = idx + 3 * m;
+    const double two_m = (double)(2 * m);
+    for (size_t c = 0; c < nc; ++c)
+        for (size_t k = 0; k < per; ++k)
+            sums[c * per + k] = (v4d){0, 0, 0, 0};
     for (size_t t = 0; t < m; ++t) {
-        s0 += y[i0[t] * bl] + y[i0[t] * bl + 1];
-        s1 += y[i1[t] * bl] + y[i1[t] * bl + 1];
-        s2 += y[i2[t] * bl] + y[i2[t] * bl + 1];
-        s3 += y[i3[t] * bl] + y[i3[t] * bl + 1];
+        const double *p0 = y + i0[t] * ab, *p1 = y + i1[t] * ab, *p2 = y + i2[t] * ab, *p3 = y + i3[t] * ab;
+        for (size_t c = 0; c < nc; ++c) {
+            const size_t o = c * cs;
+            const v4d a = {p0[o], p1[o], p2[o], p3[o]}, b = {p0[o + rs], p1[o + rs], p2[o + rs], p3[o + rs]};
+            sums[c * per] += a + b;
+        }
     }
-    const double m0 = s0 / (double)(2 * m), m1 = s1 / (double)(2 * m), m2 = s2 / (double)(2 * m),
-                 m3 = s3 / (double)(2 * m);
-    double v0 = 0, v1 = 0, v2 = 0, v3 = 0;
+    for (size_t c = 0; c < nc; ++c)
+        sums[c * per] = sums[c * per] / two_m;
     for (size_t t = 0; t < m; ++t) {
-        const double a0 = y[i0[t] * bl] - m0, b0 = y[i0[t] * bl + 1] - m0;
-        const double a1 = y[i1[t] * bl] - m1, b1 = y[i1[t] * bl + 1] - m1;
-        const double a2 = y[i2[t] * bl] - m2, b2 = y[i2[t] * bl + 1] - m2;
-        const double a3 = y[i3[t] * bl] - m3, b3 = y[i3[t] * bl + 1] - m3;
-        v0 += a0 * a0 + b0 * b0;
-        v1 += a1 * a1 + b1 * b1;
-        v2 += a2 * a2 + b2 * b2;
-        v3 += a3 * a3 + b3 * b3;
+        const double *p0 = y + i0[t] * ab, *p1 = y + i1[t] * ab, *p2 = y + i2[t] * ab, *p3 = y + i3[t] * ab;
+        for (size_t c = 0; c < nc; ++c) {
+            const size_t o = c * cs;
+            const v4d mean = sums[c * per];
+            const v4d a = (v4d){p0[o], p1[o], p2[o], p3[o]} - mean,
+                      b = (v4d){p0[o + rs], p1[o + rs], p2[o + rs], p3[o + rs]} - mean;
+            sums[c * per + 1] += a * a + b * b;
+        }
     }
-    const double mean[GROUP] = {m0, m1, m2, m3};
-    const double var[GROUP] = {v0 / (double)(2 * m), v1 / (double)(2 * m), v2 / (double)(2 * m),
-                               v3 / (double)(2 * m)};
-    double *a1 = acc, *at = acc + GROUP * f; /* [q f + i] */
-    memset(acc, 0, 2 * GROUP * f * sizeof *acc);
-    for (size_t t = 0; t < m; ++t)
-        for (size_t q = 0; q < GROUP; ++q) {
-            const double *yb = y + idx[q][t] * bl;
-            const double fa = yb[0] - mean[q], fb = yb[1] - mean[q];
-            double *a1q = a1 + q * f, *atq = at + q * f;
+    for (size_t t = 0; t < m; ++t) {
+        const double *p0 = y + i0[t] * ab, *p1 = y + i1[t] * ab, *p2 = y + i2[t] * ab, *p3 = y + i3[t] * ab;
+        for (size_t c = 0; c < nc; ++c) {
+            const size_t o = c * cs;
+            v4d *sc = sums + c * per;
+            const v4d mean = sc[0];
+            const v4d fa = (v4d){p0[o], p1[o], p2[o], p3[o]} - mean,
+                      fb = (v4d){p0[o + rs], p1[o + rs], p2[o + rs], p3[o + rs]} - mean;
             for (size_t i = 0; i < f; ++i) {
-                const double fab = yb[2 + i] - mean[q];
-                a1q[i] += fb * (fab - fa);
-                atq[i] += (fa - fab) * (fa - fab);
+                const size_t oi = o + (2 + i) * rs;
+                const v4d fab = (v4d){p0[oi], p1[oi], p2[oi], p3[oi]} - mean;
+                sc[2 + i] += fb * (fab - fa);
+                sc[2 + f + i] += (fa - fab) * (fa - fab);
             }
         }
-    for (size_t q = 0; q < GROUP; ++q)
-        for (size_t i = 0; i < f; ++i) {
-            res[q * 2 * f + i] = var[q] > 0 ? a1[q * f + i] / (double)m / var[q] : NAN;
-            res[q * 2 * f + f + i] = var[q] > 0 ? at[q * f + i] / (2.0 * (double)m) / var[q] : NAN;
-        }
+    }
 }
+
+/* Outputs per kernel call: their accumulators stay in the L1 cache. */
+enum { KERNEL_OUTPUTS = 8 };
+
+/* Indices drawn per round before the threads share the round's resamples
+ * out (at most 16 MB; fewer rounds, fewer waits at their ends). */
+enum { DRAWS_PER_ROUND = 1 << 22 };
 
 /* Percentile interval of the R values v (sorted here) at coverage level. */
 static void percentile(double *v, size_t r, double level, double *lo, double *hi)
@@ -280,20 +301,219 @@ static size_t usable(const phc_saltelli_design *d, const double *y, size_t ys, s
     return m;
 }
 
-/* The indices of n_out outputs (columns y[c * M ..], contiguous) that share
- * the usable base samples used[0..m-1]: every output's bootstrap draws the
- * same resamples (the generator is seeded the same for every output, so
- * each output's result is what estimating it alone gives), drawn once. */
-static int estimate_outputs(const phc_saltelli_design *d, const double *cols, size_t n_out, const size_t *used,
-                            size_t m, phc_sobol_indices *outs, phc_error *err)
+/* ---- the bootstrap's random base samples, drawn fast --------------------------------
+ * The resamples draw m R indices with gsl_rng_uniform_int on GSL's
+ * gsl_rng_mt19937; through GSL each costs a call through the generator's
+ * function pointer and a 64-bit division.  `draws` makes the same numbers:
+ * the Mersenne Twister (Matsumoto & Nishimura 1998, ACM TOMACS 8, 3) run on
+ * a copy of the seeded GSL state, 624 words at a time, and GSL's
+ * k = x / scale (scale = (2^32 - 1) / m, rejected while k >= m) taken in
+ * double precision, exact here: with x = k scale + r, 0 <= r < scale, the
+ * quotient lies at least 1/scale below k + 1 and (k + 1) scale <= 2^33 < 2^53,
+ * so the rounded quotient stays below k + 1 and its floor is k.  The copy is
+ * checked against GSL's own draws (1300 numbers, across a refill of the
+ * state) when made; if they differ (another GSL's layout), GSL draws. */
+enum { MT_N = 624, MT_M = 397 };
+
+typedef struct draws {
+    gsl_rng *rng;           /* seeded; used itself when !fast */
+    int fast;               /* the copy below matches GSL's numbers */
+    uint32_t mt[MT_N];
+    size_t mti;
+} draws;
+
+static void mt_refill(uint32_t *mt)
+{
+    size_t kk;
+    for (kk = 0; kk < MT_N - MT_M; ++kk) {
+        const uint32_t y = (mt[kk] & 0x80000000u) | (mt[kk + 1] & 0x7fffffffu);
+        mt[kk] = mt[kk + MT_M] ^ (y >> 1) ^ ((y & 1u) ? 0x9908b0dfu : 0u);
+    }
+    for (; kk < MT_N - 1; ++kk) {
+        const uint32_t y = (mt[kk] & 0x80000000u) | (mt[kk + 1] & 0x7fffffffu);
+        mt[kk] = mt[kk + MT_M - MT_N] ^ (y >> 1) ^ ((y & 1u) ? 0x9908b0dfu : 0u);
+    }
+    const uint32_t y = (mt[MT_N - 1] & 0x80000000u) | (mt[0] & 0x7fffffffu);
+    mt[MT_N - 1] = mt[MT_M - 1] ^ (y >> 1) ^ ((y & 1u) ? 0x9908b0dfu : 0u);
+}
+
+static inline uint32_t mt_next(draws *g)
+{
+    if (g->mti >= MT_N) {
+        mt_refill(g->mt);
+        g->mti = 0;
+    }
+    uint32_t k = g->mt[g->mti++];
+    k ^= k >> 11;
+    k ^= (k << 7) & 0x9d2c5680u;
+    k ^= (k << 15) & 0xefc60000u;
+    k ^= k >> 18;
+    return k;
+}
+
+/* Seeds GSL's generator with seed and copies its state (GSL's mt_state_t:
+ * 624 unsigned longs, then the int position), checked as said above. */
+static int draws_init(draws *g, unsigned long seed)
+{
+    memset(g, 0, sizeof *g);
+    if (!(g->rng = gsl_rng_alloc(gsl_rng_mt19937)))
+        return -1;
+    gsl_rng_set(g->rng, seed);
+    if (gsl_rng_size(g->rng) < MT_N * sizeof(unsigned long) + sizeof(int) || gsl_rng_max(g->rng) != 0xffffffffUL ||
+        gsl_rng_min(g->rng) != 0)
+        return 0;
+    const unsigned long *st = gsl_rng_state(g->rng);
+    int mti;
+    memcpy(&mti, st + MT_N, sizeof mti);
+    if (mti < 0 || mti > MT_N)
+        return 0;
+    for (size_t i = 0; i < MT_N; ++i)
+        g->mt[i] = (uint32_t)st[i];
+    g->mti = (size_t)mti;
+    gsl_rng *check = gsl_rng_clone(g->rng);
+    if (!check)
+        return -1;
+    draws copy = *g;
+    int same = 1;
+    for (int i = 0; i < 1300 && same; ++i)
+        same = mt_next(&copy) == (uint32_t)gsl_rng_get(check);
+    gsl_rng_free(check);
+    g->fast = same;
+    return 0;
+}
+
+/* count x m draws of used[gsl_rng_uniform_int(rng, m)], in GSL's order. */
+static void draws_take(draws *g, const size_t *used, size_t m, size_t count, uint32_t *out)
+{
+    if (!g->fast || m > 0xffffffffUL) {
+        for (size_t i = 0; i < count * m; ++i)
+            out[i] = (uint32_t)used[gsl_rng_uniform_int(g->rng, m)];
+        return;
+    }
+    const uint32_t scale = (uint32_t)(0xffffffffUL / m);
+    const double ds = (double)scale;
+    for (size_t i = 0; i < count * m; ++i) {
+        uint32_t k;
+        do
+            k = (uint32_t)((double)mt_next(g) / ds);
+        while (k >= m);
+        out[i] = (uint32_t)used[k];
+    }
+}
+
+/* Values per resample and output in the raw bootstrap sums: the summed
+ * squares (divisor 2m still to apply), f first-order and f total numerators. */
+#define RAW_PER(f) (1 + 2 * (f))
+
+/* The bootstrap's raw sums: R resamples of the base samples used[0..m-1]
+ * (the generator seeded with the design's seed, drawn in turn, resample by
+ * resample, as the estimators always drew them) for nc outputs (value of
+ * output c at design row r: rows[r rs + c cs]); raw[(c R + r) RAW_PER(f) ..].
+ * A round's resamples are drawn, then shared out to the threads GROUP at a time;
+ * each resample's sums land in their own place and are taken the same way
+ * by any thread, so the results do not depend on the number of threads.
+ * The last R mod GROUP resamples go through the kernel with their lanes
+ * filled by copies (their sums dropped). */
+static int bootstrap_raw(const phc_saltelli_design *d, const double *rows, size_t rs, size_t cs, size_t nc,
+                         const size_t *used, size_t m, double *raw)
+{
+    const size_t f = d->f, bl = d->block, R = d->o.bootstrap, rp = RAW_PER(f);
+    const size_t threads = (size_t)omp_get_max_threads(), kper = KERNEL_OUTPUTS * (2 + 2 * f);
+    /* resamples per round: a multiple of GROUP, all R if they fit */
+    size_t chunk = DRAWS_PER_ROUND / m / GROUP * GROUP, r_up = (R + GROUP - 1) / GROUP * GROUP;
+    chunk = chunk < GROUP ? GROUP : chunk > r_up ? r_up : chunk;
+    uint32_t *draw = malloc(chunk * m * sizeof *draw);
+    v4d *scratch = aligned_alloc(sizeof(v4d), threads * kper * sizeof *scratch); /* vectors: their alignment */
+    draws *gen = malloc(sizeof *gen);
+    /* a fixed stream: results do not depend on other outputs */
+    if (!draw || !scratch || !gen || draws_init(gen, d->o.seed ^ 0x5deece66dUL)) {
+        free(draw);
+        free(scratch);
+        if (gen)
+            gsl_rng_free(gen->rng);
+        free(gen);
+        return -1;
+    }
+    for (size_t r0 = 0; r0 < R; r0 += chunk) {
+        const size_t nr = R - r0 < chunk ? R - r0 : chunk, ng = (nr + GROUP - 1) / GROUP;
+        draws_take(gen, used, m, nr, draw);
+        for (size_t q = nr; q < ng * GROUP; ++q) /* the last group's spare lanes */
+            memcpy(draw + q * m, draw, m * sizeof *draw);
+#pragma omp parallel for schedule(dynamic, 1) if (ng > 1)
+        for (long g = 0; g < (long)ng; ++g) { /* dynamic: a thread slowed by other processes takes fewer */
+            v4d *sums = scratch + (size_t)omp_get_thread_num() * kper;
+            const size_t rg = r0 + (size_t)g * GROUP, lanes = R - rg < GROUP ? R - rg : GROUP;
+            for (size_t c0 = 0; c0 < nc; c0 += KERNEL_OUTPUTS) {
+                const size_t k = nc - c0 < KERNEL_OUTPUTS ? nc - c0 : KERNEL_OUTPUTS;
+                group_sums(f, bl, rows + c0 * cs, rs, cs, k, draw + (size_t)g * GROUP * m, m, sums);
+                for (size_t c = 0; c < k; ++c) {
+                    const v4d *sc = sums + c * (2 + 2 * f);
+                    for (size_t q = 0; q < lanes; ++q) {
+                        double *o = raw + ((c0 + c) * R + rg + q) * rp;
+                        for (size_t i = 0; i < rp; ++i)
+                            o[i] = sc[1 + i][q];
+                    }
+                }
+            }
+        }
+    }
+    free(draw);
+    free(scratch);
+    gsl_rng_free(gen->rng);
+    free(gen);
+    return 0;
+}
+
+/* Fills out's intervals from its R bootstrap values per index,
+ * boot[r stride + i] for i < per (s1, st, then s2); tmp: R values. */
+static void intervals(const phc_saltelli_design *d, const double *boot, size_t stride, size_t per, double *tmp,
+                      phc_sobol_indices *out)
+{
+    const size_t f = d->f, R = d->o.bootstrap;
+    for (size_t i = 0; i < per; ++i) {
+        size_t cnt = 0;
+        for (size_t r = 0; r < R; ++r) {
+            const double v = boot[r * stride + i];
+            if (isfinite(v))
+                tmp[cnt++] = v;
+        }
+        double lo = NAN, hi = NAN;
+        if (cnt >= R / 2)
+            percentile(tmp, cnt, d->o.level, &lo, &hi);
+        if (i < f) {
+            out->s1_lo[i] = lo;
+            out->s1_hi[i] = hi;
+        } else if (i < 2 * f) {
+            out->st_lo[i - f] = lo;
+            out->st_hi[i - f] = hi;
+        } else {
+            out->s2_lo[i - 2 * f] = lo;
+            out->s2_hi[i - 2 * f] = hi;
+        }
+    }
+}
+
+/* The indices of n_out outputs (columns cols[c M ..], contiguous; the same
+ * values also at rows[r rs + c cs] for the kernel) that share the usable
+ * base samples used[0..m-1]: every output's bootstrap draws the same
+ * resamples (the generator is seeded the same for every output, so each
+ * output's result is what estimating it alone gives), drawn once.  raw
+ * (without second order; n_out R RAW_PER(f) values, or NULL): receives the
+ * bootstrap's raw sums, for the aggregated indices of the same outputs. */
+static int estimate_outputs(const phc_saltelli_design *d, const double *cols, const double *rows, size_t rs,
+                            size_t cs, size_t n_out, const size_t *used, size_t m, phc_sobol_indices *outs,
+                            double *raw, phc_error *err)
 {
     const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, nf2 = d->o.second_order ? f * f : 0;
-    const size_t M = n * bl, per = 2 * f + nf2;
-    size_t *draw = malloc(GROUP * n * sizeof *draw);
+    const size_t M = n * bl, per = 2 * f + nf2, rp = RAW_PER(f);
+    size_t *draw = malloc(n * sizeof *draw);
     double *boot = malloc(n_out * R * per * sizeof *boot), *tmp = malloc((R > 1 ? R : 1) * sizeof *tmp);
-    double *acc = malloc((2 * f + f * f + 2 * GROUP * f) * sizeof *acc), *res = malloc(GROUP * 2 * f * sizeof *res);
+    double *acc = malloc((2 * f + f * f) * sizeof *acc);
+    double *own = !nf2 && !raw ? malloc(n_out * R * rp * sizeof *own) : NULL;
     gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
     int rc = PHC_OK;
+    if (!nf2 && !raw)
+        raw = own;
     for (size_t c = 0; c < n_out; ++c) {
         phc_sobol_indices *out = &outs[c];
         memset(out, 0, sizeof *out);
@@ -304,7 +524,7 @@ static int estimate_outputs(const phc_saltelli_design *d, const double *cols, si
         if (!out->s1 || !out->st || (nf2 && !out->s2))
             rc = PHC_ERR_NOMEM;
     }
-    if (rc || !draw || !boot || !tmp || !acc || !res || !rng) {
+    if (rc || !draw || !boot || !tmp || !acc || (!nf2 && !raw) || !rng) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
@@ -338,60 +558,43 @@ static int estimate_outputs(const phc_saltelli_design *d, const double *cols, si
         out->variance = sum2 / (double)(2 * m);
         estimate(d, y, used, m, out->s1, out->st, out->s2, acc);
     }
-    /* bootstrap: a fixed stream per estimate, so results do not depend on
-       which outputs were estimated before or together */
-    gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL);
-    for (size_t r = 0; r < R;) {
-        /* GROUP resamples at a time (drawn in turn, as one at a time would
-           draw them) when there are that many left and no second order */
-        const size_t g = !nf2 && R - r >= GROUP ? GROUP : 1;
-        for (size_t q = 0; q < g; ++q)
-            for (size_t t = 0; t < m; ++t)
-                draw[q * n + t] = used[gsl_rng_uniform_int(rng, m)];
-        for (size_t c = 0; c < n_out; ++c) {
-            if (g == GROUP) {
-                const size_t *const idx[GROUP] = {draw, draw + n, draw + 2 * n, draw + 3 * n};
-                estimate_group(d, cols + c * M, idx, m, res, acc);
-                for (size_t q = 0; q < GROUP; ++q)
-                    memcpy(boot + (c * R + r + q) * per, res + q * 2 * f, 2 * f * sizeof *res);
-            } else {
-                double *b = boot + (c * R + r) * per;
-                estimate(d, cols + c * M, draw, m, b, b + f, nf2 ? b + 2 * f : NULL, acc);
-            }
+    if (!nf2) {
+        /* the kernel's sums, finished as estimate finishes them */
+        if (bootstrap_raw(d, rows, rs, cs, n_out, used, m, raw)) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
         }
-        r += g;
-    }
-    for (size_t c = 0; c < n_out; ++c) {
-        phc_sobol_indices *out = &outs[c];
-        for (size_t i = 0; i < per; ++i) {
-            size_t cnt = 0;
+        for (size_t c = 0; c < n_out; ++c)
             for (size_t r = 0; r < R; ++r) {
-                const double v = boot[(c * R + r) * per + i];
-                if (isfinite(v))
-                    tmp[cnt++] = v;
+                const double *w = raw + (c * R + r) * rp;
+                double *b = boot + (c * R + r) * per;
+                const double var = w[0] / (double)(2 * m);
+                for (size_t i = 0; i < f; ++i) {
+                    b[i] = var > 0 ? w[1 + i] / (double)m / var : NAN;
+                    b[f + i] = var > 0 ? w[1 + f + i] / (2.0 * (double)m) / var : NAN;
+                }
             }
-            double lo = NAN, hi = NAN;
-            if (cnt >= R / 2)
-                percentile(tmp, cnt, d->o.level, &lo, &hi);
-            if (i < f) {
-                out->s1_lo[i] = lo;
-                out->s1_hi[i] = hi;
-            } else if (i < 2 * f) {
-                out->st_lo[i - f] = lo;
-                out->st_hi[i - f] = hi;
-            } else {
-                out->s2_lo[i - 2 * f] = lo;
-                out->s2_hi[i - 2 * f] = hi;
+    } else {
+        /* second order: one resample at a time, all outputs on the same draws */
+        gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL);
+        for (size_t r = 0; r < R; ++r) {
+            for (size_t t = 0; t < m; ++t)
+                draw[t] = used[gsl_rng_uniform_int(rng, m)];
+            for (size_t c = 0; c < n_out; ++c) {
+                double *b = boot + (c * R + r) * per;
+                estimate(d, cols + c * M, draw, m, b, b + f, b + 2 * f, acc);
             }
         }
     }
+    for (size_t c = 0; c < n_out; ++c)
+        intervals(d, boot + c * R * per, per, per, tmp, &outs[c]);
 done:
     gsl_rng_free(rng);
     free(draw);
     free(boot);
     free(tmp);
     free(acc);
-    free(res);
+    free(own);
     if (rc)
         for (size_t c = 0; c < n_out; ++c)
             phc_sobol_indices_clear(&outs[c]);
@@ -407,45 +610,8 @@ int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, ph
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     const size_t m = usable(d, y, 1, used);
-    const int rc = estimate_outputs(d, y, 1, used, m, out, err);
+    const int rc = estimate_outputs(d, y, y, 1, d->n * d->block, 1, used, m, out, NULL, err);
     free(used);
-    return rc;
-}
-
-int phc_sobol_indices_estimate_outputs(const phc_saltelli_design *d, const double *y, size_t n_out,
-                                       phc_sobol_indices *outs, phc_error *err)
-{
-    const size_t M = d->n * d->block;
-    size_t *used = malloc(d->n * sizeof *used), *other = malloc(d->n * sizeof *other);
-    double *cols = malloc((n_out ? n_out : 1) * M * sizeof *cols);
-    int rc = PHC_OK;
-    for (size_t c = 0; c < n_out; ++c)
-        memset(&outs[c], 0, sizeof outs[c]);
-    if (!used || !other || !cols) {
-        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-        goto done;
-    }
-    for (size_t c = 0; c < n_out; ++c)
-        for (size_t r = 0; r < M; ++r)
-            cols[c * M + r] = y[r * n_out + c];
-    /* runs of outputs with the same usable base samples share their
-       resamples (a failed evaluation makes every output of its row NAN, so
-       in a study all outputs are one run) */
-    for (size_t c0 = 0; c0 < n_out && rc == PHC_OK;) {
-        const size_t m = usable(d, cols + c0 * M, 1, used);
-        size_t c1 = c0 + 1;
-        while (c1 < n_out && usable(d, cols + c1 * M, 1, other) == m && memcmp(used, other, m * sizeof *used) == 0)
-            ++c1;
-        rc = estimate_outputs(d, cols + c0 * M, c1 - c0, used, m, outs + c0, err);
-        c0 = c1;
-    }
-    if (rc)
-        for (size_t c = 0; c < n_out; ++c)
-            phc_sobol_indices_clear(&outs[c]);
-done:
-    free(used);
-    free(other);
-    free(cols);
     return rc;
 }
 
@@ -489,63 +655,70 @@ static void estimate_aggregate(const phc_saltelli_design *d, const double *y, si
         *var_out = var_sum;
 }
 
-/* estimate_aggregate for GROUP resamples idx[q][0..m-1] at once (the same
- * sums in the same order for each: the same bits); res: GROUP x 2f values
- * (s1, st of each resample), num: scratch of 2 GROUP f values. */
-static void estimate_aggregate_group(const phc_saltelli_design *d, const double *y, size_t T,
-                                     const size_t *const idx[GROUP], size_t m, double *res, double *num)
+/* The aggregated indices of the T columns y + t M from the bootstrap's raw
+ * sums of those outputs (raw[(t R + r) RAW_PER(f) ..], all on the resamples
+ * of used[0..m-1]), combined as estimate_aggregate combines them, in the
+ * order of t. */
+static int aggregate_from_raw(const phc_saltelli_design *d, const double *y, size_t T, const size_t *used, size_t m,
+                              const double *raw, phc_sobol_indices *out, phc_error *err)
 {
-    const size_t f = d->f, bl = d->block, M = d->n * d->block;
-    const size_t *i0 = idx[0], *i1 = idx[1], *i2 = idx[2], *i3 = idx[3];
-    double var_sum[GROUP] = {0, 0, 0, 0};
-    double *num1 = num, *numt = num + GROUP * f; /* [q f + i] */
-    memset(num, 0, 2 * GROUP * f * sizeof *num);
+    const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, M = n * bl, rp = RAW_PER(f);
+    double *boot = malloc(R * 2 * f * sizeof *boot), *tmp = malloc(R * sizeof *tmp);
+    double *num = malloc(2 * f * sizeof *num);
+    int rc = PHC_OK;
+    if (!boot || !tmp || !num) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
+    }
+    double mean_sum = 0;
     for (size_t t = 0; t < T; ++t) {
-        const double *yt = y + t * M;
-        double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-        for (size_t q = 0; q < m; ++q) {
-            s0 += yt[i0[q] * bl] + yt[i0[q] * bl + 1];
-            s1 += yt[i1[q] * bl] + yt[i1[q] * bl + 1];
-            s2 += yt[i2[q] * bl] + yt[i2[q] * bl + 1];
-            s3 += yt[i3[q] * bl] + yt[i3[q] * bl + 1];
-        }
-        const double mean[GROUP] = {s0 / (double)(2 * m), s1 / (double)(2 * m), s2 / (double)(2 * m),
-                                    s3 / (double)(2 * m)};
-        double v0 = 0, v1 = 0, v2 = 0, v3 = 0;
-        for (size_t q = 0; q < m; ++q) {
-            const double a0 = yt[i0[q] * bl] - mean[0], b0 = yt[i0[q] * bl + 1] - mean[0];
-            const double a1 = yt[i1[q] * bl] - mean[1], b1 = yt[i1[q] * bl + 1] - mean[1];
-            const double a2 = yt[i2[q] * bl] - mean[2], b2 = yt[i2[q] * bl + 1] - mean[2];
-            const double a3 = yt[i3[q] * bl] - mean[3], b3 = yt[i3[q] * bl + 1] - mean[3];
-            v0 += a0 * a0 + b0 * b0;
-            v1 += a1 * a1 + b1 * b1;
-            v2 += a2 * a2 + b2 * b2;
-            v3 += a3 * a3 + b3 * b3;
-        }
-        var_sum[0] += v0 / (double)(2 * m);
-        var_sum[1] += v1 / (double)(2 * m);
-        var_sum[2] += v2 / (double)(2 * m);
-        var_sum[3] += v3 / (double)(2 * m);
-        for (size_t i = 0; i < f; ++i) {
-            double a1[GROUP] = {0, 0, 0, 0}, at[GROUP] = {0, 0, 0, 0};
-            for (size_t q = 0; q < m; ++q)
-                for (size_t g = 0; g < GROUP; ++g) {
-                    const double *yb = yt + idx[g][q] * bl;
-                    const double fa = yb[0] - mean[g], fb = yb[1] - mean[g], fab = yb[2 + i] - mean[g];
-                    a1[g] += fb * (fab - fa);
-                    at[g] += (fa - fab) * (fa - fab);
-                }
-            for (size_t g = 0; g < GROUP; ++g) {
-                num1[g * f + i] += a1[g] / (double)m;
-                numt[g * f + i] += at[g] / (2.0 * (double)m);
+        double sum = 0;
+        for (size_t q = 0; q < m; ++q)
+            sum += y[t * M + used[q] * bl] + y[t * M + used[q] * bl + 1];
+        mean_sum += sum / (double)(2 * m);
+    }
+    out->mean = mean_sum / (double)T;
+    estimate_aggregate(d, y, T, used, m, out->s1, out->st, num, num + f, &out->variance);
+    for (size_t r = 0; r < R; ++r) {
+        double var_sum = 0, *num1 = num, *numt = num + f;
+        for (size_t i = 0; i < f; ++i)
+            num1[i] = numt[i] = 0;
+        for (size_t t = 0; t < T; ++t) {
+            const double *w = raw + (t * R + r) * rp;
+            var_sum += w[0] / (double)(2 * m);
+            for (size_t i = 0; i < f; ++i) {
+                num1[i] += w[1 + i] / (double)m;
+                numt[i] += w[1 + f + i] / (2.0 * (double)m);
             }
         }
-    }
-    for (size_t g = 0; g < GROUP; ++g)
         for (size_t i = 0; i < f; ++i) {
-            res[g * 2 * f + i] = var_sum[g] > 0 ? num1[g * f + i] / var_sum[g] : NAN;
-            res[g * 2 * f + f + i] = var_sum[g] > 0 ? numt[g * f + i] / var_sum[g] : NAN;
+            boot[r * 2 * f + i] = var_sum > 0 ? num1[i] / var_sum : NAN;
+            boot[r * 2 * f + f + i] = var_sum > 0 ? numt[i] / var_sum : NAN;
         }
+    }
+    intervals(d, boot, 2 * f, 2 * f, tmp, out);
+done:
+    free(boot);
+    free(tmp);
+    free(num);
+    return rc;
+}
+
+/* out's arrays for the aggregated indices (no second order). */
+static int aggregate_alloc(const phc_saltelli_design *d, phc_sobol_indices *out)
+{
+    const size_t f = d->f;
+    memset(out, 0, sizeof *out);
+    out->n_factors = f;
+    out->s1 = malloc(3 * f * sizeof *out->s1);
+    out->st = malloc(3 * f * sizeof *out->st);
+    if (!out->s1 || !out->st)
+        return -1;
+    out->s1_lo = out->s1 + f;
+    out->s1_hi = out->s1 + 2 * f;
+    out->st_lo = out->st + f;
+    out->st_hi = out->st + 2 * f;
+    return 0;
 }
 
 int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const double *y, size_t n_outputs,
@@ -555,22 +728,13 @@ int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const dou
     const size_t f = d->f, bl = d->block, n = d->n, R = d->o.bootstrap, M = d->n * d->block;
     if (n_outputs == 0)
         return phc_error_set(err, PHC_ERR_INVALID, "aggregated indices of no output");
-    size_t *used = malloc(n * sizeof *used), *draw = malloc(GROUP * n * sizeof *draw);
-    double *boot = malloc(R * 2 * f * sizeof *boot), *tmp = malloc(R * sizeof *tmp);
-    double *num = malloc(2 * GROUP * f * sizeof *num);
-    out->n_factors = f;
-    out->s1 = malloc(3 * f * sizeof *out->s1);
-    out->st = malloc(3 * f * sizeof *out->st);
-    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    size_t *used = malloc(n * sizeof *used);
+    double *raw = malloc(n_outputs * R * RAW_PER(f) * sizeof *raw);
     int rc = PHC_OK;
-    if (!used || !draw || !boot || !tmp || !num || !out->s1 || !out->st || !rng) {
+    if (!used || !raw || aggregate_alloc(d, out)) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    out->s1_lo = out->s1 + f;
-    out->s1_hi = out->s1 + 2 * f;
-    out->st_lo = out->st + f;
-    out->st_hi = out->st + 2 * f;
     size_t m = 0;
     for (size_t j = 0; j < n; ++j) {
         int ok = 1;
@@ -587,55 +751,100 @@ int phc_sobol_indices_estimate_aggregate(const phc_saltelli_design *d, const dou
                            "the indices need at least 4", m, n);
         goto done;
     }
-    {
-        double mean_sum = 0;
-        for (size_t t = 0; t < n_outputs; ++t) {
-            double sum = 0;
-            for (size_t q = 0; q < m; ++q)
-                sum += y[t * M + used[q] * bl] + y[t * M + used[q] * bl + 1];
-            mean_sum += sum / (double)(2 * m);
-        }
-        out->mean = mean_sum / (double)n_outputs;
+    if (bootstrap_raw(d, y, 1, M, n_outputs, used, m, raw)) { /* the resamples of phc_sobol_indices_estimate */
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
     }
-    estimate_aggregate(d, y, n_outputs, used, m, out->s1, out->st, num, num + f, &out->variance);
-    gsl_rng_set(rng, d->o.seed ^ 0x5deece66dUL); /* the resamples of phc_sobol_indices_estimate */
-    for (size_t r = 0; r < R;) { /* GROUP resamples at a time while that many are left (same draws, same bits) */
-        const size_t g = R - r >= GROUP ? GROUP : 1;
-        for (size_t k = 0; k < g; ++k)
-            for (size_t q = 0; q < m; ++q)
-                draw[k * n + q] = used[gsl_rng_uniform_int(rng, m)];
-        if (g == GROUP) {
-            const size_t *const idx[GROUP] = {draw, draw + n, draw + 2 * n, draw + 3 * n};
-            estimate_aggregate_group(d, y, n_outputs, idx, m, boot + r * 2 * f, num);
-        } else {
-            estimate_aggregate(d, y, n_outputs, draw, m, boot + r * 2 * f, boot + r * 2 * f + f, num, num + f, NULL);
-        }
-        r += g;
+    rc = aggregate_from_raw(d, y, n_outputs, used, m, raw, out, err);
+done:
+    free(used);
+    free(raw);
+    if (rc)
+        phc_sobol_indices_clear(out);
+    return rc;
+}
+
+int phc_sobol_indices_estimate_outputs(const phc_saltelli_design *d, const double *y, size_t n_out,
+                                       phc_sobol_indices *outs, phc_error *err)
+{
+    return phc_sobol_indices_estimate_study(d, y, n_out, outs, 0, NULL, NULL, NULL, err);
+}
+
+int phc_sobol_indices_estimate_study(const phc_saltelli_design *d, const double *y, size_t n_out,
+                                     phc_sobol_indices *outs, size_t n_agg, const size_t *agg_first,
+                                     const size_t *agg_count, phc_sobol_indices *aggs, phc_error *err)
+{
+    const size_t M = d->n * d->block, R = d->o.bootstrap, rp = RAW_PER(d->f);
+    const int keep = n_agg > 0 && !d->o.second_order; /* raw sums kept for the aggregates */
+    size_t *used = malloc(d->n * sizeof *used), *other = malloc(d->n * sizeof *other);
+    size_t *run = malloc((n_out ? n_out : 1) * sizeof *run); /* first output of each output's run */
+    double *cols = malloc((n_out ? n_out : 1) * M * sizeof *cols);
+    double *raw = keep ? malloc(n_out * R * rp * sizeof *raw) : NULL;
+    int rc = PHC_OK;
+    for (size_t c = 0; c < n_out; ++c)
+        memset(&outs[c], 0, sizeof outs[c]);
+    for (size_t a = 0; a < n_agg; ++a)
+        memset(&aggs[a], 0, sizeof aggs[a]);
+    if (!used || !other || !run || !cols || (keep && !raw)) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto done;
     }
-    for (size_t i = 0; i < 2 * f; ++i) {
-        size_t cnt = 0;
-        for (size_t r = 0; r < R; ++r)
-            if (isfinite(boot[r * 2 * f + i]))
-                tmp[cnt++] = boot[r * 2 * f + i];
-        double lo = NAN, hi = NAN;
-        if (cnt >= R / 2)
-            percentile(tmp, cnt, d->o.level, &lo, &hi);
-        if (i < f) {
-            out->s1_lo[i] = lo;
-            out->s1_hi[i] = hi;
+    for (size_t a = 0; a < n_agg; ++a)
+        if (agg_count[a] == 0 || agg_first[a] > n_out || agg_count[a] > n_out - agg_first[a]) {
+            rc = phc_error_set(err, PHC_ERR_INVALID, "aggregate %zu: outputs %zu + %zu of %zu", a, agg_first[a],
+                               agg_count[a], n_out);
+            goto done;
+        }
+    for (size_t c = 0; c < n_out; ++c)
+        for (size_t r = 0; r < M; ++r)
+            cols[c * M + r] = y[r * n_out + c];
+    /* runs of outputs with the same usable base samples share their
+       resamples (a failed evaluation makes every output of its row NAN, so
+       in a study all outputs are one run) */
+    for (size_t c0 = 0; c0 < n_out && rc == PHC_OK;) {
+        const size_t m = usable(d, cols + c0 * M, 1, used);
+        size_t c1 = c0 + 1;
+        while (c1 < n_out && usable(d, cols + c1 * M, 1, other) == m && memcmp(used, other, m * sizeof *used) == 0)
+            ++c1;
+        for (size_t c = c0; c < c1; ++c)
+            run[c] = c0;
+        rc = estimate_outputs(d, cols + c0 * M, y + c0, n_out, 1, c1 - c0, used, m, outs + c0,
+                              keep ? raw + c0 * R * rp : NULL, err);
+        c0 = c1;
+    }
+    /* an aggregate whose outputs are one run (its usable base samples are
+       then the run's: the intersection of its outputs') has its bootstrap
+       sums already; otherwise it is estimated on its own (the same result) */
+    for (size_t a = 0; a < n_agg && rc == PHC_OK; ++a) {
+        const size_t c0 = agg_first[a], T = agg_count[a];
+        if (keep && run[c0] == run[c0 + T - 1]) {
+            const size_t m = usable(d, cols + c0 * M, 1, used);
+            if (aggregate_alloc(d, &aggs[a])) {
+                rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+                break;
+            }
+            aggs[a].n_used = m;
+            aggs[a].n_failed = d->n - m;
+            if (m < 4)
+                rc = phc_error_set(err, PHC_ERR_NUMERIC, "only %zu of %zu base samples have every evaluation "
+                                   "finished; the indices need at least 4", m, d->n);
+            else
+                rc = aggregate_from_raw(d, cols + c0 * M, T, used, m, raw + c0 * R * rp, &aggs[a], err);
         } else {
-            out->st_lo[i - f] = lo;
-            out->st_hi[i - f] = hi;
+            rc = phc_sobol_indices_estimate_aggregate(d, cols + c0 * M, T, &aggs[a], err);
         }
     }
 done:
-    gsl_rng_free(rng);
+    if (rc) {
+        for (size_t c = 0; c < n_out; ++c)
+            phc_sobol_indices_clear(&outs[c]);
+        for (size_t a = 0; a < n_agg; ++a)
+            phc_sobol_indices_clear(&aggs[a]);
+    }
     free(used);
-    free(draw);
-    free(boot);
-    free(tmp);
-    free(num);
-    if (rc)
-        phc_sobol_indices_clear(out);
+    free(other);
+    free(run);
+    free(cols);
+    free(raw);
     return rc;
 }

@@ -89,6 +89,18 @@ int phc_sobol_indices_estimate(const phc_saltelli_design *d, const double *y, ph
 int phc_sobol_indices_estimate_outputs(const phc_saltelli_design *d, const double *y, size_t n_out,
                                        phc_sobol_indices *out, phc_error *err);
 void phc_sobol_indices_clear(phc_sobol_indices *s); /* frees the arrays; accepts zeroed */
+/* phc_sobol_indices_estimate_outputs and, for n_agg runs of consecutive
+ * outputs (agg_first[a] .. agg_first[a] + agg_count[a] - 1, a time series),
+ * their aggregated indices (phc_sobol_indices_estimate_aggregate, below) in
+ * aggs[a], in one call: an aggregate whose outputs share their usable base
+ * samples takes its bootstrap from the sums its outputs' bootstrap already
+ * took (the same resamples), so a study's series cost no second bootstrap.
+ * Every result is bit for bit what the separate calls give.  The bootstrap
+ * runs on OpenMP's threads (resamples shared out in fixed places: the
+ * results do not depend on their number). */
+int phc_sobol_indices_estimate_study(const phc_saltelli_design *d, const double *y, size_t n_out,
+                                     phc_sobol_indices *outs, size_t n_agg, const size_t *agg_first,
+                                     const size_t *agg_count, phc_sobol_indices *aggs, phc_error *err);
 
 /* Generalised (aggregated) indices of T outputs together, for a time series
  * (Lamboni, Monod & Makowski 2011, Reliab. Eng. Syst. Saf. 96, 450;

@@ -11,8 +11,11 @@
  *   S_i = V_i / V, ST_i = V_i prod_{j != i} (1 + V_j) / V.
  * An additive function y = sum c_i x_i: S_i = ST_i = c_i^2 / sum c_j^2.
  * phc_sobol_indices_estimate_outputs (several outputs at once) gives each
- * output bit for bit what phc_sobol_indices_estimate gives its column. */
+ * output bit for bit what phc_sobol_indices_estimate gives its column, and
+ * phc_sobol_indices_estimate_study (outputs and series aggregates in one
+ * call) what the separate calls give, on one thread and on two. */
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -327,7 +330,7 @@ static void test_outputs_batched(void)
 }
 
 /* The bootstrap takes first-order resamples four at a time
- * (estimate_group), second-order ones one at a time (estimate): the S1 and
+ * (the vector kernel), second-order ones one at a time (estimate): the S1 and
  * ST of a second-order design, whose A, B and A_B^i rows are the
  * first-order design's, must be the same bits, intervals included, and so
  * must the aggregate of that one output; R = 1003 leaves three resamples
@@ -378,6 +381,78 @@ static void test_grouped_resamples(void)
     }
 }
 
+/* phc_sobol_indices_estimate_study: 12 outputs (more than the kernel's 8
+ * per pass) of the Ishigami design scaled and shifted, R = 1003 (rounds of
+ * 64 resamples, three left over), three aggregates: outputs 2..10 (one run:
+ * from the outputs' bootstrap sums, across two kernel passes), 0..1, and
+ * 10..11 where output 11 has a failed base sample of its own (two runs:
+ * estimated on its own).  Each
+ * result equals the separate calls' bit for bit, on one thread and on two. */
+static void test_study_call(void)
+{
+    phc_saltelli_options o = phc_saltelli_options_default();
+    o.n = 300;
+    o.bootstrap = 1003;
+    phc_error err;
+    phc_saltelli_design *d = NULL;
+    CHECK(phc_saltelli_design_new(3, NULL, 3, &o, &d, &err) == PHC_OK);
+    const size_t M = phc_saltelli_design_rows(d), n_out = 12, n_agg = 3;
+    const size_t first[3] = {2, 0, 10}, count[3] = {9, 2, 2};
+    double *y = malloc(M * n_out * sizeof *y), *cols = malloc(M * n_out * sizeof *cols), u[3];
+    for (size_t r = 0; r < M; ++r) {
+        phc_saltelli_design_point(d, r, u);
+        const double f = ishigami(u, 3);
+        for (size_t c = 0; c < n_out; ++c)
+            y[r * n_out + c] = c == 1 ? f * f : (1 + 0.1 * (double)c) * f + (double)c;
+    }
+    y[(11 * 5 + 3) * n_out + 11] = NAN; /* base sample 11 of output 11 */
+    for (size_t c = 0; c < n_out; ++c)
+        for (size_t r = 0; r < M; ++r)
+            cols[c * M + r] = y[r * n_out + c];
+    phc_sobol_indices sep[12], sep_agg[3], both[2][12], both_agg[2][3];
+    omp_set_num_threads(1);
+    CHECK(phc_sobol_indices_estimate_outputs(d, y, n_out, sep, &err) == PHC_OK);
+    for (size_t a = 0; a < n_agg; ++a)
+        CHECK(phc_sobol_indices_estimate_aggregate(d, cols + first[a] * M, count[a], &sep_agg[a], &err) == PHC_OK);
+    int same[2] = {1, 1};
+    for (int th = 0; th < 2; ++th) {
+        omp_set_num_threads(th + 1);
+        CHECK(phc_sobol_indices_estimate_study(d, y, n_out, both[th], n_agg, first, count, both_agg[th], &err) ==
+              PHC_OK);
+        for (size_t c = 0; c < n_out; ++c)
+            same[th] &= same_result(&sep[c], &both[th][c]);
+        for (size_t a = 0; a < n_agg; ++a)
+            same[th] &= same_result(&sep_agg[a], &both_agg[th][a]) && both_agg[th][a].s2 == NULL;
+    }
+    omp_set_num_threads(omp_get_num_procs());
+    CHECK(same[0] && same[1]);
+    CHECK(sep_agg[0].n_used == 300 && sep_agg[2].n_used == 299 && sep[11].n_used == 299);
+    CHECK(!same_bits(sep_agg[0].s1, sep_agg[1].s1, 3)); /* different outputs, different summaries */
+    printf("12 outputs and 3 aggregates in one call, R = 1003: %s bit for bit to the separate calls on one "
+           "thread, %s on two (aggregate 2..10: S1 = %.4f %.4f %.4f, interval of S1[0] [%.6f, %.6f])\n",
+           same[0] ? "equal" : "NOT equal", same[1] ? "equal" : "NOT equal", sep_agg[0].s1[0], sep_agg[0].s1[1],
+           sep_agg[0].s1[2], sep_agg[0].s1_lo[0], sep_agg[0].s1_hi[0]);
+    /* a bad aggregate is an error that says which */
+    const size_t bad_first = 11, bad_count = 2;
+    phc_sobol_indices bad_outs[12], bad_agg;
+    CHECK(phc_sobol_indices_estimate_study(d, y, n_out, bad_outs, 1, &bad_first, &bad_count, &bad_agg, &err) ==
+          PHC_ERR_INVALID);
+    CHECK_STR_CONTAINS(err.message, "aggregate 0");
+    for (size_t c = 0; c < n_out; ++c) {
+        phc_sobol_indices_clear(&sep[c]);
+        phc_sobol_indices_clear(&both[0][c]);
+        phc_sobol_indices_clear(&both[1][c]);
+    }
+    for (size_t a = 0; a < n_agg; ++a) {
+        phc_sobol_indices_clear(&sep_agg[a]);
+        phc_sobol_indices_clear(&both_agg[0][a]);
+        phc_sobol_indices_clear(&both_agg[1][a]);
+    }
+    free(y);
+    free(cols);
+    phc_saltelli_design_free(d);
+}
+
 int main(void)
 {
     test_grouped_resamples();
@@ -387,5 +462,6 @@ int main(void)
     test_width_rate();
     test_additive_and_failures();
     test_outputs_batched();
+    test_study_call();
     return check_finish("test_sobol_indices");
 }
