@@ -57,7 +57,7 @@ for bad in "missing.yaml" "pv_leaves.yaml --level 1.5"; do
     run "${MPIRUN[@]}" -np 2 "$PHC" profile $bad -o bad
     [ "$RC" -ne 0 ] && [ "$RC" -ne 124 ] || why "exit $RC, expected a failure"
     key=${bad##* }
-    n=$(grep -c -- "$key" "$T/stderr")
+    n=$(grep -cF -- "$key" "$T/stderr") # fixed string: "1.5" as a regex matched MPI job ids such as [[11859,1],0]
     [ "$n" = 1 ] || why "the message naming $key appears $n times, expected once"
     [ ! -e bad ] || why "a directory was written"
     finish "profile $bad with mpirun -np 2: one message, no hang, no directory"
