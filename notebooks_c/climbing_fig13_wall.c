@@ -65,6 +65,25 @@ static int crosses(const double b[3], const double t[3], const double p[3], cons
     return phc_climbing_ray_hits_triangle(b, d, 0, p, q, r) && phc_climbing_ray_hits_triangle(t, e, 0, p, q, r);
 }
 
+/* Whether particle i's segment (head to tail) crosses one of the wall's
+ * ntri triangles. */
+static int segment_clips(const phc_climbing *c, size_t i, const phc_support_mesh *wall, size_t ntri)
+{
+    double b[3], t[3];
+    phc_climbing_segment(c, i, b, t);
+    for (size_t k = 0; k < ntri; ++k) {
+        size_t id[3];
+        double p0[3], p1[3], p2[3];
+        phc_support_mesh_triangle(wall, k, id);
+        phc_support_mesh_vertex(wall, id[0], p0);
+        phc_support_mesh_vertex(wall, id[1], p1);
+        phc_support_mesh_vertex(wall, id[2], p2);
+        if (crosses(b, t, p0, p1, p2))
+            return 1;
+    }
+    return 0;
+}
+
 /* The plant of the figure: options o, the wall casting shadows, `steps`
  * steps of dt seconds; NULL (message printed) on failure. */
 static phc_climbing *grow_wall(const phc_climbing_options *o, phc_support_mesh *wall, const double seed[3],
@@ -111,7 +130,7 @@ static double smallest_depth(const phc_climbing *c, phc_support_mesh *wall, size
     *crossing = 0;
     const size_t ntri = phc_support_mesh_triangle_count(wall);
     for (size_t i = 0; i < phc_climbing_count(c); ++i) {
-        double x[3], cp[3], nf[3], b[3], t[3];
+        double x[3], cp[3], nf[3];
         phc_climbing_position(c, i, x);
         if (phc_support_mesh_closest(wall, x, cp, nf) == 0) {
             const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
@@ -119,17 +138,7 @@ static double smallest_depth(const phc_climbing *c, phc_support_mesh *wall, size
             const double delta = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist;
             m = fmin(m, delta - phc_climbing_radius(c, i));
         }
-        phc_climbing_segment(c, i, b, t);
-        int clips = 0;
-        for (size_t k = 0; k < ntri && !clips; ++k) {
-            size_t id[3];
-            double p0[3], p1[3], p2[3];
-            phc_support_mesh_triangle(wall, k, id);
-            phc_support_mesh_vertex(wall, id[0], p0);
-            phc_support_mesh_vertex(wall, id[1], p1);
-            phc_support_mesh_vertex(wall, id[2], p2);
-            clips = crosses(b, t, p0, p1, p2);
-        }
+        const int clips = segment_clips(c, i, wall, ntri);
         *crossing += (size_t)clips;
     }
     return m;
@@ -236,16 +245,7 @@ int main(int argc, char **argv)
         top = fmax(top, x[2]);
         /* a stem covers the cells along its axis, sampled every 2 mm */
         phc_climbing_segment(c, i, b, t);
-        int clips = 0;
-        for (size_t k = 0; k < ntri && !clips; ++k) {
-            size_t id[3];
-            double p0[3], p1[3], p2[3];
-            phc_support_mesh_triangle(wall, k, id);
-            phc_support_mesh_vertex(wall, id[0], p0);
-            phc_support_mesh_vertex(wall, id[1], p1);
-            phc_support_mesh_vertex(wall, id[2], p2);
-            clips = crosses(b, t, p0, p1, p2);
-        }
+        const int clips = segment_clips(c, i, wall, ntri);
         crossing += clips;
         for (int s = 0; s <= 10; ++s) {
             const double u = s / 10.0;
