@@ -2,13 +2,20 @@
 """The README's output blocks are what the commands print now (issue 13).
 
     python3 check_readme.py README.md BUILD_DIR SHARED_DATA_DIR [--only LINE]
-        [--commands REGEX | --other-than REGEX]
+        [--commands REGEX [--as-test] | --other-than REGEX]
 
 --only LINE checks the one block whose first line is LINE; --commands REGEX
 checks only the blocks whose command starts with a match of REGEX (and fails
 when there is none: a block removed from the README), --other-than
 REGEX all the others.  CMake registers one test per benchmark this way and
 one for the rest, so ctest runs them side by side.
+
+--as-test (with --commands) makes the check a test program's own ctest test:
+a test program, notebook or test script whose output the README shows runs
+once, not once as a test and again for the README.  The command then runs
+even without the shared data (only the comparison of a skip-without-shared
+block is skipped, its exit code still counts), and a command that exits 77
+(the program skipped itself) makes the check exit 77, ctest's skip.
 
 Every fenced block without a language tag must be preceded (blank lines
 allowed) by one of two HTML comments, invisible on a rendered page:
@@ -157,6 +164,9 @@ def main():
     global README
     argv = sys.argv[1:]
     only = select = exclude = None
+    as_test = "--as-test" in argv
+    if as_test:
+        argv.remove("--as-test")
     for flag in ("--only", "--commands", "--other-than"):
         if flag in argv:
             k = argv.index(flag)
@@ -178,7 +188,11 @@ def main():
     README, build = args[0], args[1]
     shared = args[2] if len(args) > 2 else ""
     have_shared = bool(shared) and os.path.isdir(shared)
+    if as_test and select is None:
+        print("--as-test needs --commands")
+        return 2
     passed = failed = skipped = 0
+    self_skipped = 0
     root, work = scratch(build, shared)
     ran = {}
     try:
@@ -204,7 +218,8 @@ def main():
             for o in options:
                 if o.startswith("exit="):
                     want_exit = int(o[5:])
-            if "skip-without-shared" in options and not have_shared:
+            no_data = "skip-without-shared" in options and not have_shared
+            if no_data and not as_test:
                 skipped += 1
                 print(f"ok - {name} # SKIP no shared data folder: {command}")
                 continue
@@ -228,7 +243,21 @@ def main():
             if "timings" in options:
                 got = [mask_timing(g) for g in got]
                 want = [w if w == "..." else mask_timing(w) for w in want]
+            if as_test and proc.returncode == 77:
+                self_skipped += 1
+                print(f"ok - {name} # SKIP the program skipped itself (exit 77): {command}\n"
+                      + proc.stdout.decode("utf-8", "replace")[-600:])
+                continue
             problems = []
+            if no_data:
+                if proc.returncode != want_exit:
+                    failed += 1
+                    print(f"not ok - {name}: {command}: exit code {proc.returncode}, expected {want_exit}\n"
+                          + (proc.stderr or b"").decode("utf-8", "replace")[-600:])
+                else:
+                    skipped += 1
+                    print(f"ok - {name} # SKIP comparison (no shared data folder), exit code {proc.returncode}: {command}")
+                continue
             if proc.returncode != want_exit:
                 problems.append(f"exit code {proc.returncode}, expected {want_exit}")
                 if proc.stderr:
@@ -247,8 +276,10 @@ def main():
     if select is not None and passed + failed + skipped == 0:
         failed += 1
         print(f"not ok - no output block of a command matching {select.pattern!r} in {README}")
-    print(f"{passed} passed, {failed} failed, {skipped} skipped")
-    return 1 if failed else 0
+    print(f"{passed} passed, {failed} failed, {skipped + self_skipped} skipped")
+    if failed:
+        return 1
+    return 77 if as_test and self_skipped and passed == 0 else 0
 
 
 if __name__ == "__main__":
