@@ -577,6 +577,13 @@ static inline void moving_chart_term(phc_rod_tree *t, const double *res, size_t 
     D[2 * 12 + 1] -= 0.5 * g[0];
 }
 
+/* assemble()'s `matrix`: MATRIX_NEWTON the exact Jacobian of the residual
+ * (with the moving-chart term), MATRIX_SYMMETRIC the KKT matrix without it:
+ * the Hessian of the Lagrangian E + λ·C − ½λᵀαλ in the chart centred at the
+ * current state, symmetric by construction (the sensitivities use it). */
+#define MATRIX_NEWTON 1
+#define MATRIX_SYMMETRIC 2
+
 /* Residual (rod->res) and, when `matrix`, the Newton matrix in rod->tree.
  * Body rows: ∇E + Σ Jᵀλ (+ inertia); joint rows: C − Aλ. */
 static void assemble(phc_rod *rod, const step_params *sp, int matrix)
@@ -641,7 +648,7 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
                         D[(3 + a) * 12 + 3 + b] += iw[a * 3 + b] * (s2 + s1);
             }
         }
-        if (matrix && rod->jleft[i] == 0) /* no joint: its residual is complete */
+        if (matrix == MATRIX_NEWTON && rod->jleft[i] == 0) /* no joint: its residual is complete */
             moving_chart_term(t, rod->res, i);
     }
     for (size_t c = 0; c < n; ++c) {
@@ -683,9 +690,9 @@ static void assemble(phc_rod *rod, const step_params *sp, int matrix)
             D[(6 + a) * 12 + 6 + a] = -alpha[a];
         }
         /* a body whose last joint this was has its residual complete */
-        if (--rod->jleft[p] == 0)
+        if (--rod->jleft[p] == 0 && matrix == MATRIX_NEWTON)
             moving_chart_term(t, rod->res, p);
-        if (--rod->jleft[c] == 0)
+        if (--rod->jleft[c] == 0 && matrix == MATRIX_NEWTON)
             moving_chart_term(t, rod->res, c);
     }
 }
@@ -737,22 +744,29 @@ static residual_norm residual_measure(const phc_rod *rod, const step_params *sp)
     return rn;
 }
 
-/* Solves the Newton system for −res into rod->sol, supports by Schur
- * complement.  Returns PHC_TREE_NONE, the singular node, or DIRECTION_NOMEM. */
+/* newton_direction: solves the Newton system for −res into rod->sol.
+ * kkt_solve and it return PHC_TREE_NONE, the singular node, or
+ * DIRECTION_NOMEM. */
 #define DIRECTION_NOMEM ((size_t)-2)
 
-static size_t newton_direction(phc_rod *rod)
+/* Solves the assembled system A u = rod->sol in place (12 per node),
+ * supports by Schur complement.  factorise: 1 factorises rod->tree first,
+ * 0 uses the factors already there.  Returns as newton_direction. */
+static size_t kkt_solve(phc_rod *rod, int factorise)
 {
     phc_rod_tree *t = rod->tree;
     const size_t n = rod->n, na = rod->n_anchors, m = 6 * na;
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 12; ++k)
-            rod->sol[12 * i + k] = (k < t->dim[i]) ? -rod->res[12 * i + k] : 0.0;
-    if (na == 0) /* factorisation and solve in one sweep */
-        return phc_rod_tree_factor_solve(t, rod->sol);
-    const size_t bad = phc_rod_tree_factor(t);
-    if (bad != PHC_TREE_NONE)
-        return bad;
+    if (na == 0) { /* factorisation and solve in one sweep */
+        if (factorise)
+            return phc_rod_tree_factor_solve(t, rod->sol);
+        phc_rod_tree_solve(t, rod->sol);
+        return PHC_TREE_NONE;
+    }
+    if (factorise) {
+        const size_t bad = phc_rod_tree_factor(t);
+        if (bad != PHC_TREE_NONE)
+            return bad;
+    }
     /* u0 = K⁻¹(−r); S = G K⁻¹ Gᵀ; μ = S⁻¹ G u0; u = K⁻¹(−r − Gᵀ μ) */
     double *mu = malloc(m * sizeof *mu);
     if (!mu)
@@ -830,6 +844,15 @@ static size_t newton_direction(phc_rod *rod)
     return PHC_TREE_NONE;
 }
 
+static size_t newton_direction(phc_rod *rod)
+{
+    const phc_rod_tree *t = rod->tree;
+    for (size_t i = 0; i < rod->n; ++i)
+        for (int k = 0; k < 12; ++k)
+            rod->sol[12 * i + k] = (k < t->dim[i]) ? -rod->res[12 * i + k] : 0.0;
+    return kkt_solve(rod, 1);
+}
+
 static void save_state(phc_rod *rod)
 {
     memcpy(rod->xs, rod->x, 3 * rod->n * sizeof *rod->x);
@@ -880,7 +903,7 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
 {
     const phc_plant_graph *g = rod->g;
     const double tol = rod->opt.tolerance, L = rod->reach;
-    assemble(rod, sp, 1);
+    assemble(rod, sp, MATRIX_NEWTON);
     residual_norm rn = residual_measure(rod, sp);
     rep->iterations = 0;
     rep->residual = rn.max;
@@ -915,7 +938,7 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
             apply_step(rod, s);
             /* the first trial (almost always accepted) assembles the matrix
              * too: the next iteration's, then not assembled again */
-            assemble(rod, sp, ls == 0);
+            assemble(rod, sp, ls == 0 ? MATRIX_NEWTON : 0);
             trial = residual_measure(rod, sp);
             if (trial.sq < (1.0 - 1e-4 * s) * phi0 || trial.max <= tol) {
                 accepted = 1;
@@ -943,7 +966,7 @@ static int newton(phc_rod *rod, const step_params *sp, int cap, phc_rod_report *
             rn.max <= STEP_RESIDUAL * tol)
             return PHC_OK;
         if (!have_matrix)
-            assemble(rod, sp, 1);
+            assemble(rod, sp, MATRIX_NEWTON);
     }
     if (rn.max <= tol)
         return PHC_OK;
@@ -1306,6 +1329,184 @@ int phc_rod_step(phc_rod *rod, double dt, phc_rod_report *report, phc_error *err
     return rc;
 }
 
+/* ---- sensitivities of the static equilibrium (rod.h) -------------------
+ *
+ * At the equilibrium F(z, λ; E) = 0 of phc_rod_solve_static (body rows
+ * ∇E_pot + Σ Jᵀλ, joint rows C − αλ: Deul et al. 2018 §3, eq. 5 and 7, in
+ * the compliant form of rod.h, λ_b = f ℓK (Ω − Ω0), α = (f ℓK)⁻¹) only the
+ * bend–twist rows of the joints depend on the moduli, through α:
+ *     α_a = 1 / (f ℓ K_a),  K_a ∝ e (E I or G J, G = e / (2(1 + ν))),
+ *     e = ℓ / (h_p/(2E_p) + h_c/(2E_c))                     (rod.h)
+ *     ∂α_a/∂E_s = −α_a e h_s / (2 ℓ E_s²)          s ∈ {p, c}   (α per Pa)
+ * so ∂F_a/∂E_s = −(∂α_a/∂E_s) λ_a = β_a w_s with β_a = α_a λ_a (the bending
+ * strain Ω − Ω0 at equilibrium, 1/m) and w_s = e h_s / (2 ℓ E_s²) (1/Pa).
+ * Implicit differentiation: A dz/dE = −∂F/∂E, A the KKT matrix at the
+ * solution.  A is assembled without the moving-chart term (MATRIX_SYMMETRIC:
+ * the Hessian of the Lagrangian in the chart centred at the solution,
+ * symmetric; the Newton matrix differs from it by −½[r_θ]×, which vanishes
+ * at equilibrium), so the adjoint A⁻ᵀ g is the same solve A⁻¹ g.
+ * Supports (more than one fixed segment per part) by the same Schur
+ * complement as the Newton steps (kkt_solve). */
+
+/* w_s of joint c for s = p (ws[0]) and s = c (ws[1]), 1/Pa */
+static void modulus_weights(const phc_rod *rod, size_t c, double ws[2])
+{
+    const phc_plant_graph *g = rod->g;
+    const size_t p = g->parent[c];
+    const double ell = rod->joint[c].ell, Ep = rod->young[p], Ec = rod->young[c];
+    const double e = ell / (0.5 * g->length[p] / Ep + 0.5 * g->length[c] / Ec);
+    ws[0] = e * g->length[p] / (2.0 * ell * Ep * Ep);
+    ws[1] = e * g->length[c] / (2.0 * ell * Ec * Ec);
+}
+
+/* β_a = α_a λ_a of joint c (its bend–twist rows), 1/m */
+static void bending_strain(const phc_rod *rod, size_t c, double beta[3])
+{
+    for (int a = 0; a < 3; ++a)
+        beta[a] = rod->lambda[6 * c + 3 + a] / (rod->factor[c] * rod->stiff[3 * c + a]);
+}
+
+/* The symmetric KKT matrix at the current state, factorised; refuses a
+ * state that is not a static equilibrium. */
+static int sensitivity_prepare(phc_rod *rod, const char *what, phc_error *err)
+{
+    const step_params sp = {0, 0.0, 0.0};
+    int rc = build_tree(rod, 1, err);
+    if (rc != PHC_OK)
+        return rc;
+    rod->load_scale = 1.0;
+    assemble(rod, &sp, MATRIX_SYMMETRIC);
+    const residual_norm rn = residual_measure(rod, &sp);
+    if (!(rn.max <= STEP_RESIDUAL * rod->opt.tolerance))
+        return phc_error_set(err, PHC_ERR_DOMAIN,
+                             "rod: %s: the rod is not at a static equilibrium (scaled residual "
+                             "%.3g, more than %g x the tolerance %.3g): call phc_rod_solve_static "
+                             "first, after the last change of moduli, loads or supports",
+                             what, rn.max, STEP_RESIDUAL, rod->opt.tolerance);
+    const size_t bad = phc_rod_tree_factor(rod->tree);
+    if (bad != PHC_TREE_NONE)
+        return phc_error_set(err, PHC_ERR_NUMERIC,
+                             "rod: %s: segment %ld: the equilibrium's KKT matrix is singular (a "
+                             "buckling point, or a joint without stiffness)",
+                             what, rod->g->source_id[bad]);
+    return PHC_OK;
+}
+
+static int sensitivity_solve(phc_rod *rod, const char *what, phc_error *err)
+{
+    const size_t bad = kkt_solve(rod, 0);
+    if (bad == DIRECTION_NOMEM)
+        return phc_error_set(err, PHC_ERR_NOMEM, "rod: %s: out of memory for the supports' system", what);
+    if (bad != PHC_TREE_NONE)
+        return phc_error_set(err, PHC_ERR_NUMERIC, "rod: %s: segment %ld: the supports' system is singular",
+                             what, rod->g->source_id[bad]);
+    for (size_t i = 0; i < 12 * rod->n; ++i)
+        if (!isfinite(rod->sol[i]))
+            return phc_error_set(err, PHC_ERR_NUMERIC, "rod: %s: the solution is not finite (segment %ld)",
+                                 what, rod->g->source_id[i / 12]);
+    return PHC_OK;
+}
+
+int phc_rod_static_sensitivity(phc_rod *rod, size_t n_dir, const double *dE, double *dz, phc_error *err)
+{
+    static const char what[] = "sensitivity";
+    const size_t n = rod->n;
+    for (size_t i = 0; i < n_dir * n; ++i)
+        if (!isfinite(dE[i]))
+            return phc_error_set(err, PHC_ERR_INPUT,
+                                 "rod: %s: direction %zu: segment %ld: dE is not finite", what, i / n,
+                                 rod->g->source_id[i % n]);
+    int rc = sensitivity_prepare(rod, what, err);
+    if (rc != PHC_OK)
+        return rc;
+    for (size_t d = 0; d < n_dir; ++d) {
+        const double *de = dE + d * n;
+        memset(rod->sol, 0, 12 * n * sizeof *rod->sol);
+        for (size_t c = 0; c < n; ++c) {
+            const size_t k = rod->jnode[c];
+            if (k == PHC_TREE_NONE)
+                continue;
+            double ws[2], beta[3];
+            modulus_weights(rod, c, ws);
+            bending_strain(rod, c, beta);
+            const double s = ws[0] * de[rod->g->parent[c]] + ws[1] * de[c];
+            for (int a = 0; a < 3; ++a)
+                rod->sol[12 * k + 9 + a] = -beta[a] * s;
+        }
+        if ((rc = sensitivity_solve(rod, what, err)) != PHC_OK)
+            return rc;
+        double *out = dz + d * 6 * n;
+        for (size_t i = 0; i < n; ++i)
+            for (int k = 0; k < 6; ++k)
+                out[6 * i + k] = (rod->tree->dim[i] >= 6 && !rod->fixed[i]) ? rod->sol[12 * i + k] : 0.0;
+    }
+    phc_error_clear(err);
+    return PHC_OK;
+}
+
+int phc_rod_static_adjoint(phc_rod *rod, const double *dg_dz, double *dg_dE, phc_error *err)
+{
+    static const char what[] = "adjoint";
+    const size_t n = rod->n;
+    for (size_t i = 0; i < 6 * n; ++i)
+        if (!isfinite(dg_dz[i]))
+            return phc_error_set(err, PHC_ERR_INPUT, "rod: %s: segment %ld: dg/dz[%zu] is not finite", what,
+                                 rod->g->source_id[i / 6], i % 6);
+    int rc = sensitivity_prepare(rod, what, err);
+    if (rc != PHC_OK)
+        return rc;
+    memset(rod->sol, 0, 12 * n * sizeof *rod->sol);
+    for (size_t i = 0; i < n; ++i)
+        if (rod->tree->dim[i] >= 6 && !rod->fixed[i])
+            memcpy(rod->sol + 12 * i, dg_dz + 6 * i, 6 * sizeof *rod->sol);
+    if ((rc = sensitivity_solve(rod, what, err)) != PHC_OK)
+        return rc;
+    memset(dg_dE, 0, n * sizeof *dg_dE);
+    for (size_t c = 0; c < n; ++c) {
+        const size_t k = rod->jnode[c];
+        if (k == PHC_TREE_NONE)
+            continue;
+        double ws[2], beta[3], vb = 0.0;
+        modulus_weights(rod, c, ws);
+        bending_strain(rod, c, beta);
+        for (int a = 0; a < 3; ++a)
+            vb += rod->sol[12 * k + 9 + a] * beta[a];
+        dg_dE[rod->g->parent[c]] -= vb * ws[0];
+        dg_dE[c] -= vb * ws[1];
+    }
+    phc_error_clear(err);
+    return PHC_OK;
+}
+
+void phc_rod_end_sensitivity(const phc_rod *rod, size_t i, const double *dz, double dhead[3], double dtail[3])
+{
+    double u[3];
+    phc_rod_internal_tail_offset(rod, i, u);
+    const double *dx = dz + 6 * i, *dth = dz + 6 * i + 3;
+    const double w[3] = {dth[1] * u[2] - dth[2] * u[1], dth[2] * u[0] - dth[0] * u[2],
+                         dth[0] * u[1] - dth[1] * u[0]};
+    for (int k = 0; k < 3; ++k) {
+        if (dhead)
+            dhead[k] = dx[k] - w[k];
+        if (dtail)
+            dtail[k] = dx[k] + w[k];
+    }
+}
+
+void phc_rod_end_gradient(const phc_rod *rod, size_t i, const double g_head[3], const double g_tail[3],
+                          double g_z[6])
+{
+    double u[3], d[3];
+    phc_rod_internal_tail_offset(rod, i, u);
+    for (int k = 0; k < 3; ++k) {
+        g_z[k] = g_tail[k] + g_head[k];
+        d[k] = g_tail[k] - g_head[k];
+    }
+    g_z[3] = u[1] * d[2] - u[2] * d[1];
+    g_z[4] = u[2] * d[0] - u[0] * d[2];
+    g_z[5] = u[0] * d[1] - u[1] * d[0];
+}
+
 /* ---- test hooks (rod_internal.h) ----------------------------------------- */
 
 int phc_rod_internal_prepare_static(phc_rod *rod, phc_error *err)
@@ -1316,7 +1517,7 @@ int phc_rod_internal_prepare_static(phc_rod *rod, phc_error *err)
 void phc_rod_internal_assemble_static(phc_rod *rod, int matrix)
 {
     const step_params sp = {0, 0.0, 0.0};
-    assemble(rod, &sp, matrix);
+    assemble(rod, &sp, matrix ? MATRIX_NEWTON : 0);
 }
 
 /* the matrix entry (row of node a, column of node b) as assembled */
@@ -1349,7 +1550,7 @@ int phc_rod_internal_jacobian_check(phc_rod *rod, double eps, double *max_error,
         free(rm);
         return phc_error_set(err, PHC_ERR_NOMEM, "rod: out of memory");
     }
-    assemble(rod, &sp, 1);
+    assemble(rod, &sp, MATRIX_NEWTON);
     memcpy(diag, rod->tree->diag, 144 * n * sizeof *diag);
     memcpy(coup, rod->tree->coup, 72 * n * sizeof *coup);
     *max_error = *max_entry = 0.0;
@@ -1377,5 +1578,30 @@ int phc_rod_internal_jacobian_check(phc_rod *rod, double eps, double *max_error,
     free(coup);
     free(rp);
     free(rm);
+    return PHC_OK;
+}
+
+int phc_rod_internal_symmetry_check(phc_rod *rod, double *max_asymmetry, double *max_entry, phc_error *err)
+{
+    const step_params sp = {0, 0.0, 0.0};
+    int rc = build_tree(rod, 1, err);
+    if (rc != PHC_OK)
+        return rc;
+    assemble(rod, &sp, MATRIX_SYMMETRIC);
+    const phc_rod_tree *t = rod->tree;
+    *max_asymmetry = *max_entry = 0.0;
+    for (size_t a = 0; a < rod->n; ++a)
+        for (size_t b = 0; b < rod->n; ++b) {
+            if (a != b && t->parent[a] != b && t->parent[b] != a)
+                continue; /* no block */
+            for (int r = 0; r < t->dim[a]; ++r)
+                for (int c = 0; c < t->dim[b]; ++c) {
+                    const double x = matrix_entry(t, t->diag, t->coup, a, r, b, c);
+                    const double y = matrix_entry(t, t->diag, t->coup, b, c, a, r);
+                    *max_asymmetry = fmax(*max_asymmetry, fabs(x - y));
+                    *max_entry = fmax(*max_entry, fabs(x));
+                }
+        }
+    assemble(rod, &sp, 0);
     return PHC_OK;
 }

@@ -136,6 +136,45 @@ int phc_rod_solve_static(phc_rod *rod, phc_rod_report *report, phc_error *err);
  * which the implicit step does not converge, and says which segment. */
 int phc_rod_step(phc_rod *rod, double dt, phc_rod_report *report, phc_error *err);
 
+/* Sensitivities of the static equilibrium with respect to the segments'
+ * Young's moduli, by implicit differentiation at the converged point
+ * (F(z, λ; E) = 0  ⇒  A dz/dE = −∂F/∂E, A the KKT matrix of the Newton
+ * solve, assembled at the solution without the moving-chart term, which
+ * vanishes there: symmetric, factorised once per call by the direct tree
+ * solver).  Only the joints' bend–twist rows depend on E, through their
+ * compliance α = 1/(f ℓK), K ∝ e the joint's harmonic-mean modulus (above):
+ * ∂α/∂E_s = −α e h_s / (2 ℓ E_s²) for its two segments s (rod.c).
+ * The rod must be at a static equilibrium (phc_rod_solve_static returned
+ * PHC_OK and nothing changed since): otherwise PHC_ERR_DOMAIN.  A singular
+ * KKT matrix (a buckling point) is PHC_ERR_NUMERIC.  Both leave the state
+ * unchanged.
+ *
+ * phc_rod_static_sensitivity: n_dir directions dE (n_dir × n, Pa per unit of
+ * the direction's parameter); writes dz (n_dir × 6n): per segment i the
+ * derivative of its centre (m) and its world-frame rotation vector (rad,
+ * the increment δθ of q ← exp(δθ) q) along each direction (zero for fixed
+ * segments).  One forward/back substitution per direction. */
+int phc_rod_static_sensitivity(phc_rod *rod, size_t n_dir, const double *dE, double *dz,
+                               phc_error *err);
+
+/* phc_rod_static_adjoint: for a scalar g of the state with gradient dg_dz
+ * (6n: per segment ∂g/∂centre, 1/m units of g, then ∂g/∂δθ, per rad; the
+ * entries of fixed segments are ignored), writes dg_dE (n: ∂g/∂E_i, per Pa)
+ * for every segment: one solve (A is symmetric, so A⁻ᵀ = A⁻¹). */
+int phc_rod_static_adjoint(phc_rod *rod, const double *dg_dz, double *dg_dE, phc_error *err);
+
+/* The derivatives of segment i's head and tail (m per unit) along one
+ * sensitivity dz (6n, as written by phc_rod_static_sensitivity): d tail =
+ * dx + δθ × u, d head = dx − δθ × u, u = R(q)(0, 0, h/2).  Either output may
+ * be NULL. */
+void phc_rod_end_sensitivity(const phc_rod *rod, size_t i, const double *dz, double dhead[3],
+                             double dtail[3]);
+/* The gradient g_z (6: centre, rotation) of segment i for a function of
+ * its head and tail with gradients g_head, g_tail (the chain rule of the
+ * above: g_x = g_t + g_h, g_θ = u × (g_t − g_h)), for phc_rod_static_adjoint. */
+void phc_rod_end_gradient(const phc_rod *rod, size_t i, const double g_head[3],
+                          const double g_tail[3], double g_z[6]);
+
 /* Current positions of segment i's head and tail, m. */
 void phc_rod_head(const phc_rod *rod, size_t i, double out[3]);
 void phc_rod_tail(const phc_rod *rod, size_t i, double out[3]);

@@ -73,6 +73,13 @@ int phc_rod_internal_gauss_seidel_substep(phc_rod *rod, double h, phc_error *err
 int phc_rod_internal_jacobian_check(phc_rod *rod, double eps, double *max_error,
                                     double *max_entry, phc_error *err);
 
+/* Assembles the symmetric KKT matrix that the sensitivities
+ * (phc_rod_static_sensitivity, _adjoint) factorise, at the current state,
+ * and writes the largest |A[r][c] − A[c][r]| over every entry and the
+ * largest |entry|.  PHC_OK or the error of building the elimination tree. */
+int phc_rod_internal_symmetry_check(phc_rod *rod, double *max_asymmetry, double *max_entry,
+                                    phc_error *err);
+
 /* The parts of one static Newton iteration, for the benchmark
  * (tests/bench/bench_rod.c): _prepare_static builds the elimination tree of
  * the statics (as phc_rod_solve_static does; PHC_OK or its error);

@@ -45,7 +45,7 @@ static const phc_key_help shape_series_help[] = {
     {"sigma", "Standard deviation of an angle, rad (> 0). Default unweighted."},
     {"every", "Keep every k-th sample (k >= 1) to thin long tracks. Default 1."},
     {"density", "Stalk tissue density, kg m-3 (> 0). Default 1000."},
-    {"fd_step", "Relative step in E of the central difference d angle / d E. Default 1e-4."},
+    {"fd_step", "dynamics: particles only: relative step in s of the central difference d angle / d s (rods use the exact derivative of the equilibrium). Default 1e-4."},
     {"plant", "A plant-graph file (relative to the config): the organ model is then the whole "
               "plant as one rod, every segment at E(t), and each series gives `segment` (the "
               "id of the segment whose direction is its angle) instead of length, radius, "

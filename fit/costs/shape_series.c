@@ -35,6 +35,8 @@ typedef struct stalk {
     long offset_slot;   /* slot of offset_<id>, or -1 */
     size_t seg;         /* the segment whose direction is the angle */
     int shared;         /* 1: g and rod are the data set's plant (not owned) */
+    double *sens;       /* rods: 8 g->n work for the sensitivities: dz or the
+                           angle's gradient (6n), a direction (n), dangle/dE_i (n) */
 } stalk;
 
 typedef struct shape_impl {
@@ -42,7 +44,7 @@ typedef struct shape_impl {
     stalk *stalks;
     size_t *stalk_of;   /* [n] stalk of each observation */
     double *t;          /* [n] s */
-    double t0, rwc0, e_min, fd_step;
+    double t0, rwc0, e_min, fd_step; /* fd_step: particles only */
     long e_min_slot;    /* slot of e_min, or -1 */
     size_t frames;
     phc_plant_graph *plant; /* options.plant's copy, or NULL */
@@ -56,7 +58,6 @@ typedef struct shape_impl {
     phc_shape_water *water; /* options.water_model: the water model on the plant, or NULL */
     double *x, *dx;         /* plant->n: relative water content, d x / d δ (work) */
     double *grad_e;         /* k x plant->n: d E_i / d slot (work) */
-    double *e_step;         /* plant->n: E ± h dE/dp (work) */
 } shape_impl;
 
 static void impl_free(void *p)
@@ -72,6 +73,7 @@ static void impl_free(void *p)
         }
         free(m->stalks[s].head);
         free(m->stalks[s].tail);
+        free(m->stalks[s].sens);
         free(m->stalks[s].young);
         free(m->stalks[s].id);
     }
@@ -83,7 +85,6 @@ static void impl_free(void *p)
     free(m->x);
     free(m->dx);
     free(m->grad_e);
-    free(m->e_step);
     free(m->stalk_of);
     free(m->t);
     free(m);
@@ -176,6 +177,61 @@ static double direction(const stalk *st, const double h[3], const double t[3])
 {
     const double a = atan2(t[2] - h[2], t[0] - h[0]);
     return st->beta + remainder(a - st->beta, 2.0 * PHC_SS_PI);
+}
+
+/* The gradients of direction() with respect to the tail (g_tail) and the
+ * head (g_head = −g_tail), rad/m: a = atan2(d_z, d_x), d = t − h, so
+ * ∂a/∂t = (−d_z, 0, d_x) / (d_x² + d_z²). */
+static void direction_gradient(const double h[3], const double t[3], double g_head[3], double g_tail[3])
+{
+    const double dx = t[0] - h[0], dz = t[2] - h[2], r2 = dx * dx + dz * dz;
+    g_tail[0] = -dz / r2;
+    g_tail[1] = 0.0;
+    g_tail[2] = dx / r2;
+    for (int k = 0; k < 3; ++k)
+        g_head[k] = -g_tail[k];
+}
+
+/* Rods, after a successful rod_solve: d angle / dE with every segment at
+ * the same E (rad/Pa), exact: one sensitivity solve of the equilibrium
+ * (phc_rod_static_sensitivity along dE_i = 1) and the angle's analytic
+ * gradient in the segment's head and tail. */
+static int rod_angle_derivative(stalk *st, double *da_dE, phc_error *err)
+{
+    const size_t n = st->g->n;
+    double *dz = st->sens, *dir = st->sens + 6 * n;
+    for (size_t i = 0; i < n; ++i)
+        dir[i] = 1.0;
+    int rc = phc_rod_static_sensitivity(st->rod, 1, dir, dz, err);
+    if (rc)
+        return rc;
+    double h[3], t[3], gh[3], gt[3], dh[3], dt[3];
+    phc_rod_head(st->rod, st->seg, h);
+    phc_rod_tail(st->rod, st->seg, t);
+    direction_gradient(h, t, gh, gt);
+    phc_rod_end_sensitivity(st->rod, st->seg, dz, dh, dt);
+    *da_dE = 0.0;
+    for (int k = 0; k < 3; ++k)
+        *da_dE += gh[k] * dh[k] + gt[k] * dt[k];
+    return isfinite(*da_dE) ? 0 : phc_error_set(err, PHC_ERR_NUMERIC, "series '%s': d angle / dE is not finite", st->id);
+}
+
+/* Rods with a modulus per segment, after a successful rod_solve_young:
+ * d angle / dE_i for every segment i (st->sens + 7n, rad/Pa), exact: one
+ * adjoint solve (phc_rod_static_adjoint) of the angle's gradient. */
+static int rod_angle_adjoint(stalk *st, const double **da_dE, phc_error *err)
+{
+    const size_t n = st->g->n;
+    double *gz = st->sens, *out = st->sens + 7 * n;
+    double h[3], t[3], gh[3], gt[3];
+    memset(gz, 0, 6 * n * sizeof *gz);
+    phc_rod_head(st->rod, st->seg, h);
+    phc_rod_tail(st->rod, st->seg, t);
+    direction_gradient(h, t, gh, gt);
+    phc_rod_end_gradient(st->rod, st->seg, gh, gt, gz + 6 * st->seg);
+    int rc = phc_rod_static_adjoint(st->rod, gz, out, err);
+    *da_dE = out;
+    return rc;
 }
 
 /* Particles at stiffness s relaxed from the rest pose to rest (see the
@@ -347,28 +403,18 @@ static int predict_water(phc_dataset *ds, const double *p, double *yhat, double 
         yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
         if (!jac)
             continue;
-        double e_top = 0.0;
-        for (size_t q = 0; q < n; ++q)
-            e_top = fmax(e_top, st->young[q]);
+        /* d angle / d slot = Σ_q (d angle / dE_q) (dE_q / d slot): the first
+         * factor for every segment by one adjoint solve, the second exact */
+        const double *da_dE;
+        if (rod_angle_adjoint(st, &da_dE, &e))
+            return 1;
         double *row = jac + i * ds->k;
         for (size_t j = 0; j < ds->k; ++j) {
             const double *d = m->grad_e + j * n;
-            double d_top = 0.0;
+            double sum = 0.0;
             for (size_t q = 0; q < n; ++q)
-                d_top = fmax(d_top, fabs(d[q]));
-            if (!(d_top > 0.0))
-                continue; /* offsets, and slots E does not depend on here */
-            const double h = m->fd_step * e_top / d_top;
-            double ap, am;
-            for (size_t q = 0; q < n; ++q)
-                m->e_step[q] = st->young[q] + h * d[q];
-            if (rod_solve_young(st, m->e_step, &ap, &e))
-                return 1;
-            for (size_t q = 0; q < n; ++q)
-                m->e_step[q] = st->young[q] - h * d[q];
-            if (rod_solve_young(st, m->e_step, &am, &e))
-                return 1;
-            row[j] = (ap - am) / (2.0 * h);
+                sum += da_dE[q] * d[q];
+            row[j] = sum; /* 0 for offsets (grad_e zero there), set below */
         }
         if (st->offset_slot >= 0)
             row[st->offset_slot] = 1.0;
@@ -410,11 +456,16 @@ static int predict_series(phc_dataset *ds, const double *p, size_t s, double *yh
         yhat[i] = a + (st->offset_slot >= 0 ? p[st->offset_slot] : 0.0);
         if (!jac)
             continue;
-        /* d angle / dz by a central difference in z (rods: warm-started;
-         * particles: each from rest, backward when z + h > 1) */
+        /* d angle / dz: rods exact (one sensitivity solve); particles by a
+         * central difference in z (each from rest, backward when z + h > 1) */
         const double h = m->fd_step * z;
         double ap, am, da_dE;
-        if (m->dynamics == PHC_SHAPE_PARTICLES && z + h > 1.0) {
+        if (m->dynamics != PHC_SHAPE_PARTICLES) {
+            if ((rc = rod_angle_derivative(st, &da_dE, NULL))) {
+                *bad = i;
+                break;
+            }
+        } else if (z + h > 1.0) {
             if ((rc = solve_angle(m, st, z - h, &am, NULL)) || (rc = solve_angle(m, st, z - 2.0 * h, &ap, NULL))) {
                 *bad = i;
                 break;
@@ -444,11 +495,12 @@ static int predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
         return predict_water(ds, p, yhat, jac);
     if (jac)
         memset(jac, 0, ds->n * ds->k * sizeof *jac);
-    /* The series are independent (a rod each), so with rods they are
+    /* The stalks are independent (a rod each), so with rods they are
      * solved side by side; each walks its own observations in order with
      * the same warm starts as one thread, so the result is the same to the
-     * bit.  Particles share the data set's step counter: one at a time. */
-    const int side_by_side = m->dynamics != PHC_SHAPE_PARTICLES && m->n_stalks > 1;
+     * bit.  The series of a plant share its one rod, and particles share
+     * the data set's step counter: one at a time. */
+    const int side_by_side = m->dynamics != PHC_SHAPE_PARTICLES && !m->plant && m->n_stalks > 1;
     size_t first_bad = ds->n;
     int bad_rc = 0;
 #pragma omp parallel for schedule(dynamic, 1) if (side_by_side)
@@ -792,6 +844,8 @@ static int plant_stalk(shape_impl *m, stalk *out, const phc_shape_stalk *spec, d
             m->plant_force[3 * i + d] += force[d];
         return PHC_OK;
     }
+    if (!(out->sens = malloc(8 * g->n * sizeof *out->sens)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     return phc_rod_set_load(m->plant_rod, i, force, err);
 }
 
@@ -848,7 +902,7 @@ static int plant_water(shape_impl *m, const phc_shape_series_options *o, const p
     if (rc)
         return phc_error_prefix(err, rc, "%s: the water model", phc_origin_key(o->origin, "shape_series", "water").text);
     if (!(m->x = malloc(n * sizeof *m->x)) || !(m->dx = malloc(n * sizeof *m->dx)) ||
-        !(m->grad_e = malloc(ds->k * n * sizeof *m->grad_e)) || !(m->e_step = malloc(n * sizeof *m->e_step)))
+        !(m->grad_e = malloc(ds->k * n * sizeof *m->grad_e)))
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     return PHC_OK;
 }
@@ -903,6 +957,8 @@ static int build_stalk(stalk *out, const phc_shape_stalk *spec, double beta, con
         memcpy(out->force + 3 * (n - 1), force, sizeof force);
         return PHC_OK;
     }
+    if (!(out->sens = malloc(8 * n * sizeof *out->sens)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     if ((rc = phc_rod_new(g, out->young, &ro, &out->rod, err)))
         return rc;
     return phc_rod_set_load(out->rod, n - 1, force, err);

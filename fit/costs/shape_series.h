@@ -97,20 +97,23 @@
  *
  * Derivatives ("analytic" to the engine): the model angle depends on the
  * shared slots only through the scalar E(t), so d angle / d p = (d angle /
- * d E) · (d E / d p) with d E / d p exact and d angle / d E by a central
- * difference in E with relative step options.fd_step (two more static
- * solves per observation, warm-started from the previous solution);
- * d angle / d offset = 1.  With water_model the moduli form a vector E(t):
- * d E / d p is exact per segment (d x / d δ from the water model's BDF6
- * sensitivities) and d angle / d p is a central difference along that
- * direction, E ± h·dE/dp with h·max|dE/dp| = fd_step·max E (two static
- * solves per slot and observation).  With particles the scalar is s(t) (d s / d p
- * exact, including the E_max and E_min slots in its denominator) and
- * d angle / d s a central difference with step fd_step·s, or the
- * second-order backward difference (3 a(s) − 4 a(s − h) + a(s − 2h)) / 2h
- * when s + h > 1; each of the two or three solves relaxes from rest.  tests/unit/test_shape_series_new.c checks the
- * Jacobian against central differences of the whole model in every slot and
- * against a second fd_step.
+ * d E) · (d E / d p) with d E / d p exact; d angle / d offset = 1.
+ * With rods d angle / d E is exact too: implicit differentiation of the
+ * converged equilibrium (phc_rod_static_sensitivity along dE_i = 1: one
+ * factorisation and one solve of the KKT matrix, no further static solve)
+ * chained with the angle's analytic gradient in the segment's head and
+ * tail (a = atan2(d_z, d_x), d = tail − head).  With water_model the moduli
+ * form a vector E(t): d E_i / d p is exact per segment (d x / d δ from the
+ * water model's BDF6 sensitivities) and d angle / d E_i for every segment
+ * comes from one adjoint solve (phc_rod_static_adjoint), so every slot
+ * costs one dot product.  options.fd_step is used by particles only: there
+ * the scalar is s(t) (d s / d p exact, including the E_max and E_min slots
+ * in its denominator) and d angle / d s a central difference with step
+ * fd_step·s, or the second-order backward difference (3 a(s) − 4 a(s − h)
+ * + a(s − 2h)) / 2h when s + h > 1; each of the two or three solves relaxes
+ * from rest.  tests/unit/test_shape_series_new.c and test_shape_water.c
+ * check the Jacobian against central differences of the whole model in
+ * every slot.
  *
  * Errors (PHC_ERR_INPUT) say what and where: a stalk naming a series that
  * is not in the tracks (with the list), a track that is not an angle,
@@ -169,7 +172,8 @@ typedef struct phc_shape_series_options {
     double density;                /* ρ, kg m⁻³, > 0; default 1000 */
     double sigma;                  /* rad, > 0; 0 (default): unweighted */
     size_t every;                  /* keep every k-th sample (>= 1, default 1) */
-    double fd_step;                /* relative step in E for d angle/dE; default 1e-4 */
+    double fd_step;                /* particles only: relative step in s for d angle/ds
+                                      (rods use exact derivatives); default 1e-4 */
     size_t frames;                 /* simulate/fit outputs: frames (side views, graphs),
                                       evenly spaced over the data's times; default 6, 0 none */
     const phc_origin *origin;      /* where the options came from, for messages; NULL */

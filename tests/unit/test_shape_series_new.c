@@ -9,9 +9,10 @@
  *    chi0 = 0.7, e_max = 1e8 Pa (e_min 1e6 Pa), delta = 2e-4 s-1 (and an offset of 0.05 rad
  *    on the second stalk), written as a CSV in degrees and read back
  *    (measurements/shape_series.h), fitted back from a perturbed start;
- * 3. the Jacobian (d angle / d E by central differences, chained with the
- *    exact d E / d slot) against central differences of the whole model in
- *    every slot, and against a second fd_step;
+ * 3. the Jacobian (d angle / d E exact, from one sensitivity solve of the
+ *    rod's equilibrium, chained with the exact d E / d slot) against central
+ *    differences of the whole model in every slot; rods do not use fd_step
+ *    (the Jacobians with two fd_steps are the same to the bit);
  * 4. errors: an unknown series, a zero radius, a negative E_min;
  * 5. e_min as a slot: its Jacobian column against central differences;
  * 6. a plant graph (options.plant) laid out as a stalk, its series mapped to
@@ -212,9 +213,9 @@ static void test_jacobian(const double *a, const double *b)
     }
     printf("Jacobian vs central differences of the whole model: largest error %.3g (relative to the column)\n",
            worst);
-    printf("Jacobian with fd_step 1e-4 vs 1e-6: largest difference %.3g (relative to the column)\n", worst2);
-    CHECK(worst < 1e-5);
-    CHECK(worst2 < 1e-5);
+    printf("Jacobian with fd_step 1e-4 vs 1e-6 (rods do not use it): largest difference %.3g\n", worst2);
+    CHECK(worst < 1e-7);
+    CHECK(worst2 == 0);
     free(jac);
     free(jac2);
     free(yp);
@@ -316,7 +317,7 @@ static void test_e_min_slot(const double *a, const double *b)
             worst = fmax(worst, fabs(jac[i * 6 + 4] - (yp[i] - ym[i]) / (2 * h)) / scale);
         printf("e_min slot: Jacobian column vs central differences: largest error %.3g (relative to the column)\n",
                worst);
-        CHECK(scale > 0 && worst < 1e-5);
+        CHECK(scale > 0 && worst < 1e-7);
     } else {
         fprintf(stderr, "%s\n", err.message);
     }

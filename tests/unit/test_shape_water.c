@@ -13,8 +13,9 @@
  *    every segment has nearly the same x(t) = exp(−δ Ā t) with Ā =
  *    Σ_leaf A_i V_i / Σ V_i (cm²; A = r h, V = π r² h): the water-driven
  *    angles equal a one-compartment stalk's at δ_c = δ Ā.
- * 2. The Jacobian (exact d E_i / d slot, directional central differences
- *    in E) against central differences of the whole model in every slot.
+ * 2. The Jacobian (exact d E_i / d slot, exact d angle / d E_i from one
+ *    adjoint solve of the rod's equilibrium) against central differences
+ *    of the whole model in every slot.
  * 3. A joint fit: the angles (σ 2 mrad) and the plant's weighings on a
  *    balance (σ 1 mg, a weight_curve on the same plant) share δ by name;
  *    synthetic data from the models at the truth with seeded noise, fitted
@@ -178,7 +179,10 @@ static void test_jacobian(phc_dataset *ds)
     for (size_t j = 0; j < 4; ++j) {
         double q[4];
         memcpy(q, p, sizeof q);
-        const double h = 1e-5 * fabs(p[j]);
+        /* 1e-4: the water model's BDF6 solves leave noise in the angles that
+         * smaller steps magnify (delta's column: 1.1e-6 of it at 1e-5, 5.8e-6
+         * at 1e-6; truncation 7.9e-6 at 1e-3) */
+        const double h = 1e-4 * fabs(p[j]);
         q[j] = p[j] + h;
         CHECK(ds->ops->predict(ds, q, yp, NULL) == 0);
         q[j] = p[j] - h;
@@ -193,7 +197,7 @@ static void test_jacobian(phc_dataset *ds)
         worst = fmax(worst, err / col);
     }
     printf("jacobian: largest relative difference %.3g\n", worst);
-    CHECK(worst < 1e-4);
+    CHECK(worst < 1e-5);
 }
 
 static phc_dataset *balance_set(const phc_plant_graph *g, double *mass_out)
