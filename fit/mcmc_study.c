@@ -335,7 +335,7 @@ static int stretch_count(phc_dist *d, posterior *q, size_t before, double second
         fprintf(stderr, "mcmc stretch: model evaluations by rank:");
         for (size_t r = 0; r < size; ++r)
             fprintf(stderr, " %zu: %.0f (%.3f s sampling)%s", r, v[2 * r], v[2 * r + 1], r + 1 < size ? "," : "");
-        fprintf(stderr, "; %zu in all, %zu before sampling on every rank (the fit and the starts)\n", total, before);
+        fprintf(stderr, "; %zu in all, and %zu on every rank before sampling (drawing the starts)\n", total, before);
     }
 out:
     free(v);
