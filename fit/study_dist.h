@@ -22,7 +22,12 @@
  * agreed, exactly one call of run().  A result the master cannot record
  * (an I/O error, a cancelled or stopped study) stops the workers: the
  * master sends each a stop with its status and receives what they still
- * had in flight, so no process hangs. */
+ * had in flight, so no process hangs.
+ *
+ * A sampler that runs on every rank alike (mcmc --method stretch) instead
+ * makes the same sequence of agree() and share() calls on every rank: the
+ * calls depend only on what every rank computes alike (the sampler's
+ * settings, the agreed statuses), never on one rank's evaluations. */
 #ifndef PHC_STUDY_DIST_H
 #define PHC_STUDY_DIST_H
 
