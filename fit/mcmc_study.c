@@ -652,7 +652,7 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         sop.progress_data = &pr;
         stretch_dist sd = {o.dist, 0};
         phc_stretch_share share = {sd_block, sd_exchange, sd_agree, &sd};
-        const size_t before = q.evaluations; /* the fit's and the starts', the same on every rank */
+        const size_t before = q.evaluations; /* the start draws', the same on every rank */
         const double t0 = o.dist ? wall_seconds() : 0;
         if (o.dist) { /* every rank runs the ensemble and evaluates its block of each half (mcmc_study.h) */
             rc = o.dist->agree(o.dist, PHC_OK, err);

@@ -28,10 +28,12 @@
  * block() gives the rows [lo, hi) this process evaluates; exchange() then
  * makes every process hold all n rows of PHC_STRETCH_ROW doubles (SS and
  * log prior; NAN where the density is 0), bit for bit: one collective per
- * batch; it fails on every process alike or on none.  agree() is collective too: once before the first exchange with
- * this process's set-up status, and after every progress report; it returns
- * 0 when every process's status is 0, else the status to stop with (err
- * set), the same on every process. */
+ * batch; it fails on every process alike or on none.  agree() is
+ * collective too: once before the first exchange with this process's
+ * set-up status, and every 50 sweeps after the progress report (whether or
+ * not there is a progress callback); it returns 0 when every process's
+ * status is 0, else the status to stop with (err set), the same on every
+ * process. */
 #define PHC_STRETCH_ROW 2
 typedef struct phc_stretch_share {
     void (*block)(void *data, size_t n, size_t *lo, size_t *hi);
