@@ -11,6 +11,7 @@
 #include <string.h>
 #include <errno.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "fit/engine/fit.h"
@@ -275,6 +276,81 @@ static int dram_on_ranks(phc_dist *dist, int rc, dram_dist *dd, phc_error *err)
     free(dd->blank.s2);
     free(dd->blank.log_post);
     free(dd->blank_counts);
+    return rc;
+}
+
+/* ---- the stretch ensemble on MPI ranks (fit/study_dist.h) -------------------------------- */
+
+/* Every rank runs the same ensemble with the same generator, so draws the
+ * same proposals; phc_stretch_share gives each rank its block of each batch
+ * (phc_dist_block) and gathers the rows on every rank (study_dist.h: share),
+ * so every rank makes the same acceptance draws and holds the same
+ * ensemble. */
+static double wall_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+typedef struct stretch_dist {
+    phc_dist *d;
+    double in_share; /* seconds in the all-gathers: waiting for the slowest rank, and the messages */
+} stretch_dist;
+
+static void sd_block(void *data, size_t n, size_t *lo, size_t *hi)
+{
+    const stretch_dist *sd = data;
+    phc_dist_block(n, sd->d->size, sd->d->rank, lo, hi);
+}
+
+static int sd_exchange(void *data, double *v, size_t n, phc_error *err)
+{
+    stretch_dist *sd = data;
+    const double t0 = wall_seconds();
+    const int rc = sd->d->share(sd->d, v, n, PHC_STRETCH_ROW, err);
+    sd->in_share += wall_seconds() - t0;
+    return rc;
+}
+
+static int sd_agree(void *data, int status, phc_error *err)
+{
+    stretch_dist *sd = data;
+    return sd->d->agree(sd->d, status, err);
+}
+
+/* Collective, after a stretch run that succeeded on every rank: each rank
+ * counted the model evaluations of its own blocks since `before` (the start
+ * draws', made alike on every rank); q->evaluations becomes before + their
+ * sum, one process's count.  PHC_STUDY_MPI_TIMES=1: rank 0 prints each
+ * rank's count, sampling time and time in the all-gathers on stderr. */
+static int stretch_count(const stretch_dist *sd, posterior *q, size_t before, double seconds, phc_error *err)
+{
+    phc_dist *d = sd->d;
+    const size_t size = (size_t)d->size;
+    double *v = calloc(3 * size, sizeof *v);
+    int rc = v ? PHC_OK : phc_error_set(err, PHC_ERR_NOMEM, "rank %d: out of memory", d->rank);
+    if ((rc = d->agree(d, rc, err)))
+        goto out;
+    double *mine = v + 3 * (size_t)d->rank;
+    mine[0] = (double)(q->evaluations - before); /* exact below 2^53 */
+    mine[1] = seconds;
+    mine[2] = sd->in_share;
+    if ((rc = d->share(d, v, size, 3, err)))
+        goto out;
+    size_t total = 0;
+    for (size_t r = 0; r < size; ++r)
+        total += (size_t)v[3 * r];
+    q->evaluations = before + total;
+    if (d->rank == 0 && getenv("PHC_STUDY_MPI_TIMES")) {
+        fprintf(stderr, "mcmc stretch: model evaluations by rank:");
+        for (size_t r = 0; r < size; ++r)
+            fprintf(stderr, " %zu: %.0f (%.3f s sampling, %.3f s in the all-gathers)%s", r, v[3 * r],
+                    v[3 * r + 1], v[3 * r + 2], r + 1 < size ? "," : "");
+        fprintf(stderr, "; %zu in all, and %zu on every rank before sampling (drawing the starts)\n", total, before);
+    }
+out:
+    free(v);
     return rc;
 }
 
@@ -574,14 +650,22 @@ int phc_mcmc_run(phc_problem *pb, const phc_mcmc_options *opts, const phc_proven
         sop.seed = o.seed;
         sop.progress = o.progress ? relay : NULL;
         sop.progress_data = &pr;
-        if (o.dist) {
-            /* not shared out yet: the master runs the ensemble alone (mcmc_study.h) */
+        stretch_dist sd = {o.dist, 0};
+        phc_stretch_share share = {sd_block, sd_exchange, sd_agree, &sd};
+        const size_t before = q.evaluations; /* the start draws', the same on every rank */
+        const double t0 = o.dist ? wall_seconds() : 0;
+        if (o.dist) { /* every rank runs the ensemble and evaluates its block of each half (mcmc_study.h) */
             rc = o.dist->agree(o.dist, PHC_OK, err);
             agreed = 1;
-            if (worker || rc)
+            if (rc)
                 goto done;
+            sop.share = &share;
         }
         rc = phc_stretch_run(&t, x0, &sop, &ch, err);
+        if (o.dist && rc == PHC_OK) /* the same status on every rank: the ranks' counts, summed */
+            rc = stretch_count(&sd, &q, before, wall_seconds() - t0, err);
+        if (worker) /* its evaluations went to every rank; the master writes DIR */
+            goto done;
     }
     if (rc)
         goto done;

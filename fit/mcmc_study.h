@@ -62,11 +62,15 @@ typedef struct phc_mcmc_options {
        fits the same start.  DRAM: the chains are shared out (one chain per
        message; a chain is sequential, each has its own seeded generator),
        rank 0 records each in DIR.ledger as it arrives and writes DIR,
-       identical to one process's; --resume works as in one process.  The
-       stretch ensemble is not shared out: rank 0 runs it alone while the
-       other ranks wait (its random stream depends on each proposal's
-       density: README, On a cluster).  The workers return PHC_OK with an
-       empty summary. */
+       identical to one process's; --resume works as in one process.
+       Stretch: every rank runs the ensemble with the same generator (so
+       draws the same proposals), evaluates its contiguous block of the
+       starts and of each half's proposals, and one all-gather per
+       half-step gives every rank every density, so every rank makes the
+       same acceptance draws (mcmc_stretch.h: the draws never depend on a
+       density); DIR is one process's, report.md's count of model
+       evaluations included (the ranks' counts, summed).  The workers
+       return PHC_OK with an empty summary. */
     struct phc_dist *dist;
 } phc_mcmc_options;
 

@@ -22,7 +22,12 @@
  * agreed, exactly one call of run().  A result the master cannot record
  * (an I/O error, a cancelled or stopped study) stops the workers: the
  * master sends each a stop with its status and receives what they still
- * had in flight, so no process hangs. */
+ * had in flight, so no process hangs.
+ *
+ * A sampler that runs on every rank alike (mcmc --method stretch) instead
+ * makes the same sequence of agree() and share() calls on every rank: the
+ * calls depend only on what every rank computes alike (the sampler's
+ * settings, the agreed statuses), never on one rank's evaluations. */
 #ifndef PHC_STUDY_DIST_H
 #define PHC_STUDY_DIST_H
 
@@ -38,8 +43,16 @@ typedef int (*phc_dist_eval_fn)(void *ctx, size_t row, double *out);
  * study on every rank. */
 typedef int (*phc_dist_record_fn)(void *ctx, size_t row, int failed, const double *out, phc_error *err);
 
-/* The version of this interface; the module refuses another. */
-#define PHC_DIST_ABI 1
+/* The version of this interface; the module refuses another.  2: share. */
+#define PHC_DIST_ABI 2
+
+/* Rank r's block of n rows in share(): [r n / size, (r + 1) n / size),
+ * contiguous, the sizes differing by at most 1, in rank order. */
+static inline void phc_dist_block(size_t n, int size, int rank, size_t *lo, size_t *hi)
+{
+    *lo = n * (size_t)rank / (size_t)size;
+    *hi = n * ((size_t)rank + 1) / (size_t)size;
+}
 
 typedef struct phc_dist phc_dist;
 struct phc_dist {
@@ -58,6 +71,15 @@ struct phc_dist {
      * study"). */
     int (*run)(phc_dist *d, size_t n_out, const size_t *rows, size_t n_rows, phc_dist_eval_fn eval,
                phc_dist_record_fn record, void *ctx, phc_error *err);
+    /* Collective, every rank with the same n and stride: v holds n rows of
+     * stride doubles, of which this rank filled its block (phc_dist_block);
+     * on return every rank holds all n rows, bit for bit (an all-gather).
+     * For samplers whose every rank draws the same proposals and evaluates
+     * its share of them (the stretch ensemble: mcmc_study.c).  Returns
+     * PHC_OK, or on every rank alike PHC_ERR_INPUT when a block holds more
+     * than INT_MAX doubles (MPI's counts are ints); MPI's own errors abort
+     * the job (Open MPI's default handler). */
+    int (*share)(phc_dist *d, double *v, size_t n, size_t stride, phc_error *err);
     /* Ends MPI (MPI_Finalize).  Called by phc_dist_close. */
     void (*finish)(phc_dist *d);
     void *impl;   /* the module's */

@@ -183,7 +183,8 @@ static const command_help commands[] = {
      "  -o DIR, --force, --quiet as for fit.\n"
      "\n"
      "Under mpirun or srun (at least 2 ranks) DRAM's chains are spread over the ranks (rank\n"
-     "0 keeps the ledger, prints and writes); the stretch ensemble runs on rank 0 alone.\n"
+     "0 keeps the ledger, prints and writes); the stretch ensemble's proposals are: every\n"
+     "rank draws the same ones and evaluates its share, one all-gather per half-step.\n"
      "The result is the one-process run's (README: \"On a cluster\")."},
     {"report", "phytocal report DIR/result.json [--strict] [--level L]\n"
                "  phytocal report --check DIR",

@@ -16,7 +16,10 @@
  * master to look.  Messages between two ranks are not overtaken (MPI), so a
  * worker evaluates every batch sent before its stop, and the master
  * receives every result in flight before it returns: nobody is left in a
- * send at MPI_Finalize. */
+ * send at MPI_Finalize.
+ *
+ * share() is one MPI_Allgatherv in place: rank r's block of rows
+ * (phc_dist_block) goes to every rank as raw doubles. */
 #include <mpi.h>
 #include <limits.h>
 #include <stdint.h>
@@ -52,6 +55,30 @@ static int mpi_agree(phc_dist *d, int rc, phc_error *err)
     if (first == 0)
         return phc_error_set(err, what.status, "%s", what.message);
     return phc_error_set(err, what.status, "rank %d: %s", first, what.message);
+}
+
+/* ---- share: an all-gather of blocks of rows ------------------------------------------- */
+
+typedef struct mpi_impl {
+    int *counts, *displs; /* per rank, in doubles */
+} mpi_impl;
+
+static int mpi_share(phc_dist *d, double *v, size_t n, size_t stride, phc_error *err)
+{
+    mpi_impl *im = d->impl;
+    /* every rank computes the same blocks from the same n, so every rank
+       refuses alike (no message needed) */
+    for (int r = 0; r < d->size; ++r) {
+        size_t lo, hi;
+        phc_dist_block(n, d->size, r, &lo, &hi);
+        if (stride && (hi - lo > (size_t)INT_MAX / stride || lo > (size_t)INT_MAX / stride))
+            return phc_error_set(err, PHC_ERR_INPUT, "%zu rows of %zu values are too many to share over MPI "
+                                 "(its counts are ints)", n, stride);
+        im->counts[r] = (int)((hi - lo) * stride);
+        im->displs[r] = (int)(lo * stride);
+    }
+    MPI_Allgatherv(MPI_IN_PLACE, 0, MPI_DATATYPE_NULL, v, im->counts, im->displs, MPI_DOUBLE, MPI_COMM_WORLD);
+    return PHC_OK;
 }
 
 /* ---- the master ------------------------------------------------------------------------- */
@@ -210,7 +237,13 @@ static int mpi_run(phc_dist *d, size_t n_out, const size_t *rows, size_t n_rows,
 
 static void mpi_finish(phc_dist *d)
 {
-    (void)d;
+    mpi_impl *im = d->impl;
+    if (im) {
+        free(im->counts);
+        free(im->displs);
+        free(im);
+        d->impl = NULL;
+    }
     int done = 0;
     MPI_Finalized(&done);
     if (!done)
@@ -238,8 +271,24 @@ int phc_mpi_module_open(int abi, phc_dist *d, phc_error *err)
         return phc_error_set(err, PHC_ERR_INPUT, "the MPI launcher started 1 rank: a master-worker study needs at "
                              "least 2 ranks (mpirun -np 2 or more; without mpirun it runs as one process)");
     }
+    mpi_impl *im = calloc(1, sizeof *im);
+    if (im) {
+        im->counts = calloc((size_t)d->size, sizeof *im->counts);
+        im->displs = calloc((size_t)d->size, sizeof *im->displs);
+    }
+    if (!im || !im->counts || !im->displs) {
+        if (im) {
+            free(im->counts);
+            free(im->displs);
+        }
+        free(im);
+        MPI_Finalize();
+        return phc_error_set(err, PHC_ERR_NOMEM, "rank %d: out of memory for the MPI module", d->rank);
+    }
+    d->impl = im;
     d->agree = mpi_agree;
     d->run = mpi_run;
+    d->share = mpi_share;
     d->finish = mpi_finish;
     return PHC_OK;
 }

@@ -8,8 +8,13 @@
 # job with its message once.  `mcmc --method dram` with -np 2 (its chains
 # shared out, one per message) equals one process, report.md's count of
 # model evaluations included; a DRAM run stopped under MPI after 2 chains
-# and resumed under MPI equals the uninterrupted one; the stretch ensemble
-# under mpirun (rank 0 alone) equals one process.
+# and resumed under MPI equals the uninterrupted one.  `mcmc --method
+# stretch` (every rank runs the ensemble and evaluates its block of each
+# half's proposals, one all-gather per half-step) with -np 2 and -np 3
+# equals one process, report.md's count of model evaluations included, and
+# every rank evaluated (PHC_STUDY_MPI_TIMES=1 prints each rank's count); a
+# bad --chains under mpirun and a stretch run with one rank exit 2 with one
+# message.
 # Skips (77) only when mpirun is absent (CI installs Open MPI through
 # scripts/setup).
 #
@@ -63,13 +68,17 @@ for bad in "missing.yaml" "pv_leaves.yaml --level 1.5"; do
     finish "profile $bad with mpirun -np 2: one message, no hang, no directory"
 done
 
-# ---- mcmc: DRAM's chains on 2 ranks, the stretch ensemble on rank 0 = one process ----
+# rank_count R LINE: rank R's count in "mcmc stretch: model evaluations by rank: 0: N (...), 1: M (...); ..."
+rank_count() { local re=" $1: ([0-9]+) \\("; [[ $2 =~ $re ]] && echo "${BASH_REMATCH[1]}"; }
+
+# ---- mcmc: DRAM's chains on 2 ranks, the stretch ensemble's proposals on 2 ranks = one process ----
 for method in dram stretch; do
     rm -rf one many
     run "$PHC" mcmc enzyme.yaml -o one --method $method --samples 1000 --chains 6 --seed 3
     [ "$RC" -eq 0 ] || why "one process: exit $RC"
     sed '/^results/d' "$T/stdout" > one.txt
-    run "${MPIRUN[@]}" -np 2 "$PHC" mcmc enzyme.yaml -o many --method $method --samples 1000 --chains 6 --seed 3
+    PHC_STUDY_MPI_TIMES=1 run "${MPIRUN[@]}" -np 2 "$PHC" mcmc enzyme.yaml -o many --method $method \
+        --samples 1000 --chains 6 --seed 3
     [ "$RC" -eq 0 ] || why "mpirun -np 2: exit $RC"
     cmp -s one/result.json many/result.json || why "result.json differs from the one-process run's"
     diff -q <(prov one/report.md) <(prov many/report.md) >/dev/null || why "report.md differs"
@@ -78,8 +87,47 @@ for method in dram stretch; do
     n=$(grep -c '^results' "$T/stdout")
     [ "$n" = 1 ] || why "the summary was printed $n times"
     [ ! -e many.ledger ] || why "the ledger stayed beside the finished run"
+    if [ $method = stretch ]; then
+        # "mcmc stretch: model evaluations by rank: 0: N (...), 1: M (...); ..."
+        line=$(grep -F 'mcmc stretch: model evaluations by rank:' "$T/stderr")
+        echo "# $line"
+        n0=$(rank_count 0 "$line")
+        n1=$(rank_count 1 "$line")
+        [ "${n0:-0}" -gt 0 ] && [ "${n1:-0}" -gt 0 ] || why "not every rank evaluated (rank 0: '$n0', rank 1: '$n1')"
+    fi
     finish "mcmc --method $method with mpirun -np 2: result.json, report.md and plots identical to one process"
 done
+
+# ---- stretch on 3 ranks (one proposal each per half of 6 walkers) = one process ----
+rm -rf many
+PHC_STUDY_MPI_TIMES=1 run "${MPIRUN[@]}" -np 3 "$PHC" mcmc enzyme.yaml -o many --method stretch --samples 1000 \
+    --chains 6 --seed 3 -q
+[ "$RC" -eq 0 ] || why "mpirun -np 3: exit $RC"
+cmp -s one/result.json many/result.json || why "result.json differs from the one-process run's"
+diff -q <(prov one/report.md) <(prov many/report.md) >/dev/null || why "report.md differs"
+line=$(grep -F 'mcmc stretch: model evaluations by rank:' "$T/stderr")
+echo "# $line"
+for r in 0 1 2; do
+    k=$(rank_count $r "$line")
+    [ "${k:-0}" -gt 0 ] || why "rank $r evaluated '$k' proposals"
+done
+finish "mcmc --method stretch with mpirun -np 3: result.json and report.md identical to one process"
+
+# ---- stretch: bad input under mpirun: one message, exit 2, no hang ----------
+rm -rf bad
+run "${MPIRUN[@]}" -np 2 "$PHC" mcmc enzyme.yaml -o bad --method stretch --chains 5
+[ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+n=$(grep -cF -- "--chains 5: the stretch-move ensemble needs an even number" "$T/stderr")
+[ "$n" = 1 ] || why "the message appears $n times, expected once"
+[ ! -e bad ] || why "a directory was written"
+finish "mcmc --method stretch --chains 5 with mpirun -np 2: exit 2, one message, no directory"
+run "${MPIRUN[@]}" -np 1 "$PHC" mcmc enzyme.yaml -o bad --method stretch
+[ "$RC" -eq 2 ] || why "exit $RC, expected 2"
+n=$(grep -cF -- "the MPI launcher started 1 rank" "$T/stderr")
+[ "$n" = 1 ] || why "the message appears $n times, expected once"
+[ ! -e bad ] || why "a directory was written"
+finish "mcmc --method stretch with mpirun -np 1: exit 2, 'the MPI launcher started 1 rank'"
+
 
 # ---- DRAM stopped under MPI after 2 chains, resumed under MPI = uninterrupted --
 rm -rf one part part.ledger
