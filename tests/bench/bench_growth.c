@@ -219,11 +219,47 @@ static timing soil_only(double hours)
     return r;
 }
 
+/* PHC_BENCH_GROWTH_ONLY=10k|20k|40k|60k: only the month step at that size,
+ * 1 thread, REPEAT_MONTH times (for profiling one size: perf record). */
+static int month_only(const char *which)
+{
+    int q = 0;
+    while (q < NT && strcmp(tname[q], which) != 0)
+        ++q;
+    if (q == NT) {
+        printf("PHC_BENCH_GROWTH_ONLY: unknown size '%s' (10k, 20k, 40k or 60k)\n", which);
+        return 1;
+    }
+    omp_set_num_threads(1);
+    for (int k = 0; k < repeat_month; ++k) {
+        plant pl;
+        int dd = 0;
+        phc_error err;
+        if (plant_new(&pl) || grow_to(&pl, target[q], &dd))
+            return 1;
+        size_t n0 = nodes_of(pl.g);
+        cpu_mark a = cpu_now();
+        int rc = phc_growth_step(pl.g, 30.0, &err);
+        cpu_mark b = cpu_now();
+        if (rc) {
+            printf("growth: %s\n", err.message);
+            return 1;
+        }
+        printf("growth_s_per_month_%s_only: %.4g s wall, %.4g s CPU (nodes %zu -> %zu; 1 thread; other load %.2f "
+               "CPUs)\n", tname[q], b.wall - a.wall, b.self - a.self, n0, nodes_of(pl.g), other_load(a, b));
+        plant_free(&pl);
+    }
+    return 0;
+}
+
 int main(void)
 {
     double t_start = now();
     repeat = bench_repeats(REPEAT);
     repeat_month = bench_repeats(REPEAT_MONTH);
+    const char *only = getenv("PHC_BENCH_GROWTH_ONLY");
+    if (only && *only)
+        return month_only(only);
     int threads[2] = {1, 2};
     timing day[2][NT], month[2][NT], soil_day[2], soil_month[2];
     double grow_s[NT];
