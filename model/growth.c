@@ -425,7 +425,10 @@ int phc_growth_new(const phc_growth_params *p, const phc_growth_options *o, phc_
         z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
         g->rng[k] = z ^ (z >> 31);
     }
-    if ((rc = reserve_nodes(g, 64, err)) || (rc = reserve_scratch(g, err))) goto fail;
+    /* the two bases, room for 64 nodes unless max_nodes is smaller */
+    if ((rc = reserve_nodes(g, node_limit(g) < 64 ? (node_limit(g) < 2 ? 2 : node_limit(g)) : 64, err)) ||
+        (rc = reserve_scratch(g, err)))
+        goto fail;
     if (soil) {
         g->sink_rate = calloc(soil->n, sizeof *g->sink_rate);
         g->sink_voxels = malloc(soil->n * sizeof *g->sink_voxels);
