@@ -53,7 +53,15 @@
  *
  * Linearity: us per node = (step time - soil-only time) / nodes, and the
  * ratio of that at 60k to 10k (1 = linear); also the ratio of the whole
- * step's time per node. */
+ * step's time per node.
+ *
+ * CPU time: each month step also records this process's CPU time (user +
+ * sys, getrusage).  On the shared machine a step's wall time includes
+ * waiting for a CPU; the 1-thread CPU time is what the wall time comes to
+ * on a quiet machine, and the _cpu lines give the speed-ups by it.
+ *
+ * PHC_BENCH_GROWTH_ONLY=10k|20k|40k|60k: only that size's month step, 1
+ * thread, REPEAT_MONTH times, wall and CPU time (for profiling one size). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -386,7 +394,7 @@ int main(void)
 
     /* ---- headline numbers: the better thread count ---- */
     printf("---- summary ----\n");
-    int all_met = 1;
+    int all_met = 1, all_met_cpu = 1;
     double us_day[NT], us_day_whole[NT], us_month[NT];
     for (int q = 0; q < NT; ++q) {
         int bd = day[0][q].best <= day[1][q].best ? 0 : 1;
@@ -406,6 +414,14 @@ int main(void)
         printf("paper_s_per_month_%s: %.4g s (%s)\n", tname[q], pm, how);
         printf("growth_speedup_vs_paper_day_%s: %.0f x\n", tname[q], sd);
         printf("growth_speedup_vs_paper_month_%s: %.0f x\n", tname[q], sm);
+        /* on a shared machine the wall time includes waiting for a CPU: the
+           CPU time of the fastest 1-thread month step is what its wall time
+           comes to when the machine is quiet */
+        double sm_cpu = pm / month[0][q].cpu;
+        printf("growth_speedup_vs_paper_month_%s_cpu: %.0f x (the paper's %.4g s over the CPU time, user + sys, of "
+               "the fastest 1-thread month step: %.4g s, wall %.4g s, other load up to %.2f CPUs)\n", tname[q], sm_cpu,
+               pm, month[0][q].cpu, month[0][q].best, month[0][q].other);
+        all_met_cpu &= sm_cpu >= TARGET_SPEEDUP;
         all_met &= sd >= TARGET_SPEEDUP && sm >= TARGET_SPEEDUP;
         double nd = 0.5 * (double)(r->n0 + r->n1);
         us_day_whole[q] = 1e6 * r->best / nd;
@@ -509,6 +525,9 @@ int main(void)
            lin > 0.5 && lin < 2.0 ? "yes" : "no", lin);
     printf("growth_target_10x_paper: %s (>= %.0f x the paper for day and month steps at all four sizes)\n",
            all_met ? "met" : "not met", TARGET_SPEEDUP);
+    printf("growth_target_10x_paper_month_cpu: %s (>= %.0f x the paper for the month steps at all four sizes, by "
+           "their CPU time: the lines growth_speedup_vs_paper_month_*_cpu)\n", all_met_cpu ? "met" : "not met",
+           TARGET_SPEEDUP);
     printf("bench_total_time: %.1f s\n", now() - t_start);
     return 0;
 }
