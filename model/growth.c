@@ -1044,10 +1044,11 @@ static void thicken(phc_growth *g)
 {
     const phc_growth_params *p = &g->p;
     double a = p->pipe_exponent, *s = g->a;
+    /* r_tip^a of each system, once per step (the same pow() per node before) */
+    const double pipe[2] = {pow(p->tip_radius_shoot, a), pow(p->tip_radius_root, a)};
     for (size_t i = 0; i < g->n; i++) {
         const phc_growth_node *n = &g->node[i];
-        double rt = n->system == PHC_GROWTH_SHOOT ? p->tip_radius_shoot : p->tip_radius_root;
-        s[i] = pow(rt, a) * n->length / seg_length(g, n->system);
+        s[i] = pipe[n->system == PHC_GROWTH_SHOOT ? 0 : 1] * n->length / seg_length(g, n->system);
     }
     for (size_t i = g->n; i-- > 0;) {
         phc_growth_node *n = &g->node[i];
