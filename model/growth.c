@@ -2,9 +2,12 @@
  * the units and the two randomness modes. */
 #include "model/growth.h"
 
+#include "model/big_array.h"
+
 #include <ctype.h>
 #include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -291,9 +294,12 @@ static void bend(double d[3], const double target[3], double w)
     normalize3(d);
 }
 
+/* The most nodes the plant may have (options.max_nodes; 0 = 10 million). */
+static size_t node_limit(const phc_growth *g) { return g->o.max_nodes ? g->o.max_nodes : 10000000; }
+
 static int reserve_nodes(phc_growth *g, size_t need, phc_error *err)
 {
-    size_t limit = g->o.max_nodes ? g->o.max_nodes : 10000000;
+    size_t limit = node_limit(g);
     if (need > limit)
         return phc_error_set(err, PHC_ERR_DOMAIN,
                              "the plant would grow past %zu nodes (max_nodes) at day %g", limit,
@@ -301,7 +307,11 @@ static int reserve_nodes(phc_growth *g, size_t need, phc_error *err)
     if (need <= g->cap) return PHC_OK;
     size_t cap = g->cap ? g->cap : 64;
     while (cap < need) cap *= 2;
-    phc_growth_node *nn = realloc(g->node, cap * sizeof *nn);
+    /* huge pages from 2 MiB up (big_array.h): a month step writes tens of
+       MiB of new nodes, and 4 KiB pages cost a fault each */
+    phc_growth_node *nn = cap <= SIZE_MAX / sizeof *nn
+                              ? phc_big_array_grow(g->node, g->n * sizeof *nn, cap * sizeof *nn)
+                              : NULL;
     if (!nn) return phc_error_set(err, PHC_ERR_NOMEM, "growth: out of memory for %zu nodes", cap);
     g->node = nn;
     g->cap = cap;
@@ -312,13 +322,14 @@ static int reserve_scratch(phc_growth *g, phc_error *err)
 {
     if (g->scratch_cap >= g->cap) return PHC_OK;
     size_t cap = g->cap;
-    double *a = realloc(g->a, cap * sizeof *a);
+    /* scratch: every pass writes before it reads, so nothing is kept */
+    double *a = phc_big_array_grow(g->a, 0, cap * sizeof *a);
     if (a) g->a = a;
-    double *b = realloc(g->b, cap * sizeof *b);
+    double *b = phc_big_array_grow(g->b, 0, cap * sizeof *b);
     if (b) g->b = b;
-    double *c = realloc(g->c, cap * sizeof *c);
+    double *c = phc_big_array_grow(g->c, 0, cap * sizeof *c);
     if (c) g->c = c;
-    size_t *v = realloc(g->voxel, cap * sizeof *v);
+    size_t *v = phc_big_array_grow(g->voxel, 0, cap * sizeof *v);
     if (v) g->voxel = v;
     if (!a || !b || !c || !v) return phc_error_set(err, PHC_ERR_NOMEM, "growth: out of memory");
     g->scratch_cap = cap;
@@ -414,7 +425,10 @@ int phc_growth_new(const phc_growth_params *p, const phc_growth_options *o, phc_
         z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
         g->rng[k] = z ^ (z >> 31);
     }
-    if ((rc = reserve_nodes(g, 64, err)) || (rc = reserve_scratch(g, err))) goto fail;
+    /* the two bases, room for 64 nodes unless max_nodes is smaller */
+    if ((rc = reserve_nodes(g, node_limit(g) < 64 ? (node_limit(g) < 2 ? 2 : node_limit(g)) : 64, err)) ||
+        (rc = reserve_scratch(g, err)))
+        goto fail;
     if (soil) {
         g->sink_rate = calloc(soil->n, sizeof *g->sink_rate);
         g->sink_voxels = malloc(soil->n * sizeof *g->sink_voxels);
@@ -895,20 +909,64 @@ static double room_in_soil(const phc_soil *s, const phc_growth_node *n)
     return room > 0 ? room : 0;
 }
 
+/* How far (m) tip i grows in a step of dt days (eqs. 19, 22); < 0 when it
+ * does not grow (not a tip, no potential, or a root tip at the pot wall). */
+static double tip_growth(const phc_growth *g, size_t i, double dt)
+{
+    const phc_growth_params *p = &g->p;
+    const phc_growth_node *n = &g->node[i];
+    if (!n->tip || n->potential <= 0) return -1;
+    int shoot = n->system == PHC_GROWTH_SHOOT;
+    double P = n->potential;
+    if (!shoot && g->soil && !inside_soil(g->soil, n)) return -1; /* pot wall */
+    double dl = shoot ? P * p->shoot_elongation * dt
+                      : P * p->root_elongation * dt / (1 + p->root_resistance * n->resistance);
+    if (!shoot && g->soil) dl = fmin(dl, room_in_soil(g->soil, n));
+    return dl;
+}
+
+/* At least as many nodes as elongate() and flush_buds() add in a step of dt
+ * days (potentials set by allocate()).  phc_growth_step reserves them up
+ * front, so the node array grows once per step, before the new nodes are
+ * written, instead of being copied to ever larger arrays during a long step
+ * (a 30-day step of the bench plant grows it from 41k to 174k nodes).
+ *   elongate: a tip of length l growing dl appends at most ceil((l + dl) /
+ *   L) segments (L the segment length); each new root segment starts at
+ *   most floor(prob) + 1 laterals (events(): prob the branching probability
+ *   of its parent's soil, which the new segments inherit), each new shoot
+ *   segment gets at most ceil(lateral_buds * P) buds;
+ *   flush_buds: at most ceil(buds) laterals per shoot node, new or old. */
+static size_t step_nodes_bound(const phc_growth *g, double dt)
+{
+    const phc_growth_params *p = &g->p;
+    double add = 0;
+    for (size_t i = 0; i < g->n; i++) {
+        const phc_growth_node *n = &g->node[i];
+        if (n->system == PHC_GROWTH_SHOOT && n->buds > 0) add += ceil(n->buds);
+        double dl = tip_growth(g, i, dt);
+        if (dl < 0) continue;
+        double segs = ceil((n->length + dl) / seg_length(g, n->system));
+        if (n->system == PHC_GROWTH_SHOOT) {
+            add += segs * (1 + ceil(p->lateral_buds * n->potential));
+        } else {
+            double prob = p->root_branching * n->potential * fmin(1.0, n->fill) *
+                          (1 + p->nutrient_branching * n->nutrient);
+            add += segs * (2 + floor(prob > 0 ? prob : 0));
+        }
+    }
+    return add < 1e15 ? (size_t)add + 2 : (size_t)-1 / 2;
+}
+
 /* Elongation (eqs. 19, 22), bud numbers (eq. 21) and root branching (eq. 24). */
 static int elongate(phc_growth *g, double dt, phc_error *err)
 {
     const phc_growth_params *p = &g->p;
     size_t n0 = g->n;
     for (size_t i = 0; i < n0; i++) {
-        if (!g->node[i].tip || g->node[i].potential <= 0) continue;
+        double dl = tip_growth(g, i, dt);
+        if (dl < 0) continue;
         int shoot = g->node[i].system == PHC_GROWTH_SHOOT;
         double P = g->node[i].potential;
-        if (!shoot && g->soil && !inside_soil(g->soil, &g->node[i])) continue; /* pot wall */
-        double dl = shoot ? P * p->shoot_elongation * dt
-                          : P * p->root_elongation * dt /
-                                (1 + p->root_resistance * g->node[i].resistance);
-        if (!shoot && g->soil) dl = fmin(dl, room_in_soil(g->soil, &g->node[i]));
         double L = seg_length(g, g->node[i].system);
         size_t cur = i;
         g->node[cur].length += dl;
@@ -986,10 +1044,11 @@ static void thicken(phc_growth *g)
 {
     const phc_growth_params *p = &g->p;
     double a = p->pipe_exponent, *s = g->a;
+    /* r_tip^a of each system, once per step (the same pow() per node before) */
+    const double pipe[2] = {pow(p->tip_radius_shoot, a), pow(p->tip_radius_root, a)};
     for (size_t i = 0; i < g->n; i++) {
         const phc_growth_node *n = &g->node[i];
-        double rt = n->system == PHC_GROWTH_SHOOT ? p->tip_radius_shoot : p->tip_radius_root;
-        s[i] = pow(rt, a) * n->length / seg_length(g, n->system);
+        s[i] = pipe[n->system == PHC_GROWTH_SHOOT ? 0 : 1] * n->length / seg_length(g, n->system);
     }
     for (size_t i = g->n; i-- > 0;) {
         phc_growth_node *n = &g->node[i];
@@ -1011,6 +1070,11 @@ int phc_growth_step(phc_growth *g, double dt, phc_error *err)
     root_flux(g);
     allocate(g, dt);
     inhibitor(g);
+    {   /* room for the step's new nodes, up to max_nodes (reserve_nodes
+           names the limit if the plant really grows past it) */
+        size_t limit = node_limit(g), add = step_nodes_bound(g, dt);
+        if ((rc = reserve_nodes(g, add < limit - g->n ? g->n + add : limit, err))) return rc;
+    }
     if ((rc = elongate(g, dt, err))) return rc;
     if ((rc = flush_buds(g, dt, err))) return rc;
     if ((rc = reserve_scratch(g, err))) return rc;

@@ -53,7 +53,15 @@
  *
  * Linearity: us per node = (step time - soil-only time) / nodes, and the
  * ratio of that at 60k to 10k (1 = linear); also the ratio of the whole
- * step's time per node. */
+ * step's time per node.
+ *
+ * CPU time: each month step also records this process's CPU time (user +
+ * sys, getrusage).  On the shared machine a step's wall time includes
+ * waiting for a CPU; the 1-thread CPU time is what the wall time comes to
+ * on a quiet machine, and the _cpu lines give the speed-ups by it.
+ *
+ * PHC_BENCH_GROWTH_ONLY=10k|20k|40k|60k: only that size's month step, 1
+ * thread, REPEAT_MONTH times, wall and CPU time (for profiling one size). */
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -184,6 +192,7 @@ static int grow_to(plant *pl, size_t n, int *day)
 
 typedef struct timing {
     double best, median, other;
+    double cpu; /* month steps: CPU seconds (user + sys) of this process in the best run */
     size_t n0, n1; /* nodes before the first timed step and after the last */
 } timing;
 
@@ -196,7 +205,7 @@ static double median(double *t, int n)
 /* The soil alone (no plant) over `hours`: best and median of REPEAT. */
 static timing soil_only(double hours)
 {
-    timing r = {INFINITY, NAN, 0, 0, 0};
+    timing r = {INFINITY, NAN, 0, NAN, 0, 0};
     double t[REPEAT];
     cpu_mark a = cpu_now();
     for (int k = 0; k < repeat; ++k) {
@@ -219,11 +228,47 @@ static timing soil_only(double hours)
     return r;
 }
 
+/* PHC_BENCH_GROWTH_ONLY=10k|20k|40k|60k: only the month step at that size,
+ * 1 thread, REPEAT_MONTH times (for profiling one size: perf record). */
+static int month_only(const char *which)
+{
+    int q = 0;
+    while (q < NT && strcmp(tname[q], which) != 0)
+        ++q;
+    if (q == NT) {
+        printf("PHC_BENCH_GROWTH_ONLY: unknown size '%s' (10k, 20k, 40k or 60k)\n", which);
+        return 1;
+    }
+    omp_set_num_threads(1);
+    for (int k = 0; k < repeat_month; ++k) {
+        plant pl;
+        int dd = 0;
+        phc_error err;
+        if (plant_new(&pl) || grow_to(&pl, target[q], &dd))
+            return 1;
+        size_t n0 = nodes_of(pl.g);
+        cpu_mark a = cpu_now();
+        int rc = phc_growth_step(pl.g, 30.0, &err);
+        cpu_mark b = cpu_now();
+        if (rc) {
+            printf("growth: %s\n", err.message);
+            return 1;
+        }
+        printf("growth_s_per_month_%s_only: %.4g s wall, %.4g s CPU (nodes %zu -> %zu; 1 thread; other load %.2f "
+               "CPUs)\n", tname[q], b.wall - a.wall, b.self - a.self, n0, nodes_of(pl.g), other_load(a, b));
+        plant_free(&pl);
+    }
+    return 0;
+}
+
 int main(void)
 {
     double t_start = now();
     repeat = bench_repeats(REPEAT);
     repeat_month = bench_repeats(REPEAT_MONTH);
+    const char *only = getenv("PHC_BENCH_GROWTH_ONLY");
+    if (only && *only)
+        return month_only(only);
     int threads[2] = {1, 2};
     timing day[2][NT], month[2][NT], soil_day[2], soil_month[2];
     double grow_s[NT];
@@ -299,7 +344,7 @@ int main(void)
         /* month steps: a fresh plant per timing */
         for (int q = 0; q < NT; ++q) {
             timing *r = &month[th][q];
-            double t[REPEAT_MONTH];
+            double t[REPEAT_MONTH], cpu[REPEAT_MONTH];
             double other = 0;
             for (int k = 0; k < repeat_month; ++k) {
                 if (plant_new(&pl))
@@ -313,7 +358,9 @@ int main(void)
                 double t0 = now();
                 int rc = phc_growth_step(pl.g, 30.0, &err);
                 t[k] = now() - t0;
-                other = fmax(other, other_load(a, cpu_now()));
+                cpu_mark b = cpu_now();
+                cpu[k] = b.self - a.self;
+                other = fmax(other, other_load(a, b));
                 if (rc) {
                     printf("growth: %s\n", err.message);
                     return 1;
@@ -327,8 +374,10 @@ int main(void)
             }
             r->other = other;
             r->best = t[0];
+            r->cpu = cpu[0];
             for (int k = 1; k < repeat_month; ++k)
-                r->best = fmin(r->best, t[k]);
+                if (t[k] < r->best)
+                    r->best = t[k], r->cpu = cpu[k];
             r->median = median(t, repeat_month);
         }
 
@@ -337,15 +386,15 @@ int main(void)
             printf("growth_s_per_day_%s_%dt: %.4g s (nodes %zu -> %zu over %d steps; best of %d, median %.4g; "
                    "other load %.2f CPUs)\n", tname[q], threads[th], r->best, r->n0, r->n1, repeat, repeat,
                    r->median, r->other);
-            printf("growth_s_per_month_%s_%dt: %.4g s (nodes %zu -> %zu in the 30-day step; best of %d, median "
-                   "%.4g; other load up to %.2f CPUs)\n", tname[q], threads[th], m->best, m->n0, m->n1,
+            printf("growth_s_per_month_%s_%dt: %.4g s (CPU %.4g s; nodes %zu -> %zu in the 30-day step; best of %d, "
+                   "median %.4g; other load up to %.2f CPUs)\n", tname[q], threads[th], m->best, m->cpu, m->n0, m->n1,
                    repeat_month, m->median, m->other);
         }
     }
 
     /* ---- headline numbers: the better thread count ---- */
     printf("---- summary ----\n");
-    int all_met = 1;
+    int all_met = 1, all_met_cpu = 1;
     double us_day[NT], us_day_whole[NT], us_month[NT];
     for (int q = 0; q < NT; ++q) {
         int bd = day[0][q].best <= day[1][q].best ? 0 : 1;
@@ -358,12 +407,21 @@ int main(void)
         double sd = pd / r->best, sm = pm / m->best;
         printf("growth_s_per_day_%s: %.4g s (nodes %zu; %d thread%s; best of %d, median %.4g)\n", tname[q], r->best,
                r->n0, threads[bd], bd ? "s" : "", repeat, r->median);
-        printf("growth_s_per_month_%s: %.4g s (nodes %zu -> %zu during the step; %d thread%s; best of %d, median "
-               "%.4g)\n", tname[q], m->best, m->n0, m->n1, threads[bm], bm ? "s" : "", repeat_month, m->median);
+        printf("growth_s_per_month_%s: %.4g s (CPU %.4g s; nodes %zu -> %zu during the step; %d thread%s; best of "
+               "%d, median %.4g; other load up to %.2f CPUs)\n", tname[q], m->best, m->cpu, m->n0, m->n1, threads[bm],
+               bm ? "s" : "", repeat_month, m->median, m->other);
         printf("paper_s_per_day_%s: %.4g s (%s)\n", tname[q], pd, how);
         printf("paper_s_per_month_%s: %.4g s (%s)\n", tname[q], pm, how);
         printf("growth_speedup_vs_paper_day_%s: %.0f x\n", tname[q], sd);
         printf("growth_speedup_vs_paper_month_%s: %.0f x\n", tname[q], sm);
+        /* on a shared machine the wall time includes waiting for a CPU: the
+           CPU time of the fastest 1-thread month step is what its wall time
+           comes to when the machine is quiet */
+        double sm_cpu = pm / month[0][q].cpu;
+        printf("growth_speedup_vs_paper_month_%s_cpu: %.0f x (the paper's %.4g s over the CPU time, user + sys, of "
+               "the fastest 1-thread month step: %.4g s, wall %.4g s, other load up to %.2f CPUs)\n", tname[q], sm_cpu,
+               pm, month[0][q].cpu, month[0][q].best, month[0][q].other);
+        all_met_cpu &= sm_cpu >= TARGET_SPEEDUP;
         all_met &= sd >= TARGET_SPEEDUP && sm >= TARGET_SPEEDUP;
         double nd = 0.5 * (double)(r->n0 + r->n1);
         us_day_whole[q] = 1e6 * r->best / nd;
@@ -467,6 +525,9 @@ int main(void)
            lin > 0.5 && lin < 2.0 ? "yes" : "no", lin);
     printf("growth_target_10x_paper: %s (>= %.0f x the paper for day and month steps at all four sizes)\n",
            all_met ? "met" : "not met", TARGET_SPEEDUP);
+    printf("growth_target_10x_paper_month_cpu: %s (>= %.0f x the paper for the month steps at all four sizes, by "
+           "their CPU time: the lines growth_speedup_vs_paper_month_*_cpu)\n", all_met_cpu ? "met" : "not met",
+           TARGET_SPEEDUP);
     printf("bench_total_time: %.1f s\n", now() - t_start);
     return 0;
 }

@@ -3,7 +3,8 @@
  * both randomness modes, the pipe model's exact relation, the segment
  * geometry, limit cases of the fluxes and the allocation, the water budget
  * of PHYSICAL uptake against the soil's own budget, the exports, nutrient
- * branching and the smoothness of EXPECTED mode.  One line per check group
+ * branching, the smoothness of EXPECTED mode and max_nodes with the
+ * step's up-front node reservation.  One line per check group
  * with the measured numbers. */
 #include "check.h"
 
@@ -804,6 +805,58 @@ static void test_long_step(void)
     CHECK(rc == PHC_ERR_INPUT && strstr(err.message, "long_step") && !g);
 }
 
+/* A step reserves room for a bound on its new nodes before it grows
+ * (step_nodes_bound in growth.c), capped at max_nodes: a 30-day step that
+ * ends with exactly max_nodes nodes must run and give the plant of an
+ * unlimited run byte for byte, and one node fewer must fail naming
+ * max_nodes (the bound itself is above the real growth, so without the cap
+ * the first case would fail). */
+static void test_node_limit(void)
+{
+    for (int mode = 0; mode < 2; ++mode) {
+        phc_growth_params p = preset("poplar"); /* made to branch, as the bench's plant */
+        p.lateral_buds = 3, p.bud_flush = 0.3, p.apical_inhibition = 0.5, p.shoot_elongation = 0.03;
+        p.root_elongation = 0.04, p.root_branching = 1.5, p.light_use = 400;
+        size_t n0 = 0, n_ref = 0, n_at = 0;
+        phc_growth_node *ref = NULL;
+        int rc_at = -1, rc_below = -1, same = 0;
+        char msg[sizeof ((phc_error *)0)->message] = "";
+        for (int run = 0; run < 3; ++run) {
+            phc_growth_options o = opts_at_surface();
+            if (mode) o.mode = PHC_GROWTH_STOCHASTIC, o.seed = 3;
+            o.max_nodes = run == 0 ? 0 : run == 1 ? n_ref : n_ref - 1;
+            phc_growth *g = grow(&p, &o, NULL, 20); /* no soil: roots grow without walls */
+            phc_error err;
+            size_t n;
+            phc_growth_nodes(g, &n);
+            if (run == 0) n0 = n;
+            int rc = phc_growth_step(g, 30.0, &err);
+            const phc_growth_node *nd = phc_growth_nodes(g, &n);
+            if (run == 0) {
+                must(rc, &err, "30-day step");
+                n_ref = n;
+                ref = malloc(n * sizeof *ref);
+                if (ref) memcpy(ref, nd, n * sizeof *ref);
+            } else if (run == 1) {
+                rc_at = rc;
+                n_at = n;
+                same = rc == 0 && ref && n == n_ref && memcmp(ref, nd, n * sizeof *ref) == 0;
+            } else {
+                rc_below = rc;
+                if (rc) snprintf(msg, sizeof msg, "%s", err.message);
+            }
+            phc_growth_free(g);
+        }
+        free(ref);
+        printf("  node limit (branchy poplar, no soil, %s, 20 d then 30 d): %zu -> %zu nodes; max_nodes %zu: rc %d, %zu nodes, %s; "
+               "max_nodes %zu: rc %d \"%s\"\n", mode ? "STOCHASTIC" : "EXPECTED", n0, n_ref, n_ref, rc_at, n_at,
+               same ? "byte-identical" : "DIFFERENT", n_ref - 1, rc_below, msg);
+        CHECK(n_ref > n0 + 10);
+        CHECK(rc_at == 0 && same);
+        CHECK(rc_below == PHC_ERR_DOMAIN && strstr(msg, "max_nodes") != NULL);
+    }
+}
+
 /* Eq. 24 scales the branching probability by (1 + nutrient_branching v):
  * in a uniform soil with v = 5, nutrient_branching = 1 and root_branching
  * rb must give the plant of nutrient_branching = 0 and 6 rb, for any step
@@ -1009,6 +1062,7 @@ int main(void)
         {"nutrient scaling", test_nutrient_scaling}, {"long steps", test_long_step},
         {"nutrient allocation", test_nutrient_allocation}, {"pot walls", test_pot_walls},
         {"smoothness", test_smoothness}, {"modes", test_modes},
+        {"node limit", test_node_limit},
     };
     for (size_t i = 0; i < sizeof groups / sizeof groups[0]; ++i) {
         clock_t t0 = clock();
