@@ -21,20 +21,6 @@
 
 /* Most water-only sub-steps one sweep over the grid takes when nothing
  * else acts between them (params.block_steps = 0: see block_levels). */
-/* Forced inlining: the plane kernel's helpers must be compiled into each
- * of its CPU-specific copies (see water_plane), not called as baseline
- * functions. */
-#if defined(__GNUC__)
-#define PHC_SOIL_INLINE static inline __attribute__((always_inline))
-#else
-#define PHC_SOIL_INLINE static inline
-#endif
-
-/* The copies of the plane kernel (water_plane) built for x86-64. */
-#ifndef PHC_SOIL_CLONES
-#define PHC_SOIL_CLONES "arch=x86-64-v4", "avx2", "default"
-#endif
-
 #ifndef PHC_SOIL_BLOCK_STEPS
 #define PHC_SOIL_BLOCK_STEPS 4
 #endif
@@ -680,175 +666,70 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
     f[7] = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
 }
 
-/* The terms of the z-face between a plane (fill l, gravity flux g, face
- * permeabilities kz to the plane above) and the plane above it (lu, gu):
- * fz = kz (lu - l), voxel_faces' f[4] of the lower voxel, and gz its f[6]
- * (Lax-Wendroff, or the upwind flux with `up`; 0 across a closed face).
- * For the upper voxel the same face gives f[7] = gz exactly (the same
- * operands in the same order) and f[5] = kz (l - lu) = -fz (a - b is
- * -(b - a) in IEEE arithmetic; only the sign of an exact zero can differ,
- * and it cannot reach w: see water_voxel). */
-PHC_SOIL_INLINE void zface_voxel(const double *restrict l, const double *restrict lu, const double *restrict g,
-                               const double *restrict gu, const double *restrict kz, size_t r, double lw,
-                               int up, double *fz, double *gz)
-{
-    const double q0 = g[r], qU = gu[r];
-    *fz = kz[r] * (lu[r] - l[r]);
-    *gz = kz[r] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kz[r]) * (q0 - qU) : 0;
-}
-
-/* zface_voxel over a plane: the faces below the first plane a sweep level
- * computes (ld, gd, kzd: the plane below; lc, gc: the plane itself). */
-static void zface_plane(size_t m, const double *restrict ld, const double *restrict lc,
-                        const double *restrict gd, const double *restrict gc, const double *restrict kzd,
-                        double *restrict fz, double *restrict gz, double lw, int up)
-{
-    for (size_t r = 0; r < m; ++r)
-        zface_voxel(ld, lc, gd, gc, kzd, r, lw, up, fz + r, gz + r);
-}
-
-/* The water update of voxel r of a z-plane: voxel_faces' terms summed as
- * transport() sums them, w + cd (f0 + f1 + f2 + f3 + f4 + f5) + cg (f6 - f7),
- * from the fill l = w/c and gravity flux g = f_grav p w of the plane (lc,
- * gc) and the plane above (lu, gu), made once per plane and sub-step.  A
- * z-face is computed once, for the lower of its two voxels: the terms of
- * the face below (f5 = -fz[r], f7 = gz[r]) come from the plane below.  The
- * products and sums are those of the one-voxel form in the same order, so
- * the same numbers to the last bit: x - y is x + (-y) in IEEE arithmetic,
- * and -(a (b - c)) differs from a (c - b) only in the sign of an exact
- * zero, which changes a sum only when all its terms are zero, and then
- * w + cd sum only when w is -0.  Returns the new w; *f4, *f6 receive the
- * terms of the face above and, with `fill`, *lo, *go the new fill and
- * gravity flux (as fill_plane computes them). */
-PHC_SOIL_INLINE double water_voxel(const double *restrict wc, const double *restrict lc,
-                                 const double *restrict lu, const double *restrict gc,
-                                 const double *restrict gu, const double *restrict kx,
-                                 const double *restrict ky, const double *restrict kz,
-                                 const double *restrict fz, const double *restrict gz,
-                                 const double *restrict ic, const double *restrict p, size_t r, size_t re,
-                                 size_t rw, size_t rn, size_t rs, double a, double cd, double cg, double lw,
-                                 int up, int fill, double *f4, double *f6, double *lo, double *go)
+/* The water update of voxel r of a z-plane, voxel_faces' terms summed as
+ * transport() sums them, from the fill l = w/c and gravity flux
+ * g = f_grav p w of the plane below (ld, gd), the plane itself (lc, gc) and
+ * the plane above (lu, gu), computed once per plane and sub-step instead of
+ * once for each of a voxel's 7 stencil entries: the same products, the
+ * same sums in the same order, so the same numbers to the last bit.  kx,
+ * ky, kzc are the plane's face permeabilities, kzd those of the plane
+ * below; re, rw, rn, rs the in-plane neighbours (wrapped). */
+static inline double water_voxel_pre(const double *restrict wc, const double *restrict ld,
+                                     const double *restrict lc, const double *restrict lu,
+                                     const double *restrict gd, const double *restrict gc,
+                                     const double *restrict gu, const double *restrict kx,
+                                     const double *restrict ky, const double *restrict kzc,
+                                     const double *restrict kzd, size_t r, size_t re, size_t rw,
+                                     size_t rn, size_t rs, double cd, double cg, double lw, int up)
 {
     const double l0 = lc[r];
     const double f0 = kx[r] * (lc[re] - l0), f1 = kx[rw] * (lc[rw] - l0);
     const double f2 = ky[r] * (lc[rn] - l0), f3 = ky[rs] * (lc[rs] - l0);
-    zface_voxel(lc, lu, gc, gu, kz, r, lw, up, f4, f6);
-    const double wn = wc[r] + cd * (f0 + f1 + f2 + f3 + *f4 - fz[r]) + cg * (*f6 - gz[r]);
-    if (fill) {
-        *lo = wn * ic[r];
-        *go = a * p[r] * wn;
-    }
-    return wn;
+    const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
+    const double q0 = gc[r], qU = gu[r], qD = gd[r];
+    const double f6 = kzc[r] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kzc[r]) * (q0 - qU) : 0;
+    const double f7 = kzd[r] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kzd[r]) * (qD - q0) : 0;
+    return wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
 }
 
-/* water_voxel over the voxels [r0, r1) of a plane, with the neighbours at
- * r + 1, r - 1 (wrong at the ends of a row: see water_plane), r + dn and
- * r - ds.  One flat loop with constant offsets: the compiler vectorises it. */
-PHC_SOIL_INLINE void water_band(size_t r0, size_t r1, size_t dn, size_t ds, const double *restrict wc,
-                              const double *restrict lc, const double *restrict lu, const double *restrict gc,
-                              const double *restrict gu, const double *restrict kx, const double *restrict ky,
-                              const double *restrict kz, double *restrict fz, double *restrict gz,
-                              const double *restrict ic, const double *restrict p, double *restrict out,
-                              double *restrict lo, double *restrict go, double a, double cd, double cg,
-                              double lw, int up, int fill)
-{
-#pragma omp simd
-    for (size_t r = r0; r < r1; ++r) {
-        double f4, f6, l, g;
-        out[r] = water_voxel(wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ic, p, r, r + 1, r - 1, r + dn, r - ds, a,
-                             cd, cg, lw, up, fill, &f4, &f6, &l, &g);
-        fz[r] = f4;
-        gz[r] = f6;
-        if (fill) {
-            lo[r] = l;
-            go[r] = g;
-        }
-    }
-}
-
-/* water_plane with `fill` a constant. */
-PHC_SOIL_INLINE void water_plane_body(size_t nx, size_t ny, const double *restrict wc, const double *restrict lc,
-                                    const double *restrict lu, const double *restrict gc,
-                                    const double *restrict gu, const double *restrict kx,
-                                    const double *restrict ky, const double *restrict kz, double *restrict fz,
-                                    double *restrict gz, double *restrict ends, const double *restrict ic,
-                                    const double *restrict p, double *restrict out, double *restrict lo,
-                                    double *restrict go, double a, double cd, double cg, double lw, int up,
-                                    int fill)
-{
-    const size_t P = nx * ny;
-    /* the two ends of every row, with the wrapped neighbours, into `ends`
-       (they read the faces below, which the bands overwrite) */
-    for (size_t j = 0; j < ny; ++j) {
-        const size_t jn = j + 1 < ny ? nx : nx - P, js = j > 0 ? nx : nx - P;
-        for (int e = 0; e < 2 && (e == 0 || nx > 1); ++e) {
-            const size_t r = nx * j + (e ? nx - 1 : 0);
-            const size_t re = e ? nx * j : (nx > 1 ? r + 1 : r), rw = e ? r - 1 : r + nx - 1;
-            double *x = ends + 10 * j + 5 * (size_t)e;
-            x[0] = water_voxel(wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ic, p, r, re, rw, r + jn, r - js, a, cd,
-                               cg, lw, up, fill, x + 1, x + 2, x + 3, x + 4);
-        }
-    }
-    /* every voxel but the plane's first and last, in three bands of rows:
-       the first row (its south neighbours wrap), the inner rows, the last
-       row (its north neighbours wrap) */
-    const size_t dn0 = ny > 1 ? nx : 0, ds0 = nx - P; /* row 0: r - ds0 = r + P - nx */
-    water_band(1, ny > 1 ? nx : P - 1, dn0, ds0, wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ic, p, out, lo, go, a,
-               cd, cg, lw, up, fill);
-    if (ny > 2)
-        water_band(nx, P - nx, nx, nx, wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ic, p, out, lo, go, a, cd, cg, lw,
-                   up, fill);
-    if (ny > 1)
-        water_band(P - nx, P - 1, nx - P, nx, wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ic, p, out, lo, go, a, cd,
-                   cg, lw, up, fill);
-    /* the row ends as computed first */
-    for (size_t j = 0; j < ny; ++j)
-        for (int e = 0; e < 2 && (e == 0 || nx > 1); ++e) {
-            const size_t r = nx * j + (e ? nx - 1 : 0);
-            const double *x = ends + 10 * j + 5 * (size_t)e;
-            out[r] = x[0];
-            fz[r] = x[1];
-            gz[r] = x[2];
-            if (fill) {
-                lo[r] = x[3];
-                go[r] = x[4];
-            }
-        }
-}
-
-/* One z-plane of a water-only sub-step into `out` (and, with lo and go,
- * the new plane's fill and gravity flux, the next sub-step's inputs, made
- * while the values are in registers).  fz and gz hold the terms of the
- * z-faces below the plane on entry and above it on return; `ends` is
- * scratch for 10 values per row.  The plane is swept as one flat array
- * (east, west, north, south neighbours at r + 1, r - 1, r + nx, r - nx),
- * which the compiler vectorises without a remainder per row; the first and
- * last voxels of every row, whose east or west neighbour wraps, are
- * computed apart first and written over the flat sweep's values.  The
- * build targets baseline x86-64 (SSE2, 2 doubles per instruction): on
- * x86-64 an AVX2 copy (4 doubles) and an AVX-512 copy (8) are compiled
- * beside it and chosen at load time by the CPU (GCC function
- * multiversioning).  The C11 build does not contract a * b + c into a fused
- * multiply-add (ISO C mode: -ffp-contract=off), so every copy rounds every
- * operation alike: the same numbers to the last bit (test_soil 4c compares
- * them with a plain one-voxel-at-a-time stencil). */
+/* One z-plane of a water-only sub-step into `out`: the x-interior of every
+ * row has no wrap-around and no branches, so the compiler vectorises it;
+ * the two ends of the row are done apart.  The build targets baseline
+ * x86-64 (SSE2, 2 doubles per instruction): on x86-64 an AVX2 copy (4
+ * doubles) is compiled beside it and chosen at load time by the CPU (GCC
+ * function multiversioning).  AVX2 does not imply FMA and the C11 build
+ * does not contract a * b + c, so both copies round every operation
+ * alike: the same numbers to the last bit. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
-__attribute__((target_clones(PHC_SOIL_CLONES)))
+__attribute__((target_clones("avx2", "default")))
 #endif
-static void water_plane(size_t nx, size_t ny, const double *restrict wc, const double *restrict lc,
-                        const double *restrict lu, const double *restrict gc, const double *restrict gu,
-                        const double *restrict kx, const double *restrict ky, const double *restrict kz,
-                        double *restrict fz, double *restrict gz, double *restrict ends,
-                        const double *restrict ic, const double *restrict p, double *restrict out,
-                        double *restrict lo, double *restrict go, double a, double cd, double cg, double lw,
-                        int up)
+static void water_plane(size_t nx, size_t ny, const double *restrict wc, const double *restrict ld,
+                        const double *restrict lc, const double *restrict lu, const double *restrict gd,
+                        const double *restrict gc, const double *restrict gu, const double *restrict kx,
+                        const double *restrict ky, const double *restrict kzc, const double *restrict kzd,
+                        double *restrict out, double cd, double cg, double lw, int up)
 {
-    if (lo)
-        water_plane_body(nx, ny, wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ends, ic, p, out, lo, go, a, cd, cg, lw,
-                         up, 1);
-    else
-        water_plane_body(nx, ny, wc, lc, lu, gc, gu, kx, ky, kz, fz, gz, ends, ic, p, out, lo, go, a, cd, cg, lw,
-                         up, 0);
+    const size_t plane = nx * ny;
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
+        const size_t row = nx * j;
+        {
+            const size_t r = row;
+            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, nx > 1 ? r + 1 : r,
+                                     r + nx - 1, r + jn, r - js, cd, cg, lw, up);
+        }
+#pragma omp simd
+        for (size_t i = 1; i < nx - 1; ++i) {
+            const size_t r = row + i;
+            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, r + 1, r - 1, r + jn,
+                                     r - js, cd, cg, lw, up);
+        }
+        if (nx > 1) {
+            const size_t r = row + nx - 1;
+            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, row, r - 1, r + jn,
+                                     r - js, cd, cg, lw, up);
+        }
+    }
 }
 
 /* A plane's fill l = w/c (as w times 1/c) and gravity flux g = f_grav p w. */
@@ -867,28 +748,16 @@ static size_t wrap_plane(long k, long nz)
     return (size_t)(((k % nz) + nz) % nz);
 }
 
-/* Per-thread scratch of sweep_chunk for T sub-steps per sweep (doubles):
- * the rings (T x 2 x 3 planes), the z-face terms of every sub-step (T x 2
- * planes) and water_plane's row ends (10 per row). */
-static size_t sweep_scratch(size_t nx, size_t ny, size_t T)
-{
-    return T * 8 * nx * ny + 10 * ny;
-}
-
 /* T water-only sub-steps of h (time blocking, a wavefront in z): the planes
  * [k0, k1) of w_new from w.  Sub-step t's plane k needs sub-step t-1's
- * planes k and k+1 (and the faces below k, kept from its plane k-1), so the
- * planes are swept once: at plane m, the fill of w's plane m, then
- * sub-step t's plane m - t for t = 1..T.  Sub-step t runs over
- * [k0 - (T - t), k1 + (T - t)): the planes next to the chunk are recomputed
- * by the thread that needs them, with the same arithmetic, so the result
- * does not depend on the chunks (nor the thread count).  Each intermediate
- * sub-step keeps 2 planes of w, l and g in `ring` (T x 2 x 3 planes) and
- * the terms of the z-faces below the plane it is at (T x 2 planes,
- * water_plane); the faces below a sub-step's first plane are computed from
- * the planes of the sub-step before it, as soon as that one has made them.
- * The face permeabilities, 1/c and p stream from memory once per T
- * sub-steps instead of once per sub-step.  (Outside the box the planes
+ * planes k-1, k and k+1, so the planes are swept once: at plane m, the fill
+ * of w's plane m, then sub-step t's plane m - t for t = 1..T.  Sub-step t
+ * runs over [k0 - (T - t), k1 + (T - t)): the planes next to the chunk are
+ * recomputed by the thread that needs them, with the same arithmetic, so
+ * the result does not depend on the chunks (nor the thread count).  Each
+ * intermediate sub-step keeps 3 planes of w, l and g in `ring` (T x 3 x 3
+ * planes); the face permeabilities, 1/c and p stream from memory once per
+ * T sub-steps instead of once per sub-step.  (Outside the box the planes
  * wrap around as the one-step stencil does: across a closed z face the
  * face permeability is 0 and the wrapped values are multiplied by it.) */
 static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1, double *ring)
@@ -899,39 +768,25 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
-    double *faces = ring + T * 6 * P, *ends = faces + T * 2 * P;
-#define RING(t, k, arr) (ring + (((size_t)(t) * 2 + (size_t)(((k) - base) % 2)) * 3 + (arr)) * P)
-#define FZ(t) (faces + ((size_t)(t) - 1) * 2 * P)
-#define GZ(t) (faces + (((size_t)(t) - 1) * 2 + 1) * P)
-/* sub-step t has made its plane k: the faces below sub-step t + 1's first plane */
-#define FIRST_FACES(t, k)                                                                                   \
-    do {                                                                                                    \
-        if ((size_t)(t) < T && (k) == k0 - (long)(T - (size_t)(t) - 1))                                     \
-            zface_plane(P, RING(t, (k) - 1, 1), RING(t, k, 1), RING(t, (k) - 1, 2), RING(t, k, 2),         \
-                        wk->kz + wrap_plane((k) - 1, nz) * P, FZ((t) + 1), GZ((t) + 1), lw, up);            \
-    } while (0)
+#define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * P)
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
         fill_plane(P, s->w + km, wk->ic + km, s->p + km, a, RING(0, m, 1), RING(0, m, 2));
-        FIRST_FACES(0, m);
         for (size_t t = 1; t <= T; ++t) {
             const long k = m - (long)t;
             if (k < k0 - (long)(T - t))
                 break; /* and so for every later t */
-            const size_t kk = wrap_plane(k, nz) * P;
+            const size_t kk = wrap_plane(k, nz) * P, kd = wrap_plane(k - 1, nz) * P;
             const double *wc = t == 1 ? s->w + kk : RING(t - 1, k, 0);
             double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
-            water_plane(nx, ny, wc, RING(t - 1, k, 1), RING(t - 1, k + 1, 1), RING(t - 1, k, 2),
-                        RING(t - 1, k + 1, 2), wk->kx + kk, wk->ky + kk, wk->kz + kk, FZ(t), GZ(t), ends,
-                        wk->ic + kk, s->p + kk, out, t < T ? RING(t, k, 1) : NULL,
-                        t < T ? RING(t, k, 2) : NULL, a, cd, cg, lw, up);
-            FIRST_FACES(t, k);
+            water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
+                        RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
+                        wk->ky + kk, wk->kz + kk, wk->kz + kd, out, cd, cg, lw, up);
+            if (t < T)
+                fill_plane(P, out, wk->ic + kk, s->p + kk, a, RING(t, k, 1), RING(t, k, 2));
         }
     }
-#undef FIRST_FACES
 #undef RING
-#undef FZ
-#undef GZ
 }
 
 /* Water only (no nutrients move), T sub-steps of h in one sweep; each
@@ -964,16 +819,16 @@ static void transport_water(phc_soil *s, double h, size_t T)
 
 /* The sub-steps one sweep may take: params.block_steps, or with 0 (the
  * default) the most, up to PHC_SOIL_BLOCK_STEPS, whose planes fit in
- * PHC_SOIL_CACHE_BYTES: a sweep with T sub-steps works on 8 T planes of
- * scratch (sweep_scratch), the face permeabilities, 1/c and p of T + 1
- * planes and a plane of w and of w_new, (13 T + 7) planes in all.  Where
+ * PHC_SOIL_CACHE_BYTES: a sweep with T sub-steps works on 9 T planes of
+ * rings (prepare_ring), the face permeabilities, 1/c and p of T + 1
+ * planes and a plane of w and of w_new, (14 T + 7) planes in all.  Where
  * they fit a core's cache the sub-steps run from it; where even T = 1
  * does not fit, the planes come from memory anyway and PHC_SOIL_BLOCK_STEPS
  * sub-steps per sweep read them once for all.  Measured on the bench soil,
- * 1 thread, voxel updates per CPU-second, best of 12 (busy machine): 64^3
- * 4.3e8 with 1 sub-step per sweep, 3.3e8 with 2 or 4; 128^3 2.1e8 with 1,
- * 2.5e8 with 4; 96^3 2.4e8 with 1, 2.5e8 with 4; 32^3 4.4e8 with 1, 4.6e8
- * with 2, 4.2e8 with 4.  At most nz / 8 either way (the planes each thread
+ * 1 thread, voxel updates per CPU-second, best of 6 alternating runs (busy
+ * machine, load average 4.3 on 2 CPUs): 64^3 3.95e8 with 1 sub-step per
+ * sweep, 3.70e8 with 2, 3.49e8 with 4; 128^3 2.27e8 with 1, 2.85e8 with 2,
+ * 3.06e8 with 4.  At most nz / 8 either way (the planes each thread
  * recomputes next to its range grow with T) and at least 1.  The numbers
  * do not depend on T. */
 static size_t block_levels(const phc_soil *s)
@@ -982,13 +837,18 @@ static size_t block_levels(const phc_soil *s)
     if (!T) {
         const double plane = (double)(s->nx * s->ny) * sizeof(double);
         T = PHC_SOIL_BLOCK_STEPS;
-        if ((13.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
-            while (T > 1 && (13.0 * (double)T + 7.0) * plane > PHC_SOIL_CACHE_BYTES)
+        if ((14.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
+            while (T > 1 && (14.0 * (double)T + 7.0) * plane > PHC_SOIL_CACHE_BYTES)
                 --T;
     }
     if (T > s->nz / 8)
         T = s->nz / 8;
     return T ? T : 1;
+}
+
+size_t phc_soil_block_steps(const phc_soil *s)
+{
+    return block_levels(s);
 }
 
 /* The rings of transport_water for T sub-steps per sweep and the threads
@@ -1001,7 +861,7 @@ static int prepare_ring(phc_soil *s, size_t T)
     if (s->n >= PHC_SOIL_PARALLEL_MIN && !omp_in_parallel())
         threads = (size_t)omp_get_max_threads();
 #endif
-    const size_t per = sweep_scratch(s->nx, s->ny, T);
+    const size_t per = T * 9 * s->nx * s->ny;
     if (wk->ring && wk->ring_per_thread >= per && wk->ring_threads == threads)
         return PHC_OK;
     free(wk->ring);

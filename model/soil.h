@@ -76,8 +76,7 @@
  * sweep over the grid (a wavefront in z), so the per-voxel constants
  * stream from memory once per sweep; with block_steps 0 as many (up to 4)
  * as keep a sweep's planes in a core's cache (1 at 64 x 64 voxels per
- * plane, 4 at 128 x 128, where the planes come from memory anyway).  Each
- * z-face's terms are computed once, for the voxel below it.  The
+ * plane, 4 at 128 x 128, where the planes come from memory anyway).  The
  * arithmetic is that of one voxel and one sub-step at a time: the result
  * is bit-identical for any block_steps (test_soil 4b, 4c).
  *
@@ -265,6 +264,11 @@ double phc_soil_stable_dt(const phc_soil *s, size_t *voxel);
 
 /* Starts the budget from the current state (water_initial = stored). */
 void phc_soil_budget_reset(phc_soil *s);
+
+/* The water-only sub-steps one sweep over the grid takes with the current
+ * size and params.block_steps (time blocking; see above): 1 to 4 for
+ * block_steps 0. */
+size_t phc_soil_block_steps(const phc_soil *s);
 
 /* Advances from s->t to t_end (h) in steps of params.dt (the last one
  * shortened to land on t_end), each sub-stepped if over the limit.  Errors:

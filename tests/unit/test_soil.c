@@ -442,16 +442,18 @@ static void test_blocked_vs_steps(void)
                 d2 = fmax(d2, fabs(s[0]->w[q] - ref[q]));
                 moved = fmax(moved, fabs(s[0]->w[q] - w0[q]));
             }
-            printf("4c. random %zux%zux%zu%s%s, %d thread%s: %zu steps in one run (4 per sweep) vs %zu runs of "
+            const size_t T = phc_soil_block_steps(s[0]);
+            printf("4c. random %zux%zux%zu%s%s, %d thread%s: %zu steps in one run (%zu per sweep) vs %zu runs of "
                    "one step: bit-identical %s (max |dw| %.1e); vs the plain one-voxel stencil: bit-identical %s "
                    "(max |dw| %.1e); sub-steps %zu vs %zu; largest change of w %.3g\n",
                    nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "", th,
-                   th > 1 ? "s" : "", K, K, same_steps ? "yes" : "NO", d1, same_ref ? "yes" : "NO", d2,
+                   th > 1 ? "s" : "", K, T, K, same_steps ? "yes" : "NO", d1, same_ref ? "yes" : "NO", d2,
                    s[0]->budget.substeps, s[1]->budget.substeps, moved);
             CHECK(same_steps);
             CHECK(same_ref);
             CHECK(s[0]->budget.substeps == K);
             CHECK(moved > 1e-3);
+            CHECK(T == 4); /* the blocked path is the one tested */
             free(ref);
             free(w0);
             for (int r = 0; r < 2; ++r)
