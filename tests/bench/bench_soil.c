@@ -19,11 +19,12 @@
  * Bytes per voxel update of transport (water only), counted as the
  * one-sub-step stencil needs them: it streams w, 1/c, p, kx, ky, kz (read)
  * and w_new (written) = 7 doubles = 56 B, plus the write-allocate read of
- * w_new's cache line = 64 B.  Since time blocking (params.block_steps,
- * default 4 sub-steps per sweep here) the code streams these 64 B once per
- * 4 sub-steps, 16 B per update: the bandwidth lines are "effective" (64 B
- * per update, the usual measure for a blocked stencil), and
- * soil_bytes_moved_per_update says what actually moves.  The neighbour loads
+ * w_new's cache line = 64 B.  With time blocking (params.block_steps;
+ * by default as many sub-steps per sweep as keep a sweep's planes in
+ * cache: 1 at 64^3, 4 at 128^3, printed as soil_block_steps_N) the code
+ * streams these 64 B once per T sub-steps: the bandwidth lines are
+ * "effective" (64 B per update, the usual measure for a blocked stencil),
+ * and soil_bytes_moved_per_update_N says what actually moves.  The neighbour loads
  * (w and 1/c at +-1, +-nx, +-nx ny; kx, ky, kz at -1, -nx, -nx ny; p at
  * +-nx ny) are counted as cache hits.  Not counted: the step's
  * memcpy(v_new, v) when nutrients are off (+16 B, +24 B with
@@ -440,8 +441,6 @@ int main(void)
            "+ write-allocate of w_new)\n", BYTES_SOIL);
     printf("soil_bytes_per_update_incl_v_copy: %.0f B (+ memcpy(v_new, v) each step with nutrients "
            "off, %.0f B more with its write-allocate)\n", BYTES_SOIL + BYTES_V_COPY, 8.0);
-    printf("soil_bytes_moved_per_update: %.0f B (time blocking: the %.0f B stream once per %d sub-steps)\n",
-           BYTES_SOIL / 4, BYTES_SOIL, 4);
     printf("copy_bytes_per_element: %.0f B (read + write; %.0f B with write-allocate)\n", BYTES_COPY,
            BYTES_COPY_WA);
 
@@ -453,6 +452,13 @@ int main(void)
             return 1;
         }
         printf("soil_dt_%zu: %.17g h (0.5 x stable dt)\n", N, s->params.dt);
+        {
+            size_t T = phc_soil_block_steps(s);
+            printf("soil_block_steps_%zu: %zu sub-step%s per sweep (phc_soil_block_steps: as many as keep a "
+                   "sweep's planes in cache)\n", N, T, T > 1 ? "s" : "");
+            printf("soil_bytes_moved_per_update_%zu: %.0f B (the %.0f B stream once per %zu sub-step%s)\n", N,
+                   BYTES_SOIL / (double)T, BYTES_SOIL, T, T > 1 ? "s" : "");
+        }
         for (int th = 0; th < 2; ++th) {
             int T = threads[th];
             result r = measure(s, T);
@@ -595,5 +601,15 @@ int main(void)
         printf("machine_quiet: no (other processes used more than %.2f CPUs during 2-thread timings: "
                "rerun on an idle machine)\n", MAX_OTHER_LOAD);
     printf("bench_total_time: %.1f s\n", now() - t_start);
+    {
+        struct rusage ru, rc;
+        getrusage(RUSAGE_SELF, &ru);
+        getrusage(RUSAGE_CHILDREN, &rc);
+        printf("bench_cpu_time: %.1f s user + %.1f s sys (this process), %.1f s + %.1f s (the NumPy peers)\n",
+               (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec,
+               (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec,
+               (double)rc.ru_utime.tv_sec + 1e-6 * (double)rc.ru_utime.tv_usec,
+               (double)rc.ru_stime.tv_sec + 1e-6 * (double)rc.ru_stime.tv_usec);
+    }
     return 0;
 }

@@ -2,7 +2,10 @@
  * solutions and limits of the finite-volume discretisation documented in
  * soil.h.  One line per check with the measured numbers.  4b: time
  * blocking (several sub-steps per sweep) gives the numbers of one sub-step
- * per sweep, bit for bit, for 1-3 threads. */
+ * per sweep, bit for bit, for 1-3 threads; 4c: on a random field, k
+ * steps in one run (blocked sweeps) equal k runs of one step and a plain
+ * one-voxel-at-a-time stencil, bit for bit, both gravity schemes, 1 and 2
+ * threads. */
 #include "check.h"
 
 #include <omp.h>
@@ -313,6 +316,149 @@ static void test_blocking(void)
         for (int r = 0; r < 4; ++r)
             phc_soil_free(s[r]);
     }
+    omp_set_num_threads(saved);
+}
+
+/* ---- 4c. blocked sweeps = one step at a time = the plain stencil ------------- */
+
+/* The water-only step written one voxel at a time, as soil.h states it
+ * (voxel_faces' terms, face permeabilities as prepare_fields makes them),
+ * without planes, rings or shared faces: k steps of h on w (n values). */
+static double ref_harmonic(double a, double b)
+{
+    return (a > 0 && b > 0) ? 2 * a * b / (a + b) : 0;
+}
+
+static void ref_steps(const phc_soil *s, double *w, double h, size_t steps)
+{
+    const size_t nx = s->nx, ny = s->ny, nz = s->nz, P = nx * ny, n = s->n;
+    const phc_soil_boundary *b = s->params.boundary;
+    const int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
+                        b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
+    double *kx = malloc(n * sizeof *kx), *ky = malloc(n * sizeof *ky), *kz = malloc(n * sizeof *kz),
+           *ic = malloc(n * sizeof *ic), *wn = malloc(n * sizeof *wn);
+    if (!kx || !ky || !kz || !ic || !wn) {
+        fprintf(stderr, "out of memory\n");
+        exit(2);
+    }
+    for (size_t k = 0; k < nz; ++k)
+        for (size_t j = 0; j < ny; ++j)
+            for (size_t i = 0; i < nx; ++i) {
+                size_t q = i + nx * (j + ny * k);
+                ic[q] = 1.0 / s->c[q];
+                kx[q] = (i + 1 < nx || per[0]) ? ref_harmonic(s->p[q], s->p[i + 1 < nx ? q + 1 : q + 1 - nx]) : 0;
+                ky[q] = (j + 1 < ny || per[1]) ? ref_harmonic(s->p[q], s->p[j + 1 < ny ? q + nx : q + nx - P]) : 0;
+                kz[q] = (k + 1 < nz || per[2]) ? ref_harmonic(s->p[q], s->p[k + 1 < nz ? q + P : q + P - n]) : 0;
+            }
+    const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav, *p = s->p;
+    const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
+    const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
+    for (size_t st = 0; st < steps; ++st) {
+        for (size_t k = 0; k < nz; ++k)
+            for (size_t j = 0; j < ny; ++j)
+                for (size_t i = 0; i < nx; ++i) {
+                    const size_t q = i + nx * (j + ny * k);
+                    const size_t qe = i + 1 < nx ? q + 1 : q + 1 - nx, qw = i > 0 ? q - 1 : q + nx - 1;
+                    const size_t qn = j + 1 < ny ? q + nx : q + nx - P, qs = j > 0 ? q - nx : q + P - nx;
+                    const size_t qu = k + 1 < nz ? q + P : q + P - n, qd = k > 0 ? q - P : q + n - P;
+                    const double l0 = w[q] * ic[q];
+                    const double f0 = kx[q] * (w[qe] * ic[qe] - l0), f1 = kx[qw] * (w[qw] * ic[qw] - l0);
+                    const double f2 = ky[q] * (w[qn] * ic[qn] - l0), f3 = ky[qs] * (w[qs] * ic[qs] - l0);
+                    const double f4 = kz[q] * (w[qu] * ic[qu] - l0), f5 = kz[qd] * (w[qd] * ic[qd] - l0);
+                    const double q0 = a * p[q] * w[q], qU = a * p[qu] * w[qu], qD = a * p[qd] * w[qd];
+                    const double f6 = kz[q] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kz[q]) * (q0 - qU) : 0;
+                    const double f7 = kz[qd] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kz[qd]) * (qD - q0) : 0;
+                    wn[q] = w[q] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
+                }
+        memcpy(w, wn, n * sizeof *w);
+    }
+    free(kx);
+    free(ky);
+    free(kz);
+    free(ic);
+    free(wn);
+}
+
+/* A random water-only field: c and p per voxel from a seeded generator,
+ * about 1 voxel in 8 rock (p = 0) and 1 in 16 dry (w = 0). */
+static phc_soil *random_soil(size_t nx, size_t ny, size_t nz, uint64_t seed)
+{
+    phc_soil *s = new_soil(nx, ny, nz, 0.01);
+    uint64_t x = seed;
+    for (size_t q = 0; q < s->n; ++q) {
+        double u[4];
+        for (int e = 0; e < 4; ++e) {
+            x = x * 6364136223846793005ull + 1442695040888963407ull;
+            u[e] = (double)(x >> 11) * 0x1.0p-53;
+        }
+        s->c[q] = 2 + 18 * u[0];
+        s->p[q] = u[1] < 0.125 ? 0 : 0.005 + 0.1 * u[2];
+        s->w[q] = u[3] < 0.0625 ? 0 : s->c[q] * u[3];
+    }
+    s->params.f_diff = 1;
+    s->params.f_grav = 1;
+    return s;
+}
+
+static void test_blocked_vs_steps(void)
+{
+    /* nz 40: 4 sub-steps per sweep (the default); 13 x 11 rows, so no row
+       is a multiple of a vector; x periodic in one case */
+    static const struct { int upwind, periodic; } C[] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
+    const size_t nx = 13, ny = 11, nz = 40, K = 23;
+    int saved = omp_get_max_threads();
+    for (size_t c = 0; c < sizeof C / sizeof C[0]; ++c)
+        for (int th = 1; th <= 2; ++th) {
+            omp_set_num_threads(th);
+            phc_soil *s[2];
+            for (int r = 0; r < 2; ++r) {
+                s[r] = random_soil(nx, ny, nz, 2026 + c);
+                s[r]->params.gravity = C[c].upwind ? PHC_SOIL_GRAVITY_UPWIND : PHC_SOIL_GRAVITY_LAX_WENDROFF;
+                if (C[c].periodic)
+                    s[r]->params.boundary[PHC_SOIL_XMIN] = s[r]->params.boundary[PHC_SOIL_XMAX] = PHC_SOIL_PERIODIC;
+                s[r]->params.substep = 0;
+            }
+            /* a power of 2 below half the limit: the times k h, and their
+               differences, are exact, so every step of either run is h */
+            const double h = exp2(floor(log2(0.5 * phc_soil_stable_dt(s[0], NULL))));
+            double *ref = malloc(s[0]->n * sizeof *ref), *w0 = malloc(s[0]->n * sizeof *w0);
+            if (!ref || !w0)
+                exit(2);
+            memcpy(w0, s[0]->w, s[0]->n * sizeof *w0);
+            memcpy(ref, s[0]->w, s[0]->n * sizeof *ref);
+            double moved = 0;
+            ref_steps(s[0], ref, h, K);
+            phc_error err;
+            /* s[0]: one run of K steps (blocked sweeps); s[1]: K runs of one step */
+            s[0]->params.dt = s[1]->params.dt = h;
+            must(phc_soil_run(s[0], (double)K * h, &err), &err, "blocked run");
+            for (size_t k = 1; k <= K; ++k)
+                must(phc_soil_run(s[1], s[1]->t + h, &err), &err, "single step");
+            int same_steps = !memcmp(s[0]->w, s[1]->w, s[0]->n * sizeof(double));
+            int same_ref = !memcmp(s[0]->w, ref, s[0]->n * sizeof(double));
+            double d1 = 0, d2 = 0;
+            for (size_t q = 0; q < s[0]->n; ++q) {
+                d1 = fmax(d1, fabs(s[0]->w[q] - s[1]->w[q]));
+                d2 = fmax(d2, fabs(s[0]->w[q] - ref[q]));
+                moved = fmax(moved, fabs(s[0]->w[q] - w0[q]));
+            }
+            const size_t T = phc_soil_block_steps(s[0]);
+            printf("4c. random %zux%zux%zu%s%s, %d thread%s: %zu steps in one run (%zu per sweep) vs %zu runs of "
+                   "one step: bit-identical %s (max |dw| %.1e); vs the plain one-voxel stencil: bit-identical %s "
+                   "(max |dw| %.1e); sub-steps %zu vs %zu; largest change of w %.3g\n",
+                   nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "", th,
+                   th > 1 ? "s" : "", K, T, K, same_steps ? "yes" : "NO", d1, same_ref ? "yes" : "NO", d2,
+                   s[0]->budget.substeps, s[1]->budget.substeps, moved);
+            CHECK(same_steps);
+            CHECK(same_ref);
+            CHECK(s[0]->budget.substeps == K);
+            CHECK(moved > 1e-3);
+            CHECK(T == 4); /* the blocked path is the one tested */
+            free(ref);
+            free(w0);
+            for (int r = 0; r < 2; ++r)
+                phc_soil_free(s[r]);
+        }
     omp_set_num_threads(saved);
 }
 
@@ -932,6 +1078,7 @@ int main(void)
     test_conservation();
     test_threads();
     test_blocking();
+    test_blocked_vs_steps();
     test_stability();
     test_absorb_rain();
     test_absorb_dt();
