@@ -12,6 +12,7 @@
 
 #include "fit/engine/cross_validation.h"
 #include "fit/engine/multistart.h"
+#include "fit/engine/qr_lstsq.h"
 #include "fit/engine/residual_checks.h"
 #include "fit/engine/uncertainty.h"
 #include "model/jacobi_svd.h"
@@ -711,7 +712,8 @@ static int polish(nls_memo *memo, const phc_problem *pb, double *x, size_t m, ph
     if (nf == 0 || m < nf)
         return PHC_OK;
     double *r = malloc(m * sizeof *r), *J = malloc(m * np * sizeof *J), *A = malloc(m * nf * sizeof *A);
-    double *b = malloc(m * sizeof *b), *sv = malloc((3 * nf + nf * nf) * sizeof *sv), *trial = malloc(np * sizeof *trial);
+    double *b = malloc(m * sizeof *b), *sv = malloc((nf + phc_qr_lstsq_work(m, nf)) * sizeof *sv),
+           *trial = malloc(np * sizeof *trial);
     double *colscale = malloc(nf * sizeof *colscale);
     size_t *fi = malloc(nf * sizeof *fi);
     int rc = PHC_OK;
@@ -745,10 +747,10 @@ static int polish(nls_memo *memo, const phc_problem *pb, double *x, size_t m, ph
         }
         for (size_t i = 0; i < m; ++i)
             b[i] = -r[i];
-        /* sv: 2 nf of work space, the step (nf), V (nf x nf) */
-        double *step_f = sv + 2 * nf, *V = sv + 3 * nf;
+        /* sv: the step (nf), then phc_qr_lstsq's work space */
+        double *step_f = sv;
         size_t rank = 0;
-        if (phc_jacobi_lstsq(A, m, nf, b, 1e-13, V, sv, step_f, &rank) != 0 || rank < nf)
+        if (phc_qr_lstsq(A, m, nf, b, 1e-13, sv + nf, step_f, &rank) != 0 || rank < nf)
             break; /* rank-deficient: leave it to the covariance analysis */
         double step = 0;
         memcpy(trial, x, np * sizeof *x);
