@@ -18,6 +18,13 @@
 
 #include <stddef.h>
 
+/* Householder QR of A (m x n row-major, m >= n >= 1): R (n x n, zero below
+ * the diagonal) with A = Q R, and c (m values, or NULL) replaced by Q'c
+ * (full m x m Q; its first n values are the least-squares right-hand side).
+ * A is overwritten.  Returns 0, 1 for a NaN/infinite entry, 2 when m < n.
+ * R has A's singular values and right singular vectors. */
+int phc_qr_triangle(double *A, size_t m, size_t n, double *c, double *R);
+
 /* x (n) minimising |A x - b| (A m x n row-major, m >= n >= 1; b m values),
  * singular values <= rcond * s_max treated as zero as phc_jacobi_lstsq;
  * *rank gets the numerical rank.  A is overwritten; work holds

@@ -2,7 +2,8 @@
  * R, against exact solutions (a consistent system; an inconsistent one
  * whose residual is built orthogonal to the columns, so the solution is
  * known exactly), against phc_jacobi_lstsq on A itself (random Jacobians of
- * the fit's shapes, columns scaled over 6 orders of magnitude), and the
+ * the fit's shapes, columns scaled over 6 orders of magnitude), R's
+ * singular values and vectors against those of A (the covariance), and the
  * limit cases: a square system, two proportional columns (rank n - 1, the
  * minimum-norm solution), a zero column, m < n and a NaN. */
 #include <math.h>
@@ -145,6 +146,37 @@ static void test_against_jacobi(void)
     printf("qr_lstsq vs jacobi_lstsq: largest difference %.3g (in units of 1 / column scale)\n", worst);
 }
 
+/* phc_qr_triangle: R has A's singular values and right singular vectors
+ * (up to sign), against phc_jacobi_svd of A itself. */
+static void test_triangle(void)
+{
+    const size_t m = 120, n = 7;
+    static double A[120 * 7], Ac[120 * 7], R[7 * 7], sA[7], sR[7], VA[7 * 7], VR[7 * 7];
+    for (size_t i = 0; i < m; ++i)
+        for (size_t j = 0; j < n; ++j)
+            A[i * n + j] = uniform() * pow(10.0, (double)j - 3.0);
+    memcpy(Ac, A, sizeof A);
+    CHECK(phc_qr_triangle(Ac, m, n, NULL, R) == 0);
+    for (size_t i = 1; i < n; ++i)
+        for (size_t j = 0; j < i; ++j)
+            CHECK(R[i * n + j] == 0.0);
+    memcpy(Ac, A, sizeof A);
+    CHECK(phc_jacobi_svd(Ac, m, n, sA, VA) == 0);
+    CHECK(phc_jacobi_svd(R, n, n, sR, VR) == 0);
+    double worst = 0;
+    for (size_t k = 0; k < n; ++k) {
+        CHECK_NEAR(sR[k], sA[k], 0, 1e-14);
+        double dot = 0; /* |v_A . v_R| = 1 for the same vector up to sign */
+        for (size_t a = 0; a < n; ++a)
+            dot += VA[a * n + k] * VR[a * n + k];
+        worst = fmax(worst, fabs(fabs(dot) - 1));
+        CHECK_NEAR(fabs(dot), 1.0, 1e-12, 0);
+    }
+    printf("qr_triangle: singular vectors agree to %.3g\n", worst);
+    double b[3] = {1, 2, 3};
+    CHECK(phc_qr_triangle(A, 2, 3, b, R) == 2);
+}
+
 /* Limit cases. */
 static void test_limits(void)
 {
@@ -200,6 +232,7 @@ int main(void)
     test_consistent();
     test_inconsistent();
     test_against_jacobi();
+    test_triangle();
     test_limits();
     return check_finish("test_qr_lstsq");
 }
