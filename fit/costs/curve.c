@@ -108,6 +108,20 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     if (c->other_cols)
         return 1; /* depends on more than x: no single curve */
     memcpy(c->slots, p, ds->k * sizeof *p);
+    if (c->tape && c->n_cols <= PHC_CURVE_MAX_BLOCK_COLS) {
+        /* x is the only column the expression reads (other_cols is 0) */
+        const double *block_cols[PHC_CURVE_MAX_BLOCK_COLS];
+        size_t done = 0;
+        for (; done < m; done += PHC_EXPR_ROWS) {
+            const size_t nr = m - done < PHC_EXPR_ROWS ? m - done : PHC_EXPR_ROWS;
+            for (size_t j = 0; j < c->n_cols; ++j)
+                block_cols[j] = x + done;
+            if (phc_expr_eval_rows(c->tape, p, block_cols, nr, y + done, NULL, 0) != PHC_OK)
+                break; /* no work space: row by row below */
+        }
+        if (done >= m)
+            return 0;
+    }
     for (size_t i = 0; i < m; ++i) {
         if (c->x_col >= 0)
             c->row[c->x_col] = x[i];
