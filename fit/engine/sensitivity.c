@@ -37,12 +37,11 @@ static int by_gamma_desc(const void *a, const void *b)
  * its singular values (model/jacobi_svd.h: no LAPACK, no allocation). */
 static double subset_gamma(const double *G, size_t n, const size_t *idx, size_t k)
 {
-    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], V[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE],
-        w[PHC_COLLIN_MAX_SIZE];
+    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], w[PHC_COLLIN_MAX_SIZE];
     for (size_t a = 0; a < k; ++a)
         for (size_t b = 0; b < k; ++b)
             A[a * k + b] = G[idx[a] * n + idx[b]];
-    if (phc_jacobi_svd(A, k, k, w, V) != 0)
+    if (phc_jacobi_svd(A, k, k, w, NULL) != 0) /* values only */
         return NAN;
     /* Singular to working precision counts as singular: the eigenvalues
      * carry an absolute error of a few k eps lambda_max, so two proportional
