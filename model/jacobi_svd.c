@@ -6,7 +6,7 @@
 
 int phc_jacobi_svd(double *A, size_t m, size_t n, double *s, double *V)
 {
-    for (size_t i = 0; V && i < n; ++i)
+    for (size_t i = 0; i < n; ++i)
         for (size_t j = 0; j < n; ++j)
             V[i * n + j] = i == j;
     double total = 0; /* |A|_F^2: columns below eps |A|_F are zero to working precision */
@@ -47,7 +47,7 @@ int phc_jacobi_svd(double *A, size_t m, size_t n, double *s, double *V)
                     A[i * n + p] = c * ap - sn * aq;
                     A[i * n + q] = sn * ap + c * aq;
                 }
-                for (size_t i = 0; V && i < n; ++i) {
+                for (size_t i = 0; i < n; ++i) {
                     const double vp = V[i * n + p], vq = V[i * n + q];
                     V[i * n + p] = c * vp - sn * vq;
                     V[i * n + q] = sn * vp + c * vq;
@@ -77,7 +77,7 @@ int phc_jacobi_svd(double *A, size_t m, size_t n, double *s, double *V)
             A[i * n + j] = A[i * n + best];
             A[i * n + best] = tmp;
         }
-        for (size_t i = 0; V && i < n; ++i) {
+        for (size_t i = 0; i < n; ++i) {
             tmp = V[i * n + j];
             V[i * n + j] = V[i * n + best];
             V[i * n + best] = tmp;

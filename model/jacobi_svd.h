@@ -19,9 +19,7 @@
 /* A (m x n, row-major, any m >= 1, n >= 1) = U diag(s) V'.  On return A holds
  * U diag(s) (column j = s[j] u_j; a zero column for s[j] = 0), s[0] >= s[1]
  * >= ... >= s[n-1] >= 0, and V (n x n, row-major: V[i*n + j] = component i of
- * the right singular vector j) is orthogonal; V may be NULL when only the
- * singular values are wanted (the same values to the bit, about a third
- * fewer operations on a square matrix).  Returns 0, or 1 when the
+ * the right singular vector j) is orthogonal.  Returns 0, or 1 when the
  * rotations did not converge in 60 sweeps (A, s, V then hold the last
  * iterate) or an input is NaN/infinite. */
 int phc_jacobi_svd(double *A, size_t m, size_t n, double *s, double *V);
