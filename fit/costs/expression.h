@@ -51,4 +51,17 @@ int phc_expr_prepare(phc_expr *e, size_t n_slots, phc_error *err);
 double phc_expr_eval(phc_expr *e, const double *slots, const double *row,
                      double *grad);
 
+/* Most rows phc_expr_eval_rows takes at once. */
+#define PHC_EXPR_ROWS 32
+
+/* n_rows (<= PHC_EXPR_ROWS) rows at once, bitwise the numbers phc_expr_eval
+ * gives row by row: column c of row r is cols[c][r] (the columns the names
+ * are bound to with is_slot = 0), the value into value[r] and, when grad is
+ * non-NULL, the n_slots derivatives into grad + r * grad_stride.
+ * PHC_OK, PHC_ERR_NOMEM when its work space (4 x nodes x PHC_EXPR_ROWS
+ * doubles, allocated on the first call) cannot be had, PHC_ERR_INVALID for
+ * too many rows.  Not thread-safe for one phc_expr. */
+int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *cols, size_t n_rows,
+                       double *value, double *grad, size_t grad_stride);
+
 #endif /* PHC_COSTS_EXPRESSION_H */

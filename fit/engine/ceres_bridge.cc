@@ -86,10 +86,25 @@ static bool call_block(const Block &b, const double *x, double *r, double *jac,
 }
 
 // A block with analytic derivatives, in scaled coordinates.
+//
+// Ceres's trust-region loop asks for the residuals alone at a candidate
+// point and, when it accepts the step, for the residuals and the Jacobian at
+// that same point (TrustRegionMinimizer: the candidate's cost, then
+// EvaluateGradientAndJacobian).  A callback that fills the Jacobian computes
+// the residuals on the way (curve expressions: one forward and one reverse
+// sweep), so while steps are being accepted the candidate is evaluated with
+// its Jacobian once and the accepted point is served from that evaluation:
+// one model run per accepted step instead of two.  After a rejected step
+// (the last candidate's Jacobian never asked for) candidates are evaluated
+// without the Jacobian again until one is accepted, so a model whose
+// Jacobian costs many runs (finite differences inside the kind) pays it for
+// at most one rejected candidate in a row.  Served values are the same
+// numbers the callback returned: the results do not change.
 class AnalyticCost final : public ceres::CostFunction {
   public:
     AnalyticCost(const Block &b, const std::vector<Parameter> &params, SolveState *state)
-        : b_(b), params_(params), state_(state)
+        : b_(b), params_(params), state_(state), x_(b.index.size()), key_(b.index.size()), r_(b.m),
+          jac_(b.m * b.index.size())
     {
         set_num_residuals(static_cast<int>(b.m));
         for (size_t j = 0; j < b.index.size(); ++j)
@@ -98,23 +113,54 @@ class AnalyticCost final : public ceres::CostFunction {
 
     bool Evaluate(double const *const *u, double *residuals, double **jacobians) const override
     {
+        std::lock_guard<std::mutex> lock(mutex_);
         const size_t k = b_.index.size();
-        std::vector<double> x(k);
-        unscale(b_, params_, u, x.data());
-        std::vector<double> jac;
-        if (jacobians)
-            jac.assign(b_.m * k, 0.0);
-        if (!call_block(b_, x.data(), residuals, jacobians ? jac.data() : nullptr, state_))
-            return false;
-        if (jacobians) {
-            // d r / d u_j = d r / d x_j * scale_j; Ceres wants per-block m x 1.
-            for (size_t j = 0; j < k; ++j) {
-                if (!jacobians[j])
-                    continue;
-                const double s = params_[b_.index[j]].scale;
-                for (size_t i = 0; i < b_.m; ++i)
-                    jacobians[j][i] = jac[i * k + j] * s;
+        bool same = has_key_;
+        for (size_t j = 0; same && j < k; ++j)
+            same = key_[j] == u[j][0];
+        if (!jacobians) {
+            if (same) {  // asked twice at one point
+                std::copy(r_.begin(), r_.end(), residuals);
+                return true;
             }
+            if (pending_)  // the last candidate's Jacobian was never asked for: rejected
+                with_jacobian_ = false;
+            has_key_ = has_jac_ = pending_ = false;
+            unscale(b_, params_, u, x_.data());
+            bool ok = false, jac_ok = false;
+            if (with_jacobian_)
+                ok = jac_ok = call_block(b_, x_.data(), r_.data(), jac_.data(), state_);
+            if (!ok)  // also when only the Jacobian was not finite
+                ok = call_block(b_, x_.data(), r_.data(), nullptr, state_);
+            if (!ok)
+                return false;
+            for (size_t j = 0; j < k; ++j)
+                key_[j] = u[j][0];
+            has_key_ = pending_ = true;
+            has_jac_ = jac_ok;
+            std::copy(r_.begin(), r_.end(), residuals);
+            return true;
+        }
+        if (same && pending_)  // the candidate was accepted
+            with_jacobian_ = true;
+        pending_ = false;
+        if (!(same && has_jac_)) {
+            has_key_ = has_jac_ = false;
+            unscale(b_, params_, u, x_.data());
+            if (!call_block(b_, x_.data(), r_.data(), jac_.data(), state_))
+                return false;
+            for (size_t j = 0; j < k; ++j)
+                key_[j] = u[j][0];
+            has_key_ = has_jac_ = true;
+        }
+        std::copy(r_.begin(), r_.end(), residuals);
+        // d r / d u_j = d r / d x_j * scale_j; Ceres wants per-block m x 1.
+        for (size_t j = 0; j < k; ++j) {
+            if (!jacobians[j])
+                continue;
+            const double s = params_[b_.index[j]].scale;
+            for (size_t i = 0; i < b_.m; ++i)
+                jacobians[j][i] = jac_[i * k + j] * s;
         }
         return true;
     }
@@ -123,6 +169,15 @@ class AnalyticCost final : public ceres::CostFunction {
     const Block &b_;
     const std::vector<Parameter> &params_;
     SolveState *state_;
+    // The last evaluation (physical x_, its scaled key_, residuals r_ and
+    // Jacobian jac_ as the callback fills it, m x k row-major) and the
+    // prediction state; guarded by mutex_ (Ceres may evaluate blocks on
+    // several threads).
+    mutable std::mutex mutex_;
+    mutable std::vector<double> x_, key_, r_, jac_;
+    mutable bool has_key_ = false, has_jac_ = false;
+    mutable bool pending_ = false;        // key_ is a candidate whose Jacobian has not been asked for
+    mutable bool with_jacobian_ = true;   // evaluate candidates with their Jacobian
 };
 
 // Residuals only, for Ceres's numerical differentiation.

@@ -12,6 +12,7 @@
 
 #include "fit/engine/cross_validation.h"
 #include "fit/engine/multistart.h"
+#include "fit/engine/qr_lstsq.h"
 #include "fit/engine/residual_checks.h"
 #include "fit/engine/uncertainty.h"
 #include "model/jacobi_svd.h"
@@ -613,15 +614,68 @@ static double effect_scale(const phc_problem *pb, const double *x, size_t i)
     return x[i] != 0 ? fabs(x[i]) : phc_problem_scale(pb, i);
 }
 
+/* The last successful evaluation of a fit's problem (residuals, Jacobian,
+ * cost at x): the rescue decision, the Gauss–Newton polish and the analysis
+ * evaluate at the same point one after the other (the best start, then the
+ * polished solution), and each such evaluation runs the model and its
+ * Jacobian once.  Only phc_fit_run's own phc_nls, whose data sets do not
+ * change during the fit, is remembered. */
+typedef struct nls_memo {
+    phc_nls *nls;
+    size_t m, np;
+    int valid;
+    double *x, *r, *J, cost;
+} nls_memo;
+
+static void nls_memo_clear(nls_memo *c)
+{
+    free(c->x);
+    free(c->r);
+    free(c->J);
+    memset(c, 0, sizeof *c);
+}
+
+/* phc_nls_evaluate(c->nls, x, r, J, cost, err) (r, J, cost may be NULL),
+ * from the memo when x is bitwise the last successfully evaluated point. */
+static int memo_evaluate(nls_memo *c, const double *x, double *r, double *J, double *cost, phc_error *err)
+{
+    if (!c->x || !c->r || !c->J) {
+        c->m = phc_nls_residual_count(c->nls);
+        if (!c->x)
+            c->x = malloc(c->np * sizeof *c->x);
+        if (!c->r)
+            c->r = malloc(c->m * sizeof *c->r);
+        if (!c->J)
+            c->J = malloc(c->m * c->np * sizeof *c->J);
+        if (!c->x || !c->r || !c->J)
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    if (!c->valid || memcmp(c->x, x, c->np * sizeof *x) != 0) {
+        c->valid = 0;
+        int rc = phc_nls_evaluate(c->nls, x, c->r, c->J, &c->cost, err);
+        if (rc)
+            return rc;
+        memcpy(c->x, x, c->np * sizeof *x);
+        c->valid = 1;
+    }
+    if (r)
+        memcpy(r, c->r, c->m * sizeof *r);
+    if (J)
+        memcpy(J, c->J, c->m * c->np * sizeof *J);
+    if (cost)
+        *cost = c->cost;
+    return PHC_OK;
+}
+
 /* 1 when some free parameter has (relatively) no effect on the residuals at
  * x (phc_negligible_columns): a stall on a plateau. */
-static int stalled_on_plateau(phc_nls *nls, const phc_problem *pb, const double *x)
+static int stalled_on_plateau(nls_memo *memo, const phc_problem *pb, const double *x)
 {
-    const size_t m = phc_nls_residual_count(nls), np = pb->n_params;
+    const size_t m = phc_nls_residual_count(memo->nls), np = pb->n_params;
     double *J = malloc(m * np * sizeof *J), *scale = malloc(np * sizeof *scale);
     int *fixed = malloc(np * sizeof *fixed), *negligible = malloc(np * sizeof *negligible);
     int stalled = 0;
-    if (J && scale && fixed && negligible && phc_nls_evaluate(nls, x, NULL, J, NULL, NULL) == PHC_OK) {
+    if (J && scale && fixed && negligible && memo_evaluate(memo, x, NULL, J, NULL, NULL) == PHC_OK) {
         for (size_t j = 0; j < np; ++j) {
             scale[j] = effect_scale(pb, x, j);
             fixed[j] = pb->params[j].fixed;
@@ -646,7 +700,7 @@ static int stalled_on_plateau(phc_nls *nls, const phc_problem *pb, const double 
  * does not rise beyond its round-off (residuals y - yhat lose digits to
  * cancellation: Misra1b's cost is only good to ~1e-13, so the allowance is
  * 1e-10 relative) and the steps keep shrinking. */
-static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_error *err)
+static int polish(nls_memo *memo, const phc_problem *pb, double *x, size_t m, phc_error *err)
 {
     const size_t np = pb->n_params;
     size_t nf = 0;
@@ -658,7 +712,8 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
     if (nf == 0 || m < nf)
         return PHC_OK;
     double *r = malloc(m * sizeof *r), *J = malloc(m * np * sizeof *J), *A = malloc(m * nf * sizeof *A);
-    double *b = malloc(m * sizeof *b), *sv = malloc((3 * nf + nf * nf) * sizeof *sv), *trial = malloc(np * sizeof *trial);
+    double *b = malloc(m * sizeof *b), *sv = malloc((nf + phc_qr_lstsq_work(m, nf)) * sizeof *sv),
+           *trial = malloc(np * sizeof *trial);
     double *colscale = malloc(nf * sizeof *colscale);
     size_t *fi = malloc(nf * sizeof *fi);
     int rc = PHC_OK;
@@ -678,7 +733,7 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
     if (nf == 0)
         goto done;
     double cost;
-    if (phc_nls_evaluate(nls, x, r, J, &cost, NULL) != PHC_OK)
+    if (memo_evaluate(memo, x, r, J, &cost, NULL) != PHC_OK)
         goto done;
     double last_step = INFINITY;
     for (int it = 0; it < 10; ++it) {
@@ -692,10 +747,10 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
         }
         for (size_t i = 0; i < m; ++i)
             b[i] = -r[i];
-        /* sv: 2 nf of work space, the step (nf), V (nf x nf) */
-        double *step_f = sv + 2 * nf, *V = sv + 3 * nf;
+        /* sv: the step (nf), then phc_qr_lstsq's work space */
+        double *step_f = sv;
         size_t rank = 0;
-        if (phc_jacobi_lstsq(A, m, nf, b, 1e-13, V, sv, step_f, &rank) != 0 || rank < nf)
+        if (phc_qr_lstsq(A, m, nf, b, 1e-13, sv + nf, step_f, &rank) != 0 || rank < nf)
             break; /* rank-deficient: leave it to the covariance analysis */
         double step = 0;
         memcpy(trial, x, np * sizeof *x);
@@ -710,9 +765,9 @@ static int polish(phc_nls *nls, const phc_problem *pb, double *x, size_t m, phc_
         if (!inside || !(step < 1e-4) || step >= last_step)
             break; /* not in the Gauss–Newton basin, or no longer contracting */
         double trial_cost;
-        if (phc_nls_evaluate(nls, trial, r, J, &trial_cost, NULL) != PHC_OK ||
+        if (memo_evaluate(memo, trial, r, J, &trial_cost, NULL) != PHC_OK ||
             !(trial_cost <= cost * (1 + 1e-10) + 1e-300)) {
-            phc_nls_evaluate(nls, x, r, J, &cost, NULL);
+            memo_evaluate(memo, x, r, J, &cost, NULL);
             break;
         }
         memcpy(x, trial, np * sizeof *x);
@@ -800,7 +855,7 @@ static int solve_setup(phc_nls *nls, const phc_problem *pb, double *x, phc_error
  * holds the lowest-cost point, and res->summary (of that start),
  * total_time, starts, rescue_starts and starts_at_best are set.  Reports
  * "start" progress; a cancelled callback is an error. */
-static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progress, void *user_data,
+static int run_starts(nls_memo *memo, const phc_problem *pb, phc_progress_fn progress, void *user_data,
                       double *x, double *best, phc_fit_result *res, phc_error *err)
 {
     const phc_fit_options *opt = &pb->options;
@@ -835,9 +890,9 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
         }
         /* a rescue start where some parameter already has no effect before
          * any step (see below) */
-        const int flat_start = s > 0 && res->rescue_starts && stalled_on_plateau(nls, pb, x);
+        const int flat_start = s > 0 && res->rescue_starts && stalled_on_plateau(memo, pb, x);
         phc_nls_summary sum;
-        if ((rc = phc_nls_solve(nls, &nls_opt, x, &sum, err)))
+        if ((rc = phc_nls_solve(memo->nls, &nls_opt, x, &sum, err)))
             goto done;
         if (relay.cancelled) {
             rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
@@ -856,7 +911,7 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
             res->summary = sum;
         }
         if (s == 0 && planned == 1 && opt->rescue_starts > 0 &&
-            (res->summary.outcome != PHC_NLS_CONVERGED || stalled_on_plateau(nls, pb, best))) {
+            (res->summary.outcome != PHC_NLS_CONVERGED || stalled_on_plateau(memo, pb, best))) {
             planned += opt->rescue_starts;
             res->rescue_starts = opt->rescue_starts;
         } else if (s > 0 && res->rescue_starts) {
@@ -870,7 +925,7 @@ static int run_starts(phc_nls *nls, const phc_problem *pb, phc_progress_fn progr
              * A start that only drifts onto a plateau while solving (NIST
              * BoxBOD from Start 1: the exponential saturates) keeps the
              * rescue going. */
-            if (flat_start && !improved && stalled_on_plateau(nls, pb, x))
+            if (flat_start && !improved && stalled_on_plateau(memo, pb, x))
                 ++useless;
             if (useless == s && s >= RESCUE_PATIENCE) {
                 res->rescue_stopped = 1;
@@ -894,16 +949,16 @@ done:
  * Gauss-Newton (polish).  On PHC_OK best (np values) is the solution, at
  * which the analyse stage judges everything; res holds the solver's
  * summary and the start counts. */
-static int fit_solve(phc_nls *nls, const phc_problem *pb, phc_progress_fn progress, void *user_data,
+static int fit_solve(nls_memo *memo, const phc_problem *pb, phc_progress_fn progress, void *user_data,
                      double *best, phc_fit_result *res, phc_error *err)
 {
     double *x = calloc(pb->n_params, sizeof *x);
     int rc;
     if (!x)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if (!(rc = solve_setup(nls, pb, x, err)) && !(rc = run_starts(nls, pb, progress, user_data, x, best, res, err)) &&
+    if (!(rc = solve_setup(memo->nls, pb, x, err)) && !(rc = run_starts(memo, pb, progress, user_data, x, best, res, err)) &&
         res->summary.outcome == PHC_NLS_CONVERGED)
-        rc = polish(nls, pb, best, phc_nls_residual_count(nls), err);
+        rc = polish(memo, pb, best, phc_nls_residual_count(memo->nls), err);
     free(x);
     return rc;
 }
@@ -1113,10 +1168,10 @@ static int analyse_datasets(const phc_problem *pb, const double *best, const dou
  * frame, covariance and intervals, sensitivities, the per-data-set results
  * and the verdict.  Reports "uncertainty" progress first; a cancelled
  * callback is an error. */
-static int fit_analyse(phc_nls *nls, phc_problem *pb, const double *best, phc_progress_fn progress,
+static int fit_analyse(nls_memo *memo, phc_problem *pb, const double *best, phc_progress_fn progress,
                        void *user_data, phc_fit_result *res, phc_error *err)
 {
-    const size_t np = pb->n_params, m = phc_nls_residual_count(nls);
+    const size_t np = pb->n_params, m = phc_nls_residual_count(memo->nls);
     if (phc_progress_report(progress, user_data, "uncertainty", 0, 0, -1, NAN, NULL))
         return phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
     double *r = calloc(m, sizeof *r), *J = calloc(m * np, sizeof *J), *Jf = NULL;
@@ -1125,7 +1180,7 @@ static int fit_analyse(phc_nls *nls, phc_problem *pb, const double *best, phc_pr
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto done;
     }
-    if ((rc = phc_nls_evaluate(nls, best, r, J, &res->cost, err)) || (rc = result_frame(pb, r, m, res, err)))
+    if ((rc = memo_evaluate(memo, best, r, J, &res->cost, err)) || (rc = result_frame(pb, r, m, res, err)))
         goto done;
     const size_t nf = res->n_free;
     if (!(Jf = malloc(m * nf * sizeof *Jf))) {
@@ -1161,14 +1216,15 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         pb->datasets[d]->progress_data = user_data;
     }
     phc_nls *nls = phc_nls_new(pb->n_params);
+    nls_memo memo = {nls, 0, pb->n_params, 0, NULL, NULL, NULL, 0};
     phc_fit_result *res = calloc(1, sizeof *res);
     double *best = calloc(pb->n_params, sizeof *best);
     if (!nls)
         rc = phc_nls_new_error("fit", err);
     else if (!res || !best)
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    else if (!(rc = fit_solve(nls, pb, progress, user_data, best, res, err)) &&
-             !(rc = fit_analyse(nls, pb, best, progress, user_data, res, err))) {
+    else if (!(rc = fit_solve(&memo, pb, progress, user_data, best, res, err)) &&
+             !(rc = fit_analyse(&memo, pb, best, progress, user_data, res, err))) {
         *out = res;
         res = NULL;
     }
@@ -1176,6 +1232,7 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
         pb->datasets[d]->progress = NULL;
         pb->datasets[d]->progress_data = NULL;
     }
+    nls_memo_clear(&memo);
     phc_nls_free(nls);
     phc_fit_result_free(res);
     free(best);

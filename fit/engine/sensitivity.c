@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "model/jacobi_svd.h"
 
 void phc_sensitivity_clear(phc_sensitivity *s)
 {
@@ -32,24 +31,72 @@ static int by_gamma_desc(const void *a, const void *b)
     return (ga < gb) - (ga > gb);
 }
 
-/* gamma of one subset from the Gram matrix G = Sn'Sn of all columns: its
- * k x k block is symmetric positive semi-definite, so its eigenvalues are
- * its singular values (model/jacobi_svd.h: no LAPACK, no allocation). */
+/* Eigenvalues of the symmetric k x k matrix A (row-major, destroyed) into
+ * w (unsorted) by the cyclic two-sided Jacobi method (Golub & Van Loan,
+ * Matrix Computations, 4th ed., section 8.5: the rotation of 8.5.2, the
+ * row-cyclic order of 8.5.3).  A pair (p, q) is skipped once |a_pq| <=
+ * eps sqrt(a_pp a_qq), the relative test under which Jacobi's method finds
+ * the eigenvalues of a positive definite matrix with a unit diagonal (a
+ * Gram matrix of unit columns) to high relative accuracy (Demmel & Veselic
+ * 1992, SIAM J. Matrix Anal. Appl. 13:1204-1245).  A rotation costs O(k),
+ * against the O(k) dot products and updates of a one-sided rotation of
+ * the same matrix.  Returns 0, or 1 after 60 sweeps without convergence. */
+static int symmetric_eigenvalues(double *A, size_t k, double *w)
+{
+    int converged = k < 2;
+    for (int sweep = 0; sweep < 60 && !converged; ++sweep) {
+        int rotated = 0;
+        for (size_t p = 0; p + 1 < k; ++p)
+            for (size_t q = p + 1; q < k; ++q) {
+                const double app = A[p * k + p], aqq = A[q * k + q], apq = A[p * k + q];
+                if (!(fabs(apq) > DBL_EPSILON * sqrt(fabs(app) * fabs(aqq))))
+                    continue;
+                rotated = 1;
+                const double zeta = (aqq - app) / (2 * apq);
+                const double t = (zeta >= 0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1 + zeta * zeta));
+                const double c = 1 / sqrt(1 + t * t), sn = c * t;
+                A[p * k + p] = app - t * apq;
+                A[q * k + q] = aqq + t * apq;
+                A[p * k + q] = A[q * k + p] = 0;
+                for (size_t r = 0; r < k; ++r) {
+                    if (r == p || r == q)
+                        continue;
+                    const double arp = A[r * k + p], arq = A[r * k + q];
+                    A[r * k + p] = A[p * k + r] = c * arp - sn * arq;
+                    A[r * k + q] = A[q * k + r] = sn * arp + c * arq;
+                }
+            }
+        converged = !rotated;
+    }
+    for (size_t j = 0; j < k; ++j)
+        w[j] = A[j * k + j];
+    return converged ? 0 : 1;
+}
+
+/* gamma of one subset from the Gram matrix G = Sn'Sn of all columns: the
+ * smallest eigenvalue of its k x k block (symmetric positive
+ * semi-definite, unit diagonal). */
 static double subset_gamma(const double *G, size_t n, const size_t *idx, size_t k)
 {
-    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], V[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE],
-        w[PHC_COLLIN_MAX_SIZE];
+    double A[PHC_COLLIN_MAX_SIZE * PHC_COLLIN_MAX_SIZE], w[PHC_COLLIN_MAX_SIZE];
     for (size_t a = 0; a < k; ++a)
         for (size_t b = 0; b < k; ++b)
             A[a * k + b] = G[idx[a] * n + idx[b]];
-    if (phc_jacobi_svd(A, k, k, w, V) != 0)
+    for (size_t a = 0; a < k * k; ++a)
+        if (!isfinite(A[a]))
+            return NAN;
+    if (symmetric_eigenvalues(A, k, w) != 0)
         return NAN;
+    double lmin = w[0], lmax = w[0];
+    for (size_t j = 1; j < k; ++j) {
+        lmin = fmin(lmin, w[j]);
+        lmax = fmax(lmax, w[j]);
+    }
     /* Singular to working precision counts as singular: the eigenvalues
      * carry an absolute error of a few k eps lambda_max, so two proportional
-     * columns (y = a b x) give lambda_min ~ 1e-16 and gamma ~ 1e8 rather
-     * than inf, depending on rounding.  w is in descending order. */
-    const double lmin = w[k - 1];
-    return lmin > 4.0 * (double)k * DBL_EPSILON * w[0] ? 1.0 / sqrt(lmin) : INFINITY;
+     * columns (y = a b x) give lambda_min ~ 1e-16 (or slightly below 0) and
+     * gamma ~ 1e8 rather than inf, depending on rounding. */
+    return lmin > 4.0 * (double)k * DBL_EPSILON * lmax ? 1.0 / sqrt(lmin) : INFINITY;
 }
 
 int phc_sensitivity_compute(const double *S, size_t m, size_t n, size_t max_sets,

@@ -1,5 +1,6 @@
 /* Covariance at the optimum: see uncertainty.h. */
 #include "fit/engine/uncertainty.h"
+#include "fit/engine/qr_lstsq.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -70,9 +71,18 @@ int phc_covariance_compute(const double *J, size_t m, size_t n, double s2, doubl
     for (size_t i = 0; i < m; ++i)
         for (size_t j = 0; j < n; ++j)
             A[i * n + j] = D[j] > 0 ? J[i * n + j] / D[j] : 0.0;
-    /* the SVD by one-sided Jacobi (model/jacobi_svd.h: no LAPACK to load);
-       VT[k][a] = V[a][k], the k-th right singular vector */
-    if (phc_jacobi_svd(A, mm, n, S, V)) {
+    /* the SVD by one-sided Jacobi (model/jacobi_svd.h: no LAPACK to load),
+       of R from A = Q R (fit/engine/qr_lstsq.h) when A has more rows than
+       columns: the same singular values and right singular vectors, a
+       Jacobi SVD of n rows instead of m; VT[k][a] = V[a][k], the k-th
+       right singular vector */
+    double *B = A;
+    size_t rows = mm;
+    if (mm > n && phc_qr_triangle(A, mm, n, NULL, VT) == 0) {
+        memcpy(A, VT, n * n * sizeof *A); /* R into A's first n rows */
+        rows = n;
+    }
+    if (phc_jacobi_svd(B, rows, n, S, V)) {
         rc = phc_error_set(err, PHC_ERR_NUMERIC, "covariance: SVD did not converge (Jacobi, 60 sweeps)");
         goto fail;
     }

@@ -2,14 +2,16 @@
  * (issue 2, "Benchmark").  Not a test: built as build/bench_nist_peers, never
  * run by ctest.
  *
- *   bench_nist_peers [DATA_DIR] [--repeat R] [--no-peers] [--table]
+ *   bench_nist_peers [DATA_DIR] [--repeat R] [--derivatives D] [--no-peers] [--table]
  *
  * DATA_DIR holds NIST's *.dat files (default PHC_SHARED_DATA "/nist").
  *
  * phytocal side: every problem from Start 1 and Start 2 goes through the
  * user's config path (nist_run_case: config + CSV written to a temporary
  * directory, phc_config_load, phc_fit_run), R times (default 5).  Per fit the
- * MINIMUM time over the R runs is kept; total_time is the sum of these minima.
+ * MINIMUM time over the R runs is kept; total_time is the sum of these minima
+ * (wall time; cpu_time likewise from the thread's CPU clock, which a busy
+ * machine inflates less: the other load is printed as load_average).
  * Score: minimum LRE over the parameters (the lowest seen over the R runs);
  * "solved" means that minimum is >= 4 (Ceres's kMinNumMatchingDigits);
  * average_lre is the mean over all fits.
@@ -31,6 +33,13 @@
  *     lmfit Parameters, interpreter start-up and imports are outside.
  * So phytocal is timed doing more work per fit than SciPy.
  *
+ * speed_target says whether issue 16's target, SciPy's total time >= 10 x
+ * phytocal's total time (fit plus full analysis) with every fit solved, is
+ * met in this run.
+ *
+ * Profiling only phytocal's part: --no-peers (e.g. under perf record -g or
+ * valgrind --tool=callgrind --toggle-collect=phc_fit_run).
+ *
  * Exit status: 0 when everything ran, 77 when the data directory is missing or
  * holds no .dat files, 1 on any other failure (unreadable .dat file, peers'
  * script failed). */
@@ -48,6 +57,20 @@
 #define PEERS_SCRIPT PHC_SOURCE_DIR "/tests/bench/nist_peers.py"
 #define DEFAULT_REPEAT 5
 #define MAX_FITS 256
+#define SPEED_TARGET 10.0 /* issue 16: >= 10 x SciPy end to end */
+
+/* The 1-, 5- and 15-minute load averages (/proc/loadavg) into buf, or "unknown". */
+static void load_average(char *buf, size_t size)
+{
+    double a = 0, b = 0, c = 0;
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (f && fscanf(f, "%lf %lf %lf", &a, &b, &c) == 3)
+        snprintf(buf, size, "%.2f %.2f %.2f", a, b, c);
+    else
+        snprintf(buf, size, "unknown");
+    if (f)
+        fclose(f);
+}
 
 static void usage(FILE *f)
 {
@@ -242,7 +265,9 @@ int main(int argc, char **argv)
 
     static nist_outcome best[MAX_FITS];
     size_t n_fits = 0, solved = 0, errors = 0;
-    double sum_lre = 0, total_time = 0, solve_time = 0;
+    double sum_lre = 0, total_time = 0, solve_time = 0, cpu_time = 0;
+    char load_start[64];
+    load_average(load_start, sizeof load_start);
     int failed = 0;
     for (size_t i = 0; i < n_files; ++i) {
         static nist_problem p;
@@ -273,6 +298,8 @@ int main(int argc, char **argv)
                 }
                 if (o.ok && o.seconds < b->seconds)
                     b->seconds = o.seconds;
+                if (o.ok && o.cpu_seconds < b->cpu_seconds)
+                    b->cpu_seconds = o.cpu_seconds;
                 if (o.ok && o.solve_seconds < b->solve_seconds)
                     b->solve_seconds = o.solve_seconds;
                 if (o.lre_param < b->lre_param)
@@ -283,6 +310,7 @@ int main(int argc, char **argv)
             if (b->ok) {
                 total_time += b->seconds;
                 solve_time += b->solve_seconds;
+                cpu_time += b->cpu_seconds;
             }
             else
                 ++errors;
@@ -312,6 +340,11 @@ int main(int argc, char **argv)
     printf("phytocal_total_time: %.4f s\n", total_time);
     printf("phytocal_solve_time: %.4f s (the Ceres solves alone, the part comparable to the peers' call)\n",
            solve_time);
+    printf("phytocal_cpu_time: %.4f s (thread CPU time of phc_fit_run, min of %d runs per fit)\n", cpu_time, repeat);
+    char load_end[64];
+    load_average(load_end, sizeof load_end);
+    printf("load_average: %s at the start, %s after phytocal's fits (1, 5, 15 min; %ld CPUs)\n", load_start,
+           load_end, sysconf(_SC_NPROCESSORS_ONLN));
     if (errors)
         printf("phytocal_errors: %zu fits (scored LRE 0, not timed)\n", errors);
 
@@ -321,11 +354,13 @@ int main(int argc, char **argv)
     }
     if (access(PYTHON, X_OK) != 0 || access(PEERS_SCRIPT, R_OK) != 0) {
         printf("scipy: not available (%s or %s missing)\n", PYTHON, PEERS_SCRIPT);
+        printf("speed_target: not measured (no SciPy)\n");
         return failed;
     }
     /* lmfit needs SciPy, so without SciPy there are no peers at all */
     if (!python_has("numpy, scipy.optimize")) {
         printf("scipy: not available (install python3-scipy)\n");
+        printf("speed_target: not measured (no SciPy)\n");
         return failed;
     }
     peer_total peers[2] = {{"scipy", 1, 0, 0, 0}, {"lmfit", 1, 0, 0, 0}};
@@ -350,6 +385,14 @@ int main(int argc, char **argv)
         if (solve_time > 0)
             printf("solve_speed_ratio_vs_%s: %.1f x (%s total time / phytocal solve time%s)\n", peers[i].name,
                    peers[i].time / solve_time, peers[i].name, caveat);
+    }
+    if (peers[0].have_time && total_time > 0) {
+        const double ratio = peers[0].time / total_time;
+        printf("speed_target: %s (scipy total time / phytocal total time %.1f x, target >= %.0f x; "
+               "%zu of %zu fits solved)\n",
+               ratio >= SPEED_TARGET && solved == n_fits ? "met" : "not met", ratio, SPEED_TARGET, solved, n_fits);
+    } else {
+        printf("speed_target: not measured (no SciPy total time)\n");
     }
     return failed;
 }

@@ -15,7 +15,10 @@
  *  - invalid arguments give errors with messages;
  *  - phc_nls_evaluate: residuals, cost with and without losses, and the
  *    Jacobian (analytic, central, Ridders; with parameter scales and fixed
- *    parameters) against numerical derivatives computed here. */
+ *    parameters) against numerical derivatives computed here;
+ *  - an analytic block's accepted candidates are served from the
+ *    candidate's evaluation (fewer callback runs than Ceres's residual plus
+ *    Jacobian evaluations, same optimum). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -822,6 +825,58 @@ static void test_evaluate_domain(void)
     phc_nls_free(nls);
 }
 
+/* y = a exp(-b x) on exact data (a = 3, b = 0.7), counting the callback's
+ * runs with and without a Jacobian. */
+typedef struct decay_data {
+    long with_jac, without_jac;
+} decay_data;
+
+#define NDEC 20
+static int decay_residuals(const double *p, double *r, double *jac, void *ud)
+{
+    decay_data *d = ud;
+    ++*(jac ? &d->with_jac : &d->without_jac);
+    for (size_t i = 0; i < NDEC; ++i) {
+        const double x = 0.25 * (double)i, e = exp(-p[1] * x);
+        r[i] = 3.0 * exp(-0.7 * x) - p[0] * e;
+        if (jac) {
+            jac[2 * i] = -e;
+            jac[2 * i + 1] = p[0] * x * e;
+        }
+    }
+    return 0;
+}
+
+/* Ceres asks for the residuals at a candidate and, once it accepts the
+ * step, for the residuals and the Jacobian there: the bridge serves the
+ * second from the first, so the callback runs fewer times than Ceres
+ * evaluates, and the optimum is the exact one. */
+static void test_candidate_reuse(void)
+{
+    decay_data d = {0, 0};
+    phc_nls *nls = phc_nls_new(2);
+    const size_t idx[2] = {0, 1};
+    phc_error err;
+    CHECK(phc_nls_add_block(nls, NDEC, idx, 2, decay_residuals, PHC_DERIV_ANALYTIC, PHC_LOSS_NONE, 1.0, &d, &err) ==
+          PHC_OK);
+    phc_nls_options o = phc_nls_options_default();
+    phc_nls_summary s;
+    double x[2] = {1.0, 2.0};
+    CHECK(phc_nls_solve(nls, &o, x, &s, &err) == PHC_OK);
+    CHECK(s.outcome == PHC_NLS_CONVERGED);
+    CHECK_NEAR(x[0], 3.0, 0, SOLVER_TOL);
+    CHECK_NEAR(x[1], 0.7, 0, SOLVER_TOL);
+    const long runs = d.with_jac + d.without_jac;
+    printf("candidate reuse: %ld callback runs (%ld with the Jacobian) for %d residual and %d Jacobian "
+           "evaluations\n", runs, d.with_jac, s.residual_evaluations, s.jacobian_evaluations);
+    CHECK(s.jacobian_evaluations >= 3);
+    /* at most one run per residual evaluation (candidates) plus the start's
+     * Jacobian and one per rejected candidate's successor */
+    CHECK(runs < s.residual_evaluations + s.jacobian_evaluations);
+    CHECK(runs <= s.residual_evaluations + 1 + (s.iterations - s.jacobian_evaluations + 1));
+    phc_nls_free(nls);
+}
+
 int main(void)
 {
     test_linear();
@@ -833,5 +888,6 @@ int main(void)
     test_invalid_arguments();
     test_evaluate();
     test_evaluate_domain();
+    test_candidate_reuse();
     return check_finish("test_ceres_bridge");
 }

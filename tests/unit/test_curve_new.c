@@ -111,6 +111,13 @@ static void test_fit(void)
                res->params[1].value);
         CHECK_NEAR(res->params[0].value, 2.0, 0, 1e-8);
         CHECK_NEAR(res->params[1].value, 0.5, 0, 1e-8);
+        /* the dense curve (blocks of rows through the tape) is the formula
+         * at the fitted values, at every point */
+        const phc_dataset_result *d = &res->datasets[0];
+        CHECK(d->curve_n > 64);
+        const double vmax = res->params[0].value, km = res->params[1].value;
+        for (size_t i = 0; i < d->curve_n; ++i)
+            CHECK_NEAR(d->curve_y[i], vmax * d->curve_x[i] / (km + d->curve_x[i]), 1e-15, 1e-14);
     } else {
         fprintf(stderr, "%s\n", err.message);
     }

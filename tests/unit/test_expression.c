@@ -7,7 +7,12 @@
  *     points, including the 22 NIST StRD models of tests/nist_problem.h;
  * (c) syntax errors and unsupported functions: status, 0-based position and
  *     the "at character N" (1-based) message;
- * (d) the x^2 and x^3 fast paths against pow() and the general power rule.
+ * (d) the x^2 and x^3 fast paths against pow() and the general power rule;
+ * (e) phc_expr_eval_rows (blocks of rows) against phc_expr_eval row by row:
+ *     bitwise the same values and gradients for every expression above on
+ *     rows that include zeros, negative values and points outside the
+ *     domain (NaN, inf), for 1, 7 and PHC_EXPR_ROWS rows, and the grad
+ *     stride (nothing written between rows' gradients).
  *
  * Numerical derivatives: central differences with Richardson extrapolation
  * (Ridders' method, Numerical Recipes 3rd ed. §5.7), whose error is ~1e-12
@@ -779,9 +784,70 @@ static void test_depth_limit(void)
     }
 }
 
+/* 1 when a and b are the same bits (NaN with NaN of the same payload) */
+static int same_bits(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+static void test_rows(void)
+{
+    static const char *const slots[] = {"a", "b", "c"};
+    static const char *const cols[] = {"x", "t"};
+    double x[PHC_EXPR_ROWS], t[PHC_EXPR_ROWS];
+    for (size_t r = 0; r < PHC_EXPR_ROWS; ++r) { /* zeros, negatives, 2, 3 */
+        x[r] = r % 8 == 0 ? 0.0 : (r % 5 == 0 ? 2.0 : -1.5 + 0.37 * (double)r);
+        t[r] = r % 7 == 0 ? 3.0 : (r % 6 == 0 ? 0.0 : 2.2 - 0.29 * (double)r);
+    }
+    const double params[][3] = {{0.7, 0.4, 0.3}, {1.3, 2.0, 0.6}, {-2.1, 3.0, 1.1}, {0.0, 1.25, -0.9}};
+    const size_t counts[] = {1, 7, PHC_EXPR_ROWS};
+    const size_t stride = 5; /* 3 slots and 2 guard values per row */
+    long compared = 0;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        phc_expr *e = build(cases[c].text, slots, 3, cols, 2);
+        if (!e)
+            continue;
+        for (size_t q = 0; q < sizeof params / sizeof params[0]; ++q)
+            for (size_t k = 0; k < sizeof counts / sizeof counts[0]; ++k) {
+                const size_t n = counts[k];
+                const double *colp[2] = {x, t};
+                double v[PHC_EXPR_ROWS], g[PHC_EXPR_ROWS * 5], v1[PHC_EXPR_ROWS];
+                for (size_t i = 0; i < n * stride; ++i)
+                    g[i] = 12345;
+                CHECK(phc_expr_eval_rows(e, params[q], colp, n, v, g, stride) == PHC_OK);
+                CHECK(phc_expr_eval_rows(e, params[q], colp, n, v1, NULL, 0) == PHC_OK);
+                for (size_t r = 0; r < n; ++r) {
+                    const double row[2] = {x[r], t[r]};
+                    double g1[3];
+                    const double want = phc_expr_eval(e, params[q], row, g1);
+                    int ok = same_bits(v[r], want) && same_bits(v1[r], want);
+                    for (size_t j = 0; j < 3; ++j)
+                        ok &= same_bits(g[r * stride + j], g1[j]);
+                    ok &= g[r * stride + 3] == 12345 && g[r * stride + 4] == 12345;
+                    if (!ok)
+                        fprintf(stderr, "\"%s\" rows %zu, row %zu: %.17g (%.17g %.17g %.17g), row by row %.17g "
+                                "(%.17g %.17g %.17g)\n", cases[c].text, n, r, v[r], g[r * stride],
+                                g[r * stride + 1], g[r * stride + 2], want, g1[0], g1[1], g1[2]);
+                    CHECK(ok);
+                    ++compared;
+                }
+            }
+        phc_expr_free(e);
+    }
+    phc_expr *e = build("a + b*x", slots, 3, cols, 2);
+    if (e) {
+        const double *colp[2] = {x, t};
+        double v[PHC_EXPR_ROWS + 1];
+        CHECK(phc_expr_eval_rows(e, params[0], colp, PHC_EXPR_ROWS + 1, v, NULL, 0) == PHC_ERR_INVALID);
+        phc_expr_free(e);
+    }
+    printf("blocks of rows: %ld rows bitwise equal to row-by-row evaluation\n", compared);
+}
+
 int main(void)
 {
     test_values_and_gradients();
+    test_rows();
     test_gradient_layout();
     test_power_at_zero_base();
     test_constants();
