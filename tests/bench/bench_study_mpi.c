@@ -72,14 +72,15 @@ static int run(char *const argv[])
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/* One study into TMP/OUT (mpi: under mpirun -np 2; resume: from OUT.ledger);
- * its wall time in seconds, or -1 when it failed.  *load: CPUs kept busy
- * by other processes meanwhile. */
-static double study(int mpi, const char *out, const char *samples, int resume, double *load)
+/* phytocal ARGS... (ARGS NULL-terminated, at most 16), under mpirun -np 2
+ * when mpi; its wall time in seconds, or -1 when it failed (the message
+ * names WHAT and DIR).  *cpu (may be NULL): the command's CPU seconds (user
+ * + system of it and its descendants); *load: CPUs kept busy by other
+ * processes meanwhile. */
+static double timed_phytocal(int mpi, char *const *args, const char *what, const char *dir, double *cpu,
+                             double *load)
 {
-    char dir[4200];
-    snprintf(dir, sizeof dir, "%s/%s", tmp, out);
-    char *argv[20];
+    char *argv[24];
     int n = 0;
     if (mpi) {
         argv[n++] = "mpirun";
@@ -87,28 +88,35 @@ static double study(int mpi, const char *out, const char *samples, int resume, d
         argv[n++] = "2";
     }
     argv[n++] = phytocal;
-    argv[n++] = "sensitivity";
-    argv[n++] = config;
-    argv[n++] = "-o";
-    argv[n++] = dir;
-    argv[n++] = "--samples";
-    argv[n++] = (char *)samples;
-    argv[n++] = "--force";
-    argv[n++] = "-q";
-    if (resume)
-        argv[n++] = "--resume";
+    for (int i = 0; args[i] && n < 23; ++i)
+        argv[n++] = args[i];
     argv[n] = NULL;
     const mark a = mark_now();
     const int rc = run(argv);
     const mark b = mark_now();
-    const double other = ((b.machine - a.machine) - (b.children - a.children)) / (b.wall - a.wall);
+    const double used = b.children - a.children;
+    if (cpu)
+        *cpu = used;
+    const double other = ((b.machine - a.machine) - used) / (b.wall - a.wall);
     *load = other < 0 ? 0 : other;
     if (rc != 0) {
-        fprintf(stderr, "bench_study_mpi: %s%s sensitivity ... -o %s: exit %d\n", mpi ? "mpirun -np 2 " : "",
-                phytocal, dir, rc);
+        fprintf(stderr, "bench_study_mpi: %s%s %s ... -o %s: exit %d\n", mpi ? "mpirun -np 2 " : "", phytocal,
+                what, dir, rc);
         return -1;
     }
     return b.wall - a.wall;
+}
+
+/* One study into TMP/OUT (mpi: under mpirun -np 2; resume: from OUT.ledger);
+ * its wall time in seconds, or -1 when it failed.  *load: CPUs kept busy
+ * by other processes meanwhile. */
+static double study(int mpi, const char *out, const char *samples, int resume, double *load)
+{
+    char dir[4200];
+    snprintf(dir, sizeof dir, "%s/%s", tmp, out);
+    char *args[] = {"sensitivity", config, "-o", dir, "--samples", (char *)samples, "--force", "-q",
+                    resume ? "--resume" : NULL, NULL};
+    return timed_phytocal(mpi, args, "sensitivity", dir, NULL, load);
 }
 
 /* Copies TMP/FROM/ledger.tsv (a finished study's) to TMP/TO.ledger. */
@@ -161,41 +169,9 @@ static double stretch_run(int mpi, const char *out, const char *sweeps, double *
 {
     char dir[4200];
     snprintf(dir, sizeof dir, "%s/%s", tmp, out);
-    char *argv[24];
-    int n = 0;
-    if (mpi) {
-        argv[n++] = "mpirun";
-        argv[n++] = "-np";
-        argv[n++] = "2";
-    }
-    argv[n++] = phytocal;
-    argv[n++] = "mcmc";
-    argv[n++] = config;
-    argv[n++] = "-o";
-    argv[n++] = dir;
-    argv[n++] = "--method";
-    argv[n++] = "stretch";
-    argv[n++] = "--samples";
-    argv[n++] = (char *)sweeps;
-    argv[n++] = "--chains";
-    argv[n++] = "32";
-    argv[n++] = "--seed";
-    argv[n++] = "1";
-    argv[n++] = "--force";
-    argv[n++] = "-q";
-    argv[n] = NULL;
-    const mark a = mark_now();
-    const int rc = run(argv);
-    const mark b = mark_now();
-    *cpu = b.children - a.children;
-    const double other = ((b.machine - a.machine) - *cpu) / (b.wall - a.wall);
-    *load = other < 0 ? 0 : other;
-    if (rc != 0) {
-        fprintf(stderr, "bench_study_mpi: %s%s mcmc ... -o %s --method stretch: exit %d\n",
-                mpi ? "mpirun -np 2 " : "", phytocal, dir, rc);
-        return -1;
-    }
-    return b.wall - a.wall;
+    char *args[] = {"mcmc", config, "-o", dir, "--method", "stretch", "--samples", (char *)sweeps,
+                    "--chains", "32", "--seed", "1", "--force", "-q", NULL};
+    return timed_phytocal(mpi, args, "mcmc --method stretch", dir, cpu, load);
 }
 
 /* The count of model evaluations in TMP/DIR/report.md, or -1. */
