@@ -57,26 +57,24 @@ static int curve_predict(phc_dataset *ds, const double *p, double *yhat, double 
 {
     curve_impl *c = ds->impl;
     if (c->tape) {
-        /* blocks of rows through phc_expr_eval_rows (the same numbers as
-         * row by row, a fraction of the interpreter's overhead); row by row
-         * only when its work space cannot be allocated */
-        const double *block_cols[PHC_CURVE_MAX_BLOCK_COLS];
-        int blocks = c->n_cols <= PHC_CURVE_MAX_BLOCK_COLS;
-        for (size_t i0 = 0; blocks && i0 < ds->n; i0 += PHC_EXPR_ROWS) {
-            const size_t nr = ds->n - i0 < PHC_EXPR_ROWS ? ds->n - i0 : PHC_EXPR_ROWS;
-            for (size_t j = 0; j < c->n_cols; ++j)
-                block_cols[j] = c->cols[j] + i0;
-            if (phc_expr_eval_rows(c->tape, p, block_cols, nr, yhat + i0, jac ? jac + i0 * ds->k : NULL, ds->k) !=
-                PHC_OK) {
-                blocks = 0;
-                break;
+        /* blocks of rows through phc_expr_eval_rows (a fraction of the
+         * interpreter's overhead of one row at a time, the same numbers);
+         * one row at a time only for more columns than block_cols holds */
+        if (c->n_cols <= PHC_CURVE_MAX_BLOCK_COLS) {
+            const double *block_cols[PHC_CURVE_MAX_BLOCK_COLS];
+            for (size_t i0 = 0; i0 < ds->n; i0 += PHC_EXPR_ROWS) {
+                const size_t nr = ds->n - i0 < PHC_EXPR_ROWS ? ds->n - i0 : PHC_EXPR_ROWS;
+                for (size_t j = 0; j < c->n_cols; ++j)
+                    block_cols[j] = c->cols[j] + i0;
+                if (phc_expr_eval_rows(c->tape, p, block_cols, nr, yhat + i0, jac ? jac + i0 * ds->k : NULL,
+                                       ds->k) != PHC_OK)
+                    return -1; /* a prepared tape takes PHC_EXPR_ROWS rows: cannot happen */
+                for (size_t r = 0; r < nr; ++r)
+                    if (!isfinite(yhat[i0 + r]))
+                        return 1; /* outside the expression's domain: reject the step */
             }
-            for (size_t r = 0; r < nr; ++r)
-                if (!isfinite(yhat[i0 + r]))
-                    return 1; /* outside the expression's domain: reject the step */
-        }
-        if (blocks)
             return 0;
+        }
         for (size_t i = 0; i < ds->n; ++i) {
             for (size_t j = 0; j < c->n_cols; ++j)
                 c->row[j] = c->cols[j][i];
@@ -111,16 +109,14 @@ static int curve_predict_at(phc_dataset *ds, const double *p, const double *x,
     if (c->tape && c->n_cols <= PHC_CURVE_MAX_BLOCK_COLS) {
         /* x is the only column the expression reads (other_cols is 0) */
         const double *block_cols[PHC_CURVE_MAX_BLOCK_COLS];
-        size_t done = 0;
-        for (; done < m; done += PHC_EXPR_ROWS) {
+        for (size_t done = 0; done < m; done += PHC_EXPR_ROWS) {
             const size_t nr = m - done < PHC_EXPR_ROWS ? m - done : PHC_EXPR_ROWS;
             for (size_t j = 0; j < c->n_cols; ++j)
                 block_cols[j] = x + done;
             if (phc_expr_eval_rows(c->tape, p, block_cols, nr, y + done, NULL, 0) != PHC_OK)
-                break; /* no work space: row by row below */
+                return -1; /* a prepared tape takes PHC_EXPR_ROWS rows: cannot happen */
         }
-        if (done >= m)
-            return 0;
+        return 0;
     }
     for (size_t i = 0; i < m; ++i) {
         if (c->x_col >= 0)

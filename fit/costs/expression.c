@@ -38,10 +38,10 @@ struct phc_expr {
     size_t *index;    /* per name: slot or column */
     int *bound;
     size_t n_slots;
-    double *val;      /* n_nodes values */
-    double *grad;     /* 3 x n_nodes: partials to child a, to child b, adjoints */
-    double *rows;     /* phc_expr_eval_rows: 4 x n_nodes x PHC_EXPR_ROWS (values,
-                         partials a, b, adjoints per node and row), NULL until used */
+    double *rows;     /* 4 x n_nodes x PHC_EXPR_ROWS: values, partials to
+                         child a and b, adjoints per node and row (prepare) */
+    const double **row_cols; /* n_cols: phc_expr_eval's one row as columns */
+    size_t n_cols;    /* 1 + the largest column a name is bound to (0: none) */
 };
 
 typedef struct parser {
@@ -302,9 +302,8 @@ void phc_expr_free(phc_expr *e)
     free(e->is_slot);
     free(e->index);
     free(e->bound);
-    free(e->val);
-    free(e->grad);
     free(e->rows);
+    free(e->row_cols);
     free(e);
 }
 
@@ -368,11 +367,15 @@ int phc_expr_prepare(phc_expr *e, size_t n_slots, phc_error *err)
             return phc_error_set(err, PHC_ERR_INVALID, "slot %zu out of range", e->index[i]);
     }
     e->n_slots = n_slots;
-    free(e->val);
-    free(e->grad);
-    e->val = calloc(e->n_nodes, sizeof *e->val);
-    e->grad = calloc(3 * e->n_nodes, sizeof *e->grad); /* partials a, b; adjoints */
-    if (!e->val || !e->grad)
+    e->n_cols = 0;
+    for (size_t i = 0; i < e->n_names; ++i)
+        if (!e->is_slot[i] && e->index[i] + 1 > e->n_cols)
+            e->n_cols = e->index[i] + 1;
+    free(e->rows);
+    free(e->row_cols);
+    e->rows = malloc(4 * e->n_nodes * PHC_EXPR_ROWS * sizeof *e->rows);
+    e->row_cols = malloc((e->n_cols ? e->n_cols : 1) * sizeof *e->row_cols);
+    if (!e->rows || !e->row_cols)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     for (size_t i = 0; i < e->n_nodes; ++i) {
         node *n = &e->nodes[i];
@@ -392,99 +395,31 @@ int phc_expr_prepare(phc_expr *e, size_t n_slots, phc_error *err)
 
 double phc_expr_eval(phc_expr *e, const double *slots, const double *row, double *grad)
 {
-    double *v = e->val;
-    double *pa = e->grad;              /* local partial d node / d child a */
-    double *pb = e->grad + e->n_nodes; /* ... and d node / d child b */
-    double *adj = pb + e->n_nodes;     /* adjoints for the reverse sweep */
-    /* Forward sweep: values and local partials. */
-    for (size_t i = 0; i < e->n_nodes; ++i) {
-        const node *n = &e->nodes[i];
-        const double a = v[n->a], b = v[n->b];
-        double r = 0, da = 0, db = 0;
-        switch (n->op) {
-        case OP_CONST: r = n->value; break;
-        case OP_NAME: r = e->is_slot[n->name] ? slots[e->index[n->name]] : row[e->index[n->name]]; break;
-        case OP_NEG: r = -a; da = -1; break;
-        case OP_ADD: r = a + b; da = 1; db = 1; break;
-        case OP_SUB: r = a - b; da = 1; db = -1; break;
-        case OP_MUL: r = a * b; da = b; db = a; break;
-        case OP_DIV: r = a / b; da = 1 / b; db = -r / b; break;
-        case OP_POW:
-            if (!e->nodes[n->b].active && b == 2) { /* x^2 is common in models: no pow() */
-                r = a * a;
-                da = 2 * a;
-                break;
-            }
-            if (!e->nodes[n->b].active && b == 3) {
-                r = a * a * a;
-                da = 3 * a * a;
-                break;
-            }
-            r = pow(a, b);
-            /* d/da a^b = b a^(b-1); d/db a^b = a^b log a (only needed when b varies) */
-            da = b == 0 ? 0 : (a != 0 ? b * r / a : b * pow(a, b - 1));
-            /* 0^b = 0 for every b > 0, so d/db is 0 there (r log a would be 0 * -inf = NaN,
-             * e.g. b1*x^b2 on a data row with x = 0) */
-            db = e->nodes[n->b].active ? (a == 0 && b > 0 ? 0 : r * log(a)) : 0;
-            break;
-        case OP_EXP: r = exp(a); da = r; break;
-        case OP_LOG: r = log(a); da = 1 / a; break;
-        case OP_SQRT: r = sqrt(a); da = 0.5 / r; break;
-        case OP_SIN: r = sin(a); da = cos(a); break;
-        case OP_COS: r = cos(a); da = -sin(a); break;
-        case OP_TAN: r = tan(a); da = 1 + r * r; break;
-        case OP_ATAN: r = atan(a); da = 1 / (1 + a * a); break;
-        case OP_ABS: r = fabs(a); da = a > 0 ? 1 : (a < 0 ? -1 : 0); break;
-        }
-        v[i] = r;
-        pa[i] = da;
-        pb[i] = db;
-    }
-    const size_t root = e->n_nodes - 1;
-    if (!grad)
-        return v[root];
-    /* Reverse sweep (reverse-mode AD): one pass gives all k derivatives, so
-     * a Jacobian row costs about twice a value whatever k is. */
-    memset(grad, 0, e->n_slots * sizeof *grad);
-    memset(adj, 0, e->n_nodes * sizeof *adj);
-    adj[root] = 1.0;
-    for (size_t i = root + 1; i-- > 0;) {
-        const node *n = &e->nodes[i];
-        const double w = adj[i];
-        if (!n->active || w == 0)
-            continue;
-        switch (n->op) {
-        case OP_CONST: break;
-        case OP_NAME: grad[e->index[n->name]] += w; break;
-        case OP_ADD:
-        case OP_SUB:
-        case OP_MUL:
-        case OP_DIV:
-        case OP_POW:
-            adj[n->a] += pa[i] * w;
-            adj[n->b] += pb[i] * w;
-            break;
-        default: adj[n->a] += pa[i] * w; break;
-        }
-    }
-    return v[root];
+    /* one row is a block of one: the same code, so the same numbers as in
+     * blocks by construction */
+    for (size_t c = 0; c < e->n_cols; ++c)
+        e->row_cols[c] = row + c;
+    double value;
+    if (phc_expr_eval_rows(e, slots, e->row_cols, 1, &value, grad, e->n_slots) != PHC_OK)
+        return NAN;
+    return value;
 }
 
-/* The same sweeps as phc_expr_eval, node by node over a block of rows: the
+/* The tape's two sweeps, node by node over a block of rows: forward in
+ * node order (values and local partials), then reverse-mode AD (adjoints
+ * accumulated in reverse node order: one pass gives all n_slots
+ * derivatives, so a Jacobian row costs about twice a value).  The
  * interpreter's dispatch (switch, child look-ups) is paid once per node and
- * block instead of once per node and row.  Each row sees the same
- * operations in the same order as phc_expr_eval (forward in node order,
- * adjoints accumulated in reverse node order), so the numbers are the
- * same to the bit. */
+ * block instead of once per node and row; each row sees the same operations
+ * in the same order whatever the block, so the numbers do not depend on
+ * how the rows are blocked. */
 int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *cols, size_t n_rows, double *value,
                        double *grad, size_t grad_stride)
 {
     enum { B = PHC_EXPR_ROWS };
-    if (n_rows > B)
-        return PHC_ERR_INVALID;
+    if (n_rows > B || !e->rows)
+        return PHC_ERR_INVALID; /* too many rows, or not prepared */
     const size_t nn = e->n_nodes;
-    if (!e->rows && !(e->rows = malloc(4 * nn * B * sizeof *e->rows)))
-        return PHC_ERR_NOMEM;
     double *V = e->rows, *PA = V + nn * B, *PB = PA + nn * B, *ADJ = PB + nn * B;
     for (size_t i = 0; i < nn; ++i) {
         const node *n = &e->nodes[i];
@@ -633,7 +568,8 @@ int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *co
         return PHC_OK;
     for (size_t r = 0; r < n_rows; ++r)
         memset(grad + r * grad_stride, 0, e->n_slots * sizeof *grad);
-    memset(ADJ, 0, nn * B * sizeof *ADJ);
+    for (size_t i = 0; i < nn; ++i)
+        memset(ADJ + i * B, 0, n_rows * sizeof *ADJ);
     for (size_t r = 0; r < n_rows; ++r)
         ADJ[root * B + r] = 1.0;
     for (size_t i = root + 1; i-- > 0;) {

@@ -58,9 +58,10 @@ double phc_expr_eval(phc_expr *e, const double *slots, const double *row,
  * gives row by row: column c of row r is cols[c][r] (the columns the names
  * are bound to with is_slot = 0), the value into value[r] and, when grad is
  * non-NULL, the n_slots derivatives into grad + r * grad_stride.
- * PHC_OK, PHC_ERR_NOMEM when its work space (4 x nodes x PHC_EXPR_ROWS
- * doubles, allocated on the first call) cannot be had, PHC_ERR_INVALID for
- * too many rows.  Not thread-safe for one phc_expr. */
+ * phc_expr_eval is this with one row.  PHC_OK, or PHC_ERR_INVALID for
+ * too many rows or a tape not prepared (its work space, 4 x nodes x
+ * PHC_EXPR_ROWS doubles, is allocated by phc_expr_prepare).  Not
+ * thread-safe for one phc_expr. */
 int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *cols, size_t n_rows,
                        double *value, double *grad, size_t grad_stride);
 
