@@ -99,6 +99,7 @@ phc_climbing_options phc_climbing_options_default(void)
     o.min_stiffness = 0.1;
     o.particles = phc_particles_options_default();
     o.particles.maturity_age = 50;
+    o.particles.follow_parent = 1; /* mature shoots hold their shape (Fig. 12 b) */
     o.leaf_step = 0;
     o.leaf_angle_deg = 137.5;
     o.leaf_size = 0.03;
