@@ -54,6 +54,7 @@ struct phc_particles {
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
     size_t *child_start, *child; /* children (CSR, in index order) */
     size_t *topo;            /* n: every particle after its parent (roots first) */
+    double *frame;           /* 4n: the parent-frame pass's frame of each particle */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
@@ -349,6 +350,7 @@ void phc_particles_free(phc_particles *p)
     free(p->child_start);
     free(p->child);
     free(p->topo);
+    free(p->frame);
     free(p->gq);
     free(p->stress);
     free(p->source_id);
@@ -408,6 +410,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(child_start, n + 1);
     ALLOC(child, n);
     ALLOC(topo, n);
+    ALLOC(frame, 4 * n);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
@@ -537,6 +540,7 @@ static int reserve(phc_particles *p, size_t want)
     GROW(linked, 1);
     GROW(child, 1);
     GROW(topo, 1);
+    GROW(frame, 4);
     GROW(gq, 4);
     GROW(stress, 1);
     GROW(source_id, 1);
@@ -1304,42 +1308,43 @@ static void blend(phc_particles *p, size_t i)
     }
 }
 
-/* The parent-frame pass (particles.h, "Stiff shoots"): every linked
- * particle, parents first, blended toward its rest place and orientation
- * in its parent's current frame by k = s Δt² / (s Δt² + (1 − s) T²), then
- * held by its anchor.  Sequential (each particle reads its parent's new
- * state), so the result does not depend on the thread count. */
+/* The parent-frame pass (particles.h, "Stiff shoots"), parents first:
+ * each linked particle's frame is its parent's (p->frame: the turn from
+ * the rest pose of the root of its linked subtree); its orientation
+ * becomes the frame applied to its rest orientation, and its centre is
+ * blended toward its rest place in the frame, x_i ← x_i + k (x_i* − x_i),
+ * k = s Δt² / (s Δt² + (1 − s) T²); then its anchor.  Sequential (each
+ * particle reads its parent's new state), so the result does not depend
+ * on the thread count. */
 static void follow_parents(phc_particles *p, double dt)
 {
     const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
     for (size_t t = 0; t < p->n; ++t) {
         const size_t i = p->topo[t];
-        if (!p->linked[i])
+        double *f = p->frame + 4 * i;
+        const double *q0 = p->q0 + 4 * i;
+        const double q0_inv[4] = {q0[0], -q0[1], -q0[2], -q0[3]};
+        if (!p->linked[i]) { /* a root: its own turn q q̄⁻¹ */
+            quat_mul(p->qp + 4 * i, q0_inv, f);
             continue;
+        }
         const size_t u = p->parent[i];
+        memcpy(f, p->frame + 4 * u, 4 * sizeof(double));
         const double s = phc_particles_stiffness(p, i);
         const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
         if (!(k > 0))
-            continue;
-        /* turn of the parent from its rest pose: q_p q̄_p⁻¹ */
-        const double *q0u = p->q0 + 4 * u;
-        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
-        double turn[4], Rt[9], goal_q[4];
-        quat_mul(p->qp + 4 * u, q0u_inv, turn);
-        phc_quat_to_matrix(turn, Rt);
-        quat_mul(turn, p->q0 + 4 * i, goal_q);
-        double d0[3], rd[3];
+            continue; /* s = 0: no hold */
+        double Rf[9], goal_q[4], dc[3], rc[3];
+        phc_quat_to_matrix(f, Rf);
+        quat_mul(f, q0, goal_q); /* q_i* = f q̄_i */
         for (int d = 0; d < 3; ++d)
-            d0[d] = p->x0[3 * i + d] - p->x0[3 * u + d];
-        mat_vec(Rt, d0, rd);
+            dc[d] = p->x0[3 * i + d] - p->x0[3 * u + d];
+        mat_vec(Rf, dc, rc); /* x_i* − x_p = R_f (x̄_i − x̄_p) */
         double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
+        const double *xu = p->xp + 3 * u;
         for (int d = 0; d < 3; ++d)
-            x[d] += k * (p->xp[3 * u + d] + rd[d] - x[d]);
-        /* the same hemisphere before blending the quaternions */
-        const double sg = q[0] * goal_q[0] + q[1] * goal_q[1] + q[2] * goal_q[2] + q[3] * goal_q[3] < 0 ? -1 : 1;
-        for (int d = 0; d < 4; ++d)
-            q[d] += k * (sg * goal_q[d] - q[d]);
-        quat_normalize(q);
+            x[d] += k * (xu[d] + rc[d] - x[d]);
+        memcpy(q, goal_q, sizeof goal_q);
         if (p->anchored[i]) { /* eq. 5, as after every projection */
             const double ka = p->anchor_k[i];
             for (int d = 0; d < 3; ++d)
@@ -1426,6 +1431,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         memcpy(p->q + 4 * i, p->qp + 4 * i, 4 * sizeof(double));
         p->age[i] += dt;
     }
+
     /* Stress of every group on the new state (§4.3), and breaking. */
     if (p->no_stress && !(p->o.break_threshold > 0)) {
         if (report) {
