@@ -784,7 +784,7 @@ static void collide(phc_particles *p)
         memcpy(axis, axis0, sizeof axis);
         push_point(p, r, x, 1);
         int turned = 0;
-        for (int round = 0; round < 16; ++round) {
+        for (int round = 0; round < 64; ++round) {
             double a[3], b[3];
             for (int d = 0; d < 3; ++d) {
                 a[d] = x[d] - h * axis[d];

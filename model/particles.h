@@ -202,7 +202,7 @@ void phc_particles_measure_stress(phc_particles *p, int on);
  * ends x_p ∓ R(q_p)(0, 0, L/2); when an end moved, the centre becomes the
  * pushed ends' midpoint and the axis their direction (length kept: q_p
  * turned by the shortest rotation from the old axis to the new), the
- * centre is pushed again, up to 16 rounds.  (A straight segment across a
+ * centre is pushed again, up to 64 rounds.  (A straight segment across a
  * convex edge with both ends and its centre outside is not seen.)
  * Particles whose orientation is held (clamped) are left alone.  The
  * callback is called from one thread, particles in index order.  fn =

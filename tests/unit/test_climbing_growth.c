@@ -809,5 +809,85 @@ int main(void)
         CHECK(centre_min[0] >= -1e-12 && centre_min[1] >= -1e-12);
     }
 
+    /* 8e. Whole segments inside the dynamics (option collide with
+       dynamics: the collision pass pushes each particle's centre and its
+       segment's two ends, model/particles.h): the shoot of 8c grown for
+       120 s (33 particles) up the box's side, over its top edge and along
+       its top.  After every growth step: the smallest signed distance
+       minus radius of any segment end and of any centre (seed excluded);
+       the largest centre speed between growth steps in the last 60 s (no
+       explosion: it stays at the growth's own pace, mm/s).  Without
+       collisions the ends cut into the box. */
+    {
+        double ends_min[2] = {INFINITY, INFINITY}, centre_min[2] = {INFINITY, INFINITY};
+        double vmax_late[2] = {0, 0};
+        size_t count_end[2] = {0, 0};
+        for (int on = 0; on < 2; ++on) {
+            phc_climbing_options o = phc_climbing_options_default();
+            o.branch_probability = 0;
+            o.growth_rate = 0.2;
+            o.radius = 0.003;
+            o.surface_adaption = 0.5;
+            o.closest = box_closest;
+            o.collide = on;
+            o.dynamics_substeps = 10;
+            o.particles.maturity_age = 20;
+            o.min_stiffness = 0.3;
+            const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
+            phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
+            CHECK(c != NULL);
+            if (!c)
+                continue;
+            double *prev = NULL;
+            size_t nprev = 0;
+            for (int k = 0; k < 480; ++k) {
+                CHECK(phc_climbing_step(c, 0.25, &err) == 0);
+                const size_t n = phc_climbing_count(c);
+                for (size_t i = 1; i < n; ++i) {
+                    double pts[9];
+                    phc_climbing_segment(c, i, pts, pts + 3);
+                    phc_climbing_position(c, i, pts + 6);
+                    for (int j = 0; j < 3; ++j) {
+                        double cp[3], nf[3];
+                        const double *x = pts + 3 * j;
+                        box_closest(NULL, x, cp, nf);
+                        const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+                        const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+                        const double dr = (e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist) -
+                                          phc_climbing_radius(c, i);
+                        if (j < 2)
+                            ends_min[on] = fmin(ends_min[on], dr);
+                        else
+                            centre_min[on] = fmin(centre_min[on], dr);
+                    }
+                    if (k >= 240 && i < nprev && phc_climbing_is_apical(c, i) == 0) {
+                        const double *a = prev + 3 * i, *b = pts + 6;
+                        const double v = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]) / 0.25;
+                        vmax_late[on] = fmax(vmax_late[on], v);
+                    }
+                }
+                double *t = realloc(prev, 3 * n * sizeof *t);
+                CHECK(t != NULL);
+                if (!t)
+                    break;
+                prev = t;
+                nprev = n;
+                for (size_t i = 0; i < n; ++i)
+                    phc_climbing_position(c, i, prev + 3 * i);
+            }
+            count_end[on] = phc_climbing_count(c);
+            free(prev);
+            phc_climbing_free(c);
+        }
+        printf("collisions of whole segments, dynamics, 120 s: off: %zu particles, smallest signed distance - "
+               "radius over the run of an end %.3g m, of a centre %.3g m; on: %zu particles, %.3g m, %.3g m; "
+               "largest speed of a grown centre in the last 60 s: off %.3g m/s, on %.3g m/s\n",
+               count_end[0], ends_min[0], centre_min[0], count_end[1], ends_min[1], centre_min[1],
+               vmax_late[0], vmax_late[1]);
+        CHECK(ends_min[0] < -1e-4); /* without collisions the ends cut in */
+        CHECK(ends_min[1] >= -1e-12 && centre_min[1] >= -1e-12);
+        CHECK(vmax_late[1] < 0.01 && isfinite(vmax_late[1]));
+    }
+
     return check_finish("test_climbing_growth");
 }

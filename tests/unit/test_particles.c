@@ -973,6 +973,11 @@ static void test_bad_input(void)
     printf("bad input: %s\n", err.message);
     CHECK_STR_CONTAINS(err.message, "density must be positive");
     opt = phc_particles_options_default();
+    opt.stiffness_step = 0;
+    CHECK(phc_particles_new(g, &opt, &err) == NULL);
+    printf("bad input: %s\n", err.message);
+    CHECK_STR_CONTAINS(err.message, "stiffness step must be positive and finite, found 0 s");
+    opt = phc_particles_options_default();
     g->radius[2] = -0.001; /* a graph changed after it was finished */
     CHECK(phc_particles_new(g, &opt, &err) == NULL);
     printf("bad input: %s\n", err.message);
