@@ -105,6 +105,44 @@ static int box_closest(void *user, const double x[3], double c[3], double n[3])
     return 0;
 }
 
+/* Smallest signed distance minus radius to the box of any segment end and
+ * of any centre of plant c (seed excluded), folded into *ends_min and
+ * *centre_min. */
+static void box_depths(const phc_climbing *c, double *ends_min, double *centre_min)
+{
+    for (size_t i = 1; i < phc_climbing_count(c); ++i) {
+        double pts[9];
+        phc_climbing_segment(c, i, pts, pts + 3);
+        phc_climbing_position(c, i, pts + 6);
+        for (int j = 0; j < 3; ++j) {
+            double cp[3], nf[3];
+            const double *x = pts + 3 * j;
+            box_closest(NULL, x, cp, nf);
+            const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+            const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            const double delta =
+                (e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist) - phc_climbing_radius(c, i);
+            if (j < 2)
+                *ends_min = fmin(*ends_min, delta);
+            else
+                *centre_min = fmin(*centre_min, delta);
+        }
+    }
+}
+
+/* The shoot of the collision tests: no laterals, r = 3 mm, surface
+ * adaption toward the box. */
+static phc_climbing_options box_shoot_options(void)
+{
+    phc_climbing_options o = phc_climbing_options_default();
+    o.branch_probability = 0;
+    o.growth_rate = 0.2;
+    o.radius = 0.003;
+    o.surface_adaption = 0.5;
+    o.closest = box_closest;
+    return o;
+}
+
 int main(void)
 {
     const double origin[3] = {0, 0, 0}, up[3] = {0, 0, 1}, east[3] = {1, 0, 0};
@@ -707,12 +745,7 @@ int main(void)
         double worst[2] = {0, 0};
         size_t pushed_total[2] = {0, 0}, count_end[2] = {0, 0};
         for (int on = 0; on < 2; ++on) {
-            phc_climbing_options o = phc_climbing_options_default();
-            o.branch_probability = 0;
-            o.growth_rate = 0.2;
-            o.radius = 0.003;
-            o.surface_adaption = 0.5;
-            o.closest = box_closest;
+            phc_climbing_options o = box_shoot_options();
             o.collide = on;
             if (dyn) {
                 o.dynamics_substeps = 10;
@@ -765,12 +798,7 @@ int main(void)
         double ends_min[2] = {INFINITY, INFINITY}, centre_min[2] = {INFINITY, INFINITY};
         size_t count_end[2] = {0, 0};
         for (int ends = 0; ends < 2; ++ends) {
-            phc_climbing_options o = phc_climbing_options_default();
-            o.branch_probability = 0;
-            o.growth_rate = 0.2;
-            o.radius = 0.003;
-            o.surface_adaption = 0.5;
-            o.closest = box_closest;
+            phc_climbing_options o = box_shoot_options();
             o.collide = 1;
             o.collide_ends = ends;
             const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
@@ -781,24 +809,7 @@ int main(void)
             for (int k = 0; k < 120; ++k)
                 CHECK(phc_climbing_step(c, 0.25, &err) == 0);
             count_end[ends] = phc_climbing_count(c);
-            for (size_t i = 1; i < count_end[ends]; ++i) {
-                double pts[9];
-                phc_climbing_segment(c, i, pts, pts + 3);
-                phc_climbing_position(c, i, pts + 6);
-                for (int j = 0; j < 3; ++j) {
-                    double cp[3], nf[3];
-                    const double *x = pts + 3 * j;
-                    box_closest(NULL, x, cp, nf);
-                    const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
-                    const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-                    const double delta =
-                        (e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist) - phc_climbing_radius(c, i);
-                    if (j < 2)
-                        ends_min[ends] = fmin(ends_min[ends], delta);
-                    else
-                        centre_min[ends] = fmin(centre_min[ends], delta);
-                }
-            }
+            box_depths(c, &ends_min[ends], &centre_min[ends]);
             phc_climbing_free(c);
         }
         printf("collide_ends, kinematic: %zu / %zu particles; smallest signed distance - radius of a segment end: "
@@ -823,12 +834,7 @@ int main(void)
         double vmax_late[2] = {0, 0};
         size_t count_end[2] = {0, 0};
         for (int on = 0; on < 2; ++on) {
-            phc_climbing_options o = phc_climbing_options_default();
-            o.branch_probability = 0;
-            o.growth_rate = 0.2;
-            o.radius = 0.003;
-            o.surface_adaption = 0.5;
-            o.closest = box_closest;
+            phc_climbing_options o = box_shoot_options();
             o.collide = on;
             o.dynamics_substeps = 10;
             o.particles.maturity_age = 20;
@@ -843,28 +849,15 @@ int main(void)
             for (int k = 0; k < 480; ++k) {
                 CHECK(phc_climbing_step(c, 0.25, &err) == 0);
                 const size_t n = phc_climbing_count(c);
-                for (size_t i = 1; i < n; ++i) {
-                    double pts[9];
-                    phc_climbing_segment(c, i, pts, pts + 3);
-                    phc_climbing_position(c, i, pts + 6);
-                    for (int j = 0; j < 3; ++j) {
-                        double cp[3], nf[3];
-                        const double *x = pts + 3 * j;
-                        box_closest(NULL, x, cp, nf);
-                        const double e[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
-                        const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-                        const double dr = (e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0 ? dist : -dist) -
-                                          phc_climbing_radius(c, i);
-                        if (j < 2)
-                            ends_min[on] = fmin(ends_min[on], dr);
-                        else
-                            centre_min[on] = fmin(centre_min[on], dr);
-                    }
-                    if (k >= 240 && i < nprev && phc_climbing_is_apical(c, i) == 0) {
-                        const double *a = prev + 3 * i, *b = pts + 6;
-                        const double v = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]) / 0.25;
-                        vmax_late[on] = fmax(vmax_late[on], v);
-                    }
+                box_depths(c, &ends_min[on], &centre_min[on]);
+                for (size_t i = 1; k >= 240 && i < nprev; ++i) {
+                    if (phc_climbing_is_apical(c, i))
+                        continue;
+                    double b[3];
+                    const double *a = prev + 3 * i;
+                    phc_climbing_position(c, i, b);
+                    const double v = hypot(hypot(b[0] - a[0], b[1] - a[1]), b[2] - a[2]) / 0.25;
+                    vmax_late[on] = fmax(vmax_late[on], v);
                 }
                 double *t = realloc(prev, 3 * n * sizeof *t);
                 CHECK(t != NULL);
