@@ -239,9 +239,10 @@ int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
  * > 0 with particles.maturity_age = 0 (PHC_ERR_INVALID, nothing changed). */
 int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err);
 
-/* Collisions of the last step (option collide): particles pushed out and
- * the smallest δ − r (m) before the pushes (+INFINITY when none measured;
- * δ: signed distance of a centre to the supports, model/particles.h). */
+/* Collisions of the last step (option collide): points pushed out and the
+ * smallest δ − r (m) before the pushes (+INFINITY when none measured; δ:
+ * signed distance to the supports of a centre, and with dynamics or
+ * collide_ends of a segment end too, model/particles.h). */
 void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth);
 
 /* Counters since the seed. */

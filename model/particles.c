@@ -754,20 +754,43 @@ void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *de
         *depth = p ? p->depth : INFINITY;
 }
 
-/* One point of particle i pushed out (phc_particles_push_out); the
- * smallest δ − r of the first round goes into p->depth. */
-static int push_point(phc_particles *p, double r, double x[3], int first)
+int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
+                                   int rounds, double x[3], double axis[3], double *depth)
 {
     double d;
-    const int moved = phc_particles_push_out(p->collide, p->collide_user, r, x, &d);
-    if (first && d - r < p->depth)
-        p->depth = d - r;
-    p->pushed += (size_t)moved;
-    return moved;
+    int pushed = phc_particles_push_out(fn, user, r, x, &d);
+    double first = d - r;
+    for (int round = 0; round < rounds; ++round) {
+        double a[3], b[3], da, db;
+        for (int k = 0; k < 3; ++k) {
+            a[k] = x[k] - h * axis[k];
+            b[k] = x[k] + h * axis[k];
+        }
+        const int pa = phc_particles_push_out(fn, user, r, a, &da);
+        const int pb = phc_particles_push_out(fn, user, r, b, &db);
+        if (round == 0)
+            first = fmin(first, fmin(da - r, db - r));
+        pushed += pa + pb;
+        if (!pa && !pb)
+            break;
+        const double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        if (!(len > 0))
+            break; /* both ends pushed onto one point: keep the axis */
+        for (int k = 0; k < 3; ++k) {
+            x[k] = 0.5 * (a[k] + b[k]);
+            axis[k] = e[k] / len;
+        }
+        pushed += phc_particles_push_out(fn, user, r, x, NULL);
+    }
+    if (depth)
+        *depth = first;
+    return pushed;
 }
 
 /* The collision pass on the predicted state (see particles.h): every
- * particle a capsule, its centre and its segment's ends pushed out. */
+ * particle a capsule, its centre and its segment's ends pushed out, its
+ * orientation turned with its axis. */
 static void collide(phc_particles *p)
 {
     p->pushed = 0;
@@ -777,35 +800,14 @@ static void collide(phc_particles *p)
     for (size_t i = 0; i < p->n; ++i) {
         if (p->hold_q[i])
             continue;
-        const double r = p->ax[3 * i], h = p->ax[3 * i + 2];
-        double *x = p->xp + 3 * i, R[9], axis[3];
+        double R[9], axis[3], d;
         phc_quat_to_matrix(p->qp + 4 * i, R);
         const double axis0[3] = {R[2], R[5], R[8]}; /* R·(0, 0, 1) */
         memcpy(axis, axis0, sizeof axis);
-        push_point(p, r, x, 1);
-        int turned = 0;
-        for (int round = 0; round < 64; ++round) {
-            double a[3], b[3];
-            for (int d = 0; d < 3; ++d) {
-                a[d] = x[d] - h * axis[d];
-                b[d] = x[d] + h * axis[d];
-            }
-            const int pa = push_point(p, r, a, round == 0);
-            const int pb = push_point(p, r, b, round == 0);
-            if (!pa && !pb)
-                break;
-            const double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-            const double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-            if (!(len > 0))
-                break; /* both ends pushed onto one point: keep the axis */
-            for (int d = 0; d < 3; ++d) {
-                x[d] = 0.5 * (a[d] + b[d]);
-                axis[d] = e[d] / len;
-            }
-            turned = 1;
-            push_point(p, r, x, 0);
-        }
-        if (!turned)
+        p->pushed += (size_t)phc_particles_push_segment_out(p->collide, p->collide_user, p->ax[3 * i],
+                                                            p->ax[3 * i + 2], 64, p->xp + 3 * i, axis, &d);
+        p->depth = fmin(p->depth, d);
+        if (memcmp(axis, axis0, sizeof axis) == 0)
             continue;
         /* q_p turned by the shortest rotation taking axis0 to axis:
          * quaternion (1 + a0·a, a0 × a), normalised */

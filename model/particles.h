@@ -215,6 +215,16 @@ void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, v
  * without a support). */
 int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
                            double *delta);
+/* The capsule push of the collision pass on one segment of radius r (m)
+ * and half length h (m) with centre x and unit axis `axis`: the centre is
+ * pushed, then the two ends x ∓ h·axis; when an end moved, x becomes the
+ * pushed ends' midpoint and `axis` their direction, the centre is pushed
+ * again, up to `rounds` rounds.  Returns the points pushed (centre pushes
+ * and end pushes); *depth (may be NULL) gets the smallest δ − r of the
+ * centre and of the two ends before their first push (+INFINITY without
+ * a support). */
+int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
+                                   int rounds, double x[3], double axis[3], double *depth);
 /* Collisions of the last step: points pushed out (centres and ends) and
  * the smallest δ − r (m) of a centre or an end seen before its particle's
  * first push (+INFINITY when none was measured). */
