@@ -131,8 +131,9 @@ static void box_depths(const phc_climbing *c, double *ends_min, double *centre_m
 }
 
 /* The shoot of the collision tests: no laterals, r = 3 mm, surface
- * adaption toward the box. */
-static phc_climbing_options box_shoot_options(void)
+ * adaption toward the box, collisions on or off; with dynamics 10
+ * substeps, t_m = 20 s, s_min = 0.3. */
+static phc_climbing_options box_shoot_options(int collide, int dynamics)
 {
     phc_climbing_options o = phc_climbing_options_default();
     o.branch_probability = 0;
@@ -140,6 +141,12 @@ static phc_climbing_options box_shoot_options(void)
     o.radius = 0.003;
     o.surface_adaption = 0.5;
     o.closest = box_closest;
+    o.collide = collide;
+    if (dynamics) {
+        o.dynamics_substeps = 10;
+        o.particles.maturity_age = 20;
+        o.min_stiffness = 0.3;
+    }
     return o;
 }
 
@@ -745,13 +752,7 @@ int main(void)
         double worst[2] = {0, 0};
         size_t pushed_total[2] = {0, 0}, count_end[2] = {0, 0};
         for (int on = 0; on < 2; ++on) {
-            phc_climbing_options o = box_shoot_options();
-            o.collide = on;
-            if (dyn) {
-                o.dynamics_substeps = 10;
-                o.particles.maturity_age = 20;
-                o.min_stiffness = 0.3;
-            }
+            phc_climbing_options o = box_shoot_options(on, dyn);
             const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
             phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
             CHECK(c != NULL);
@@ -798,8 +799,7 @@ int main(void)
         double ends_min[2] = {INFINITY, INFINITY}, centre_min[2] = {INFINITY, INFINITY};
         size_t count_end[2] = {0, 0};
         for (int ends = 0; ends < 2; ++ends) {
-            phc_climbing_options o = box_shoot_options();
-            o.collide = 1;
+            phc_climbing_options o = box_shoot_options(1, 0);
             o.collide_ends = ends;
             const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
             phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
@@ -834,11 +834,7 @@ int main(void)
         double vmax_late[2] = {0, 0};
         size_t count_end[2] = {0, 0};
         for (int on = 0; on < 2; ++on) {
-            phc_climbing_options o = box_shoot_options();
-            o.collide = on;
-            o.dynamics_substeps = 10;
-            o.particles.maturity_age = 20;
-            o.min_stiffness = 0.3;
+            phc_climbing_options o = box_shoot_options(on, 1);
             const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
             phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
             CHECK(c != NULL);
