@@ -99,6 +99,7 @@ phc_climbing_options phc_climbing_options_default(void)
     o.min_stiffness = 0.1;
     o.particles = phc_particles_options_default();
     o.particles.maturity_age = 50;
+    o.particles.follow_parent = 1; /* mature shoots hold their shape (Fig. 12 b) */
     o.leaf_step = 0;
     o.leaf_angle_deg = 137.5;
     o.leaf_size = 0.03;
@@ -754,33 +755,16 @@ static void collide_kinematic(phc_climbing *c)
         double d;
         const double r = c->radius[i];
         double *x = c->x + 3 * i, *dir = c->d + 3 * i;
-        c->pushed += (size_t)phc_particles_push_out(c->o.closest, c->o.closest_user, r, x, &d);
-        c->depth = fmin(c->depth, d - r);
-        if (!c->o.collide_ends)
-            continue;
-        /* the two ends too (ours): push them out, rebuild centre and
-           direction from them with the length kept, centre again */
-        const double h = seg_half(c, i);
-        for (int round = 0; round < 16; ++round) {
-            double a[3], b[3];
-            for (int k = 0; k < 3; ++k) {
-                a[k] = x[k] - h * dir[k];
-                b[k] = x[k] + h * dir[k];
-            }
-            const int pa = phc_particles_push_out(c->o.closest, c->o.closest_user, r, a, NULL);
-            const int pb = phc_particles_push_out(c->o.closest, c->o.closest_user, r, b, NULL);
-            if (!pa && !pb)
-                break;
-            const double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-            const double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-            if (!(len > 0))
-                break; /* both ends pushed onto one point: keep the direction */
-            for (int k = 0; k < 3; ++k) {
-                x[k] = 0.5 * (a[k] + b[k]);
-                dir[k] = e[k] / len;
-            }
+        if (!c->o.collide_ends) {
             c->pushed += (size_t)phc_particles_push_out(c->o.closest, c->o.closest_user, r, x, &d);
+            c->depth = fmin(c->depth, d - r);
+            continue;
         }
+        /* the two ends too (ours): pushed out, centre and direction rebuilt
+           from them with the length kept, centre again, up to 16 rounds */
+        c->pushed += (size_t)phc_particles_push_segment_out(c->o.closest, c->o.closest_user, r,
+                                                            seg_half(c, i), 16, x, dir, &d);
+        c->depth = fmin(c->depth, d);
     }
 }
 

@@ -43,8 +43,10 @@
  *     the anchors; it is stepped dynamics_substeps times by Δt/substeps
  *     (stiffness s = max(s_min, min(1, t_l/t_m)) from the particles'
  *     maturity age t_m, passed to model/particles as the age
- *     max(t_l, s_min·t_m); the seed particle is clamped), and the current
- *     centres and directions are read back.  Velocities and the groups'
+ *     max(t_l, s_min·t_m); the seed particle is clamped; the particles'
+ *     parent-frame pass, particles.follow_parent, holds a mature particle
+ *     in its parent's frame), and the current centres and directions are
+ *     read back.  Velocities and the groups'
  *     rotations carry over from one growth step to the next.  Switching
  *     the dynamics off, or a failed dynamics step, drops the system (the
  *     next dynamic step starts afresh, at rest).  With collide, every
@@ -158,7 +160,8 @@ typedef struct phc_climbing_options {
                                    link to the plant and falls free) */
     phc_particles_options particles; /* its maturity_age is t_m; default
                                         phc_particles_options_default() with
-                                        maturity_age 50 s */
+                                        maturity_age 50 s and follow_parent 1
+                                        (mature shoots keep their shape) */
     /* supports */
     phc_climbing_closest_fn closest; /* NULL: no supports */
     void *closest_user;
@@ -187,7 +190,8 @@ typedef struct phc_climbing_options {
                                    model/particles.h phc_particles_set_collider): a particle
                                    whose centre lies closer than its radius to the supports, or
                                    behind a face, is pushed out to its radius along the surface
-                                   normal, inside each dynamics step (before the velocities) or,
+                                   normal, inside each dynamics step (before the velocities; there
+                                   the segment's two ends too: the particle is a capsule) or,
                                    kinematic, after current = rest; the seed particle is left
                                    alone.  0 (default): off */
     int collide_ends;           /* with collide, kinematic plants only (ours): after the centre
@@ -197,8 +201,9 @@ typedef struct phc_climbing_options {
                                    length kept), up to 16 rounds per particle, the centre pushed
                                    again after each; a straight internode rounding a convex edge
                                    then cuts less of its corner.  The current shape's segments
-                                   need not join (as with the centre push alone).  Ignored with
-                                   dynamics.  0 (default): off */
+                                   need not join (as with the centre push alone).  Not needed
+                                   with dynamics (collide pushes the ends there).  0 (default):
+                                   off */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -234,9 +239,10 @@ int phc_climbing_set_gravity(phc_climbing *c, const double g[3], phc_error *err)
  * > 0 with particles.maturity_age = 0 (PHC_ERR_INVALID, nothing changed). */
 int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_error *err);
 
-/* Collisions of the last step (option collide): particles pushed out and
- * the smallest δ − r (m) before the pushes (+INFINITY when none measured;
- * δ: signed distance of a centre to the supports, model/particles.h). */
+/* Collisions of the last step (option collide): points pushed out and the
+ * smallest δ − r (m) before the pushes (+INFINITY when none measured; δ:
+ * signed distance to the supports of a centre, and with dynamics or
+ * collide_ends of a segment end too, model/particles.h). */
 void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth);
 
 /* Counters since the seed. */

@@ -53,6 +53,8 @@ struct phc_particles {
     size_t *parent;          /* n: parent from the graph */
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
     size_t *child_start, *child; /* children (CSR, in index order) */
+    size_t *topo;            /* n: every particle after its parent (roots first) */
+    double *frame;           /* 4n: the parent-frame pass's frame of each particle */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
@@ -83,6 +85,8 @@ phc_particles_options phc_particles_options_default(void)
     o.iterations = 4;
     o.damping = 0.01;
     o.break_threshold = 0.0;
+    o.follow_parent = 0;
+    o.stiffness_step = 0.01;
     return o;
 }
 
@@ -307,6 +311,9 @@ static const char *opt_problem(const phc_particles_options *o, char *buf, size_t
         snprintf(buf, size, "iterations must be >= 1, found %zu", o->iterations);
     else if (!(o->damping >= 0 && o->damping < 1))
         snprintf(buf, size, "damping must be in [0, 1), found %g", o->damping);
+    else if (!(o->stiffness_step > 0) || !isfinite(o->stiffness_step))
+        snprintf(buf, size, "stiffness step must be positive and finite, found %g s",
+                 o->stiffness_step);
     else if (!isfinite(o->break_threshold))
         snprintf(buf, size, "break threshold must be finite, found %g", o->break_threshold);
     else if (!isfinite(o->gravity[0]) || !isfinite(o->gravity[1]) || !isfinite(o->gravity[2]))
@@ -342,6 +349,8 @@ void phc_particles_free(phc_particles *p)
     free(p->linked);
     free(p->child_start);
     free(p->child);
+    free(p->topo);
+    free(p->frame);
     free(p->gq);
     free(p->stress);
     free(p->source_id);
@@ -400,6 +409,8 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(linked, n);
     ALLOC(child_start, n + 1);
     ALLOC(child, n);
+    ALLOC(topo, n);
+    ALLOC(frame, 4 * n);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
@@ -412,6 +423,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(goal, 3 * slots);
 #undef ALLOC
     memcpy(p->child_start, g->child_start, (n + 1) * sizeof *p->child_start);
+    memcpy(p->topo, g->order, n * sizeof *p->topo); /* breadth-first: parents first */
     if (n > 1)
         memcpy(p->child, g->child, (n - 1) * sizeof *p->child);
     for (size_t i = 0; i < n; ++i) {
@@ -527,6 +539,8 @@ static int reserve(phc_particles *p, size_t want)
     GROW(parent, 1);
     GROW(linked, 1);
     GROW(child, 1);
+    GROW(topo, 1);
+    GROW(frame, 4);
     GROW(gq, 4);
     GROW(stress, 1);
     GROW(source_id, 1);
@@ -665,6 +679,7 @@ int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
     p->parent[i] = parent == PHC_PARTICLES_NONE ? PHC_PLANT_NO_PARENT : parent;
     p->linked[i] = parent != PHC_PARTICLES_NONE;
     p->child_index[i] = 0;
+    p->topo[i] = i; /* after its parent, which exists already */
     p->gq[4 * i] = 1; /* at rest: its group has not turned */
     p->gq[4 * i + 1] = p->gq[4 * i + 2] = p->gq[4 * i + 3] = 0;
     p->stress[i] = 0;
@@ -739,7 +754,43 @@ void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *de
         *depth = p ? p->depth : INFINITY;
 }
 
-/* The collision pass on the predicted positions (see particles.h). */
+int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
+                                   int rounds, double x[3], double axis[3], double *depth)
+{
+    double d;
+    int pushed = phc_particles_push_out(fn, user, r, x, &d);
+    double first = d - r;
+    for (int round = 0; round < rounds; ++round) {
+        double a[3], b[3], da, db;
+        for (int k = 0; k < 3; ++k) {
+            a[k] = x[k] - h * axis[k];
+            b[k] = x[k] + h * axis[k];
+        }
+        const int pa = phc_particles_push_out(fn, user, r, a, &da);
+        const int pb = phc_particles_push_out(fn, user, r, b, &db);
+        if (round == 0)
+            first = fmin(first, fmin(da - r, db - r));
+        pushed += pa + pb;
+        if (!pa && !pb)
+            break;
+        const double e[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        if (!(len > 0))
+            break; /* both ends pushed onto one point: keep the axis */
+        for (int k = 0; k < 3; ++k) {
+            x[k] = 0.5 * (a[k] + b[k]);
+            axis[k] = e[k] / len;
+        }
+        pushed += phc_particles_push_out(fn, user, r, x, NULL);
+    }
+    if (depth)
+        *depth = first;
+    return pushed;
+}
+
+/* The collision pass on the predicted state (see particles.h): every
+ * particle a capsule, its centre and its segment's ends pushed out, its
+ * orientation turned with its axis. */
 static void collide(phc_particles *p)
 {
     p->pushed = 0;
@@ -749,12 +800,28 @@ static void collide(phc_particles *p)
     for (size_t i = 0; i < p->n; ++i) {
         if (p->hold_q[i])
             continue;
-        double d;
-        const double r = p->ax[3 * i];
-        p->pushed += (size_t)phc_particles_push_out(p->collide, p->collide_user, r,
-                                                    p->xp + 3 * i, &d);
-        if (d - r < p->depth)
-            p->depth = d - r;
+        double R[9], axis[3], d;
+        phc_quat_to_matrix(p->qp + 4 * i, R);
+        const double axis0[3] = {R[2], R[5], R[8]}; /* R·(0, 0, 1) */
+        memcpy(axis, axis0, sizeof axis);
+        p->pushed += (size_t)phc_particles_push_segment_out(p->collide, p->collide_user, p->ax[3 * i],
+                                                            p->ax[3 * i + 2], 64, p->xp + 3 * i, axis, &d);
+        p->depth = fmin(p->depth, d);
+        if (memcmp(axis, axis0, sizeof axis) == 0)
+            continue;
+        /* q_p turned by the shortest rotation taking axis0 to axis:
+         * quaternion (1 + a0·a, a0 × a), normalised */
+        const double c = axis0[0] * axis[0] + axis0[1] * axis[1] + axis0[2] * axis[2];
+        double dq[4] = {1 + c, axis0[1] * axis[2] - axis0[2] * axis[1],
+                        axis0[2] * axis[0] - axis0[0] * axis[2],
+                        axis0[0] * axis[1] - axis0[1] * axis[0]};
+        if (!(dq[0] > 1e-12))
+            continue; /* a half turn: no unique shortest rotation, keep q_p */
+        quat_normalize(dq);
+        double qn[4];
+        quat_mul(dq, p->qp + 4 * i, qn);
+        quat_normalize(qn);
+        memcpy(p->qp + 4 * i, qn, sizeof qn);
     }
 }
 
@@ -1243,6 +1310,53 @@ static void blend(phc_particles *p, size_t i)
     }
 }
 
+/* The parent-frame pass (particles.h, "Stiff shoots"), parents first:
+ * each linked particle's frame is its parent's (p->frame: the turn from
+ * the rest pose of the root of its linked subtree); its orientation
+ * becomes the frame applied to its rest orientation, and its centre is
+ * blended toward its rest place in the frame, x_i ← x_i + k (x_i* − x_i),
+ * k = s Δt² / (s Δt² + (1 − s) T²); then its anchor.  Sequential (each
+ * particle reads its parent's new state), so the result does not depend
+ * on the thread count. */
+static void follow_parents(phc_particles *p, double dt)
+{
+    const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
+    for (size_t t = 0; t < p->n; ++t) {
+        const size_t i = p->topo[t];
+        double *f = p->frame + 4 * i;
+        const double *q0 = p->q0 + 4 * i;
+        const double q0_inv[4] = {q0[0], -q0[1], -q0[2], -q0[3]};
+        if (!p->linked[i]) { /* a root: its own turn q q̄⁻¹ */
+            quat_mul(p->qp + 4 * i, q0_inv, f);
+            continue;
+        }
+        const size_t u = p->parent[i];
+        memcpy(f, p->frame + 4 * u, 4 * sizeof(double));
+        const double s = phc_particles_stiffness(p, i);
+        const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
+        if (!(k > 0))
+            continue; /* s = 0: no hold */
+        double Rf[9], goal_q[4], dc[3], rc[3];
+        phc_quat_to_matrix(f, Rf);
+        quat_mul(f, q0, goal_q); /* q_i* = f q̄_i */
+        for (int d = 0; d < 3; ++d)
+            dc[d] = p->x0[3 * i + d] - p->x0[3 * u + d];
+        mat_vec(Rf, dc, rc); /* x_i* − x_p = R_f (x̄_i − x̄_p) */
+        double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
+        const double *xu = p->xp + 3 * u;
+        for (int d = 0; d < 3; ++d)
+            x[d] += k * (xu[d] + rc[d] - x[d]);
+        memcpy(q, goal_q, sizeof goal_q);
+        if (p->anchored[i]) { /* eq. 5, as after every projection */
+            const double ka = p->anchor_k[i];
+            for (int d = 0; d < 3; ++d)
+                x[d] += ka * (p->anchor_at[3 * i + d] - x[d]);
+            if (p->hold_q[i])
+                memcpy(q, p->anchor_q + 4 * i, 4 * sizeof(double));
+        }
+    }
+}
+
 int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report, phc_error *err)
 {
     if (report) {
@@ -1289,6 +1403,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         if (rc)
             return rc;
     }
+    if (p->o.follow_parent)
+        follow_parents(p, dt);
     collide(p);
     for (size_t i = 0; i < n; ++i)
         for (int d = 0; d < 3; ++d)
@@ -1317,6 +1433,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         memcpy(p->q + 4 * i, p->qp + 4 * i, 4 * sizeof(double));
         p->age[i] += dt;
     }
+
     /* Stress of every group on the new state (§4.3), and breaking. */
     if (p->no_stress && !(p->o.break_threshold > 0)) {
         if (report) {

@@ -53,9 +53,40 @@
  *
  * Time step (position-based dynamics): predict v += Δt (g + f/m),
  * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
- * from the current x_p (Jacobi), blend, stiffness, anchors}; with a
- * collider, one collision pass (phc_particles_set_collider); update
- * v = (x_p − x)/Δt, ω from q_p q⁻¹, both times (1 − damping); age += Δt.
+ * from the current x_p (Jacobi), blend, stiffness, anchors}; with
+ * follow_parent, the parent-frame pass below; with a collider, one
+ * collision pass (phc_particles_set_collider); update v = (x_p − x)/Δt,
+ * ω from q_p q⁻¹, both times (1 − damping); age += Δt.
+ *
+ * Stiff shoots (follow_parent; ours).  The Jacobi projections above move
+ * a shape only by one group per iteration, so a long chain with s = 1
+ * still bends under a sustained load: a 22 cm shoot clamped at one end
+ * hangs nearly vertical after 4000 substeps of 0.01 s (climbing Fig. 12 b),
+ * and how far it hangs depends on the time step and the iteration count
+ * (README "Effective stiffness").  With follow_parent, after the N
+ * iterations every linked particle i, parents before children, is held in
+ * its parent's frame (a follow-the-leader pass: Müller, Kim, Chentanez,
+ * "Fast simulation of inextensible hair and fur", VRIPHYS 2012, §3, with
+ * orientations and rest offsets).  The frame F of a linked subtree is the
+ * turn of its root from the rest pose, q_root q̄_root⁻¹, handed from
+ * parent to child; then
+ *   q_i = F q̄_i,   x_i ← x_i + k_i (x_i* − x_i),   x_i* = x_p + R(F)(x̄_i − x̄_p),
+ * and i's anchor again.  The blend is XPBD's first iteration for one
+ * constraint of compliance α = (1 − s) T² / (s m) (Macklin, Müller,
+ * Chentanez, "XPBD", MIG 2016, eq. 18 with α̃ = α/Δt²):
+ *   k_i = s Δt² / (s Δt² + (1 − s) T²),
+ * so k = s at Δt = T, k = 1 at s = 1 for every Δt (a tree clamped at its
+ * root keeps its rest shape exactly, whatever the substep), and under a
+ * constant acceleration a a link settles (1 − s) a T² / s off its place in
+ * the frame (quasi-static: it is moved by a Δt² each step and back by the
+ * fraction k), the same for every Δt, larger for smaller s.  The links keep
+ * their rest angles (orientations are the frame's): a soft shoot sinks by
+ * these offsets, it does not bend.  (Orientations that follow the sunken
+ * centres, or a blend k of the orientations, made the pass feed the
+ * Jacobi projections through the ellipsoid term and settle into lasting
+ * oscillations of a 0.5 m cantilever for k between about 0.15 and 0.4.)
+ * The pass does not conserve momentum (a parent does not feel its
+ * children): meant for plants held at their root.
  *
  * Breaking (climbing §4.3; our definition of the stress): after the step,
  * each group's stress is its relative RMS misfit to the best rigid motion,
@@ -95,6 +126,10 @@ typedef struct phc_particles_options {
     double damping;        /* fraction of velocity removed per step, [0, 1); default 0.01 */
     double break_threshold;/* group stress above which the parent link breaks;
                               <= 0: no breaking (default 0) */
+    int follow_parent;     /* 1: the parent-frame pass after the projections
+                              (see "Stiff shoots" above); default 0 */
+    double stiffness_step; /* T, s, > 0: the time step at which the
+                              parent-frame pass blends by s itself; default 0.01 */
 } phc_particles_options;
 
 phc_particles_options phc_particles_options_default(void);
@@ -156,15 +191,22 @@ void phc_particles_measure_stress(phc_particles *p, int on);
  * attach to them).  fn gives the closest support point c (m) to x and the
  * unit outward face normal n there (0; nonzero: no support).  With a
  * collider set, every step ends its projection with one collision pass
- * over the predicted positions x_p, before the velocities are derived
- * from them (position-based dynamics: the inward velocity goes too):
- * the particle's signed distance is δ = |x_p − c| when (x_p − c)·n >= 0
- * (in front of the face) and −|x_p − c| otherwise; when δ < r (the
- * particle's radius) it is moved to c + r·u, u = (x_p − c)/|x_p − c| in
- * front (the surface normal at c, also round an edge or a corner), u = n
- * behind or on the face.  Particles whose orientation is held (clamped)
- * are left alone.  The callback is called once per particle and step,
- * from one thread, in index order.  fn = NULL: no collisions (default). */
+ * over the predicted positions x_p and orientations q_p, before the
+ * velocities are derived from them (position-based dynamics: the inward
+ * velocity goes too).  A point's signed distance is δ = |x − c| when
+ * (x − c)·n >= 0 (in front of the face) and −|x − c| otherwise; when
+ * δ < r (the particle's radius) it is moved to c + r·u, u = (x − c)/|x −
+ * c| in front (the surface normal at c, also round an edge or a corner),
+ * u = n behind or on the face.  Each particle is a capsule (its segment
+ * with radius r, ours): its centre is pushed, then its segment's two
+ * ends x_p ∓ R(q_p)(0, 0, L/2); when an end moved, the centre becomes the
+ * pushed ends' midpoint and the axis their direction (length kept: q_p
+ * turned by the shortest rotation from the old axis to the new), the
+ * centre is pushed again, up to 64 rounds.  (A straight segment across a
+ * convex edge with both ends and its centre outside is not seen.)
+ * Particles whose orientation is held (clamped) are left alone.  The
+ * callback is called from one thread, particles in index order.  fn =
+ * NULL: no collisions (default). */
 typedef int (*phc_particles_closest_fn)(void *user, const double x[3], double c[3], double n[3]);
 void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, void *user);
 /* The push of the collision pass on one point x (m) for a particle of
@@ -173,8 +215,19 @@ void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, v
  * without a support). */
 int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
                            double *delta);
-/* Collisions of the last step: particles pushed out and the smallest δ − r
- * (m) seen before the pushes (+INFINITY when none was measured). */
+/* The capsule push of the collision pass on one segment of radius r (m)
+ * and half length h (m) with centre x and unit axis `axis`: the centre is
+ * pushed, then the two ends x ∓ h·axis; when an end moved, x becomes the
+ * pushed ends' midpoint and `axis` their direction, the centre is pushed
+ * again, up to `rounds` rounds.  Returns the points pushed (centre pushes
+ * and end pushes); *depth (may be NULL) gets the smallest δ − r of the
+ * centre and of the two ends before their first push (+INFINITY without
+ * a support). */
+int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
+                                   int rounds, double x[3], double axis[3], double *depth);
+/* Collisions of the last step: points pushed out (centres and ends) and
+ * the smallest δ − r (m) of a centre or an end seen before its particle's
+ * first push (+INFINITY when none was measured). */
 void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth);
 
 /* Setters; each validates and names the particle in its message. */

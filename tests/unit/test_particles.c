@@ -12,6 +12,9 @@
  *  5. A horizontal cantilever under gravity, root clamped: tip sag against
  *     s, iteration count and time step (table), next to the Euler–Bernoulli
  *     sag qL⁴/(8EI) for E = 1 GPa.  Asserts the measured qualitative facts.
+ *     5b: with the parent-frame pass (follow_parent): s = 1 keeps the rest
+ *     shape at every time step, s < 1 sags as the quasi-static sum of the
+ *     links' offsets (1 − s) g T² / s, monotone in s.
  *  6. Breaking: a tip force growing every step breaks the most stressed link
  *     at the first step whose stress exceeds the threshold, never before.
  *  7. Anchors (eq. 5) and the attachment rule, age-dependent stiffness,
@@ -529,8 +532,11 @@ static void test_momentum(void)
 }
 
 /* Tip sag of a clamped horizontal chain at rest under gravity. */
-static double cantilever_sag(size_t nseg, double s, size_t iters, double dt, size_t *steps_out,
-                             double *qout, double *Lc, double *stretch)
+/* follow != 0: with the parent-frame pass; *dev (may be NULL) gets the
+ * largest distance of a centre from its rest place (m). */
+static double cantilever_run(size_t nseg, double s, size_t iters, double dt, int follow,
+                             size_t *steps_out, double *qout, double *Lc, double *stretch,
+                             double *dev)
 {
     const double o[3] = {0, 0, 0}, dx[3] = {1, 0, 0}, Lt = 0.5, r = 0.005;
     phc_plant_graph *g = chain(nseg, o, dx, Lt / (double)nseg, r, 1);
@@ -538,13 +544,15 @@ static double cantilever_sag(size_t nseg, double s, size_t iters, double dt, siz
     opt.stiffness = s;
     opt.iterations = iters;
     opt.damping = 0.02;
+    opt.follow_parent = follow;
     phc_error err;
     phc_particles *p = phc_particles_new(g, &opt, &err);
     double sag = NAN;
     size_t steps = 0;
     if (p) {
         double *head = malloc(3 * nseg * sizeof *head), *tail = malloc(3 * nseg * sizeof *tail);
-        for (steps = 1; steps <= 200000; ++steps) {
+        const size_t cap = follow ? 20000 : 200000;
+        for (steps = 1; steps <= cap; ++steps) {
             if (phc_particles_step(p, dt, NULL, &err))
                 break;
             double vmax = 0;
@@ -567,6 +575,18 @@ static double cantilever_sag(size_t nseg, double s, size_t iters, double dt, siz
         for (int d = 0; d < 3; ++d)
             d2 += (b[d] - a[d]) * (b[d] - a[d]);
         *stretch = sqrt(d2) / (Lt * (double)(nseg - 1) / (double)nseg) - 1;
+        if (dev) {
+            *dev = 0;
+            for (size_t i = 0; i < nseg; ++i) {
+                double x[3], e2 = 0;
+                phc_particles_position(p, i, x);
+                for (int d = 0; d < 3; ++d) {
+                    const double e = x[d] - 0.5 * (g->head[3 * i + d] + g->tail[3 * i + d]);
+                    e2 += e * e;
+                }
+                *dev = fmax(*dev, sqrt(e2));
+            }
+        }
         free(head);
         free(tail);
         *qout = opt.density * 9.81 * PI * r * r;
@@ -576,6 +596,57 @@ static double cantilever_sag(size_t nseg, double s, size_t iters, double dt, siz
     phc_particles_free(p);
     phc_plant_graph_free(g);
     return sag;
+}
+
+static double cantilever_sag(size_t nseg, double s, size_t iters, double dt, size_t *steps_out,
+                             double *qout, double *Lc, double *stretch)
+{
+    return cantilever_run(nseg, s, iters, dt, 0, steps_out, qout, Lc, stretch, NULL);
+}
+
+/* 5b. The same cantilever with the parent-frame pass (follow_parent, 4
+ * iterations): s = 1 keeps the rest shape at every time step (every centre
+ * within 1e-12 m of its rest place); s < 1 sags, the less the larger s,
+ * and the sag is the quasi-static sum of the 9 links' offsets (1 - s) g
+ * T^2 / s of particles.h, whatever the time step (measured within 19%;
+ * checked within 25%). */
+static void test_follow_parent(void)
+{
+    const double svals[] = {0.2, 0.5, 0.9, 1.0};
+    const double dts[] = {1.0 / 30, 1.0 / 120, 1.0 / 480};
+    double sag[4][3], dev[4][3];
+    const double T = phc_particles_options_default().stiffness_step;
+    printf("follow_parent: the cantilever above, 4 iterations, T = %g s; at rest or after 20000 "
+           "steps\n", T);
+    printf("  %5s %9s %12s %16s %11s %7s %18s\n", "s", "dt (s)", "sag (mm)", "max |x - x0| (m)",
+           "stretch (%)", "steps", "9(1-s)gT^2/s (mm)");
+    double worst = 0;
+    for (int a = 0; a < 4; ++a)
+        for (int c = 0; c < 3; ++c) {
+            size_t steps;
+            double q, Lc, stretch;
+            sag[a][c] = cantilever_run(10, svals[a], 4, dts[c], 1, &steps, &q, &Lc, &stretch,
+                                       &dev[a][c]);
+            const double qs = 9 * (1 - svals[a]) * 9.81 * T * T / svals[a];
+            printf("  %5.2f %9.5f %12.5g %16.3g %11.3g %7zu %18.4g\n", svals[a], dts[c],
+                   1e3 * sag[a][c], dev[a][c], 100 * stretch, steps, 1e3 * qs);
+            if (svals[a] < 1)
+                worst = fmax(worst, fabs(sag[a][c] / qs - 1));
+        }
+    double rigid = 0;
+    int mono = 1;
+    for (int c = 0; c < 3; ++c) {
+        rigid = fmax(rigid, dev[3][c]);
+        for (int a = 1; a < 4; ++a)
+            mono &= sag[a][c] < sag[a - 1][c];
+    }
+    printf("follow_parent: s = 1 at dt = 1/30, 1/120, 1/480 s: largest distance from the rest "
+           "shape %.3g m; sag falls with s at every dt: %s; s < 1: largest |sag / (9 (1-s) g "
+           "T^2 / s) - 1| = %.3g\n",
+           rigid, mono ? "yes" : "no", worst);
+    CHECK(rigid <= 1e-12);
+    CHECK(mono);
+    CHECK(worst < 0.25);
 }
 
 static void test_cantilever(void)
@@ -902,6 +973,11 @@ static void test_bad_input(void)
     printf("bad input: %s\n", err.message);
     CHECK_STR_CONTAINS(err.message, "density must be positive");
     opt = phc_particles_options_default();
+    opt.stiffness_step = 0;
+    CHECK(phc_particles_new(g, &opt, &err) == NULL);
+    printf("bad input: %s\n", err.message);
+    CHECK_STR_CONTAINS(err.message, "stiffness step must be positive and finite, found 0 s");
+    opt = phc_particles_options_default();
     g->radius[2] = -0.001; /* a graph changed after it was finished */
     CHECK(phc_particles_new(g, &opt, &err) == NULL);
     printf("bad input: %s\n", err.message);
@@ -1031,6 +1107,7 @@ int main(void)
     test_rigid_limit();
     test_momentum();
     test_cantilever();
+    test_follow_parent();
     test_breaking();
     test_anchor_age_fall();
     test_bad_input();
