@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/costs/shoot_tracer.h"
+#include "fit/costs/unique_times.h"
 #include "fit/engine/problem.h"
 #include "model/climbing_statistics.h"
 #include "model/jacobi_svd.h"
@@ -44,7 +46,9 @@ typedef struct st_impl {
     phc_shoot_traces_options o;   /* times point into `times` below */
     double *times;
     size_t n_times;
-    size_t *steps;                /* round(t_j / Δt) */
+    double *frames;               /* s: the times the tracer looks at a model plant */
+    size_t *frame_steps;          /* round(frame / Δt) */
+    size_t n_frames;
     int *stat;                    /* n: statistic of each observation */
     size_t *tindex;               /* n: time index of each observation */
     size_t slot[N_SLOTS];         /* data-set slot j -> slot_names index */
@@ -77,7 +81,8 @@ static void st_free(void *p)
     phc_shoot_traces_free(im->traces);
     if (im->o.support_free) im->o.support_free(im->o.support_owner);
     free(im->times);
-    free(im->steps);
+    free(im->frames);
+    free(im->frame_steps);
     free(im->stat);
     free(im->tindex);
     free(im);
@@ -109,11 +114,13 @@ static phc_climbing_stat_options stat_options(const phc_shoot_traces_options *o)
     return so;
 }
 
-/* Grows one plant with options po and seed, summarising it after steps[j]
- * steps (j < nt) into s[j].  0, 1 (outside the model's domain), -1 memory. */
-static int grow_one(const phc_shoot_traces_options *o, const phc_climbing_options *po, uint64_t seed,
-                    const size_t *steps, size_t nt, phc_climbing_summary *s)
+/* Grows one plant with options po and seed, looks at it with a tracer at
+ * every frame (fit/costs/shoot_tracer.h) and summarises the traced plant
+ * at each observation time j < nt into s[j], the same way as the traces
+ * themselves.  0, 1 (outside the model's domain), -1 memory. */
+static int grow_one(const st_impl *im, const phc_climbing_options *po, uint64_t seed, phc_climbing_summary *s)
 {
+    const phc_shoot_traces_options *o = &im->o;
     phc_climbing_options co = *po;
     co.seed = seed;
     phc_error e;
@@ -121,25 +128,28 @@ static int grow_one(const phc_shoot_traces_options *o, const phc_climbing_option
     if (!(co.growth_rate * o->time_step < 1 - co.bud_fraction)) return 1;
     phc_climbing *c = phc_climbing_new(o->position, o->direction, &co, &e);
     if (!c) return e.status == PHC_ERR_NOMEM ? -1 : 1;
-    const phc_climbing_stat_options so = stat_options(o);
-    phc_shoot_segment *seg = NULL;
-    size_t cap = 0, done = 0;
+    phc_shoot_tracer tracer;
+    phc_shoot_tracer_init(&tracer);
+    size_t done = 0;
     int rc = 0;
-    for (size_t j = 0; j < nt && !rc; ++j) {
-        for (; done < steps[j] && !rc; ++done)
+    for (size_t f = 0; f < im->n_frames && !rc; ++f) {
+        for (; done < im->frame_steps[f] && !rc; ++done)
             if (phc_climbing_step(c, o->time_step, &e)) rc = e.status == PHC_ERR_NOMEM ? -1 : 1;
-        if (rc) break;
-        const size_t n = phc_climbing_count(c);
-        if (n > cap) {
-            phc_shoot_segment *g = realloc(seg, n * sizeof *g);
-            if (!g) { rc = -1; break; }
-            seg = g;
-            cap = n;
-        }
-        phc_climbing_segments(c, seg);
-        if (phc_climbing_summarize_segments(seg, n, &so, &s[j], &e)) rc = 1;
+        if (!rc && phc_shoot_tracer_look(&tracer, c, im->frames[f], &e)) rc = -1;
     }
-    free(seg);
+    phc_shoot_traces *traced = NULL;
+    if (!rc && tracer.n && phc_shoot_tracer_traces(&tracer, "model", &traced, &e))
+        rc = e.status == PHC_ERR_NOMEM ? -1 : 1;
+    const phc_climbing_stat_options so = stat_options(o);
+    for (size_t j = 0; j < im->n_times && !rc; ++j) {
+        phc_shoot_segment *seg = NULL;
+        size_t n = 0;
+        if (traced && phc_shoot_traces_segments(traced, im->times[j], &seg, &n, &e)) rc = -1;
+        else if (phc_climbing_summarize_segments(seg, n, &so, &s[j], &e)) rc = 1;
+        free(seg);
+    }
+    phc_shoot_traces_free(traced);
+    phc_shoot_tracer_clear(&tracer);
     phc_climbing_free(c);
     return rc;
 }
@@ -155,7 +165,7 @@ int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *
     if (!s || !one) { free(s); free(one); return -1; }
     int rc = 0;
     for (size_t a = 0; a < K && !rc; ++a) {
-        rc = grow_one(&im->o, &po, im->o.first_seed + a, im->steps, nt, s + a * nt);
+        rc = grow_one(im, &po, im->o.first_seed + a, s + a * nt);
         im->plants++;
     }
     for (size_t i = 0; !rc && i < ds->n; ++i) {
@@ -420,6 +430,37 @@ static double sigma_for(const phc_shoot_traces_options *o, int stat, double v)
     }
 }
 
+/* The frames at which the tracer looks at a model plant: multiples of
+ * frame_interval, or else the distinct point times of the traces, in
+ * (0, last observation time] (at time 0 the model plant is its seed, whose
+ * base the first frame records). */
+static int make_frames(st_impl *im, phc_error *err)
+{
+    const double last = im->times[im->n_times - 1], dt = im->o.frame_interval;
+    double *f = NULL;
+    size_t m = 0;
+    if (dt > 0) {
+        const size_t cap = (size_t)floor(last / dt * (1 + 1e-12)) + 1;
+        if (!(f = malloc(cap * sizeof *f))) return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t q = 1; q < cap + 1 && (double)q * dt <= last * (1 + 1e-12); ++q) f[m++] = (double)q * dt;
+    } else {
+        double *u = NULL;
+        size_t nu = 0, *at = NULL;
+        int rc = phc_unique_times(im->traces->t, im->traces->n_points, &u, &nu, &at, err);
+        if (rc) return rc;
+        free(at);
+        f = u;
+        for (size_t q = 0; q < nu; ++q)
+            if (u[q] > 0 && u[q] <= last) f[m++] = u[q];
+    }
+    im->frames = f;
+    im->n_frames = m;
+    if (!(im->frame_steps = malloc((m ? m : 1) * sizeof *im->frame_steps)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t q = 0; q < m; ++q) im->frame_steps[q] = (size_t)llround(f[q] / im->o.time_step);
+    return PHC_OK;
+}
+
 int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_options *o, phc_dataset **out,
                          phc_error *err)
 {
@@ -435,17 +476,17 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
     }
     im->traces = traces;
     im->o = *o;
-    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->sigma_rel >= 0) ||
+    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->frame_interval >= 0) || !(o->sigma_rel >= 0) ||
         !(o->sigma_length > 0) || !(o->sigma_fraction > 0) || !(o->sigma_cosine > 0) || !(o->sigma_angle > 0)) {
         rc = phc_error_set(err, PHC_ERR_INPUT,
-                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1) and every sigma > 0");
+                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1), frame_interval >= 0 and "
+                           "every sigma > 0");
         goto fail;
     }
     /* times */
     im->n_times = o->times ? o->n_times : 4;
     im->times = malloc(im->n_times * sizeof *im->times);
-    im->steps = malloc(im->n_times * sizeof *im->steps);
-    if (!im->times || !im->steps) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
+    if (!im->times) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
     for (size_t j = 0; j < im->n_times; ++j) {
         im->times[j] = o->times ? o->times[j] : traces->t_end * (double)(j + 1) / 4.0;
         if (!(im->times[j] > 0) || (j && !(im->times[j] > im->times[j - 1])) ||
@@ -456,8 +497,8 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
                                im->times[j], traces->t_end);
             goto fail;
         }
-        im->steps[j] = (size_t)llround(im->times[j] / o->time_step);
     }
+    if ((rc = make_frames(im, err))) goto fail;
     /* slots */
     for (size_t s = 0; s < N_SLOTS; ++s)
         if (o->is_parameter ? o->is_parameter(slot_names[s], o->user_data) : s == 0) im->slot[im->k++] = s;
@@ -580,100 +621,23 @@ fail:
     return rc;
 }
 
-/* phc_shoot_traces_from_model: see the header. */
-typedef struct rows {
-    size_t n, cap;
-    double *t, *x, *y, *z;
-    char **shoot, **parent;
-} rows;
-
-static int rows_push(rows *r, double t, const double p[3], const char *shoot, const char *parent)
-{
-    if (r->n == r->cap) {
-        size_t cap = r->cap ? 2 * r->cap : 256;
-        double *a = realloc(r->t, cap * sizeof *a); if (a) r->t = a;
-        double *b = realloc(r->x, cap * sizeof *b); if (b) r->x = b;
-        double *c = realloc(r->y, cap * sizeof *c); if (c) r->y = c;
-        double *d = realloc(r->z, cap * sizeof *d); if (d) r->z = d;
-        char **e = realloc(r->shoot, cap * sizeof *e); if (e) r->shoot = e;
-        char **f = realloc(r->parent, cap * sizeof *f); if (f) r->parent = f;
-        if (!a || !b || !c || !d || !e || !f) return -1;
-        r->cap = cap;
-    }
-    r->t[r->n] = t;
-    r->x[r->n] = p[0];
-    r->y[r->n] = p[1];
-    r->z[r->n] = p[2];
-    r->shoot[r->n] = strdup(shoot);
-    r->parent[r->n] = strdup(parent);
-    if (!r->shoot[r->n] || !r->parent[r->n]) return -1;
-    r->n++;
-    return 0;
-}
-
 int phc_shoot_traces_from_model(const phc_shoot_traces_options *o, const double *times, size_t n_times,
                                 phc_shoot_traces **out, phc_error *err)
 {
     *out = NULL;
     phc_climbing *c = phc_climbing_new(o->position, o->direction, &o->plant, err);
     if (!c) return err ? err->status : PHC_ERR_INVALID;
-    rows r = {0};
-    size_t *shoot_of = NULL, *joints = NULL, cap = 0, done = 0;
+    phc_shoot_tracer tracer;
+    phc_shoot_tracer_init(&tracer);
+    size_t done = 0;
     int rc = PHC_OK;
     for (size_t j = 0; j < n_times && !rc; ++j) {
         const size_t steps = (size_t)llround(times[j] / o->time_step);
         for (; done < steps && !rc; ++done) rc = phc_climbing_step(c, o->time_step, err);
-        if (rc) break;
-        const size_t n = phc_climbing_count(c);
-        if (n > cap) {
-            size_t *a = realloc(shoot_of, n * sizeof *a);
-            if (a) shoot_of = a;
-            size_t *b = realloc(joints, n * sizeof *b);
-            if (b) joints = b;
-            if (!a || !b) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); break; }
-            for (size_t i = cap; i < n; ++i) joints[i] = 0;
-            cap = n;
-        }
-        /* shoots: a particle starts one when it has no parent or is a lateral; joints[s]
-         * counts the completed joints written for shoot s (its start particle's index) */
-        for (size_t i = 0; i < n && !rc; ++i) {
-            const size_t p = phc_climbing_parent(c, i);
-            shoot_of[i] = (p == PHC_CLIMBING_NONE || phc_climbing_is_lateral(c, i)) ? i : shoot_of[p];
-        }
-        for (size_t i = 0; i < n && !rc; ++i) {
-            const size_t s = shoot_of[i];
-            char name[32], parent[32] = "";
-            snprintf(name, sizeof name, "s%zu", s);
-            if (s != 0) snprintf(parent, sizeof parent, "s%zu", shoot_of[phc_climbing_parent(c, s)]);
-            /* the position of i in its shoot's chain: particles of one shoot in index order */
-            size_t pos = 0;
-            for (size_t q = s; q < i; ++q) pos += shoot_of[q] == s;
-            double base[3], tip[3];
-            phc_climbing_segment(c, i, base, tip);
-            if (pos == 0 && joints[s] == 0) {
-                if (rows_push(&r, times[j], base, name, parent)) rc = -1;
-                joints[s] = 1;
-            }
-            const int apical = phc_climbing_is_apical(c, i);
-            if (!rc && !apical && joints[s] == pos + 1) {
-                if (rows_push(&r, times[j], tip, name, parent)) rc = -1;
-                joints[s] = pos + 2;
-            } else if (!rc && apical) {
-                if (rows_push(&r, times[j], tip, name, parent)) rc = -1;
-            }
-        }
-        if (rc < 0) rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (!rc) rc = phc_shoot_tracer_look(&tracer, c, times[j], err);
     }
-    /* a shoot born at the last time has its base and tip only: at least 2 points */
-    if (!rc) rc = phc_shoot_traces_from_rows("model traces", r.n, r.t, (const char *const *)r.shoot, r.x, r.y, r.z,
-                                             (const char *const *)r.parent, out, err);
-    for (size_t i = 0; i < r.n; ++i) {
-        free(r.shoot[i]);
-        free(r.parent[i]);
-    }
-    free(r.t); free(r.x); free(r.y); free(r.z); free(r.shoot); free(r.parent);
-    free(shoot_of);
-    free(joints);
+    if (!rc) rc = phc_shoot_tracer_traces(&tracer, "model traces", out, err);
+    phc_shoot_tracer_clear(&tracer);
     phc_climbing_free(c);
     return rc;
 }

@@ -58,6 +58,8 @@ typedef struct phc_shoot_traces_options {
     double sigma_rel, sigma_length; /* default 0.1, 0.01 m */
     double sigma_fraction, sigma_cosine, sigma_angle; /* default 0.05, 0.05, 5° */
     double fd_step;              /* relative, default 0.05 */
+    double frame_interval;       /* s, >= 0: the tracer looked at the plant every frame_interval;
+                                    0 (default): at every distinct point time of the traces */
     phc_is_parameter_fn is_parameter; /* which slots are fitted (NULL: branch_probability) */
     void *user_data;
     void *support_owner;         /* freed with support_free when the data set is freed */
