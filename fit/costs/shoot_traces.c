@@ -46,6 +46,7 @@ typedef struct st_impl {
     phc_shoot_traces_options o;   /* times point into `times` below */
     double *times;
     size_t n_times;
+    double *sigma_given;          /* n: sigma before the seed spread is added */
     double *frames;               /* s: the times the tracer looks at a model plant */
     size_t *frame_steps;          /* round(frame / Δt) */
     size_t n_frames;
@@ -70,7 +71,7 @@ phc_shoot_traces_options phc_shoot_traces_options_default(void)
     o.sigma_fraction = 0.05;
     o.sigma_cosine = 0.05;
     o.sigma_angle = 5;
-    o.fd_step = 0.05;
+    o.fd_step = 0.2;
     return o;
 }
 
@@ -82,6 +83,7 @@ static void st_free(void *p)
     if (im->o.support_free) im->o.support_free(im->o.support_owner);
     free(im->times);
     free(im->frames);
+    free(im->sigma_given);
     free(im->frame_steps);
     free(im->stat);
     free(im->tindex);
@@ -461,6 +463,28 @@ static int make_frames(st_impl *im, phc_error *err)
     return PHC_OK;
 }
 
+int phc_shoot_traces_sigma_at(phc_dataset *ds, const double *p, phc_error *err)
+{
+    st_impl *im = ds->impl;
+    const size_t n = ds->n;
+    double *y = malloc(n * sizeof *y), *sd = malloc(n * sizeof *sd);
+    if (!y || !sd) {
+        free(y); free(sd);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    const int r = phc_shoot_traces_model(ds, p, y, sd);
+    /* sigma^2 = sigma_given^2 + (1 + 1/K) sd^2: the traced plant's own draw (sd) and the K-seed mean's (sd/sqrt(K)) */
+    for (size_t i = 0; !r && i < n; ++i) {
+        const double v = isfinite(sd[i]) ? sd[i] : 0, g = im->sigma_given[i];
+        ds->sigma[i] = sqrt(g * g + (1 + 1.0 / (double)im->o.seeds) * v * v);
+    }
+    free(y);
+    free(sd);
+    if (r) return phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
+                                "shoot_traces: the model plant cannot be grown at these values (sigma unchanged)");
+    return PHC_OK;
+}
+
 int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_options *o, phc_dataset **out,
                          phc_error *err)
 {
@@ -578,26 +602,23 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
         }
     }
     /* the traced plant is one draw of the process and the model value a mean over K:
-     * each sigma is widened by the seed-to-seed spread sd at the start options,
-     * sigma^2 = sigma_given^2 + (1 + 1/K) sd^2 */
+     * each sigma is widened by the seed-to-seed spread sd at the start options */
+    if (!(im->sigma_given = malloc(n * sizeof *im->sigma_given))) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_ds;
+    }
+    memcpy(im->sigma_given, ds->sigma, n * sizeof *ds->sigma);
     {
-        double *p0 = malloc(im->k * sizeof *p0), *y0 = malloc(n * sizeof *y0), *sd0 = malloc(n * sizeof *sd0);
-        if (!p0 || !y0 || !sd0) {
-            free(p0); free(y0); free(sd0);
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail_ds;
-        }
+        double *p0 = malloc(im->k * sizeof *p0);
+        if (!p0) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail_ds; }
         for (size_t j = 0; j < im->k; ++j) p0[j] = *slot_ref(&im->o.plant, im->slot[j]);
-        int r = phc_shoot_traces_model(ds, p0, y0, sd0);
-        for (i = 0; !r && i < n; ++i) {
-            const double v = isfinite(sd0[i]) ? sd0[i] : 0;
-            ds->sigma[i] = sqrt(ds->sigma[i] * ds->sigma[i] + (1 + 1.0 / (double)o->seeds) * v * v);
-        }
-        free(p0); free(y0); free(sd0);
-        if (r) {
-            rc = phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_INPUT,
-                               "shoot_traces: the model plant cannot be grown at the start options (or it "
-                               "makes no lateral while the traces have some)");
+        rc = phc_shoot_traces_sigma_at(ds, p0, err);
+        free(p0);
+        if (rc) {
+            if (rc != PHC_ERR_NOMEM)
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "shoot_traces: the model plant cannot be grown at the start options (or it "
+                                   "makes no lateral while the traces have some)");
             goto fail_ds;
         }
         im->plants = 0;
