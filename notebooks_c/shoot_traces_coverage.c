@@ -13,7 +13,7 @@
  *   pass 1: sigma widened by the seed sd at the start values (the kind's
  *           default);
  *   pass 2: sigma widened by the seed sd at pass 1's fitted values
- *           (phc_shoot_traces_sigma_at), refitted from there.
+ *           (phc_shoot_traces_covariance_at), refitted from there.
  * Prints every estimate and interval (* = the truth outside) and the count
  * of intervals that cover the truth per parameter and pass; writes
  * shoot_traces_coverage.md.  Exit 1 when a fit fails.
@@ -144,7 +144,7 @@ int main(int argc, char **argv)
         phc_problem *pb = NULL;
         int bad = fit_once(ds, start, est[0], ci[0], &pb);
         /* pass 2: the seed spread at the fitted values; the problem keeps owning ds */
-        if (!bad && phc_shoot_traces_sigma_at(ds, est[0], &err)) bad = 1;
+        if (!bad && phc_shoot_traces_covariance_at(ds, est[0], &err)) bad = 1;
         phc_problem *pb2 = NULL;
         if (!bad) {
             pb->n_datasets = 0; /* hand ds to the second problem */

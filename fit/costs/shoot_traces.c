@@ -47,6 +47,9 @@ typedef struct st_impl {
     double *times;
     size_t n_times;
     double *sigma_given;          /* n: sigma before the seed spread is added */
+    double *sigma_total;          /* n: sqrt of the covariance's diagonal */
+    double *y_raw;                /* n: the traced statistics (ds->y holds them whitened) */
+    double *L;                    /* n x n: Cholesky factor of the statistics' covariance */
     double *frames;               /* s: the times the tracer looks at a model plant */
     size_t *frame_steps;          /* round(frame / Δt) */
     size_t n_frames;
@@ -72,6 +75,8 @@ phc_shoot_traces_options phc_shoot_traces_options_default(void)
     o.sigma_cosine = 0.05;
     o.sigma_angle = 5;
     o.fd_step = 0.2;
+    o.covariance_seeds = 64;
+    o.correlation = 0.5;
     return o;
 }
 
@@ -84,6 +89,9 @@ static void st_free(void *p)
     free(im->times);
     free(im->frames);
     free(im->sigma_given);
+    free(im->sigma_total);
+    free(im->y_raw);
+    free(im->L);
     free(im->frame_steps);
     free(im->stat);
     free(im->tindex);
@@ -156,48 +164,11 @@ static int grow_one(const st_impl *im, const phc_climbing_options *po, uint64_t 
     return rc;
 }
 
-/* Averages over the K seeds at slot values p: y (n) and sd (n or NULL). */
-int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd)
+/* Central differences of the K-seed means (raw, not whitened) at p, yhat the values at p. */
+static int fd_jacobian(phc_dataset *ds, const double *p, const double *yhat, double *jac)
 {
     st_impl *im = ds->impl;
-    const size_t K = im->o.seeds, nt = im->n_times;
-    phc_climbing_options po = im->o.plant;
-    for (size_t j = 0; j < im->k; ++j) *slot_ref(&po, im->slot[j]) = p[j];
-    phc_climbing_summary *s = malloc(K * nt * sizeof *s), *one = malloc(K * sizeof *one), mean;
-    if (!s || !one) { free(s); free(one); return -1; }
     int rc = 0;
-    for (size_t a = 0; a < K && !rc; ++a) {
-        rc = grow_one(im, &po, im->o.first_seed + a, s + a * nt);
-        im->plants++;
-    }
-    for (size_t i = 0; !rc && i < ds->n; ++i) {
-        const size_t j = im->tindex[i];
-        for (size_t a = 0; a < K; ++a) one[a] = s[a * nt + j];
-        phc_climbing_summary_mean(one, K, &mean);
-        y[i] = stat_value(&mean, im->stat[i]);
-        if (!isfinite(y[i])) rc = 1; /* no lateral at all: no angle */
-        if (sd) {
-            double m = 0, v = 0;
-            for (size_t a = 0; a < K; ++a) m += stat_value(&one[a], im->stat[i]);
-            m /= (double)K;
-            size_t q = 0;
-            for (size_t a = 0; a < K; ++a) {
-                const double d = stat_value(&one[a], im->stat[i]);
-                if (isfinite(d)) { v += (d - m) * (d - m); q++; }
-            }
-            sd[i] = q > 1 ? sqrt(v / (double)(q - 1)) : NAN;
-        }
-    }
-    free(s);
-    free(one);
-    return rc;
-}
-
-static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
-{
-    st_impl *im = ds->impl;
-    int rc = phc_shoot_traces_model(ds, p, yhat, NULL);
-    if (rc || !jac) return rc;
     const size_t k = ds->k, n = ds->n;
     double *q = malloc(k * sizeof *q), *yp = malloc(n * sizeof *yp), *ym = malloc(n * sizeof *ym);
     if (!q || !yp || !ym) { free(q); free(yp); free(ym); return -1; }
@@ -226,6 +197,87 @@ static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
     free(yp);
     free(ym);
     return rc;
+}
+
+/* Grows `count` plants (seeds first .. first + count - 1) at slot values p:
+ * y (n) the statistics of their mean (angles pooled), per (count x n, or
+ * NULL) each plant's own (NAN for an angle of a plant without laterals).
+ * 0, 1 (outside the model's domain, or no lateral at all for an angle), -1. */
+static int model_seeds(phc_dataset *ds, const double *p, uint64_t first, size_t count, double *y, double *per)
+{
+    st_impl *im = ds->impl;
+    const size_t nt = im->n_times;
+    phc_climbing_options po = im->o.plant;
+    for (size_t j = 0; j < im->k; ++j) *slot_ref(&po, im->slot[j]) = p[j];
+    phc_climbing_summary *s = malloc(count * nt * sizeof *s), *one = malloc(count * sizeof *one), mean;
+    if (!s || !one) { free(s); free(one); return -1; }
+    int rc = 0;
+    for (size_t a = 0; a < count && !rc; ++a) {
+        rc = grow_one(im, &po, first + a, s + a * nt);
+        im->plants++;
+    }
+    for (size_t i = 0; !rc && i < ds->n; ++i) {
+        const size_t j = im->tindex[i];
+        for (size_t a = 0; a < count; ++a) one[a] = s[a * nt + j];
+        phc_climbing_summary_mean(one, count, &mean);
+        y[i] = stat_value(&mean, im->stat[i]);
+        if (!isfinite(y[i])) rc = 1; /* no lateral at all: no angle */
+        for (size_t a = 0; per && a < count; ++a) per[a * ds->n + i] = stat_value(&one[a], im->stat[i]);
+    }
+    free(s);
+    free(one);
+    return rc;
+}
+
+/* Averages over the K seeds at slot values p: y (n) and sd (n or NULL). */
+int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd)
+{
+    st_impl *im = ds->impl;
+    const size_t K = im->o.seeds, n = ds->n;
+    double *per = sd ? malloc(K * n * sizeof *per) : NULL;
+    if (sd && !per) return -1;
+    const int rc = model_seeds(ds, p, im->o.first_seed, K, y, per);
+    for (size_t i = 0; sd && !rc && i < n; ++i) {
+        double m = 0, v = 0;
+        size_t q = 0;
+        for (size_t a = 0; a < K; ++a)
+            if (isfinite(per[a * n + i])) { m += per[a * n + i]; q++; }
+        m /= (double)(q ? q : 1);
+        for (size_t a = 0; a < K; ++a)
+            if (isfinite(per[a * n + i])) v += (per[a * n + i] - m) * (per[a * n + i] - m);
+        sd[i] = q > 1 ? sqrt(v / (double)(q - 1)) : NAN;
+    }
+    free(per);
+    return rc;
+}
+
+/* v <- L^-1 v (L lower triangular, n x n row-major; v with stride). */
+static void whiten(const double *L, size_t n, double *v, size_t stride)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double x = v[i * stride];
+        for (size_t l = 0; l < i; ++l) x -= L[i * n + l] * v[l * stride];
+        v[i * stride] = x / L[i * n + i];
+    }
+}
+
+int phc_shoot_traces_model_jacobian(phc_dataset *ds, const double *p, double *y, double *jac)
+{
+    const int rc = phc_shoot_traces_model(ds, p, y, NULL);
+    return rc || !jac ? rc : fd_jacobian(ds, p, y, jac);
+}
+
+const double *phc_shoot_traces_traced(const phc_dataset *ds) { return ((const st_impl *)ds->impl)->y_raw; }
+
+static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    st_impl *im = ds->impl;
+    const int rc = phc_shoot_traces_model_jacobian(ds, p, yhat, jac);
+    if (rc) return rc;
+    /* the engine sees L^-1 (traced - model), L L^T the statistics' covariance */
+    whiten(im->L, ds->n, yhat, 1);
+    for (size_t j = 0; jac && j < ds->k; ++j) whiten(im->L, ds->n, jac + j, ds->k);
+    return 0;
 }
 
 int phc_shoot_traces_identifiability(phc_dataset *ds, const double *p, phc_shoot_traces_ident *out, phc_error *err)
@@ -375,7 +427,7 @@ static int st_report_section(phc_dataset *ds, const double *p, char **markdown, 
                "|---:|---|---:|---:|---:|---:|\n");
     for (size_t i = 0; i < n; ++i)
         fprintf(f, "| %g | %s | %.4g | %.4g | %.3g | %.3g |\n", im->times[im->tindex[i]], stat_names[im->stat[i]],
-                ds->y[i], y[i], sd[i], ds->sigma ? ds->sigma[i] : 1.0);
+                im->y_raw[i], y[i], sd[i], im->sigma_total[i]);
     fprintf(f, "\nIdentifiability from the statistics (this data set's Jacobian at the fitted values, "
                "the data set's sigma, not rescaled by the fit's residual variance): rank %zu of %zu, condition number %.3g.\n\n",
             id.rank, ds->k, id.condition);
@@ -463,25 +515,74 @@ static int make_frames(st_impl *im, phc_error *err)
     return PHC_OK;
 }
 
-int phc_shoot_traces_sigma_at(phc_dataset *ds, const double *p, phc_error *err)
+int phc_shoot_traces_covariance_at(phc_dataset *ds, const double *p, phc_error *err)
 {
     st_impl *im = ds->impl;
-    const size_t n = ds->n;
-    double *y = malloc(n * sizeof *y), *sd = malloc(n * sizeof *sd);
-    if (!y || !sd) {
-        free(y); free(sd);
+    const size_t n = ds->n, K = im->o.seeds;
+    const size_t M = im->o.covariance_seeds > K ? im->o.covariance_seeds : K;
+    double *y = malloc(n * sizeof *y), *per = malloc(M * n * sizeof *per), *S = calloc(n * n, sizeof *S),
+           *L = calloc(n * n, sizeof *L);
+    if (!y || !per || !S || !L) {
+        free(y); free(per); free(S); free(L);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
-    const int r = phc_shoot_traces_model(ds, p, y, sd);
-    /* sigma^2 = sigma_given^2 + (1 + 1/K) sd^2: the traced plant's own draw (sd) and the K-seed mean's (sd/sqrt(K)) */
-    for (size_t i = 0; !r && i < n; ++i) {
-        const double v = isfinite(sd[i]) ? sd[i] : 0, g = im->sigma_given[i];
-        ds->sigma[i] = sqrt(g * g + (1 + 1.0 / (double)im->o.seeds) * v * v);
+    const int r = model_seeds(ds, p, im->o.first_seed, M, y, per);
+    if (r) {
+        free(y); free(per); free(S); free(L);
+        return phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
+                             "shoot_traces: the model plant cannot be grown at these values (sigma unchanged)");
     }
-    free(y);
-    free(sd);
-    if (r) return phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
-                                "shoot_traces: the model plant cannot be grown at these values (sigma unchanged)");
+    /* deviations of each plant from the plants' mean; an angle a plant has not (no lateral) deviates by 0 */
+    for (size_t i = 0; i < n; ++i) {
+        double m = 0;
+        size_t q = 0;
+        for (size_t a = 0; a < M; ++a)
+            if (isfinite(per[a * n + i])) { m += per[a * n + i]; q++; }
+        m /= (double)(q ? q : 1);
+        for (size_t a = 0; a < M; ++a) per[a * n + i] = isfinite(per[a * n + i]) ? per[a * n + i] - m : 0;
+    }
+    /* Sigma = diag(sigma_given^2) + (1 + 1/K) C_g: the traced plant is one draw (C, the plants'
+     * covariance, estimated from M plants) and the model value a mean of K (C/K); C_g keeps C's
+     * diagonal and g (correlation) times its off-diagonal part: the correlations shrunk toward 0
+     * (Warton, JASA 103, 2008: ridge regularisation of a correlation matrix), g = 0 independent
+     * sigmas, g = 1 Wood's (Nature 466, 2010) synthetic-likelihood covariance as estimated. */
+    const int full = im->o.correlation > 0;
+    for (size_t i = 0; i < n; ++i)
+        for (size_t l = 0; l <= i; ++l) {
+            if (!full && l != i) continue;
+            double c = 0;
+            for (size_t a = 0; a < M; ++a) c += per[a * n + i] * per[a * n + l];
+            c *= (1 + 1.0 / (double)K) / (double)(M > 1 ? M - 1 : 1);
+            if (l != i) c *= im->o.correlation; /* shrunk toward the diagonal (Warton 2008) */
+            if (l == i) c += im->sigma_given[i] * im->sigma_given[i];
+            S[i * n + l] = S[l * n + i] = c;
+        }
+    /* Cholesky S = L L^T (S is positive definite: sigma_given > 0 on its diagonal) */
+    int ok = 1;
+    for (size_t i = 0; i < n && ok; ++i)
+        for (size_t l = 0; l <= i && ok; ++l) {
+            double v = S[i * n + l];
+            for (size_t q = 0; q < l; ++q) v -= L[i * n + q] * L[l * n + q];
+            if (l == i) {
+                if (!(v > 0)) ok = 0;
+                else L[i * n + i] = sqrt(v);
+            } else {
+                L[i * n + l] = v / L[l * n + l];
+            }
+        }
+    if (ok) {
+        free(im->L);
+        im->L = L;
+        L = NULL;
+        for (size_t i = 0; i < n; ++i) {
+            im->sigma_total[i] = sqrt(S[i * n + i]);
+            ds->y[i] = im->y_raw[i];
+            ds->sigma[i] = 1;
+        }
+        whiten(im->L, n, ds->y, 1);
+    }
+    free(y); free(per); free(S); free(L);
+    if (!ok) return phc_error_set(err, PHC_ERR_DOMAIN, "shoot_traces: the statistics' covariance is not positive definite");
     return PHC_OK;
 }
 
@@ -500,10 +601,10 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
     }
     im->traces = traces;
     im->o = *o;
-    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->frame_interval >= 0) || !(o->sigma_rel >= 0) ||
+    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->frame_interval >= 0) || o->covariance_seeds > 100000 || !(o->correlation >= 0 && o->correlation <= 1) || !(o->sigma_rel >= 0) ||
         !(o->sigma_length > 0) || !(o->sigma_fraction > 0) || !(o->sigma_cosine > 0) || !(o->sigma_angle > 0)) {
         rc = phc_error_set(err, PHC_ERR_INPUT,
-                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1), frame_interval >= 0 and "
+                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1), frame_interval >= 0, covariance_seeds <= 1e5, correlation in [0, 1] and "
                            "every sigma > 0");
         goto fail;
     }
@@ -601,18 +702,22 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
             goto fail_ds;
         }
     }
-    /* the traced plant is one draw of the process and the model value a mean over K:
-     * each sigma is widened by the seed-to-seed spread sd at the start options */
-    if (!(im->sigma_given = malloc(n * sizeof *im->sigma_given))) {
+    /* the traced plant is one draw of the process and the model value a mean over K: the
+     * statistics' covariance at the start options widens sigma and couples the statistics */
+    im->sigma_given = malloc(n * sizeof *im->sigma_given);
+    im->sigma_total = malloc(n * sizeof *im->sigma_total);
+    im->y_raw = malloc(n * sizeof *im->y_raw);
+    if (!im->sigma_given || !im->sigma_total || !im->y_raw) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail_ds;
     }
     memcpy(im->sigma_given, ds->sigma, n * sizeof *ds->sigma);
+    memcpy(im->y_raw, ds->y, n * sizeof *ds->y);
     {
         double *p0 = malloc(im->k * sizeof *p0);
         if (!p0) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail_ds; }
         for (size_t j = 0; j < im->k; ++j) p0[j] = *slot_ref(&im->o.plant, im->slot[j]);
-        rc = phc_shoot_traces_sigma_at(ds, p0, err);
+        rc = phc_shoot_traces_covariance_at(ds, p0, err);
         free(p0);
         if (rc) {
             if (rc != PHC_ERR_NOMEM)
@@ -624,7 +729,7 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
         im->plants = 0;
     }
     ds->x_label = strdup("time (s)");
-    ds->y_label = strdup("statistic (its unit)");
+    ds->y_label = strdup("whitened statistic L^-1 y (1)");
     ds->derivatives = PHC_DERIV_ANALYTIC;
     ds->model_tolerance = 1e-3;
     if (!ds->x_label || !ds->y_label || (rc = phc_dataset_add_input(ds, traces->source))) {
