@@ -98,7 +98,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "N must be 1..1000\n");
         return 2;
     }
-    int cover[2][NP] = {{0}}, fits = 0;
+    static const char *const way[3] = {"independent sigmas (g = 0)", "g = 0.5 (default)",
+                                       "g = 0.5, covariance at the fitted values"};
+    int cover[3][NP] = {{0}}, fits = 0;
     char md[1024], mdtmp[1024];
     FILE *f = nb_open_md(out, "shoot_traces_coverage.md", md, mdtmp, sizeof md);
     if (!f) {
@@ -108,7 +110,7 @@ int main(int argc, char **argv)
     fprintf(f, "# Coverage of the shoot_traces intervals\n\n"
                "%d model plants at BP 0.3, V 0.6, eta 0.02, tau 0.5, r 0.15 (60 s, steps of 0.5 s, traced "
                "every 10 s), each fitted with K = 8 seeds; absolute sigmas. * = the truth outside the 95%% "
-               "interval.\n\n| plant | pass | BP | V | eta | tau | r |\n|---|---|---|---|---|---|---|\n",
+               "interval.\n\n| plant | fit | BP | V | eta | tau | r |\n|---|---|---|---|---|---|---|\n",
             n_plants);
     for (int pl = 0; pl < n_plants; ++pl) {
         phc_error err;
@@ -125,41 +127,46 @@ int main(int argc, char **argv)
         o.time_step = 0.5;
         o.plant.seed = 1001 + (uint64_t)pl;
         const double times[6] = {10, 20, 30, 40, 50, 60};
-        phc_shoot_traces *tr = NULL;
-        if (phc_shoot_traces_from_model(&o, times, 6, &tr, &err)) {
-            fprintf(stderr, "plant %d: %s\n", pl, err.message);
-            return 1;
-        }
-        set_values(&o.plant, start); /* the fit knows only the starts */
         o.seeds = 8;
         o.first_seed = 1;
         o.is_parameter = is_param;
-        phc_dataset *ds = NULL;
-        if (phc_shoot_traces_new(tr, &o, &ds, &err)) {
-            fprintf(stderr, "plant %d: %s\n", pl, err.message);
-            return 1;
+        double est[3][NP], ci[3][NP][2];
+        int bad = 0;
+        for (int w = 0; w < 2 && !bad; ++w) {
+            o.correlation = w == 0 ? 0 : 0.5;
+            phc_shoot_traces *traces = NULL; /* the data set takes them */
+            set_values(&o.plant, truth);
+            if (phc_shoot_traces_from_model(&o, times, 6, &traces, &err)) {
+                fprintf(stderr, "plant %d: %s\n", pl, err.message);
+                return 1;
+            }
+            set_values(&o.plant, start); /* the fit knows only the starts */
+            phc_dataset *ds = NULL;
+            if (phc_shoot_traces_new(traces, &o, &ds, &err)) {
+                fprintf(stderr, "plant %d: %s\n", pl, err.message);
+                return 1;
+            }
+            ds->name = strdup("model-traces");
+            phc_problem *pb = NULL, *pb2 = NULL;
+            bad = fit_once(ds, start, est[w], ci[w], &pb);
+            if (w == 1 && !bad) { /* the covariance at the fitted values; the problem keeps owning ds */
+                if (phc_shoot_traces_covariance_at(ds, est[1], &err)) bad = 1;
+                if (!bad) {
+                    pb->n_datasets = 0; /* hand ds to the second problem */
+                    bad = fit_once(ds, est[1], est[2], ci[2], &pb2);
+                }
+            }
+            phc_problem_free(pb);
+            if (pb2) phc_problem_free(pb2);
         }
-        ds->name = strdup("model-traces");
-        double est[2][NP], ci[2][NP][2];
-        phc_problem *pb = NULL;
-        int bad = fit_once(ds, start, est[0], ci[0], &pb);
-        /* pass 2: the seed spread at the fitted values; the problem keeps owning ds */
-        if (!bad && phc_shoot_traces_covariance_at(ds, est[0], &err)) bad = 1;
-        phc_problem *pb2 = NULL;
-        if (!bad) {
-            pb->n_datasets = 0; /* hand ds to the second problem */
-            bad = fit_once(ds, est[0], est[1], ci[1], &pb2);
-        }
-        phc_problem_free(pb);
-        if (pb2) phc_problem_free(pb2);
         if (bad) {
             fprintf(stderr, "plant %d: a fit failed\n", pl);
             return 1;
         }
         fits++;
-        for (int pass = 0; pass < 2; ++pass) {
-            printf("plant %d pass %d:", 1001 + pl, pass + 1);
-            fprintf(f, "| %d | %d |", 1001 + pl, pass + 1);
+        for (int pass = 0; pass < 3; ++pass) {
+            printf("plant %d, %s:", 1001 + pl, way[pass]);
+            fprintf(f, "| %d | %s |", 1001 + pl, way[pass]);
             for (size_t j = 0; j < NP; ++j) {
                 const int in = truth[j] >= ci[pass][j][0] && truth[j] <= ci[pass][j][1];
                 cover[pass][j] += in;
@@ -171,10 +178,9 @@ int main(int argc, char **argv)
         }
     }
     fprintf(f, "\n| intervals covering the truth | BP | V | eta | tau | r |\n|---|---|---|---|---|---|\n");
-    for (int pass = 0; pass < 2; ++pass) {
-        printf("coverage, pass %d (sigma at the %s values), of %d plants:", pass + 1, pass ? "fitted" : "start",
-               fits);
-        fprintf(f, "| pass %d (sigma at the %s values) |", pass + 1, pass ? "fitted" : "start");
+    for (int pass = 0; pass < 3; ++pass) {
+        printf("coverage, %s, of %d plants:", way[pass], fits);
+        fprintf(f, "| %s |", way[pass]);
         for (size_t j = 0; j < NP; ++j) {
             printf(" %s %d", names[j], cover[pass][j]);
             fprintf(f, " %d of %d |", cover[pass][j], fits);
