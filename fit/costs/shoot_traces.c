@@ -418,11 +418,15 @@ static int st_report_section(phc_dataset *ds, const double *p, char **markdown, 
     fprintf(f, "Traces: `%s`, %zu shoots, %zu points, up to %g s.\n\n", im->traces->source,
             im->traces->n_shoots, im->traces->n_points, im->traces->t_end);
     fprintf(f, "Model: the climbing plant (Hädrich et al. 2017) grown with %zu seeds (%llu .. %llu, the same "
-               "at every parameter value) in steps of %g s; statistics averaged over the seeds. "
+               "at every parameter value) in steps of %g s, traced at %zu frames like the traces; statistics "
+               "averaged over the seeds. Residuals weighted by the statistics' covariance between %zu model "
+               "plants (correlations times %g; sigma below is the square root of its diagonal). "
                "Derivatives: central differences, step %g of each value. %lu plants grown before this "
                "report.\n\n",
             im->o.seeds, (unsigned long long)im->o.first_seed,
-            (unsigned long long)(im->o.first_seed + im->o.seeds - 1), im->o.time_step, im->o.fd_step, before);
+            (unsigned long long)(im->o.first_seed + im->o.seeds - 1), im->o.time_step, im->n_frames,
+            im->o.covariance_seeds > im->o.seeds ? im->o.covariance_seeds : im->o.seeds, im->o.correlation,
+            im->o.fd_step, before);
     fprintf(f, "| time (s) | statistic | traced | model (mean of seeds) | seed sd | sigma |\n"
                "|---:|---|---:|---:|---:|---:|\n");
     for (size_t i = 0; i < n; ++i)
