@@ -375,6 +375,17 @@ static size_t end_at(const phc_shoot_traces *tr, size_t s, double t)
     return j;
 }
 
+/* Insertion sort of shoot indices by name (a plant has few shoots). */
+static void sort_by_name(size_t *idx, size_t n, char *const *names)
+{
+    for (size_t i = 1; i < n; ++i) {
+        const size_t v = idx[i];
+        size_t j = i;
+        for (; j > 0 && strcmp(names[idx[j - 1]], names[v]) > 0; --j) idx[j] = idx[j - 1];
+        idx[j] = v;
+    }
+}
+
 int phc_shoot_traces_segments(const phc_shoot_traces *tr, double t, phc_shoot_segment **seg, size_t *n,
                               phc_error *err)
 {
@@ -387,9 +398,19 @@ int phc_shoot_traces_segments(const phc_shoot_traces *tr, double t, phc_shoot_se
     }
     if (!total) return PHC_OK;
     phc_shoot_segment *g = calloc(total, sizeof *g);
-    if (!g) return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    size_t *by_name = malloc(tr->n_shoots * sizeof *by_name);
+    if (!g || !by_name) {
+        free(g);
+        free(by_name);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    /* shoots in the order of their names, so that the statistics' sums run in one order whatever
+     * order the file lists the shoots in (a CSV by first appearance, RSML nested) */
+    for (size_t s = 0; s < tr->n_shoots; ++s) by_name[s] = s;
+    sort_by_name(by_name, tr->n_shoots, tr->names);
     size_t m = 0;
-    for (size_t s = 0; s < tr->n_shoots; ++s) {
+    for (size_t q = 0; q < tr->n_shoots; ++q) {
+        const size_t s = by_name[q];
         const size_t e = end_at(tr, s, t);
         for (size_t j = tr->start[s]; j + 1 < e; ++j) {
             phc_shoot_segment *q = &g[m++];
@@ -410,6 +431,7 @@ int phc_shoot_traces_segments(const phc_shoot_traces *tr, double t, phc_shoot_se
             q->lateral_start = isfinite(best);
         }
     }
+    free(by_name);
     *seg = g;
     *n = m;
     return PHC_OK;

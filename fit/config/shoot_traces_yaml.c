@@ -16,7 +16,7 @@
 #include "measurements/support_mesh.h"
 
 static const char *const shoot_traces_keys[] = {"file", "plant", "seeds", "first_seed", "times", "sigma",
-                                                "fd_step", NULL};
+                                                "fd_step", "frame_interval", "covariance_seeds", "correlation", NULL};
 static const phc_key_help shoot_traces_help[] = {
     {"file", "CSV of traced shoots: columns time (s), shoot, x, y, z (m) and optionally parent "
              "(measurements/shoot_traces.h), relative to the config file. Required."},
@@ -31,10 +31,18 @@ static const phc_key_help shoot_traces_help[] = {
     {"sigma", "{relative, length, fraction, cosine, angle}: lengths and height have sigma "
               "max(relative * value, length) (default 0.1, 0.01 m), attached fraction and light "
               "cosine `fraction` and `cosine` (0.05), angles `angle` degrees (5); shoot counts "
-              "sqrt(max(1, count)); then each is widened by the statistic's spread sd between the K "
-              "model plants at the grow config's values: sigma^2 + (1 + 1/K) sd^2. Default: "
-              "those values."},
-    {"fd_step", "Relative step of the central differences, in (0, 1). Default: 0.05."},
+              "sqrt(max(1, count)); then the statistics' covariance C between model plants at the "
+              "grow config's values is added: sigma^2 + (1 + 1/K) C (see covariance_seeds, "
+              "correlation). Default: those values."},
+    {"fd_step", "Relative step of the central differences, in (0, 1). Default: 0.2."},
+    {"covariance_seeds", "M: the statistics' covariance (the synthetic likelihood's) is estimated from "
+                         "max(K, M) model plants at the start values, 0..100000. Default: 64."},
+    {"correlation", "g in [0, 1]: the weight of the estimated correlations between the statistics "
+                    "(0: independent sigmas; 1: the covariance as estimated). Default: 0.5."},
+    {"frame_interval", "s, > 0: the tracer looked at the plant every frame_interval seconds (each "
+                       "apex recorded where it was then; nodes may carry the time they were laid "
+                       "down). The model plants are traced at the same frames. Default: every "
+                       "distinct point time of the traces is a frame."},
     {NULL, NULL}};
 
 static void mesh_free(void *m) { phc_support_mesh_free(m); }
@@ -48,7 +56,7 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
     phc_support_mesh *mesh = NULL;
     phc_shoot_traces *tr = NULL;
     double *times = NULL;
-    long seeds = 8, first = -1;
+    long seeds = 8, first = -1, cov_seeds = 64;
     phc_shoot_traces_options o = phc_shoot_traces_options_default();
     int rc;
     *out = NULL;
@@ -56,8 +64,28 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
         (rc = phc_yaml_map_string(doc, node, "plant", 1, ctx, &plant, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "seeds", 0, ctx, &seeds, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "first_seed", 0, ctx, &first, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "fd_step", 0, ctx, &o.fd_step, err)))
+        (rc = phc_yaml_map_number(doc, node, "fd_step", 0, ctx, &o.fd_step, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "frame_interval", 0, ctx, &o.frame_interval, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "covariance_seeds", 0, ctx, &cov_seeds, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "correlation", 0, ctx, &o.correlation, err)))
         goto done;
+    if (cov_seeds < 0 || cov_seeds > 100000) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu: key 'covariance_seeds': expected a whole number in 0..100000, found %ld",
+                           doc->path, phc_yaml_get(node, "covariance_seeds")->line, cov_seeds);
+        goto done;
+    }
+    o.covariance_seeds = (size_t)cov_seeds;
+    if (!(o.correlation >= 0 && o.correlation <= 1)) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'correlation': expected a number in [0, 1], found %g",
+                           doc->path, phc_yaml_get(node, "correlation")->line, o.correlation);
+        goto done;
+    }
+    if (phc_yaml_get(node, "frame_interval") && !(o.frame_interval > 0)) {
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'frame_interval': expected a time > 0 s, found %g",
+                           doc->path, phc_yaml_get(node, "frame_interval")->line, o.frame_interval);
+        goto done;
+    }
     if (seeds < 1 || seeds > 1000) {
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: key 'seeds': expected a whole number in 1..1000, found %ld",
                            doc->path, phc_yaml_get(node, "seeds")->line, seeds);

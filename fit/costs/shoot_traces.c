@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/costs/shoot_tracer.h"
+#include "fit/costs/unique_times.h"
 #include "fit/engine/problem.h"
 #include "model/climbing_statistics.h"
 #include "model/jacobi_svd.h"
@@ -44,7 +46,13 @@ typedef struct st_impl {
     phc_shoot_traces_options o;   /* times point into `times` below */
     double *times;
     size_t n_times;
-    size_t *steps;                /* round(t_j / Δt) */
+    double *sigma_given;          /* n: sigma before the seed spread is added */
+    double *sigma_total;          /* n: sqrt of the covariance's diagonal */
+    double *y_raw;                /* n: the traced statistics (ds->y holds them whitened) */
+    double *L;                    /* n x n: Cholesky factor of the statistics' covariance */
+    double *frames;               /* s: the times the tracer looks at a model plant */
+    size_t *frame_steps;          /* round(frame / Δt) */
+    size_t n_frames;
     int *stat;                    /* n: statistic of each observation */
     size_t *tindex;               /* n: time index of each observation */
     size_t slot[N_SLOTS];         /* data-set slot j -> slot_names index */
@@ -66,7 +74,9 @@ phc_shoot_traces_options phc_shoot_traces_options_default(void)
     o.sigma_fraction = 0.05;
     o.sigma_cosine = 0.05;
     o.sigma_angle = 5;
-    o.fd_step = 0.05;
+    o.fd_step = 0.2;
+    o.covariance_seeds = 64;
+    o.correlation = 0.5;
     return o;
 }
 
@@ -77,7 +87,12 @@ static void st_free(void *p)
     phc_shoot_traces_free(im->traces);
     if (im->o.support_free) im->o.support_free(im->o.support_owner);
     free(im->times);
-    free(im->steps);
+    free(im->frames);
+    free(im->sigma_given);
+    free(im->sigma_total);
+    free(im->y_raw);
+    free(im->L);
+    free(im->frame_steps);
     free(im->stat);
     free(im->tindex);
     free(im);
@@ -109,11 +124,13 @@ static phc_climbing_stat_options stat_options(const phc_shoot_traces_options *o)
     return so;
 }
 
-/* Grows one plant with options po and seed, summarising it after steps[j]
- * steps (j < nt) into s[j].  0, 1 (outside the model's domain), -1 memory. */
-static int grow_one(const phc_shoot_traces_options *o, const phc_climbing_options *po, uint64_t seed,
-                    const size_t *steps, size_t nt, phc_climbing_summary *s)
+/* Grows one plant with options po and seed, looks at it with a tracer at
+ * every frame (fit/costs/shoot_tracer.h) and summarises the traced plant
+ * at each observation time j < nt into s[j], the same way as the traces
+ * themselves.  0, 1 (outside the model's domain), -1 memory. */
+static int grow_one(const st_impl *im, const phc_climbing_options *po, uint64_t seed, phc_climbing_summary *s)
 {
+    const phc_shoot_traces_options *o = &im->o;
     phc_climbing_options co = *po;
     co.seed = seed;
     phc_error e;
@@ -121,71 +138,37 @@ static int grow_one(const phc_shoot_traces_options *o, const phc_climbing_option
     if (!(co.growth_rate * o->time_step < 1 - co.bud_fraction)) return 1;
     phc_climbing *c = phc_climbing_new(o->position, o->direction, &co, &e);
     if (!c) return e.status == PHC_ERR_NOMEM ? -1 : 1;
-    const phc_climbing_stat_options so = stat_options(o);
-    phc_shoot_segment *seg = NULL;
-    size_t cap = 0, done = 0;
+    phc_shoot_tracer tracer;
+    phc_shoot_tracer_init(&tracer);
+    size_t done = 0;
     int rc = 0;
-    for (size_t j = 0; j < nt && !rc; ++j) {
-        for (; done < steps[j] && !rc; ++done)
+    for (size_t f = 0; f < im->n_frames && !rc; ++f) {
+        for (; done < im->frame_steps[f] && !rc; ++done)
             if (phc_climbing_step(c, o->time_step, &e)) rc = e.status == PHC_ERR_NOMEM ? -1 : 1;
-        if (rc) break;
-        const size_t n = phc_climbing_count(c);
-        if (n > cap) {
-            phc_shoot_segment *g = realloc(seg, n * sizeof *g);
-            if (!g) { rc = -1; break; }
-            seg = g;
-            cap = n;
-        }
-        phc_climbing_segments(c, seg);
-        if (phc_climbing_summarize_segments(seg, n, &so, &s[j], &e)) rc = 1;
+        if (!rc && phc_shoot_tracer_look(&tracer, c, im->frames[f], &e)) rc = -1;
     }
-    free(seg);
+    phc_shoot_traces *traced = NULL;
+    if (!rc && tracer.n && phc_shoot_tracer_traces(&tracer, "model", &traced, &e))
+        rc = e.status == PHC_ERR_NOMEM ? -1 : 1;
+    const phc_climbing_stat_options so = stat_options(o);
+    for (size_t j = 0; j < im->n_times && !rc; ++j) {
+        phc_shoot_segment *seg = NULL;
+        size_t n = 0;
+        if (traced && phc_shoot_traces_segments(traced, im->times[j], &seg, &n, &e)) rc = -1;
+        else if (phc_climbing_summarize_segments(seg, n, &so, &s[j], &e)) rc = 1;
+        free(seg);
+    }
+    phc_shoot_traces_free(traced);
+    phc_shoot_tracer_clear(&tracer);
     phc_climbing_free(c);
     return rc;
 }
 
-/* Averages over the K seeds at slot values p: y (n) and sd (n or NULL). */
-int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd)
+/* Central differences of the K-seed means (raw, not whitened) at p, yhat the values at p. */
+static int fd_jacobian(phc_dataset *ds, const double *p, const double *yhat, double *jac)
 {
     st_impl *im = ds->impl;
-    const size_t K = im->o.seeds, nt = im->n_times;
-    phc_climbing_options po = im->o.plant;
-    for (size_t j = 0; j < im->k; ++j) *slot_ref(&po, im->slot[j]) = p[j];
-    phc_climbing_summary *s = malloc(K * nt * sizeof *s), *one = malloc(K * sizeof *one), mean;
-    if (!s || !one) { free(s); free(one); return -1; }
     int rc = 0;
-    for (size_t a = 0; a < K && !rc; ++a) {
-        rc = grow_one(&im->o, &po, im->o.first_seed + a, im->steps, nt, s + a * nt);
-        im->plants++;
-    }
-    for (size_t i = 0; !rc && i < ds->n; ++i) {
-        const size_t j = im->tindex[i];
-        for (size_t a = 0; a < K; ++a) one[a] = s[a * nt + j];
-        phc_climbing_summary_mean(one, K, &mean);
-        y[i] = stat_value(&mean, im->stat[i]);
-        if (!isfinite(y[i])) rc = 1; /* no lateral at all: no angle */
-        if (sd) {
-            double m = 0, v = 0;
-            for (size_t a = 0; a < K; ++a) m += stat_value(&one[a], im->stat[i]);
-            m /= (double)K;
-            size_t q = 0;
-            for (size_t a = 0; a < K; ++a) {
-                const double d = stat_value(&one[a], im->stat[i]);
-                if (isfinite(d)) { v += (d - m) * (d - m); q++; }
-            }
-            sd[i] = q > 1 ? sqrt(v / (double)(q - 1)) : NAN;
-        }
-    }
-    free(s);
-    free(one);
-    return rc;
-}
-
-static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
-{
-    st_impl *im = ds->impl;
-    int rc = phc_shoot_traces_model(ds, p, yhat, NULL);
-    if (rc || !jac) return rc;
     const size_t k = ds->k, n = ds->n;
     double *q = malloc(k * sizeof *q), *yp = malloc(n * sizeof *yp), *ym = malloc(n * sizeof *ym);
     if (!q || !yp || !ym) { free(q); free(yp); free(ym); return -1; }
@@ -214,6 +197,87 @@ static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *ja
     free(yp);
     free(ym);
     return rc;
+}
+
+/* Grows `count` plants (seeds first .. first + count - 1) at slot values p:
+ * y (n) the statistics of their mean (angles pooled), per (count x n, or
+ * NULL) each plant's own (NAN for an angle of a plant without laterals).
+ * 0, 1 (outside the model's domain, or no lateral at all for an angle), -1. */
+static int model_seeds(phc_dataset *ds, const double *p, uint64_t first, size_t count, double *y, double *per)
+{
+    st_impl *im = ds->impl;
+    const size_t nt = im->n_times;
+    phc_climbing_options po = im->o.plant;
+    for (size_t j = 0; j < im->k; ++j) *slot_ref(&po, im->slot[j]) = p[j];
+    phc_climbing_summary *s = malloc(count * nt * sizeof *s), *one = malloc(count * sizeof *one), mean;
+    if (!s || !one) { free(s); free(one); return -1; }
+    int rc = 0;
+    for (size_t a = 0; a < count && !rc; ++a) {
+        rc = grow_one(im, &po, first + a, s + a * nt);
+        im->plants++;
+    }
+    for (size_t i = 0; !rc && i < ds->n; ++i) {
+        const size_t j = im->tindex[i];
+        for (size_t a = 0; a < count; ++a) one[a] = s[a * nt + j];
+        phc_climbing_summary_mean(one, count, &mean);
+        y[i] = stat_value(&mean, im->stat[i]);
+        if (!isfinite(y[i])) rc = 1; /* no lateral at all: no angle */
+        for (size_t a = 0; per && a < count; ++a) per[a * ds->n + i] = stat_value(&one[a], im->stat[i]);
+    }
+    free(s);
+    free(one);
+    return rc;
+}
+
+/* Averages over the K seeds at slot values p: y (n) and sd (n or NULL). */
+int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd)
+{
+    st_impl *im = ds->impl;
+    const size_t K = im->o.seeds, n = ds->n;
+    double *per = sd ? malloc(K * n * sizeof *per) : NULL;
+    if (sd && !per) return -1;
+    const int rc = model_seeds(ds, p, im->o.first_seed, K, y, per);
+    for (size_t i = 0; sd && !rc && i < n; ++i) {
+        double m = 0, v = 0;
+        size_t q = 0;
+        for (size_t a = 0; a < K; ++a)
+            if (isfinite(per[a * n + i])) { m += per[a * n + i]; q++; }
+        m /= (double)(q ? q : 1);
+        for (size_t a = 0; a < K; ++a)
+            if (isfinite(per[a * n + i])) v += (per[a * n + i] - m) * (per[a * n + i] - m);
+        sd[i] = q > 1 ? sqrt(v / (double)(q - 1)) : NAN;
+    }
+    free(per);
+    return rc;
+}
+
+/* v <- L^-1 v (L lower triangular, n x n row-major; v with stride). */
+static void whiten(const double *L, size_t n, double *v, size_t stride)
+{
+    for (size_t i = 0; i < n; ++i) {
+        double x = v[i * stride];
+        for (size_t l = 0; l < i; ++l) x -= L[i * n + l] * v[l * stride];
+        v[i * stride] = x / L[i * n + i];
+    }
+}
+
+int phc_shoot_traces_model_jacobian(phc_dataset *ds, const double *p, double *y, double *jac)
+{
+    const int rc = phc_shoot_traces_model(ds, p, y, NULL);
+    return rc || !jac ? rc : fd_jacobian(ds, p, y, jac);
+}
+
+const double *phc_shoot_traces_traced(const phc_dataset *ds) { return ((const st_impl *)ds->impl)->y_raw; }
+
+static int st_predict(phc_dataset *ds, const double *p, double *yhat, double *jac)
+{
+    st_impl *im = ds->impl;
+    const int rc = phc_shoot_traces_model_jacobian(ds, p, yhat, jac);
+    if (rc) return rc;
+    /* the engine sees L^-1 (traced - model), L L^T the statistics' covariance */
+    whiten(im->L, ds->n, yhat, 1);
+    for (size_t j = 0; jac && j < ds->k; ++j) whiten(im->L, ds->n, jac + j, ds->k);
+    return 0;
 }
 
 int phc_shoot_traces_identifiability(phc_dataset *ds, const double *p, phc_shoot_traces_ident *out, phc_error *err)
@@ -354,16 +418,20 @@ static int st_report_section(phc_dataset *ds, const double *p, char **markdown, 
     fprintf(f, "Traces: `%s`, %zu shoots, %zu points, up to %g s.\n\n", im->traces->source,
             im->traces->n_shoots, im->traces->n_points, im->traces->t_end);
     fprintf(f, "Model: the climbing plant (Hädrich et al. 2017) grown with %zu seeds (%llu .. %llu, the same "
-               "at every parameter value) in steps of %g s; statistics averaged over the seeds. "
+               "at every parameter value) in steps of %g s, traced at %zu frames like the traces; statistics "
+               "averaged over the seeds. Residuals weighted by the statistics' covariance between %zu model "
+               "plants (correlations times %g; sigma below is the square root of its diagonal). "
                "Derivatives: central differences, step %g of each value. %lu plants grown before this "
                "report.\n\n",
             im->o.seeds, (unsigned long long)im->o.first_seed,
-            (unsigned long long)(im->o.first_seed + im->o.seeds - 1), im->o.time_step, im->o.fd_step, before);
+            (unsigned long long)(im->o.first_seed + im->o.seeds - 1), im->o.time_step, im->n_frames,
+            im->o.covariance_seeds > im->o.seeds ? im->o.covariance_seeds : im->o.seeds, im->o.correlation,
+            im->o.fd_step, before);
     fprintf(f, "| time (s) | statistic | traced | model (mean of seeds) | seed sd | sigma |\n"
                "|---:|---|---:|---:|---:|---:|\n");
     for (size_t i = 0; i < n; ++i)
         fprintf(f, "| %g | %s | %.4g | %.4g | %.3g | %.3g |\n", im->times[im->tindex[i]], stat_names[im->stat[i]],
-                ds->y[i], y[i], sd[i], ds->sigma ? ds->sigma[i] : 1.0);
+                im->y_raw[i], y[i], sd[i], im->sigma_total[i]);
     fprintf(f, "\nIdentifiability from the statistics (this data set's Jacobian at the fitted values, "
                "the data set's sigma, not rescaled by the fit's residual variance): rank %zu of %zu, condition number %.3g.\n\n",
             id.rank, ds->k, id.condition);
@@ -420,6 +488,108 @@ static double sigma_for(const phc_shoot_traces_options *o, int stat, double v)
     }
 }
 
+/* The frames at which the tracer looks at a model plant: multiples of
+ * frame_interval, or else the distinct point times of the traces, in
+ * (0, last observation time] (at time 0 the model plant is its seed, whose
+ * base the first frame records). */
+static int make_frames(st_impl *im, phc_error *err)
+{
+    const double last = im->times[im->n_times - 1], dt = im->o.frame_interval;
+    double *f = NULL;
+    size_t m = 0;
+    if (dt > 0) {
+        const size_t cap = (size_t)floor(last / dt * (1 + 1e-12)) + 1;
+        if (!(f = malloc(cap * sizeof *f))) return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        for (size_t q = 1; q < cap + 1 && (double)q * dt <= last * (1 + 1e-12); ++q) f[m++] = (double)q * dt;
+    } else {
+        double *u = NULL;
+        size_t nu = 0, *at = NULL;
+        int rc = phc_unique_times(im->traces->t, im->traces->n_points, &u, &nu, &at, err);
+        if (rc) return rc;
+        free(at);
+        f = u;
+        for (size_t q = 0; q < nu; ++q)
+            if (u[q] > 0 && u[q] <= last) f[m++] = u[q];
+    }
+    im->frames = f;
+    im->n_frames = m;
+    if (!(im->frame_steps = malloc((m ? m : 1) * sizeof *im->frame_steps)))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    for (size_t q = 0; q < m; ++q) im->frame_steps[q] = (size_t)llround(f[q] / im->o.time_step);
+    return PHC_OK;
+}
+
+int phc_shoot_traces_covariance_at(phc_dataset *ds, const double *p, phc_error *err)
+{
+    st_impl *im = ds->impl;
+    const size_t n = ds->n, K = im->o.seeds;
+    const size_t M = im->o.covariance_seeds > K ? im->o.covariance_seeds : K;
+    double *y = malloc(n * sizeof *y), *per = malloc(M * n * sizeof *per), *S = calloc(n * n, sizeof *S),
+           *L = calloc(n * n, sizeof *L);
+    if (!y || !per || !S || !L) {
+        free(y); free(per); free(S); free(L);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    const int r = model_seeds(ds, p, im->o.first_seed, M, y, per);
+    if (r) {
+        free(y); free(per); free(S); free(L);
+        return phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_DOMAIN,
+                             "shoot_traces: the model plant cannot be grown at these values (sigma unchanged)");
+    }
+    /* deviations of each plant from the plants' mean; an angle a plant has not (no lateral) deviates by 0 */
+    for (size_t i = 0; i < n; ++i) {
+        double m = 0;
+        size_t q = 0;
+        for (size_t a = 0; a < M; ++a)
+            if (isfinite(per[a * n + i])) { m += per[a * n + i]; q++; }
+        m /= (double)(q ? q : 1);
+        for (size_t a = 0; a < M; ++a) per[a * n + i] = isfinite(per[a * n + i]) ? per[a * n + i] - m : 0;
+    }
+    /* Sigma = diag(sigma_given^2) + (1 + 1/K) C_g: the traced plant is one draw (C, the plants'
+     * covariance, estimated from M plants) and the model value a mean of K (C/K); C_g keeps C's
+     * diagonal and g (correlation) times its off-diagonal part: the correlations shrunk toward 0
+     * (Warton, JASA 103, 2008: ridge regularisation of a correlation matrix), g = 0 independent
+     * sigmas, g = 1 Wood's (Nature 466, 2010) synthetic-likelihood covariance as estimated. */
+    const int full = im->o.correlation > 0;
+    for (size_t i = 0; i < n; ++i)
+        for (size_t l = 0; l <= i; ++l) {
+            if (!full && l != i) continue;
+            double c = 0;
+            for (size_t a = 0; a < M; ++a) c += per[a * n + i] * per[a * n + l];
+            c *= (1 + 1.0 / (double)K) / (double)(M > 1 ? M - 1 : 1);
+            if (l != i) c *= im->o.correlation; /* shrunk toward the diagonal (Warton 2008) */
+            if (l == i) c += im->sigma_given[i] * im->sigma_given[i];
+            S[i * n + l] = S[l * n + i] = c;
+        }
+    /* Cholesky S = L L^T (S is positive definite: sigma_given > 0 on its diagonal) */
+    int ok = 1;
+    for (size_t i = 0; i < n && ok; ++i)
+        for (size_t l = 0; l <= i && ok; ++l) {
+            double v = S[i * n + l];
+            for (size_t q = 0; q < l; ++q) v -= L[i * n + q] * L[l * n + q];
+            if (l == i) {
+                if (!(v > 0)) ok = 0;
+                else L[i * n + i] = sqrt(v);
+            } else {
+                L[i * n + l] = v / L[l * n + l];
+            }
+        }
+    if (ok) {
+        free(im->L);
+        im->L = L;
+        L = NULL;
+        for (size_t i = 0; i < n; ++i) {
+            im->sigma_total[i] = sqrt(S[i * n + i]);
+            ds->y[i] = im->y_raw[i];
+            ds->sigma[i] = 1;
+        }
+        whiten(im->L, n, ds->y, 1);
+    }
+    free(y); free(per); free(S); free(L);
+    if (!ok) return phc_error_set(err, PHC_ERR_DOMAIN, "shoot_traces: the statistics' covariance is not positive definite");
+    return PHC_OK;
+}
+
 int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_options *o, phc_dataset **out,
                          phc_error *err)
 {
@@ -435,17 +605,17 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
     }
     im->traces = traces;
     im->o = *o;
-    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->sigma_rel >= 0) ||
+    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->frame_interval >= 0) || o->covariance_seeds > 100000 || !(o->correlation >= 0 && o->correlation <= 1) || !(o->sigma_rel >= 0) ||
         !(o->sigma_length > 0) || !(o->sigma_fraction > 0) || !(o->sigma_cosine > 0) || !(o->sigma_angle > 0)) {
         rc = phc_error_set(err, PHC_ERR_INPUT,
-                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1) and every sigma > 0");
+                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1), frame_interval >= 0, covariance_seeds <= 1e5, correlation in [0, 1] and "
+                           "every sigma > 0");
         goto fail;
     }
     /* times */
     im->n_times = o->times ? o->n_times : 4;
     im->times = malloc(im->n_times * sizeof *im->times);
-    im->steps = malloc(im->n_times * sizeof *im->steps);
-    if (!im->times || !im->steps) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
+    if (!im->times) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail; }
     for (size_t j = 0; j < im->n_times; ++j) {
         im->times[j] = o->times ? o->times[j] : traces->t_end * (double)(j + 1) / 4.0;
         if (!(im->times[j] > 0) || (j && !(im->times[j] > im->times[j - 1])) ||
@@ -456,8 +626,8 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
                                im->times[j], traces->t_end);
             goto fail;
         }
-        im->steps[j] = (size_t)llround(im->times[j] / o->time_step);
     }
+    if ((rc = make_frames(im, err))) goto fail;
     /* slots */
     for (size_t s = 0; s < N_SLOTS; ++s)
         if (o->is_parameter ? o->is_parameter(slot_names[s], o->user_data) : s == 0) im->slot[im->k++] = s;
@@ -536,33 +706,34 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
             goto fail_ds;
         }
     }
-    /* the traced plant is one draw of the process and the model value a mean over K:
-     * each sigma is widened by the seed-to-seed spread sd at the start options,
-     * sigma^2 = sigma_given^2 + (1 + 1/K) sd^2 */
+    /* the traced plant is one draw of the process and the model value a mean over K: the
+     * statistics' covariance at the start options widens sigma and couples the statistics */
+    im->sigma_given = malloc(n * sizeof *im->sigma_given);
+    im->sigma_total = malloc(n * sizeof *im->sigma_total);
+    im->y_raw = malloc(n * sizeof *im->y_raw);
+    if (!im->sigma_given || !im->sigma_total || !im->y_raw) {
+        rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        goto fail_ds;
+    }
+    memcpy(im->sigma_given, ds->sigma, n * sizeof *ds->sigma);
+    memcpy(im->y_raw, ds->y, n * sizeof *ds->y);
     {
-        double *p0 = malloc(im->k * sizeof *p0), *y0 = malloc(n * sizeof *y0), *sd0 = malloc(n * sizeof *sd0);
-        if (!p0 || !y0 || !sd0) {
-            free(p0); free(y0); free(sd0);
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail_ds;
-        }
+        double *p0 = malloc(im->k * sizeof *p0);
+        if (!p0) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); goto fail_ds; }
         for (size_t j = 0; j < im->k; ++j) p0[j] = *slot_ref(&im->o.plant, im->slot[j]);
-        int r = phc_shoot_traces_model(ds, p0, y0, sd0);
-        for (i = 0; !r && i < n; ++i) {
-            const double v = isfinite(sd0[i]) ? sd0[i] : 0;
-            ds->sigma[i] = sqrt(ds->sigma[i] * ds->sigma[i] + (1 + 1.0 / (double)o->seeds) * v * v);
-        }
-        free(p0); free(y0); free(sd0);
-        if (r) {
-            rc = phc_error_set(err, r < 0 ? PHC_ERR_NOMEM : PHC_ERR_INPUT,
-                               "shoot_traces: the model plant cannot be grown at the start options (or it "
-                               "makes no lateral while the traces have some)");
+        rc = phc_shoot_traces_covariance_at(ds, p0, err);
+        free(p0);
+        if (rc) {
+            if (rc != PHC_ERR_NOMEM)
+                rc = phc_error_set(err, PHC_ERR_INPUT,
+                                   "shoot_traces: the model plant cannot be grown at the start options (or it "
+                                   "makes no lateral while the traces have some)");
             goto fail_ds;
         }
         im->plants = 0;
     }
     ds->x_label = strdup("time (s)");
-    ds->y_label = strdup("statistic (its unit)");
+    ds->y_label = strdup("whitened statistic L^-1 y (1)");
     ds->derivatives = PHC_DERIV_ANALYTIC;
     ds->model_tolerance = 1e-3;
     if (!ds->x_label || !ds->y_label || (rc = phc_dataset_add_input(ds, traces->source))) {
@@ -580,100 +751,23 @@ fail:
     return rc;
 }
 
-/* phc_shoot_traces_from_model: see the header. */
-typedef struct rows {
-    size_t n, cap;
-    double *t, *x, *y, *z;
-    char **shoot, **parent;
-} rows;
-
-static int rows_push(rows *r, double t, const double p[3], const char *shoot, const char *parent)
-{
-    if (r->n == r->cap) {
-        size_t cap = r->cap ? 2 * r->cap : 256;
-        double *a = realloc(r->t, cap * sizeof *a); if (a) r->t = a;
-        double *b = realloc(r->x, cap * sizeof *b); if (b) r->x = b;
-        double *c = realloc(r->y, cap * sizeof *c); if (c) r->y = c;
-        double *d = realloc(r->z, cap * sizeof *d); if (d) r->z = d;
-        char **e = realloc(r->shoot, cap * sizeof *e); if (e) r->shoot = e;
-        char **f = realloc(r->parent, cap * sizeof *f); if (f) r->parent = f;
-        if (!a || !b || !c || !d || !e || !f) return -1;
-        r->cap = cap;
-    }
-    r->t[r->n] = t;
-    r->x[r->n] = p[0];
-    r->y[r->n] = p[1];
-    r->z[r->n] = p[2];
-    r->shoot[r->n] = strdup(shoot);
-    r->parent[r->n] = strdup(parent);
-    if (!r->shoot[r->n] || !r->parent[r->n]) return -1;
-    r->n++;
-    return 0;
-}
-
 int phc_shoot_traces_from_model(const phc_shoot_traces_options *o, const double *times, size_t n_times,
                                 phc_shoot_traces **out, phc_error *err)
 {
     *out = NULL;
     phc_climbing *c = phc_climbing_new(o->position, o->direction, &o->plant, err);
     if (!c) return err ? err->status : PHC_ERR_INVALID;
-    rows r = {0};
-    size_t *shoot_of = NULL, *joints = NULL, cap = 0, done = 0;
+    phc_shoot_tracer tracer;
+    phc_shoot_tracer_init(&tracer);
+    size_t done = 0;
     int rc = PHC_OK;
     for (size_t j = 0; j < n_times && !rc; ++j) {
         const size_t steps = (size_t)llround(times[j] / o->time_step);
         for (; done < steps && !rc; ++done) rc = phc_climbing_step(c, o->time_step, err);
-        if (rc) break;
-        const size_t n = phc_climbing_count(c);
-        if (n > cap) {
-            size_t *a = realloc(shoot_of, n * sizeof *a);
-            if (a) shoot_of = a;
-            size_t *b = realloc(joints, n * sizeof *b);
-            if (b) joints = b;
-            if (!a || !b) { rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory"); break; }
-            for (size_t i = cap; i < n; ++i) joints[i] = 0;
-            cap = n;
-        }
-        /* shoots: a particle starts one when it has no parent or is a lateral; joints[s]
-         * counts the completed joints written for shoot s (its start particle's index) */
-        for (size_t i = 0; i < n && !rc; ++i) {
-            const size_t p = phc_climbing_parent(c, i);
-            shoot_of[i] = (p == PHC_CLIMBING_NONE || phc_climbing_is_lateral(c, i)) ? i : shoot_of[p];
-        }
-        for (size_t i = 0; i < n && !rc; ++i) {
-            const size_t s = shoot_of[i];
-            char name[32], parent[32] = "";
-            snprintf(name, sizeof name, "s%zu", s);
-            if (s != 0) snprintf(parent, sizeof parent, "s%zu", shoot_of[phc_climbing_parent(c, s)]);
-            /* the position of i in its shoot's chain: particles of one shoot in index order */
-            size_t pos = 0;
-            for (size_t q = s; q < i; ++q) pos += shoot_of[q] == s;
-            double base[3], tip[3];
-            phc_climbing_segment(c, i, base, tip);
-            if (pos == 0 && joints[s] == 0) {
-                if (rows_push(&r, times[j], base, name, parent)) rc = -1;
-                joints[s] = 1;
-            }
-            const int apical = phc_climbing_is_apical(c, i);
-            if (!rc && !apical && joints[s] == pos + 1) {
-                if (rows_push(&r, times[j], tip, name, parent)) rc = -1;
-                joints[s] = pos + 2;
-            } else if (!rc && apical) {
-                if (rows_push(&r, times[j], tip, name, parent)) rc = -1;
-            }
-        }
-        if (rc < 0) rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+        if (!rc) rc = phc_shoot_tracer_look(&tracer, c, times[j], err);
     }
-    /* a shoot born at the last time has its base and tip only: at least 2 points */
-    if (!rc) rc = phc_shoot_traces_from_rows("model traces", r.n, r.t, (const char *const *)r.shoot, r.x, r.y, r.z,
-                                             (const char *const *)r.parent, out, err);
-    for (size_t i = 0; i < r.n; ++i) {
-        free(r.shoot[i]);
-        free(r.parent[i]);
-    }
-    free(r.t); free(r.x); free(r.y); free(r.z); free(r.shoot); free(r.parent);
-    free(shoot_of);
-    free(joints);
+    if (!rc) rc = phc_shoot_tracer_traces(&tracer, "model traces", out, err);
+    phc_shoot_tracer_clear(&tracer);
     phc_climbing_free(c);
     return rc;
 }

@@ -10,18 +10,27 @@
  * branching angle's mean and standard deviation.
  * Model: the plant grown from the grow config's seed, support and light
  * (fit/grow_config.h) with each of the seeds first_seed .. first_seed+K-1
- * (common random numbers: the same K seeds at every parameter value), the
- * statistics of each at t_j (after round(t_j/Δt) steps), averaged
+ * (common random numbers: the same K seeds at every parameter value),
+ * looked at by a tracer at the traces' frames (fit/costs/shoot_tracer.h:
+ * new nodes and every apex where they are at each frame, as a time-lapse
+ * tracer records them; frames every frame_interval s, or the traces'
+ * distinct point times), the statistics of that traced record at t_j
+ * computed exactly as the traces' (phc_shoot_traces_segments), averaged
  * (phc_climbing_summary_mean: the angles pooled over all laterals).
- * Residual: (model − traced)/σ per statistic (the dataset's convention is
- * (traced − model)/σ; the sign does not matter to the fit).
+ * Residuals: L⁻¹(traced − model), Σ = L Lᵀ the statistics' covariance (a
+ * synthetic likelihood, Wood, Nature 466, 2010): the data set holds the
+ * whitened traced statistics with σ = 1 (phc_shoot_traces_traced gives
+ * them as traced).
  *
- * σ per statistic: lengths and height max(σ_rel·value, σ_len) (defaults
- * 0.1 and 0.01 m), attached fraction and light cosine 0.05, counts
- * sqrt(max(1, count)) (Poisson), angles 5°; then widened by the spread of
- * the statistic between the K model plants at the start options (the grow
- * config's values): σ² = σ_given² + (1 + 1/K)·sd², because the traced plant
- * is one draw of the random process and the model value a mean over K.
+ * Σ = diag(σ_given²) + (1 + 1/K)·C_g.  σ_given per statistic: lengths and
+ * height max(σ_rel·value, σ_len) (defaults 0.1 and 0.01 m), attached
+ * fraction and light cosine 0.05, counts sqrt(max(1, count)) (Poisson),
+ * angles 5°.  C is the covariance of the statistics between M =
+ * max(K, covariance_seeds) model plants at the start options (the grow
+ * config's values; phc_shoot_traces_covariance_at recomputes it
+ * elsewhere), C_g its diagonal plus `correlation` (g, default 0.5) times
+ * its off-diagonal part; (1 + 1/K) because the traced plant is one draw of
+ * the random process (C) and the model value a mean over K (C/K).
  *
  * Slots (the grow config's values are the start of the ones not fitted):
  * branch_probability, direction_variance, phototropism (s-1),
@@ -29,11 +38,14 @@
  * thickness_falloff, min_stiffness, anchor_strength.
  *
  * Derivatives: central differences with a relative step fd_step (default
- * 0.05 of the value, or 0.05 of the slot's scale when the value is 0): the
+ * 0.2 of the value, or 0.2 of the slot's scale when the value is 0): the
  * averaged statistics are piecewise constant in BP, V, η, ... with fixed
  * seeds (a bud flips at a threshold of its uniform draw), so steps of 1e-6
- * would see zero or a jump; a step of 5% spans many flips over K plants and
- * gives the slope of the trend.  A step that leaves the model's domain
+ * would see zero or a jump; a wide step spans many flips over K plants and
+ * gives the slope of the trend.  5% (the old default) still saw single
+ * jumps of a shoot's path (the attached fraction of a recovery plant moved
+ * by 3σ between τ = 0.525 and 0.55 s⁻¹), which made the Jacobian steep and
+ * the intervals far too narrow (README "Fitting growth to traced shoots").  A step that leaves the model's domain
  * (BP + h > 1) falls back to the one-sided difference. */
 #ifndef PHC_COSTS_SHOOT_TRACES_H
 #define PHC_COSTS_SHOOT_TRACES_H
@@ -57,7 +69,13 @@ typedef struct phc_shoot_traces_options {
     size_t n_times;
     double sigma_rel, sigma_length; /* default 0.1, 0.01 m */
     double sigma_fraction, sigma_cosine, sigma_angle; /* default 0.05, 0.05, 5° */
-    double fd_step;              /* relative, default 0.05 */
+    double fd_step;              /* relative, default 0.2 */
+    size_t covariance_seeds;     /* M: plants the statistics' covariance is estimated from
+                                    (max(K, M) plants; default 64) */
+    double correlation;          /* g in [0, 1]: the weight of the estimated correlations
+                                    between statistics (0: independent sigmas; default 0.5) */
+    double frame_interval;       /* s, >= 0: the tracer looked at the plant every frame_interval;
+                                    0 (default): at every distinct point time of the traces */
     phc_is_parameter_fn is_parameter; /* which slots are fitted (NULL: branch_probability) */
     void *user_data;
     void *support_owner;         /* freed with support_free when the data set is freed */
@@ -78,10 +96,30 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
  * (outside the model's domain), < 0 (memory). */
 int phc_shoot_traces_model(phc_dataset *ds, const double *p, double *y, double *sd);
 
+/* The K-seed means y (n) at slot values p and their central-difference
+ * Jacobian (n x k row-major, may be NULL), not whitened; 0, > 0, < 0 as
+ * phc_shoot_traces_model. */
+int phc_shoot_traces_model_jacobian(phc_dataset *ds, const double *p, double *y, double *jac);
+
+/* The traced statistics (n, in observation order; ds->y holds them
+ * whitened). */
+const double *phc_shoot_traces_traced(const phc_dataset *ds);
+
+/* Recomputes the statistics' covariance at slot values p (e.g. the fitted
+ * values, for a second fit): Σ = diag(σ_given²) + (1 + 1/K) C, C the
+ * covariance of the statistics between M = max(K, covariance_seeds)
+ * plants (seeds first_seed ..), its off-diagonal part times `correlation`;
+ * the data set then holds the whitened traced statistics L⁻¹y (Σ = L Lᵀ)
+ * with σ = 1, and predicts L⁻¹ŷ.  PHC_OK; PHC_ERR_DOMAIN (the model cannot
+ * be grown at p: nothing changed), PHC_ERR_NOMEM. */
+int phc_shoot_traces_covariance_at(phc_dataset *ds, const double *p, phc_error *err);
+
 /* Traces of a plant grown by the model (for regression tests and
- * examples): the tip of every particle, written when the particle is born
- * and at every time of `times`, as traces (shoot = the particle chain of
- * one apex from its lateral start; parent the shoot it leaves). */
+ * examples): the plant grown with o's options, looked at by the tracer of
+ * fit/costs/shoot_tracer.h at every time of `times` (the frames), the same
+ * record the data set makes of its model plants (so a data set with these
+ * frames, seeds = 1 and first_seed = o->plant.seed gives the traced
+ * statistics exactly at the same values). */
 int phc_shoot_traces_from_model(const phc_shoot_traces_options *o, const double *times, size_t n_times,
                                 phc_shoot_traces **out, phc_error *err);
 

@@ -77,5 +77,17 @@ sed 's/^tropisms:/tropisms:\n  seek_light: maybe/' plant.yaml >seek.yaml
 config seek_fit.yaml ok.csv seek.yaml
 bad_case "seek_light neither true nor false" seek_fit.yaml "seek.yaml:30:15" "tropisms.seek_light" "expected a boolean"
 
+config frame.yaml ok.csv
+printf '    frame_interval: 0\n' >>frame.yaml
+bad_case "frame_interval of 0 s" frame.yaml "frame.yaml:9" "key 'frame_interval'" "expected a time > 0 s, found 0"
+
+config corr.yaml ok.csv
+printf '    correlation: 1.5\n' >>corr.yaml
+bad_case "correlation above 1" corr.yaml "corr.yaml:9" "key 'correlation'" "expected a number in [0, 1], found 1.5"
+
+config covs.yaml ok.csv
+printf '    covariance_seeds: -3\n' >>covs.yaml
+bad_case "negative covariance_seeds" covs.yaml "covs.yaml:9" "key 'covariance_seeds'" "0..100000, found -3"
+
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

@@ -28,7 +28,7 @@ else
 fi
 cp "$EX/plant.yaml" "$EX/wall.obj" "$T/"
 for f in csv rsml; do
-    printf 'name: st-%s\nparameters:\n  growth_rate: {value: 0.15, lower: 0.05, upper: 0.5, unit: "s-1"}\n  surface_adaption: {value: 0.3, lower: 0.01, upper: 3, unit: "s-1"}\ndatasets:\n  - kind: shoot_traces\n    name: ivy\n    file: t.%s\n    plant: plant.yaml\n    seeds: 2\n' "$f" "$f" >"$T/fit_$f.yaml"
+    printf 'name: st-%s\nparameters:\n  growth_rate: {value: 0.15, lower: 0.05, upper: 0.5, unit: "s-1"}\n  surface_adaption: {value: 0.3, lower: 0.01, upper: 3, unit: "s-1"}\ndatasets:\n  - kind: shoot_traces\n    name: ivy\n    file: t.%s\n    plant: plant.yaml\n    seeds: 2\n    frame_interval: 10\n' "$f" "$f" >"$T/fit_$f.yaml"
     "$PHC" fit "$T/fit_$f.yaml" -o "$T/run_$f" >"$T/out_$f" 2>"$T/err_$f"
     echo "$?" >"$T/rc_$f"
     grep -o '"value": [^,]*' "$T/run_$f/result.json" 2>/dev/null | head -2 | tr '\n' ' ' >"$T/values_$f"
