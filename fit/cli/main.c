@@ -1,6 +1,6 @@
 /* The phytocal command (DESIGN.md §4).  The only place that prints.
  *
- *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal fit CONFIG.yaml [-o DIR] [--plots all|none] [--force] [--quiet]
  *   phytocal fit A.yaml B.yaml ... -o DIR | CONFIG.yaml --each COLUMN -o DIR   (batch)
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal grow CONFIG.yaml [-o DIR] [--force] [--quiet]
@@ -53,9 +53,9 @@ typedef struct command_help {
 } command_help;
 
 static const command_help commands[] = {
-    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]\n"
-            "  phytocal fit A.yaml B.yaml ... -o DIR [--force] [--quiet]\n"
-            "  phytocal fit CONFIG.yaml --each COLUMN -o DIR [--force] [--quiet]",
+    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--plots all|none] [--force] [--quiet]\n"
+            "  phytocal fit A.yaml B.yaml ... -o DIR [--plots all|none] [--force] [--quiet]\n"
+            "  phytocal fit CONFIG.yaml --each COLUMN -o DIR [--plots all|none] [--force] [--quiet]",
      "Fits the configuration's parameters to its data sets (Ceres Solver), then judges\n"
      "the residuals and parameters, and writes a run directory:\n"
      "  result.json        machine-readable result (README: result.json)\n"
@@ -66,6 +66,10 @@ static const command_help commands[] = {
      "\n"
      "options:\n"
      "  -o, --output DIR   run directory (default runs/<name>/, name from the config)\n"
+     "  --plots all|none   all (default): the plots above and a kind's own pictures and\n"
+     "                     files at the fitted values; none: result.json, report.md\n"
+     "                     (saying no plots were drawn) and the manifest only, the\n"
+     "                     same numbers (for batches of many fits)\n"
      "  --force            replace DIR if it is an earlier phytocal run directory that\n"
      "                     holds nothing but what phytocal wrote (its manifest lists\n"
      "                     it); anything else in DIR, and any DIR holding the run's\n"
@@ -74,7 +78,9 @@ static const command_help commands[] = {
      "  -h, --help         this text\n"
      "\n"
      "Progress goes to stderr: one updating line on a terminal (start k of n, solver\n"
-     "iteration and cost, elapsed time), plain lines otherwise.\n"
+     "iteration and cost, elapsed time), plain lines otherwise.  The files are on disk\n"
+     "when phytocal returns: one sync of the file system before DIR is renamed into\n"
+     "place (not one per file).\n"
      "\n"
      "Batch (many small fits in one process; -o DIR is required):\n"
      "  A.yaml B.yaml ...  each config fitted into DIR/<config stem>/ (two configs with\n"
@@ -88,7 +94,8 @@ static const command_help commands[] = {
      "errors) and its own manifest, so --force and report --check treat DIR as one run.\n"
      "A fit that fails to load or solve is named in the summary and the others are\n"
      "still done.  Exit code: 0 when every fit converged, else the worst (highest) of\n"
-     "the fits' own codes (2 bad input, 3 not converged, 4 internal)."},
+     "the fits' own codes (2 bad input, 3 not converged, 4 internal).  --each reads and\n"
+     "hashes the config and its tables once for all groups; the batch is synced once."},
     {"simulate", "phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]",
      "Runs every data set's model at the configured start values, without fitting, and\n"
      "writes a run directory (default runs/<name>-simulation/) with <data set>_simulated.csv\n"
