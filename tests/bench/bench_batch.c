@@ -4,7 +4,7 @@
  * the plots (the default) and once with `--plots none`, beside SciPy one
  * Python process per fit and all in one.
  *
- *   build/bench_bench_batch [GROUPS]     (GROUPS: runs of the generated table, default 240)
+ *   build/bench_bench_batch [GROUPS]     (GROUPS: runs of the generated table, default 120)
  *
  * Workloads:
  *  (a) ten small NIST StRD problems (../shared/data/nist, Start 1): the
@@ -59,7 +59,7 @@
 
 #define ROUNDS 2
 #define N_RUNS 12
-#define DEFAULT_GROUPS 240
+#define DEFAULT_GROUPS 120
 
 static const char *const NIST_CASES[] = {"Misra1a", "Chwirut2", "Chwirut1", "Lanczos3", "Gauss1",
                                          "Gauss2",  "DanWood",  "Misra1b",  "Misra1c",  "Misra1d"};
@@ -380,13 +380,13 @@ int main(int argc, char **argv)
     print_timing("nist_scipy_process_per_fit", N_NIST, t_py_each, py_each);
     print_timing("nist_scipy_one_process", N_NIST, t_py_all, py_all);
     print_ratio("nist_batch_speedup", t_each[0], t_batch[0],
-                "with plots on both sides: phytocal one process per fit / one call; at most 10 for 10 fits");
+                "with plots on both sides: phytocal one process per fit / one call; 10 fits cap it near 10");
     printf("nist_batch_vs_scipy_process_per_fit: %.1f x\n", t_py_each.wall / t_batch[0].wall);
     printf("nist_batch_vs_scipy_one_process: %.1f x\n", t_py_all.wall / t_batch[0].wall);
     print_timing("nist_phytocal_process_per_fit_no_plots", N_NIST, t_each[1], one_each[1]);
     print_timing("nist_phytocal_one_call_no_plots", N_NIST, t_batch[1], batch[1]);
     print_ratio("nist_batch_speedup_no_plots", t_each[1], t_batch[1],
-                "--plots none on both sides; at most 10 for 10 fits");
+                "--plots none on both sides; 10 fits cap it near 10");
     printf("nist_no_plots_vs_scipy_one_process: %.1f x (SciPy all in one process / phytocal one call, --plots "
            "none)\n", t_py_all.wall / t_batch[1].wall);
     printf("startup_phytocal_version: %.1f ms wall per process (%.1f ms CPU)\n", 1e3 * t_version.wall / N_NIST,
@@ -407,7 +407,7 @@ int main(int argc, char **argv)
 
     /* (b) the bundled example, --each run */
     char *src = str("%s/measurements/examples/enzyme_kinetics", PHC_SOURCE_DIR);
-    each_workload(phytocal, "enzyme_runs", src, N_RUNS, "--plots none on both sides; at most 12 for 12 fits",
+    each_workload(phytocal, "enzyme_runs", src, N_RUNS, "--plots none on both sides; 12 fits cap it near 12",
                   &failures);
 
     /* (c) a generated table of `groups` runs */
