@@ -381,7 +381,67 @@ typedef struct row_filter {
     char **values; /* collected, in order of first appearance */
     size_t n_values;
     size_t tables; /* tables the filter was applied to */
+    phc_config_table_cache *cache; /* NULL: every table read afresh */
 } row_filter;
+
+/* phc_config_table_cache: the tables read so far, by the path the config
+ * named them with. */
+struct phc_config_table_cache {
+    char **paths;
+    phc_table **tables;
+    size_t n;
+};
+
+phc_config_table_cache *phc_config_table_cache_new(void)
+{
+    return calloc(1, sizeof(phc_config_table_cache));
+}
+
+void phc_config_table_cache_free(phc_config_table_cache *c)
+{
+    if (!c)
+        return;
+    for (size_t i = 0; i < c->n; ++i) {
+        free(c->paths[i]);
+        phc_table_free(c->tables[i]);
+    }
+    free(c->paths);
+    free(c->tables);
+    free(c);
+}
+
+/* The table at path: from the cache, or read (and kept there when there
+ * is a cache; then *owned is 0 and the caller must not free it). */
+static int read_table_cached(phc_config_table_cache *c, const char *path, phc_table **t, int *owned,
+                             phc_error *err)
+{
+    *owned = 1;
+    for (size_t i = 0; c && i < c->n; ++i)
+        if (strcmp(c->paths[i], path) == 0) {
+            *t = c->tables[i];
+            *owned = 0;
+            return PHC_OK;
+        }
+    int rc = phc_table_read(path, t, err);
+    if (rc || !c)
+        return rc;
+    char **paths = realloc(c->paths, (c->n + 1) * sizeof *paths);
+    if (paths)
+        c->paths = paths;
+    phc_table **tables = realloc(c->tables, (c->n + 1) * sizeof *tables);
+    if (tables)
+        c->tables = tables;
+    char *copy = paths && tables ? strdup(path) : NULL;
+    if (!copy) {
+        phc_table_free(*t);
+        *t = NULL;
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    c->paths[c->n] = copy;
+    c->tables[c->n++] = *t;
+    *owned = 0;
+    return PHC_OK;
+}
 
 /* The loader's context for a kind: which expression names are parameters,
  * and the row filter (phc_kind_read_table). */
@@ -410,15 +470,13 @@ int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_
 {
     const binding_ctx *b = user_data;
     phc_table *t = NULL;
-    int rc;
+    int rc, owned = 1;
     *out = NULL;
-    if ((rc = phc_table_read(path, &t, err)))
-        return rc;
     row_filter *f = b ? b->rows : NULL;
-    if (!f) {
-        *out = t;
-        return PHC_OK;
-    }
+    if (!f)
+        return phc_table_read(path, out, err);
+    if ((rc = read_table_cached(f->cache, path, &t, &owned, err)))
+        return rc;
     const long col = phc_table_find(t, f->column);
     if (col < 0) {
         const size_t nc = phc_table_columns(t);
@@ -433,7 +491,8 @@ int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_
         const char *near = phc_suggest(f->column, names, nc < 64 ? nc : 64);
         rc = phc_error_set(err, PHC_ERR_INPUT, "%s: --each: no column '%s'%s%s%s (columns: %s)", path, f->column,
                            near ? "; did you mean '" : "", near ? near : "", near ? "'?" : "", list);
-        phc_table_free(t);
+        if (owned)
+            phc_table_free(t);
         return rc;
     }
     const size_t n = phc_table_rows(t);
@@ -446,18 +505,23 @@ int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_
         const size_t before = f->n_values;
         for (size_t r = 0; r < n; ++r)
             if (collect_value(f, phc_table_cell(t, r, (size_t)col))) {
-                phc_table_free(t);
+                if (owned)
+                    phc_table_free(t);
                 return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
             }
         if (n == 0) {
-            *out = t;
-            return PHC_OK;
+            if (owned) {
+                *out = t;
+                return PHC_OK;
+            }
+            return phc_table_select_rows(t, NULL, 0, out, err);
         }
         value = before ? f->values[0] : phc_table_cell(t, 0, (size_t)col);
     }
     size_t *rows = malloc((n ? n : 1) * sizeof *rows), k = 0;
     if (!rows) {
-        phc_table_free(t);
+        if (owned)
+            phc_table_free(t);
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
     for (size_t r = 0; r < n; ++r)
@@ -472,7 +536,8 @@ int phc_kind_read_table(void *user_data, const char *path, phc_table **out, phc_
     else
         rc = phc_table_select_rows(t, rows, k, out, err);
     free(rows);
-    phc_table_free(t);
+    if (owned)
+        phc_table_free(t);
     return rc;
 }
 
@@ -944,7 +1009,13 @@ int phc_config_load(const char *path, phc_problem **out, phc_error *err)
 int phc_config_group_values(const char *path, const char *column, char ***values, size_t *n, phc_problem **whole,
                             phc_error *err)
 {
-    row_filter f = {column, NULL, NULL, 0, 0};
+    return phc_config_group_values_cached(path, column, NULL, values, n, whole, err);
+}
+
+int phc_config_group_values_cached(const char *path, const char *column, phc_config_table_cache *cache,
+                                   char ***values, size_t *n, phc_problem **whole, phc_error *err)
+{
+    row_filter f = {column, NULL, NULL, 0, 0, cache};
     phc_problem *pb = NULL;
     *values = NULL;
     *n = 0;
@@ -974,8 +1045,14 @@ void phc_config_group_values_free(char **values, size_t n)
 int phc_config_load_group(const char *path, const char *column, const char *value, phc_problem **out,
                           phc_error *err)
 {
+    return phc_config_load_group_cached(path, column, value, NULL, out, err);
+}
+
+int phc_config_load_group_cached(const char *path, const char *column, const char *value,
+                                 phc_config_table_cache *cache, phc_problem **out, phc_error *err)
+{
     if (!column || !value)
         return phc_error_set(err, PHC_ERR_INVALID, "phc_config_load_group: invalid argument");
-    row_filter f = {column, value, NULL, 0, 0};
+    row_filter f = {column, value, NULL, 0, 0, cache};
     return load(path, &f, out, err);
 }

@@ -55,6 +55,20 @@ void phc_config_group_values_free(char **values, size_t n);
 int phc_config_load_group(const char *path, const char *column, const char *value, phc_problem **out,
                           phc_error *err);
 
+/* The tables of a batch, read once: given the same cache, group_values and
+ * load_group read and parse each table file the first time it is named and
+ * reuse it for every later group (without one, a table of G groups is read
+ * and parsed G + 1 times).  What was read is kept: a file changed during
+ * the batch is not read again, so every group is cut from the bytes the
+ * first read saw.  The cache holds the tables until freed. */
+typedef struct phc_config_table_cache phc_config_table_cache;
+phc_config_table_cache *phc_config_table_cache_new(void); /* NULL: out of memory */
+void phc_config_table_cache_free(phc_config_table_cache *cache); /* accepts NULL */
+int phc_config_group_values_cached(const char *path, const char *column, phc_config_table_cache *cache,
+                                   char ***values, size_t *n, phc_problem **whole, phc_error *err);
+int phc_config_load_group_cached(const char *path, const char *column, const char *value,
+                                 phc_config_table_cache *cache, phc_problem **out, phc_error *err);
+
 /* A set of configuration keys: a data-set kind, or a block of the file. */
 typedef struct phc_config_section {
     const char *name;          /* the kind ("weight_curve") or block ("solver") */

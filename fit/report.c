@@ -227,6 +227,8 @@ int phc_report_write_markdown(const phc_fit_result *res, const char *path, const
         }
     }
     fprintf(f, "\n## Data sets\n");
+    if (!plots)
+        fprintf(f, "\nNo plots were drawn for this run (`--plots none`).\n");
     for (size_t d = 0; d < res->n_datasets; ++d) {
         const phc_dataset_result *ds = &res->datasets[d];
         fprintf(f, "\n### %s (%s)\n\n", ds->name, ds->kind);

@@ -15,7 +15,9 @@
 #include "model/status.h"
 
 /* Markdown report.  `plots` lists the PNG file names (relative to the
- * report), NULL-terminated; may be NULL. */
+ * report), NULL-terminated; each data set links the names that start with
+ * its name and '_'.  NULL: no plots were drawn (`phytocal fit --plots
+ * none`), which the report says. */
 int phc_report_write_markdown(const phc_fit_result *res, const char *path,
                               const char *const *plots, phc_error *err);
 

@@ -1,9 +1,10 @@
 /* Run directories: see run_dir.h. */
-#define _XOPEN_SOURCE 700 /* realpath */
+#define _GNU_SOURCE /* realpath, syncfs */
 #include "fit/run_dir.h"
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <jansson.h>
 #include <limits.h>
 #include <math.h>
@@ -437,10 +438,58 @@ static void remove_listed(const char *old, const entry_list *l)
     rmdir(old);
 }
 
-int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
+/* One sync for a whole new run: syncfs(2) of the file system that holds
+ * tmpdir writes back every file written there (and the directories'
+ * entries) and commits the journal once, where an fsync per file commits it
+ * once per file.  It also writes back other processes' dirty data on that
+ * file system, which is a cost, not a risk. */
+static int sync_tree(const char *tmpdir, phc_error *err)
+{
+    const int fd = open(tmpdir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot open to sync: %s", tmpdir, strerror(errno));
+    int rc = syncfs(fd);
+    const int saved = errno;
+    close(fd);
+    if (rc != 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write to disk: %s", tmpdir, strerror(saved));
+    return PHC_OK;
+}
+
+/* fsync of the folder that holds dir, so that its new entry (the rename)
+ * is on disk too.  File systems that cannot (EINVAL) are not an error. */
+static int sync_parent(const char *dir, phc_error *err)
+{
+    char parent[4096];
+    snprintf(parent, sizeof parent, "%s", dir);
+    char *slash = strrchr(parent, '/');
+    if (!slash)
+        snprintf(parent, sizeof parent, ".");
+    else if (slash == parent)
+        parent[1] = '\0';
+    else
+        *slash = '\0';
+    const int fd = open(parent, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot open to sync: %s", parent, strerror(errno));
+    const int rc = fsync(fd);
+    const int saved = errno;
+    close(fd);
+    if (rc != 0 && saved != EINVAL && saved != ENOTSUP)
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot write to disk: %s", parent, strerror(saved));
+    return PHC_OK;
+}
+
+static int commit(const char *tmpdir, const char *dir, const phc_provenance *pv, int synced, phc_error *err)
 {
     int rc;
-    if ((rc = write_manifest(tmpdir, pv, err))) {
+    const int was = synced ? phc_atomic_file_defer_sync(1) : 0;
+    rc = write_manifest(tmpdir, pv, err);
+    if (synced)
+        phc_atomic_file_defer_sync(was);
+    if (!rc && synced)
+        rc = sync_tree(tmpdir, err);
+    if (rc) {
         remove_tree(tmpdir);
         return rc;
     }
@@ -480,7 +529,17 @@ int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance
         remove_listed(old, &listed);
     entries_free(&listed);
     chmod(dir, 0755); /* mkdtemp made it private; results are for sharing */
-    return PHC_OK;
+    return synced ? sync_parent(dir, err) : PHC_OK;
+}
+
+int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
+{
+    return commit(tmpdir, dir, pv, 0, err);
+}
+
+int phc_run_dir_commit_synced(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
+{
+    return commit(tmpdir, dir, pv, 1, err);
 }
 
 /* The kinds' own files at the fitted values (dataset.h, fit_outputs). */
@@ -509,50 +568,102 @@ static int write_kind_outputs(const phc_fit_result *res, const phc_problem *pb, 
     return PHC_OK;
 }
 
+phc_run_dir_options phc_run_dir_options_default(void)
+{
+    phc_run_dir_options o = {.force = 0, .plots = PHC_RUN_PLOTS_ALL, .nested = 0};
+    return o;
+}
+
+int phc_run_plots_parse(const char *text, phc_run_plots *out)
+{
+    if (text && strcmp(text, "all") == 0)
+        *out = PHC_RUN_PLOTS_ALL;
+    else if (text && strcmp(text, "none") == 0)
+        *out = PHC_RUN_PLOTS_NONE;
+    else
+        return -1;
+    return 0;
+}
+
 int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const char *dir, int force,
                       phc_error *err)
 {
-    char tmpdir[4096], path[8192];
+    phc_run_dir_options o = phc_run_dir_options_default();
+    o.force = force;
+    return phc_run_dir_write_with(res, pb, dir, &o, err);
+}
+
+/* The plots of a run: the standard ones, then the kinds' own outputs; the
+ * kinds' PNG files are linked in the report too, after the standard ones.
+ * names[] gets every PNG's name (malloc'd). */
+static int write_plots(const phc_fit_result *res, const phc_problem *pb, const char *tmpdir, char **names,
+                       size_t *n_names, phc_error *err)
+{
     int rc;
-    if ((rc = phc_run_dir_begin(dir, force, pb, tmpdir, sizeof tmpdir, err)))
-        return rc;
-    char *names[MAX_PLOTS] = {0};
-    size_t n_names = 0;
-    if ((rc = phc_fit_plots_write(res, tmpdir, names, &n_names, MAX_PLOTS, err)) ||
+    if ((rc = phc_fit_plots_write(res, tmpdir, names, n_names, MAX_PLOTS, err)) ||
         (rc = write_kind_outputs(res, pb, tmpdir, err)))
-        goto fail;
-    /* the kinds' own plots (the classic PV plot, photos beside the model)
-     * are linked in the report too, after the standard ones */
+        return rc;
     entry_list extra = {0};
     if (walk(tmpdir, "", entries_add, &extra) < 0) {
         entries_free(&extra);
-        rc = phc_error_set(err, PHC_ERR_IO, "%s: cannot list the new run", tmpdir);
-        goto fail;
+        return phc_error_set(err, PHC_ERR_IO, "%s: cannot list the new run", tmpdir);
     }
     entries_sort(&extra);
-    for (size_t i = 0; i < extra.n && n_names + 1 < MAX_PLOTS; ++i) {
+    for (size_t i = 0; i < extra.n && *n_names + 1 < MAX_PLOTS; ++i) {
         const size_t len = strlen(extra.paths[i]);
         int known = extra.is_dir[i] || len < 4 || strcmp(extra.paths[i] + len - 4, ".png") != 0;
-        for (size_t j = 0; j < n_names && !known; ++j)
+        for (size_t j = 0; j < *n_names && !known; ++j)
             known = strcmp(names[j], extra.paths[i]) == 0;
-        if (!known && !(names[n_names++] = strdup(extra.paths[i]))) {
+        if (!known && !(names[(*n_names)++] = strdup(extra.paths[i]))) {
             entries_free(&extra);
-            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-            goto fail;
+            return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         }
     }
     entries_free(&extra);
+    return PHC_OK;
+}
+
+int phc_run_dir_write_with(const phc_fit_result *res, const phc_problem *pb, const char *dir,
+                           const phc_run_dir_options *opts, phc_error *err)
+{
+    const phc_run_dir_options o = opts ? *opts : phc_run_dir_options_default();
+    char tmpdir[4096], path[8192];
+    int rc;
+    if (o.nested) { /* the caller's new folder: written in place (run_dir.h) */
+        if ((size_t)snprintf(tmpdir, sizeof tmpdir, "%s", dir) >= sizeof tmpdir)
+            return phc_error_set(err, PHC_ERR_IO, "%s: output path too long", dir);
+        if (mkdir(tmpdir, 0755) != 0)
+            return phc_error_set(err, errno == EEXIST ? PHC_ERR_EXISTS : PHC_ERR_IO, "%s: cannot create: %s", dir,
+                                 strerror(errno));
+    } else if ((rc = phc_run_dir_begin(dir, o.force, pb, tmpdir, sizeof tmpdir, err))) {
+        return rc;
+    }
+    /* no fsync per file: one sync of the whole run before its rename (or
+       none here, when the caller syncs the folder that holds it) */
+    const int was = phc_atomic_file_defer_sync(1);
+    char *names[MAX_PLOTS] = {0};
+    size_t n_names = 0;
+    if (o.plots == PHC_RUN_PLOTS_ALL && (rc = write_plots(res, pb, tmpdir, names, &n_names, err)))
+        goto fail;
     snprintf(path, sizeof path, "%s/result.json", tmpdir);
     if ((rc = phc_result_write_json(res, path, err)))
         goto fail;
     snprintf(path, sizeof path, "%s/report.md", tmpdir);
-    if ((rc = phc_report_write_markdown(res, path, (const char *const *)names, err)))
+    if ((rc = phc_report_write_markdown(res, path, o.plots == PHC_RUN_PLOTS_ALL ? (const char *const *)names : NULL,
+                                        err)))
         goto fail;
-    rc = phc_run_dir_commit(tmpdir, dir, res->provenance, err);
+    if (o.nested) {
+        if ((rc = write_manifest(tmpdir, res->provenance, err)))
+            goto fail;
+    } else {
+        rc = phc_run_dir_commit_synced(tmpdir, dir, res->provenance, err);
+    }
+    phc_atomic_file_defer_sync(was);
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return rc;
 fail:
+    phc_atomic_file_defer_sync(was);
     phc_run_dir_discard(tmpdir);
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);

@@ -31,11 +31,44 @@
 int phc_run_dir_check(const char *dir, int force, const phc_problem *pb, phc_error *err);
 
 /* Writes a fit's run directory (result.json, report.md, plots, manifest with
- * res->provenance when set) by the three steps below.  pb (may be NULL) is
- * the problem that was fitted: data sets whose kind writes its own files
- * (dataset.h, fit_outputs) add them, at the fitted values. */
+ * res->provenance when set) by the three steps below, with the default
+ * options (all plots, synced) and `force`.  pb (may be NULL) is the problem
+ * that was fitted: data sets whose kind writes its own files (dataset.h,
+ * fit_outputs) add them, at the fitted values. */
 int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const char *dir, int force,
                       phc_error *err);
+
+/* Which pictures a fit's run directory gets (`phytocal fit --plots`). */
+typedef enum phc_run_plots {
+    PHC_RUN_PLOTS_ALL = 0, /* the diagnostic plots of every data set (fit_plots.h) and the kinds' own
+                              outputs at the fitted values (dataset.h, fit_outputs) */
+    PHC_RUN_PLOTS_NONE     /* neither: result.json, report.md (saying so) and the manifest only */
+} phc_run_plots;
+
+/* Parses "all" or "none"; -1 for anything else. */
+int phc_run_plots_parse(const char *text, phc_run_plots *out);
+
+typedef struct phc_run_dir_options {
+    int force;           /* replace an earlier run directory (the rules above); default 0 */
+    phc_run_plots plots; /* default PHC_RUN_PLOTS_ALL */
+    /* 0 (default): a run directory of its own, made as above (checked,
+     * written into a temporary sibling, renamed into place); when
+     * phc_run_dir_write_with returns, its files are on disk: they are
+     * written without an fsync each, then one syncfs of the file system
+     * holding them precedes the rename, and the parent folder is fsynced
+     * after it (phc_run_dir_commit_synced).
+     * 1: DIR is a new folder inside a folder that the caller created for
+     * this work, will sync once and rename into place itself (a batch's
+     * temporary folder, cmd_fit_batch): DIR is created directly, written and
+     * given its manifest, with no checks, no temporary sibling and no sync;
+     * DIR must not exist (PHC_ERR_EXISTS); on failure it is removed. */
+    int nested;
+} phc_run_dir_options;
+
+phc_run_dir_options phc_run_dir_options_default(void);
+
+int phc_run_dir_write_with(const phc_fit_result *res, const phc_problem *pb, const char *dir,
+                           const phc_run_dir_options *opts, phc_error *err);
 
 /* The steps, for any command that writes a run directory:
  * begin checks DIR (as phc_run_dir_check), creates its parents and a
@@ -47,6 +80,13 @@ int phc_run_dir_write(const phc_fit_result *res, const phc_problem *pb, const ch
 int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *tmpdir, size_t size,
                       phc_error *err);
 int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err);
+/* commit for a writer that wrote tmpdir's files without an fsync each
+ * (atomic_file.h, phc_atomic_file_defer_sync): the manifest, then one
+ * syncfs of the file system holding tmpdir, the rename, and an fsync of
+ * DIR's parent folder, so that DIR and all it holds are on disk when this
+ * returns; a crash before the rename leaves only the temporary folder (DIR
+ * or the earlier run is untouched). */
+int phc_run_dir_commit_synced(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err);
 void phc_run_dir_discard(const char *tmpdir);
 
 /* `phytocal report --check DIR`: each file the run read (its config and

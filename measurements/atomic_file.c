@@ -117,6 +117,16 @@ const char *phc_atomic_file_path(const phc_atomic_file *af)
     return af ? af->path : NULL;
 }
 
+/* phc_atomic_file_defer_sync: this thread's writer syncs a whole folder itself. */
+static _Thread_local int sync_deferred;
+
+int phc_atomic_file_defer_sync(int defer)
+{
+    const int was = sync_deferred;
+    sync_deferred = defer != 0;
+    return was;
+}
+
 /* fsync of the temporary file.  A library that wrote by name may have
  * replaced the file rather than rewritten it: then the file now under that
  * name is the one to flush.  File systems without fsync (EINVAL, ENOTSUP)
@@ -151,7 +161,7 @@ int phc_atomic_file_commit(phc_atomic_file *af, phc_error *err)
     errno = 0;
     if (fflush(af->f) != 0 || ferror(af->f))
         saved = errno ? errno : EIO;
-    if (!saved && sync_temp(fileno(af->f), af->tmp) != 0)
+    if (!saved && !sync_deferred && sync_temp(fileno(af->f), af->tmp) != 0)
         saved = errno ? errno : EIO;
     errno = 0;
     if (fclose(af->f) != 0 && !saved)

@@ -1,6 +1,6 @@
 /* The phytocal command (DESIGN.md §4).  The only place that prints.
  *
- *   phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]
+ *   phytocal fit CONFIG.yaml [-o DIR] [--plots all|none] [--force] [--quiet]
  *   phytocal fit A.yaml B.yaml ... -o DIR | CONFIG.yaml --each COLUMN -o DIR   (batch)
  *   phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]
  *   phytocal grow CONFIG.yaml [-o DIR] [--force] [--quiet]
@@ -41,6 +41,7 @@
 #include "fit/study_dist.h"
 #include "fit/simulate.h"
 #include "fit/version.h"
+#include "measurements/atomic_file.h"
 #include "phc_git_commit.h"
 
 enum { EXIT_OK = 0, EXIT_USAGE = 1, EXIT_INPUT = 2, EXIT_FIT = 3, EXIT_INTERNAL = 4 };
@@ -52,9 +53,9 @@ typedef struct command_help {
 } command_help;
 
 static const command_help commands[] = {
-    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--force] [--quiet]\n"
-            "  phytocal fit A.yaml B.yaml ... -o DIR [--force] [--quiet]\n"
-            "  phytocal fit CONFIG.yaml --each COLUMN -o DIR [--force] [--quiet]",
+    {"fit", "phytocal fit CONFIG.yaml [-o DIR] [--plots all|none] [--force] [--quiet]\n"
+            "  phytocal fit A.yaml B.yaml ... -o DIR [--plots all|none] [--force] [--quiet]\n"
+            "  phytocal fit CONFIG.yaml --each COLUMN -o DIR [--plots all|none] [--force] [--quiet]",
      "Fits the configuration's parameters to its data sets (Ceres Solver), then judges\n"
      "the residuals and parameters, and writes a run directory:\n"
      "  result.json        machine-readable result (README: result.json)\n"
@@ -65,6 +66,10 @@ static const command_help commands[] = {
      "\n"
      "options:\n"
      "  -o, --output DIR   run directory (default runs/<name>/, name from the config)\n"
+     "  --plots all|none   all (default): the plots above and a kind's own pictures and\n"
+     "                     files at the fitted values; none: result.json, report.md\n"
+     "                     (saying no plots were drawn) and the manifest only, the\n"
+     "                     same numbers (for batches of many fits)\n"
      "  --force            replace DIR if it is an earlier phytocal run directory that\n"
      "                     holds nothing but what phytocal wrote (its manifest lists\n"
      "                     it); anything else in DIR, and any DIR holding the run's\n"
@@ -73,7 +78,9 @@ static const command_help commands[] = {
      "  -h, --help         this text\n"
      "\n"
      "Progress goes to stderr: one updating line on a terminal (start k of n, solver\n"
-     "iteration and cost, elapsed time), plain lines otherwise.\n"
+     "iteration and cost, elapsed time), plain lines otherwise.  The files are on disk\n"
+     "when phytocal returns: one sync of the file system before DIR is renamed into\n"
+     "place (not one per file).\n"
      "\n"
      "Batch (many small fits in one process; -o DIR is required):\n"
      "  A.yaml B.yaml ...  each config fitted into DIR/<config stem>/ (two configs with\n"
@@ -87,7 +94,8 @@ static const command_help commands[] = {
      "errors) and its own manifest, so --force and report --check treat DIR as one run.\n"
      "A fit that fails to load or solve is named in the summary and the others are\n"
      "still done.  Exit code: 0 when every fit converged, else the worst (highest) of\n"
-     "the fits' own codes (2 bad input, 3 not converged, 4 internal)."},
+     "the fits' own codes (2 bad input, 3 not converged, 4 internal).  --each reads and\n"
+     "hashes the config and its tables once for all groups; the batch is synced once."},
     {"simulate", "phytocal simulate CONFIG.yaml [-o DIR] [--force] [--quiet]",
      "Runs every data set's model at the configured start values, without fitting, and\n"
      "writes a run directory (default runs/<name>-simulation/) with <data set>_simulated.csv\n"
@@ -324,17 +332,36 @@ typedef struct cli_options {
     const char *out_dir;
     int force, quiet, strict, check;
     double level;
+    phc_run_plots plots; /* fit --plots */
 } cli_options;
 
-/* Parses the arguments after the command; returns -1 on a usage error.
- * `allowed` holds a letter per accepted option: o f q s l c. */
+/* --plots VALUE of fit: 0, or EXIT_INPUT with the message printed. */
+static int parse_plots(const char *value, phc_run_plots *out)
+{
+    if (phc_run_plots_parse(value, out) == 0)
+        return 0;
+    fprintf(stderr, "phytocal fit: --plots: expected all or none, found '%s'\n", value);
+    return EXIT_INPUT;
+}
+
+/* Parses the arguments after the command; returns -1 on a usage error,
+ * EXIT_INPUT on a bad option value (message printed).  `allowed` holds a
+ * letter per accepted option: o f q s l c p (--plots). */
 static int parse_args(const char *cmd, int argc, char **argv, cli_options *o, const char *allowed)
 {
     memset(o, 0, sizeof *o);
     o->level = -1;
+    o->plots = PHC_RUN_PLOTS_ALL;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
-        if ((strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) && strchr(allowed, 'o')) {
+        if (strcmp(a, "--plots") == 0 && strchr(allowed, 'p')) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "phytocal %s: --plots needs a value (all or none)\n", cmd);
+                return -1;
+            }
+            if (parse_plots(argv[++i], &o->plots))
+                return EXIT_INPUT;
+        } else if ((strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) && strchr(allowed, 'o')) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "phytocal %s: %s needs a directory\n", cmd, a);
                 return -1;
@@ -447,7 +474,12 @@ static int load_for_run(const char *cmd, int full_argc, char **full_argv, int ar
     phc_error_clear(&err);
     *pb = NULL;
     *pv = NULL;
-    if (parse_args(cmd, argc, argv, o, "ofq") != 0) {
+    const int prc = parse_args(cmd, argc, argv, o, strcmp(cmd, "fit") == 0 ? "ofqp" : "ofq");
+    if (prc == EXIT_INPUT) {
+        *exit_code = EXIT_INPUT;
+        return -1;
+    }
+    if (prc != 0) {
         fprintf(stderr, "usage: %s\n", find_command(cmd)->synopsis);
         *exit_code = EXIT_USAGE;
         return -1;
@@ -507,7 +539,10 @@ static int cmd_fit(int full_argc, char **full_argv, int argc, char **argv)
     phc_progress_report(progress, &prog, "writing", 0, 0, -1, 0, dir);
     phc_provenance_end(pv);
     res->provenance = pv;
-    rc = phc_run_dir_write(res, pb, dir, o.force, &err);
+    phc_run_dir_options wo = phc_run_dir_options_default();
+    wo.force = o.force;
+    wo.plots = o.plots;
+    rc = phc_run_dir_write_with(res, pb, dir, &wo, &err);
     progress_end(&prog);
     phc_problem_free(pb);
     if (rc) {
@@ -516,7 +551,7 @@ static int cmd_fit(int full_argc, char **full_argv, int argc, char **argv)
     }
     if (!o.quiet) {
         phc_report_print_summary(res, stdout);
-        printf("results: %s/ (result.json, report.md, plots)\n", dir);
+        printf("results: %s/ (result.json, report.md%s)\n", dir, o.plots == PHC_RUN_PLOTS_ALL ? ", plots" : "");
     }
     const int converged = res->summary.outcome == PHC_NLS_CONVERGED;
     phc_fit_result_free(res);
@@ -578,7 +613,7 @@ static int is_batch(int argc, char **argv)
     for (int i = 0; i < argc; ++i) {
         if (strcmp(argv[i], "--each") == 0)
             return 1;
-        if (strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--output") == 0)
+        if (strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--output") == 0 || strcmp(argv[i], "--plots") == 0)
             ++i;
         else if (argv[i][0] != '-' || argv[i][1] == '\0')
             ++positional;
@@ -588,6 +623,8 @@ static int is_batch(int argc, char **argv)
 
 typedef struct batch_job {
     const char *config;  /* the config file */
+    const phc_provenance *shared; /* --each: the inputs every group reads, hashed once */
+    phc_config_table_cache *tables; /* --each: the tables, read once */
     char *group;         /* --each: the group's value */
     char name[128];      /* its folder below DIR ("" when refused) */
     phc_problem *pb;     /* several configs: loaded up front (NULL after an error) */
@@ -602,10 +639,67 @@ static int batch_row_text(char **field, const char *text)
     return text && !*field ? -1 : 0;
 }
 
+static char *copy_text(const char *s, int *failed)
+{
+    char *c = s ? strdup(s) : NULL;
+    *failed |= s && !c;
+    return c;
+}
+
+static int copy_file_record(phc_provenance_file *to, const phc_provenance_file *from)
+{
+    int failed = 0;
+    *to = *from;
+    to->path = copy_text(from->path, &failed);
+    to->absolute = copy_text(from->absolute, &failed);
+    return failed;
+}
+
+/* A copy of the provenance every group of an --each batch shares (its
+ * config and data were hashed once, when the batch read them), started now. */
+static int provenance_copy(const phc_provenance *from, phc_provenance **out, phc_error *err)
+{
+    int failed = 0;
+    phc_provenance *pv = calloc(1, sizeof *pv);
+    if (!pv)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    *pv = *from;
+    pv->version = copy_text(from->version, &failed);
+    pv->git = copy_text(from->git, &failed);
+    pv->command_line = copy_text(from->command_line, &failed);
+    pv->working_directory = copy_text(from->working_directory, &failed);
+    pv->host = copy_text(from->host, &failed);
+    pv->config = from->config ? calloc(1, sizeof *pv->config) : NULL;
+    pv->inputs = from->n_inputs ? calloc(from->n_inputs, sizeof *pv->inputs) : NULL;
+    pv->seeds = from->n_seeds ? calloc(from->n_seeds, sizeof *pv->seeds) : NULL;
+    failed |= (from->config && !pv->config) || (from->n_inputs && !pv->inputs) || (from->n_seeds && !pv->seeds);
+    if (!failed && pv->config)
+        failed |= copy_file_record(pv->config, from->config);
+    for (size_t i = 0; !failed && i < from->n_inputs; ++i)
+        failed |= copy_file_record(&pv->inputs[i], &from->inputs[i]);
+    for (size_t i = 0; !failed && i < from->n_seeds; ++i)
+        pv->seeds[i] = copy_text(from->seeds[i], &failed);
+    if (failed) { /* phc_provenance_free frees what was copied (NULL where not) */
+        if (!pv->inputs)
+            pv->n_inputs = 0;
+        if (!pv->seeds)
+            pv->n_seeds = 0;
+        phc_provenance_free(pv);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    const time_t t = time(NULL);
+    struct tm tm;
+    if (!gmtime_r(&t, &tm) || !strftime(pv->started, sizeof pv->started, "%Y-%m-%dT%H:%M:%SZ", &tm))
+        pv->started[0] = '\0';
+    pv->finished[0] = '\0';
+    *out = pv;
+    return PHC_OK;
+}
+
 /* Fits one job into tmpdir/<name>/ and fills its row.  Returns the exit
  * code `phytocal fit` alone would give it. */
 static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n, int full_argc, char **full_argv,
-                         const char *tmpdir, int quiet, phc_batch_row *row)
+                         const char *tmpdir, int quiet, phc_run_plots plots, phc_batch_row *row)
 {
     phc_error err;
     phc_error_clear(&err);
@@ -620,7 +714,7 @@ static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n,
     if (rc)
         err = job->load_err;
     else if (!pb)
-        rc = phc_config_load_group(job->config, column, job->group, &pb, &err);
+        rc = phc_config_load_group_cached(job->config, column, job->group, job->tables, &pb, &err);
     phc_provenance *pv = NULL;
     phc_fit_result *res = NULL;
     const int tty = isatty(STDERR_FILENO);
@@ -629,7 +723,8 @@ static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n,
     if (!quiet && !tty)
         fprintf(stderr, "%s\n", prefix);
     if (!rc)
-        rc = phc_provenance_begin(pb, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, &pv, &err);
+        rc = job->shared ? provenance_copy(job->shared, &pv, &err)
+                         : phc_provenance_begin(pb, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, &pv, &err);
     if (!rc && (rc = phc_fit_run(pb, progress, &prog, &res, &err)))
         batch_row_text(&row->status, "failed");
     if (!rc) {
@@ -642,7 +737,12 @@ static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n,
         res->provenance = pv;
         pv = NULL;
         snprintf(subdir, sizeof subdir, "%s/%s", tmpdir, job->name);
-        if (!(rc = phc_run_dir_write(res, pb, subdir, 0, &err)))
+        /* written in place in the batch's new folder, which the batch syncs
+           once and renames into place (cmd_fit_batch) */
+        phc_run_dir_options wo = phc_run_dir_options_default();
+        wo.plots = plots;
+        wo.nested = 1;
+        if (!(rc = phc_run_dir_write_with(res, pb, subdir, &wo, &err)))
             batch_row_text(&row->dir, job->name);
     }
     progress_end(&prog);
@@ -687,17 +787,29 @@ static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
 {
     const char *out_dir = NULL, *column = NULL;
     int force = 0, quiet = 0, n_configs = 0;
+    phc_run_plots plots = PHC_RUN_PLOTS_ALL;
     const char **configs = calloc((size_t)argc + 1, sizeof *configs);
     if (!configs)
         return EXIT_INTERNAL;
     for (int i = 0; i < argc; ++i) {
         const char *a = argv[i];
-        if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0 || strcmp(a, "--each") == 0) {
+        if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0 || strcmp(a, "--each") == 0 ||
+            strcmp(a, "--plots") == 0) {
             if (i + 1 >= argc) {
                 fprintf(stderr, "phytocal fit: %s needs %s\nusage: %s\n", a,
-                        a[2] == 'e' ? "a column name" : "a directory", find_command("fit")->synopsis);
+                        a[2] == 'e'   ? "a column name"
+                        : a[2] == 'p' ? "a value (all or none)"
+                                      : "a directory",
+                        find_command("fit")->synopsis);
                 free(configs);
                 return EXIT_USAGE;
+            }
+            if (a[2] == 'p') {
+                if (parse_plots(argv[++i], &plots)) {
+                    free(configs);
+                    return EXIT_INPUT;
+                }
+                continue;
             }
             *(a[2] == 'e' ? &column : &out_dir) = argv[++i];
         } else if (strcmp(a, "--force") == 0) {
@@ -732,25 +844,39 @@ static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
     batch_job *jobs = NULL;
     size_t n_jobs = 0;
     int code = EXIT_OK;
+    phc_config_table_cache *tables = NULL;
+    phc_provenance *shared = NULL;
     if (column) {
         char **values = NULL;
         size_t n_values = 0;
         phc_problem *whole = NULL;
-        if (phc_config_group_values(configs[0], column, &values, &n_values, &whole, &err)) {
+        if (!(tables = phc_config_table_cache_new())) {
+            free(configs);
+            return EXIT_INTERNAL;
+        }
+        if (phc_config_group_values_cached(configs[0], column, tables, &values, &n_values, &whole, &err)) {
+            phc_config_table_cache_free(tables);
             free(configs);
             return fail(&err);
         }
-        /* DIR may not hold the config or its data (run_dir.h) */
-        const int rc = phc_run_dir_check(dir, force, whole, &err);
+        /* DIR may not hold the config or its data (run_dir.h); the config
+           and data every group reads are hashed once, for all groups */
+        int rc = phc_run_dir_check(dir, force, whole, &err);
+        if (!rc)
+            rc = phc_provenance_begin(whole, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, &shared, &err);
         phc_problem_free(whole);
         if (rc || !(jobs = calloc(n_values ? n_values : 1, sizeof *jobs))) {
             phc_config_group_values_free(values, n_values);
+            phc_config_table_cache_free(tables);
+            phc_provenance_free(shared);
             free(configs);
             return rc ? fail(&err) : EXIT_INTERNAL;
         }
         for (size_t g = 0; g < n_values; ++g) {
             batch_job *j = &jobs[n_jobs++];
             j->config = configs[0];
+            j->shared = shared;
+            j->tables = tables;
             j->group = values[g];
             values[g] = NULL;
             if (batch_dir_name(j->group, j->name, sizeof j->name) != 0)
@@ -801,15 +927,23 @@ static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
     if (code == EXIT_OK) {
         int worst = EXIT_OK;
         size_t n_ok = 0;
+        /* Durability: no file of the batch is fsynced on its own; the whole
+           folder is synced once, before it is renamed to DIR (run_dir.h,
+           phc_run_dir_commit_synced).  DIR appears only complete and on disk;
+           a crash before leaves only DIR.tmp-XXXXXX, as before. */
+        const int was = phc_atomic_file_defer_sync(1);
         for (size_t k = 0; k < n_jobs; ++k) {
-            const int c = batch_fit_one(&jobs[k], column, k, n_jobs, full_argc, full_argv, tmpdir, quiet, &rows[k]);
+            const int c =
+                batch_fit_one(&jobs[k], column, k, n_jobs, full_argc, full_argv, tmpdir, quiet, plots, &rows[k]);
             worst = c > worst ? c : worst;
             n_ok += c == EXIT_OK;
         }
-        if (phc_batch_summary_write(tmpdir, column, rows, n_jobs, &err)) {
+        const int src = phc_batch_summary_write(tmpdir, column, rows, n_jobs, &err);
+        phc_atomic_file_defer_sync(was);
+        if (src) {
             phc_run_dir_discard(tmpdir);
             code = fail(&err);
-        } else if (phc_run_dir_commit(tmpdir, dir, NULL, &err)) {
+        } else if (phc_run_dir_commit_synced(tmpdir, dir, NULL, &err)) {
             code = fail(&err);
         } else {
             code = worst;
@@ -830,6 +964,8 @@ static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
     }
     free(jobs);
     free(configs);
+    phc_config_table_cache_free(tables);
+    phc_provenance_free(shared);
     return code;
 }
 

@@ -1,9 +1,12 @@
 /* Unit tests for measurements/atomic_file.c: commit writes, abort leaves
  * nothing and the earlier file as it was, clear messages for directories
- * that cannot be written, distinct temporary names, and failed commits (a
- * full disk, a directory in the way) that keep the earlier file. */
+ * that cannot be written, distinct temporary names, failed commits (a
+ * full disk, a directory in the way) that keep the earlier file, and the
+ * deferred sync: a setting of the calling thread only, restored by its
+ * caller, that still writes and renames every file. */
 #include <dirent.h>
 #include <errno.h>
+#include <pthread.h>
 #include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -291,6 +294,39 @@ static void test_failed_commit(void)
     unlink(path);
 }
 
+/* Another thread's setting: the default (every commit syncs), whatever
+ * the main thread chose. */
+static void *setting_elsewhere(void *out)
+{
+    *(int *)out = phc_atomic_file_defer_sync(0);
+    return NULL;
+}
+
+static void test_deferred_sync(void)
+{
+    phc_error err;
+    CHECK(phc_atomic_file_defer_sync(1) == 0); /* the default: sync */
+    CHECK(phc_atomic_file_defer_sync(1) == 1); /* returns what it was */
+    int other = -1;
+    pthread_t t;
+    CHECK(pthread_create(&t, NULL, setting_elsewhere, &other) == 0);
+    CHECK(pthread_join(t, NULL) == 0);
+    CHECK(other == 0);
+    /* deferred: the file is still written whole and renamed into place */
+    const char *path = in_dir("e.txt");
+    put(path, "earlier\n");
+    phc_atomic_file *af = NULL;
+    CHECK(phc_atomic_file_open(path, &af, &err) == PHC_OK);
+    fputs("deferred\n", phc_atomic_file_stream(af));
+    CHECK(strcmp(contents(path), "earlier\n") == 0);
+    CHECK(phc_atomic_file_commit(af, &err) == PHC_OK);
+    CHECK(strcmp(contents(path), "deferred\n") == 0);
+    CHECK(count_entries("e.txt") == 1);
+    CHECK(phc_atomic_file_defer_sync(0) == 1);
+    CHECK(phc_atomic_file_defer_sync(0) == 0);
+    unlink(path);
+}
+
 int main(void)
 {
     if (!mkdtemp(dir)) {
@@ -302,6 +338,7 @@ int main(void)
     test_unwritable();
     test_distinct_names();
     test_failed_commit();
+    test_deferred_sync();
     CHECK(count_entries("") == 2); /* "." and "..": nothing left behind */
     rmdir(dir);
     return check_finish("test_atomic_file");
