@@ -412,7 +412,14 @@ double phc_expr_eval(phc_expr *e, const double *slots, const double *row, double
  * interpreter's dispatch (switch, child look-ups) is paid once per node and
  * block instead of once per node and row; each row sees the same operations
  * in the same order whatever the block, so the numbers do not depend on
- * how the rows are blocked. */
+ * how the rows are blocked.
+ *
+ * Only what the reverse sweep reads is computed: no partials at all for a
+ * value alone (grad NULL), and with grad only the partials of an active
+ * node (one that depends on a slot) towards its active children; only the
+ * adjoints of active nodes are kept.  A node's adjoint receives the same
+ * contributions in the same order as when every partial was computed (an
+ * inactive child's adjoint was never read), so the numbers are the same. */
 int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *cols, size_t n_rows, double *value,
                        double *grad, size_t grad_stride)
 {
@@ -420,17 +427,19 @@ int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *co
     if (n_rows > B || !e->rows)
         return PHC_ERR_INVALID; /* too many rows, or not prepared */
     const size_t nn = e->n_nodes;
+    const node *nodes = e->nodes;
     double *V = e->rows, *PA = V + nn * B, *PB = PA + nn * B, *ADJ = PB + nn * B;
     for (size_t i = 0; i < nn; ++i) {
-        const node *n = &e->nodes[i];
+        const node *n = &nodes[i];
         double *v = V + i * B, *pa = PA + i * B, *pb = PB + i * B;
         const double *va = V + n->a * B, *vb = V + n->b * B;
+        /* the partials towards child a and b are wanted */
+        const int da = grad && n->active && nodes[n->a].active;
+        const int db = grad && n->active && nodes[n->b].active;
         switch (n->op) {
         case OP_CONST:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = n->value;
-                pa[r] = pb[r] = 0;
-            }
             break;
         case OP_NAME:
             if (e->is_slot[n->name]) {
@@ -442,123 +451,135 @@ int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *co
                 for (size_t r = 0; r < n_rows; ++r)
                     v[r] = col[r];
             }
-            for (size_t r = 0; r < n_rows; ++r)
-                pa[r] = pb[r] = 0;
             break;
         case OP_NEG:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = -va[r];
-                pa[r] = -1;
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = -1;
             break;
         case OP_ADD:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = va[r] + vb[r];
-                pa[r] = 1;
-                pb[r] = 1;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 1;
+            if (db)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pb[r] = 1;
             break;
         case OP_SUB:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = va[r] - vb[r];
-                pa[r] = 1;
-                pb[r] = -1;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 1;
+            if (db)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pb[r] = -1;
             break;
         case OP_MUL:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = va[r] * vb[r];
-                pa[r] = vb[r];
-                pb[r] = va[r];
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = vb[r];
+            if (db)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pb[r] = va[r];
             break;
         case OP_DIV:
-            for (size_t r = 0; r < n_rows; ++r) {
-                const double q = va[r] / vb[r];
-                v[r] = q;
-                pa[r] = 1 / vb[r];
-                pb[r] = -q / vb[r];
-            }
+            for (size_t r = 0; r < n_rows; ++r)
+                v[r] = va[r] / vb[r];
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 1 / vb[r];
+            if (db)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pb[r] = -v[r] / vb[r];
             break;
         case OP_POW: {
-            const int b_active = e->nodes[n->b].active;
+            const int b_active = nodes[n->b].active;
             for (size_t r = 0; r < n_rows; ++r) {
                 const double a = va[r], b = vb[r];
-                double q, da, db = 0;
+                double q, dqa = 0, dqb = 0;
                 if (!b_active && b == 2) {
                     q = a * a;
-                    da = 2 * a;
+                    dqa = 2 * a;
                 } else if (!b_active && b == 3) {
                     q = a * a * a;
-                    da = 3 * a * a;
+                    dqa = 3 * a * a;
                 } else {
                     q = pow(a, b);
-                    da = b == 0 ? 0 : (a != 0 ? b * q / a : b * pow(a, b - 1));
-                    db = b_active ? (a == 0 && b > 0 ? 0 : q * log(a)) : 0;
+                    if (da)
+                        dqa = b == 0 ? 0 : (a != 0 ? b * q / a : b * pow(a, b - 1));
+                    if (db)
+                        dqb = a == 0 && b > 0 ? 0 : q * log(a);
                 }
                 v[r] = q;
-                pa[r] = da;
-                pb[r] = db;
+                if (da)
+                    pa[r] = dqa;
+                if (db)
+                    pb[r] = dqb;
             }
             break;
         }
         case OP_EXP:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = exp(va[r]);
-                pa[r] = v[r];
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = v[r];
             break;
         case OP_LOG:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = log(va[r]);
-                pa[r] = 1 / va[r];
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 1 / va[r];
             break;
         case OP_SQRT:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = sqrt(va[r]);
-                pa[r] = 0.5 / v[r];
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 0.5 / v[r];
             break;
         case OP_SIN:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = sin(va[r]);
-                pa[r] = cos(va[r]);
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = cos(va[r]);
             break;
         case OP_COS:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = cos(va[r]);
-                pa[r] = -sin(va[r]);
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = -sin(va[r]);
             break;
         case OP_TAN:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = tan(va[r]);
-                pa[r] = 1 + v[r] * v[r];
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 1 + v[r] * v[r];
             break;
         case OP_ATAN:
-            for (size_t r = 0; r < n_rows; ++r) {
+            for (size_t r = 0; r < n_rows; ++r)
                 v[r] = atan(va[r]);
-                pa[r] = 1 / (1 + va[r] * va[r]);
-                pb[r] = 0;
-            }
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = 1 / (1 + va[r] * va[r]);
             break;
         case OP_ABS:
-            for (size_t r = 0; r < n_rows; ++r) {
-                const double a = va[r];
-                v[r] = fabs(a);
-                pa[r] = a > 0 ? 1 : (a < 0 ? -1 : 0);
-                pb[r] = 0;
-            }
+            for (size_t r = 0; r < n_rows; ++r)
+                v[r] = fabs(va[r]);
+            if (da)
+                for (size_t r = 0; r < n_rows; ++r)
+                    pa[r] = va[r] > 0 ? 1 : (va[r] < 0 ? -1 : 0);
             break;
         }
     }
@@ -567,13 +588,18 @@ int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *co
     if (!grad)
         return PHC_OK;
     for (size_t r = 0; r < n_rows; ++r)
-        memset(grad + r * grad_stride, 0, e->n_slots * sizeof *grad);
-    for (size_t i = 0; i < nn; ++i)
-        memset(ADJ + i * B, 0, n_rows * sizeof *ADJ);
+        for (size_t j = 0; j < e->n_slots; ++j)
+            grad[r * grad_stride + j] = 0;
+    if (!nodes[root].active)
+        return PHC_OK; /* depends on no slot */
+    for (size_t i = 0; i < root; ++i)
+        if (nodes[i].active)
+            for (size_t r = 0; r < n_rows; ++r)
+                ADJ[i * B + r] = 0;
     for (size_t r = 0; r < n_rows; ++r)
         ADJ[root * B + r] = 1.0;
     for (size_t i = root + 1; i-- > 0;) {
-        const node *n = &e->nodes[i];
+        const node *n = &nodes[i];
         if (!n->active)
             continue;
         const double *adj = ADJ + i * B, *pa = PA + i * B, *pb = PB + i * B;
@@ -592,20 +618,19 @@ int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *co
         case OP_MUL:
         case OP_DIV:
         case OP_POW:
-            for (size_t r = 0; r < n_rows; ++r) {
-                const double w = adj[r];
-                if (w == 0)
-                    continue;
-                adja[r] += pa[r] * w;
-                adjb[r] += pb[r] * w;
-            }
+            if (nodes[n->a].active)
+                for (size_t r = 0; r < n_rows; ++r)
+                    if (adj[r] != 0)
+                        adja[r] += pa[r] * adj[r];
+            if (nodes[n->b].active)
+                for (size_t r = 0; r < n_rows; ++r)
+                    if (adj[r] != 0)
+                        adjb[r] += pb[r] * adj[r];
             break;
         default:
-            for (size_t r = 0; r < n_rows; ++r) {
-                const double w = adj[r];
-                if (w != 0)
-                    adja[r] += pa[r] * w;
-            }
+            for (size_t r = 0; r < n_rows; ++r)
+                if (adj[r] != 0)
+                    adja[r] += pa[r] * adj[r];
             break;
         }
     }
