@@ -643,11 +643,14 @@ static void reverse_sweep(phc_expr *e, size_t n_rows, double *grad, size_t grad_
         double *adja = ADJ + n->a * B, *adjb = ADJ + n->b * B;
         switch (n->op) {
         case OP_CONST: break;
+        /* A zero adjoint adds nothing (not even 0 x inf = NaN from a
+         * partial at a singular point): it adds -0.0, for which x + -0.0
+         * is x for every x (signed zeros included), so the loops need no
+         * branch and vectorise. */
         case OP_NAME: {
             const size_t slot = e->index[n->name];
             for (size_t r = 0; r < n_rows; ++r)
-                if (adj[r] != 0)
-                    grad[r * grad_stride + slot] += adj[r];
+                grad[r * grad_stride + slot] += adj[r] != 0 ? adj[r] : -0.0;
             break;
         }
         case OP_ADD:
@@ -657,17 +660,14 @@ static void reverse_sweep(phc_expr *e, size_t n_rows, double *grad, size_t grad_
         case OP_POW:
             if (nodes[n->a].active)
                 for (size_t r = 0; r < n_rows; ++r)
-                    if (adj[r] != 0)
-                        adja[r] += pa[r] * adj[r];
+                    adja[r] += adj[r] != 0 ? pa[r] * adj[r] : -0.0;
             if (nodes[n->b].active)
                 for (size_t r = 0; r < n_rows; ++r)
-                    if (adj[r] != 0)
-                        adjb[r] += pb[r] * adj[r];
+                    adjb[r] += adj[r] != 0 ? pb[r] * adj[r] : -0.0;
             break;
         default:
             for (size_t r = 0; r < n_rows; ++r)
-                if (adj[r] != 0)
-                    adja[r] += pa[r] * adj[r];
+                adja[r] += adj[r] != 0 ? pa[r] * adj[r] : -0.0;
             break;
         }
     }
