@@ -610,6 +610,18 @@ static void forward_node(const phc_expr *e, size_t i, const double *slots, const
     }
 }
 
+/* A child's adjoint from its parent's adjoint adj and the parent's partial
+ * p towards it (see reverse_sweep): three different rows of the work
+ * space, so the loop vectorises. */
+static inline void child_adjoint(double *restrict out, const double *restrict p, const double *restrict adj,
+                                 size_t n_rows)
+{
+    for (size_t r = 0; r < n_rows; ++r) {
+        const double w = adj[r], t = p[r] * w; /* t unused when w is 0 */
+        out[r] = 0.0 + (w != 0 ? t : -0.0);
+    }
+}
+
 /* The reverse sweep over the block (forward_node with partials done for
  * every node the root depends on): the n_slots derivatives of each row
  * into grad + r * grad_stride.  Adjoints accumulate in reverse node order
@@ -624,15 +636,13 @@ static void reverse_sweep(phc_expr *e, size_t n_rows, double *grad, size_t grad_
     const size_t nn = e->n_nodes, root = nn - 1;
     const node *nodes = e->nodes;
     double *PA = e->rows + nn * B, *PB = PA + nn * B, *ADJ = PB + nn * B;
-    for (size_t r = 0; r < n_rows; ++r)
-        for (size_t j = 0; j < e->n_slots; ++j)
-            grad[r * grad_stride + j] = 0;
+    if (grad_stride == e->n_slots)
+        memset(grad, 0, n_rows * e->n_slots * sizeof *grad);
+    else
+        for (size_t r = 0; r < n_rows; ++r)
+            memset(grad + r * grad_stride, 0, e->n_slots * sizeof *grad);
     if (!nodes[root].active)
         return; /* depends on no slot */
-    for (size_t i = 0; i < root; ++i)
-        if (nodes[i].active)
-            for (size_t r = 0; r < n_rows; ++r)
-                ADJ[i * B + r] = 0;
     for (size_t r = 0; r < n_rows; ++r)
         ADJ[root * B + r] = 1.0;
     for (size_t i = root + 1; i-- > 0;) {
@@ -646,11 +656,18 @@ static void reverse_sweep(phc_expr *e, size_t n_rows, double *grad, size_t grad_
         /* A zero adjoint adds nothing (not even 0 x inf = NaN from a
          * partial at a singular point): it adds -0.0, for which x + -0.0
          * is x for every x (signed zeros included), so the loops need no
-         * branch and vectorise. */
+         * branch and vectorise.  A node other than a name has one parent
+         * (the parser never shares a node), so its adjoint receives exactly
+         * one contribution, from its parent, before it is read: written as
+         * 0 + contribution (the sum into an adjoint set to 0, a -0
+         * contribution giving +0 as that sum does) instead of zeroing every
+         * adjoint first. */
         case OP_NAME: {
             const size_t slot = e->index[n->name];
-            for (size_t r = 0; r < n_rows; ++r)
-                grad[r * grad_stride + slot] += adj[r] != 0 ? adj[r] : -0.0;
+            for (size_t r = 0; r < n_rows; ++r) {
+                const double w = adj[r];
+                grad[r * grad_stride + slot] += w != 0 ? w : -0.0;
+            }
             break;
         }
         case OP_ADD:
@@ -659,15 +676,12 @@ static void reverse_sweep(phc_expr *e, size_t n_rows, double *grad, size_t grad_
         case OP_DIV:
         case OP_POW:
             if (nodes[n->a].active)
-                for (size_t r = 0; r < n_rows; ++r)
-                    adja[r] += adj[r] != 0 ? pa[r] * adj[r] : -0.0;
+                child_adjoint(adja, pa, adj, n_rows);
             if (nodes[n->b].active)
-                for (size_t r = 0; r < n_rows; ++r)
-                    adjb[r] += adj[r] != 0 ? pb[r] * adj[r] : -0.0;
+                child_adjoint(adjb, pb, adj, n_rows);
             break;
         default:
-            for (size_t r = 0; r < n_rows; ++r)
-                adja[r] += adj[r] != 0 ? pa[r] * adj[r] : -0.0;
+            child_adjoint(adja, pa, adj, n_rows);
             break;
         }
     }
