@@ -44,6 +44,25 @@ static inline void rotate_at(double *a, size_t k, size_t r, size_t p, size_t q, 
     a[r * k + q] = a[q * k + r] = sn * arp + c * arq;
 }
 
+/* Jacobi's test |a_pq| > eps sqrt(|a_pp a_qq|) (jacobi_lanes), decided
+ * without the square root when the squares settle it: with P = |a_pp a_qq|
+ * and q = a_pq^2 both normal, q > 4 eps^2 P means |a_pq| > 2 eps sqrt(P)
+ * and q < eps^2 P / 4 means |a_pq| < eps sqrt(P) / 2, far beyond the
+ * roundings of q, P and the square root; only between the two (and for
+ * numbers near underflow, overflow or NaN) is the test itself evaluated,
+ * so every decision is the test's. */
+static inline int rotation_wanted(double app, double aqq, double apq)
+{
+    const double P = fabs(app) * fabs(aqq), q = apq * apq, e2P = DBL_EPSILON * DBL_EPSILON * P;
+    if (e2P >= DBL_MIN && e2P <= DBL_MAX / 8 && q >= DBL_MIN) {
+        if (q > 4 * e2P)
+            return 1;
+        if (q < 0.25 * e2P)
+            return 0;
+    }
+    return fabs(apq) > DBL_EPSILON * sqrt(P);
+}
+
 /* Eigenvalues of the symmetric k x k matrices A[l] (row-major, destroyed)
  * of the lanes l < n_lanes with use[l] set, on their diagonals, by the
  * cyclic two-sided Jacobi method (Golub & Van Loan, Matrix Computations,
@@ -78,7 +97,7 @@ static void jacobi_lanes(double A[][MAX_K2], const int *use, size_t n_lanes, siz
                         continue;
                     double *a = A[l];
                     const double app = a[p * k + p], aqq = a[q * k + q], apq = a[p * k + q];
-                    if (!(fabs(apq) > DBL_EPSILON * sqrt(fabs(app) * fabs(aqq))))
+                    if (!rotation_wanted(app, aqq, apq))
                         continue;
                     rotated[l] = 1;
                     const double zeta = (aqq - app) / (2 * apq);
