@@ -105,9 +105,11 @@ class AnalyticCost final : public ceres::CostFunction {
     // one_block: the block's k parameters are one Ceres parameter block of
     // size k (one_parameter_block) instead of k blocks of size 1.
     AnalyticCost(const Block &b, const std::vector<Parameter> &params, SolveState *state, bool one_block = false)
-        : b_(b), params_(params), state_(state), one_block_(one_block), x_(b.index.size()), key_(b.index.size()),
-          r_(b.m), jac_(b.m * b.index.size())
+        : b_(b), params_(params), state_(state), one_block_(one_block), scale_(b.index.size()), x_(b.index.size()),
+          key_(b.index.size()), r_(b.m), jac_(b.m * b.index.size())
     {
+        for (size_t j = 0; j < b.index.size(); ++j)
+            scale_[j] = params[b.index[j]].scale;
         set_num_residuals(static_cast<int>(b.m));
         if (one_block)
             mutable_parameter_block_sizes()->push_back(static_cast<int>(b.index.size()));
@@ -167,13 +169,13 @@ class AnalyticCost final : public ceres::CostFunction {
             if (jacobians[0])
                 for (size_t i = 0; i < b_.m; ++i)
                     for (size_t j = 0; j < k; ++j)
-                        jacobians[0][i * k + j] = jac_[i * k + j] * params_[b_.index[j]].scale;
+                        jacobians[0][i * k + j] = jac_[i * k + j] * scale_[j];
             return true;
         }
         for (size_t j = 0; j < k; ++j) {
             if (!jacobians[j])
                 continue;
-            const double s = params_[b_.index[j]].scale;
+            const double s = scale_[j];
             for (size_t i = 0; i < b_.m; ++i)
                 jacobians[j][i] = jac_[i * k + j] * s;
         }
@@ -185,13 +187,14 @@ class AnalyticCost final : public ceres::CostFunction {
     template <class U> void unscale_u(const U &uj) const
     {
         for (size_t j = 0; j < b_.index.size(); ++j)
-            x_[j] = uj(j) * params_[b_.index[j]].scale;
+            x_[j] = uj(j) * scale_[j];
     }
 
     const Block &b_;
     const std::vector<Parameter> &params_;
     SolveState *state_;
     bool one_block_;
+    std::vector<double> scale_;  // scale_j of the block's parameters
     // The last evaluation (physical x_, its scaled key_, residuals r_ and
     // Jacobian jac_ as the callback fills it, m x k row-major) and the
     // prediction state; guarded by mutex_ (Ceres may evaluate blocks on
