@@ -445,8 +445,11 @@ static void sin_cos(double a, double *s, double *c)
  * children into PA and PB when the node is active (only what the reverse
  * sweep reads: nothing for a value alone).  Slots and columns as for
  * phc_expr_eval_rows; slots may be NULL for a node that depends on none. */
-static void forward_node(const phc_expr *e, size_t i, const double *slots, const double *const *cols,
-                         size_t n_rows, int with_partials)
+/* inlined into its three callers: their node loops then keep the work
+ * space's pointers in registers instead of a call per node and block */
+static inline __attribute__((always_inline)) void forward_node(const phc_expr *e, size_t i, const double *slots,
+                                                              const double *const *cols, size_t n_rows,
+                                                              int with_partials)
 {
     enum { B = PHC_EXPR_ROWS };
     const size_t nn = e->n_nodes;
