@@ -57,30 +57,17 @@ static int curve_predict(phc_dataset *ds, const double *p, double *yhat, double 
 {
     curve_impl *c = ds->impl;
     if (c->tape) {
-        /* blocks of rows through phc_expr_eval_rows (a fraction of the
-         * interpreter's overhead of one row at a time, the same numbers);
-         * one row at a time only for more columns than block_cols holds */
-        if (c->n_cols <= PHC_CURVE_MAX_BLOCK_COLS) {
-            const double *block_cols[PHC_CURVE_MAX_BLOCK_COLS];
-            for (size_t i0 = 0; i0 < ds->n; i0 += PHC_EXPR_ROWS) {
-                const size_t nr = ds->n - i0 < PHC_EXPR_ROWS ? ds->n - i0 : PHC_EXPR_ROWS;
-                for (size_t j = 0; j < c->n_cols; ++j)
-                    block_cols[j] = c->cols[j] + i0;
-                if (phc_expr_eval_rows(c->tape, p, block_cols, nr, yhat + i0, jac ? jac + i0 * ds->k : NULL,
-                                       ds->k) != PHC_OK)
-                    return -1; /* a prepared tape takes PHC_EXPR_ROWS rows: cannot happen */
-                for (size_t r = 0; r < nr; ++r)
-                    if (!isfinite(yhat[i0 + r]))
-                        return 1; /* outside the expression's domain: reject the step */
-            }
-            return 0;
-        }
-        for (size_t i = 0; i < ds->n; ++i) {
-            for (size_t j = 0; j < c->n_cols; ++j)
-                c->row[j] = c->cols[j][i];
-            yhat[i] = phc_expr_eval(c->tape, p, c->row, jac ? jac + i * ds->k : NULL);
-            if (!isfinite(yhat[i]))
-                return 1; /* outside the expression's domain: reject the step */
+        /* blocks of rows of the data bound to the tape (bind_tape): a
+         * fraction of the interpreter's overhead of one row at a time, and
+         * the parts of the expression without parameters computed once;
+         * the same numbers */
+        for (size_t i0 = 0; i0 < ds->n; i0 += PHC_EXPR_ROWS) {
+            const size_t nr = ds->n - i0 < PHC_EXPR_ROWS ? ds->n - i0 : PHC_EXPR_ROWS;
+            if (phc_expr_eval_data(c->tape, p, i0, nr, yhat + i0, jac ? jac + i0 * ds->k : NULL, ds->k) != PHC_OK)
+                return -1; /* the tape holds the data set's n rows: cannot happen */
+            for (size_t r = 0; r < nr; ++r)
+                if (!isfinite(yhat[i0 + r]))
+                    return 1; /* outside the expression's domain: reject the step */
         }
         return 0;
     }
@@ -146,10 +133,11 @@ const phc_dataset_ops phc_curve_ops = {.kind = "curve", .predict = curve_predict
                                        .predict_at = curve_predict_at, .free_impl = curve_free,
                                        .baseline = curve_baseline};
 
-/* Compiles the derivative tape and binds its names to the slots and to the
- * columns muparser registered (same names, same order as c->cols). */
+/* Compiles the derivative tape, binds its names to the slots and to the
+ * columns muparser registered (same names, same order as c->cols) and
+ * binds the columns' n_rows rows as its data (phc_expr_bind_data). */
 static int bind_tape(curve_impl *c, const char *expr, const char *const *slot_names, size_t n_slots,
-                     phc_error *err)
+                     size_t n_rows, phc_error *err)
 {
     phc_error tape_err;
     size_t pos = 0;
@@ -173,7 +161,8 @@ static int bind_tape(curve_impl *c, const char *expr, const char *const *slot_na
             return PHC_OK;
         }
     }
-    if (phc_expr_prepare(c->tape, n_slots, err) != PHC_OK) {
+    if (phc_expr_prepare(c->tape, n_slots, err) != PHC_OK ||
+        phc_expr_bind_data(c->tape, (const double *const *)c->cols, n_rows, err) != PHC_OK) {
         phc_expr_free(c->tape);
         c->tape = NULL;
         return err->status == PHC_ERR_NOMEM ? PHC_ERR_NOMEM : PHC_OK;
@@ -509,7 +498,8 @@ int phc_curve_new(const phc_table *table, const phc_curve_options *opt,
     /* Exact derivatives when the expression stays within DESIGN.md's
      * grammar; otherwise muparser with numerical derivatives. */
     if ((rc = bind_names(c, table, opt, n_vars, slot_names, &n_slots, err)) ||
-        (rc = bind_tape(c, opt->expression, (const char *const *)slot_names, n_slots, err)))
+        (rc = bind_tape(c, opt->expression, (const char *const *)slot_names, n_slots, phc_table_rows(table),
+                         err)))
         goto fail;
     if (!(ds = phc_dataset_new(&phc_curve_ops, n_slots))) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");

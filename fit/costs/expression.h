@@ -65,4 +65,20 @@ double phc_expr_eval(phc_expr *e, const double *slots, const double *row,
 int phc_expr_eval_rows(phc_expr *e, const double *slots, const double *const *cols, size_t n_rows,
                        double *value, double *grad, size_t grad_stride);
 
+/* Binds the data the tape will be evaluated on: column c (the index a name
+ * is bound to with is_slot = 0) is cols[c][0 .. n-1]; the arrays must stay
+ * valid and unchanged while the tape uses them.  The values of every
+ * largest subtree that depends on no slot (beyond a single constant or
+ * column: cos(2*pi*x/12), x^2, ...) are computed here once per row instead
+ * of at every evaluation.  After phc_expr_prepare (which drops a binding);
+ * PHC_OK, PHC_ERR_NOMEM, or PHC_ERR_INVALID when not prepared. */
+int phc_expr_bind_data(phc_expr *e, const double *const *cols, size_t n, phc_error *err);
+
+/* phc_expr_eval_rows on rows row0 .. row0 + n_rows - 1 (n_rows <=
+ * PHC_EXPR_ROWS) of the bound data: bitwise the same values and
+ * derivatives (the hoisted subtrees' values were computed by the same
+ * operations).  PHC_ERR_INVALID without bound data or for rows outside it. */
+int phc_expr_eval_data(phc_expr *e, const double *slots, size_t row0, size_t n_rows, double *value, double *grad,
+                       size_t grad_stride);
+
 #endif /* PHC_COSTS_EXPRESSION_H */

@@ -102,22 +102,31 @@ static bool call_block(const Block &b, const double *x, double *r, double *jac,
 // numbers the callback returned: the results do not change.
 class AnalyticCost final : public ceres::CostFunction {
   public:
-    AnalyticCost(const Block &b, const std::vector<Parameter> &params, SolveState *state)
-        : b_(b), params_(params), state_(state), x_(b.index.size()), key_(b.index.size()), r_(b.m),
-          jac_(b.m * b.index.size())
+    // one_block: the block's k parameters are one Ceres parameter block of
+    // size k (one_parameter_block) instead of k blocks of size 1.
+    AnalyticCost(const Block &b, const std::vector<Parameter> &params, SolveState *state, bool one_block = false)
+        : b_(b), params_(params), state_(state), one_block_(one_block), scale_(b.index.size()), x_(b.index.size()),
+          key_(b.index.size()), r_(b.m), jac_(b.m * b.index.size())
     {
-        set_num_residuals(static_cast<int>(b.m));
         for (size_t j = 0; j < b.index.size(); ++j)
-            mutable_parameter_block_sizes()->push_back(1);
+            scale_[j] = params[b.index[j]].scale;
+        set_num_residuals(static_cast<int>(b.m));
+        if (one_block)
+            mutable_parameter_block_sizes()->push_back(static_cast<int>(b.index.size()));
+        else
+            for (size_t j = 0; j < b.index.size(); ++j)
+                mutable_parameter_block_sizes()->push_back(1);
     }
 
     bool Evaluate(double const *const *u, double *residuals, double **jacobians) const override
     {
         std::lock_guard<std::mutex> lock(mutex_);
         const size_t k = b_.index.size();
+        // the scaled parameters u_j, as one block or k blocks
+        const auto uj = [&](size_t j) { return one_block_ ? u[0][j] : u[j][0]; };
         bool same = has_key_;
         for (size_t j = 0; same && j < k; ++j)
-            same = key_[j] == u[j][0];
+            same = key_[j] == uj(j);
         if (!jacobians) {
             if (same) {  // asked twice at one point
                 std::copy(r_.begin(), r_.end(), residuals);
@@ -126,7 +135,7 @@ class AnalyticCost final : public ceres::CostFunction {
             if (pending_)  // the last candidate's Jacobian was never asked for: rejected
                 with_jacobian_ = false;
             has_key_ = has_jac_ = pending_ = false;
-            unscale(b_, params_, u, x_.data());
+            unscale_u(uj);
             bool ok = false, jac_ok = false;
             if (with_jacobian_)
                 ok = jac_ok = call_block(b_, x_.data(), r_.data(), jac_.data(), state_);
@@ -135,7 +144,7 @@ class AnalyticCost final : public ceres::CostFunction {
             if (!ok)
                 return false;
             for (size_t j = 0; j < k; ++j)
-                key_[j] = u[j][0];
+                key_[j] = uj(j);
             has_key_ = pending_ = true;
             has_jac_ = jac_ok;
             std::copy(r_.begin(), r_.end(), residuals);
@@ -146,19 +155,27 @@ class AnalyticCost final : public ceres::CostFunction {
         pending_ = false;
         if (!(same && has_jac_)) {
             has_key_ = has_jac_ = false;
-            unscale(b_, params_, u, x_.data());
+            unscale_u(uj);
             if (!call_block(b_, x_.data(), r_.data(), jac_.data(), state_))
                 return false;
             for (size_t j = 0; j < k; ++j)
-                key_[j] = u[j][0];
+                key_[j] = uj(j);
             has_key_ = has_jac_ = true;
         }
         std::copy(r_.begin(), r_.end(), residuals);
-        // d r / d u_j = d r / d x_j * scale_j; Ceres wants per-block m x 1.
+        // d r / d u_j = d r / d x_j * scale_j; Ceres wants per-block m x 1,
+        // or for one block m x k row-major: the callback's own layout.
+        if (one_block_) {
+            if (jacobians[0])
+                for (size_t i = 0; i < b_.m; ++i)
+                    for (size_t j = 0; j < k; ++j)
+                        jacobians[0][i * k + j] = jac_[i * k + j] * scale_[j];
+            return true;
+        }
         for (size_t j = 0; j < k; ++j) {
             if (!jacobians[j])
                 continue;
-            const double s = params_[b_.index[j]].scale;
+            const double s = scale_[j];
             for (size_t i = 0; i < b_.m; ++i)
                 jacobians[j][i] = jac_[i * k + j] * s;
         }
@@ -166,9 +183,18 @@ class AnalyticCost final : public ceres::CostFunction {
     }
 
   private:
+    // x_ = the physical parameters of the scaled ones uj(j).
+    template <class U> void unscale_u(const U &uj) const
+    {
+        for (size_t j = 0; j < b_.index.size(); ++j)
+            x_[j] = uj(j) * scale_[j];
+    }
+
     const Block &b_;
     const std::vector<Parameter> &params_;
     SolveState *state_;
+    bool one_block_;
+    std::vector<double> scale_;  // scale_j of the block's parameters
     // The last evaluation (physical x_, its scaled key_, residuals r_ and
     // Jacobian jac_ as the callback fills it, m x k row-major) and the
     // prediction state; guarded by mutex_ (Ceres may evaluate blocks on
@@ -444,6 +470,25 @@ extern "C" size_t phc_nls_residual_count(const phc_nls *nls)
     return nls ? nls->total_residuals : 0;
 }
 
+// One residual block with exact derivatives and no loss, over parameters
+// that are free, unbounded (no bound for a parameter to be held at, below)
+// and in increasing order (the order Ceres would give k blocks of size 1):
+// the case phc_nls_solve declares as one parameter block.
+static bool one_parameter_block(const phc_nls &nls)
+{
+    if (nls.blocks.size() != 1)
+        return false;
+    const Block &b = nls.blocks[0];
+    if (b.derivs != PHC_DERIV_ANALYTIC || b.loss != PHC_LOSS_NONE)
+        return false;
+    for (size_t j = 0; j < b.index.size(); ++j) {
+        const Parameter &p = nls.params[b.index[j]];
+        if (p.fixed || std::isfinite(p.lower) || std::isfinite(p.upper) || (j > 0 && b.index[j] <= b.index[j - 1]))
+            return false;
+    }
+    return true;
+}
+
 static int check_point(const phc_nls *nls, const double *x, phc_error *err)
 {
     for (size_t i = 0; i < nls->params.size(); ++i) {
@@ -488,7 +533,22 @@ extern "C" int phc_nls_solve(phc_nls *nls, const phc_nls_options *options, doubl
         popts.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
         popts.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
         ceres::Problem problem(popts);
-        for (size_t i = 0; i < n; ++i) {
+        // One data set with exact derivatives over free, unbounded
+        // parameters: its parameters are one Ceres parameter block (ub), in
+        // the order the blocks of size 1 would have (one_parameter_block),
+        // so Ceres assembles the same Jacobian and gradient with a
+        // fraction of its per-block bookkeeping.
+        const bool one = one_parameter_block(*nls);
+        std::vector<double> ub;
+        if (one) {
+            const Block &b = nls->blocks[0];
+            for (size_t i : b.index)
+                ub.push_back(u[i]);
+            problem.AddParameterBlock(ub.data(), static_cast<int>(ub.size()));
+            assembly.costs.push_back(std::make_unique<AnalyticCost>(b, nls->params, &state, true));
+            problem.AddResidualBlock(assembly.costs.back().get(), nullptr, ub.data());
+        }
+        for (size_t i = 0; i < n && !one; ++i) {
             if (!used[i])
                 continue;
             const Parameter &p = nls->params[i];
@@ -503,6 +563,8 @@ extern "C" int phc_nls_solve(phc_nls *nls, const phc_nls_options *options, doubl
                 problem.SetParameterUpperBound(&u[i], 0, p.upper / p.scale);
         }
         for (const Block &b : nls->blocks) {
+            if (one)
+                break;
             std::vector<double *> blocks;
             for (size_t i : b.index)
                 blocks.push_back(&u[i]);
@@ -542,6 +604,8 @@ extern "C" int phc_nls_solve(phc_nls *nls, const phc_nls_options *options, doubl
 
         ceres::Solver::Summary s;
         ceres::Solve(o, &problem, &s);
+        for (size_t j = 0; j < ub.size(); ++j)
+            u[nls->blocks[0].index[j]] = ub[j];
 
         // Ceres projects each trust-region step onto the bounds (Ceres issue
         // #187): once a parameter reaches its bound, the steps that would

@@ -153,8 +153,16 @@ int phc_dataset_residuals(const double *p, double *r, double *jac, void *user_da
     int rc = ds->ops->predict(ds, p, r, jac);
     if (rc)
         return rc;
+    if (!ds->sigma) { /* weight 1: the same numbers as the loop below with w = 1 */
+        for (size_t i = 0; i < ds->n; ++i)
+            r[i] = ds->y[i] - r[i];
+        if (jac)
+            for (size_t t = 0; t < ds->n * ds->k; ++t)
+                jac[t] = -jac[t];
+        return 0;
+    }
     for (size_t i = 0; i < ds->n; ++i) {
-        const double w = ds->sigma ? 1.0 / ds->sigma[i] : 1.0;
+        const double w = 1.0 / ds->sigma[i];
         r[i] = (ds->y[i] - r[i]) * w;
         if (jac)
             for (size_t j = 0; j < ds->k; ++j)

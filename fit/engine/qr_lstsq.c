@@ -6,6 +6,10 @@
 
 #include "model/jacobi_svd.h"
 
+/* Most columns whose Householder updates run row by row (more: column by
+ * column, the same numbers). */
+#define PHC_QR_MAX_COLS 64
+
 size_t phc_qr_lstsq_work(size_t m, size_t n)
 {
     return m + 2 * n * n + 2 * n;
@@ -37,13 +41,38 @@ int phc_qr_triangle(double *A, size_t m, size_t n, double *c, double *R)
         /* v = (v0, a_{k+1,k}, ..., a_{m-1,k}): v'v = -2 alpha v0 */
         const double tau = -1.0 / (alpha * v0);
         A[k * n + k] = v0;
-        for (size_t j = k + 1; j < n; ++j) {
-            double d = 0;
-            for (size_t i = k; i < m; ++i)
-                d += A[i * n + k] * A[i * n + j];
-            d *= tau;
-            for (size_t i = k; i < m; ++i)
-                A[i * n + j] -= d * A[i * n + k];
+        /* d_j = tau v'a_j for every later column j at once, row by row:
+         * each d_j sums the same products in the same order (i ascending)
+         * as a column-by-column loop, so the numbers are the same, but the
+         * n - k - 1 sums run side by side along contiguous rows instead of
+         * one chain of dependent additions after another down a column */
+        double d[PHC_QR_MAX_COLS];
+        if (n <= PHC_QR_MAX_COLS) {
+            for (size_t j = k + 1; j < n; ++j)
+                d[j] = 0;
+            for (size_t i = k; i < m; ++i) {
+                const double vi = A[i * n + k];
+                const double *row = A + i * n;
+                for (size_t j = k + 1; j < n; ++j)
+                    d[j] += vi * row[j];
+            }
+            for (size_t j = k + 1; j < n; ++j)
+                d[j] *= tau;
+            for (size_t i = k; i < m; ++i) {
+                const double vi = A[i * n + k];
+                double *row = A + i * n;
+                for (size_t j = k + 1; j < n; ++j)
+                    row[j] -= d[j] * vi;
+            }
+        } else {
+            for (size_t j = k + 1; j < n; ++j) {
+                double dj = 0;
+                for (size_t i = k; i < m; ++i)
+                    dj += A[i * n + k] * A[i * n + j];
+                dj *= tau;
+                for (size_t i = k; i < m; ++i)
+                    A[i * n + j] -= dj * A[i * n + k];
+            }
         }
         if (c) {
             double d = 0;

@@ -375,20 +375,31 @@ int phc_check_durbin_watson(const double *r, size_t n, const double *X,
         double trB = 0.0, trC = 0.0, trB2 = 0.0;
         for (size_t j = 0; j < rank; ++j)
             dw_apply_A(U + j * n, AU + j * n, n);
+        /* row i of B and C: the rank sums B_ij, C_ij side by side along t
+         * (each in the order of t, as one at a time would), then added up
+         * in the order of j */
+        double *bi = malloc(2 * (rank ? rank : 1) * sizeof *bi), *ci = bi + (rank ? rank : 1);
+        if (!bi)
+            goto fail;
         for (size_t i = 0; i < rank; ++i) {
+            for (size_t j = 0; j < rank; ++j)
+                bi[j] = ci[j] = 0.0;
+            for (size_t t = 0; t < n; ++t) {
+                const double u = U[i * n + t], au = AU[i * n + t];
+                for (size_t j = 0; j < rank; ++j) {
+                    bi[j] += u * AU[j * n + t];
+                    ci[j] += au * AU[j * n + t];
+                }
+            }
             for (size_t j = 0; j < rank; ++j) {
-                double bij = 0.0, cij = 0.0;
-                for (size_t t = 0; t < n; ++t) {
-                    bij += U[i * n + t] * AU[j * n + t];
-                    cij += AU[i * n + t] * AU[j * n + t];
-                }
                 if (i == j) {
-                    trB += bij;
-                    trC += cij;
+                    trB += bi[j];
+                    trC += ci[j];
                 }
-                trB2 += bij * bij; /* B symmetric: tr(B^2) = sum B_ij^2 */
+                trB2 += bi[j] * bi[j]; /* B symmetric: tr(B^2) = sum B_ij^2 */
             }
         }
+        free(bi);
         P -= trB;
         Q += trB2 - 2.0 * trC;
     }

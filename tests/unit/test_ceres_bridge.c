@@ -18,7 +18,9 @@
  *    parameters) against numerical derivatives computed here;
  *  - an analytic block's accepted candidates are served from the
  *    candidate's evaluation (fewer callback runs than Ceres's residual plus
- *    Jacobian evaluations, same optimum). */
+ *    Jacobian evaluations, same optimum);
+ *  - one data set over free, unbounded parameters (one Ceres parameter
+ *    block) solves bitwise as with blocks of size 1. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -877,6 +879,64 @@ static void test_candidate_reuse(void)
     phc_nls_free(nls);
 }
 
+/* exp_residuals with a fourth parameter that the model ignores (held fixed
+ * below): the same residuals and Jacobian columns for (A, k, c). */
+static int exp4_residuals(const double *p, double *r, double *jac, void *ud)
+{
+    double j3[3 * NEXP];
+    const int rc = exp_residuals(p, r, jac ? j3 : NULL, ud);
+    for (size_t i = 0; jac && i < NEXP; ++i) {
+        for (size_t j = 0; j < 3; ++j)
+            jac[4 * i + j] = j3[3 * i + j];
+        jac[4 * i + 3] = 0.0;
+    }
+    return rc;
+}
+
+/* One data set over free, unbounded parameters is declared to Ceres as one
+ * parameter block of size k instead of k blocks of size 1 (less of Ceres's
+ * per-block work): the same Jacobian columns in the same order, so the
+ * same solve.  The same model with a fourth, fixed parameter takes the k
+ * blocks of size 1: optimum, cost and every count bitwise the same, with
+ * unit and with uneven parameter scales. */
+static void test_one_parameter_block(void)
+{
+    exp_data d;
+    exp_make(&d, 0.02);
+    const double ones[4] = {1, 1, 1, 1}, scales[4] = {3, 1e-2, 1e3, 1};
+    for (int sc = 0; sc < 2; ++sc) {
+        double x[2][4];
+        phc_nls_summary s[2];
+        for (int blocks = 0; blocks < 2; ++blocks) {
+            const size_t np = blocks ? 4 : 3, idx[4] = {0, 1, 2, 3};
+            phc_nls *nls = phc_nls_new(np);
+            phc_error err;
+            phc_error_clear(&err);
+            for (size_t j = 0; j < np; ++j)
+                CHECK(phc_nls_set_parameter(nls, j, -INFINITY, INFINITY, j == 3, (sc ? scales : ones)[j], &err) ==
+                      PHC_OK);
+            CHECK(phc_nls_add_block(nls, NEXP, idx, np, blocks ? exp4_residuals : exp_residuals, PHC_DERIV_ANALYTIC,
+                                    PHC_LOSS_NONE, 1, &d, &err) == PHC_OK);
+            x[blocks][0] = 1;
+            x[blocks][1] = 0.3;
+            x[blocks][2] = 0;
+            x[blocks][3] = 0;
+            phc_nls_options o = phc_nls_options_default();
+            CHECK(phc_nls_solve(nls, &o, x[blocks], &s[blocks], &err) == PHC_OK);
+            CHECK(s[blocks].outcome == PHC_NLS_CONVERGED);
+            phc_nls_free(nls);
+        }
+        CHECK(memcmp(x[0], x[1], 3 * sizeof x[0][0]) == 0);
+        CHECK(memcmp(&s[0].final_cost, &s[1].final_cost, sizeof s[0].final_cost) == 0);
+        CHECK(s[0].iterations == s[1].iterations);
+        CHECK(s[0].residual_evaluations == s[1].residual_evaluations);
+        CHECK(s[0].jacobian_evaluations == s[1].jacobian_evaluations);
+        printf("one parameter block (scales %s): %d iterations, x = %.17g %.17g %.17g; blocks of size 1: %d, "
+               "%.17g %.17g %.17g\n", sc ? "uneven" : "1", s[0].iterations, x[0][0], x[0][1], x[0][2],
+               s[1].iterations, x[1][0], x[1][1], x[1][2]);
+    }
+}
+
 int main(void)
 {
     test_linear();
@@ -889,5 +949,6 @@ int main(void)
     test_evaluate();
     test_evaluate_domain();
     test_candidate_reuse();
+    test_one_parameter_block();
     return check_finish("test_ceres_bridge");
 }

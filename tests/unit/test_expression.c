@@ -12,7 +12,9 @@
  *     bitwise the same values and gradients for every expression above on
  *     rows that include zeros, negative values and points outside the
  *     domain (NaN, inf), for 1, 7 and PHC_EXPR_ROWS rows, and the grad
- *     stride (nothing written between rows' gradients).
+ *     stride (nothing written between rows' gradients);
+ * (f) phc_expr_eval_data (data bound to the tape, its parameter-free parts
+ *     computed once) against phc_expr_eval row by row: bitwise the same.
  *
  * Numerical derivatives: central differences with Richardson extrapolation
  * (Ridders' method, Numerical Recipes 3rd ed. §5.7), whose error is ~1e-12
@@ -844,10 +846,79 @@ static void test_rows(void)
     printf("blocks of rows: %ld rows bitwise equal to row-by-row evaluation\n", compared);
 }
 
+/* phc_expr_eval_data (the data bound to the tape, the parts without
+ * parameters computed once at binding) against phc_expr_eval row by row:
+ * bitwise the same values and gradients, for every expression above and
+ * some whose parameter-free parts are larger (cos(2*pi*x/12), x^2, t*t,
+ * log(x) outside its domain), over blocks at several offsets; rows outside
+ * the data and a tape prepared again (which drops the data) are refused. */
+static void test_bound_data(void)
+{
+    static const char *const slots[] = {"a", "b", "c"};
+    static const char *const cols[] = {"x", "t"};
+    static const char *const more[] = {"b*cos(2*pi*x/12) + c*sin(2*pi*x/a) + a",
+                                       "a*exp(-(x-b)^2/c^2) + log(x)*c + sqrt(abs(t))*b",
+                                       "a*(x^2 + x*b)/(x^2 + x*c + t*t)",
+                                       "-(x*t) + a", "exp(-x)*(a + b*atan(t/3))"};
+    enum { N = 2 * PHC_EXPR_ROWS + 9 };
+    double x[N], t[N];
+    for (size_t r = 0; r < N; ++r) { /* zeros, negatives, 2, 3 */
+        x[r] = r % 8 == 0 ? 0.0 : (r % 5 == 0 ? 2.0 : -1.5 + 0.37 * (double)r);
+        t[r] = r % 7 == 0 ? 3.0 : (r % 6 == 0 ? 0.0 : 2.2 - 0.29 * (double)r);
+    }
+    const double *colp[2] = {x, t};
+    const double params[][3] = {{0.7, 0.4, 0.3}, {1.3, 2.0, 0.6}, {-2.1, 3.0, 1.1}};
+    const size_t blocks[][2] = {{0, PHC_EXPR_ROWS}, {PHC_EXPR_ROWS, PHC_EXPR_ROWS}, {2 * PHC_EXPR_ROWS, 9},
+                                {5, 7}, {N - 1, 1}, {0, 1}};
+    const size_t n_cases = sizeof cases / sizeof cases[0], n_more = sizeof more / sizeof more[0];
+    long compared = 0;
+    for (size_t c = 0; c < n_cases + n_more; ++c) {
+        const char *text = c < n_cases ? cases[c].text : more[c - n_cases];
+        phc_expr *e = build(text, slots, 3, cols, 2);
+        phc_error err;
+        phc_error_clear(&err);
+        if (!e || phc_expr_bind_data(e, colp, N, &err) != PHC_OK) {
+            fprintf(stderr, "\"%s\": cannot bind the data: %s\n", text, err.message);
+            CHECK(0);
+            phc_expr_free(e);
+            continue;
+        }
+        for (size_t q = 0; q < sizeof params / sizeof params[0]; ++q)
+            for (size_t k = 0; k < sizeof blocks / sizeof blocks[0]; ++k) {
+                const size_t row0 = blocks[k][0], n = blocks[k][1];
+                double v[PHC_EXPR_ROWS], g[PHC_EXPR_ROWS * 3], v1[PHC_EXPR_ROWS];
+                CHECK(phc_expr_eval_data(e, params[q], row0, n, v, g, 3) == PHC_OK);
+                CHECK(phc_expr_eval_data(e, params[q], row0, n, v1, NULL, 0) == PHC_OK);
+                for (size_t r = 0; r < n; ++r) {
+                    const double row[2] = {x[row0 + r], t[row0 + r]};
+                    double g1[3];
+                    const double want = phc_expr_eval(e, params[q], row, g1);
+                    int ok = same_bits(v[r], want) && same_bits(v1[r], want);
+                    for (size_t j = 0; j < 3; ++j)
+                        ok &= same_bits(g[r * 3 + j], g1[j]);
+                    if (!ok)
+                        fprintf(stderr, "\"%s\" bound data, row %zu: %.17g (%.17g %.17g %.17g), row by row "
+                                "%.17g (%.17g %.17g %.17g)\n", text, row0 + r, v[r], g[r * 3], g[r * 3 + 1],
+                                g[r * 3 + 2], want, g1[0], g1[1], g1[2]);
+                    CHECK(ok);
+                    ++compared;
+                }
+            }
+        double v[PHC_EXPR_ROWS + 1];
+        CHECK(phc_expr_eval_data(e, params[0], N - 3, 4, v, NULL, 0) == PHC_ERR_INVALID);
+        CHECK(phc_expr_eval_data(e, params[0], 0, PHC_EXPR_ROWS + 1, v, NULL, 0) == PHC_ERR_INVALID);
+        CHECK(phc_expr_prepare(e, 3, &err) == PHC_OK);
+        CHECK(phc_expr_eval_data(e, params[0], 0, 1, v, NULL, 0) == PHC_ERR_INVALID);
+        phc_expr_free(e);
+    }
+    printf("bound data: %ld rows bitwise equal to row-by-row evaluation\n", compared);
+}
+
 int main(void)
 {
     test_values_and_gradients();
     test_rows();
+    test_bound_data();
     test_gradient_layout();
     test_power_at_zero_base();
     test_constants();
