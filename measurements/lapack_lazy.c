@@ -66,3 +66,15 @@ PHC_LAZY_FORWARD_VOID(phc_lazy_blas, cblas_dsyr2,
                        OPENBLAS_CONST blasint incx, OPENBLAS_CONST double *y, OPENBLAS_CONST blasint incy,
                        double *a, OPENBLAS_CONST blasint lda),
                       (order, uplo, n, alpha, x, incx, y, incy, a, lda))
+
+/* LAPACK's divide-and-conquer merge (model/tree_eigen.c); not in lapack.h,
+ * so declared here with model/tree_eigen.c's prototype.  liblapacke's
+ * handle reaches it through its dependency liblapack. */
+void dlaed1_(const lapack_int *n, double *d, double *q, const lapack_int *ldq, lapack_int *indxq,
+             const double *rho, const lapack_int *cutpnt, double *work, lapack_int *iwork,
+             lapack_int *info);
+PHC_LAZY_FORWARD_VOID(phc_lazy_lapack, dlaed1_,
+                      (const lapack_int *n, double *d, double *q, const lapack_int *ldq,
+                       lapack_int *indxq, const double *rho, const lapack_int *cutpnt, double *work,
+                       lapack_int *iwork, lapack_int *info),
+                      (n, d, q, ldq, indxq, rho, cutpnt, work, iwork, info))
