@@ -309,18 +309,25 @@ static int refine_modes(const phc_water_system *s, const double *sqd, double *la
     size_t K = 0;
     while (K < n && fabs(lambda[n - 1 - K]) <= cutoff)
         ++K;
+    double *p = malloc(2 * n * sizeof *p), *isqd = p + n; /* p = D^-1/2 q: pressures */
+    if (!p)
+        return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory");
+    for (size_t k = 0; k < n; ++k)
+        isqd[k] = 1.0 / sqd[k];
     for (size_t i = 0; i + K < n; ++i) {
         const double *q = Q + i * n;
         double fq = 0.0;
+        for (size_t k = 0; k < n; ++k) {
+            p[k] = q[k] * isqd[k];
+            fq += s->ell[k] * q[k] * q[k];
+        }
         for (size_t k = 1; k < n; ++k) {
-            size_t pk = s->par[k];
-            double g = q[k] / sqd[k] - q[pk] / sqd[pk];
+            double g = p[k] - p[s->par[k]];
             fq += s->w[k] * g * g;
         }
-        for (size_t k = 0; k < n; ++k)
-            fq += s->ell[k] * q[k] * q[k];
         lambda[i] = -fq;
     }
+    free(p);
     if (K == 0)
         return PHC_OK;
     size_t rows = n - 1;
@@ -475,17 +482,28 @@ int phc_water_exact_new(const phc_water_system *s, phc_water_exact_kind kind,
     for (size_t i = 0; i < n; ++i)
         e->ab[i] = e->a[i] * e->b[i];
     if (kind == PHC_WATER_EXACT_SENSITIVITY) {
-        double *T = malloc(n * n * sizeof *T);
+        /* M = Q^T D_a Q = T^T T with T = D_a^1/2 Q: only the rows of the
+         * segments that lose water (leaves), so n^2 per such segment. */
+        size_t nl = 0;
+        for (size_t k = 0; k < n; ++k)
+            nl += s->area[k] > 0.0;
+        double *T = malloc((nl ? nl : 1) * n * sizeof *T);
         e->M = malloc(n * n * sizeof *e->M);
         if (!T || !e->M) {
             free(T);
             goto nomem;
         }
-        for (size_t j = 0; j < n; ++j)
+        for (size_t j = 0; j < n; ++j) {
+            size_t r = 0;
             for (size_t k = 0; k < n; ++k)
-                T[j * n + k] = s->area[k] * e->Q[j * n + k];
-        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)n, (int)n, 1.0, e->Q,
-                    (int)n, T, (int)n, 0.0, e->M, (int)n);
+                if (s->area[k] > 0.0)
+                    T[j * nl + r++] = sqrt(s->area[k]) * e->Q[j * n + k];
+        }
+        if (nl == 0)
+            memset(e->M, 0, n * n * sizeof *e->M);
+        else
+            cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)n, (int)nl, 1.0, T,
+                        (int)nl, T, (int)nl, 0.0, e->M, (int)n);
         free(T);
     }
     *out = e;
