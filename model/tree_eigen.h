@@ -15,10 +15,12 @@
  * i's row to the end of the first block and node j's to the start of the
  * second (rows of the eigenvector block are nodes in any order).  Each cut
  * is the edge that splits the subtree's nodes most evenly; subtrees of at
- * most PHC_TREE_EIGEN_LEAF nodes are solved densely (dsyevd).  No
- * tridiagonalisation and no back-transformation: O(n^2) memory, the flops
- * of the merges only (fewer with deflation).  A tree whose nodes have many
- * children (a star) splits unevenly and costs up to O(n^3) per level.
+ * most PHC_TREE_EIGEN_LEAF nodes are solved densely (dsyevd), and so are
+ * subtrees without a cut that leaves >= 1/8 of them on either side (a node
+ * with many children: a star is one dense problem).  No tridiagonalisation
+ * and no back-transformation: O(n^2) memory, the flops of the merges only
+ * (far fewer with deflation: 2000 nodes in 0.04 s for a path, 0.3 s for
+ * random parents, against 0.6-0.9 s for dsyevd, one thread).
  *
  * Pure C, no I/O; LAPACK through the lazy forwarders
  * (measurements/lapack_lazy.c). */

@@ -136,8 +136,8 @@ static void test_path(size_t n)
 }
 
 /* Star: centre c, n - 1 leaves of diagonal a on edges b.  Eigenvalues: a
- * (n - 2 times) and a pair from (x - c)(x - a) = (n - 1) b^2: heavy
- * deflation in every merge. */
+ * (n - 2 times) and a pair from (x - c)(x - a) = (n - 1) b^2.  No cut
+ * leaves 1/8 of the nodes on its smaller side: solved as one dense block. */
 static void test_star(size_t n)
 {
     const double a = -3.0, c = -1.0, b = 0.5;
@@ -158,6 +158,43 @@ static void test_star(size_t n)
     free(diag);
     free(off);
     free(ex);
+}
+
+/* Brooms along a path: `hubs` hubs in a row, each with `leaves` leaves of
+ * equal diagonal a on equal edges b.  Per hub, leaves - 1 eigenvalues are
+ * exactly a (differences of two leaves, zero elsewhere); the cuts run along
+ * the path, so the merges meet these equal eigenvalues in both halves
+ * (deflation of equal poles); the rest against dense dsyevd. */
+static void test_brooms(size_t hubs, size_t leaves)
+{
+    const double a = -2.0, b = 0.7, c = -5.0, e = 0.3;
+    size_t n = hubs * (leaves + 1);
+    size_t *par = calloc(n, sizeof *par);
+    double *diag = malloc(n * sizeof *diag), *off = calloc(n, sizeof *off);
+    size_t k = 0, prev_hub = 0;
+    for (size_t h = 0; h < hubs; ++h) {
+        size_t hub = k++;
+        par[hub] = h ? prev_hub : 0;
+        diag[hub] = c - 0.1 * (double)h;
+        off[hub] = h ? e : 0.0;
+        for (size_t l = 0; l < leaves; ++l, ++k) {
+            par[k] = hub;
+            diag[k] = a;
+            off[k] = b;
+        }
+        prev_hub = hub;
+    }
+    double *lam = solve_and_check("brooms along a path", n, par, diag, off, NULL,
+                                  20.0 * n * DBL_EPSILON * 6.0);
+    size_t at_a = 0;
+    for (size_t i = 0; i < n; ++i)
+        at_a += fabs(lam[i] - a) <= 1e-13;
+    printf("brooms: %zu eigenvalues at a (exactly %zu expected)\n", at_a, hubs * (leaves - 1));
+    CHECK(at_a == hubs * (leaves - 1));
+    free(lam);
+    free(par);
+    free(diag);
+    free(off);
 }
 
 /* Random trees (random parents: bushy; or parent k - 1 - (k % 3 == 0)...:
@@ -203,6 +240,7 @@ int main(void)
     test_path(300);
     test_path(PHC_TREE_EIGEN_LEAF + 1);
     test_star(150);
+    test_brooms(12, 15);
     for (size_t n = 1; n <= 3; ++n)
         test_random_tree(n, 0, 0);
     test_random_tree(PHC_TREE_EIGEN_LEAF, 0, 0);
