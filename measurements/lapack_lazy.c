@@ -1,5 +1,5 @@
 /* The LAPACKE and CBLAS functions libphytocal calls (model/water.c,
- * water_balance.c, particles.c, rod.c; the fit analysis uses
+ * tree_eigen.c, water_balance.c, particles.c, rod.c; the fit analysis uses
  * model/jacobi_svd instead), forwarded to liblapacke and OpenBLAS opened on first use
  * (measurements/lazy_library_internal.h): a run that solves no eigen- or
  * singular-value problem never loads them (nor the reference LAPACK,
@@ -14,21 +14,10 @@ PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dgesvd,
                  (int layout, char jobu, char jobvt, lapack_int m, lapack_int n, double *a, lapack_int lda,
                   double *s, double *u, lapack_int ldu, double *vt, lapack_int ldvt, double *superb),
                  (layout, jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, superb))
-PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dstedc,
-                 (int layout, char compz, lapack_int n, double *d, double *e, double *z, lapack_int ldz),
-                 (layout, compz, n, d, e, z, ldz))
 PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dsyevd,
                  (int layout, char jobz, char uplo, lapack_int n, double *a, lapack_int lda, double *w),
                  (layout, jobz, uplo, n, a, lda, w))
-PHC_LAZY_FORWARD(phc_lazy_lapack, lapack_int, LAPACKE_dsytrd,
-                 (int layout, char uplo, lapack_int n, double *a, lapack_int lda, double *d, double *e,
-                  double *tau),
-                 (layout, uplo, n, a, lda, d, e, tau))
 
-PHC_LAZY_FORWARD_VOID(phc_lazy_blas, cblas_daxpy,
-                      (OPENBLAS_CONST blasint n, OPENBLAS_CONST double alpha, OPENBLAS_CONST double *x,
-                       OPENBLAS_CONST blasint incx, double *y, OPENBLAS_CONST blasint incy),
-                      (n, alpha, x, incx, y, incy))
 PHC_LAZY_FORWARD(phc_lazy_blas, double, cblas_ddot,
                  (OPENBLAS_CONST blasint n, OPENBLAS_CONST double *x, OPENBLAS_CONST blasint incx,
                   OPENBLAS_CONST double *y, OPENBLAS_CONST blasint incy),
@@ -48,21 +37,15 @@ PHC_LAZY_FORWARD_VOID(phc_lazy_blas, cblas_dgemv,
                        OPENBLAS_CONST blasint incx, OPENBLAS_CONST double beta, double *y,
                        OPENBLAS_CONST blasint incy),
                       (order, trans, m, n, alpha, a, lda, x, incx, beta, y, incy))
-PHC_LAZY_FORWARD_VOID(phc_lazy_blas, cblas_dger,
-                      (OPENBLAS_CONST enum CBLAS_ORDER order, OPENBLAS_CONST blasint m, OPENBLAS_CONST blasint n,
-                       OPENBLAS_CONST double alpha, OPENBLAS_CONST double *x, OPENBLAS_CONST blasint incx,
-                       OPENBLAS_CONST double *y, OPENBLAS_CONST blasint incy, double *a,
-                       OPENBLAS_CONST blasint lda),
-                      (order, m, n, alpha, x, incx, y, incy, a, lda))
-PHC_LAZY_FORWARD_VOID(phc_lazy_blas, cblas_dsymv,
-                      (OPENBLAS_CONST enum CBLAS_ORDER order, OPENBLAS_CONST enum CBLAS_UPLO uplo,
-                       OPENBLAS_CONST blasint n, OPENBLAS_CONST double alpha, OPENBLAS_CONST double *a,
-                       OPENBLAS_CONST blasint lda, OPENBLAS_CONST double *x, OPENBLAS_CONST blasint incx,
-                       OPENBLAS_CONST double beta, double *y, OPENBLAS_CONST blasint incy),
-                      (order, uplo, n, alpha, a, lda, x, incx, beta, y, incy))
-PHC_LAZY_FORWARD_VOID(phc_lazy_blas, cblas_dsyr2,
-                      (OPENBLAS_CONST enum CBLAS_ORDER order, OPENBLAS_CONST enum CBLAS_UPLO uplo,
-                       OPENBLAS_CONST blasint n, OPENBLAS_CONST double alpha, OPENBLAS_CONST double *x,
-                       OPENBLAS_CONST blasint incx, OPENBLAS_CONST double *y, OPENBLAS_CONST blasint incy,
-                       double *a, OPENBLAS_CONST blasint lda),
-                      (order, uplo, n, alpha, x, incx, y, incy, a, lda))
+
+/* LAPACK's divide-and-conquer merge (model/tree_eigen.c); not in lapack.h,
+ * so declared here with model/tree_eigen.c's prototype.  liblapacke's
+ * handle reaches it through its dependency liblapack. */
+void dlaed1_(const lapack_int *n, double *d, double *q, const lapack_int *ldq, lapack_int *indxq,
+             const double *rho, const lapack_int *cutpnt, double *work, lapack_int *iwork,
+             lapack_int *info);
+PHC_LAZY_FORWARD_VOID(phc_lazy_lapack, dlaed1_,
+                      (const lapack_int *n, double *d, double *q, const lapack_int *ldq,
+                       lapack_int *indxq, const double *rho, const lapack_int *cutpnt, double *work,
+                       lapack_int *iwork, lapack_int *info),
+                      (n, d, q, ldq, indxq, rho, cutpnt, work, iwork, info))

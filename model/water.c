@@ -6,6 +6,7 @@
  * then runs over contiguous arrays, leaves first (k = n-1 .. 1) and back
  * (k = 1 .. n-1), without fill-in. */
 #include "model/water.h"
+#include "model/tree_eigen.h"
 #include "model/water_internal.h"
 
 #include <cblas.h>
@@ -263,65 +264,124 @@ static void diffusion_apply(const phc_water_system *s, const double *x, double *
     }
 }
 
-/* Dense symmetric A = D^-1/2 R D^-1/2 - D_l, column major, both triangles. */
-static double *dense_symmetric(const phc_water_system *s)
-{
-    size_t n = s->n;
-    double *A = calloc(n * n, sizeof *A);
-    if (!A)
-        return NULL;
-    for (size_t k = 0; k < n; ++k)
-        A[k * n + k] = -s->wsum[k] / s->d[k] - s->ell[k];
-    for (size_t k = 1; k < n; ++k) {
-        size_t pk = s->par[k];
-        double o = s->w[k] / sqrt(s->d[k] * s->d[pk]);
-        A[pk * n + k] = o;
-        A[k * n + pk] = o;
-    }
-    return A;
-}
-
 /* ------------------------------------------------------------------------ */
 /* Exact evaluator                                                           */
 
-/* Tridiagonal form of the lower triangle of A (n x n, column major): d (n),
- * off (n-1).  A is overwritten.  One-stage dsytrd: LAPACK's two-stage
- * reduction (dsytrd_2stage) is ~15% faster here but its W(t) drifted 10x
- * further from BDF6 at t = 1e5 s on plant000 (1e-6 against 1e-7), so the
- * W-only evaluator stays with the accurate one. */
-static int tridiagonal_no_q(lapack_int n, double *A, double *d, double *off, double *tau)
+/* The symmetric A = D^-1/2 R D^-1/2 - D_l (1/s; similar to S, eq. 5) as a
+ * tree (model/tree_eigen.h): diag (n), off (n; off[k] = A(k, par[k]),
+ * off[0] unused). */
+static void symmetric_tree(const phc_water_system *s, double *diag, double *off)
 {
-    return LAPACKE_dsytrd(LAPACK_COL_MAJOR, 'L', n, A, n, d, off, tau);
+    off[0] = 0.0;
+    for (size_t k = 0; k < s->n; ++k)
+        diag[k] = -s->wsum[k] / s->d[k] - s->ell[k];
+    for (size_t k = 1; k < s->n; ++k)
+        off[k] = s->w[k] / sqrt(s->d[k] * s->d[s->par[k]]);
 }
 
-/* A <- H A H with H = I - 2 u u^T, u (n, out) chosen so that H maps
- * vh = sqd/|sqd| onto -sign(sqd_0) e1 (stable choice).  Used by both exact
- * kinds: it puts the initial direction on e1 (W-only) and, as a side effect,
- * fills the tree's sparse matrix, whose Householder reduction otherwise runs
- * through subnormal intermediates and is twice as slow.  q: n workspace. */
-static void reflect_onto_e1(size_t n, double *A, const double *sqd, double sumd, double *u,
-                            double *q)
+/* Refinement of the eigenvalues (and of the slow eigenvectors) of A.  A
+ * backward-stable eigensolver gives every eigenvalue to about eps |A|
+ * absolute; the water model is stiff (|A| = 2.2e8 1/s on plant000 in the
+ * reference mode) while W(t) at long times depends on its slowest modes
+ * (|lambda| ~ 1e-5 1/s), which would then be known to a few digits only.
+ * But -A = F^T F with F = [W^1/2 B D^-1/2; D_l^1/2] (B the tree's edge
+ * incidence, row of edge (k, par k) = e_k - e_par; W the edge weights):
+ * q^T (-A) q = |F q|^2 is a sum of positive terms, with no cancellation of
+ * the large diagonal against the off-diagonal.  So
+ *  1. every eigenvalue becomes the Rayleigh quotient -|F q_i|^2 of its
+ *     vector (error of order |A| times the square of the vector's error);
+ *  2. the K slowest modes (|lambda| <= sqrt(eps) |A|), whose vectors mix
+ *     with each other (gaps below eps |A| / sqrt(eps)), are replaced by the
+ *     Ritz pairs of their span: H = (F V)^T (F V) (K x K, LAPACK dsyevd),
+ *     vectors V Y.  A larger K would bring faster modes into H and, with
+ *     them, absolute errors eps |H| back onto the slow ones.
+ * On plant000 (reference mode) W(1e4 s) moves from 1e-6 to 3e-12 of the
+ * contour-integral value.  lambda ascending on entry (the slow modes are
+ * the last K columns of Q); the refined values may reorder eigenvalues
+ * closer than eps |A|.  Returns PHC_OK, PHC_ERR_NOMEM or PHC_ERR_NUMERIC. */
+static int refine_modes(const phc_water_system *s, const double *sqd, double *lambda, double *Q,
+                        phc_error *err)
 {
-    double nrm = sqrt(sumd), un = 0.0;
-    double sgn = sqd[0] >= 0 ? 1.0 : -1.0;
+    size_t n = s->n;
+    if (n < 2)
+        return PHC_OK;
+    double cutoff = sqrt(DBL_EPSILON) * fmax(fabs(lambda[0]), fabs(lambda[n - 1]));
+    size_t K = 0;
+    while (K < n && fabs(lambda[n - 1 - K]) <= cutoff)
+        ++K;
+    double *p = malloc(2 * n * sizeof *p), *isqd = p + n; /* p = D^-1/2 q: pressures */
+    if (!p)
+        return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory");
     for (size_t k = 0; k < n; ++k)
-        u[k] = sqd[k] / nrm;
-    u[0] += sgn;
+        isqd[k] = 1.0 / sqd[k];
+    for (size_t i = 0; i + K < n; ++i) {
+        const double *q = Q + i * n;
+        double fq = 0.0;
+        for (size_t k = 0; k < n; ++k) {
+            p[k] = q[k] * isqd[k];
+            fq += s->ell[k] * q[k] * q[k];
+        }
+        for (size_t k = 1; k < n; ++k) {
+            double g = p[k] - p[s->par[k]];
+            fq += s->w[k] * g * g;
+        }
+        lambda[i] = -fq;
+    }
+    free(p);
+    if (K == 0)
+        return PHC_OK;
+    size_t rows = n - 1;
     for (size_t k = 0; k < n; ++k)
-        un += u[k] * u[k];
-    un = sqrt(un);
-    for (size_t k = 0; k < n; ++k)
-        u[k] /= un;
-    cblas_dsymv(CblasColMajor, CblasLower, (int)n, 1.0, A, (int)n, u, 1, 0.0, q, 1);
-    double Kq = cblas_ddot((int)n, u, 1, q, 1);
-    cblas_daxpy((int)n, -Kq, u, 1, q, 1);
-    cblas_dsyr2(CblasColMajor, CblasLower, (int)n, -2.0, u, 1, q, 1, A, (int)n);
+        rows += s->ell[k] > 0.0;
+    double *F = malloc(rows * K * sizeof *F), *H = malloc(K * K * sizeof *H);
+    double *mu = malloc(K * sizeof *mu), *G = malloc(n * K * sizeof *G);
+    if (!F || !H || !mu || !G) {
+        free(F);
+        free(H);
+        free(mu);
+        free(G);
+        return phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory for %zu slow modes", K);
+    }
+    const double *V = Q + (n - K) * n; /* the last K columns */
+    for (size_t c = 0; c < K; ++c) {
+        const double *v = V + c * n;
+        double *f = F + c * rows;
+        size_t r = 0;
+        for (size_t k = 1; k < n; ++k) {
+            size_t pk = s->par[k];
+            f[r++] = sqrt(s->w[k]) * (v[k] / sqd[k] - v[pk] / sqd[pk]);
+        }
+        for (size_t k = 0; k < n; ++k)
+            if (s->ell[k] > 0.0)
+                f[r++] = sqrt(s->ell[k]) * v[k];
+    }
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)K, (int)K, (int)rows, 1.0, F,
+                (int)rows, F, (int)rows, 0.0, H, (int)K);
+    free(F);
+    if (LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'L', (lapack_int)K, H, (lapack_int)K, mu) != 0) {
+        free(H);
+        free(mu);
+        free(G);
+        return phc_error_set(err, PHC_ERR_NUMERIC,
+                             "water exact: dsyevd did not converge on the %zu slow modes", K);
+    }
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, (int)n, (int)K, (int)K, 1.0, V, (int)n,
+                H, (int)K, 0.0, G, (int)n);
+    /* mu ascending: lambda = -mu descending, so Ritz pair c goes last - c */
+    for (size_t c = 0; c < K; ++c) {
+        lambda[n - 1 - c] = -mu[c];
+        memcpy(Q + (n - 1 - c) * n, G + c * n, n * sizeof *G);
+    }
+    free(H);
+    free(mu);
+    free(G);
+    return PHC_OK;
 }
 
 struct phc_water_exact {
     size_t n;
     phc_water_exact_kind kind;
-    double *lambda;  /* n, ascending */
+    double *lambda;  /* n, ascending (to within eps |A|: refine_modes) */
     double *ab;      /* n: a_i b_i (g) */
     double *a, *b;   /* n (full kinds) */
     double *Q;       /* n x n column major (full kinds) */
@@ -350,13 +410,12 @@ int phc_water_exact_new(const phc_water_system *s, phc_water_exact_kind kind,
                         phc_water_exact **out, phc_error *err)
 {
     phc_water_exact *e = NULL;
-    double *A = NULL, *tau = NULL, *off = NULL, *Z = NULL;
+    double *Q = NULL, *diag = NULL, *off = NULL;
     if (out)
         *out = NULL;
     if (!s || !out)
         return phc_error_set(err, PHC_ERR_INVALID, "water exact: NULL argument");
     size_t n = s->n;
-    lapack_int ln = (lapack_int)n;
     e = calloc(1, sizeof *e);
     if (!e)
         goto nomem;
@@ -370,8 +429,11 @@ int phc_water_exact_new(const phc_water_system *s, phc_water_exact_kind kind,
     e->ab = malloc(n * sizeof *e->ab);
     e->sqd = malloc(n * sizeof *e->sqd);
     e->perm = malloc(n * sizeof *e->perm);
-    A = dense_symmetric(s);
-    if (!e->lambda || !e->ab || !e->sqd || !e->perm || !A)
+    e->a = malloc(n * sizeof *e->a);
+    diag = malloc(n * sizeof *diag);
+    off = malloc(n * sizeof *off);
+    Q = malloc(n * n * sizeof *Q);
+    if (!e->lambda || !e->ab || !e->sqd || !e->perm || !e->a || !diag || !off || !Q)
         goto nomem;
     memcpy(e->perm, s->perm, n * sizeof *e->perm);
     double sumd = 0.0;
@@ -380,96 +442,68 @@ int phc_water_exact_new(const phc_water_system *s, phc_water_exact_kind kind,
         sumd += s->d[k];
     }
 
+    /* A = Q Lambda Q^T by divide and conquer on the plant's tree. */
+    symmetric_tree(s, diag, off);
+    if (phc_tree_eigen(n, s->par, diag, off, e->lambda, Q, err) ||
+        refine_modes(s, e->sqd, e->lambda, Q, err))
+        goto fail;
+    free(diag);
+    free(off);
+    diag = off = NULL;
+    /* theta(t) = D^1/2 Q exp(Lambda t) Q^T D^-1/2 theta0 and W = 1^T theta:
+     * a = Q^T D^1/2 1, b = Q^T D^-1/2 theta0, W(t) = sum_i a_i b_i
+     * exp(lambda_i t).  theta0 is proportional to d (theta0 = W0 d / sum d),
+     * so b = W0 a / sum d. */
+    cblas_dgemv(CblasColMajor, CblasTrans, (int)n, (int)n, 1.0, Q, (int)n, e->sqd, 1, 0.0, e->a,
+                1);
     if (kind == PHC_WATER_EXACT_TOTAL_ONLY) {
-        /* theta0 is proportional to d, so W(t) = W0 vh^T exp(A t) vh with
-         * vh = sqrt(d)/|sqrt(d)|.  Reflect vh onto e1 (H = I - 2uu^T), reduce
-         * H A H to tridiagonal T with dsytrd('L'), whose Q = H(1)..H(n-1)
-         * leaves e1 fixed: W(t) = W0 sum_i Z(1,i)^2 exp(lambda_i t). */
-        double *u = malloc(n * sizeof *u), *q = malloc(n * sizeof *q);
-        if (!u || !q) {
-            free(u);
-            free(q);
-            goto nomem;
-        }
-        reflect_onto_e1(n, A, e->sqd, sumd, u, q);
-        free(u);
-        free(q);
-        off = malloc((n > 1 ? n - 1 : 1) * sizeof *off);
-        tau = malloc((n > 1 ? n - 1 : 1) * sizeof *tau);
-        Z = malloc(n * n * sizeof *Z);
-        if (!off || !tau || !Z)
-            goto nomem;
-        if (n > 1 && tridiagonal_no_q(ln, A, e->lambda, off, tau) != 0) {
-            phc_error_set(err, PHC_ERR_NUMERIC, "water exact: dsytrd failed");
-            goto fail;
-        }
-        if (n == 1)
-            e->lambda[0] = A[0];
-        if (LAPACKE_dstedc(LAPACK_COL_MAJOR, 'I', ln, e->lambda, off, Z, ln) != 0) {
-            phc_error_set(err, PHC_ERR_NUMERIC, "water exact: dstedc did not converge");
-            goto fail;
-        }
         for (size_t i = 0; i < n; ++i)
-            e->ab[i] = e->w0 * Z[i * n] * Z[i * n];
-        free(A);
-        free(off);
-        free(tau);
-        free(Z);
+            e->ab[i] = e->w0 * e->a[i] * e->a[i] / sumd;
+        free(e->a);
+        e->a = NULL;
+        free(Q);
         *out = e;
         return PHC_OK;
     }
-
-    e->a = malloc(n * sizeof *e->a);
+    e->Q = Q;
+    Q = NULL;
     e->b = malloc(n * sizeof *e->b);
-    if (!e->a || !e->b)
+    if (!e->b)
         goto nomem;
-    {
-        /* A' = H A H (see reflect_onto_e1), A' = Q' L Q'^T, Q = H Q'. */
-        double *u = malloc(n * sizeof *u), *q = malloc(n * sizeof *q);
-        if (!u || !q) {
-            free(u);
-            free(q);
-            goto nomem;
-        }
-        reflect_onto_e1(n, A, e->sqd, sumd, u, q);
-        if (LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'L', ln, A, ln, e->lambda) != 0) {
-            free(u);
-            free(q);
-            phc_error_set(err, PHC_ERR_NUMERIC, "water exact: dsyevd did not converge");
-            goto fail;
-        }
-        cblas_dgemv(CblasColMajor, CblasTrans, (int)n, (int)n, 1.0, A, (int)n, u, 1, 0.0, q, 1);
-        cblas_dger(CblasColMajor, (int)n, (int)n, -2.0, u, 1, q, 1, A, (int)n);
-        free(u);
-        free(q);
-    }
-    e->Q = A;
-    A = NULL;
     {
         double *x = malloc(n * sizeof *x);
         if (!x)
             goto nomem;
         for (size_t k = 0; k < n; ++k)
             x[k] = s->theta0[k] / e->sqd[k];
-        cblas_dgemv(CblasColMajor, CblasTrans, (int)n, (int)n, 1.0, e->Q, (int)n, e->sqd, 1, 0.0,
-                    e->a, 1);
         cblas_dgemv(CblasColMajor, CblasTrans, (int)n, (int)n, 1.0, e->Q, (int)n, x, 1, 0.0, e->b, 1);
         free(x);
     }
     for (size_t i = 0; i < n; ++i)
         e->ab[i] = e->a[i] * e->b[i];
     if (kind == PHC_WATER_EXACT_SENSITIVITY) {
-        double *T = malloc(n * n * sizeof *T);
+        /* M = Q^T D_a Q = T^T T with T = D_a^1/2 Q: only the rows of the
+         * segments that lose water (leaves), so n^2 per such segment. */
+        size_t nl = 0;
+        for (size_t k = 0; k < n; ++k)
+            nl += s->area[k] > 0.0;
+        double *T = malloc((nl ? nl : 1) * n * sizeof *T);
         e->M = malloc(n * n * sizeof *e->M);
         if (!T || !e->M) {
             free(T);
             goto nomem;
         }
-        for (size_t j = 0; j < n; ++j)
+        for (size_t j = 0; j < n; ++j) {
+            size_t r = 0;
             for (size_t k = 0; k < n; ++k)
-                T[j * n + k] = s->area[k] * e->Q[j * n + k];
-        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)n, (int)n, 1.0, e->Q,
-                    (int)n, T, (int)n, 0.0, e->M, (int)n);
+                if (s->area[k] > 0.0)
+                    T[j * nl + r++] = sqrt(s->area[k]) * e->Q[j * n + k];
+        }
+        if (nl == 0)
+            memset(e->M, 0, n * n * sizeof *e->M);
+        else
+            cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, (int)n, (int)n, (int)nl, 1.0, T,
+                        (int)nl, T, (int)nl, 0.0, e->M, (int)n);
         free(T);
     }
     *out = e;
@@ -477,10 +511,9 @@ int phc_water_exact_new(const phc_water_system *s, phc_water_exact_kind kind,
 nomem:
     phc_error_set(err, PHC_ERR_NOMEM, "water exact: out of memory for %zu segments", s->n);
 fail:
-    free(A);
+    free(Q);
+    free(diag);
     free(off);
-    free(tau);
-    free(Z);
     phc_water_exact_free(e);
     return err ? err->status : PHC_ERR_NOMEM;
 }

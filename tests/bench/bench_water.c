@@ -4,11 +4,13 @@
  * Setting: the authors' reference mode (PHC_WATER_REFERENCE: their 2023 C++
  * code's weights and constants, loss 6e-3, initial water 8 g), BDF6 step 10 s.
  *   plant000 (1964 segments, ../shared/data/plants): BDF6 ns per segment per
- *     step over 1000 steps; exact set-up (full dsyevd-style decomposition and
- *     the W-only path); W(t) evaluation; BDF6 W(1e4) error against the exact
+ *     step over 1000 steps; exact set-up (full decomposition and the W-only
+ *     path: divide and conquer on the tree, model/tree_eigen.h), wall and
+ *     CPU time; W(t) evaluation; BDF6 W(1e4) error against the exact
  *     W(1e4) = EXACT_W_1E4 (the authors' matrix evaluated by a contour
- *     integral, tests/realdata/test_water_reference; the eigen evaluators
- *     lose about 1e-16 x stiffness x t, 6e-9 here, and are printed too);
+ *     integral, tests/realdata/test_water_reference; a plain eigensolver
+ *     loses about 1e-16 x stiffness x t, 3e-4 here, the exact evaluator
+ *     refines its eigenvalues: its error is printed too);
  *     a complete delta fit (built through the C API: plant file, CSV table,
  *     phc_weight_curve_new, a problem; then phc_fit_run) to a 1000-sample
  *     weight curve generated from the model itself: mass = 20 g + W(t) with
@@ -79,6 +81,7 @@
 #define TARGET_FIT_S 0.5
 #define TARGET_ERROR_FACTOR 100.0
 #define TARGET_PEER_FACTOR 20.0
+#define TARGET_EXACT_PEER_FACTOR 3.0 /* issue 16: the full exact set-up */
 
 #define REPEAT 5
 #define TRUE_DELTA 6e-3
@@ -112,20 +115,25 @@ static double bdf6_ns(const phc_water_system *s, size_t steps)
     return best;
 }
 
+/* Best wall time of `repeat` set-ups; *cpu: the CPU time (user + sys) of
+ * that run and *load the CPUs other processes kept busy meanwhile. */
 static double exact_setup(const phc_water_system *s, phc_water_exact_kind kind, int repeat,
-                          phc_water_exact **keep)
+                          phc_water_exact **keep, double *cpu, double *load)
 {
     double best = INFINITY;
     phc_error err;
     for (int r = 0; r < repeat; ++r) {
         phc_water_exact *e = NULL;
-        double t0 = now();
+        cpu_mark c0 = cpu_now();
         int rc = phc_water_exact_new(s, kind, &e, &err);
-        double dt = now() - t0;
+        cpu_mark c1 = cpu_now();
         if (rc)
             return NAN;
-        if (dt < best)
-            best = dt;
+        if (c1.wall - c0.wall < best) {
+            best = c1.wall - c0.wall;
+            *cpu = c1.self - c0.self;
+            *load = other_load(c0, c1);
+        }
         if (r == repeat - 1 && keep)
             *keep = e;
         else
@@ -388,10 +396,16 @@ int main(void)
         bdf6_p = bdf6_ns(s, 1000);
         printf("bdf6_ns_per_segment_step_plant000: %.2f ns\n", bdf6_p);
         phc_water_exact *e = NULL, *w = NULL;
-        full_s = exact_setup(s, PHC_WATER_EXACT_FULL, bench_repeats(3), &e);
-        wonly_s = exact_setup(s, PHC_WATER_EXACT_TOTAL_ONLY, bench_repeats(3), &w);
+        double full_cpu = NAN, full_load = NAN, wonly_cpu = NAN, wonly_load = NAN;
+        full_s = exact_setup(s, PHC_WATER_EXACT_FULL, bench_repeats(5), &e, &full_cpu, &full_load);
+        wonly_s = exact_setup(s, PHC_WATER_EXACT_TOTAL_ONLY, bench_repeats(5), &w, &wonly_cpu,
+                              &wonly_load);
         printf("exact_setup_full_plant000: %.3f s\n", full_s);
         printf("exact_setup_w_only_plant000: %.3f s\n", wonly_s);
+        printf("exact_setup_full_cpu_plant000: %.3f s (user + sys of the fastest set-up; other "
+               "processes kept %.1f CPUs busy)\n", full_cpu, full_load);
+        printf("exact_setup_w_only_cpu_plant000: %.3f s (user + sys; other processes kept %.1f CPUs "
+               "busy)\n", wonly_cpu, wonly_load);
         eval_us = INFINITY;
         for (int r = 0; r < bench_repeats(REPEAT); ++r) {
             volatile double acc = 0;
@@ -602,7 +616,7 @@ int main(void)
         printf("speedup_vs_scipy_exact_setup_w_only: %.1f x (target >= %.0f: %s)\n", r_wonly,
                TARGET_PEER_FACTOR, met(r_wonly >= TARGET_PEER_FACTOR));
         printf("speedup_vs_scipy_exact_setup_full: %.1f x (target >= %.0f: %s)\n", r_full,
-               TARGET_PEER_FACTOR, met(r_full >= TARGET_PEER_FACTOR));
+               TARGET_EXACT_PEER_FACTOR, met(r_full >= TARGET_EXACT_PEER_FACTOR));
         printf("speedup_vs_scipy_fit: %.1f x (target >= %.0f: %s)\n", r_fit, TARGET_PEER_FACTOR,
                met(r_fit >= TARGET_PEER_FACTOR));
         printf("speedup_vs_scipy_fit_solve_only: %.1f x (target >= %.0f: %s)\n", r_solve,

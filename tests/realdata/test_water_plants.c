@@ -56,8 +56,10 @@ int main(void)
                    "stiffness*t %.1e\n",
                    names[k], g->n, mode == PHC_WATER_REFERENCE ? "reference" : "reference_2024",
                    W, worst, phc_water_system_stiffness(s) * 1e4);
-            /* exact loses ~1e-16 * stiffness * t relative accuracy */
-            CHECK(worst < 1e-9 + 1e-15 * phc_water_system_stiffness(s) * 1e4);
+            /* a plain eigensolver loses ~1e-16 * stiffness * t relative
+             * accuracy (up to 3e-4 here); the exact evaluator's refined
+             * eigenvalues do not (model/water.c, refine_modes) */
+            CHECK(worst < 1e-9);
             /* the authors' numbers are checked in test_water_reference */
             phc_water_bdf6_free(b);
             phc_water_exact_free(e);

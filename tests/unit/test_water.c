@@ -503,6 +503,55 @@ static void test_sensitivity_delta_only(void)
     phc_plant_graph_free(g);
 }
 
+/* The exact evaluator on a stiff tree large enough for several divide-and-
+ * conquer merges (model/tree_eigen.h): W(t) and theta(t) against BDF6 far
+ * tighter than the 1e-16 * stiffness * t a plain eigensolver guarantees
+ * (the cancellation-free refinement of the eigenvalues; printed), the
+ * W-only evaluator equal to the full one. */
+static void test_exact_stiff_tree(void)
+{
+    enum { N = 400 };
+    phc_plant_graph *g = phc_plant_graph_random(N, 13);
+    const phc_water_weights modes[2] = {PHC_WATER_REFERENCE, PHC_WATER_POISEUILLE};
+    for (int m = 0; m < 2; ++m) {
+        phc_water_system *s = make_system(g, modes[m], 6e-3, 8.0);
+        phc_error err;
+        phc_water_exact *e = NULL, *w = NULL;
+        phc_water_bdf6 *b = NULL;
+        CHECK(phc_water_exact_new(s, PHC_WATER_EXACT_FULL, &e, &err) == 0);
+        CHECK(phc_water_exact_new(s, PHC_WATER_EXACT_TOTAL_ONLY, &w, &err) == 0);
+        CHECK(phc_water_bdf6_new(s, 5.0, 0, &b, &err) == 0);
+        CHECK(phc_water_bdf6_advance(b, 1e4, &err) == 0);
+        double worst = 0.0, worst_w = 0.0;
+        for (double t = 1000.0; t <= 1e4; t += 1000.0) {
+            double Wb = 0.0, We = phc_water_exact_total(e, t);
+            CHECK(phc_water_bdf6_total(b, t, &Wb, NULL, &err) == 0);
+            worst = fmax(worst, fabs(We - Wb) / Wb);
+            worst_w = fmax(worst_w, fabs(phc_water_exact_total(w, t) - We) / We);
+        }
+        double th_e[N], th_b[N], dth = 0.0, thmax = 0.0;
+        CHECK(phc_water_exact_state(e, 1e4, th_e, &err) == 0);
+        CHECK(phc_water_bdf6_state_at(b, 1e4, th_b, NULL, &err) == 0);
+        for (int k = 0; k < N; ++k) {
+            dth = fmax(dth, fabs(th_e[k] - th_b[k]));
+            thmax = fmax(thmax, fabs(th_b[k]));
+        }
+        double stiff = phc_water_system_stiffness(s);
+        printf("exact vs BDF6 (random %d, %s, stiffness %.1e 1/s): W max rel diff %.2e (1e-16 * "
+               "stiffness * 1e4 s = %.1e); W-only vs full %.1e; theta(1e4) %.1e of %.3f g\n",
+               N, m ? "poiseuille" : "reference", stiff, worst, 1e-16 * stiff * 1e4, worst_w, dth,
+               thmax);
+        CHECK(worst < 1e-9);
+        CHECK(worst_w < 1e-12);
+        CHECK(dth < 1e-9 * thmax);
+        phc_water_bdf6_free(b);
+        phc_water_exact_free(e);
+        phc_water_exact_free(w);
+        phc_water_system_free(s);
+    }
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_conservation();
@@ -513,6 +562,7 @@ int main(void)
     test_dense_state();
     test_sensitivity_delta_only();
     test_cut_edge();
+    test_exact_stiff_tree();
     test_errors();
     return check_finish("test_water");
 }
