@@ -672,19 +672,22 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
  * the plane above (lu, gu), computed once per plane and sub-step instead of
  * once for each of a voxel's 7 stencil entries: the same products, the
  * same sums in the same order, so the same numbers to the last bit.  kx,
- * ky, kzc are the plane's face permeabilities, kzd those of the plane
- * below; re, rw, rn, rs the in-plane neighbours (wrapped). */
+ * ky, kzc are the voxel's face permeabilities to its +x, +y, +z
+ * neighbours, kzd[r] the +z face of the voxel below; ln[r], ls[r] and
+ * kys[r] are the fill of the +y and -y neighbours and the -y neighbour's
+ * ky; re and rw index the x neighbours' fill in lc. */
 static inline double water_voxel_pre(const double *restrict wc, const double *restrict ld,
                                      const double *restrict lc, const double *restrict lu,
+                                     const double *restrict ln, const double *restrict ls,
                                      const double *restrict gd, const double *restrict gc,
                                      const double *restrict gu, const double *restrict kx,
-                                     const double *restrict ky, const double *restrict kzc,
-                                     const double *restrict kzd, size_t r, size_t re, size_t rw,
-                                     size_t rn, size_t rs, double cd, double cg, double lw, int up)
+                                     const double *restrict ky, const double *restrict kys,
+                                     const double *restrict kzc, const double *restrict kzd, size_t r,
+                                     size_t re, size_t rw, double cd, double cg, double lw, int up)
 {
     const double l0 = lc[r];
     const double f0 = kx[r] * (lc[re] - l0), f1 = kx[rw] * (lc[rw] - l0);
-    const double f2 = ky[r] * (lc[rn] - l0), f3 = ky[rs] * (lc[rs] - l0);
+    const double f2 = ky[r] * (ln[r] - l0), f3 = kys[r] * (ls[r] - l0);
     const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
     const double q0 = gc[r], qU = gu[r], qD = gd[r];
     const double f6 = kzc[r] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kzc[r]) * (q0 - qU) : 0;
@@ -692,49 +695,81 @@ static inline double water_voxel_pre(const double *restrict wc, const double *re
     return wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
 }
 
-/* One z-plane of a water-only sub-step into `out`: the x-interior of every
- * row has no wrap-around and no branches, so the compiler vectorises it;
- * the two ends of the row are done apart.  The build targets baseline
- * x86-64 (SSE2, 2 doubles per instruction): on x86-64 an AVX2 copy (4
- * doubles) is compiled beside it and chosen at load time by the CPU (GCC
- * function multiversioning).  AVX2 does not imply FMA and the C11 build
- * does not contract a * b + c, so both copies round every operation
+/* GCC function multiversioning for the water sweep's row loops: the build
+ * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
+ * AVX2 copy (4 doubles) and an AVX-512 copy (8 doubles) are compiled
+ * beside it and chosen at load time by the CPU.  Neither uses FMA: the C11
+ * build does not contract a * b + c, so every copy rounds every operation
  * alike: the same numbers to the last bit. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
-__attribute__((target_clones("avx2", "default")))
+#define PHC_SOIL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define PHC_SOIL_CLONES
 #endif
-static void water_plane(size_t nx, size_t ny, const double *restrict wc, const double *restrict ld,
-                        const double *restrict lc, const double *restrict lu, const double *restrict gd,
-                        const double *restrict gc, const double *restrict gu, const double *restrict kx,
-                        const double *restrict ky, const double *restrict kzc, const double *restrict kzd,
-                        double *restrict out, double cd, double cg, double lw, int up)
+
+/* `rows` consecutive full rows (nx voxels each) of a z-plane's water
+ * sub-step into `out`.  Every pointer points at the first row's first
+ * voxel; ln and ls at the fill of the rows' +y and -y neighbours, kys at
+ * the ky of the -y neighbours.  The rows run as one loop over the flat
+ * index, r - 1 and r + 1 the x neighbours: no wrap-around and no branches,
+ * so the compiler vectorises it over all the rows at once (row by row, a
+ * 64-voxel row left a vector loop of 7 AVX-512 iterations and 6 scalar
+ * ones).  That loop gives the first and last voxel of every row the voxel
+ * across the row end as x neighbour (all indices stay inside the rows);
+ * those voxels are then computed again with the x neighbour wrapped around
+ * the row, as the one-voxel stencil has it, so every voxel gets that
+ * stencil's value to the last bit. */
+PHC_SOIL_CLONES
+static void water_rows(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
+                       const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                       const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                       const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                       const double *restrict kys, const double *restrict kzc, const double *restrict kzd,
+                       double *restrict out, double cd, double cg, double lw, int up)
 {
-    const size_t plane = nx * ny;
-    for (size_t j = 0; j < ny; ++j) {
-        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
-        const size_t row = nx * j;
-        {
-            const size_t r = row;
-            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, nx > 1 ? r + 1 : r,
-                                     r + nx - 1, r + jn, r - js, cd, cg, lw, up);
-        }
+    const size_t m = nx * rows, end = m > 0 ? m - 1 : 0;
 #pragma omp simd
-        for (size_t i = 1; i < nx - 1; ++i) {
-            const size_t r = row + i;
-            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, r + 1, r - 1, r + jn,
-                                     r - js, cd, cg, lw, up);
-        }
-        if (nx > 1) {
-            const size_t r = row + nx - 1;
-            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, row, r - 1, r + jn,
-                                     r - js, cd, cg, lw, up);
-        }
+    for (size_t r = 1; r < end; ++r)
+        out[r] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, r, r + 1, r - 1, cd,
+                                 cg, lw, up);
+    for (size_t row = 0; row < m; row += nx) {
+        const size_t last = row + nx - 1;
+        out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
+                                   nx > 1 ? row + 1 : row, last, cd, cg, lw, up);
+        if (nx > 1)
+            out[last] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, last, row,
+                                        last - 1, cd, cg, lw, up);
     }
 }
 
-/* A plane's fill l = w/c (as w times 1/c) and gravity flux g = f_grav p w. */
-static inline void fill_plane(size_t m, const double *restrict w, const double *restrict ic,
-                              const double *restrict p, double a, double *restrict l, double *restrict g)
+/* One z-plane of a water-only sub-step into `out` (pointers at the
+ * plane's first voxel; ld, gd of the plane below, lu, gu of the plane
+ * above, kzd the +z faces of the plane below): the rows 1 .. ny - 2 as
+ * one run of water_rows, whose -y and +y neighbours are the rows before
+ * and after in memory, then rows 0 and ny - 1, whose -y or +y neighbour
+ * wraps around the plane (as the one-voxel stencil has it: across a
+ * closed face the face permeability is 0 and the wrapped value is
+ * multiplied by it). */
+static void water_plane(size_t nx, size_t ny, const double *wc, const double *ld, const double *lc,
+                        const double *lu, const double *gd, const double *gc, const double *gu,
+                        const double *kx, const double *ky, const double *kzc, const double *kzd, double *out,
+                        double cd, double cg, double lw, int up)
+{
+    if (ny > 2)
+        water_rows(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx, gu + nx,
+                   kx + nx, ky + nx, ky, kzc + nx, kzd + nx, out + nx, cd, cg, lw, up);
+    for (size_t j = 0; j < ny; j += ny > 1 ? ny - 1 : 1) {
+        const size_t o = nx * j, on = j + 1 < ny ? o + nx : 0, os = j > 0 ? o - nx : nx * (ny - 1);
+        water_rows(nx, 1, wc + o, ld + o, lc + o, lu + o, lc + on, lc + os, gd + o, gc + o, gu + o, kx + o,
+                   ky + o, ky + os, kzc + o, kzd + o, out + o, cd, cg, lw, up);
+    }
+}
+
+/* The fill l = w/c (as w times 1/c) and gravity flux g = f_grav p w of m
+ * voxels. */
+PHC_SOIL_CLONES
+static void fill_plane(size_t m, const double *restrict w, const double *restrict ic, const double *restrict p,
+                       double a, double *restrict l, double *restrict g)
 {
     for (size_t q = 0; q < m; ++q) {
         l[q] = w[q] * ic[q];
@@ -765,10 +800,11 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, P = nx * ny;
     const long nz = (long)s->nz, base = k0 - (long)T;
+    const size_t S = P + 8; /* ring plane stride: see prepare_ring */
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
-#define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * P)
+#define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
         fill_plane(P, s->w + km, wk->ic + km, s->p + km, a, RING(0, m, 1), RING(0, m, 2));
@@ -861,7 +897,7 @@ static int prepare_ring(phc_soil *s, size_t T)
     if (s->n >= PHC_SOIL_PARALLEL_MIN && !omp_in_parallel())
         threads = (size_t)omp_get_max_threads();
 #endif
-    const size_t per = T * 9 * s->nx * s->ny;
+    const size_t per = T * 9 * (s->nx * s->ny + 8);
     if (wk->ring && wk->ring_per_thread >= per && wk->ring_threads == threads)
         return PHC_OK;
     free(wk->ring);
