@@ -39,7 +39,8 @@ struct phc_soil_work {
     double *sink_w, *sink_v;   /* sink hook buffers */
     double *ring;              /* transport_water's plane rings, ring_per_thread each */
     size_t ring_per_thread, ring_threads;
-    double *plane;             /* nz partial sums */
+    double *plane;             /* nz partial sums (or minima) */
+    size_t *plane_at;          /* nz: the voxel of each plane's minimum (stable_dt_prepared) */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
@@ -86,6 +87,7 @@ static void work_free(phc_soil_work *wk)
     free(wk->sink_v);
     free(wk->ring);
     free(wk->plane);
+    free(wk->plane_at);
     free(wk->top);
     free(wk->damp_x);
     free(wk->damp_y);
@@ -149,11 +151,12 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->ky = field_alloc(n, 0);
     wk->kz = field_alloc(n, 0);
     wk->plane = malloc(nz * sizeof(double));
+    wk->plane_at = malloc(nz * sizeof(size_t));
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
-    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane ||
+    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane || !wk->plane_at ||
         !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
@@ -607,12 +610,16 @@ static void prepare_fields(phc_soil *s)
  * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux. */
 static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
 {
-    const phc_soil_work *wk = s->work;
+    phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
     const double dx2 = s->dx * s->dx;
-    double best = INFINITY;
-    size_t at = 0;
-    for (size_t k = 0; k < nz; ++k)
+    /* the smallest limit of each z-plane and its first voxel, in parallel;
+       then the first plane holding the smallest: the voxel a scan in index
+       order finds */
+#pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
+    for (size_t k = 0; k < nz; ++k) {
+        double best = INFINITY;
+        size_t at = 0;
         for (size_t j = 0; j < ny; ++j)
             for (size_t i = 0; i < nx; ++i) {
                 size_t q = idx3(s, i, j, k);
@@ -633,6 +640,16 @@ static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
                     at = q;
                 }
             }
+        wk->plane[k] = best;
+        wk->plane_at[k] = at;
+    }
+    double best = INFINITY;
+    size_t at = 0;
+    for (size_t k = 0; k < nz; ++k)
+        if (wk->plane[k] < best) {
+            best = wk->plane[k];
+            at = wk->plane_at[k];
+        }
     if (voxel)
         *voxel = at;
     return best;
