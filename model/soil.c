@@ -1,6 +1,8 @@
 /* Soil water and nutrients (Rhizomorph §6): see soil.h. */
 #include "model/soil.h"
 
+#include "model/big_array.h"
+
 #include <ctype.h>
 #include <math.h>
 #ifdef _OPENMP
@@ -106,14 +108,21 @@ static void work_free(phc_soil_work *wk)
 #define PHC_SOIL_ALIGN 64
 
 /* n doubles starting on a PHC_SOIL_ALIGN boundary (zeroed with `zero`),
- * freed by free(); NULL when out of memory. */
+ * freed by free(); NULL when out of memory.  From 2 MiB up in transparent
+ * huge pages where the system allows them (phc_big_array_grow, aligned to
+ * 2 MiB): the 128^3 bench soil's fields and rings span 130 MB, 33000 pages
+ * of 4 KiB, and a sweep streams eight of them side by side.  Measured, 1
+ * thread, CPU time, 3 alternating runs each (load average 5 on 2 CPUs):
+ * 128^3 5.05e8-5.30e8 voxel updates/s in huge pages against 4.62e8-4.77e8
+ * without; 64^3 (14 MB) 5.9e8-7.3e8 against 5.6e8-7.2e8. */
 static double *field_alloc(size_t n, int zero)
 {
     const size_t a = PHC_SOIL_ALIGN / sizeof(double);
     if (n > SIZE_MAX / sizeof(double) - a)
         return NULL;
     const size_t bytes = (n + a - 1) / a * a * sizeof(double);
-    double *f = aligned_alloc(PHC_SOIL_ALIGN, bytes ? bytes : PHC_SOIL_ALIGN);
+    double *f = bytes >= ((size_t)2 << 20) ? phc_big_array_grow(NULL, 0, bytes)
+                                           : aligned_alloc(PHC_SOIL_ALIGN, bytes ? bytes : PHC_SOIL_ALIGN);
     if (f && zero)
         memset(f, 0, bytes);
     return f;
