@@ -964,9 +964,13 @@ static void transport_water(phc_soil *s, double h, size_t T)
  * 1 thread, voxel updates per CPU-second, best of 6 alternating runs (busy
  * machine, load average 4.3 on 2 CPUs): 64^3 3.95e8 with 1 sub-step per
  * sweep, 3.70e8 with 2, 3.49e8 with 4; 128^3 2.27e8 with 1, 2.85e8 with 2,
- * 3.06e8 with 4.  At most nz / 8 either way (the planes each thread
- * recomputes next to its range grow with T) and at least 1.  The numbers
- * do not depend on T. */
+ * 3.06e8 with 4.  Again after the aligned row runs of water_rows and the
+ * huge pages (same measure, 2 runs each, load average 5.8 on 2 CPUs):
+ * 64^3 6.1e8-6.7e8 with 1, 6.2e8-6.5e8 with 2, 5.2e8-5.6e8 with 4;
+ * 128^3 4.3e8-4.4e8 with 2, 5.0e8-5.1e8 with 4, 5.3e8 with 6, 5.1e8-5.2e8
+ * with 8: the rule stands.  At most nz / 8 either way (the planes each
+ * thread recomputes next to its range grow with T) and at least 1.  The
+ * numbers do not depend on T. */
 static size_t block_levels(const phc_soil *s)
 {
     size_t T = s->params.block_steps;
