@@ -102,9 +102,11 @@ static void work_free(phc_soil_work *wk)
 
 /* Bytes a voxel field's start is aligned to: a cache line, so that the
  * water sweep's vector loads of a row run (water_plane) do not each
- * straddle two lines.  Measured on the bench's machine (AMD EPYC, AVX-512
- * copy of water_rows, 1 thread, arrays in L1): 1.30e9 voxel updates/s with
- * the loads aligned against 1.04e9-1.12e9 with them 8, 16 or 32 bytes off. */
+ * straddle two lines.  Measured on the bench's machine (AMD EPYC, AVX2
+ * copy of water_rows, 1 thread, CPU time, 3 runs, arrays in L1 cache):
+ * 1.25e9-1.32e9 voxel updates/s with the loads aligned against
+ * 1.02e9-1.13e9 with them 8 or 16 bytes off (fill_plane: 8.1e9-9.2e9
+ * against 5.4e9-5.5e9). */
 #define PHC_SOIL_ALIGN 64
 
 /* n doubles starting on a PHC_SOIL_ALIGN boundary (zeroed with `zero`),
@@ -752,12 +754,15 @@ static inline double gravity_face(double lower, double upper, double kz, double 
 
 /* GCC function multiversioning for the water sweep's row loops: the build
  * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
- * AVX2 copy (4 doubles) and an AVX-512 copy (8 doubles) are compiled
- * beside it and chosen at load time by the CPU.  Neither uses FMA: the C11
- * build does not contract a * b + c, so every copy rounds every operation
- * alike: the same numbers to the last bit. */
+ * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
+ * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
+ * a * b + c, so both copies round every operation alike: the same numbers
+ * to the last bit.  An AVX-512F copy (8 doubles) measured the same as AVX2
+ * on the bench's machine (AMD EPYC, 1 thread, CPU time, 3 alternating runs,
+ * load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel updates/s against
+ * 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8) and is not built. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
-#define PHC_SOIL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define PHC_SOIL_CLONES
 #endif
@@ -767,9 +772,8 @@ static inline double gravity_face(double lower, double upper, double kz, double 
  * voxel; ln and ls at the fill of the rows' +y and -y neighbours, kys at
  * the ky of the -y neighbours.  The rows run as one loop over the flat
  * index, r - 1 and r + 1 the x neighbours: no wrap-around and no branches,
- * so the compiler vectorises it over all the rows at once (row by row, a
- * 64-voxel row left a vector loop of 7 AVX-512 iterations and 6 scalar
- * ones).  That loop gives the first and last voxel of every row the voxel
+ * so the compiler vectorises it over all the rows at once (row by row,
+ * each row had its own short vector loop and scalar remainder).  That loop gives the first and last voxel of every row the voxel
  * across the row end as x neighbour; those voxels are then computed again
  * with the x neighbour wrapped around the row, as the one-voxel stencil
  * has it, so every voxel gets that stencil's value to the last bit.  With
