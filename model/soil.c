@@ -773,10 +773,11 @@ static inline double gravity_face(double lower, double upper, double kz, double 
  * the ky of the -y neighbours.  The rows run as one loop over the flat
  * index, r - 1 and r + 1 the x neighbours: no wrap-around and no branches,
  * so the compiler vectorises it over all the rows at once (row by row,
- * each row had its own short vector loop and scalar remainder).  That loop gives the first and last voxel of every row the voxel
- * across the row end as x neighbour; those voxels are then computed again
- * with the x neighbour wrapped around the row, as the one-voxel stencil
- * has it, so every voxel gets that stencil's value to the last bit.  With
+ * each row had its own short vector loop and scalar remainder).  That
+ * loop gives the first and last voxel of every row the voxel across the
+ * row end as x neighbour; those voxels are then computed again with the x
+ * neighbour wrapped around the row, as the one-voxel stencil has it, so
+ * every voxel gets that stencil's value to the last bit.  With
  * `inner` (rows with a row before and after them in the plane) the loop
  * takes every voxel, reading the voxel before the first and after the
  * last, which are in the plane, and its loads start on a cache line when
@@ -892,7 +893,10 @@ static size_t wrap_plane(long k, long nz)
  * recomputed by the thread that needs them, with the same arithmetic, so
  * the result does not depend on the chunks (nor the thread count).  Each
  * intermediate sub-step keeps 3 planes of w, l and g in `ring` (T x 3 x 3
- * planes); the face permeabilities, 1/c and p stream from memory once per
+ * planes), and every sub-step a plane of the gravity fluxes through the
+ * faces below its current plane (water_rows' gf: T planes after those,
+ * filled for the sub-step's first plane by gravity_faces); the face
+ * permeabilities, 1/c and p stream from memory once per
  * T sub-steps instead of once per sub-step.  (Outside the box the planes
  * wrap around as the one-step stencil does: across a closed z face the
  * face permeability is 0 and the wrapped values are multiplied by it.) */
@@ -959,9 +963,9 @@ static void transport_water(phc_soil *s, double h, size_t T)
 
 /* The sub-steps one sweep may take: params.block_steps, or with 0 (the
  * default) the most, up to PHC_SOIL_BLOCK_STEPS, whose planes fit in
- * PHC_SOIL_CACHE_BYTES: a sweep with T sub-steps works on 9 T planes of
+ * PHC_SOIL_CACHE_BYTES: a sweep with T sub-steps works on 10 T planes of
  * rings (prepare_ring), the face permeabilities, 1/c and p of T + 1
- * planes and a plane of w and of w_new, (14 T + 7) planes in all.  Where
+ * planes and a plane of w and of w_new, (15 T + 7) planes in all.  Where
  * they fit a core's cache the sub-steps run from it; where even T = 1
  * does not fit, the planes come from memory anyway and PHC_SOIL_BLOCK_STEPS
  * sub-steps per sweep read them once for all.  Measured on the bench soil,
@@ -981,8 +985,8 @@ static size_t block_levels(const phc_soil *s)
     if (!T) {
         const double plane = (double)(s->nx * s->ny) * sizeof(double);
         T = PHC_SOIL_BLOCK_STEPS;
-        if ((14.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
-            while (T > 1 && (14.0 * (double)T + 7.0) * plane > PHC_SOIL_CACHE_BYTES)
+        if ((15.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
+            while (T > 1 && (15.0 * (double)T + 7.0) * plane > PHC_SOIL_CACHE_BYTES)
                 --T;
     }
     if (T > s->nz / 8)
