@@ -574,6 +574,19 @@ static double harmonic(double a, double b)
     return (a > 0 && b > 0) ? 2 * a * b / (a + b) : 0;
 }
 
+/* k = the face permeabilities harmonic(a, b) of m faces, or 0 when the
+ * faces are closed (not `open`). */
+static void face_permeabilities(size_t m, const double *restrict a, const double *restrict b, int open,
+                                double *restrict k)
+{
+    if (open)
+        for (size_t i = 0; i < m; ++i)
+            k[i] = harmonic(a[i], b[i]);
+    else
+        for (size_t i = 0; i < m; ++i)
+            k[i] = 0;
+}
+
 /* 1/c, face permeabilities, surface voxels of every column. */
 static void prepare_fields(phc_soil *s)
 {
@@ -582,19 +595,25 @@ static void prepare_fields(phc_soil *s)
     const phc_soil_boundary *b = s->params.boundary;
     int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
                   b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
+    /* by rows and planes, so that the divisions vectorise: the +x face of a
+       row's last voxel, the +y faces of a plane's last row and the +z faces
+       of the top plane lead to the first voxel, row or plane (wrapped), and
+       are 0 unless that axis is periodic */
+    const double *p = s->p;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
-    for (size_t k = 0; k < nz; ++k)
-        for (size_t j = 0; j < ny; ++j)
-            for (size_t i = 0; i < nx; ++i) {
-                size_t q = idx3(s, i, j, k);
-                wk->ic[q] = 1.0 / s->c[q];
-                size_t qx = i + 1 < nx ? q + 1 : q + 1 - nx;
-                size_t qy = j + 1 < ny ? q + nx : q + nx - plane;
-                size_t qz = k + 1 < nz ? q + plane : q + plane - s->n;
-                wk->kx[q] = (i + 1 < nx || per[0]) ? harmonic(s->p[q], s->p[qx]) : 0;
-                wk->ky[q] = (j + 1 < ny || per[1]) ? harmonic(s->p[q], s->p[qy]) : 0;
-                wk->kz[q] = (k + 1 < nz || per[2]) ? harmonic(s->p[q], s->p[qz]) : 0;
-            }
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kq = plane * k;
+        for (size_t q = kq; q < kq + plane; ++q)
+            wk->ic[q] = 1.0 / s->c[q];
+        for (size_t j = 0; j < ny; ++j) {
+            const size_t r = kq + nx * j, last = r + nx - 1;
+            face_permeabilities(nx - 1, p + r, p + r + 1, 1, wk->kx + r);
+            wk->kx[last] = per[0] ? harmonic(p[last], p[r]) : 0;
+            face_permeabilities(nx, p + r, p + (j + 1 < ny ? r + nx : kq), j + 1 < ny || per[1], wk->ky + r);
+        }
+        face_permeabilities(plane, p + kq, p + (k + 1 < nz ? kq + plane : 0), k + 1 < nz || per[2],
+                            wk->kz + kq);
+    }
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
         for (long k = (long)nz - 1; k >= 0; --k)
