@@ -746,6 +746,23 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
  * ky; re and rw index the x neighbours' fill in lc. */
 static inline double gravity_face(double lower, double upper, double kz, double lw, int up);
 
+/* water_voxel_pre with the gravity fluxes through the voxel's top (f6)
+ * and bottom (f7) faces given. */
+static inline double water_voxel_faces(const double *restrict wc, const double *restrict ld,
+                                       const double *restrict lc, const double *restrict lu,
+                                       const double *restrict ln, const double *restrict ls,
+                                       const double *restrict kx, const double *restrict ky,
+                                       const double *restrict kys, const double *restrict kzc,
+                                       const double *restrict kzd, size_t r, size_t re, size_t rw, double cd,
+                                       double cg, double f6, double f7)
+{
+    const double l0 = lc[r];
+    const double f0 = kx[r] * (lc[re] - l0), f1 = kx[rw] * (lc[rw] - l0);
+    const double f2 = ky[r] * (ln[r] - l0), f3 = kys[r] * (ls[r] - l0);
+    const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
+    return wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
+}
+
 static inline double water_voxel_pre(const double *restrict wc, const double *restrict ld,
                                      const double *restrict lc, const double *restrict lu,
                                      const double *restrict ln, const double *restrict ls,
@@ -755,12 +772,8 @@ static inline double water_voxel_pre(const double *restrict wc, const double *re
                                      const double *restrict kzc, const double *restrict kzd, size_t r,
                                      size_t re, size_t rw, double cd, double cg, double lw, int up)
 {
-    const double l0 = lc[r];
-    const double f0 = kx[r] * (lc[re] - l0), f1 = kx[rw] * (lc[rw] - l0);
-    const double f2 = ky[r] * (ln[r] - l0), f3 = kys[r] * (ls[r] - l0);
-    const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
-    const double f6 = gravity_face(gc[r], gu[r], kzc[r], lw, up), f7 = gravity_face(gd[r], gc[r], kzd[r], lw, up);
-    return wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
+    return water_voxel_faces(wc, ld, lc, lu, ln, ls, kx, ky, kys, kzc, kzd, r, re, rw, cd, cg,
+                             gravity_face(gc[r], gu[r], kzc[r], lw, up), gravity_face(gd[r], gc[r], kzd[r], lw, up));
 }
 
 /* The downward gravity flux through a z face (voxel_faces' f[6] and f[7]):
@@ -820,12 +833,8 @@ static void water_rows(size_t nx, size_t rows, const double *restrict wc, const 
     const size_t m = nx * rows, first = inner ? 0 : 1, end = inner ? m : m > 0 ? m - 1 : 0;
 #pragma omp simd
     for (size_t r = first; r < end; ++r) {
-        const double l0 = lc[r];
-        const double f0 = kx[r] * (lc[r + 1] - l0), f1 = kx[r - 1] * (lc[r - 1] - l0);
-        const double f2 = ky[r] * (ln[r] - l0), f3 = kys[r] * (ls[r] - l0);
-        const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
-        const double f6 = gravity_face(gc[r], gu[r], kzc[r], lw, up), f7 = gf[r];
-        out[r] = wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
+        const double f6 = gravity_face(gc[r], gu[r], kzc[r], lw, up);
+        out[r] = water_voxel_faces(wc, ld, lc, lu, ln, ls, kx, ky, kys, kzc, kzd, r, r + 1, r - 1, cd, cg, f6, gf[r]);
         gf[r] = f6;
     }
     for (size_t row = 0; row < m; row += nx) {
