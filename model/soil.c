@@ -1,6 +1,8 @@
 /* Soil water and nutrients (Rhizomorph §6): see soil.h. */
 #include "model/soil.h"
 
+#include "model/big_array.h"
+
 #include <ctype.h>
 #include <math.h>
 #ifdef _OPENMP
@@ -39,7 +41,8 @@ struct phc_soil_work {
     double *sink_w, *sink_v;   /* sink hook buffers */
     double *ring;              /* transport_water's plane rings, ring_per_thread each */
     size_t ring_per_thread, ring_threads;
-    double *plane;             /* nz partial sums */
+    double *plane;             /* nz partial sums (or minima) */
+    size_t *plane_at;          /* nz: the voxel of each plane's minimum (stable_dt_prepared) */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
@@ -86,6 +89,7 @@ static void work_free(phc_soil_work *wk)
     free(wk->sink_v);
     free(wk->ring);
     free(wk->plane);
+    free(wk->plane_at);
     free(wk->top);
     free(wk->damp_x);
     free(wk->damp_y);
@@ -94,6 +98,36 @@ static void work_free(phc_soil_work *wk)
     free(wk->src_idx);
     free(wk->src_first);
     free(wk);
+}
+
+/* Bytes a voxel field's start is aligned to: a cache line, so that the
+ * water sweep's vector loads of a row run (water_plane) do not each
+ * straddle two lines.  Measured on the bench's machine (AMD EPYC, AVX2
+ * copy of water_rows, 1 thread, CPU time, 3 runs, arrays in L1 cache):
+ * 1.25e9-1.32e9 voxel updates/s with the loads aligned against
+ * 1.02e9-1.13e9 with them 8 or 16 bytes off (fill_plane: 8.1e9-9.2e9
+ * against 5.4e9-5.5e9). */
+#define PHC_SOIL_ALIGN 64
+
+/* n doubles starting on a PHC_SOIL_ALIGN boundary (zeroed with `zero`),
+ * freed by free(); NULL when out of memory.  From 2 MiB up in transparent
+ * huge pages where the system allows them (phc_big_array_grow, aligned to
+ * 2 MiB): the 128^3 bench soil's fields and rings span 130 MB, 33000 pages
+ * of 4 KiB, and a sweep streams eight of them side by side.  Measured, 1
+ * thread, CPU time, 3 alternating runs each (load average 5 on 2 CPUs):
+ * 128^3 5.05e8-5.30e8 voxel updates/s in huge pages against 4.62e8-4.77e8
+ * without; 64^3 (14 MB) 5.9e8-7.3e8 against 5.6e8-7.2e8. */
+static double *field_alloc(size_t n, int zero)
+{
+    const size_t a = PHC_SOIL_ALIGN / sizeof(double);
+    if (n > SIZE_MAX / sizeof(double) - a)
+        return NULL;
+    const size_t bytes = (n + a - 1) / a * a * sizeof(double);
+    double *f = bytes >= ((size_t)2 << 20) ? phc_big_array_grow(NULL, 0, bytes)
+                                           : aligned_alloc(PHC_SOIL_ALIGN, bytes ? bytes : PHC_SOIL_ALIGN);
+    if (f && zero)
+        memset(f, 0, bytes);
+    return f;
 }
 
 phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
@@ -110,29 +144,30 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     s->dx = dx;
     s->params = phc_soil_params_default();
     size_t n = s->n;
-    s->w = calloc(n, sizeof *s->w);
-    s->v = calloc(n, sizeof *s->v);
-    s->c = malloc(n * sizeof *s->c);
-    s->p = calloc(n, sizeof *s->p);
-    s->d = malloc(n * sizeof *s->d);
+    s->w = field_alloc(n, 1);
+    s->v = field_alloc(n, 1);
+    s->c = field_alloc(n, 0);
+    s->p = field_alloc(n, 1);
+    s->d = field_alloc(n, 0);
     s->work = calloc(1, sizeof *s->work);
     phc_soil_work *wk = s->work;
     if (!s->w || !s->v || !s->c || !s->p || !s->d || !wk) {
         phc_soil_free(s);
         return NULL;
     }
-    wk->w_new = malloc(n * sizeof(double));
-    wk->v_new = malloc(n * sizeof(double));
-    wk->ic = malloc(n * sizeof(double));
-    wk->kx = malloc(n * sizeof(double));
-    wk->ky = malloc(n * sizeof(double));
-    wk->kz = malloc(n * sizeof(double));
+    wk->w_new = field_alloc(n, 0);
+    wk->v_new = field_alloc(n, 0);
+    wk->ic = field_alloc(n, 0);
+    wk->kx = field_alloc(n, 0);
+    wk->ky = field_alloc(n, 0);
+    wk->kz = field_alloc(n, 0);
     wk->plane = malloc(nz * sizeof(double));
+    wk->plane_at = malloc(nz * sizeof(size_t));
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
-    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane ||
+    if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane || !wk->plane_at ||
         !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
@@ -539,6 +574,19 @@ static double harmonic(double a, double b)
     return (a > 0 && b > 0) ? 2 * a * b / (a + b) : 0;
 }
 
+/* k = the face permeabilities harmonic(a, b) of m faces, or 0 when the
+ * faces are closed (not `open`). */
+static void face_permeabilities(size_t m, const double *restrict a, const double *restrict b, int open,
+                                double *restrict k)
+{
+    if (open)
+        for (size_t i = 0; i < m; ++i)
+            k[i] = harmonic(a[i], b[i]);
+    else
+        for (size_t i = 0; i < m; ++i)
+            k[i] = 0;
+}
+
 /* 1/c, face permeabilities, surface voxels of every column. */
 static void prepare_fields(phc_soil *s)
 {
@@ -547,19 +595,25 @@ static void prepare_fields(phc_soil *s)
     const phc_soil_boundary *b = s->params.boundary;
     int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
                   b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
+    /* by rows and planes, so that the divisions vectorise: the +x face of a
+       row's last voxel, the +y faces of a plane's last row and the +z faces
+       of the top plane lead to the first voxel, row or plane (wrapped), and
+       are 0 unless that axis is periodic */
+    const double *p = s->p;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
-    for (size_t k = 0; k < nz; ++k)
-        for (size_t j = 0; j < ny; ++j)
-            for (size_t i = 0; i < nx; ++i) {
-                size_t q = idx3(s, i, j, k);
-                wk->ic[q] = 1.0 / s->c[q];
-                size_t qx = i + 1 < nx ? q + 1 : q + 1 - nx;
-                size_t qy = j + 1 < ny ? q + nx : q + nx - plane;
-                size_t qz = k + 1 < nz ? q + plane : q + plane - s->n;
-                wk->kx[q] = (i + 1 < nx || per[0]) ? harmonic(s->p[q], s->p[qx]) : 0;
-                wk->ky[q] = (j + 1 < ny || per[1]) ? harmonic(s->p[q], s->p[qy]) : 0;
-                wk->kz[q] = (k + 1 < nz || per[2]) ? harmonic(s->p[q], s->p[qz]) : 0;
-            }
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kq = plane * k;
+        for (size_t q = kq; q < kq + plane; ++q)
+            wk->ic[q] = 1.0 / s->c[q];
+        for (size_t j = 0; j < ny; ++j) {
+            const size_t r = kq + nx * j, last = r + nx - 1;
+            face_permeabilities(nx - 1, p + r, p + r + 1, 1, wk->kx + r);
+            wk->kx[last] = per[0] ? harmonic(p[last], p[r]) : 0;
+            face_permeabilities(nx, p + r, p + (j + 1 < ny ? r + nx : kq), j + 1 < ny || per[1], wk->ky + r);
+        }
+        face_permeabilities(plane, p + kq, p + (k + 1 < nz ? kq + plane : 0), k + 1 < nz || per[2],
+                            wk->kz + kq);
+    }
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
         for (long k = (long)nz - 1; k >= 0; --k)
@@ -586,12 +640,16 @@ static void prepare_fields(phc_soil *s)
  * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux. */
 static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
 {
-    const phc_soil_work *wk = s->work;
+    phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
     const double dx2 = s->dx * s->dx;
-    double best = INFINITY;
-    size_t at = 0;
-    for (size_t k = 0; k < nz; ++k)
+    /* the smallest limit of each z-plane and its first voxel, in parallel;
+       then the first plane holding the smallest: the voxel a scan in index
+       order finds */
+#pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
+    for (size_t k = 0; k < nz; ++k) {
+        double best = INFINITY;
+        size_t at = 0;
         for (size_t j = 0; j < ny; ++j)
             for (size_t i = 0; i < nx; ++i) {
                 size_t q = idx3(s, i, j, k);
@@ -612,6 +670,16 @@ static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
                     at = q;
                 }
             }
+        wk->plane[k] = best;
+        wk->plane_at[k] = at;
+    }
+    double best = INFINITY;
+    size_t at = 0;
+    for (size_t k = 0; k < nz; ++k)
+        if (wk->plane[k] < best) {
+            best = wk->plane[k];
+            at = wk->plane_at[k];
+        }
     if (voxel)
         *voxel = at;
     return best;
@@ -672,74 +740,171 @@ static inline void voxel_faces(const double *restrict w, const double *restrict 
  * the plane above (lu, gu), computed once per plane and sub-step instead of
  * once for each of a voxel's 7 stencil entries: the same products, the
  * same sums in the same order, so the same numbers to the last bit.  kx,
- * ky, kzc are the plane's face permeabilities, kzd those of the plane
- * below; re, rw, rn, rs the in-plane neighbours (wrapped). */
-static inline double water_voxel_pre(const double *restrict wc, const double *restrict ld,
-                                     const double *restrict lc, const double *restrict lu,
-                                     const double *restrict gd, const double *restrict gc,
-                                     const double *restrict gu, const double *restrict kx,
-                                     const double *restrict ky, const double *restrict kzc,
-                                     const double *restrict kzd, size_t r, size_t re, size_t rw,
-                                     size_t rn, size_t rs, double cd, double cg, double lw, int up)
+ * ky, kzc are the voxel's face permeabilities to its +x, +y, +z
+ * neighbours, kzd[r] the +z face of the voxel below; ln[r], ls[r] and
+ * kys[r] are the fill of the +y and -y neighbours and the -y neighbour's
+ * ky; re and rw index the x neighbours' fill in lc. */
+static inline double gravity_face(double lower, double upper, double kz, double lw, int up);
+
+/* water_voxel_pre with the gravity fluxes through the voxel's top (f6)
+ * and bottom (f7) faces given. */
+static inline double water_voxel_faces(const double *restrict wc, const double *restrict ld,
+                                       const double *restrict lc, const double *restrict lu,
+                                       const double *restrict ln, const double *restrict ls,
+                                       const double *restrict kx, const double *restrict ky,
+                                       const double *restrict kys, const double *restrict kzc,
+                                       const double *restrict kzd, size_t r, size_t re, size_t rw, double cd,
+                                       double cg, double f6, double f7)
 {
     const double l0 = lc[r];
     const double f0 = kx[r] * (lc[re] - l0), f1 = kx[rw] * (lc[rw] - l0);
-    const double f2 = ky[r] * (lc[rn] - l0), f3 = ky[rs] * (lc[rs] - l0);
+    const double f2 = ky[r] * (ln[r] - l0), f3 = kys[r] * (ls[r] - l0);
     const double f4 = kzc[r] * (lu[r] - l0), f5 = kzd[r] * (ld[r] - l0);
-    const double q0 = gc[r], qU = gu[r], qD = gd[r];
-    const double f6 = kzc[r] > 0 ? 0.5 * (qU + q0) - (up ? 0.5 : lw * kzc[r]) * (q0 - qU) : 0;
-    const double f7 = kzd[r] > 0 ? 0.5 * (q0 + qD) - (up ? 0.5 : lw * kzd[r]) * (qD - q0) : 0;
     return wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - f7);
 }
 
-/* One z-plane of a water-only sub-step into `out`: the x-interior of every
- * row has no wrap-around and no branches, so the compiler vectorises it;
- * the two ends of the row are done apart.  The build targets baseline
- * x86-64 (SSE2, 2 doubles per instruction): on x86-64 an AVX2 copy (4
- * doubles) is compiled beside it and chosen at load time by the CPU (GCC
- * function multiversioning).  AVX2 does not imply FMA and the C11 build
- * does not contract a * b + c, so both copies round every operation
- * alike: the same numbers to the last bit. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
-__attribute__((target_clones("avx2", "default")))
-#endif
-static void water_plane(size_t nx, size_t ny, const double *restrict wc, const double *restrict ld,
-                        const double *restrict lc, const double *restrict lu, const double *restrict gd,
-                        const double *restrict gc, const double *restrict gu, const double *restrict kx,
-                        const double *restrict ky, const double *restrict kzc, const double *restrict kzd,
-                        double *restrict out, double cd, double cg, double lw, int up)
+static inline double water_voxel_pre(const double *restrict wc, const double *restrict ld,
+                                     const double *restrict lc, const double *restrict lu,
+                                     const double *restrict ln, const double *restrict ls,
+                                     const double *restrict gd, const double *restrict gc,
+                                     const double *restrict gu, const double *restrict kx,
+                                     const double *restrict ky, const double *restrict kys,
+                                     const double *restrict kzc, const double *restrict kzd, size_t r,
+                                     size_t re, size_t rw, double cd, double cg, double lw, int up)
 {
-    const size_t plane = nx * ny;
-    for (size_t j = 0; j < ny; ++j) {
-        const size_t jn = j + 1 < ny ? nx : nx - plane, js = j > 0 ? nx : nx - plane;
-        const size_t row = nx * j;
-        {
-            const size_t r = row;
-            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, nx > 1 ? r + 1 : r,
-                                     r + nx - 1, r + jn, r - js, cd, cg, lw, up);
-        }
+    return water_voxel_faces(wc, ld, lc, lu, ln, ls, kx, ky, kys, kzc, kzd, r, re, rw, cd, cg,
+                             gravity_face(gc[r], gu[r], kzc[r], lw, up), gravity_face(gd[r], gc[r], kzd[r], lw, up));
+}
+
+/* The downward gravity flux through a z face (voxel_faces' f[6] and f[7]):
+ * g = f_grav p w of the voxel below (`lower`) and above (`upper`), kz the
+ * face permeability; the upwind form when `up`. */
+static inline double gravity_face(double lower, double upper, double kz, double lw, int up)
+{
+    return kz > 0 ? 0.5 * (upper + lower) - (up ? 0.5 : lw * kz) * (lower - upper) : 0;
+}
+
+/* GCC function multiversioning for the water sweep's row loops: the build
+ * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
+ * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
+ * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
+ * a * b + c, so both copies round every operation alike: the same numbers
+ * to the last bit.  An AVX-512F copy (8 doubles) measured the same as AVX2
+ * on the bench's machine (AMD EPYC, 1 thread, CPU time, 3 alternating runs,
+ * load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel updates/s against
+ * 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8) and is not built. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
+#define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define PHC_SOIL_CLONES
+#endif
+
+/* `rows` consecutive full rows (nx voxels each) of a z-plane's water
+ * sub-step into `out`.  Every pointer points at the first row's first
+ * voxel; ln and ls at the fill of the rows' +y and -y neighbours, kys at
+ * the ky of the -y neighbours.  The rows run as one loop over the flat
+ * index, r - 1 and r + 1 the x neighbours: no wrap-around and no branches,
+ * so the compiler vectorises it over all the rows at once (row by row,
+ * each row had its own short vector loop and scalar remainder).  That
+ * loop gives the first and last voxel of every row the voxel across the
+ * row end as x neighbour; those voxels are then computed again with the x
+ * neighbour wrapped around the row, as the one-voxel stencil has it, so
+ * every voxel gets that stencil's value to the last bit.  With
+ * `inner` (rows with a row before and after them in the plane) the loop
+ * takes every voxel, reading the voxel before the first and after the
+ * last, which are in the plane, and its loads start on a cache line when
+ * the plane's rows do; otherwise it skips the first and last voxel.
+ *
+ * gf holds the gravity flux through each voxel's bottom face (f7 of
+ * water_voxel_pre) on entry and through its top face (f6) on return: the
+ * top face of plane k is the bottom face of plane k + 1, so each face's
+ * flux is computed once per sub-step instead of twice, by the same
+ * expression on the same numbers (gravity_face).  The row ends, computed
+ * again, take f7 from gd and kzd as water_voxel_pre does. */
+PHC_SOIL_CLONES
+static void water_rows(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
+                       const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                       const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                       const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                       const double *restrict kys, const double *restrict kzc, const double *restrict kzd,
+                       double *restrict gf, double *restrict out, double cd, double cg, double lw, int up,
+                       int inner)
+{
+    const size_t m = nx * rows, first = inner ? 0 : 1, end = inner ? m : m > 0 ? m - 1 : 0;
 #pragma omp simd
-        for (size_t i = 1; i < nx - 1; ++i) {
-            const size_t r = row + i;
-            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, r + 1, r - 1, r + jn,
-                                     r - js, cd, cg, lw, up);
-        }
+    for (size_t r = first; r < end; ++r) {
+        const double f6 = gravity_face(gc[r], gu[r], kzc[r], lw, up);
+        out[r] = water_voxel_faces(wc, ld, lc, lu, ln, ls, kx, ky, kys, kzc, kzd, r, r + 1, r - 1, cd, cg, f6, gf[r]);
+        gf[r] = f6;
+    }
+    for (size_t row = 0; row < m; row += nx) {
+        const size_t last = row + nx - 1;
+        out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
+                                   nx > 1 ? row + 1 : row, last, cd, cg, lw, up);
+        gf[row] = gravity_face(gc[row], gu[row], kzc[row], lw, up);
         if (nx > 1) {
-            const size_t r = row + nx - 1;
-            out[r] = water_voxel_pre(wc, ld, lc, lu, gd, gc, gu, kx, ky, kzc, kzd, r, row, r - 1, r + jn,
-                                     r - js, cd, cg, lw, up);
+            out[last] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, last, row,
+                                        last - 1, cd, cg, lw, up);
+            gf[last] = gravity_face(gc[last], gu[last], kzc[last], lw, up);
         }
     }
 }
 
-/* A plane's fill l = w/c (as w times 1/c) and gravity flux g = f_grav p w. */
-static inline void fill_plane(size_t m, const double *restrict w, const double *restrict ic,
-                              const double *restrict p, double a, double *restrict l, double *restrict g)
+/* gf = the gravity fluxes through the z faces between two planes (g of
+ * the lower and upper plane, kz of the lower): the face below a sweep's
+ * first plane, water_rows' f7 there. */
+PHC_SOIL_CLONES
+static void gravity_faces(size_t m, const double *restrict lower, const double *restrict upper,
+                          const double *restrict kz, double lw, int up, double *restrict gf)
+{
+    for (size_t q = 0; q < m; ++q)
+        gf[q] = gravity_face(lower[q], upper[q], kz[q], lw, up);
+}
+
+/* One z-plane of a water-only sub-step into `out` (pointers at the
+ * plane's first voxel; ld, gd of the plane below, lu, gu of the plane
+ * above, kzd the +z faces of the plane below): the rows 1 .. ny - 2 as
+ * one run of water_rows, whose -y and +y neighbours are the rows before
+ * and after in memory, then rows 0 and ny - 1, whose -y or +y neighbour
+ * wraps around the plane (as the one-voxel stencil has it: across a
+ * closed face the face permeability is 0 and the wrapped value is
+ * multiplied by it). */
+static void water_plane(size_t nx, size_t ny, const double *wc, const double *ld, const double *lc,
+                        const double *lu, const double *gd, const double *gc, const double *gu,
+                        const double *kx, const double *ky, const double *kzc, const double *kzd, double *gf,
+                        double *out, double cd, double cg, double lw, int up)
+{
+    if (ny > 2)
+        water_rows(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx, gu + nx,
+                   kx + nx, ky + nx, ky, kzc + nx, kzd + nx, gf + nx, out + nx, cd, cg, lw, up, 1);
+    for (size_t j = 0; j < ny; j += ny > 1 ? ny - 1 : 1) {
+        const size_t o = nx * j, on = j + 1 < ny ? o + nx : 0, os = j > 0 ? o - nx : nx * (ny - 1);
+        water_rows(nx, 1, wc + o, ld + o, lc + o, lu + o, lc + on, lc + os, gd + o, gc + o, gu + o, kx + o,
+                   ky + o, ky + os, kzc + o, kzd + o, gf + o, out + o, cd, cg, lw, up, 0);
+    }
+}
+
+/* The fill l = w/c (as w times 1/c) and gravity flux g = f_grav p w of m
+ * voxels. */
+PHC_SOIL_CLONES
+static void fill_plane(size_t m, const double *restrict w, const double *restrict ic, const double *restrict p,
+                       double a, double *restrict l, double *restrict g)
 {
     for (size_t q = 0; q < m; ++q) {
         l[q] = w[q] * ic[q];
         g[q] = a * p[q] * w[q];
     }
+}
+
+/* The stride of the ring's planes of P voxels (doubles): P rounded up to
+ * whole cache lines, so every plane starts on one as the fields do
+ * (field_alloc), and one line more, so that planes of 2^k voxels do not all
+ * start at the same offset in a 4 KiB page (they would compete for the
+ * same sets of the L1 cache). */
+static size_t ring_stride(size_t P)
+{
+    const size_t a = PHC_SOIL_ALIGN / sizeof(double);
+    return (P + a - 1) / a * a + a;
 }
 
 /* The z-plane of unwrapped index k (k < 0 or >= nz wrap around). */
@@ -756,7 +921,10 @@ static size_t wrap_plane(long k, long nz)
  * recomputed by the thread that needs them, with the same arithmetic, so
  * the result does not depend on the chunks (nor the thread count).  Each
  * intermediate sub-step keeps 3 planes of w, l and g in `ring` (T x 3 x 3
- * planes); the face permeabilities, 1/c and p stream from memory once per
+ * planes), and every sub-step a plane of the gravity fluxes through the
+ * faces below its current plane (water_rows' gf: T planes after those,
+ * filled for the sub-step's first plane by gravity_faces); the face
+ * permeabilities, 1/c and p stream from memory once per
  * T sub-steps instead of once per sub-step.  (Outside the box the planes
  * wrap around as the one-step stencil does: across a closed z face the
  * face permeability is 0 and the wrapped values are multiplied by it.) */
@@ -765,10 +933,11 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const phc_soil_work *wk = s->work;
     const size_t nx = s->nx, ny = s->ny, P = nx * ny;
     const long nz = (long)s->nz, base = k0 - (long)T;
+    const size_t S = ring_stride(P);
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
-#define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * P)
+#define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
         fill_plane(P, s->w + km, wk->ic + km, s->p + km, a, RING(0, m, 1), RING(0, m, 2));
@@ -779,9 +948,12 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
             const size_t kk = wrap_plane(k, nz) * P, kd = wrap_plane(k - 1, nz) * P;
             const double *wc = t == 1 ? s->w + kk : RING(t - 1, k, 0);
             double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
+            double *gf = ring + (9 * T + t - 1) * S; /* sub-step t's gravity fluxes through the faces below */
+            if (k == k0 - (long)(T - t))
+                gravity_faces(P, RING(t - 1, k - 1, 2), RING(t - 1, k, 2), wk->kz + kd, lw, up, gf);
             water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
                         RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
-                        wk->ky + kk, wk->kz + kk, wk->kz + kd, out, cd, cg, lw, up);
+                        wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up);
             if (t < T)
                 fill_plane(P, out, wk->ic + kk, s->p + kk, a, RING(t, k, 1), RING(t, k, 2));
         }
@@ -819,26 +991,30 @@ static void transport_water(phc_soil *s, double h, size_t T)
 
 /* The sub-steps one sweep may take: params.block_steps, or with 0 (the
  * default) the most, up to PHC_SOIL_BLOCK_STEPS, whose planes fit in
- * PHC_SOIL_CACHE_BYTES: a sweep with T sub-steps works on 9 T planes of
+ * PHC_SOIL_CACHE_BYTES: a sweep with T sub-steps works on 10 T planes of
  * rings (prepare_ring), the face permeabilities, 1/c and p of T + 1
- * planes and a plane of w and of w_new, (14 T + 7) planes in all.  Where
+ * planes and a plane of w and of w_new, (15 T + 7) planes in all.  Where
  * they fit a core's cache the sub-steps run from it; where even T = 1
  * does not fit, the planes come from memory anyway and PHC_SOIL_BLOCK_STEPS
  * sub-steps per sweep read them once for all.  Measured on the bench soil,
  * 1 thread, voxel updates per CPU-second, best of 6 alternating runs (busy
  * machine, load average 4.3 on 2 CPUs): 64^3 3.95e8 with 1 sub-step per
  * sweep, 3.70e8 with 2, 3.49e8 with 4; 128^3 2.27e8 with 1, 2.85e8 with 2,
- * 3.06e8 with 4.  At most nz / 8 either way (the planes each thread
- * recomputes next to its range grow with T) and at least 1.  The numbers
- * do not depend on T. */
+ * 3.06e8 with 4.  Again after the aligned row runs of water_rows and the
+ * huge pages (same measure, 2 runs each, load average 5.8 on 2 CPUs):
+ * 64^3 6.1e8-6.7e8 with 1, 6.2e8-6.5e8 with 2, 5.2e8-5.6e8 with 4;
+ * 128^3 4.3e8-4.4e8 with 2, 5.0e8-5.1e8 with 4, 5.3e8 with 6, 5.1e8-5.2e8
+ * with 8: the rule stands.  At most nz / 8 either way (the planes each
+ * thread recomputes next to its range grow with T) and at least 1.  The
+ * numbers do not depend on T. */
 static size_t block_levels(const phc_soil *s)
 {
     size_t T = s->params.block_steps;
     if (!T) {
         const double plane = (double)(s->nx * s->ny) * sizeof(double);
         T = PHC_SOIL_BLOCK_STEPS;
-        if ((14.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
-            while (T > 1 && (14.0 * (double)T + 7.0) * plane > PHC_SOIL_CACHE_BYTES)
+        if ((15.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
+            while (T > 1 && (15.0 * (double)T + 7.0) * plane > PHC_SOIL_CACHE_BYTES)
                 --T;
     }
     if (T > s->nz / 8)
@@ -861,11 +1037,11 @@ static int prepare_ring(phc_soil *s, size_t T)
     if (s->n >= PHC_SOIL_PARALLEL_MIN && !omp_in_parallel())
         threads = (size_t)omp_get_max_threads();
 #endif
-    const size_t per = T * 9 * s->nx * s->ny;
+    const size_t per = T * 10 * ring_stride(s->nx * s->ny);
     if (wk->ring && wk->ring_per_thread >= per && wk->ring_threads == threads)
         return PHC_OK;
     free(wk->ring);
-    wk->ring = malloc(threads * per * sizeof(double));
+    wk->ring = field_alloc(threads * per, 0);
     wk->ring_threads = wk->ring ? threads : 0;
     wk->ring_per_thread = per;
     return wk->ring ? PHC_OK : PHC_ERR_NOMEM;

@@ -403,19 +403,27 @@ static phc_soil *random_soil(size_t nx, size_t ny, size_t nz, uint64_t seed)
 static void test_blocked_vs_steps(void)
 {
     /* nz 40: 4 sub-steps per sweep (the default); 13 x 11 rows, so no row
-       is a multiple of a vector; x periodic in one case */
-    static const struct { int upwind, periodic; } C[] = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
-    const size_t nx = 13, ny = 11, nz = 40, K = 23;
+       is a multiple of a vector; x periodic in some cases, y periodic in
+       one; planes of one row or one column and of two rows, where every
+       voxel is at a row's end or in the first or last row (water_plane
+       computes those apart from the rest) */
+    static const struct { int upwind, periodic, yperiodic; size_t nx, ny; } C[] = {
+        {0, 0, 0, 13, 11}, {1, 0, 0, 13, 11}, {0, 1, 0, 13, 11}, {1, 1, 0, 13, 11}, {0, 1, 1, 13, 11},
+        {0, 0, 1, 1, 9},   {1, 1, 0, 7, 1},   {0, 1, 1, 6, 2}};
+    const size_t nz = 40, K = 23;
     int saved = omp_get_max_threads();
     for (size_t c = 0; c < sizeof C / sizeof C[0]; ++c)
         for (int th = 1; th <= 2; ++th) {
             omp_set_num_threads(th);
+            const size_t nx = C[c].nx, ny = C[c].ny;
             phc_soil *s[2];
             for (int r = 0; r < 2; ++r) {
                 s[r] = random_soil(nx, ny, nz, 2026 + c);
                 s[r]->params.gravity = C[c].upwind ? PHC_SOIL_GRAVITY_UPWIND : PHC_SOIL_GRAVITY_LAX_WENDROFF;
                 if (C[c].periodic)
                     s[r]->params.boundary[PHC_SOIL_XMIN] = s[r]->params.boundary[PHC_SOIL_XMAX] = PHC_SOIL_PERIODIC;
+                if (C[c].yperiodic)
+                    s[r]->params.boundary[PHC_SOIL_YMIN] = s[r]->params.boundary[PHC_SOIL_YMAX] = PHC_SOIL_PERIODIC;
                 s[r]->params.substep = 0;
             }
             /* a power of 2 below half the limit: the times k h, and their
@@ -443,10 +451,11 @@ static void test_blocked_vs_steps(void)
                 moved = fmax(moved, fabs(s[0]->w[q] - w0[q]));
             }
             const size_t T = phc_soil_block_steps(s[0]);
-            printf("4c. random %zux%zux%zu%s%s, %d thread%s: %zu steps in one run (%zu per sweep) vs %zu runs of "
+            printf("4c. random %zux%zux%zu%s%s%s, %d thread%s: %zu steps in one run (%zu per sweep) vs %zu runs of "
                    "one step: bit-identical %s (max |dw| %.1e); vs the plain one-voxel stencil: bit-identical %s "
                    "(max |dw| %.1e); sub-steps %zu vs %zu; largest change of w %.3g\n",
-                   nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "", th,
+                   nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "",
+                   C[c].yperiodic ? ", y periodic" : "", th,
                    th > 1 ? "s" : "", K, T, K, same_steps ? "yes" : "NO", d1, same_ref ? "yes" : "NO", d2,
                    s[0]->budget.substeps, s[1]->budget.substeps, moved);
             CHECK(same_steps);
