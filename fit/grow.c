@@ -386,19 +386,12 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
         }
     }
     if (mesh && cfg->shadows) { /* the support blocks the direct light */
-        const size_t nv = phc_support_mesh_vertex_count(mesh), nt = phc_support_mesh_triangle_count(mesh);
-        double *v = malloc(3 * nv * sizeof *v);
-        size_t *t = malloc(3 * nt * sizeof *t);
+        double *v = NULL;
+        size_t *t = NULL, nv = 0, nt = 0;
         phc_error e;
         phc_error_clear(&e);
-        int src = !v || !t;
-        for (size_t i = 0; !src && i < nv; ++i)
-            phc_support_mesh_vertex(mesh, i, v + 3 * i);
-        for (size_t i = 0; !src && i < nt; ++i)
-            phc_support_mesh_triangle(mesh, i, t + 3 * i);
-        if (src)
-            phc_error_set(&e, PHC_ERR_NOMEM, "out of memory");
-        else
+        int src = phc_support_mesh_arrays(mesh, &v, &nv, &t, &nt, &e);
+        if (!src)
             src = phc_climbing_set_shadow_triangles(plant, v, nv, t, nt, &e);
         free(v);
         free(t);

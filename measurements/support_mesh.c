@@ -5,6 +5,8 @@
  * loaded, so the functions that take one use the loaded table. */
 #include "measurements/support_mesh.h"
 
+#include <stdlib.h>
+
 #include "measurements/module_internal.h"
 #include "measurements/support_mesh_module_internal.h"
 
@@ -63,4 +65,26 @@ void phc_support_mesh_triangle(const phc_support_mesh *m, size_t t, size_t idx[3
 int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double n[3])
 {
     return mesh ? loaded()->closest(mesh, x, c, n) : -1;
+}
+
+int phc_support_mesh_arrays(const phc_support_mesh *m, double **vertices, size_t *nv, size_t **triangles,
+                            size_t *nt, phc_error *err)
+{
+    const size_t v = phc_support_mesh_vertex_count(m), t = phc_support_mesh_triangle_count(m);
+    double *vs = malloc((v ? 3 * v : 1) * sizeof *vs);
+    size_t *ts = malloc((t ? 3 * t : 1) * sizeof *ts);
+    if (!vs || !ts) {
+        free(vs);
+        free(ts);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    for (size_t i = 0; i < v; ++i)
+        phc_support_mesh_vertex(m, i, vs + 3 * i);
+    for (size_t i = 0; i < t; ++i)
+        phc_support_mesh_triangle(m, i, ts + 3 * i);
+    *vertices = vs;
+    *nv = v;
+    *triangles = ts;
+    *nt = t;
+    return PHC_OK;
 }

@@ -53,6 +53,13 @@ void phc_support_mesh_bounds(const phc_support_mesh *m, double lo[3], double hi[
 void phc_support_mesh_vertex(const phc_support_mesh *m, size_t i, double v[3]);
 void phc_support_mesh_triangle(const phc_support_mesh *m, size_t t, size_t idx[3]);
 
+/* Copies of all vertices (*vertices: 3·nv doubles, m) and triangles
+ * (*triangles: 3·nt vertex indices), malloc'd, for a caller that needs the
+ * mesh as arrays (the light grid's shadows: phc_climbing_set_shadow_triangles).
+ * Returns 0, or PHC_ERR_NOMEM (err filled, nothing allocated). */
+int phc_support_mesh_arrays(const phc_support_mesh *m, double **vertices, size_t *nv, size_t **triangles,
+                            size_t *nt, phc_error *err);
+
 /* Closest point c (m) on the mesh to x (m), and the unit normal n of the
  * triangle it lies on (right-hand rule over the triangle's vertex order;
  * (0,0,0) for a degenerate triangle).  `mesh` is a phc_support_mesh *.

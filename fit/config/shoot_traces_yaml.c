@@ -45,7 +45,23 @@ static const phc_key_help shoot_traces_help[] = {
                        "distinct point time of the traces is a frame."},
     {NULL, NULL}};
 
-static void mesh_free(void *m) { phc_support_mesh_free(m); }
+/* What the data set keeps alive: the support mesh (closest points) and its
+ * triangles as arrays (shadows). */
+typedef struct support_owner {
+    phc_support_mesh *mesh;
+    double *vertices;
+    size_t *triangles;
+} support_owner;
+
+static void support_owner_free(void *p)
+{
+    support_owner *s = p;
+    if (!s) return;
+    phc_support_mesh_free(s->mesh);
+    free(s->vertices);
+    free(s->triangles);
+    free(s);
+}
 
 static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                              phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
@@ -54,6 +70,7 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
     char *path = NULL, *ppath = NULL;
     phc_grow_config *cfg = NULL;
     phc_support_mesh *mesh = NULL;
+    support_owner *owner = NULL;
     phc_shoot_traces *tr = NULL;
     double *times = NULL;
     long seeds = 8, first = -1, cov_seeds = 64;
@@ -147,7 +164,24 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
         }
     }
     o.plant = cfg->options;
-    if (o.plant.light.extinction > 0 || cfg->light_grid_given) phc_grow_light_grid(cfg, mesh, &o.plant);
+    /* the light grid and the supports' shadows as `phytocal grow` sets them up (fit/grow.c) */
+    if (o.plant.light.extinction > 0 || cfg->light_grid_given || (mesh && cfg->shadows))
+        phc_grow_light_grid(cfg, mesh, &o.plant);
+    if (mesh) {
+        if (!(owner = calloc(1, sizeof *owner))) {
+            rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+            goto done;
+        }
+        owner->mesh = mesh;
+        mesh = NULL;
+        if (cfg->shadows &&
+            (rc = phc_support_mesh_arrays(owner->mesh, &owner->vertices, &o.shadow_vertex_count,
+                                          &owner->triangles, &o.shadow_triangle_count, err)))
+            goto done;
+        o.shadow_vertices = owner->vertices;
+        o.shadow_triangles = owner->triangles;
+        mesh = owner->mesh;
+    }
     if (mesh) {
         o.plant.closest = phc_support_mesh_closest;
         o.plant.closest_user = mesh;
@@ -161,13 +195,14 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
     o.first_seed = first >= 0 ? (uint64_t)first : cfg->options.seed;
     o.is_parameter = is_parameter;
     o.user_data = user_data;
-    o.support_owner = mesh;
-    o.support_free = mesh_free;
+    o.support_owner = owner;
+    o.support_free = support_owner_free;
     if ((rc = phc_shoot_traces_read(path, &tr, err))) {
         if (rc == PHC_ERR_IO) phc_error_prefix(err, rc, "%s:%zu: key 'file'", doc->path, phc_yaml_get(node, "file")->line);
         goto done;
     }
-    mesh = NULL; /* handed over, with the traces */
+    mesh = NULL;
+    owner = NULL; /* handed over, with the traces */
     rc = phc_shoot_traces_new(tr, &o, out, err);
     if (rc)
         phc_error_prefix(err, rc, "%s:%zu", doc->path, node->line);
@@ -177,7 +212,10 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     }
 done:
-    phc_support_mesh_free(mesh);
+    if (owner)
+        support_owner_free(owner); /* holds the mesh */
+    else
+        phc_support_mesh_free(mesh);
     phc_grow_config_free(cfg);
     free(times);
     free(path);

@@ -124,6 +124,15 @@ static phc_climbing_stat_options stat_options(const phc_shoot_traces_options *o)
     return so;
 }
 
+/* The supports' shadows in plant c's light grid, when the options carry
+ * them (0, or the error of phc_climbing_set_shadow_triangles). */
+static int cast_shadows(const phc_shoot_traces_options *o, phc_climbing *c, phc_error *err)
+{
+    if (!o->shadow_triangle_count) return 0;
+    return phc_climbing_set_shadow_triangles(c, o->shadow_vertices, o->shadow_vertex_count,
+                                             o->shadow_triangles, o->shadow_triangle_count, err);
+}
+
 /* Grows one plant with options po and seed, looks at it with a tracer at
  * every frame (fit/costs/shoot_tracer.h) and summarises the traced plant
  * at each observation time j < nt into s[j], the same way as the traces
@@ -138,6 +147,10 @@ static int grow_one(const st_impl *im, const phc_climbing_options *po, uint64_t 
     if (!(co.growth_rate * o->time_step < 1 - co.bud_fraction)) return 1;
     phc_climbing *c = phc_climbing_new(o->position, o->direction, &co, &e);
     if (!c) return e.status == PHC_ERR_NOMEM ? -1 : 1;
+    if (cast_shadows(o, c, &e)) {
+        phc_climbing_free(c);
+        return e.status == PHC_ERR_NOMEM ? -1 : 1;
+    }
     phc_shoot_tracer tracer;
     phc_shoot_tracer_init(&tracer);
     size_t done = 0;
@@ -757,6 +770,10 @@ int phc_shoot_traces_from_model(const phc_shoot_traces_options *o, const double 
     *out = NULL;
     phc_climbing *c = phc_climbing_new(o->position, o->direction, &o->plant, err);
     if (!c) return err ? err->status : PHC_ERR_INVALID;
+    if (cast_shadows(o, c, err)) {
+        phc_climbing_free(c);
+        return err ? err->status : PHC_ERR_INVALID;
+    }
     phc_shoot_tracer tracer;
     phc_shoot_tracer_init(&tracer);
     size_t done = 0;

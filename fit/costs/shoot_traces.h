@@ -76,6 +76,15 @@ typedef struct phc_shoot_traces_options {
                                     between statistics (0: independent sigmas; default 0.5) */
     double frame_interval;       /* s, >= 0: the tracer looked at the plant every frame_interval;
                                     0 (default): at every distinct point time of the traces */
+    /* Supports that cast shadows (the grow config's light.supports_cast_shadows):
+     * triangles rasterised into every grown plant's light grid with
+     * phc_climbing_set_shadow_triangles, as `phytocal grow` does; vertices
+     * 3·n (m), triangles 3·n indices; borrowed (kept alive by the support
+     * owner); 0 triangles: no shadows. */
+    const double *shadow_vertices;
+    size_t shadow_vertex_count;
+    const size_t *shadow_triangles;
+    size_t shadow_triangle_count;
     phc_is_parameter_fn is_parameter; /* which slots are fitted (NULL: branch_probability) */
     void *user_data;
     void *support_owner;         /* freed with support_free when the data set is freed */

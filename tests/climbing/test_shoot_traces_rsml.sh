@@ -43,6 +43,22 @@ else
     echo "not ok - the fits differ: $(head -c 300 "$T/err_csv") $(head -c 300 "$T/err_rsml")"
     FAILED=1
 fi
+# The kind grows its plants as `phytocal grow` does: with the grow config's
+# supports_cast_shadows on (its default), the wall's shadow enters every
+# model plant's light grid, and the same fit comes out otherwise.
+sed 's/supports_cast_shadows: false/supports_cast_shadows: true/' "$T/plant.yaml" >"$T/plant_shadows.yaml"
+sed 's/plant: plant.yaml/plant: plant_shadows.yaml/' "$T/fit_csv.yaml" >"$T/fit_shadows.yaml"
+"$PHC" fit "$T/fit_shadows.yaml" -o "$T/run_shadows" >"$T/out_shadows" 2>"$T/err_shadows"
+RC=$?
+grep -o '"value": [^,]*' "$T/run_shadows/result.json" 2>/dev/null | head -2 | tr '\n' ' ' >"$T/values_shadows"
+echo "csv, wall casting shadows: exit $RC, estimates $(cat "$T/values_shadows")"
+if grep -q 'supports_cast_shadows: true' "$T/plant_shadows.yaml" && [ "$RC" -eq 0 ] && [ -s "$T/values_shadows" ] &&
+   ! cmp -s "$T/values_shadows" "$T/values_csv"; then
+    echo "ok - the wall's shadows change the fit (the kind honours light.supports_cast_shadows)"
+else
+    echo "not ok - shadows on: exit $RC, $(head -c 300 "$T/err_shadows")"
+    FAILED=1
+fi
 REAL="$DATA/rsml/lupin_aero.rsml"
 if [ -r "$REAL" ]; then
     printf 'name: st-real\nparameters:\n  growth_rate: {value: 0.15, lower: 0.05, upper: 0.5}\ndatasets:\n  - kind: shoot_traces\n    file: %s\n    plant: plant.yaml\n    seeds: 2\n' "$REAL" >"$T/fit_real.yaml"
