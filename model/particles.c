@@ -54,7 +54,6 @@ struct phc_particles {
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
     size_t *child_start, *child; /* children (CSR, in index order) */
     size_t *topo;            /* n: every particle after its parent (roots first) */
-    double *frame;           /* 4n: the parent-frame pass's frame of each particle */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
@@ -350,7 +349,6 @@ void phc_particles_free(phc_particles *p)
     free(p->child_start);
     free(p->child);
     free(p->topo);
-    free(p->frame);
     free(p->gq);
     free(p->stress);
     free(p->source_id);
@@ -410,7 +408,6 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(child_start, n + 1);
     ALLOC(child, n);
     ALLOC(topo, n);
-    ALLOC(frame, 4 * n);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
@@ -540,7 +537,6 @@ static int reserve(phc_particles *p, size_t want)
     GROW(linked, 1);
     GROW(child, 1);
     GROW(topo, 1);
-    GROW(frame, 4);
     GROW(gq, 4);
     GROW(stress, 1);
     GROW(source_id, 1);
@@ -1310,43 +1306,88 @@ static void blend(phc_particles *p, size_t i)
     }
 }
 
-/* The parent-frame pass (particles.h, "Stiff shoots"), parents first:
- * each linked particle's frame is its parent's (p->frame: the turn from
- * the rest pose of the root of its linked subtree); its orientation
- * becomes the frame applied to its rest orientation, and its centre is
- * blended toward its rest place in the frame, x_i ← x_i + k (x_i* − x_i),
- * k = s Δt² / (s Δt² + (1 − s) T²); then its anchor.  Sequential (each
- * particle reads its parent's new state), so the result does not depend
- * on the thread count. */
+/* The joint pass (particles.h, "Shoots that bend"), parents first.  For
+ * each linked particle i with parent u (already placed this substep):
+ *   joint      J  = x_u + R(q_u) j_i,   j_i = R(q̄_u)ᵀ (h̄_i − x̄_u) (m),
+ *              the rest head h̄_i = x̄_i − R(q̄_i)(0, 0, L_i/2) held in u's frame;
+ *   free turn  q_f = rot(R(q̃_i) ẑ → (x̃_i − J)/|x̃_i − J|) q̃_i, with the
+ *              inertial prediction x̃_i = x_i + Δt (v_i + Δt a_i),
+ *              q̃_i = exp(ω_i Δt) q_i (follow-the-leader, Müller, Kim,
+ *              Chentanez 2012 §3, on a segment);
+ *   rest turn  q* = q_u q̄_u⁻¹ q̄_i (the rest relative rotation);
+ *   joint      q_i = exp(k log(q* q_f⁻¹)) q_f, k = s Δt² / (s Δt² + (1 − s) T²)
+ *              (one XPBD step of the angular constraint C = log(q* q_f⁻¹),
+ *              compliance α̃ = (1 − s) T² / (s Δt²) per unit inverse inertia,
+ *              λ reset every substep);
+ *   centre     x_i = J + R(q_i)(0, 0, L_i/2) (the segment hangs from J);
+ * then its anchor.  Sequential (each particle reads its parent's new
+ * state), so the result does not depend on the thread count. */
 static void follow_parents(phc_particles *p, double dt)
 {
     const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
     for (size_t t = 0; t < p->n; ++t) {
         const size_t i = p->topo[t];
-        double *f = p->frame + 4 * i;
-        const double *q0 = p->q0 + 4 * i;
-        const double q0_inv[4] = {q0[0], -q0[1], -q0[2], -q0[3]};
-        if (!p->linked[i]) { /* a root: its own turn q q̄⁻¹ */
-            quat_mul(p->qp + 4 * i, q0_inv, f);
+        if (!p->linked[i])
             continue;
-        }
         const size_t u = p->parent[i];
-        memcpy(f, p->frame + 4 * u, 4 * sizeof(double));
         const double s = phc_particles_stiffness(p, i);
         const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
-        if (!(k > 0))
+        if (!(s > 0))
             continue; /* s = 0: no hold */
-        double Rf[9], goal_q[4], dc[3], rc[3];
-        phc_quat_to_matrix(f, Rf);
-        quat_mul(f, q0, goal_q); /* q_i* = f q̄_i */
+        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
+        const double half[3] = {0, 0, p->ax[3 * i + 2]};
+        /* the joint J in u's current frame */
+        double hr[3], hb[3], ju[3], J[3];
+        phc_quat_rotate(q0i, half, hr);
         for (int d = 0; d < 3; ++d)
-            dc[d] = p->x0[3 * i + d] - p->x0[3 * u + d];
-        mat_vec(Rf, dc, rc); /* x_i* − x_p = R_f (x̄_i − x̄_p) */
+            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
+        phc_quat_rotate_inverse(q0u, hb, ju);
+        phc_quat_rotate(qu, ju, J);
+        for (int d = 0; d < 3; ++d)
+            J[d] += p->xp[3 * u + d];
+        /* the free turn: the segment as it was, hung from J, its centre
+         * moved by its load from rest, a Δt² */
+        double dq[4], axis[3], dir[3], qf[4];
+        const double *qt = p->q + 4 * i;
+        phc_quat_rotate(qt, half, axis);
+        for (int d = 0; d < 3; ++d) {
+            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
+            dir[d] = axis[d] + dt * dt * a;
+            axis[d] /= half[2];
+        }
+        const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (dn > 0) {
+            for (int d = 0; d < 3; ++d)
+                dir[d] /= dn;
+            phc_quat_from_two_vectors(axis, dir, dq);
+            quat_mul(dq, qt, qf);
+        } else {
+            memcpy(qf, qt, sizeof qf);
+        }
+        /* the joint's spring: turn q_f by the fraction k toward q* */
+        double q0u_inv[4], rel[4], qs[4], qf_inv[4], dev[4], rv[3];
+        phc_quat_conj(q0u, q0u_inv);
+        quat_mul(q0u_inv, q0i, rel);
+        quat_mul(qu, rel, qs);
+        phc_quat_conj(qf, qf_inv);
+        quat_mul(qs, qf_inv, dev);
+        if (dev[0] < 0)
+            for (int d = 0; d < 4; ++d)
+                dev[d] = -dev[d];
+        phc_quat_log(dev, rv);
+        for (int d = 0; d < 3; ++d)
+            rv[d] *= k;
         double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
-        const double *xu = p->xp + 3 * u;
+        if (k >= 1) {
+            memcpy(q, qs, sizeof qs);
+        } else {
+            quat_exp(rv, dq);
+            quat_mul(dq, qf, q);
+        }
+        quat_normalize(q);
+        phc_quat_rotate(q, half, hr);
         for (int d = 0; d < 3; ++d)
-            x[d] += k * (xu[d] + rc[d] - x[d]);
-        memcpy(q, goal_q, sizeof goal_q);
+            x[d] = J[d] + hr[d];
         if (p->anchored[i]) { /* eq. 5, as after every projection */
             const double ka = p->anchor_k[i];
             for (int d = 0; d < 3; ++d)
