@@ -55,6 +55,9 @@ typedef struct plant_out {
     double mean_angle; /* rad, (a) */
     double tip_z;      /* m, (b) */
     double tip_z_qs;   /* m, (b): the quasi-static tip height (model/particles.h) */
+    double bend;       /* rad, (b): the tip segment's angle below the horizontal */
+    double bend_qs;    /* rad, (b): the same, quasi-static */
+    size_t held;       /* (b): the last particle held by an anchor */
 } plant_out;
 
 /* Copies the plant's segments for the plots and writes its VTK file. */
@@ -163,20 +166,39 @@ static int run_stiffness(int stiff, const phc_support_mesh *table, const char *o
     double b[3], t[3];
     phc_climbing_segment(c, n - 1, b, t);
     p->tip_z = t[2];
-    /* quasi-static: every link settles (1 - s) g T^2 / s below its place in
-       the seed's frame (model/particles.h, follow_parent), s = max(s_min,
-       min(1, age / t_m)) (model/climbing_growth.h); the rest shape is level */
+    /* quasi-static (model/particles.h, "Shoots that bend", the limit
+       Δt -> 0): from the last particle held by an anchor on, each link i
+       turns down from its rest angle to its parent by c_i cos φ_i,
+       φ_i = φ_u + (φ̄_i − φ̄_u) + c_i cos φ_i, c_i = 2 g T² (1 − s_i)/(s_i L_i),
+       s_i = max(s_min, min(1, age / t_m)) (model/climbing_growth.h); φ the
+       angle below the horizontal in the x–z plane (Newton per link). */
     const double T = o.particles.stiffness_step, g = -o.particles.gravity[2];
-    double rb[3], rt[3], d[3];
-    phc_climbing_rest_position(c, n - 1, rb);
-    phc_climbing_rest_direction(c, n - 1, d);
-    for (int k = 0; k < 3; ++k)
-        rt[k] = rb[k] + 0.5 * phc_climbing_length(c, n - 1) * d[k];
-    p->tip_z_qs = rt[2];
-    for (size_t i = 1; i < n; ++i) {
-        const double si = fmax(o.min_stiffness, fmin(1, phc_climbing_age(c, i) / o.particles.maturity_age));
-        p->tip_z_qs -= (1 - si) * g * T * T / si;
+    size_t held = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double a[3];
+        if (phc_climbing_anchor(c, i, a))
+            held = i;
     }
+    double d[3], rd[3], x[3];
+    phc_climbing_direction(c, held, d);
+    phc_climbing_rest_direction(c, held, rd);
+    phc_climbing_position(c, held, x);
+    double phi = atan2(-d[2], d[0]), rphi = atan2(-rd[2], rd[0]);
+    p->tip_z_qs = x[2] - 0.5 * phc_climbing_length(c, held) * sin(phi);
+    for (size_t i = held + 1; i < n; ++i) {
+        const double si = fmax(o.min_stiffness, fmin(1, phc_climbing_age(c, i) / o.particles.maturity_age));
+        const double Li = phc_climbing_length(c, i), ci = 2 * g * T * T * (1 - si) / (si * Li);
+        phc_climbing_rest_direction(c, i, rd);
+        const double rphi_i = atan2(-rd[2], rd[0]), pu = phi + (rphi_i - rphi);
+        for (int it = 0; it < 100; ++it) /* φ − pu − c cos φ = 0 */
+            phi -= (phi - pu - ci * cos(phi)) / (1 + ci * sin(phi));
+        rphi = rphi_i;
+        p->tip_z_qs -= Li * sin(phi);
+    }
+    p->bend_qs = phi;
+    phc_climbing_direction(c, n - 1, d);
+    p->bend = atan2(-d[2], d[0]); /* the tip segment's angle below the horizontal */
+    p->held = held;
     snprintf(p->tag, sizeof p->tag, "%s", stiff ? "stiff" : "soft");
     snprintf(p->title, sizeof p->title, "(b) %s stiffness: tip z = %.1f cm", stiff ? "high" : "low", 100 * p->tip_z);
     const int rc = keep(c, out, p);
@@ -247,18 +269,21 @@ int main(int argc, char **argv)
     const double z_stiff = pl[NETA].tip_z, z_soft = pl[NETA + 1].tip_z;
     printf("climbing Fig. 12 (b): a shoot grown 40 s toward +x from 1 cm before a table edge (top z = 0), dynamics in "
            "0.01 s substeps\n");
-    printf("  high stiffness (t_m 2 s, s_min 0.90): %2zu particles, tip z = %7.2f cm (quasi-static %7.2f cm)\n",
-           pl[NETA].n, 100 * z_stiff, 100 * pl[NETA].tip_z_qs);
-    printf("  low stiffness (t_m 50 s, s_min 0.30): %2zu particles, tip z = %7.2f cm (quasi-static %7.2f cm)\n",
-           pl[NETA + 1].n, 100 * z_soft, 100 * pl[NETA + 1].tip_z_qs);
+    for (int k = NETA; k < NETA + 2; ++k)
+        printf("  %s stiffness (t_m %s s, s_min %s): %2zu particles, %2zu held on the table, tip z = %7.2f cm "
+               "(quasi-static %7.2f cm), tip segment %5.1f deg below the horizontal (quasi-static %5.1f deg)\n",
+               k == NETA ? "high" : "low", k == NETA ? "2" : "50", k == NETA ? "0.90" : "0.30", pl[k].n,
+               pl[k].held + 1, 100 * pl[k].tip_z, 100 * pl[k].tip_z_qs, pl[k].bend * 180 / PI,
+               pl[k].bend_qs * 180 / PI);
     const int level = fabs(z_stiff) < 0.01;
     printf("check: the stiff tip stays within 1 cm of the table top, %.2f cm: %s\n", 100 * z_stiff,
            level ? "pass" : "FAIL");
-    const int hangs = z_soft < z_stiff;
-    printf("check: the soft tip hangs lower, by %.2f cm: %s\n", 100 * (z_stiff - z_soft), hangs ? "pass" : "FAIL");
+    const int hangs = z_soft < z_stiff - 0.05;
+    printf("check: the soft tip hangs at least 5 cm lower, by %.2f cm: %s\n", 100 * (z_stiff - z_soft),
+           hangs ? "pass" : "FAIL");
     const double qs_off = fmax(fabs(z_stiff - pl[NETA].tip_z_qs), fabs(z_soft - pl[NETA + 1].tip_z_qs));
-    const int qs = qs_off < 0.002;
-    printf("check: both tips within 0.2 cm of the quasi-static height, largest difference %.3f cm: %s\n",
+    const int qs = qs_off < 0.01;
+    printf("check: both tips within 1 cm of the quasi-static height, largest difference %.3f cm: %s\n",
            100 * qs_off, qs ? "pass" : "FAIL");
     const int ok = falls && level && hangs && qs;
 
