@@ -120,10 +120,10 @@ static const key_spec KEYS[] = {
      "with collide, kinematic plants (substeps 0) only: each segment's two ends are pushed out too and its centre and "
      "direction rebuilt from them (whole segments out of the support)"},
     {"dynamics", "follow_parent", K_BOOL, OPT(particles.follow_parent), 0, 1, 0, 0, "",
-     "after the projections every particle is held in its parent's frame: s = 1 keeps the rest shape, s < 1 lets a "
-     "link settle (1 - s) g T^2 / s below its place (model/particles.h)"},
+     "after the projections every particle hangs from a joint on its parent, an angular spring: s = 1 keeps the rest "
+     "shape, s < 1 lets a link bend down under its load (model/particles.h)"},
     {"dynamics", "stiffness_step", K_NUM, OPT(particles.stiffness_step), 0, INF, 1, 1, "s",
-     "T: the substep at which follow_parent's blend is s itself"},
+     "T: the substep at which follow_parent's joint turns by the fraction s toward its rest angle"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 

@@ -44,8 +44,9 @@
  *     (stiffness s = max(s_min, min(1, t_l/t_m)) from the particles'
  *     maturity age t_m, passed to model/particles as the age
  *     max(t_l, s_min·t_m); the seed particle is clamped; the particles'
- *     parent-frame pass, particles.follow_parent, holds a mature particle
- *     in its parent's frame), and the current centres and directions are
+ *     joint pass, particles.follow_parent, holds a mature particle at its
+ *     rest angle to its parent and lets a young one bend about its joint),
+ *     and the current centres and directions are
  *     read back.  Velocities and the groups'
  *     rotations carry over from one growth step to the next.  Switching
  *     the dynamics off, or a failed dynamics step, drops the system (the

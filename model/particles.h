@@ -54,39 +54,45 @@
  * Time step (position-based dynamics): predict v += Δt (g + f/m),
  * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
  * from the current x_p (Jacobi), blend, stiffness, anchors}; with
- * follow_parent, the parent-frame pass below; with a collider, one
+ * follow_parent, the joint pass below; with a collider, one
  * collision pass (phc_particles_set_collider); update v = (x_p − x)/Δt,
  * ω from q_p q⁻¹, both times (1 − damping); age += Δt.
  *
- * Stiff shoots (follow_parent; ours).  The Jacobi projections above move
- * a shape only by one group per iteration, so a long chain with s = 1
+ * Shoots that bend (follow_parent; ours).  The Jacobi projections above
+ * move a shape only by one group per iteration, so a long chain with s = 1
  * still bends under a sustained load: a 22 cm shoot clamped at one end
  * hangs nearly vertical after 4000 substeps of 0.01 s (climbing Fig. 12 b),
  * and how far it hangs depends on the time step and the iteration count
  * (README "Effective stiffness").  With follow_parent, after the N
- * iterations every linked particle i, parents before children, is held in
- * its parent's frame (a follow-the-leader pass: Müller, Kim, Chentanez,
- * "Fast simulation of inextensible hair and fur", VRIPHYS 2012, §3, with
- * orientations and rest offsets).  The frame F of a linked subtree is the
- * turn of its root from the rest pose, q_root q̄_root⁻¹, handed from
- * parent to child; then
- *   q_i = F q̄_i,   x_i ← x_i + k_i (x_i* − x_i),   x_i* = x_p + R(F)(x̄_i − x̄_p),
- * and i's anchor again.  The blend is XPBD's first iteration for one
- * constraint of compliance α = (1 − s) T² / (s m) (Macklin, Müller,
- * Chentanez, "XPBD", MIG 2016, eq. 18 with α̃ = α/Δt²):
- *   k_i = s Δt² / (s Δt² + (1 − s) T²),
- * so k = s at Δt = T, k = 1 at s = 1 for every Δt (a tree clamped at its
- * root keeps its rest shape exactly, whatever the substep), and under a
- * constant acceleration a a link settles (1 − s) a T² / s off its place in
- * the frame (quasi-static: it is moved by a Δt² each step and back by the
- * fraction k), the same for every Δt, larger for smaller s.  The links keep
- * their rest angles (orientations are the frame's): a soft shoot sinks by
- * these offsets, it does not bend.  (Orientations that follow the sunken
- * centres, or a blend k of the orientations, made the pass feed the
- * Jacobi projections through the ellipsoid term and settle into lasting
- * oscillations of a 0.5 m cantilever for k between about 0.15 and 0.4.)
- * The pass does not conserve momentum (a parent does not feel its
- * children): meant for plants held at their root.
+ * iterations every linked particle i, parents u before children, hangs
+ * from a joint on its parent (an angular spring, one XPBD step per
+ * substep: Macklin, Müller, Chentanez, "XPBD", MIG 2016, eq. 18; the
+ * segment follow-the-leader of Müller, Kim, Chentanez, "Fast simulation of
+ * inextensible hair and fur", VRIPHYS 2012, §3):
+ *   J   = x_u + R(q_u) R(q̄_u)ᵀ (h̄_i − x̄_u)      the joint: i's rest head
+ *         h̄_i = x̄_i − R(q̄_i)(0, 0, L_i/2) held in u's frame (m);
+ *   q_f = rot(h → h + a Δt²) q_i,  h = R(q_i)(0, 0, L_i/2)   the free turn:
+ *         the last orientation turned by the load a = g + f/m (m s⁻²)
+ *         moving the centre from rest for one substep;
+ *   q*  = q_u q̄_u⁻¹ q̄_i                            the rest angle to u;
+ *   q_i ← exp(k log(q* q_f⁻¹)) q_f,  k = s Δt² / (s Δt² + (1 − s) T²),
+ *   x_i ← J + R(q_i)(0, 0, L_i/2),
+ * then i's anchor.  k is XPBD's answer for the angular constraint
+ * C = log(q* q_f⁻¹) with compliance α̃ = (1 − s) T² / (s Δt²) per unit
+ * inverse inertia and its multiplier reset each substep (so it does not
+ * depend on N); T = stiffness_step.  s = 1 gives k = 1: a tree clamped at
+ * its root keeps its rest shape exactly, whatever the substep.  The centre
+ * follows the orientation, so the joints stay connected and a soft shoot
+ * BENDS.  Static balance (Δt → 0, a link at angle φ below the horizontal,
+ * its parent at φ_u, rest angle 0 between them):
+ *   φ − φ_u = c cos φ,   c = 2 g T² (1 − s) / (s L)  (rad),
+ * the same for every Δt in that limit; each link carries its own weight
+ * only (not the moment of its subtree).  The pass reads the last
+ * orientation and the load, not the velocity, so a soft link relaxes to
+ * its balance in geometric steps of 1 − k without overshoot (a version
+ * predicting with x + vΔt whipped a 0.5 m cantilever to 19 m/s).  The pass
+ * does not conserve momentum (a parent does not feel its children): meant
+ * for plants held at their root.  A particle with s = 0 is not held.
  *
  * Breaking (climbing §4.3; our definition of the stress): after the step,
  * each group's stress is its relative RMS misfit to the best rigid motion,
@@ -126,10 +132,10 @@ typedef struct phc_particles_options {
     double damping;        /* fraction of velocity removed per step, [0, 1); default 0.01 */
     double break_threshold;/* group stress above which the parent link breaks;
                               <= 0: no breaking (default 0) */
-    int follow_parent;     /* 1: the parent-frame pass after the projections
-                              (see "Stiff shoots" above); default 0 */
-    double stiffness_step; /* T, s, > 0: the time step at which the
-                              parent-frame pass blends by s itself; default 0.01 */
+    int follow_parent;     /* 1: the joint pass after the projections
+                              (see "Shoots that bend" above); default 0 */
+    double stiffness_step; /* T, s, > 0: the time step at which the joint
+                              pass turns by the fraction s; default 0.01 */
 } phc_particles_options;
 
 phc_particles_options phc_particles_options_default(void);

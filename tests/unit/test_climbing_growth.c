@@ -425,7 +425,7 @@ int main(void)
 
     /* 6b. release: a shoot anchored on a floor without gravity, then the
        scene turned upside down (gravity +z): weak anchors let go beyond
-       the release distance, strong ones hold.  Without the parent-frame
+       the release distance, strong ones hold.  Without the joint
        pass (particles.follow_parent = 0: the paper's shape matching alone,
        which yields under the load): with it the shoot held at its clamped
        seed particle keeps its shape and hardly pulls on its anchors */

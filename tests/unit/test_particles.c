@@ -533,7 +533,7 @@ static void test_momentum(void)
 }
 
 /* Tip sag of a clamped horizontal chain at rest under gravity. */
-/* follow != 0: with the parent-frame pass; *dev (may be NULL) gets the
+/* follow != 0: with the joint pass; *dev (may be NULL) gets the
  * largest distance of a centre from its rest place (m). */
 static double cantilever_run(size_t nseg, double s, size_t iters, double dt, int follow,
                              size_t *steps_out, double *qout, double *Lc, double *stretch,
