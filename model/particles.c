@@ -1345,42 +1345,44 @@ static void follow_parents(phc_particles *p, double dt)
         phc_quat_rotate(qu, ju, J);
         for (int d = 0; d < 3; ++d)
             J[d] += p->xp[3 * u + d];
-        /* the free turn: the segment as it was, hung from J, its centre
-         * moved by its load from rest, a Δt² */
-        double dq[4], axis[3], dir[3], qf[4];
-        const double *qt = p->q + 4 * i;
-        phc_quat_rotate(qt, half, axis);
-        for (int d = 0; d < 3; ++d) {
-            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
-            dir[d] = axis[d] + dt * dt * a;
-            axis[d] /= half[2];
-        }
-        const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-        if (dn > 0) {
-            for (int d = 0; d < 3; ++d)
-                dir[d] /= dn;
-            phc_quat_from_two_vectors(axis, dir, dq);
-            quat_mul(dq, qt, qf);
-        } else {
-            memcpy(qf, qt, sizeof qf);
-        }
-        /* the joint's spring: turn q_f by the fraction k toward q* */
-        double q0u_inv[4], rel[4], qs[4], qf_inv[4], dev[4], rv[3];
+        /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
+        double q0u_inv[4], rel[4], qs[4];
         phc_quat_conj(q0u, q0u_inv);
         quat_mul(q0u_inv, q0i, rel);
         quat_mul(qu, rel, qs);
-        phc_quat_conj(qf, qf_inv);
-        quat_mul(qs, qf_inv, dev);
-        if (dev[0] < 0)
-            for (int d = 0; d < 4; ++d)
-                dev[d] = -dev[d];
-        phc_quat_log(dev, rv);
-        for (int d = 0; d < 3; ++d)
-            rv[d] *= k;
         double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
         if (k >= 1) {
-            memcpy(q, qs, sizeof qs);
+            memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
         } else {
+            /* the free turn: the segment as it was, hung from J, its
+             * centre moved by its load from rest, a Δt² */
+            double dq[4], axis[3], dir[3], qf[4];
+            const double *qt = p->q + 4 * i;
+            phc_quat_rotate(qt, half, axis);
+            for (int d = 0; d < 3; ++d) {
+                const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
+                dir[d] = axis[d] + dt * dt * a;
+                axis[d] /= half[2];
+            }
+            const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+            if (dn > 0) {
+                for (int d = 0; d < 3; ++d)
+                    dir[d] /= dn;
+                phc_quat_from_two_vectors(axis, dir, dq);
+                quat_mul(dq, qt, qf);
+            } else {
+                memcpy(qf, qt, sizeof qf);
+            }
+            /* the joint's spring: turn q_f by the fraction k toward q* */
+            double qf_inv[4], dev[4], rv[3];
+            phc_quat_conj(qf, qf_inv);
+            quat_mul(qs, qf_inv, dev);
+            if (dev[0] < 0)
+                for (int d = 0; d < 4; ++d)
+                    dev[d] = -dev[d];
+            phc_quat_log(dev, rv);
+            for (int d = 0; d < 3; ++d)
+                rv[d] *= k;
             quat_exp(rv, dq);
             quat_mul(dq, qf, q);
         }
