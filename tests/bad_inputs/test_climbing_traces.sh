@@ -75,7 +75,7 @@ bad_case "light.spread over 89 degrees" spread_fit.yaml "spread.yaml:26" "light.
 
 sed 's/^tropisms:/tropisms:\n  seek_light: maybe/' plant.yaml >seek.yaml
 config seek_fit.yaml ok.csv seek.yaml
-bad_case "seek_light neither true nor false" seek_fit.yaml "seek.yaml:30:15" "tropisms.seek_light" "expected a boolean"
+bad_case "seek_light neither true nor false" seek_fit.yaml "seek.yaml:31:15" "tropisms.seek_light" "expected a boolean"
 
 config frame.yaml ok.csv
 printf '    frame_interval: 0\n' >>frame.yaml
