@@ -54,6 +54,9 @@ struct phc_particles {
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
     size_t *child_start, *child; /* children (CSR, in index order) */
     size_t *topo;            /* n: every particle after its parent (roots first) */
+    size_t *link_depth;      /* n: links from i up to its root (follow_parents' levels) */
+    size_t *level;           /* n: the particles by depth (follow_parents) */
+    size_t *level_start;     /* n + 1: level d is level[level_start[d] .. level_start[d + 1]) */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
@@ -349,6 +352,9 @@ void phc_particles_free(phc_particles *p)
     free(p->child_start);
     free(p->child);
     free(p->topo);
+    free(p->link_depth);
+    free(p->level);
+    free(p->level_start);
     free(p->gq);
     free(p->stress);
     free(p->source_id);
@@ -408,6 +414,9 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(child_start, n + 1);
     ALLOC(child, n);
     ALLOC(topo, n);
+    ALLOC(link_depth, n);
+    ALLOC(level, n);
+    ALLOC(level_start, n + 1);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
@@ -537,6 +546,8 @@ static int reserve(phc_particles *p, size_t want)
     GROW(linked, 1);
     GROW(child, 1);
     GROW(topo, 1);
+    GROW(link_depth, 1);
+    GROW(level, 1);
     GROW(gq, 4);
     GROW(stress, 1);
     GROW(source_id, 1);
@@ -551,6 +562,10 @@ static int reserve(phc_particles *p, size_t want)
     if (!t)
         return -1;
     p->child_start = t;
+    t = realloc(p->level_start, (cap + 1) * sizeof *p->level_start);
+    if (!t)
+        return -1;
+    p->level_start = t;
     t = realloc(p->goff, (cap + 1) * sizeof *p->goff);
     if (!t)
         return -1;
@@ -1310,93 +1325,137 @@ static void blend(phc_particles *p, size_t i)
  * each linked particle i with parent u (already placed this substep):
  *   joint      J  = x_u + R(q_u) j_i,   j_i = R(q̄_u)ᵀ (h̄_i − x̄_u) (m),
  *              the rest head h̄_i = x̄_i − R(q̄_i)(0, 0, L_i/2) held in u's frame;
- *   free turn  q_f = rot(R(q̃_i) ẑ → (x̃_i − J)/|x̃_i − J|) q̃_i, with the
- *              inertial prediction x̃_i = x_i + Δt (v_i + Δt a_i),
- *              q̃_i = exp(ω_i Δt) q_i (follow-the-leader, Müller, Kim,
- *              Chentanez 2012 §3, on a segment);
+ *   free turn  q_f = rot(R(q_i) ẑ → d/|d|) q_i, d = R(q_i)(0, 0, L_i/2) + Δt² a_i,
+ *              a_i = g + f_i/m_i (m s⁻²): the last orientation turned by what
+ *              the load moves the centre in one substep from rest
+ *              (follow-the-leader, Müller, Kim, Chentanez 2012 §3, on a
+ *              segment; no velocity: an inertial prediction whipped a
+ *              0.5 m cantilever to 19 m/s);
  *   rest turn  q* = q_u q̄_u⁻¹ q̄_i (the rest relative rotation);
  *   joint      q_i = exp(k log(q* q_f⁻¹)) q_f, k = s Δt² / (s Δt² + (1 − s) T²)
  *              (one XPBD step of the angular constraint C = log(q* q_f⁻¹),
  *              compliance α̃ = (1 − s) T² / (s Δt²) per unit inverse inertia,
  *              λ reset every substep);
  *   centre     x_i = J + R(q_i)(0, 0, L_i/2) (the segment hangs from J);
- * then its anchor.  Sequential (each particle reads its parent's new
- * state), so the result does not depend on the thread count. */
+ * then its anchor.  Each particle reads only its parent's new state: small
+ * plants run in topological order, large ones level by level (all
+ * particles of one depth at once), with the same numbers, so the result
+ * does not depend on the thread count. */
+/* follow_parents' step for one linked particle i: reads its parent's
+ * final xp, qp and its own state, writes its own xp, qp only, so the
+ * particles of one depth may run in any order or at once. */
+static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double T2)
+{
+    const size_t u = p->parent[i];
+    const double s = phc_particles_stiffness(p, i);
+    const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
+    if (!(s > 0))
+        return; /* s = 0: no hold */
+    const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
+    const double half[3] = {0, 0, p->ax[3 * i + 2]};
+    /* the joint J in u's current frame */
+    double hr[3], hb[3], ju[3], J[3];
+    phc_quat_rotate(q0i, half, hr);
+    for (int d = 0; d < 3; ++d)
+        hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
+    phc_quat_rotate_inverse(q0u, hb, ju);
+    phc_quat_rotate(qu, ju, J);
+    for (int d = 0; d < 3; ++d)
+        J[d] += p->xp[3 * u + d];
+    /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
+    double q0u_inv[4], rel[4], qs[4];
+    phc_quat_conj(q0u, q0u_inv);
+    quat_mul(q0u_inv, q0i, rel);
+    quat_mul(qu, rel, qs);
+    double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
+    if (k >= 1) {
+        memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
+    } else {
+        /* the free turn: the segment as it was, hung from J, its
+         * centre moved by its load from rest, a Δt² */
+        double dq[4], axis[3], dir[3], qf[4];
+        const double *qt = p->q + 4 * i;
+        phc_quat_rotate(qt, half, axis);
+        for (int d = 0; d < 3; ++d) {
+            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
+            dir[d] = axis[d] + dt * dt * a;
+            axis[d] /= half[2];
+        }
+        const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+        if (dn > 0) {
+            for (int d = 0; d < 3; ++d)
+                dir[d] /= dn;
+            phc_quat_from_two_vectors(axis, dir, dq);
+            quat_mul(dq, qt, qf);
+        } else {
+            memcpy(qf, qt, sizeof qf);
+        }
+        /* the joint's spring: turn q_f by the fraction k toward q* */
+        double qf_inv[4], dev[4], rv[3];
+        phc_quat_conj(qf, qf_inv);
+        quat_mul(qs, qf_inv, dev);
+        if (dev[0] < 0)
+            for (int d = 0; d < 4; ++d)
+                dev[d] = -dev[d];
+        phc_quat_log(dev, rv);
+        for (int d = 0; d < 3; ++d)
+            rv[d] *= k;
+        quat_exp(rv, dq);
+        quat_mul(dq, qf, q);
+    }
+    quat_normalize(q);
+    phc_quat_rotate(q, half, hr);
+    for (int d = 0; d < 3; ++d)
+        x[d] = J[d] + hr[d];
+    if (p->anchored[i]) { /* eq. 5, as after every projection */
+        const double ka = p->anchor_k[i];
+        for (int d = 0; d < 3; ++d)
+            x[d] += ka * (p->anchor_at[3 * i + d] - x[d]);
+        if (p->hold_q[i])
+            memcpy(q, p->anchor_q + 4 * i, 4 * sizeof(double));
+    }
+}
+
 static void follow_parents(phc_particles *p, double dt)
 {
     const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
-    for (size_t t = 0; t < p->n; ++t) {
+    const size_t n = p->n;
+    if (!team((long)n)) {
+        for (size_t t = 0; t < n; ++t)
+            if (p->linked[p->topo[t]])
+                follow_one(p, p->topo[t], dt, dt2, T2);
+        return;
+    }
+    /* Levels by depth (a counting sort in topological order, O(n)): a
+     * particle depends only on its parent, one level up, so each level runs
+     * in parallel with the same numbers as the sequential pass. */
+    size_t max_depth = 0;
+    for (size_t t = 0; t < n; ++t) {
         const size_t i = p->topo[t];
-        if (!p->linked[i])
-            continue;
-        const size_t u = p->parent[i];
-        const double s = phc_particles_stiffness(p, i);
-        const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
-        if (!(s > 0))
-            continue; /* s = 0: no hold */
-        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
-        const double half[3] = {0, 0, p->ax[3 * i + 2]};
-        /* the joint J in u's current frame */
-        double hr[3], hb[3], ju[3], J[3];
-        phc_quat_rotate(q0i, half, hr);
-        for (int d = 0; d < 3; ++d)
-            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-        phc_quat_rotate_inverse(q0u, hb, ju);
-        phc_quat_rotate(qu, ju, J);
-        for (int d = 0; d < 3; ++d)
-            J[d] += p->xp[3 * u + d];
-        /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
-        double q0u_inv[4], rel[4], qs[4];
-        phc_quat_conj(q0u, q0u_inv);
-        quat_mul(q0u_inv, q0i, rel);
-        quat_mul(qu, rel, qs);
-        double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
-        if (k >= 1) {
-            memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
-        } else {
-            /* the free turn: the segment as it was, hung from J, its
-             * centre moved by its load from rest, a Δt² */
-            double dq[4], axis[3], dir[3], qf[4];
-            const double *qt = p->q + 4 * i;
-            phc_quat_rotate(qt, half, axis);
-            for (int d = 0; d < 3; ++d) {
-                const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
-                dir[d] = axis[d] + dt * dt * a;
-                axis[d] /= half[2];
-            }
-            const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-            if (dn > 0) {
-                for (int d = 0; d < 3; ++d)
-                    dir[d] /= dn;
-                phc_quat_from_two_vectors(axis, dir, dq);
-                quat_mul(dq, qt, qf);
-            } else {
-                memcpy(qf, qt, sizeof qf);
-            }
-            /* the joint's spring: turn q_f by the fraction k toward q* */
-            double qf_inv[4], dev[4], rv[3];
-            phc_quat_conj(qf, qf_inv);
-            quat_mul(qs, qf_inv, dev);
-            if (dev[0] < 0)
-                for (int d = 0; d < 4; ++d)
-                    dev[d] = -dev[d];
-            phc_quat_log(dev, rv);
-            for (int d = 0; d < 3; ++d)
-                rv[d] *= k;
-            quat_exp(rv, dq);
-            quat_mul(dq, qf, q);
-        }
-        quat_normalize(q);
-        phc_quat_rotate(q, half, hr);
-        for (int d = 0; d < 3; ++d)
-            x[d] = J[d] + hr[d];
-        if (p->anchored[i]) { /* eq. 5, as after every projection */
-            const double ka = p->anchor_k[i];
-            for (int d = 0; d < 3; ++d)
-                x[d] += ka * (p->anchor_at[3 * i + d] - x[d]);
-            if (p->hold_q[i])
-                memcpy(q, p->anchor_q + 4 * i, 4 * sizeof(double));
-        }
+        const size_t d = p->linked[i] ? p->link_depth[p->parent[i]] + 1 : 0;
+        p->link_depth[i] = d;
+        if (d > max_depth)
+            max_depth = d;
+    }
+    size_t *start = p->level_start;
+    memset(start, 0, (max_depth + 2) * sizeof *start);
+    for (size_t i = 0; i < n; ++i)
+        ++start[p->link_depth[i] + 1];
+    for (size_t d = 0; d <= max_depth; ++d)
+        start[d + 1] += start[d];
+    for (size_t t = 0; t < n; ++t) { /* stable: each level in topological order */
+        const size_t i = p->topo[t];
+        p->level[start[p->link_depth[i]]++] = i;
+    }
+    for (size_t d = max_depth + 1; d > 0; --d)
+        start[d] = start[d - 1];
+    start[0] = 0;
+#pragma omp parallel
+    for (size_t d = 1; d <= max_depth; ++d) { /* level 0: the roots, not linked */
+        const long lo = (long)start[d], hi = (long)start[d + 1];
+#pragma omp for schedule(static)
+        for (long t = lo; t < hi; ++t)
+            follow_one(p, p->level[t], dt, dt2, T2);
     }
 }
 
