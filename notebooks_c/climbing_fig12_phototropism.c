@@ -132,7 +132,7 @@ static int run_phototropism(double eta, const char *out, plant_out *p)
     }
     p->mean_angle = sum / (double)n;
     snprintf(p->tag, sizeof p->tag, "eta%g", eta);
-    snprintf(p->title, sizeof p->title, "(a) eta = %g/s: %.1f deg to the light", eta, p->mean_angle * 180 / PI);
+    snprintf(p->title, sizeof p->title, "(a) eta = %g/s: %.1f deg to light", eta, p->mean_angle * 180 / PI);
     const int rc = keep(c, out, p);
     phc_climbing_free(c);
     return rc;
