@@ -315,10 +315,11 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
     return rc;
 }
 
-/* The light grid when the config gives none: the support's box (or, with
- * no support, a 1 m box over the seed) widened by 0.25 m on every side. */
+/* The light grid, when the plant needs one (grow.h). */
 void phc_grow_light_grid(const phc_grow_config *cfg, const phc_support_mesh *m, phc_climbing_options *o)
 {
+    if (!(o->light.extinction > 0 || cfg->light_grid_given || (m && cfg->shadows)))
+        return;
     double lo[3], hi[3];
     if (cfg->light_grid_given) {
         for (int k = 0; k < 3; ++k) {
@@ -370,8 +371,7 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
                                  cfg->source, cfg->support_line, e.message);
     }
     phc_climbing_options o = cfg->options;
-    if (o.light.extinction > 0 || cfg->light_grid_given || (mesh && cfg->shadows))
-        phc_grow_light_grid(cfg, mesh, &o);
+    phc_grow_light_grid(cfg, mesh, &o);
     if (mesh) {
         o.closest = phc_support_mesh_closest;
         o.closest_user = mesh;

@@ -49,9 +49,13 @@ typedef struct phc_grow_summary {
     double max_radius;         /* m: thickest particle (after secondary growth) */
 } phc_grow_summary;
 
-/* Fills o's light grid (origin and dims) when the config gives none: the
+/* Sets up o's light grid (origin and dims) when the plant needs one: light
+ * extinction (self-shading), a grid given in the config, or a support m that
+ * casts shadows (light.supports_cast_shadows); otherwise leaves o alone.
+ * The grid: with light.origin and light.size given, their box; else the
  * support's box (or, with no support, a 1 m box over the seed) widened by
- * 0.25 m on every side; with light.origin and light.size given, their box. */
+ * 0.25 m on every side.  `phytocal grow` and the shoot_traces kind both
+ * set up their plants' light through it. */
 struct phc_support_mesh;
 void phc_grow_light_grid(const phc_grow_config *cfg, const struct phc_support_mesh *m, phc_climbing_options *o);
 

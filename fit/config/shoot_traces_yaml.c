@@ -165,8 +165,7 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
     }
     o.plant = cfg->options;
     /* the light grid and the supports' shadows as `phytocal grow` sets them up (fit/grow.c) */
-    if (o.plant.light.extinction > 0 || cfg->light_grid_given || (mesh && cfg->shadows))
-        phc_grow_light_grid(cfg, mesh, &o.plant);
+    phc_grow_light_grid(cfg, mesh, &o.plant);
     if (mesh) {
         if (!(owner = calloc(1, sizeof *owner))) {
             rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
