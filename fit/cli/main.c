@@ -639,63 +639,6 @@ static int batch_row_text(char **field, const char *text)
     return text && !*field ? -1 : 0;
 }
 
-static char *copy_text(const char *s, int *failed)
-{
-    char *c = s ? strdup(s) : NULL;
-    *failed |= s && !c;
-    return c;
-}
-
-static int copy_file_record(phc_provenance_file *to, const phc_provenance_file *from)
-{
-    int failed = 0;
-    *to = *from;
-    to->path = copy_text(from->path, &failed);
-    to->absolute = copy_text(from->absolute, &failed);
-    return failed;
-}
-
-/* A copy of the provenance every group of an --each batch shares (its
- * config and data were hashed once, when the batch read them), started now. */
-static int provenance_copy(const phc_provenance *from, phc_provenance **out, phc_error *err)
-{
-    int failed = 0;
-    phc_provenance *pv = calloc(1, sizeof *pv);
-    if (!pv)
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    *pv = *from;
-    pv->version = copy_text(from->version, &failed);
-    pv->git = copy_text(from->git, &failed);
-    pv->command_line = copy_text(from->command_line, &failed);
-    pv->working_directory = copy_text(from->working_directory, &failed);
-    pv->host = copy_text(from->host, &failed);
-    pv->config = from->config ? calloc(1, sizeof *pv->config) : NULL;
-    pv->inputs = from->n_inputs ? calloc(from->n_inputs, sizeof *pv->inputs) : NULL;
-    pv->seeds = from->n_seeds ? calloc(from->n_seeds, sizeof *pv->seeds) : NULL;
-    failed |= (from->config && !pv->config) || (from->n_inputs && !pv->inputs) || (from->n_seeds && !pv->seeds);
-    if (!failed && pv->config)
-        failed |= copy_file_record(pv->config, from->config);
-    for (size_t i = 0; !failed && i < from->n_inputs; ++i)
-        failed |= copy_file_record(&pv->inputs[i], &from->inputs[i]);
-    for (size_t i = 0; !failed && i < from->n_seeds; ++i)
-        pv->seeds[i] = copy_text(from->seeds[i], &failed);
-    if (failed) { /* phc_provenance_free frees what was copied (NULL where not) */
-        if (!pv->inputs)
-            pv->n_inputs = 0;
-        if (!pv->seeds)
-            pv->n_seeds = 0;
-        phc_provenance_free(pv);
-        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    }
-    const time_t t = time(NULL);
-    struct tm tm;
-    if (!gmtime_r(&t, &tm) || !strftime(pv->started, sizeof pv->started, "%Y-%m-%dT%H:%M:%SZ", &tm))
-        pv->started[0] = '\0';
-    pv->finished[0] = '\0';
-    *out = pv;
-    return PHC_OK;
-}
-
 /* Fits one job into tmpdir/<name>/ and fills its row.  Returns the exit
  * code `phytocal fit` alone would give it. */
 static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n, int full_argc, char **full_argv,
@@ -723,7 +666,7 @@ static int batch_fit_one(batch_job *job, const char *column, size_t k, size_t n,
     if (!quiet && !tty)
         fprintf(stderr, "%s\n", prefix);
     if (!rc)
-        rc = job->shared ? provenance_copy(job->shared, &pv, &err)
+        rc = job->shared ? phc_provenance_restart(job->shared, &pv, &err)
                          : phc_provenance_begin(pb, full_argc, full_argv, phc_version(), PHC_GIT_COMMIT, &pv, &err);
     if (!rc && (rc = phc_fit_run(pb, progress, &prog, &res, &err)))
         batch_row_text(&row->status, "failed");

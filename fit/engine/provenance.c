@@ -180,6 +180,58 @@ void phc_provenance_end(phc_provenance *pv)
         utc_now(pv->finished);
 }
 
+static char *copy_text(const char *s, int *failed)
+{
+    char *c = s ? strdup(s) : NULL;
+    *failed |= s && !c;
+    return c;
+}
+
+static int copy_file_record(phc_provenance_file *to, const phc_provenance_file *from)
+{
+    int failed = 0;
+    *to = *from;
+    to->path = copy_text(from->path, &failed);
+    to->absolute = copy_text(from->absolute, &failed);
+    return failed;
+}
+
+int phc_provenance_restart(const phc_provenance *from, phc_provenance **out, phc_error *err)
+{
+    int failed = 0;
+    phc_provenance *pv = calloc(1, sizeof *pv);
+    if (!pv)
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    *pv = *from;
+    pv->version = copy_text(from->version, &failed);
+    pv->git = copy_text(from->git, &failed);
+    pv->command_line = copy_text(from->command_line, &failed);
+    pv->working_directory = copy_text(from->working_directory, &failed);
+    pv->host = copy_text(from->host, &failed);
+    pv->config = from->config ? calloc(1, sizeof *pv->config) : NULL;
+    pv->inputs = from->n_inputs ? calloc(from->n_inputs, sizeof *pv->inputs) : NULL;
+    pv->seeds = from->n_seeds ? calloc(from->n_seeds, sizeof *pv->seeds) : NULL;
+    failed |= (from->config && !pv->config) || (from->n_inputs && !pv->inputs) || (from->n_seeds && !pv->seeds);
+    if (!failed && pv->config)
+        failed |= copy_file_record(pv->config, from->config);
+    for (size_t i = 0; !failed && i < from->n_inputs; ++i)
+        failed |= copy_file_record(&pv->inputs[i], &from->inputs[i]);
+    for (size_t i = 0; !failed && i < from->n_seeds; ++i)
+        pv->seeds[i] = copy_text(from->seeds[i], &failed);
+    if (failed) { /* phc_provenance_free frees what was copied (NULL where not) */
+        if (!pv->inputs)
+            pv->n_inputs = 0;
+        if (!pv->seeds)
+            pv->n_seeds = 0;
+        phc_provenance_free(pv);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    utc_now(pv->started);
+    pv->finished[0] = '\0';
+    *out = pv;
+    return PHC_OK;
+}
+
 void phc_provenance_free(phc_provenance *pv)
 {
     if (!pv)

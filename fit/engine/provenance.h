@@ -49,6 +49,10 @@ int phc_provenance_begin(const phc_problem *pb, int argc, char *const argv[], co
 /* Stamps the end time. */
 void phc_provenance_end(phc_provenance *pv);
 void phc_provenance_free(phc_provenance *pv); /* accepts NULL */
+/* A deep copy of `from` started now (finished empty): the record of a new
+ * run over the same inputs, hashed once (`phytocal fit --each`: every
+ * group's run shares the config and tables the batch read). */
+int phc_provenance_restart(const phc_provenance *from, phc_provenance **out, phc_error *err);
 
 /* SHA-256 of a file's bytes as 64 hex digits, and its size. */
 int phc_file_sha256(const char *path, char hex[65], long long *bytes, phc_error *err);
