@@ -336,6 +336,24 @@ void phc_run_dir_safe_name(const char *in, char *out, size_t size)
     out[j] = '\0';
 }
 
+/* Run directories this thread has begun and not yet committed or
+ * discarded, and the thread's deferred-sync setting before the first of
+ * them (atomic_file.h): while one is open the thread's files are written
+ * without an fsync each, and commit syncs the whole run once. */
+static _Thread_local int open_runs, sync_setting_before;
+
+static void open_run(void)
+{
+    if (open_runs++ == 0)
+        sync_setting_before = phc_atomic_file_defer_sync(1);
+}
+
+static void close_run(void)
+{
+    if (open_runs > 0 && --open_runs == 0)
+        phc_atomic_file_defer_sync(sync_setting_before);
+}
+
 int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *tmpdir, size_t size,
                       phc_error *err)
 {
@@ -346,12 +364,14 @@ int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *t
         return phc_error_set(err, PHC_ERR_IO, "%s: output path too long", dir);
     if (!mkdtemp(tmpdir))
         return phc_error_set(err, PHC_ERR_IO, "%s: cannot create a temporary directory: %s", tmpdir, strerror(errno));
+    open_run();
     return PHC_OK;
 }
 
 void phc_run_dir_discard(const char *tmpdir)
 {
     remove_tree(tmpdir);
+    close_run();
 }
 
 /* Writes tmpdir's manifest: every file (with its SHA-256) and directory in
@@ -480,14 +500,15 @@ static int sync_parent(const char *dir, phc_error *err)
     return PHC_OK;
 }
 
-static int commit(const char *tmpdir, const char *dir, const phc_provenance *pv, int synced, phc_error *err)
+/* The manifest, one sync of the new run, the swap into place and an fsync
+ * of the parent folder (run_dir.h, phc_run_dir_commit). */
+static int commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
 {
     int rc;
-    const int was = synced ? phc_atomic_file_defer_sync(1) : 0;
+    const int was = phc_atomic_file_defer_sync(1);
     rc = write_manifest(tmpdir, pv, err);
-    if (synced)
-        phc_atomic_file_defer_sync(was);
-    if (!rc && synced)
+    phc_atomic_file_defer_sync(was);
+    if (!rc)
         rc = sync_tree(tmpdir, err);
     if (rc) {
         remove_tree(tmpdir);
@@ -529,17 +550,14 @@ static int commit(const char *tmpdir, const char *dir, const phc_provenance *pv,
         remove_listed(old, &listed);
     entries_free(&listed);
     chmod(dir, 0755); /* mkdtemp made it private; results are for sharing */
-    return synced ? sync_parent(dir, err) : PHC_OK;
+    return sync_parent(dir, err);
 }
 
 int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
 {
-    return commit(tmpdir, dir, pv, 0, err);
-}
-
-int phc_run_dir_commit_synced(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err)
-{
-    return commit(tmpdir, dir, pv, 1, err);
+    const int rc = commit(tmpdir, dir, pv, err);
+    close_run();
+    return rc;
 }
 
 /* The kinds' own files at the fitted values (dataset.h, fit_outputs). */
@@ -638,9 +656,10 @@ int phc_run_dir_write_with(const phc_fit_result *res, const phc_problem *pb, con
     } else if ((rc = phc_run_dir_begin(dir, o.force, pb, tmpdir, sizeof tmpdir, err))) {
         return rc;
     }
-    /* no fsync per file: one sync of the whole run before its rename (or
-       none here, when the caller syncs the folder that holds it) */
-    const int was = phc_atomic_file_defer_sync(1);
+    /* no fsync per file: one sync of the whole run before its rename
+       (phc_run_dir_begin turned that on for this thread), or none here,
+       when the caller syncs the folder that holds it */
+    const int was = o.nested ? phc_atomic_file_defer_sync(1) : 0;
     char *names[MAX_PLOTS] = {0};
     size_t n_names = 0;
     if (o.plots == PHC_RUN_PLOTS_ALL && (rc = write_plots(res, pb, tmpdir, names, &n_names, err)))
@@ -655,16 +674,20 @@ int phc_run_dir_write_with(const phc_fit_result *res, const phc_problem *pb, con
     if (o.nested) {
         if ((rc = write_manifest(tmpdir, res->provenance, err)))
             goto fail;
+        phc_atomic_file_defer_sync(was);
     } else {
-        rc = phc_run_dir_commit_synced(tmpdir, dir, res->provenance, err);
+        rc = phc_run_dir_commit(tmpdir, dir, res->provenance, err);
     }
-    phc_atomic_file_defer_sync(was);
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return rc;
 fail:
-    phc_atomic_file_defer_sync(was);
-    phc_run_dir_discard(tmpdir);
+    if (o.nested) {
+        phc_atomic_file_defer_sync(was);
+        remove_tree(tmpdir); /* not phc_run_dir_discard: the caller's run stays open */
+    } else {
+        phc_run_dir_discard(tmpdir);
+    }
     for (size_t i = 0; i < n_names; ++i)
         free(names[i]);
     return rc;

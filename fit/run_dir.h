@@ -56,7 +56,7 @@ typedef struct phc_run_dir_options {
      * phc_run_dir_write_with returns, its files are on disk: they are
      * written without an fsync each, then one syncfs of the file system
      * holding them precedes the rename, and the parent folder is fsynced
-     * after it (phc_run_dir_commit_synced).
+     * after it (phc_run_dir_commit).
      * 1: DIR is a new folder inside a folder that the caller created for
      * this work, will sync once and rename into place itself (a batch's
      * temporary folder, cmd_fit_batch): DIR is created directly, written and
@@ -72,21 +72,23 @@ int phc_run_dir_write_with(const phc_fit_result *res, const phc_problem *pb, con
 
 /* The steps, for any command that writes a run directory:
  * begin checks DIR (as phc_run_dir_check), creates its parents and a
- * temporary sibling, whose path goes to tmpdir (size bytes);
- * commit writes the manifest (with provenance pv, may be NULL) and renames
- * the temporary directory to DIR (replacing an earlier run only now) or, on
- * failure, removes it and keeps the earlier run;
- * discard removes the temporary directory after a failure. */
+ * temporary sibling, whose path goes to tmpdir (size bytes), and from then
+ * on the calling thread writes files without an fsync each
+ * (atomic_file.h, phc_atomic_file_defer_sync; other threads still fsync
+ * theirs);
+ * commit writes the manifest (with provenance pv, may be NULL), makes one
+ * syncfs of the file system holding tmpdir, renames the temporary
+ * directory to DIR (replacing an earlier run only now) and fsyncs DIR's
+ * parent folder, so that DIR and all it holds are on disk when it returns;
+ * on failure it removes the temporary directory and keeps the earlier run
+ * (a crash before the rename leaves only the temporary folder);
+ * discard removes the temporary directory after a failure.
+ * Every begin that succeeded is followed by exactly one commit or discard
+ * on the same thread, which restores the thread's per-file fsync (begins
+ * may nest: the setting comes back after the last). */
 int phc_run_dir_begin(const char *dir, int force, const phc_problem *pb, char *tmpdir, size_t size,
                       phc_error *err);
 int phc_run_dir_commit(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err);
-/* commit for a writer that wrote tmpdir's files without an fsync each
- * (atomic_file.h, phc_atomic_file_defer_sync): the manifest, then one
- * syncfs of the file system holding tmpdir, the rename, and an fsync of
- * DIR's parent folder, so that DIR and all it holds are on disk when this
- * returns; a crash before the rename leaves only the temporary folder (DIR
- * or the earlier run is untouched). */
-int phc_run_dir_commit_synced(const char *tmpdir, const char *dir, const phc_provenance *pv, phc_error *err);
 void phc_run_dir_discard(const char *tmpdir);
 
 /* `phytocal report --check DIR`: each file the run read (its config and

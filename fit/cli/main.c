@@ -872,9 +872,9 @@ static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
         size_t n_ok = 0;
         /* Durability: no file of the batch is fsynced on its own; the whole
            folder is synced once, before it is renamed to DIR (run_dir.h,
-           phc_run_dir_commit_synced).  DIR appears only complete and on disk;
-           a crash before leaves only DIR.tmp-XXXXXX, as before. */
-        const int was = phc_atomic_file_defer_sync(1);
+           phc_run_dir_begin and phc_run_dir_commit).  DIR appears only
+           complete and on disk; a crash before leaves only
+           DIR.tmp-XXXXXX, as before. */
         for (size_t k = 0; k < n_jobs; ++k) {
             const int c =
                 batch_fit_one(&jobs[k], column, k, n_jobs, full_argc, full_argv, tmpdir, quiet, plots, &rows[k]);
@@ -882,11 +882,10 @@ static int cmd_fit_batch(int full_argc, char **full_argv, int argc, char **argv)
             n_ok += c == EXIT_OK;
         }
         const int src = phc_batch_summary_write(tmpdir, column, rows, n_jobs, &err);
-        phc_atomic_file_defer_sync(was);
         if (src) {
             phc_run_dir_discard(tmpdir);
             code = fail(&err);
-        } else if (phc_run_dir_commit_synced(tmpdir, dir, NULL, &err)) {
+        } else if (phc_run_dir_commit(tmpdir, dir, NULL, &err)) {
             code = fail(&err);
         } else {
             code = worst;
