@@ -3,6 +3,7 @@
 #include "model/climbing_growth.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,6 +16,12 @@
 #include "model/quaternion.h"
 
 static const double PI = 3.14159265358979323846;
+
+/* Loops over this many particles or more run on the OpenMP threads (each
+ * particle's work is its own, so the results do not depend on the thread
+ * count); inside an outer parallel region they stay on its thread. */
+#define PHC_CLIMBING_PARALLEL_MIN 1024
+static int team(size_t n) { return n >= PHC_CLIMBING_PARALLEL_MIN && omp_get_level() == 0; }
 
 struct phc_climbing {
     phc_climbing_options o;
@@ -815,12 +822,14 @@ fail: /* the next dynamic step starts a fresh system from the plant */
     return -1;
 }
 
-/* Step 7: anchors (eq. 5). */
+/* Step 7: anchors (eq. 5); each particle's anchor is its own. */
 static void anchors(phc_climbing *c)
 {
     const phc_climbing_options *o = &c->o;
     if (!o->closest)
         return;
+    size_t made = 0, released = 0;
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released) if (team(c->n))
     for (size_t i = 0; i < c->n; ++i) {
         const double *x = c->x + 3 * i;
         if (c->anchored[i]) {
@@ -828,7 +837,7 @@ static void anchors(phc_climbing *c)
             const double r[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
             if (sqrt(dot(r, r)) > o->release_distance) {
                 c->anchored[i] = 0;
-                c->stats.anchors_released++;
+                ++released;
             }
             continue;
         }
@@ -842,9 +851,11 @@ static void anchors(phc_climbing *c)
             c->anchored[i] = 1;
             memcpy(c->anchor_at + 3 * i, cp, sizeof cp);
             c->anchor_t0[i] = c->stats.time;
-            c->stats.anchors_made++;
+            ++made;
         }
     }
+    c->stats.anchors_made += made;
+    c->stats.anchors_released += released;
 }
 
 /* The counters of the current state. */
@@ -1068,12 +1079,18 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     /* 1. light */
     if ((o->light.extinction > 0 || c->opaque) && light_step(c, n0))
         return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for the light field");
-    /* 2.–4. tropisms, growth, branching of the tips present at the start */
+    /* 2. tropisms of the tips present at the start: each turns only its
+       own particle, so all at once (before any growth appends) */
+#pragma omp parallel for schedule(dynamic, 256) if (team(n0))
+    for (size_t i = 0; i < n0; ++i)
+        if (c->apical[i]) {
+            tropisms(c, i, dt);
+            keep_outside(c, i);
+        }
+    /* 3.–4. growth and branching, in index order (the random numbers) */
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])
             continue;
-        tropisms(c, i, dt);
-        keep_outside(c, i);
         /* apical dominance (ours): a tip of order k grows at r·a^k */
         const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
         if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {

@@ -281,10 +281,16 @@ static void line_depths(const phc_climbing_light_grid *g, const light_lines *L, 
  * costs more than it saves. */
 #define PHC_CLIMBING_LIGHT_PARALLEL_MIN 2048
 
-/* The light along the grid axis a (ℓ = ±e_a): the regular rays' depths
- * come from line_depths, once per cell instead of once per point; the
- * others (points within δ of a face, rays that meet an opaque cell) march.
- * Returns -1 (nothing done) when its scratch cannot be allocated. */
+/* While the light is computed, light[i] < 0 holds point i's own cell c as
+ * −1 − c (exact below 2⁵³) until its light replaces it. */
+static double pending(size_t c) { return -1 - (double)c; }
+static size_t pending_cell(double v) { return (size_t)(-1 - v); }
+
+/* The light along the grid axis a (ℓ = ±e_a) at the points whose light is
+ * pending: the regular rays' depths come from line_depths, once per cell
+ * instead of once per point; the others (points within δ of a face, rays
+ * that meet an opaque cell) march.  Returns -1 (nothing done) when its
+ * scratch cannot be allocated. */
 static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
                             const unsigned char *opaque, int a, const double *x, size_t n,
                             double *phi, double *light)
@@ -292,33 +298,26 @@ static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing
     const int absorb = g->extinction > 0;
     const light_lines L = lines_of(g, a);
     const size_t threads = (size_t)omp_get_max_threads();
-    const size_t NONE = (size_t)-1;
-    /* own cell of every point still to be lit (NONE: done), the lines to
-       process, and per thread a line's φ and partial sums (2n + 1) and its
-       filled cells (n) */
-    size_t *own = malloc(n * sizeof *own);
+    /* the lines to process, and per thread a line's φ and partial sums
+       (2n + 1) and its filled cells (n) */
     unsigned char *wanted = calloc(L.count, 1);
     double *sums = malloc(threads * (2 * L.n + 1) * sizeof *sums);
     size_t *filled = malloc(threads * L.n * sizeof *filled);
-    if (!own || !wanted || !sums || !filled) {
-        free(own);
+    if (!wanted || !sums || !filled) {
         free(wanted);
         free(sums);
         free(filled);
         return -1;
     }
     const int parallel = n >= PHC_CLIMBING_LIGHT_PARALLEL_MIN;
-    /* 1. points outside the grid, near a face or in a shadowed line: done
-          here (with φ still the volume fractions) */
+    /* 1. points near a face or in a shadowed line march (φ still the
+          volume fractions); the others mark their line */
 #pragma omp parallel for schedule(static) if (parallel)
     for (size_t i = 0; i < n; ++i) {
-        const double *xi = x + 3 * i;
-        const size_t c = cell_of(g, xi);
-        own[i] = NONE;
-        if (c == NONE) { /* outside the grid: full light */
-            light[i] = 1;
+        if (!(light[i] < 0))
             continue;
-        }
+        const double *xi = x + 3 * i;
+        const size_t c = pending_cell(light[i]);
         int march = !ray_is_regular(g, a, xi[a]);
         if (!march && opaque) { /* an opaque cell on the way: the exact test */
             const size_t line = line_of(&L, c), z = c / L.stride % L.n;
@@ -329,7 +328,6 @@ static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing
             light[i] = light_marched(g, occ, opaque, phi, xi, c);
             continue;
         }
-        own[i] = c;
         const size_t line = line_of(&L, c);
 #pragma omp atomic write
         wanted[line] = 1;
@@ -350,9 +348,8 @@ static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing
     /* 3. the regular points */
 #pragma omp parallel for schedule(static) if (parallel)
     for (size_t i = 0; i < n; ++i)
-        if (own[i] != NONE)
-            light[i] = light_of(g, 0, absorb ? phi[own[i]] : 0);
-    free(own);
+        if (light[i] < 0)
+            light[i] = light_of(g, 0, absorb ? phi[pending_cell(light[i])] : 0);
     free(wanted);
     free(sums);
     free(filled);
@@ -370,22 +367,25 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
             light[i] = 1;
         return;
     }
-    const size_t cells = phc_climbing_light_cells(g);
+    const int parallel = n >= PHC_CLIMBING_LIGHT_PARALLEL_MIN;
+    /* own cells (outside the grid: full light) */
+#pragma omp parallel for schedule(static) if (parallel)
+    for (size_t i = 0; i < n; ++i) {
+        const size_t c = cell_of(g, x + 3 * i);
+        light[i] = c == (size_t)-1 ? 1 : pending(c);
+    }
     if (absorb) { /* φ: in the points' order, so the sums are reproducible */
-        memset(phi, 0, cells * sizeof *phi);
+        memset(phi, 0, phc_climbing_light_cells(g) * sizeof *phi);
         const double h3 = g->cell * g->cell * g->cell;
-        for (size_t i = 0; i < n; ++i) {
-            const size_t c = cell_of(g, x + 3 * i);
-            if (c != (size_t)-1)
-                phi[c] += vol[i] / h3;
-        }
+        for (size_t i = 0; i < n; ++i)
+            if (light[i] < 0)
+                phi[pending_cell(light[i])] += vol[i] / h3;
     }
     const int a = light_axis(g);
     if (a >= 0 && light_along_axis(g, occ, opaque, a, x, n, phi, light) == 0)
         return;
-#pragma omp parallel for schedule(dynamic, 256) if (n >= PHC_CLIMBING_LIGHT_PARALLEL_MIN)
-    for (size_t i = 0; i < n; ++i) {
-        const size_t own = cell_of(g, x + 3 * i);
-        light[i] = own == (size_t)-1 ? 1 : light_marched(g, occ, opaque, phi, x + 3 * i, own);
-    }
+#pragma omp parallel for schedule(dynamic, 256) if (parallel)
+    for (size_t i = 0; i < n; ++i)
+        if (light[i] < 0)
+            light[i] = light_marched(g, occ, opaque, phi, x + 3 * i, pending_cell(light[i]));
 }
