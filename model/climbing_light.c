@@ -248,13 +248,15 @@ static size_t line_cell(const light_lines *L, size_t line, size_t t)
     return line % L->stride + line / L->stride * L->stride * L->n + z * L->stride;
 }
 
-/* Replaces φ along one line of cells by the depth a regular ray from each
- * cell meets: D(t) = Σ_{t' > t} φ(t') h, summed in the march's order (t + 1
- * first) as light_marched sums it, so D is bit for bit its depth.  Empty
- * cells add exact zeros and are skipped: with m filled cells the line costs
- * O(m² + n).  phi_line, nonzero (n each) and partial (n + 1) are scratch. */
-static void line_depths(const phc_climbing_light_grid *g, const light_lines *L, size_t line,
-                        double *phi, double *phi_line, size_t *nonzero, double *partial)
+/* Replaces φ along one line of cells by the light a regular ray from each
+ * cell receives, light_of(D(t)) with the depth D(t) = Σ_{t' > t} φ(t') h
+ * summed in the march's order (t + 1 first) as light_marched sums it, so
+ * the light is bit for bit the marched one.  Empty cells add exact zeros
+ * and are skipped: with m filled cells the line costs O(m² + n) additions
+ * and m + 1 exponentials.  phi_line, nonzero (n each) and partial (n + 1)
+ * are scratch. */
+static void line_light(const phc_climbing_light_grid *g, const light_lines *L, size_t line,
+                       double *phi, double *phi_line, size_t *nonzero, double *partial)
 {
     size_t m = 0;
     for (size_t t = 0; t < L->n; ++t) {
@@ -262,12 +264,12 @@ static void line_depths(const phc_climbing_light_grid *g, const light_lines *L, 
         if (phi_line[t] != 0)
             nonzero[m++] = t;
     }
-    /* partial[j]: the sum over the filled cells nonzero[j..m-1] in march order */
+    /* partial[j]: the light behind the filled cells nonzero[j..m-1] */
     for (size_t j = 0; j <= m; ++j) {
         double depth = 0;
         for (size_t r = j; r < m; ++r)
             depth += phi_line[nonzero[r]] * g->cell;
-        partial[j] = depth;
+        partial[j] = light_of(g, 0, depth);
     }
     size_t j = 0; /* the first filled cell beyond t */
     for (size_t t = 0; t < L->n; ++t) {
@@ -287,7 +289,7 @@ static double pending(size_t c) { return -1 - (double)c; }
 static size_t pending_cell(double v) { return (size_t)(-1 - v); }
 
 /* The light along the grid axis a (ℓ = ±e_a) at the points whose light is
- * pending: the regular rays' depths come from line_depths, once per cell
+ * pending: the regular rays' light comes from line_light, once per cell
  * instead of once per point; the others (points within δ of a face, rays
  * that meet an opaque cell) march.  Returns -1 (nothing done) when its
  * scratch cannot be allocated. */
@@ -332,7 +334,7 @@ static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing
 #pragma omp atomic write
         wanted[line] = 1;
     }
-    /* 2. depths along the lines that hold a regular point */
+    /* 2. light along the lines that hold a regular point */
     if (absorb) {
 #pragma omp parallel if (parallel)
         {
@@ -342,14 +344,15 @@ static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing
 #pragma omp for schedule(dynamic, 64)
             for (size_t line = 0; line < L.count; ++line)
                 if (wanted[line])
-                    line_depths(g, &L, line, phi, phi_line, nonzero, partial);
+                    line_light(g, &L, line, phi, phi_line, nonzero, partial);
         }
     }
     /* 3. the regular points */
+    const double unshaded = light_of(g, 0, 0);
 #pragma omp parallel for schedule(static) if (parallel)
     for (size_t i = 0; i < n; ++i)
         if (light[i] < 0)
-            light[i] = light_of(g, 0, absorb ? phi[pending_cell(light[i])] : 0);
+            light[i] = absorb ? phi[pending_cell(light[i])] : unshaded;
     free(wanted);
     free(sums);
     free(filled);
@@ -375,7 +378,10 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
         light[i] = c == (size_t)-1 ? 1 : pending(c);
     }
     if (absorb) { /* φ: in the points' order, so the sums are reproducible */
-        memset(phi, 0, phc_climbing_light_cells(g) * sizeof *phi);
+        const size_t cells = phc_climbing_light_cells(g), block = 4096;
+#pragma omp parallel for schedule(static) if (parallel)
+        for (size_t b = 0; b < cells; b += block)
+            memset(phi + b, 0, (cells - b < block ? cells - b : block) * sizeof *phi);
         const double h3 = g->cell * g->cell * g->cell;
         for (size_t i = 0; i < n; ++i)
             if (light[i] < 0)
