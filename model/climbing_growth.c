@@ -19,8 +19,9 @@ static const double PI = 3.14159265358979323846;
 
 /* Loops over this many particles or more run on the OpenMP threads (each
  * particle's work is its own, so the results do not depend on the thread
- * count); inside an outer parallel region they stay on its thread. */
-#define PHC_CLIMBING_PARALLEL_MIN 1024
+ * count; below it waking the threads costs more than it saves); inside an
+ * outer parallel region they stay on its thread. */
+#define PHC_CLIMBING_PARALLEL_MIN 4096
 static int team(size_t n) { return n >= PHC_CLIMBING_PARALLEL_MIN && omp_get_level() == 0; }
 
 struct phc_climbing {

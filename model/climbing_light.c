@@ -280,8 +280,9 @@ static void line_light(const phc_climbing_light_grid *g, const light_lines *L, s
 }
 
 /* Below this many points the light runs on one thread: a parallel region
- * costs more than it saves. */
-#define PHC_CLIMBING_LIGHT_PARALLEL_MIN 2048
+ * (a few tens of µs to wake a sleeping thread, more when other programs
+ * hold the cores) costs more than it saves. */
+#define PHC_CLIMBING_LIGHT_PARALLEL_MIN 16384
 
 /* While the light is computed, light[i] < 0 holds point i's own cell c as
  * −1 − c (exact below 2⁵³) until its light replaces it. */
