@@ -515,6 +515,15 @@ static void keep_outside(phc_climbing *c, size_t i)
         c->x[3 * i + k] = b[k] + h * d[k];
 }
 
+/* Step 2 for particle i when it is a tip: tropisms, then keep_outside. */
+static void turn_tip(phc_climbing *c, size_t i, double dt)
+{
+    if (!c->apical[i])
+        return;
+    tropisms(c, i, dt);
+    keep_outside(c, i);
+}
+
 /* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
  * Returns 0 or -1 (out of memory). */
 static int grow(phc_climbing *c, size_t i, double dsig)
@@ -823,37 +832,48 @@ fail: /* the next dynamic step starts a fresh system from the plant */
     return -1;
 }
 
-/* Step 7: anchors (eq. 5); each particle's anchor is its own. */
-static void anchors(phc_climbing *c)
+/* Step 7: anchor of particle i (eq. 5); counts the anchors made and
+ * released. */
+static void anchor(phc_climbing *c, size_t i, size_t *made, size_t *released)
 {
     const phc_climbing_options *o = &c->o;
-    if (!o->closest)
+    const double *x = c->x + 3 * i;
+    if (c->anchored[i]) {
+        const double *a = c->anchor_at + 3 * i;
+        const double r[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
+        if (sqrt(dot(r, r)) > o->release_distance) {
+            c->anchored[i] = 0;
+            ++*released;
+        }
+        return;
+    }
+    if (!(o->attach_distance > 0))
+        return;
+    double cp[3], nf[3];
+    if (o->closest(o->closest_user, x, cp, nf))
+        return;
+    const double r[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+    if (sqrt(dot(r, r)) <= o->attach_distance) {
+        c->anchored[i] = 1;
+        memcpy(c->anchor_at + 3 * i, cp, sizeof cp);
+        c->anchor_t0[i] = c->stats.time;
+        ++*made;
+    }
+}
+
+/* Step 7: anchors; each particle's anchor is its own. */
+static void anchors(phc_climbing *c)
+{
+    if (!c->o.closest)
         return;
     size_t made = 0, released = 0;
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released) if (team(c->n))
-    for (size_t i = 0; i < c->n; ++i) {
-        const double *x = c->x + 3 * i;
-        if (c->anchored[i]) {
-            const double *a = c->anchor_at + 3 * i;
-            const double r[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
-            if (sqrt(dot(r, r)) > o->release_distance) {
-                c->anchored[i] = 0;
-                ++released;
-            }
-            continue;
-        }
-        if (!(o->attach_distance > 0))
-            continue;
-        double cp[3], nf[3];
-        if (o->closest(o->closest_user, x, cp, nf))
-            continue;
-        const double r[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
-        if (sqrt(dot(r, r)) <= o->attach_distance) {
-            c->anchored[i] = 1;
-            memcpy(c->anchor_at + 3 * i, cp, sizeof cp);
-            c->anchor_t0[i] = c->stats.time;
-            ++made;
-        }
+    if (team(c->n)) {
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released)
+        for (size_t i = 0; i < c->n; ++i)
+            anchor(c, i, &made, &released);
+    } else {
+        for (size_t i = 0; i < c->n; ++i)
+            anchor(c, i, &made, &released);
     }
     c->stats.anchors_made += made;
     c->stats.anchors_released += released;
@@ -1082,12 +1102,14 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for the light field");
     /* 2. tropisms of the tips present at the start: each turns only its
        own particle, so all at once (before any growth appends) */
-#pragma omp parallel for schedule(dynamic, 256) if (team(n0))
-    for (size_t i = 0; i < n0; ++i)
-        if (c->apical[i]) {
-            tropisms(c, i, dt);
-            keep_outside(c, i);
-        }
+    if (team(n0)) {
+#pragma omp parallel for schedule(dynamic, 256)
+        for (size_t i = 0; i < n0; ++i)
+            turn_tip(c, i, dt);
+    } else {
+        for (size_t i = 0; i < n0; ++i)
+            turn_tip(c, i, dt);
+    }
     /* 3.–4. growth and branching, in index order (the random numbers) */
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])

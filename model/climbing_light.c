@@ -289,75 +289,105 @@ static void line_light(const phc_climbing_light_grid *g, const light_lines *L, s
 static double pending(size_t c) { return -1 - (double)c; }
 static size_t pending_cell(double v) { return (size_t)(-1 - v); }
 
-/* The light along the grid axis a (ℓ = ±e_a) at the points whose light is
- * pending: the regular rays' light comes from line_light, once per cell
- * instead of once per point; the others (points within δ of a face, rays
- * that meet an opaque cell) march.  Returns -1 (nothing done) when its
- * scratch cannot be allocated. */
-static int light_along_axis(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
-                            const unsigned char *opaque, int a, const double *x, size_t n,
-                            double *phi, double *light)
+/* One light computation: its inputs and, for light along the grid axis
+ * axis (−1: another direction, every point marches), the lines, the lines
+ * to process and per thread a line's φ and partial sums (2n + 1) and its
+ * filled cells (n). */
+typedef struct light_run {
+    const phc_climbing_light_grid *g;
+    const phc_climbing_occluders *occ;
+    const unsigned char *opaque;
+    const double *x, *vol;
+    size_t n;
+    double *phi, *light;
+    int axis;
+    light_lines L;
+    unsigned char *wanted;
+    double *sums;
+    size_t *filled;
+} light_run;
+
+/* Point i of a light along the axis, before the lines: a point near a face
+ * or in a shadowed line marches (φ still the volume fractions); the others
+ * mark their line. */
+static void classify_point(const light_run *r, size_t i)
 {
-    const int absorb = g->extinction > 0;
-    const light_lines L = lines_of(g, a);
-    const size_t threads = (size_t)omp_get_max_threads();
-    /* the lines to process, and per thread a line's φ and partial sums
-       (2n + 1) and its filled cells (n) */
-    unsigned char *wanted = calloc(L.count, 1);
-    double *sums = malloc(threads * (2 * L.n + 1) * sizeof *sums);
-    size_t *filled = malloc(threads * L.n * sizeof *filled);
-    if (!wanted || !sums || !filled) {
-        free(wanted);
-        free(sums);
-        free(filled);
-        return -1;
+    if (!(r->light[i] < 0))
+        return;
+    const light_lines *L = &r->L;
+    const double *xi = r->x + 3 * i;
+    const size_t c = pending_cell(r->light[i]), line = line_of(L, c);
+    int march = !ray_is_regular(r->g, r->axis, xi[r->axis]);
+    if (!march && r->opaque) { /* an opaque cell on the way: the exact test */
+        const size_t z = c / L->stride % L->n;
+        for (size_t t = L->toward_plus ? z : L->n - 1 - z; t < L->n && !march; ++t)
+            march = r->opaque[line_cell(L, line, t)];
     }
-    const int parallel = n >= PHC_CLIMBING_LIGHT_PARALLEL_MIN;
-    /* 1. points near a face or in a shadowed line march (φ still the
-          volume fractions); the others mark their line */
-#pragma omp parallel for schedule(static) if (parallel)
-    for (size_t i = 0; i < n; ++i) {
-        if (!(light[i] < 0))
-            continue;
-        const double *xi = x + 3 * i;
-        const size_t c = pending_cell(light[i]);
-        int march = !ray_is_regular(g, a, xi[a]);
-        if (!march && opaque) { /* an opaque cell on the way: the exact test */
-            const size_t line = line_of(&L, c), z = c / L.stride % L.n;
-            for (size_t t = L.toward_plus ? z : L.n - 1 - z; t < L.n && !march; ++t)
-                march = opaque[line_cell(&L, line, t)];
-        }
-        if (march) {
-            light[i] = light_marched(g, occ, opaque, phi, xi, c);
-            continue;
-        }
-        const size_t line = line_of(&L, c);
+    if (march) {
+        r->light[i] = light_marched(r->g, r->occ, r->opaque, r->phi, xi, c);
+        return;
+    }
 #pragma omp atomic write
-        wanted[line] = 1;
+    r->wanted[line] = 1;
+}
+
+/* The passes of one light computation.  Its loops are OpenMP worksharing
+ * loops: inside a parallel region the team shares them (each point's and
+ * each line's result its own, the deposit into φ on one thread in the
+ * points' order), outside one the calling thread runs them all. */
+static void light_passes(const light_run *r)
+{
+    const phc_climbing_light_grid *g = r->g;
+    const int absorb = g->extinction > 0;
+    const size_t n = r->n;
+    double *light = r->light, *phi = r->phi;
+    /* own cells (outside the grid: full light) */
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < n; ++i) {
+        const size_t c = cell_of(g, r->x + 3 * i);
+        light[i] = c == (size_t)-1 ? 1 : pending(c);
     }
-    /* 2. light along the lines that hold a regular point */
-    if (absorb) {
-#pragma omp parallel if (parallel)
+    if (absorb) { /* φ: in the points' order, so the sums are reproducible */
+        const size_t cells = phc_climbing_light_cells(g), block = 4096;
+#pragma omp for schedule(static)
+        for (size_t b = 0; b < cells; b += block)
+            memset(phi + b, 0, (cells - b < block ? cells - b : block) * sizeof *phi);
+#pragma omp single
         {
-            const size_t tid = (size_t)omp_get_thread_num();
-            double *phi_line = sums + tid * (2 * L.n + 1), *partial = phi_line + L.n;
-            size_t *nonzero = filled + tid * L.n;
-#pragma omp for schedule(dynamic, 64)
-            for (size_t line = 0; line < L.count; ++line)
-                if (wanted[line])
-                    line_light(g, &L, line, phi, phi_line, nonzero, partial);
+            const double h3 = g->cell * g->cell * g->cell;
+            for (size_t i = 0; i < n; ++i)
+                if (light[i] < 0)
+                    phi[pending_cell(light[i])] += r->vol[i] / h3;
         }
     }
-    /* 3. the regular points */
+    if (r->axis < 0) { /* every point marches */
+#pragma omp for schedule(dynamic, 256)
+        for (size_t i = 0; i < n; ++i)
+            if (light[i] < 0)
+                light[i] = light_marched(g, r->occ, r->opaque, phi, r->x + 3 * i,
+                                         pending_cell(light[i]));
+        return;
+    }
+    /* along the axis: 1. the points that march, the lines wanted */
+#pragma omp for schedule(static)
+    for (size_t i = 0; i < n; ++i)
+        classify_point(r, i);
+    /* 2. the light along the lines that hold a regular point */
+    if (absorb) {
+        const size_t tid = (size_t)omp_get_thread_num(), len = r->L.n;
+        double *phi_line = r->sums + tid * (2 * len + 1), *partial = phi_line + len;
+        size_t *nonzero = r->filled + tid * len;
+#pragma omp for schedule(dynamic, 64)
+        for (size_t line = 0; line < r->L.count; ++line)
+            if (r->wanted[line])
+                line_light(g, &r->L, line, phi, phi_line, nonzero, partial);
+    }
+    /* 3. the regular points: their line's light */
     const double unshaded = light_of(g, 0, 0);
-#pragma omp parallel for schedule(static) if (parallel)
+#pragma omp for schedule(static)
     for (size_t i = 0; i < n; ++i)
         if (light[i] < 0)
             light[i] = absorb ? phi[pending_cell(light[i])] : unshaded;
-    free(wanted);
-    free(sums);
-    free(filled);
-    return 0;
 }
 
 void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
@@ -365,34 +395,30 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
                                double *light)
 {
     const unsigned char *opaque = occ && occ->nt ? occ->mask : NULL;
-    const int absorb = g->extinction > 0;
-    if (!absorb && !opaque) {
+    if (!(g->extinction > 0) && !opaque) {
         for (size_t i = 0; i < n; ++i)
             light[i] = 1;
         return;
     }
-    const int parallel = n >= PHC_CLIMBING_LIGHT_PARALLEL_MIN;
-    /* own cells (outside the grid: full light) */
-#pragma omp parallel for schedule(static) if (parallel)
-    for (size_t i = 0; i < n; ++i) {
-        const size_t c = cell_of(g, x + 3 * i);
-        light[i] = c == (size_t)-1 ? 1 : pending(c);
+    light_run r = {g, occ, opaque, x, vol, n, phi, light, light_axis(g), {0}, NULL, NULL, NULL};
+    if (r.axis >= 0) { /* its scratch; without it every point marches */
+        const size_t threads = (size_t)omp_get_max_threads();
+        r.L = lines_of(g, r.axis);
+        r.wanted = calloc(r.L.count, 1);
+        r.sums = malloc(threads * (2 * r.L.n + 1) * sizeof *r.sums);
+        r.filled = malloc(threads * r.L.n * sizeof *r.filled);
+        if (!r.wanted || !r.sums || !r.filled)
+            r.axis = -1;
     }
-    if (absorb) { /* φ: in the points' order, so the sums are reproducible */
-        const size_t cells = phc_climbing_light_cells(g), block = 4096;
-#pragma omp parallel for schedule(static) if (parallel)
-        for (size_t b = 0; b < cells; b += block)
-            memset(phi + b, 0, (cells - b < block ? cells - b : block) * sizeof *phi);
-        const double h3 = g->cell * g->cell * g->cell;
-        for (size_t i = 0; i < n; ++i)
-            if (light[i] < 0)
-                phi[pending_cell(light[i])] += vol[i] / h3;
+    /* a parallel region only for enough points: waking the threads costs
+       tens of µs */
+    if (n >= PHC_CLIMBING_LIGHT_PARALLEL_MIN && omp_get_level() == 0) {
+#pragma omp parallel
+        light_passes(&r);
+    } else {
+        light_passes(&r);
     }
-    const int a = light_axis(g);
-    if (a >= 0 && light_along_axis(g, occ, opaque, a, x, n, phi, light) == 0)
-        return;
-#pragma omp parallel for schedule(dynamic, 256) if (parallel)
-    for (size_t i = 0; i < n; ++i)
-        if (light[i] < 0)
-            light[i] = light_marched(g, occ, opaque, phi, x + 3 * i, pending_cell(light[i]));
+    free(r.wanted);
+    free(r.sums);
+    free(r.filled);
 }
