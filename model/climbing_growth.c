@@ -937,45 +937,59 @@ static void cambium(phc_climbing *c, double dt)
         c->radius[i] = phc_climbing_cambium_step(c->radius[i], c->target[i], c->o.cambium_rate, dt);
 }
 
-/* Step 8: new leaves at grown nodes; every blade placed and oriented. */
+/* Step 8 for particle i: a new leaf when its node is grown and due one;
+ * its blade placed and oriented.  Returns 1 when it bears a leaf. */
+static int leaf_update(phc_climbing *c, size_t i, double alpha, double tmax)
+{
+    const phc_climbing_options *o = &c->o;
+    if (!c->has_leaf[i]) {
+        if (c->apical[i] || c->node_k[i] % o->leaf_step != 0)
+            return 0;
+        c->has_leaf[i] = 1; /* its first light: the stem's at the node */
+        c->leaf_light[i] = c->light[i];
+    }
+    double tip[3];
+    const double *d = c->d + 3 * i;
+    seg_tip(c, i, 0, tip);
+    double *p = c->leaf_p + 3 * i;
+    phc_climbing_leaf_petiole(d, (double)(c->node_k[i] / o->leaf_step), alpha, p);
+    /* a petiole that points into a support within a blade's reach is
+       mirrored in the support's face (ours: blades stay in front of the
+       wall the shoot climbs on), then made ⊥ the stem again */
+    double cp[3], nf[3];
+    if (o->closest && o->closest(o->closest_user, tip, cp, nf) == 0) {
+        const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
+        const double pn = dot(p, nf);
+        if (sqrt(dot(r, r)) < o->leaf_size && pn < 0) {
+            for (int k = 0; k < 3; ++k)
+                p[k] -= 2 * pn * nf[k];
+            const double pd = dot(p, d);
+            double q[3] = {p[0] - pd * d[0], p[1] - pd * d[1], p[2] - pd * d[2]};
+            if (unit(q, q) == 0)
+                memcpy(p, q, sizeof q);
+        }
+    }
+    for (int k = 0; k < 3; ++k)
+        c->leaf_c[3 * i + k] = tip[k] + 0.5 * o->leaf_size * p[k];
+    phc_climbing_leaf_normal(d, o->light.direction, o->leaf_response, c->leaf_light[i], tmax,
+                             c->leaf_n + 3 * i);
+    return 1;
+}
+
+/* Step 8: new leaves at grown nodes; every blade placed and oriented (each
+ * particle's leaf its own). */
 static void leaves_update(phc_climbing *c)
 {
     const phc_climbing_options *o = &c->o;
     const double alpha = o->leaf_angle_deg * PI / 180, tmax = o->leaf_max_angle_deg * PI / 180;
     size_t count_leaves = 0;
-    for (size_t i = 0; i < c->n; ++i) {
-        if (!c->has_leaf[i]) {
-            if (c->apical[i] || c->node_k[i] % o->leaf_step != 0)
-                continue;
-            c->has_leaf[i] = 1; /* its first light: the stem's at the node */
-            c->leaf_light[i] = c->light[i];
-        }
-        ++count_leaves;
-        double tip[3];
-        const double *d = c->d + 3 * i;
-        seg_tip(c, i, 0, tip);
-        double *p = c->leaf_p + 3 * i;
-        phc_climbing_leaf_petiole(d, (double)(c->node_k[i] / o->leaf_step), alpha, p);
-        /* a petiole that points into a support within a blade's reach is
-           mirrored in the support's face (ours: blades stay in front of the
-           wall the shoot climbs on), then made ⊥ the stem again */
-        double cp[3], nf[3];
-        if (o->closest && o->closest(o->closest_user, tip, cp, nf) == 0) {
-            const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
-            const double pn = dot(p, nf);
-            if (sqrt(dot(r, r)) < o->leaf_size && pn < 0) {
-                for (int k = 0; k < 3; ++k)
-                    p[k] -= 2 * pn * nf[k];
-                const double pd = dot(p, d);
-                double q[3] = {p[0] - pd * d[0], p[1] - pd * d[1], p[2] - pd * d[2]};
-                if (unit(q, q) == 0)
-                    memcpy(p, q, sizeof q);
-            }
-        }
-        for (int k = 0; k < 3; ++k)
-            c->leaf_c[3 * i + k] = tip[k] + 0.5 * o->leaf_size * p[k];
-        phc_climbing_leaf_normal(d, o->light.direction, o->leaf_response, c->leaf_light[i], tmax,
-                                 c->leaf_n + 3 * i);
+    if (team(c->n)) {
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : count_leaves)
+        for (size_t i = 0; i < c->n; ++i)
+            count_leaves += (size_t)leaf_update(c, i, alpha, tmax);
+    } else {
+        for (size_t i = 0; i < c->n; ++i)
+            count_leaves += (size_t)leaf_update(c, i, alpha, tmax);
     }
     c->leaves = count_leaves;
 }
