@@ -6,9 +6,10 @@
  *  1b. Growth on the OpenMP threads: a bushy plant on a floor under a
  *     light grid (the bench's settings, seed 3, but the light from the
  *     side, +x, so that the flat plant shades itself) grown kinematically to
- *     20,000 particles (the light's, the tropisms' and the anchors' loops
- *     then run in parallel) on 1 and 2 threads: the same plant bit for bit
- *     (centres, directions, light, anchors).
+ *     20,000 particles with a leaf every 3rd node (the light's, the
+ *     tropisms', the anchors' and the leaves' loops then run in parallel)
+ *     on 1 and 2 threads: the same plant bit for bit (centres, directions,
+ *     light, anchors, leaf centres and normals).
  *  2. Apical growth without branching: after k steps of Δt in full light a
  *     shoot holds exactly 1 + ⌊r k Δt / (1 − σ₀)⌋ particles (every k up to
  *     400), its length is L_max(n σ₀ + r k Δt) and its tip lies on the
@@ -227,10 +228,11 @@ int main(void)
         o.light.direction[2] = 0;
         o.surface_adaption = 0.2;
         o.closest = floor_closest;
+        o.leaf_step = 3;
         const double seed[3] = {0, 0, 0.01};
         const int keep = omp_get_max_threads();
         double *state[2] = {NULL, NULL};
-        size_t ns[2] = {0, 0}, steps[2] = {0, 0};
+        size_t ns[2] = {0, 0}, steps[2] = {0, 0}, leaves[2] = {0, 0};
         for (int run = 0; run < 2; ++run) {
             omp_set_num_threads(run + 1);
             phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
@@ -246,34 +248,39 @@ int main(void)
                 after += phc_climbing_count(c) >= o.max_particles;
             }
             ns[run] = phc_climbing_count(c);
-            state[run] = malloc(10 * ns[run] * sizeof(double));
+            state[run] = malloc(16 * ns[run] * sizeof(double));
             for (size_t i = 0; state[run] && i < ns[run]; ++i) {
-                double *s = state[run] + 10 * i;
+                double *s = state[run] + 16 * i;
                 phc_climbing_position(c, i, s);
                 phc_climbing_direction(c, i, s + 3);
                 s[6] = phc_climbing_light_at(c, i);
-                s[7] = s[8] = s[9] = -1;
+                for (int k = 7; k < 16; ++k)
+                    s[k] = -1;
                 phc_climbing_anchor(c, i, s + 7);
+                phc_climbing_leaf(c, i, s + 10, s + 13, NULL);
             }
+            leaves[run] = phc_climbing_leaf_count(c);
             phc_climbing_free(c);
         }
         omp_set_num_threads(keep);
         size_t differ = 0, anchored = 0;
         double darkest = 1;
         CHECK(ns[0] == ns[1] && ns[0] == o.max_particles && steps[0] == steps[1]);
+        CHECK(leaves[0] == leaves[1]);
         if (state[0] && state[1] && ns[0] == ns[1])
-            for (size_t k = 0; k < 10 * ns[0]; ++k) {
+            for (size_t k = 0; k < 16 * ns[0]; ++k) {
                 differ += memcmp(state[0] + k, state[1] + k, sizeof(double)) != 0;
-                if (k % 10 == 6)
+                if (k % 16 == 6)
                     darkest = fmin(darkest, state[0][k]);
-                anchored += k % 10 == 7 && state[0][k] != -1;
+                anchored += k % 16 == 7 && state[0][k] != -1;
             }
-        printf("threads: bushy plant on a floor, %zu particles after %zu steps; 1 vs 2 threads: "
-               "%zu of %zu numbers differ; smallest light %.4f, %zu anchored\n",
-               ns[0], steps[0], differ, 10 * ns[0], darkest, anchored);
+        printf("threads: bushy plant on a floor, %zu particles, %zu leaves after %zu steps; 1 vs 2 "
+               "threads: %zu of %zu numbers differ; smallest light %.4f, %zu anchored\n",
+               ns[0], leaves[0], steps[0], differ, 16 * ns[0], darkest, anchored);
         CHECK(differ == 0);
         CHECK(darkest < 0.9);
         CHECK(anchored > 0);
+        CHECK(leaves[0] > 0);
         free(state[0]);
         free(state[1]);
     }
