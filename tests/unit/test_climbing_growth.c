@@ -67,6 +67,20 @@ static int floor_closest(void *user, const double x[3], double c[3], double n[3]
     return 0;
 }
 
+/* A bushy plant: growth 0.2 s⁻¹, BP 0.9, B 2, V 0.8, orders up to 6 (the
+ * bench's plant). */
+static phc_climbing_options bushy_options(uint64_t seed)
+{
+    phc_climbing_options o = phc_climbing_options_default();
+    o.seed = seed;
+    o.growth_rate = 0.2;
+    o.branch_probability = 0.9;
+    o.max_buds = 2;
+    o.direction_variance = 0.8;
+    o.max_order = 6;
+    return o;
+}
+
 static phc_climbing *grow(const phc_climbing_options *o, const double base[3],
                           const double dir[3], size_t steps, double dt)
 {
@@ -211,13 +225,7 @@ int main(void)
 
     /* 1b. the same plant on 1 and 2 threads */
     {
-        phc_climbing_options o = phc_climbing_options_default();
-        o.seed = 3;
-        o.growth_rate = 0.2;
-        o.branch_probability = 0.9;
-        o.max_buds = 2;
-        o.direction_variance = 0.8;
-        o.max_order = 6;
+        phc_climbing_options o = bushy_options(3);
         o.max_particles = 20000;
         o.light.origin[0] = o.light.origin[1] = -2;
         o.light.cell = 0.05;
@@ -788,13 +796,7 @@ int main(void)
        then 6 dynamic steps; 1 and 2 OpenMP threads, and the same seed
        twice, give the same plant bit for bit. */
     {
-        phc_climbing_options o = phc_climbing_options_default();
-        o.seed = 5;
-        o.growth_rate = 0.2;
-        o.branch_probability = 0.9;
-        o.max_buds = 2;
-        o.direction_variance = 0.8;
-        o.max_order = 6;
+        phc_climbing_options o = bushy_options(5);
         o.particles.maturity_age = 20;
         o.min_stiffness = 0.3;
         const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
