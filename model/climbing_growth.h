@@ -81,10 +81,9 @@
  * and options give the same plant, bit for bit, on any number of OpenMP
  * threads: the light, the tropisms (step 2), the anchors (step 7) and the
  * leaves (step 8) run over the particles in parallel from 4096 particles
- * (16,384 light points) on, each particle's result its own.  After all
- * tropisms, the tips that reach σ = 1 grow and branch in index order
- * (steps 3–4: the random numbers and new particles as in one pass over the
- * tips), then the other tips grow, in parallel too.
+ * (16,384 light points) on, each particle's result its own; the
+ * growth and branching (steps 3–4, which draw the random numbers) run in
+ * index order after all tropisms, as before.
  *
  * Supports enter only as a closest-point callback (phc_climbing_closest_fn),
  * so model/ needs no mesh library (measurements/support_mesh.h provides one).
@@ -237,8 +236,7 @@ void phc_climbing_free(phc_climbing *c); /* accepts NULL */
  * spawns at most one successor per tip).  Errors: a bad dt (PHC_ERR_INVALID,
  * nothing changed); a dynamics failure (its message: the step's growth is
  * kept, the current shape is the one before the dynamics, anchors are not
- * updated); out of memory (the tips turned in the step and the spawning
- * tips grown so far are kept; the tips that do not spawn have not grown). */
+ * updated); out of memory (the tips grown so far in the step are kept). */
 int phc_climbing_step(phc_climbing *c, double dt, phc_error *err);
 
 /* Changes the gravity of the dynamics (m s^-2, finite), e.g. when the scene
