@@ -524,16 +524,6 @@ static void turn_tip(phc_climbing *c, size_t i, double dt)
     keep_outside(c, i);
 }
 
-/* Step 3: dσ of tip i in a step of dt, r·a^k·I·dt (apical dominance, ours:
- * a tip of branch order k grows at r·a^k). */
-static double tip_growth(const phc_climbing *c, size_t i, double dt)
-{
-    const phc_climbing_options *o = &c->o;
-    const double dominance =
-        o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
-    return o->growth_rate * dominance * c->light[i] * dt;
-}
-
 /* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
  * Returns 0 or -1 (out of memory). */
 static int grow(phc_climbing *c, size_t i, double dsig)
@@ -1134,26 +1124,17 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         for (size_t i = 0; i < n0; ++i)
             turn_tip(c, i, dt);
     }
-    /* 3.–4. growth and branching of the tips present at the start: first,
-       in index order, the tips that reach σ = 1 and spawn (successors,
-       laterals and random numbers in the order of one pass), then the
-       others, each of which changes only its own particle, all at once */
-    for (size_t i = 0; i < n0; ++i)
-        if (c->apical[i] && c->sigma[i] + tip_growth(c, i, dt) >= 1 &&
-            grow(c, i, tip_growth(c, i, dt))) {
+    /* 3.–4. growth and branching, in index order (the random numbers) */
+    for (size_t i = 0; i < n0; ++i) {
+        if (!c->apical[i])
+            continue;
+        /* apical dominance (ours): a tip of order k grows at r·a^k */
+        const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
+        if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
             count(c);
             return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory at %zu particles",
                                  c->n);
         }
-    if (team(n0)) {
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n0; ++i)
-            if (c->apical[i])
-                grow(c, i, tip_growth(c, i, dt)); /* below σ = 1: no allocation */
-    } else {
-        for (size_t i = 0; i < n0; ++i)
-            if (c->apical[i])
-                grow(c, i, tip_growth(c, i, dt));
     }
     /* keep_outside (ours) once more on the grown tips, the new ones included */
     if (o->keep_outside)
