@@ -401,6 +401,8 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
         return;
     }
     light_run r = {g, occ, opaque, x, vol, n, phi, light, light_axis(g), {0}, NULL, NULL, NULL};
+    if (!(g->cell > 0) || phc_climbing_light_cells(g) == 0)
+        r.axis = -1; /* outside the header's preconditions: march as the definition does */
     if (r.axis >= 0) { /* its scratch; without it every point marches */
         const size_t threads = (size_t)omp_get_max_threads();
         r.L = lines_of(g, r.axis);
