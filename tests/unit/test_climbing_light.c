@@ -15,7 +15,8 @@
  *     triangles and their mask) across the grid: equal to the reference.
  *  3. One and two OpenMP threads give the same bits (17,293 points: above
  *     the count from which the light runs in parallel).
- *  4. Limits: λ = 0 and no occluders gives 1 everywhere; a single column
+ *  4. Limits: λ = 0 and no occluders gives 1 everywhere, and so does a
+ *     grid with no cells (dims 0, outside the preconditions); a single column
  *     of 3 cells with φ = 0.2 per cell in the two upper cells gives the
  *     bottom point exp(−λ·0.4 h) (λ = 10, h = 0.1). */
 #include "model/climbing_light.h"
@@ -251,6 +252,14 @@ int main(void)
         not_one += light[i] != 1;
     printf("no extinction, no occluders: %zu of %zu points not 1\n", not_one, n);
     CHECK(not_one == 0);
+    phc_climbing_light_grid empty = g;
+    empty.dims[2] = 0; /* outside the header's preconditions: every point outside, no crash */
+    phc_climbing_light_shaded(&empty, NULL, x, vol, n, phi, light);
+    size_t lit = 0;
+    for (size_t i = 0; i < n; ++i)
+        lit += light[i] == 1;
+    printf("a grid with no cells: %zu of %zu points in full light\n", lit, n);
+    CHECK(lit == n);
     const phc_climbing_light_grid column = {{0, 0, 0}, 0.1, {1, 1, 3}, 10, {0, 0, 1}, 0};
     const double cx[9] = {0.05, 0.05, 0.05, 0.05, 0.05, 0.15, 0.05, 0.05, 0.25};
     const double h3 = 1e-3, cv[3] = {0, 0.2 * h3, 0.2 * h3};
