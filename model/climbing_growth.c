@@ -3,6 +3,7 @@
 #include "model/climbing_growth.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,6 +16,13 @@
 #include "model/quaternion.h"
 
 static const double PI = 3.14159265358979323846;
+
+/* Loops over this many particles or more run on the OpenMP threads (each
+ * particle's work is its own, so the results do not depend on the thread
+ * count; below it waking the threads costs more than it saves); inside an
+ * outer parallel region they stay on its thread. */
+#define PHC_CLIMBING_PARALLEL_MIN 4096
+static int team(size_t n) { return n >= PHC_CLIMBING_PARALLEL_MIN && omp_get_level() == 0; }
 
 struct phc_climbing {
     phc_climbing_options o;
@@ -507,6 +515,15 @@ static void keep_outside(phc_climbing *c, size_t i)
         c->x[3 * i + k] = b[k] + h * d[k];
 }
 
+/* Step 2 for particle i when it is a tip: tropisms, then keep_outside. */
+static void turn_tip(phc_climbing *c, size_t i, double dt)
+{
+    if (!c->apical[i])
+        return;
+    tropisms(c, i, dt);
+    keep_outside(c, i);
+}
+
 /* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
  * Returns 0 or -1 (out of memory). */
 static int grow(phc_climbing *c, size_t i, double dsig)
@@ -815,36 +832,51 @@ fail: /* the next dynamic step starts a fresh system from the plant */
     return -1;
 }
 
-/* Step 7: anchors (eq. 5). */
-static void anchors(phc_climbing *c)
+/* Step 7: anchor of particle i (eq. 5); counts the anchors made and
+ * released. */
+static void anchor(phc_climbing *c, size_t i, size_t *made, size_t *released)
 {
     const phc_climbing_options *o = &c->o;
-    if (!o->closest)
+    const double *x = c->x + 3 * i;
+    if (c->anchored[i]) {
+        const double *a = c->anchor_at + 3 * i;
+        const double r[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
+        if (sqrt(dot(r, r)) > o->release_distance) {
+            c->anchored[i] = 0;
+            ++*released;
+        }
         return;
-    for (size_t i = 0; i < c->n; ++i) {
-        const double *x = c->x + 3 * i;
-        if (c->anchored[i]) {
-            const double *a = c->anchor_at + 3 * i;
-            const double r[3] = {x[0] - a[0], x[1] - a[1], x[2] - a[2]};
-            if (sqrt(dot(r, r)) > o->release_distance) {
-                c->anchored[i] = 0;
-                c->stats.anchors_released++;
-            }
-            continue;
-        }
-        if (!(o->attach_distance > 0))
-            continue;
-        double cp[3], nf[3];
-        if (o->closest(o->closest_user, x, cp, nf))
-            continue;
-        const double r[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
-        if (sqrt(dot(r, r)) <= o->attach_distance) {
-            c->anchored[i] = 1;
-            memcpy(c->anchor_at + 3 * i, cp, sizeof cp);
-            c->anchor_t0[i] = c->stats.time;
-            c->stats.anchors_made++;
-        }
     }
+    if (!(o->attach_distance > 0))
+        return;
+    double cp[3], nf[3];
+    if (o->closest(o->closest_user, x, cp, nf))
+        return;
+    const double r[3] = {x[0] - cp[0], x[1] - cp[1], x[2] - cp[2]};
+    if (sqrt(dot(r, r)) <= o->attach_distance) {
+        c->anchored[i] = 1;
+        memcpy(c->anchor_at + 3 * i, cp, sizeof cp);
+        c->anchor_t0[i] = c->stats.time;
+        ++*made;
+    }
+}
+
+/* Step 7: anchors; each particle's anchor is its own. */
+static void anchors(phc_climbing *c)
+{
+    if (!c->o.closest)
+        return;
+    size_t made = 0, released = 0;
+    if (team(c->n)) {
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released)
+        for (size_t i = 0; i < c->n; ++i)
+            anchor(c, i, &made, &released);
+    } else {
+        for (size_t i = 0; i < c->n; ++i)
+            anchor(c, i, &made, &released);
+    }
+    c->stats.anchors_made += made;
+    c->stats.anchors_released += released;
 }
 
 /* The counters of the current state. */
@@ -905,45 +937,59 @@ static void cambium(phc_climbing *c, double dt)
         c->radius[i] = phc_climbing_cambium_step(c->radius[i], c->target[i], c->o.cambium_rate, dt);
 }
 
-/* Step 8: new leaves at grown nodes; every blade placed and oriented. */
+/* Step 8 for particle i: a new leaf when its node is grown and due one;
+ * its blade placed and oriented.  Returns 1 when it bears a leaf. */
+static int leaf_update(phc_climbing *c, size_t i, double alpha, double tmax)
+{
+    const phc_climbing_options *o = &c->o;
+    if (!c->has_leaf[i]) {
+        if (c->apical[i] || c->node_k[i] % o->leaf_step != 0)
+            return 0;
+        c->has_leaf[i] = 1; /* its first light: the stem's at the node */
+        c->leaf_light[i] = c->light[i];
+    }
+    double tip[3];
+    const double *d = c->d + 3 * i;
+    seg_tip(c, i, 0, tip);
+    double *p = c->leaf_p + 3 * i;
+    phc_climbing_leaf_petiole(d, (double)(c->node_k[i] / o->leaf_step), alpha, p);
+    /* a petiole that points into a support within a blade's reach is
+       mirrored in the support's face (ours: blades stay in front of the
+       wall the shoot climbs on), then made ⊥ the stem again */
+    double cp[3], nf[3];
+    if (o->closest && o->closest(o->closest_user, tip, cp, nf) == 0) {
+        const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
+        const double pn = dot(p, nf);
+        if (sqrt(dot(r, r)) < o->leaf_size && pn < 0) {
+            for (int k = 0; k < 3; ++k)
+                p[k] -= 2 * pn * nf[k];
+            const double pd = dot(p, d);
+            double q[3] = {p[0] - pd * d[0], p[1] - pd * d[1], p[2] - pd * d[2]};
+            if (unit(q, q) == 0)
+                memcpy(p, q, sizeof q);
+        }
+    }
+    for (int k = 0; k < 3; ++k)
+        c->leaf_c[3 * i + k] = tip[k] + 0.5 * o->leaf_size * p[k];
+    phc_climbing_leaf_normal(d, o->light.direction, o->leaf_response, c->leaf_light[i], tmax,
+                             c->leaf_n + 3 * i);
+    return 1;
+}
+
+/* Step 8: new leaves at grown nodes; every blade placed and oriented (each
+ * particle's leaf its own). */
 static void leaves_update(phc_climbing *c)
 {
     const phc_climbing_options *o = &c->o;
     const double alpha = o->leaf_angle_deg * PI / 180, tmax = o->leaf_max_angle_deg * PI / 180;
     size_t count_leaves = 0;
-    for (size_t i = 0; i < c->n; ++i) {
-        if (!c->has_leaf[i]) {
-            if (c->apical[i] || c->node_k[i] % o->leaf_step != 0)
-                continue;
-            c->has_leaf[i] = 1; /* its first light: the stem's at the node */
-            c->leaf_light[i] = c->light[i];
-        }
-        ++count_leaves;
-        double tip[3];
-        const double *d = c->d + 3 * i;
-        seg_tip(c, i, 0, tip);
-        double *p = c->leaf_p + 3 * i;
-        phc_climbing_leaf_petiole(d, (double)(c->node_k[i] / o->leaf_step), alpha, p);
-        /* a petiole that points into a support within a blade's reach is
-           mirrored in the support's face (ours: blades stay in front of the
-           wall the shoot climbs on), then made ⊥ the stem again */
-        double cp[3], nf[3];
-        if (o->closest && o->closest(o->closest_user, tip, cp, nf) == 0) {
-            const double r[3] = {tip[0] - cp[0], tip[1] - cp[1], tip[2] - cp[2]};
-            const double pn = dot(p, nf);
-            if (sqrt(dot(r, r)) < o->leaf_size && pn < 0) {
-                for (int k = 0; k < 3; ++k)
-                    p[k] -= 2 * pn * nf[k];
-                const double pd = dot(p, d);
-                double q[3] = {p[0] - pd * d[0], p[1] - pd * d[1], p[2] - pd * d[2]};
-                if (unit(q, q) == 0)
-                    memcpy(p, q, sizeof q);
-            }
-        }
-        for (int k = 0; k < 3; ++k)
-            c->leaf_c[3 * i + k] = tip[k] + 0.5 * o->leaf_size * p[k];
-        phc_climbing_leaf_normal(d, o->light.direction, o->leaf_response, c->leaf_light[i], tmax,
-                                 c->leaf_n + 3 * i);
+    if (team(c->n)) {
+#pragma omp parallel for schedule(dynamic, 256) reduction(+ : count_leaves)
+        for (size_t i = 0; i < c->n; ++i)
+            count_leaves += (size_t)leaf_update(c, i, alpha, tmax);
+    } else {
+        for (size_t i = 0; i < c->n; ++i)
+            count_leaves += (size_t)leaf_update(c, i, alpha, tmax);
     }
     c->leaves = count_leaves;
 }
@@ -1068,12 +1114,20 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     /* 1. light */
     if ((o->light.extinction > 0 || c->opaque) && light_step(c, n0))
         return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for the light field");
-    /* 2.–4. tropisms, growth, branching of the tips present at the start */
+    /* 2. tropisms of the tips present at the start: each turns only its
+       own particle, so all at once (before any growth appends) */
+    if (team(n0)) {
+#pragma omp parallel for schedule(dynamic, 256)
+        for (size_t i = 0; i < n0; ++i)
+            turn_tip(c, i, dt);
+    } else {
+        for (size_t i = 0; i < n0; ++i)
+            turn_tip(c, i, dt);
+    }
+    /* 3.–4. growth and branching, in index order (the random numbers) */
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])
             continue;
-        tropisms(c, i, dt);
-        keep_outside(c, i);
         /* apical dominance (ours): a tip of order k grows at r·a^k */
         const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
         if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {

@@ -28,7 +28,23 @@
  * is the pure Beer–Lambert law above, bit for bit.  A face is an occluder
  * from both sides; hits closer than h/50 along the ray do not count (ours:
  * a shoot pressed onto a wall, its centre a hair behind the face after a
- * tropism step, is not shadowed by the wall it lies on). */
+ * tropism step, is not shadowed by the wall it lies on).
+ *
+ * Computation (ours; the numbers are those of the march above, bit for
+ * bit).  φ is summed in the points' order.  When ℓ is a grid axis (±e_x,
+ * ±e_y or ±e_z exactly, as the default light from above), every point of
+ * a cell whose samples fall, rounding included, in the cells j0 ± 1,
+ * j0 ± 2, … to the grid's face receives the same depth, summed in the
+ * march's order once per cell along the cell's line (empty cells add exact
+ * zeros and are skipped) with one exponential per distinct depth.  Which
+ * points qualify is decided from a bound on the rounding of the samples'
+ * quotients (climbing_light.c, ray_is_regular): a point within about
+ * 1e-13 cells of a face, or with an opaque cell on its way to the light
+ * (its own cell included), marches as above.  Other directions march every
+ * point.  From 16,384 points on, the points and lines run on the OpenMP
+ * threads (the same numbers on any count).  For a bushy plant of 29,569
+ * particles in an 80×80×40 grid this is about 0.4 ms per step on one core
+ * against 10 ms for the march. */
 #ifndef PHC_CLIMBING_LIGHT_H
 #define PHC_CLIMBING_LIGHT_H
 

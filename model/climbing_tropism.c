@@ -22,12 +22,13 @@ double phc_climbing_angle(const double a[3], const double b[3])
     return atan2(sqrt(dot(c, c)), dot(a, b));
 }
 
-/* Rodrigues: v ← v cos β + (k × v) sin β + k (k·v)(1 − cos β), |k| = 1. */
-static void rotate(double v[3], const double k[3], double beta)
+/* Rodrigues: v ← v cos β + (k × v) sin β + k (k·v)(1 − cos β), |k| = 1,
+ * given c = cos β and s = sin β; then v is renormalised. */
+static void rotate(double v[3], const double k[3], double c, double s)
 {
     double kv[3];
     cross(k, v, kv);
-    const double c = cos(beta), s = sin(beta), kd = dot(k, v) * (1 - c);
+    const double kd = dot(k, v) * (1 - c);
     for (int i = 0; i < 3; ++i)
         v[i] = v[i] * c + kv[i] * s + k[i] * kd;
     const double len = sqrt(dot(v, v));
@@ -41,12 +42,14 @@ double phc_climbing_turn(double d[3], double rest[3], const double t[3], double 
         return 0;
     if (fraction > 1)
         fraction = 1;
-    const double alpha = phc_climbing_angle(d, t);
-    if (!(alpha > 0))
-        return 0;
+    /* the angle as phc_climbing_angle(d, t) computes it, from the same
+       cross product that gives the axis */
     double k[3];
     cross(d, t, k);
     double len = sqrt(dot(k, k));
+    const double alpha = atan2(len, dot(d, t));
+    if (!(alpha > 0))
+        return 0;
     if (len < 1e-12) { /* t opposite to d: any axis perpendicular to d */
         int m = 0;
         for (int i = 1; i < 3; ++i)
@@ -59,9 +62,10 @@ double phc_climbing_turn(double d[3], double rest[3], const double t[3], double 
     for (int i = 0; i < 3; ++i)
         k[i] /= len;
     const double beta = fraction * alpha;
-    rotate(d, k, beta);
+    const double c = cos(beta), s = sin(beta); /* one evaluation for both vectors */
+    rotate(d, k, c, s);
     if (rest)
-        rotate(rest, k, beta);
+        rotate(rest, k, c, s);
     return beta;
 }
 

@@ -3,6 +3,13 @@
  * printed.
  *  1. Determinism: the same seed gives the same plant bit for bit; another
  *     seed gives another plant.
+ *  1b. Growth on the OpenMP threads: a bushy plant on a floor under a
+ *     light grid (the bench's settings, seed 3, but the light from the
+ *     side, +x, so that the flat plant shades itself) grown kinematically to
+ *     20,000 particles with a leaf every 3rd node (the light's, the
+ *     tropisms', the anchors' and the leaves' loops then run in parallel)
+ *     on 1 and 2 threads: the same plant bit for bit (centres, directions,
+ *     light, anchors, leaf centres and normals).
  *  2. Apical growth without branching: after k steps of Δt in full light a
  *     shoot holds exactly 1 + ⌊r k Δt / (1 − σ₀)⌋ particles (every k up to
  *     400), its length is L_max(n σ₀ + r k Δt) and its tip lies on the
@@ -47,6 +54,32 @@
 #include "check.h"
 
 static const double PI = 3.14159265358979323846;
+
+/* The plane z = 0 (normal +z). */
+static int floor_closest(void *user, const double x[3], double c[3], double n[3])
+{
+    (void)user;
+    c[0] = x[0];
+    c[1] = x[1];
+    c[2] = 0;
+    n[0] = n[1] = 0;
+    n[2] = 1;
+    return 0;
+}
+
+/* A bushy plant: growth 0.2 s⁻¹, BP 0.9, B 2, V 0.8, orders up to 6 (the
+ * bench's plant). */
+static phc_climbing_options bushy_options(uint64_t seed)
+{
+    phc_climbing_options o = phc_climbing_options_default();
+    o.seed = seed;
+    o.growth_rate = 0.2;
+    o.branch_probability = 0.9;
+    o.max_buds = 2;
+    o.direction_variance = 0.8;
+    o.max_order = 6;
+    return o;
+}
 
 static phc_climbing *grow(const phc_climbing_options *o, const double base[3],
                           const double dir[3], size_t steps, double dt)
@@ -188,6 +221,76 @@ int main(void)
         phc_climbing_free(a);
         phc_climbing_free(b);
         phc_climbing_free(c);
+    }
+
+    /* 1b. the same plant on 1 and 2 threads */
+    {
+        phc_climbing_options o = bushy_options(3);
+        o.max_particles = 20000;
+        o.light.origin[0] = o.light.origin[1] = -2;
+        o.light.cell = 0.05;
+        o.light.dims[0] = o.light.dims[1] = 80;
+        o.light.dims[2] = 40;
+        o.light.extinction = 40;
+        o.light.direction[0] = 1; /* from the side: the flat plant shades itself */
+        o.light.direction[2] = 0;
+        o.surface_adaption = 0.2;
+        o.closest = floor_closest;
+        o.leaf_step = 3;
+        const double seed[3] = {0, 0, 0.01};
+        const int keep = omp_get_max_threads();
+        double *state[2] = {NULL, NULL};
+        size_t ns[2] = {0, 0}, steps[2] = {0, 0}, leaves[2] = {0, 0};
+        for (int run = 0; run < 2; ++run) {
+            omp_set_num_threads(run + 1);
+            phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
+            CHECK(c != NULL);
+            if (!c)
+                break;
+            /* up to the cap, then 4 steps more (tips still turn, anchors form) */
+            size_t after = 0;
+            while (after < 4 && steps[run] < 400) {
+                if (phc_climbing_step(c, 0.25, &err))
+                    break;
+                ++steps[run];
+                after += phc_climbing_count(c) >= o.max_particles;
+            }
+            ns[run] = phc_climbing_count(c);
+            state[run] = malloc(16 * ns[run] * sizeof(double));
+            for (size_t i = 0; state[run] && i < ns[run]; ++i) {
+                double *s = state[run] + 16 * i;
+                phc_climbing_position(c, i, s);
+                phc_climbing_direction(c, i, s + 3);
+                s[6] = phc_climbing_light_at(c, i);
+                for (int k = 7; k < 16; ++k)
+                    s[k] = -1;
+                phc_climbing_anchor(c, i, s + 7);
+                phc_climbing_leaf(c, i, s + 10, s + 13, NULL);
+            }
+            leaves[run] = phc_climbing_leaf_count(c);
+            phc_climbing_free(c);
+        }
+        omp_set_num_threads(keep);
+        size_t differ = 0, anchored = 0;
+        double darkest = 1;
+        CHECK(ns[0] == ns[1] && ns[0] == o.max_particles && steps[0] == steps[1]);
+        CHECK(leaves[0] == leaves[1]);
+        if (state[0] && state[1] && ns[0] == ns[1])
+            for (size_t k = 0; k < 16 * ns[0]; ++k) {
+                differ += memcmp(state[0] + k, state[1] + k, sizeof(double)) != 0;
+                if (k % 16 == 6)
+                    darkest = fmin(darkest, state[0][k]);
+                anchored += k % 16 == 7 && state[0][k] != -1;
+            }
+        printf("threads: bushy plant on a floor, %zu particles, %zu leaves after %zu steps; 1 vs 2 "
+               "threads: %zu of %zu numbers differ; smallest light %.4f, %zu anchored\n",
+               ns[0], leaves[0], steps[0], differ, 16 * ns[0], darkest, anchored);
+        CHECK(differ == 0);
+        CHECK(darkest < 0.9);
+        CHECK(anchored > 0);
+        CHECK(leaves[0] > 0);
+        free(state[0]);
+        free(state[1]);
     }
 
     /* 2. exact particle count of one apical shoot */
@@ -693,13 +796,7 @@ int main(void)
        then 6 dynamic steps; 1 and 2 OpenMP threads, and the same seed
        twice, give the same plant bit for bit. */
     {
-        phc_climbing_options o = phc_climbing_options_default();
-        o.seed = 5;
-        o.growth_rate = 0.2;
-        o.branch_probability = 0.9;
-        o.max_buds = 2;
-        o.direction_variance = 0.8;
-        o.max_order = 6;
+        phc_climbing_options o = bushy_options(5);
         o.particles.maturity_age = 20;
         o.min_stiffness = 0.3;
         const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
