@@ -74,6 +74,7 @@ struct phc_particles {
     int *plev, *glev;        /* n each: the last iteration a particle / group is needed at, -1 */
     size_t *pcount, *gcount; /* iterations + 1 each */
     int use_lists;
+    size_t *pins, npins;     /* n: the pinned particles (k_a = 1, orientation held) */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
@@ -484,6 +485,7 @@ void phc_particles_free(phc_particles *p)
     free(p->plev);
     free(p->glev);
     free(p->pcount);
+    free(p->pins);
     free(p->gcount);
     free(p->gq);
     free(p->stress);
@@ -557,6 +559,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(plev, n);
     ALLOC(glev, n);
     ALLOC(pcount, o.iterations + 1);
+    ALLOC(pins, n);
     ALLOC(gcount, o.iterations + 1);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
@@ -699,6 +702,7 @@ static int reserve(phc_particles *p, size_t want)
     GROW(gmatch, 1);
     GROW(plev, 1);
     GROW(glev, 1);
+    GROW(pins, 1);
     GROW(gq, 4);
     GROW(stress, 1);
     GROW(source_id, 1);
@@ -1439,8 +1443,10 @@ static void need_group(phc_particles *p, size_t k, int t, size_t *ng, size_t *np
 /* Which projections can change the step's result (ours; exact).  With the
  * joint pass, a linked particle with s > 0 gets its final x_p and q_p from
  * follow_one, which reads its parent's final state, its rest state and its
- * last orientation q, never what the projections gave it.  The others (the
- * "free" particles: roots, broken links, s = 0) keep their projected
+ * last orientation q, never what the projections gave it; a pinned
+ * particle (anchor k_a = 1, orientation held) ends at its anchor after any
+ * blend.  The others (the "free" particles: roots, broken links, s = 0,
+ * not pinned) keep their projected
  * state, which after N Jacobi iterations depends only on the groups near
  * them: with need_N = the free particles, iteration t must match the groups
  * with a member in need_t (M_t) and blend need_t, and need_{t−1} = the
@@ -1460,12 +1466,15 @@ static void plan_projections(phc_particles *p)
     size_t np = 0, ng = 0;
     for (size_t i = 0; i < n; ++i)
         p->plev[i] = p->glev[i] = -1;
-    for (size_t i = 0; i < n; ++i)
-        if (!(p->linked[i] && stiffness_of(p, i) > 0)) {
+    p->npins = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
+            p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
+        else if (!(p->linked[i] && stiffness_of(p, i) > 0))
             need_particle(p, i, N, &np);
-            if (np > n / 4)
-                return; /* many free particles: project everything */
-        }
+        if (np > n / 4)
+            return; /* many free particles: project everything */
+    }
     /* need_t = plist[0 .. pcount[t]); M_t = gmatch[0 .. gcount[t]) */
     p->pcount[N] = np;
     for (int t = N; t >= 1; --t) {
@@ -1495,6 +1504,19 @@ void phc_particles_project_all(phc_particles *p, int on)
 {
     if (p)
         p->project_all = on != 0;
+}
+
+/* The anchor of particle i (eq. 5) on its predicted state: x_p ← x_p +
+ * k_a (a − x_p), exactly a when k_a = 1; q_p ← the held orientation when
+ * it is held. */
+static void apply_anchor(phc_particles *p, size_t i)
+{
+    const double ka = p->anchor_k[i], *a = p->anchor_at + 3 * i;
+    double *x = p->xp + 3 * i;
+    for (int d = 0; d < 3; ++d)
+        x[d] = ka == 1 ? a[d] : x[d] + ka * (a[d] - x[d]);
+    if (p->hold_q[i])
+        memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
 }
 
 /* Predict (symplectic Euler) particle i: x_p = x + Δt (v + Δt a),
@@ -1544,13 +1566,8 @@ static void blend(phc_particles *p, size_t i, int next)
     /* q_i = R_i q̄_i: own group's rotation applied to the rest pose. */
     quat_mul(p->gq + 4 * i, p->q0 + 4 * i, p->qp + 4 * i);
     quat_normalize(p->qp + 4 * i);
-    if (p->anchored[i]) { /* eq. 5 */
-        const double ka = p->anchor_k[i];
-        for (int d = 0; d < 3; ++d)
-            p->xp[3 * i + d] += ka * (p->anchor_at[3 * i + d] - p->xp[3 * i + d]);
-        if (p->hold_q[i])
-            memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
-    }
+    if (p->anchored[i])
+        apply_anchor(p, i);
     if (next)
         ellipsoid_term(p, i, p->qp);
 }
@@ -1671,13 +1688,8 @@ static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double
     phc_quat_rotate(q, half, hr);
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];
-    if (p->anchored[i]) { /* eq. 5, as after every projection */
-        const double ka = p->anchor_k[i];
-        for (int d = 0; d < 3; ++d)
-            x[d] += ka * (p->anchor_at[3 * i + d] - x[d]);
-        if (p->hold_q[i])
-            memcpy(q, p->anchor_q + 4 * i, 4 * sizeof(double));
-    }
+    if (p->anchored[i]) /* as after every projection */
+        apply_anchor(p, i);
 }
 
 /* The joint pass's order (see struct phc_particles): subtree sizes, the
@@ -1781,6 +1793,9 @@ static void step_body(phc_particles *p, const crew *c, double dt, long *bad, siz
             blend(p, pick(plist, t), it < N);
         crew_barrier(c);
     }
+    if (p->use_lists && c->tid == 0) /* the pinned particles no blend reached */
+        for (size_t t = 0; t < p->npins; ++t)
+            apply_anchor(p, p->pins[t]);
     if (p->o.follow_parent)
         follow_parents(p, c, dt, next_item);
 }
