@@ -1602,6 +1602,29 @@ static void match_pass(phc_particles *p, const crew *c, const size_t *list, size
     crew_barrier(c);
 }
 
+/* R(q) u (phc_quat_rotate: u + 2w (v × u) + 2 v × (v × u), v = Im q), and
+ * R(q)(0, 0, h), the same with the zeros left out (the same numbers), here
+ * so that the joint pass inlines them. */
+static inline void rotate(const double q[4], const double u[3], double out[3])
+{
+    const double w = q[0], vx = q[1], vy = q[2], vz = q[3];
+    const double tx = 2.0 * (vy * u[2] - vz * u[1]);
+    const double ty = 2.0 * (vz * u[0] - vx * u[2]);
+    const double tz = 2.0 * (vx * u[1] - vy * u[0]);
+    out[0] = u[0] + w * tx + (vy * tz - vz * ty);
+    out[1] = u[1] + w * ty + (vz * tx - vx * tz);
+    out[2] = u[2] + w * tz + (vx * ty - vy * tx);
+}
+
+static inline void rotate_z(const double q[4], double h, double out[3])
+{
+    const double w = q[0], vx = q[1], vy = q[2], vz = q[3];
+    const double tx = 2.0 * (vy * h), ty = 2.0 * -(vx * h);
+    out[0] = w * tx - vz * ty;
+    out[1] = w * ty + vz * tx;
+    out[2] = h + (vx * ty - vy * tx);
+}
+
 /* The joint pass (particles.h, "Shoots that bend"), parents first.  For
  * each linked particle i with parent u (already placed this substep):
  *   joint      J  = x_u + R(q_u) j_i,   j_i = R(q̄_u)ᵀ (h̄_i − x̄_u) (m),
@@ -1633,19 +1656,19 @@ static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double
     if (!(s > 0))
         return; /* s = 0: no hold */
     const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
-    const double half[3] = {0, 0, p->ax[3 * i + 2]};
+    const double half = p->ax[3 * i + 2];
     /* the joint J in u's current frame */
     double hr[3], hb[3], ju[3], J[3];
-    phc_quat_rotate(q0i, half, hr);
+    const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+    rotate_z(q0i, half, hr);
     for (int d = 0; d < 3; ++d)
         hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-    phc_quat_rotate_inverse(q0u, hb, ju);
-    phc_quat_rotate(qu, ju, J);
+    rotate(q0u_inv, hb, ju);
+    rotate(qu, ju, J);
     for (int d = 0; d < 3; ++d)
         J[d] += p->xp[3 * u + d];
     /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
-    double q0u_inv[4], rel[4], qs[4];
-    phc_quat_conj(q0u, q0u_inv);
+    double rel[4], qs[4];
     quat_mul(q0u_inv, q0i, rel);
     quat_mul(qu, rel, qs);
     double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
@@ -1656,11 +1679,11 @@ static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double
          * centre moved by its load from rest, a Δt² */
         double dq[4], axis[3], dir[3], qf[4];
         const double *qt = p->q + 4 * i;
-        phc_quat_rotate(qt, half, axis);
+        rotate_z(qt, half, axis);
         for (int d = 0; d < 3; ++d) {
             const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
             dir[d] = axis[d] + dt * dt * a;
-            axis[d] /= half[2];
+            axis[d] /= half;
         }
         const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
         if (dn > 0) {
@@ -1672,8 +1695,8 @@ static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double
             memcpy(qf, qt, sizeof qf);
         }
         /* the joint's spring: turn q_f by the fraction k toward q* */
-        double qf_inv[4], dev[4], rv[3];
-        phc_quat_conj(qf, qf_inv);
+        const double qf_inv[4] = {qf[0], -qf[1], -qf[2], -qf[3]};
+        double dev[4], rv[3];
         quat_mul(qs, qf_inv, dev);
         if (dev[0] < 0)
             for (int d = 0; d < 4; ++d)
@@ -1685,7 +1708,7 @@ static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double
         quat_mul(dq, qf, q);
     }
     quat_normalize(q);
-    phc_quat_rotate(q, half, hr);
+    rotate_z(q, half, hr);
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];
     if (p->anchored[i]) /* as after every projection */
