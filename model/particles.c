@@ -116,7 +116,7 @@ phc_particles_options phc_particles_options_default(void)
 /* ---- small linear algebra (row-major 3x3) -------------------------------- */
 
 
-static void quat_mul(const double a[4], const double b[4], double c[4])
+static inline void quat_mul(const double a[4], const double b[4], double c[4])
 {
     const double w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
     const double x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
@@ -128,7 +128,7 @@ static void quat_mul(const double a[4], const double b[4], double c[4])
     c[3] = z;
 }
 
-static void quat_normalize(double q[4])
+static inline void quat_normalize(double q[4])
 {
     const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     for (int k = 0; k < 4; ++k)
@@ -136,7 +136,7 @@ static void quat_normalize(double q[4])
 }
 
 /* Unit quaternion of the rotation vector phi (rad): exp(phi/2). */
-static void quat_exp(const double phi[3], double q[4])
+static inline void quat_exp(const double phi[3], double q[4])
 {
     const double a = sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]);
     if (a < 1e-300) {
@@ -151,7 +151,7 @@ static void quat_exp(const double phi[3], double q[4])
     q[3] = phi[2] * sh;
 }
 
-static void mat_vec(const double R[9], const double a[3], double b[3])
+static inline void mat_vec(const double R[9], const double a[3], double b[3])
 {
     b[0] = R[0] * a[0] + R[1] * a[1] + R[2] * a[2];
     b[1] = R[3] * a[0] + R[4] * a[1] + R[5] * a[2];
@@ -828,7 +828,7 @@ int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
         return phc_error_set(err, PHC_ERR_INVALID,
                              "particles: append: parent %zu does not exist (%zu particles)",
                              parent, p->n);
-    double L;
+    double L = 0;
     if (check_segment(p, p->n, head, tail, radius, &L, err))
         return err ? err->status : PHC_ERR_INPUT;
     if (reserve(p, p->n + 1))
@@ -868,7 +868,7 @@ int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], con
         return phc_error_set(err, PHC_ERR_INVALID,
                              "particles: rest: particle %zu does not exist (%zu particles)", i,
                              p ? p->n : 0);
-    double L;
+    double L = 0;
     if (check_segment(p, i, head, tail, radius, &L, err))
         return err ? err->status : PHC_ERR_INPUT;
     rest_from_segment(p, i, head, tail, radius, L);
@@ -1806,16 +1806,19 @@ static void step_body(phc_particles *p, const crew *c, double dt, long *bad, siz
     share(c, p->pcount[0], &lo, &hi);
     for (size_t t = lo; t < hi; ++t)
         predict(p, pick(plist, t), dt);
-    crew_barrier(c);
     for (size_t it = 1; it <= N; ++it) {
+        if (p->gcount[it] == 0)
+            break; /* nothing planned from here on (the sets shrink with it) */
+        crew_barrier(c);
         match_pass(p, c, glist, p->gcount[it], p->xp, 0, bad, tot, fb);
         if (*bad >= 0)
             return;
         share(c, p->pcount[it], &lo, &hi);
         for (size_t t = lo; t < hi; ++t)
             blend(p, pick(plist, t), it < N);
-        crew_barrier(c);
     }
+    if (p->gcount[1] > 0) /* (no group: nothing was predicted either) */
+        crew_barrier(c);
     if (p->use_lists && c->tid == 0) /* the pinned particles no blend reached */
         for (size_t t = 0; t < p->npins; ++t)
             apply_anchor(p, p->pins[t]);
@@ -1848,6 +1851,78 @@ static void finish(phc_particles *p, size_t lo, size_t hi, double dt)
     }
 }
 
+/* What the threads of a step share: the first particle with a non-finite
+ * position (n: none), the largest group with a non-finite moment matrix
+ * (−1: none), the first particle with a non-finite new state (n: none),
+ * the joint pass's next subtree. */
+typedef struct step_shared {
+    long bad;
+    size_t bad_x, bad_state;
+    size_t next_item;
+} step_shared;
+
+static void lower_to(size_t *shared, size_t i)
+{
+#pragma omp critical(phc_particles_bad)
+    if (i < *shared)
+        *shared = i;
+}
+
+/* The whole step on one thread of the crew: positions checked, step_body,
+ * the collision pass (one thread, index order), the new state checked,
+ * then (nothing non-finite) velocities and the new state (finish).  Stops
+ * at the first failure, all threads alike (each reads the shared verdict
+ * after a barrier). */
+static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *sh, size_t *tot,
+                       size_t *fb)
+{
+    size_t lo, hi;
+    share(c, p->n, &lo, &hi);
+    for (size_t i = lo; i < hi; ++i)
+        if (!isfinite(p->x[3 * i]) || !isfinite(p->x[3 * i + 1]) || !isfinite(p->x[3 * i + 2])) {
+            lower_to(&sh->bad_x, i);
+            break;
+        }
+    crew_barrier(c);
+    if (sh->bad_x < p->n)
+        return;
+    step_body(p, c, dt, &sh->bad, &sh->next_item, tot, fb);
+    if (sh->bad >= 0)
+        return;
+    if (p->collide) {
+        if (c->tid == 0)
+            collide(p);
+        crew_barrier(c);
+    } else if (c->tid == 0) {
+        p->pushed = 0;
+        p->depth = INFINITY;
+    }
+    for (size_t i = lo; i < hi; ++i)
+        if (!isfinite(p->xp[3 * i]) || !isfinite(p->xp[3 * i + 1]) || !isfinite(p->xp[3 * i + 2]) ||
+            !isfinite(p->qp[4 * i]) || !isfinite(p->qp[4 * i + 1]) || !isfinite(p->qp[4 * i + 2])) {
+            lower_to(&sh->bad_state, i);
+            break;
+        }
+    crew_barrier(c);
+    if (sh->bad_state < p->n)
+        return;
+    finish(p, lo, hi, dt);
+}
+
+/* Every group matched against the new state with its stress (§4.3), on
+ * one thread of the crew. */
+static void stress_pass(phc_particles *p, const crew *c, long *bad, size_t *tot, size_t *fb)
+{
+    size_t lo, hi;
+    share(c, p->n, &lo, &hi);
+    for (size_t j = lo; j < hi; ++j) {
+        group_statics(p, j);
+        ellipsoid_term(p, j, p->q);
+    }
+    crew_barrier(c);
+    match_pass(p, c, NULL, p->n, p->x, 1, bad, tot, fb);
+}
+
 static int bad_group(const phc_particles *p, long bad, phc_error *err)
 {
     return phc_error_set(err, PHC_ERR_NUMERIC,
@@ -1877,52 +1952,38 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         relayout(p);
     const size_t n = p->n;
     p->polar_total = p->polar_fallbacks = 0;
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d)
-            if (!isfinite(p->x[3 * i + d]))
-                return phc_error_set(err, PHC_ERR_INPUT,
-                                     "particles: particle %zu (segment %ld): position %c is not "
-                                     "finite (%g m)",
-                                     i, p->source_id[i], "xyz"[d], p->x[3 * i + d]);
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);
     plan_projections(p);
-    long bad = -1;
-    size_t next_item = 0, tot = 0, fb = 0;
-    const int par = team((long)n);
-    if (!par) {
+    step_shared sh = {-1, n, n, 0};
+    size_t tot = 0, fb = 0;
+    if (!team((long)n)) {
         const crew one = {0, 1};
-        step_body(p, &one, dt, &bad, &next_item, &tot, &fb);
+        whole_step(p, &one, dt, &sh, &tot, &fb);
     } else {
 #pragma omp parallel reduction(+ : tot, fb)
         {
             const crew c = {omp_get_thread_num(), omp_get_num_threads()};
-            step_body(p, &c, dt, &bad, &next_item, &tot, &fb);
+            whole_step(p, &c, dt, &sh, &tot, &fb);
         }
     }
     p->polar_total += tot;
     p->polar_fallbacks += fb;
-    if (bad >= 0)
-        return bad_group(p, bad, err);
-    collide(p);
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d)
-            if (!isfinite(p->xp[3 * i + d]) || !isfinite(p->qp[4 * i + d]))
-                return phc_error_set(err, PHC_ERR_NUMERIC,
-                                     "particles: particle %zu (segment %ld): the step of %g s gave "
-                                     "a non-finite state; nothing was changed",
-                                     i, p->source_id[i], dt);
-    if (!par) {
-        finish(p, 0, n, dt);
-    } else {
-#pragma omp parallel
-        {
-            const crew c = {omp_get_thread_num(), omp_get_num_threads()};
-            size_t lo, hi;
-            share(&c, n, &lo, &hi);
-            finish(p, lo, hi, dt);
-        }
+    if (sh.bad_x < n) {
+        const size_t i = sh.bad_x;
+        const int d = !isfinite(p->x[3 * i]) ? 0 : !isfinite(p->x[3 * i + 1]) ? 1 : 2;
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): position %c is not finite "
+                             "(%g m)",
+                             i, p->source_id[i], "xyz"[d], p->x[3 * i + d]);
     }
+    if (sh.bad >= 0)
+        return bad_group(p, sh.bad, err);
+    if (sh.bad_state < n)
+        return phc_error_set(err, PHC_ERR_NUMERIC,
+                             "particles: particle %zu (segment %ld): the step of %g s gave a "
+                             "non-finite state; nothing was changed",
+                             sh.bad_state, p->source_id[sh.bad_state], dt);
 
     /* Stress of every group on the new state (§4.3), and breaking. */
     if (p->no_stress && !(p->o.break_threshold > 0)) {
@@ -1933,25 +1994,15 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         return PHC_OK;
     }
     tot = fb = 0;
-    if (!par) {
+    long bad = -1;
+    if (!team((long)n)) {
         const crew one = {0, 1};
-        for (size_t j = 0; j < n; ++j) {
-            group_statics(p, j);
-            ellipsoid_term(p, j, p->q);
-        }
-        match_pass(p, &one, NULL, n, p->x, 1, &bad, &tot, &fb);
+        stress_pass(p, &one, &bad, &tot, &fb);
     } else {
 #pragma omp parallel reduction(+ : tot, fb)
         {
             const crew c = {omp_get_thread_num(), omp_get_num_threads()};
-            size_t lo, hi;
-            share(&c, n, &lo, &hi);
-            for (size_t j = lo; j < hi; ++j) {
-                group_statics(p, j);
-                ellipsoid_term(p, j, p->q);
-            }
-            crew_barrier(&c);
-            match_pass(p, &c, NULL, n, p->x, 1, &bad, &tot, &fb);
+            stress_pass(p, &c, &bad, &tot, &fb);
         }
     }
     p->polar_total += tot;
