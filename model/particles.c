@@ -130,9 +130,9 @@ static inline void quat_mul(const double a[4], const double b[4], double c[4])
 
 static inline void quat_normalize(double q[4])
 {
-    const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    const double r = 1.0 / sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     for (int k = 0; k < 4; ++k)
-        q[k] /= r;
+        q[k] *= r;
 }
 
 /* Unit quaternion of the rotation vector phi (rad): exp(phi/2). */
@@ -1648,7 +1648,7 @@ static inline void rotate_z(const double q[4], double h, double out[3])
 /* follow_parents' step for one linked particle i: reads its parent's
  * final xp, qp and its own state, writes its own xp, qp only, so the
  * particles of one depth may run in any order or at once. */
-static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double T2)
+static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
 {
     const size_t u = p->parent[i];
     const double s = stiffness_of(p, i);
@@ -1675,36 +1675,51 @@ static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double
     if (k >= 1) {
         memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
     } else {
-        /* the free turn: the segment as it was, hung from J, its
-         * centre moved by its load from rest, a Δt² */
-        double dq[4], axis[3], dir[3], qf[4];
-        const double *qt = p->q + 4 * i;
-        rotate_z(qt, half, axis);
-        for (int d = 0; d < 3; ++d) {
-            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
-            dir[d] = axis[d] + dt * dt * a;
-            axis[d] /= half;
-        }
-        const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-        if (dn > 0) {
+        /* the free turn: the segment as it was, hung from J, its centre
+         * moved by its load from rest, a Δt²: the shortest turn from its
+         * axis e to the direction of (L/2) e + a Δt² (phc_quat_from_two_vectors,
+         * (1 + e·d, e × d) normalised; a half turn there when they oppose) */
+        double axis[3], dir[3], dq[4], qf[4];
+        const double *qt = p->q + 4 * i, *f = p->f + 3 * i;
+        rotate_z(qt, 1.0, axis);
+        const int loaded = f[0] != 0 || f[1] != 0 || f[2] != 0;
+        for (int d = 0; d < 3; ++d)
+            dir[d] = half * axis[d] + dt2 * (p->o.gravity[d] + (loaded ? f[d] / p->m[i] : 0.0));
+        const double dn2 = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
+        if (dn2 > 0) {
+            const double inv = 1.0 / sqrt(dn2);
             for (int d = 0; d < 3; ++d)
-                dir[d] /= dn;
-            phc_quat_from_two_vectors(axis, dir, dq);
+                dir[d] *= inv;
+            const double c = axis[0] * dir[0] + axis[1] * dir[1] + axis[2] * dir[2];
+            if (c < -1.0 + 1e-12) {
+                phc_quat_from_two_vectors(axis, dir, dq);
+            } else {
+                dq[0] = 1.0 + c;
+                dq[1] = axis[1] * dir[2] - axis[2] * dir[1];
+                dq[2] = axis[2] * dir[0] - axis[0] * dir[2];
+                dq[3] = axis[0] * dir[1] - axis[1] * dir[0];
+                quat_normalize(dq);
+            }
             quat_mul(dq, qt, qf);
         } else {
             memcpy(qf, qt, sizeof qf);
         }
-        /* the joint's spring: turn q_f by the fraction k toward q* */
+        /* the joint's spring: turn q_f by the fraction k toward q*,
+         * exp(k log δ) δ = q* q_f⁻¹ = (cos φ, sin φ n): (cos kφ, sin kφ n) */
         const double qf_inv[4] = {qf[0], -qf[1], -qf[2], -qf[3]};
-        double dev[4], rv[3];
+        double dev[4];
         quat_mul(qs, qf_inv, dev);
         if (dev[0] < 0)
             for (int d = 0; d < 4; ++d)
                 dev[d] = -dev[d];
-        phc_quat_log(dev, rv);
-        for (int d = 0; d < 3; ++d)
-            rv[d] *= k;
-        quat_exp(rv, dq);
+        const double sn = sqrt(dev[1] * dev[1] + dev[2] * dev[2] + dev[3] * dev[3]);
+        const double phi = atan2(sn, dev[0]);
+        const double sk = sin(k * phi), ck = cos(k * phi); /* one sincos call (GCC) */
+        /* sin(kφ)/sin φ, by its limit k/cos φ below 1e-8 (error ~ sn²) */
+        const double fac = sn > 1e-8 ? sk / sn : k / dev[0];
+        dq[0] = ck;
+        for (int d = 1; d < 4; ++d)
+            dq[d] = fac * dev[d];
         quat_mul(dq, qf, q);
     }
     quat_normalize(q);
@@ -1767,13 +1782,13 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
     if (c->nth == 1) {
         for (size_t t = 0; t < p->n; ++t)
             if (p->linked[order[t]])
-                follow_one(p, order[t], dt, dt2, T2);
+                follow_one(p, order[t], dt2, T2);
         return;
     }
     if (c->tid == 0)
         for (size_t t = 0; t < p->follow_top; ++t)
             if (p->linked[order[t]])
-                follow_one(p, order[t], dt, dt2, T2);
+                follow_one(p, order[t], dt2, T2);
     crew_barrier(c);
     for (;;) {
         size_t item;
@@ -1783,7 +1798,7 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
             break;
         for (size_t t = p->follow_start[item]; t < p->follow_start[item + 1]; ++t)
             if (p->linked[order[t]])
-                follow_one(p, order[t], dt, dt2, T2);
+                follow_one(p, order[t], dt2, T2);
     }
     crew_barrier(c);
 }
@@ -1826,26 +1841,40 @@ static void step_body(phc_particles *p, const crew *c, double dt, long *bad, siz
         follow_parents(p, c, dt, next_item);
 }
 
+/* atan2(s, c) for s >= 0, c > 0 (a unit quaternion's half angle): by the
+ * series t − t³/3 + ... − t¹¹/11 of atan t, t = s/c, when t < 0.03 (the
+ * next term is below 4e-20 of the sum: rounding), else atan2.  A step's
+ * turn of a particle is small (all of the 29569 particles' turns in the
+ * bench's 0.25 s frames had t < 0.03). */
+static inline double half_angle(double s, double c)
+{
+    if (!(s < 0.03 * c))
+        return atan2(s, c);
+    const double t = s / c, t2 = t * t;
+    return t * (1 + t2 * (-1.0 / 3 + t2 * (1.0 / 5 + t2 * (-1.0 / 7 + t2 * (1.0 / 9 - t2 / 11)))));
+}
+
 /* Velocities of particles lo .. hi from the positions (PBD), then damping;
  * the new state becomes the current one, ages advance. */
 static void finish(phc_particles *p, size_t lo, size_t hi, double dt)
 {
-    const double keep = 1 - p->o.damping;
+    const double keep_dt = (1 - p->o.damping) / dt;
     for (size_t i = lo; i < hi; ++i) {
         for (int d = 0; d < 3; ++d) {
-            p->v[3 * i + d] = keep * (p->xp[3 * i + d] - p->x[3 * i + d]) / dt;
+            p->v[3 * i + d] = keep_dt * (p->xp[3 * i + d] - p->x[3 * i + d]);
             p->x[3 * i + d] = p->xp[3 * i + d];
         }
-        double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
+        /* ω = (1 − damping) θ n / Δt, q_p q⁻¹ = (cos θ/2, sin θ/2 n) */
+        const double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
         double dq[4];
         quat_mul(p->qp + 4 * i, inv, dq);
         if (dq[0] < 0)
             for (int d = 0; d < 4; ++d)
                 dq[d] = -dq[d];
         const double sn = sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3]);
-        const double ang = 2 * atan2(sn, dq[0]);
+        const double fac = sn > 0 ? keep_dt * 2 * half_angle(sn, dq[0]) / sn : 0.0;
         for (int d = 0; d < 3; ++d)
-            p->w[3 * i + d] = sn > 0 ? keep * dq[1 + d] / sn * ang / dt : 0.0;
+            p->w[3 * i + d] = fac * dq[1 + d];
         memcpy(p->q + 4 * i, p->qp + 4 * i, 4 * sizeof(double));
         p->age[i] += dt;
     }
