@@ -1581,6 +1581,14 @@ static void raise_bad(long *bad, long k)
         *bad = k;
 }
 
+/* The smallest failing particle index (n: none), lowered by any thread. */
+static void lower_to(size_t *shared, size_t i)
+{
+#pragma omp critical(phc_particles_bad)
+    if (i < *shared)
+        *shared = i;
+}
+
 /* Entry t of a plan list (all particles without one). */
 static inline size_t pick(const size_t *list, size_t t) { return list ? list[t] : t; }
 
@@ -1775,20 +1783,46 @@ static void follow_order_build(phc_particles *p)
  * on one thread, taken in turn from a shared counter (each particle reads
  * only its parent's final state, so any order of the subtrees gives the
  * same numbers). */
-static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *next_item)
+/* 1 when particle i's predicted state is finite (x_p, and q_p's first
+ * three components as always checked). */
+static inline int state_finite(const phc_particles *p, size_t i)
+{
+    return isfinite(p->xp[3 * i]) && isfinite(p->xp[3 * i + 1]) && isfinite(p->xp[3 * i + 2]) &&
+           isfinite(p->qp[4 * i]) && isfinite(p->qp[4 * i + 1]) && isfinite(p->qp[4 * i + 2]);
+}
+
+/* follow_one on order[lo .. hi) (the linked ones); with `check`, the
+ * smallest index among them whose state is not finite lowers *bad. */
+static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt2, double T2, int check,
+                         size_t *bad)
+{
+    const size_t *order = p->follow_order;
+    for (size_t t = lo; t < hi; ++t) {
+        const size_t i = order[t];
+        if (p->linked[i])
+            follow_one(p, i, dt2, T2);
+        if (check && i < *bad && !state_finite(p, i))
+            *bad = i;
+    }
+}
+
+/* The joint pass over the order; with `check` (no collision pass after
+ * it), every particle's new state is checked by the thread that placed it
+ * and the smallest non-finite index lowers *bad_state, so the barrier
+ * that ends the pass also ends the check. */
+static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *next_item,
+                           int check, size_t *bad_state)
 {
     const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
-    const size_t *order = p->follow_order;
+    size_t bad = p->n;
     if (c->nth == 1) {
-        for (size_t t = 0; t < p->n; ++t)
-            if (p->linked[order[t]])
-                follow_one(p, order[t], dt2, T2);
+        follow_range(p, 0, p->n, dt2, T2, check, &bad);
+        if (bad < p->n)
+            lower_to(bad_state, bad);
         return;
     }
     if (c->tid == 0)
-        for (size_t t = 0; t < p->follow_top; ++t)
-            if (p->linked[order[t]])
-                follow_one(p, order[t], dt2, T2);
+        follow_range(p, 0, p->follow_top, dt2, T2, check, &bad);
     crew_barrier(c);
     for (;;) {
         size_t item;
@@ -1796,10 +1830,10 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
         item = (*next_item)++;
         if (item >= p->follow_items)
             break;
-        for (size_t t = p->follow_start[item]; t < p->follow_start[item + 1]; ++t)
-            if (p->linked[order[t]])
-                follow_one(p, order[t], dt2, T2);
+        follow_range(p, p->follow_start[item], p->follow_start[item + 1], dt2, T2, check, &bad);
     }
+    if (bad < p->n)
+        lower_to(bad_state, bad);
     crew_barrier(c);
 }
 
@@ -1809,7 +1843,7 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
  * blends), the joint pass.  *bad: a group whose moment matrix was not
  * finite (the step stops there). */
 static void step_body(phc_particles *p, const crew *c, double dt, long *bad, size_t *next_item,
-                      size_t *tot, size_t *fb)
+                      size_t *bad_state, size_t *tot, size_t *fb)
 {
     const size_t N = p->o.iterations;
     const size_t *plist = p->use_lists ? p->plist : NULL;
@@ -1838,7 +1872,7 @@ static void step_body(phc_particles *p, const crew *c, double dt, long *bad, siz
         for (size_t t = 0; t < p->npins; ++t)
             apply_anchor(p, p->pins[t]);
     if (p->o.follow_parent)
-        follow_parents(p, c, dt, next_item);
+        follow_parents(p, c, dt, next_item, !p->collide, bad_state);
 }
 
 /* atan2(s, c) for s >= 0, c > 0 (a unit quaternion's half angle): by the
@@ -1890,18 +1924,13 @@ typedef struct step_shared {
     size_t next_item;
 } step_shared;
 
-static void lower_to(size_t *shared, size_t i)
-{
-#pragma omp critical(phc_particles_bad)
-    if (i < *shared)
-        *shared = i;
-}
-
 /* The whole step on one thread of the crew: positions checked, step_body,
  * the collision pass (one thread, index order), the new state checked,
- * then (nothing non-finite) velocities and the new state (finish).  Stops
- * at the first failure, all threads alike (each reads the shared verdict
- * after a barrier). */
+ * then (nothing non-finite) velocities and the new state (finish).  The
+ * checks' verdicts are read after a barrier, by all threads alike; a
+ * non-finite position is judged with the new state (what runs before
+ * writes only the predicted state and the warm starts, and a group's
+ * non-finite moment matrix stops the projections). */
 static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *sh, size_t *tot,
                        size_t *fb)
 {
@@ -1912,28 +1941,26 @@ static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *
             lower_to(&sh->bad_x, i);
             break;
         }
-    crew_barrier(c);
-    if (sh->bad_x < p->n)
-        return;
-    step_body(p, c, dt, &sh->bad, &sh->next_item, tot, fb);
+    step_body(p, c, dt, &sh->bad, &sh->next_item, &sh->bad_state, tot, fb);
     if (sh->bad >= 0)
         return;
-    if (p->collide) {
-        if (c->tid == 0)
+    if (p->collide) { /* (step_body ended with a barrier: every check of x is in) */
+        if (c->tid == 0 && sh->bad_x == p->n)
             collide(p);
         crew_barrier(c);
     } else if (c->tid == 0) {
         p->pushed = 0;
         p->depth = INFINITY;
     }
-    for (size_t i = lo; i < hi; ++i)
-        if (!isfinite(p->xp[3 * i]) || !isfinite(p->xp[3 * i + 1]) || !isfinite(p->xp[3 * i + 2]) ||
-            !isfinite(p->qp[4 * i]) || !isfinite(p->qp[4 * i + 1]) || !isfinite(p->qp[4 * i + 2])) {
-            lower_to(&sh->bad_state, i);
-            break;
-        }
-    crew_barrier(c);
-    if (sh->bad_state < p->n)
+    if (p->collide || !p->o.follow_parent) { /* else checked in the joint pass */
+        for (size_t i = lo; i < hi; ++i)
+            if (!state_finite(p, i)) {
+                lower_to(&sh->bad_state, i);
+                break;
+            }
+        crew_barrier(c);
+    }
+    if (sh->bad_state < p->n || sh->bad_x < p->n)
         return;
     finish(p, lo, hi, dt);
 }
