@@ -180,6 +180,34 @@ static int polar_svd(const double A[9], double R[9])
     return 0;
 }
 
+/* The Newton terms of tr(Rᵀ A) at R along a left turn exp([ω]×) R:
+ * gradient g = Σ_c r_c × a_c = axial(B − Bᵀ) and T = tr(B) I − sym(B)
+ * (the Hessian is −T), B = A Rᵀ (rows of A against rows of R); T as
+ * T00, T11, T22, T01, T02, T12.  Returns tr(B) = Σ_c r_c · a_c. */
+static inline double newton_terms(const double A[9], const double R[9], double g[3], double T[6])
+{
+    double dot = 0, B[9];
+    g[0] = g[1] = g[2] = 0;
+    for (int c = 0; c < 3; ++c) {
+        const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
+        const double a0 = A[c], a1 = A[3 + c], a2 = A[6 + c];
+        g[0] += r1 * a2 - r2 * a1;
+        g[1] += r2 * a0 - r0 * a2;
+        g[2] += r0 * a1 - r1 * a0;
+        dot += r0 * a0 + r1 * a1 + r2 * a2;
+    }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            B[3 * i + j] = A[3 * i] * R[3 * j] + A[3 * i + 1] * R[3 * j + 1] + A[3 * i + 2] * R[3 * j + 2];
+    T[0] = dot - B[0];
+    T[1] = dot - B[4];
+    T[2] = dot - B[8];
+    T[3] = -0.5 * (B[1] + B[3]);
+    T[4] = -0.5 * (B[2] + B[6]);
+    T[5] = -0.5 * (B[5] + B[7]);
+    return dot;
+}
+
 int phc_particles_polar_rotation(const double A[9], double q[4])
 {
     double a[9], norm = 0;
@@ -214,23 +242,9 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     int converged = 0, slow = 0;
     for (int it = 0; it < 100; ++it) {
         phc_quat_to_matrix(q, R);
-        double om[3] = {0, 0, 0}, dot = 0, B[9];
-        for (int c = 0; c < 3; ++c) {
-            const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
-            const double a0 = a[c], a1 = a[3 + c], a2 = a[6 + c];
-            om[0] += r1 * a2 - r2 * a1;
-            om[1] += r2 * a0 - r0 * a2;
-            om[2] += r0 * a1 - r1 * a0;
-            dot += r0 * a0 + r1 * a1 + r2 * a2;
-        }
-        /* T = tr(B) I − sym(B), B = A Rᵀ (rows of A against rows of R) */
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                B[3 * i + j] = a[3 * i] * R[3 * j] + a[3 * i + 1] * R[3 * j + 1] +
-                               a[3 * i + 2] * R[3 * j + 2];
-        const double T00 = dot - B[0], T11 = dot - B[4], T22 = dot - B[8];
-        const double T01 = -0.5 * (B[1] + B[3]), T02 = -0.5 * (B[2] + B[6]),
-                     T12 = -0.5 * (B[5] + B[7]);
+        double om[3], Tm[6];
+        const double dot = newton_terms(a, R, om, Tm);
+        const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2], T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
         /* Cholesky of T; pivots must stay above 1e-10 (|a|_F = 1). */
         int newton = 0;
         double nw[3];
@@ -318,22 +332,6 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     return 1;
 }
 
-/* R(q) (row-major) of a unit quaternion, as phc_quat_to_matrix, here so
- * that the step's inner loops inline it. */
-static inline void rotation_of(const double q[4], double r[9])
-{
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    r[0] = 1.0 - 2.0 * (y * y + z * z);
-    r[1] = 2.0 * (x * y - w * z);
-    r[2] = 2.0 * (x * z + w * y);
-    r[3] = 2.0 * (x * y + w * z);
-    r[4] = 1.0 - 2.0 * (x * x + z * z);
-    r[5] = 2.0 * (y * z - w * x);
-    r[6] = 2.0 * (x * z - w * y);
-    r[7] = 2.0 * (y * z + w * x);
-    r[8] = 1.0 - 2.0 * (x * x + y * y);
-}
-
 /* Newton steps phc_particles_polar_rotation_warm takes before it hands
  * over to the full routine (a warm start needs 1 to 3). */
 #define POLAR_WARM_MAX_STEPS 8
@@ -351,23 +349,10 @@ int phc_particles_polar_rotation_warm(const double A[9], double q[4], double R[9
          * definite), cut to 1 rad */
         const double piv_min = 1e-10 * sqrt(n2);
         while (it < POLAR_WARM_MAX_STEPS) {
-            rotation_of(q, R);
-            double g[3] = {0, 0, 0}, dot = 0, B[9];
-            for (int c = 0; c < 3; ++c) {
-                const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
-                const double a0 = A[c], a1 = A[3 + c], a2 = A[6 + c];
-                g[0] += r1 * a2 - r2 * a1;
-                g[1] += r2 * a0 - r0 * a2;
-                g[2] += r0 * a1 - r1 * a0;
-                dot += r0 * a0 + r1 * a1 + r2 * a2;
-            }
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    B[3 * i + j] = A[3 * i] * R[3 * j] + A[3 * i + 1] * R[3 * j + 1] +
-                                   A[3 * i + 2] * R[3 * j + 2];
-            const double T00 = dot - B[0], T11 = dot - B[4], T22 = dot - B[8];
-            const double T01 = -0.5 * (B[1] + B[3]), T02 = -0.5 * (B[2] + B[6]),
-                         T12 = -0.5 * (B[5] + B[7]);
+            phc_quat_to_matrix(q, R);
+            double g[3], Tm[6];
+            newton_terms(A, R, g, Tm);
+            const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2], T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
             const double d0 = T00;
             if (!(d0 > piv_min))
                 break;
@@ -402,7 +387,7 @@ int phc_particles_polar_rotation_warm(const double A[9], double q[4], double R[9
             for (int k = 0; k < 4; ++k)
                 q[k] = t[k] * inv;
             if (wn2 < 1e-18) { /* a Newton step below 1e-9 rad: the next is below rounding */
-                rotation_of(q, R);
+                phc_quat_to_matrix(q, R);
                 goto done;
             }
         }
@@ -410,7 +395,7 @@ int phc_particles_polar_rotation_warm(const double A[9], double q[4], double R[9
     {
         const int how = phc_particles_polar_rotation(A, q);
         if (how >= 0)
-            rotation_of(q, R);
+            phc_quat_to_matrix(q, R);
         if (steps)
             *steps = -1;
         return how;
@@ -1270,7 +1255,7 @@ static void group_statics(phc_particles *p, size_t k)
 static void ellipsoid_term(phc_particles *p, size_t j, const double *Q)
 {
     double Rj[9];
-    rotation_of(Q + 4 * j, Rj);
+    phc_quat_to_matrix(Q + 4 * j, Rj);
     const double *E = p->ell0 + 9 * j;
     double *F = p->ell + 9 * j;
     for (int r = 0; r < 3; ++r)

@@ -98,25 +98,33 @@ static void svd_rotation(const double A[9], double R[9])
     matmul(u, vt, R);
 }
 
+/* A = Q S with Q = R(q) a random rotation and S = V diag(λ) Vᵀ, V random:
+ * λ in [1e-3, 1], or rod-like (1, ~1e-3, ~1e-3). */
+static void random_qs(double q[4], double Q[9], double A[9], int rodlike)
+{
+    double v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9];
+    random_quat(q);
+    random_quat(v);
+    phc_quat_to_matrix(q, Q);
+    phc_quat_to_matrix(v, V);
+    for (int i = 0; i < 3; ++i) {
+        L[4 * i] = rodlike ? (i == 0 ? 1 : 1e-3 * (1 + 0.5 * urand())) : 1e-3 + fabs(urand());
+        for (int j = 0; j < 3; ++j)
+            Vt[3 * i + j] = V[3 * j + i];
+    }
+    matmul(V, L, T);
+    matmul(T, Vt, S);
+    matmul(Q, S, A);
+}
+
 static void test_polar(void)
 {
     double worst_exact = 0, worst_svd = 0, worst_bad = 0;
     int fallbacks = 0, negdet = 0;
     for (int t = 0; t < 2000; ++t) {
         /* exact: A = Q S, S = V diag(λ) Vᵀ with λ in [1e-3, 1] */
-        double q[4], Q[9], v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9], A[9];
-        random_quat(q);
-        random_quat(v);
-        phc_quat_to_matrix(q, Q);
-        phc_quat_to_matrix(v, V);
-        for (int i = 0; i < 3; ++i) {
-            L[4 * i] = 1e-3 + fabs(urand());
-            for (int j = 0; j < 3; ++j)
-                Vt[3 * i + j] = V[3 * j + i];
-        }
-        matmul(V, L, T);
-        matmul(T, Vt, S);
-        matmul(Q, S, A);
+        double q[4], Q[9], A[9];
+        random_qs(q, Q, A, 0);
         double start[4] = {1, 0, 0, 0}, R[9];
         fallbacks += phc_particles_polar_rotation(A, start) == 1;
         phc_quat_to_matrix(start, R);
@@ -1247,19 +1255,8 @@ static void test_polar_warm(void)
         int most = 0, full = 0, refused = 0;
         long total = 0;
         for (int t = 0; t < 2000; ++t) {
-            double q[4], Q[9], v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9], A[9];
-            random_quat(q);
-            random_quat(v);
-            phc_quat_to_matrix(q, Q);
-            phc_quat_to_matrix(v, V);
-            for (int i = 0; i < 3; ++i) {
-                L[4 * i] = t % 2 ? (i == 0 ? 1 : 1e-3 * (1 + 0.5 * urand())) : 1e-3 + fabs(urand());
-                for (int j = 0; j < 3; ++j)
-                    Vt[3 * i + j] = V[3 * j + i];
-            }
-            matmul(V, L, T);
-            matmul(T, Vt, S);
-            matmul(Q, S, A);
+            double q[4], Q[9], A[9];
+            random_qs(q, Q, A, t % 2);
             /* start: q turned by delta about a random axis */
             double ax[3] = {urand(), urand(), urand()}, an = 0, dq[4], start[4], R[9];
             for (int k = 0; k < 3; ++k)
