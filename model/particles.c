@@ -1455,10 +1455,11 @@ static void plan_projections(phc_particles *p)
     for (size_t i = 0; i < n; ++i) {
         if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
             p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
-        else if (!(p->linked[i] && stiffness_of(p, i) > 0))
+        else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)))
             need_particle(p, i, N, &np);
         if (np > n / 4)
             return; /* many free particles: project everything */
+        /* (s_i > 0 read without the division: age > 0 when t_m > 0) */
     }
     /* need_t = plist[0 .. pcount[t]); M_t = gmatch[0 .. gcount[t]) */
     p->pcount[N] = np;
