@@ -1792,24 +1792,27 @@ static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt2, dou
     }
 }
 
-/* The joint pass over the order; with `check` (no collision pass after
- * it), every particle's new state is checked by the thread that placed it
- * and the smallest non-finite index lowers *bad_state, so the barrier
- * that ends the pass also ends the check. */
+/* The joint pass over the order (from the top's end when `top_done`: the
+ * caller placed the top before the threads started); with `check` (no
+ * collision pass after it), every particle's new state is checked by the
+ * thread that placed it and the smallest non-finite index lowers
+ * *bad_state, so the barrier that ends the pass also ends the check. */
 static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *next_item,
-                           int check, size_t *bad_state)
+                           int top_done, int check, size_t *bad_state)
 {
     const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
     size_t bad = p->n;
     if (c->nth == 1) {
-        follow_range(p, 0, p->n, dt2, T2, check, &bad);
+        follow_range(p, top_done ? p->follow_top : 0, p->n, dt2, T2, check, &bad);
         if (bad < p->n)
             lower_to(bad_state, bad);
         return;
     }
-    if (c->tid == 0)
-        follow_range(p, 0, p->follow_top, dt2, T2, check, &bad);
-    crew_barrier(c);
+    if (!top_done) {
+        if (c->tid == 0)
+            follow_range(p, 0, p->follow_top, dt2, T2, check, &bad);
+        crew_barrier(c);
+    }
     for (;;) {
         size_t item;
 #pragma omp atomic capture
@@ -1829,7 +1832,7 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
  * blends), the joint pass.  *bad: a group whose moment matrix was not
  * finite (the step stops there). */
 static void step_body(phc_particles *p, const crew *c, double dt, long *bad, size_t *next_item,
-                      size_t *bad_state, size_t *tot, size_t *fb)
+                      int top_done, size_t *bad_state, size_t *tot, size_t *fb)
 {
     const size_t N = p->o.iterations;
     const size_t *plist = p->use_lists ? p->plist : NULL;
@@ -1854,11 +1857,11 @@ static void step_body(phc_particles *p, const crew *c, double dt, long *bad, siz
     }
     if (p->gcount[1] > 0) /* (no group: nothing was predicted either) */
         crew_barrier(c);
-    if (p->use_lists && c->tid == 0) /* the pinned particles no blend reached */
+    if (p->use_lists && c->tid == 0 && !top_done) /* the pinned particles no blend reached */
         for (size_t t = 0; t < p->npins; ++t)
             apply_anchor(p, p->pins[t]);
     if (p->o.follow_parent)
-        follow_parents(p, c, dt, next_item, !p->collide, bad_state);
+        follow_parents(p, c, dt, next_item, top_done, !p->collide, bad_state);
 }
 
 /* atan2(s, c) for s >= 0, c > 0 (a unit quaternion's half angle): by the
@@ -1908,6 +1911,7 @@ typedef struct step_shared {
     long bad;
     size_t bad_x, bad_state;
     size_t next_item;
+    int top_done; /* the pins and the joint pass's top placed before the threads started */
 } step_shared;
 
 /* The whole step on one thread of the crew: positions checked, step_body,
@@ -1927,7 +1931,7 @@ static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *
             lower_to(&sh->bad_x, i);
             break;
         }
-    step_body(p, c, dt, &sh->bad, &sh->next_item, &sh->bad_state, tot, fb);
+    step_body(p, c, dt, &sh->bad, &sh->next_item, sh->top_done, &sh->bad_state, tot, fb);
     if (sh->bad >= 0)
         return;
     if (p->collide) { /* (step_body ended with a barrier: every check of x is in) */
@@ -1997,8 +2001,19 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);
     plan_projections(p);
-    step_shared sh = {-1, n, n, 0};
+    step_shared sh = {-1, n, n, 0, 0};
     size_t tot = 0, fb = 0;
+    if (p->use_lists && p->gcount[1] == 0 && p->o.follow_parent && team((long)n)) {
+        /* nothing projected (the climbing plants): the pins and the joint
+         * pass's top here, so that the threads meet once (one barrier) */
+        const double T2 = p->o.stiffness_step * p->o.stiffness_step;
+        size_t bad = n;
+        for (size_t t = 0; t < p->npins; ++t)
+            apply_anchor(p, p->pins[t]);
+        follow_range(p, 0, p->follow_top, dt * dt, T2, !p->collide, &bad);
+        sh.bad_state = bad;
+        sh.top_done = 1;
+    }
     if (!team((long)n)) {
         const crew one = {0, 1};
         whole_step(p, &one, dt, &sh, &tot, &fb);
