@@ -1635,13 +1635,13 @@ static inline void rotate_z(const double q[4], double h, double out[3])
  *              compliance α̃ = (1 − s) T² / (s Δt²) per unit inverse inertia,
  *              λ reset every substep);
  *   centre     x_i = J + R(q_i)(0, 0, L_i/2) (the segment hangs from J);
- * then its anchor.  Each particle reads only its parent's new state: small
- * plants run in topological order, large ones level by level (all
- * particles of one depth at once), with the same numbers, so the result
- * does not depend on the thread count. */
+ * then its anchor.  Each particle reads only its parent's new state: a
+ * small plant runs in the pass's order on one thread, a large one hands
+ * whole subtrees to the threads (follow_parents), with the same numbers,
+ * so the result does not depend on the thread count. */
 /* follow_parents' step for one linked particle i: reads its parent's
- * final xp, qp and its own state, writes its own xp, qp only, so the
- * particles of one depth may run in any order or at once. */
+ * final xp, qp and its own state, writes its own xp, qp only, so
+ * particles whose parents are placed may run in any order or at once. */
 static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
 {
     const size_t u = p->parent[i];
