@@ -1316,18 +1316,24 @@ static void test_polar_warm(void)
  * all hold projects no group at all. */
 static void test_projection_plan(void)
 {
-    phc_plant_graph *g = phc_plant_graph_random(300, 13);
+    phc_plant_graph *g = phc_plant_graph_random(1500, 13);
     phc_error err;
     const size_t n = g->n;
-    double *x[2] = {malloc(7 * n * sizeof(double)), malloc(7 * n * sizeof(double))};
-    size_t polar[2] = {0, 0};
-    for (int all = 0; all < 2; ++all) {
+    /* runs: planned on 1 thread, planned on 2 (a plant this large runs its
+     * step in an OpenMP team), every projection */
+    double *x[3] = {malloc(7 * n * sizeof(double)), malloc(7 * n * sizeof(double)),
+                    malloc(7 * n * sizeof(double))};
+    size_t polar[3] = {0, 0, 0};
+    const int keep = omp_get_max_threads();
+    for (int run = 0; run < 3; ++run) {
+        const int all = run == 2;
+        omp_set_num_threads(run == 1 ? 2 : 1);
         phc_particles_options opt = phc_particles_options_default();
         opt.follow_parent = 1;
         opt.maturity_age = 0.5;
         phc_particles *p = phc_particles_new(g, &opt, &err);
         CHECK(p != NULL);
-        if (!p || !x[all])
+        if (!p || !x[run])
             break;
         phc_particles_project_all(p, all);
         phc_particles_measure_stress(p, 0); /* count the projections' decompositions only */
@@ -1338,22 +1344,27 @@ static void test_projection_plan(void)
         for (int s = 0; s < 40; ++s) {
             phc_particles_report rep;
             CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
-            polar[all] += rep.polar_total;
+            polar[run] += rep.polar_total;
         }
         for (size_t i = 0; i < n; ++i) {
-            phc_particles_position(p, i, x[all] + 7 * i);
-            phc_particles_orientation(p, i, x[all] + 7 * i + 3);
+            phc_particles_position(p, i, x[run] + 7 * i);
+            phc_particles_orientation(p, i, x[run] + 7 * i + 3);
         }
         phc_particles_free(p);
     }
+    omp_set_num_threads(keep);
     double dmax = 0;
-    for (size_t i = 0; x[0] && x[1] && i < 7 * n; ++i)
-        dmax = fmax(dmax, fabs(x[0][i] - x[1][i]));
+    size_t differ = 0;
+    for (size_t i = 0; x[0] && x[1] && x[2] && i < 7 * n; ++i) {
+        dmax = fmax(dmax, fabs(x[0][i] - x[2][i]));
+        differ += x[0][i] != x[1][i];
+    }
     printf("projection plan: %zu-segment random plant with the joint pass, 40 steps: max |state "
-           "planned - state with every projection| = %.3g; polar decompositions %zu vs %zu\n",
-           n, dmax, polar[0], polar[1]);
-    CHECK(dmax < 1e-12);
-    CHECK(polar[1] == 40 * 4 * n && polar[0] > 0 && polar[0] < polar[1]);
+           "planned - state with every projection| = %.3g; polar decompositions %zu vs %zu; "
+           "planned on 1 vs 2 threads: %zu coordinates differ\n",
+           n, dmax, polar[0], polar[2], differ);
+    CHECK(dmax < 1e-12 && differ == 0 && polar[1] == polar[0]);
+    CHECK(polar[2] == 40 * 4 * n && polar[0] > 0 && polar[0] < polar[2]);
     /* the climbing plants' case: root pinned, every link held */
     phc_particles_options opt = phc_particles_options_default();
     opt.follow_parent = 1;
@@ -1381,8 +1392,8 @@ static void test_projection_plan(void)
            none, moved);
     CHECK(p != NULL && none == 0 && moved == 0);
     phc_particles_free(p);
-    free(x[0]);
-    free(x[1]);
+    for (int run = 0; run < 3; ++run)
+        free(x[run]);
     phc_plant_graph_free(g);
 }
 
