@@ -198,7 +198,8 @@ static inline double newton_terms(const double A[9], const double R[9], double g
     }
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
-            B[3 * i + j] = A[3 * i] * R[3 * j] + A[3 * i + 1] * R[3 * j + 1] + A[3 * i + 2] * R[3 * j + 2];
+            B[3 * i + j] =
+                A[3 * i] * R[3 * j] + A[3 * i + 1] * R[3 * j + 1] + A[3 * i + 2] * R[3 * j + 2];
     T[0] = dot - B[0];
     T[1] = dot - B[4];
     T[2] = dot - B[8];
@@ -244,7 +245,8 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
         phc_quat_to_matrix(q, R);
         double om[3], Tm[6];
         const double dot = newton_terms(a, R, om, Tm);
-        const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2], T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
+        const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2];
+        const double T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
         /* Cholesky of T; pivots must stay above 1e-10 (|a|_F = 1). */
         int newton = 0;
         double nw[3];
@@ -352,7 +354,8 @@ int phc_particles_polar_rotation_warm(const double A[9], double q[4], double R[9
             phc_quat_to_matrix(q, R);
             double g[3], Tm[6];
             newton_terms(A, R, g, Tm);
-            const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2], T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
+            const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2];
+            const double T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
             const double d0 = T00;
             if (!(d0 > piv_min))
                 break;

@@ -48,10 +48,10 @@
  *
  * Anchors (climbing eq. 5): an anchored particle is pulled to its anchor
  * point a after every projection, x ← x + k_a (a − x), 0 < k_a <= 1
- * (k_a = 1 pins it: x = a exactly); optionally its orientation is held too (a clamp).
- * phc_particles_attach applies the paper's rule: a free particle attaches
- * to its closest support point when that point is within the attach
- * distance.
+ * (k_a = 1 pins it: x = a exactly); optionally its orientation is held
+ * too (a clamp).  phc_particles_attach applies the paper's rule: a free
+ * particle attaches to its closest support point when that point is
+ * within the attach distance.
  *
  * Time step (position-based dynamics): predict v += Δt (g + f/m),
  * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
@@ -200,10 +200,10 @@ void phc_particles_measure_stress(phc_particles *p, int on);
  * particle with s > 0 from its parent's final state and its own last
  * orientation, and a pinned particle (anchor strength 1, orientation
  * held) ends at its anchor, so the N projections are computed only where
- * they reach the other particles (roots, broken links, s = 0): the
- * groups within two links per remaining iteration.  on = 1: every group is projected
- * anyway (for tests comparing the two; the state differs by rounding
- * only, through the polar warm starts).  Default off. */
+ * they reach the other particles (roots, broken links, s = 0): the groups
+ * within two links per remaining iteration.  on = 1: every group is
+ * projected anyway (for tests comparing the two; the state differs by
+ * rounding only, through the polar warm starts).  Default off. */
 void phc_particles_project_all(phc_particles *p, int on);
 
 /* Collisions with supports (ours; the climbing paper's particles only
