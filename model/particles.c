@@ -44,6 +44,11 @@ struct phc_particles {
     double *m;               /* n: kg */
     double *ax;              /* 3n: ellipsoid radii (r, r, L/2), m */
     double *age;             /* n: s */
+    /* The step's new velocities, angular velocities and ages, computed
+     * with its new state and swapped in (with x ↔ xp, q ↔ qp) when the
+     * whole step succeeded: nothing is copied back, nothing changes on a
+     * failure. */
+    double *vn, *wn, *agen;  /* 3n, 3n, n */
     double *s;               /* n: own stiffness (used when maturity_age == 0) */
     double *f;               /* 3n: external force, N */
     unsigned char *anchored, *hold_q;
@@ -452,6 +457,9 @@ void phc_particles_free(phc_particles *p)
     free(p->m);
     free(p->ax);
     free(p->age);
+    free(p->vn);
+    free(p->wn);
+    free(p->agen);
     free(p->s);
     free(p->f);
     free(p->anchored);
@@ -526,6 +534,9 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(m, n);
     ALLOC(ax, 3 * n);
     ALLOC(age, n);
+    ALLOC(vn, 3 * n);
+    ALLOC(wn, 3 * n);
+    ALLOC(agen, n);
     ALLOC(s, n);
     ALLOC(f, 3 * n);
     ALLOC(anchored, n);
@@ -672,6 +683,9 @@ static int reserve(phc_particles *p, size_t want)
     GROW(m, 1);
     GROW(ax, 3);
     GROW(age, 1);
+    GROW(vn, 3);
+    GROW(wn, 3);
+    GROW(agen, 1);
     GROW(s, 1);
     GROW(f, 3);
     GROW(anchored, 1);
@@ -1780,40 +1794,84 @@ static inline int state_finite(const phc_particles *p, size_t i)
            isfinite(p->qp[4 * i]) && isfinite(p->qp[4 * i + 1]) && isfinite(p->qp[4 * i + 2]);
 }
 
-/* follow_one on order[lo .. hi) (the linked ones); with `check`, the
- * smallest index among them whose state is not finite lowers *bad. */
-static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt2, double T2, int check,
+/* atan2(s, c) for s >= 0, c > 0 (a unit quaternion's half angle): by the
+ * series t − t³/3 + ... − t¹¹/11 of atan t, t = s/c, when t < 0.03 (the
+ * next term is below 4e-20 of the sum: rounding), else atan2.  A step's
+ * turn of a particle is small (all of the 29569 particles' turns in the
+ * bench's 0.25 s frames had t < 0.03). */
+static inline double half_angle(double s, double c)
+{
+    if (!(s < 0.03 * c))
+        return atan2(s, c);
+    const double t = s / c, t2 = t * t;
+    return t * (1 + t2 * (-1.0 / 3 + t2 * (1.0 / 5 + t2 * (-1.0 / 7 + t2 * (1.0 / 9 - t2 / 11)))));
+}
+
+/* Particle i's new velocity from its positions (PBD), then damping, its
+ * new angular velocity from its turn, its new age: into p->vn, p->wn,
+ * p->agen (the step swaps them in when it succeeds). */
+static inline void finish_one(phc_particles *p, size_t i, double keep_dt, double dt)
+{
+    for (int d = 0; d < 3; ++d)
+        p->vn[3 * i + d] = keep_dt * (p->xp[3 * i + d] - p->x[3 * i + d]);
+    /* ω = (1 − damping) θ n / Δt, q_p q⁻¹ = (cos θ/2, sin θ/2 n) */
+    const double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
+    double dq[4];
+    quat_mul(p->qp + 4 * i, inv, dq);
+    if (dq[0] < 0)
+        for (int d = 0; d < 4; ++d)
+            dq[d] = -dq[d];
+    const double sn = sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3]);
+    const double fac = sn > 0 ? keep_dt * 2 * half_angle(sn, dq[0]) / sn : 0.0;
+    for (int d = 0; d < 3; ++d)
+        p->wn[3 * i + d] = fac * dq[1 + d];
+    p->agen[i] = p->age[i] + dt;
+}
+
+/* The end of particle i's step: its new state checked (the smallest
+ * non-finite index lowers *bad), its velocities and age (finish_one). */
+static inline void close_one(phc_particles *p, size_t i, double dt, size_t *bad)
+{
+    if (i < *bad && !state_finite(p, i))
+        *bad = i;
+    finish_one(p, i, (1 - p->o.damping) / dt, dt);
+}
+
+/* follow_one on order[lo .. hi) (the linked ones); with `close`, each
+ * particle's step ends there too (close_one: checked, velocities). */
+static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, double T2, int close,
                          size_t *bad)
 {
     const size_t *order = p->follow_order;
+    const double dt2 = dt * dt;
     for (size_t t = lo; t < hi; ++t) {
         const size_t i = order[t];
         if (p->linked[i])
             follow_one(p, i, dt2, T2);
-        if (check && i < *bad && !state_finite(p, i))
-            *bad = i;
+        if (close)
+            close_one(p, i, dt, bad);
     }
 }
 
 /* The joint pass over the order (from the top's end when `top_done`: the
- * caller placed the top before the threads started); with `check` (no
- * collision pass after it), every particle's new state is checked by the
- * thread that placed it and the smallest non-finite index lowers
- * *bad_state, so the barrier that ends the pass also ends the check. */
+ * caller placed the top before the threads started); with `close` (no
+ * collision pass after it), every particle's step ends with the thread
+ * that placed it (close_one; the smallest non-finite index lowers
+ * *bad_state). */
 static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *next_item,
-                           int top_done, int check, size_t *bad_state)
+                           int top_done, int close, size_t *bad_state)
 {
-    const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
+    const double T2 = p->o.stiffness_step * p->o.stiffness_step;
     size_t bad = p->n;
     if (c->nth == 1) {
-        follow_range(p, top_done ? p->follow_top : 0, p->n, dt2, T2, check, &bad);
+        follow_range(p, top_done ? p->follow_top : 0, p->n, dt, T2, close, &bad);
         if (bad < p->n)
             lower_to(bad_state, bad);
         return;
     }
     if (!top_done) {
         if (c->tid == 0)
-            follow_range(p, 0, p->follow_top, dt2, T2, check, &bad);
+            follow_range(p, 0, p->follow_top, dt, T2, close, &bad);
         crew_barrier(c);
     }
     for (;;) {
@@ -1822,11 +1880,12 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
         item = (*next_item)++;
         if (item >= p->follow_items)
             break;
-        follow_range(p, p->follow_start[item], p->follow_start[item + 1], dt2, T2, check, &bad);
+        follow_range(p, p->follow_start[item], p->follow_start[item + 1], dt, T2, close, &bad);
     }
     if (bad < p->n)
         lower_to(bad_state, bad);
-    crew_barrier(c);
+    if (!close)
+        crew_barrier(c); /* the collision pass comes next */
 }
 
 /* The step up to the collision pass, on one thread of the crew: the
@@ -1865,45 +1924,6 @@ static void step_body(phc_particles *p, const crew *c, double dt, long *bad, siz
             apply_anchor(p, p->pins[t]);
     if (p->o.follow_parent)
         follow_parents(p, c, dt, next_item, top_done, !p->collide, bad_state);
-}
-
-/* atan2(s, c) for s >= 0, c > 0 (a unit quaternion's half angle): by the
- * series t − t³/3 + ... − t¹¹/11 of atan t, t = s/c, when t < 0.03 (the
- * next term is below 4e-20 of the sum: rounding), else atan2.  A step's
- * turn of a particle is small (all of the 29569 particles' turns in the
- * bench's 0.25 s frames had t < 0.03). */
-static inline double half_angle(double s, double c)
-{
-    if (!(s < 0.03 * c))
-        return atan2(s, c);
-    const double t = s / c, t2 = t * t;
-    return t * (1 + t2 * (-1.0 / 3 + t2 * (1.0 / 5 + t2 * (-1.0 / 7 + t2 * (1.0 / 9 - t2 / 11)))));
-}
-
-/* Velocities of particles lo .. hi from the positions (PBD), then damping;
- * the new state becomes the current one, ages advance. */
-static void finish(phc_particles *p, size_t lo, size_t hi, double dt)
-{
-    const double keep_dt = (1 - p->o.damping) / dt;
-    for (size_t i = lo; i < hi; ++i) {
-        for (int d = 0; d < 3; ++d) {
-            p->v[3 * i + d] = keep_dt * (p->xp[3 * i + d] - p->x[3 * i + d]);
-            p->x[3 * i + d] = p->xp[3 * i + d];
-        }
-        /* ω = (1 − damping) θ n / Δt, q_p q⁻¹ = (cos θ/2, sin θ/2 n) */
-        const double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
-        double dq[4];
-        quat_mul(p->qp + 4 * i, inv, dq);
-        if (dq[0] < 0)
-            for (int d = 0; d < 4; ++d)
-                dq[d] = -dq[d];
-        const double sn = sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3]);
-        const double fac = sn > 0 ? keep_dt * 2 * half_angle(sn, dq[0]) / sn : 0.0;
-        for (int d = 0; d < 3; ++d)
-            p->w[3 * i + d] = fac * dq[1 + d];
-        memcpy(p->q + 4 * i, p->qp + 4 * i, 4 * sizeof(double));
-        p->age[i] += dt;
-    }
 }
 
 /* What the threads of a step share: the first particle with a non-finite
@@ -1945,17 +1965,20 @@ static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *
         p->pushed = 0;
         p->depth = INFINITY;
     }
-    if (p->collide || !p->o.follow_parent) { /* else checked in the joint pass */
+    if (p->collide || !p->o.follow_parent) { /* else closed in the joint pass */
+        size_t bad = p->n;
         for (size_t i = lo; i < hi; ++i)
-            if (!state_finite(p, i)) {
-                lower_to(&sh->bad_state, i);
-                break;
-            }
-        crew_barrier(c);
+            close_one(p, i, dt, &bad);
+        if (bad < p->n)
+            lower_to(&sh->bad_state, bad);
     }
-    if (sh->bad_state < p->n || sh->bad_x < p->n)
-        return;
-    finish(p, lo, hi, dt);
+}
+
+static void swap_arrays(double **a, double **b)
+{
+    double *t = *a;
+    *a = *b;
+    *b = t;
 }
 
 /* Every group matched against the new state with its stress (§4.3), on
@@ -2013,7 +2036,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         size_t bad = n;
         for (size_t t = 0; t < p->npins; ++t)
             apply_anchor(p, p->pins[t]);
-        follow_range(p, 0, p->follow_top, dt * dt, T2, !p->collide, &bad);
+        follow_range(p, 0, p->follow_top, dt, T2, !p->collide, &bad);
         sh.bad_state = bad;
         sh.top_done = 1;
     }
@@ -2044,6 +2067,12 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
                              "particles: particle %zu (segment %ld): the step of %g s gave a "
                              "non-finite state; nothing was changed",
                              sh.bad_state, p->source_id[sh.bad_state], dt);
+    /* the step succeeded: its new state becomes the current one */
+    swap_arrays(&p->x, &p->xp);
+    swap_arrays(&p->q, &p->qp);
+    swap_arrays(&p->v, &p->vn);
+    swap_arrays(&p->w, &p->wn);
+    swap_arrays(&p->age, &p->agen);
 
     /* Stress of every group on the new state (§4.3), and breaking. */
     if (p->no_stress && !(p->o.break_threshold > 0)) {
