@@ -258,6 +258,27 @@ static void test_polar_rodlike(void)
 /* The projection matches the groups in parallel and blends in a fixed
  * order: one and two OpenMP threads give bit-identical states (1500
  * segments: above PHC_PARTICLES_PARALLEL_MIN, so the loops do run in parallel). */
+/* `steps` steps of 0.01 s of p (each checked), their polar decompositions
+ * and SVD fallbacks added to *polar and *fallbacks (may be NULL), then
+ * positions and orientations into state (7 per particle); frees p. */
+static void run_and_keep(phc_particles *p, int steps, size_t *polar, size_t *fallbacks,
+                         double *state)
+{
+    phc_error err;
+    for (int s = 0; s < steps; ++s) {
+        phc_particles_report rep;
+        CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
+        *polar += rep.polar_total;
+        if (fallbacks)
+            *fallbacks += rep.polar_fallbacks;
+    }
+    for (size_t i = 0; i < phc_particles_count(p); ++i) {
+        phc_particles_position(p, i, state + 7 * i);
+        phc_particles_orientation(p, i, state + 7 * i + 3);
+    }
+    phc_particles_free(p);
+}
+
 static void test_threads(void)
 {
     phc_plant_graph *g = phc_plant_graph_random(1500, 11);
@@ -277,17 +298,7 @@ static void test_threads(void)
         if (!p || !x[th])
             break;
         phc_particles_set_age(p, 0, 1, &err);
-        for (int s = 0; s < 50; ++s) {
-            phc_particles_report rep;
-            CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
-            polar[th] += rep.polar_total;
-            fallbacks[th] += rep.polar_fallbacks;
-        }
-        for (size_t i = 0; i < n; ++i) {
-            phc_particles_position(p, i, x[th] + 7 * i);
-            phc_particles_orientation(p, i, x[th] + 7 * i + 3);
-        }
-        phc_particles_free(p);
+        run_and_keep(p, 50, &polar[th], &fallbacks[th], x[th]);
     }
     omp_set_num_threads(keep);
     size_t differ = 0;
@@ -1341,16 +1352,7 @@ static void test_projection_plan(void)
          * (s = 0: free for its first step), root 0 free (not anchored) */
         for (size_t i = 0; i < n; ++i)
             phc_particles_set_age(p, i, i % 17 == 5 ? 0.0 : 0.05 + 0.95 * (double)(i % 7) / 6, &err);
-        for (int s = 0; s < 40; ++s) {
-            phc_particles_report rep;
-            CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
-            polar[run] += rep.polar_total;
-        }
-        for (size_t i = 0; i < n; ++i) {
-            phc_particles_position(p, i, x[run] + 7 * i);
-            phc_particles_orientation(p, i, x[run] + 7 * i + 3);
-        }
-        phc_particles_free(p);
+        run_and_keep(p, 40, &polar[run], NULL, x[run]);
     }
     omp_set_num_threads(keep);
     double dmax = 0;
