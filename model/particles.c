@@ -1828,18 +1828,10 @@ static inline void finish_one(phc_particles *p, size_t i, double keep_dt, double
     p->agen[i] = p->age[i] + dt;
 }
 
-/* The end of particle i's step: its new state checked (the smallest
- * non-finite index lowers *bad), its velocities and age (finish_one). */
-static inline void close_one(phc_particles *p, size_t i, double dt, size_t *bad)
-{
-    if (i < *bad && !state_finite(p, i))
-        *bad = i;
-    finish_one(p, i, (1 - p->o.damping) / dt, dt);
-}
-
-/* follow_one on order[lo .. hi) (the linked ones); with `close`, each
- * particle's step ends there too (close_one: checked, velocities). */
-static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, double T2, int close,
+/* follow_one on order[lo .. hi) (the linked ones); with `check`, each
+ * particle's new state is checked there, while it is in the cache (the
+ * smallest non-finite index lowers *bad). */
+static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, double T2, int check,
                          size_t *bad)
 {
     const size_t *order = p->follow_order;
@@ -1848,30 +1840,30 @@ static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, doub
         const size_t i = order[t];
         if (p->linked[i])
             follow_one(p, i, dt2, T2);
-        if (close)
-            close_one(p, i, dt, bad);
+        if (check && i < *bad && !state_finite(p, i))
+            *bad = i;
     }
 }
 
 /* The joint pass over the order (from the top's end when `top_done`: the
- * caller placed the top before the threads started); with `close` (no
- * collision pass after it), every particle's step ends with the thread
- * that placed it (close_one; the smallest non-finite index lowers
- * *bad_state). */
+ * caller placed the top before the threads started); with `check` (no
+ * collision pass after it), every particle's new state is checked by the
+ * thread that placed it (the smallest non-finite index lowers
+ * *bad_state).  Ends with a barrier. */
 static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *next_item,
-                           int top_done, int close, size_t *bad_state)
+                           int top_done, int check, size_t *bad_state)
 {
     const double T2 = p->o.stiffness_step * p->o.stiffness_step;
     size_t bad = p->n;
     if (c->nth == 1) {
-        follow_range(p, top_done ? p->follow_top : 0, p->n, dt, T2, close, &bad);
+        follow_range(p, top_done ? p->follow_top : 0, p->n, dt, T2, check, &bad);
         if (bad < p->n)
             lower_to(bad_state, bad);
         return;
     }
     if (!top_done) {
         if (c->tid == 0)
-            follow_range(p, 0, p->follow_top, dt, T2, close, &bad);
+            follow_range(p, 0, p->follow_top, dt, T2, check, &bad);
         crew_barrier(c);
     }
     for (;;) {
@@ -1880,12 +1872,11 @@ static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *n
         item = (*next_item)++;
         if (item >= p->follow_items)
             break;
-        follow_range(p, p->follow_start[item], p->follow_start[item + 1], dt, T2, close, &bad);
+        follow_range(p, p->follow_start[item], p->follow_start[item + 1], dt, T2, check, &bad);
     }
     if (bad < p->n)
         lower_to(bad_state, bad);
-    if (!close)
-        crew_barrier(c); /* the collision pass comes next */
+    crew_barrier(c);
 }
 
 /* The step up to the collision pass, on one thread of the crew: the
@@ -1965,13 +1956,18 @@ static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *
         p->pushed = 0;
         p->depth = INFINITY;
     }
-    if (p->collide || !p->o.follow_parent) { /* else closed in the joint pass */
-        size_t bad = p->n;
-        for (size_t i = lo; i < hi; ++i)
-            close_one(p, i, dt, &bad);
-        if (bad < p->n)
-            lower_to(&sh->bad_state, bad);
+    /* velocities in index order (streams; the joint pass's order jumps),
+     * the new state checked here unless the joint pass did */
+    const int checked = p->o.follow_parent && !p->collide;
+    const double keep_dt = (1 - p->o.damping) / dt;
+    size_t bad = p->n;
+    for (size_t i = lo; i < hi; ++i) {
+        if (!checked && i < bad && !state_finite(p, i))
+            bad = i;
+        finish_one(p, i, keep_dt, dt);
     }
+    if (bad < p->n)
+        lower_to(&sh->bad_state, bad);
 }
 
 static void swap_arrays(double **a, double **b)
