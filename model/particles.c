@@ -44,6 +44,11 @@ struct phc_particles {
     double *m;               /* n: kg */
     double *ax;              /* 3n: ellipsoid radii (r, r, L/2), m */
     double *age;             /* n: s */
+    /* The step's new velocities, angular velocities and ages, computed
+     * with its new state and swapped in (with x ↔ xp, q ↔ qp) when the
+     * whole step succeeded: nothing is copied back, nothing changes on a
+     * failure. */
+    double *vn, *wn, *agen;  /* 3n, 3n, n */
     double *s;               /* n: own stiffness (used when maturity_age == 0) */
     double *f;               /* 3n: external force, N */
     unsigned char *anchored, *hold_q;
@@ -54,15 +59,33 @@ struct phc_particles {
     unsigned char *linked;   /* n: 1 while i is linked to its parent */
     size_t *child_start, *child; /* children (CSR, in index order) */
     size_t *topo;            /* n: every particle after its parent (roots first) */
-    size_t *link_depth;      /* n: links from i up to its root (follow_parents' levels) */
-    size_t *level;           /* n: the particles by depth (follow_parents) */
-    size_t *level_start;     /* n + 1: level d is level[level_start[d] .. level_start[d + 1]) */
+    /* The joint pass's order (follow_parents), rebuilt after a change of
+     * the parents: the top of the tree (particles whose subtree holds more
+     * than a share of all) in topological order, follow_order[0 ..
+     * follow_top), then whole subtrees hanging from it, item t being
+     * follow_order[follow_start[t] .. follow_start[t + 1]) in preorder. */
+    int follow_dirty;
+    size_t follow_top, follow_items;
+    size_t *follow_order;    /* n */
+    size_t *follow_start;    /* n + 1 */
+    size_t *subtree;         /* n: subtree sizes (scratch of the order) */
+    size_t *fstack;          /* n: depth-first stack (scratch of the order) */
+    /* The projections that can change the result (plan_projections): the
+     * particles to blend at iteration t are plist[0 .. pcount[t]) (t = 0:
+     * to predict), the groups to match gmatch[0 .. gcount[t]), t = 1 .. N;
+     * plist = NULL: all of them. */
+    int project_all;         /* 1: every projection (phc_particles_project_all) */
+    size_t *plist, *gmatch;  /* n each */
+    int *plev, *glev;        /* n each: the last iteration a particle / group is needed at, -1 */
+    size_t *pcount, *gcount; /* iterations + 1 each */
+    int use_lists;
+    size_t *pins, npins;     /* n: the pinned particles (k_a = 1, orientation held) */
     double *gq;              /* 4n: last rotation of each group (warm start) */
     double *stress;          /* n: group stress after the last step */
     long *source_id;         /* n: segment ids for messages */
     size_t *child_index;     /* n: position of i among its parent's children */
     double *ell0;            /* 9n: D_j R̄_jᵀ / 5 (kg-free ellipsoid term, m²) */
-    double *Rq;              /* 9n: R(q_j) of the orientations being matched */
+    double *ell;             /* 9n: R_j D_j R̄_jᵀ / 5 of the orientations being matched (m²) */
     /* Group slots: group k owns slots goff[k] .. goff[k+1]−1: slot 0 = k,
      * slot 1 = its parent, slot 2 + c = its c-th child; a slot whose link
      * is broken has μ = 0.  Each group writes only its own slots, so the
@@ -71,6 +94,9 @@ struct phc_particles {
     size_t *goff;            /* n + 1 */
     size_t *mem;             /* slots: member particle */
     double *mu, *goal;       /* slots: μ_jk (kg); 3·slots: goal (m) */
+    double *om;              /* slots: blend weight ω_jk = μ_jk / m_j (1) */
+    double *d0;              /* 3·slots: rest offset x̄_j − c̄_k (m) */
+    double *gM, *gden;       /* n: group mass Σ μ (kg), Σ μ |x̄ − c̄|² (kg m²) */
     size_t polar_total, polar_fallbacks; /* counters of the current step */
 };
 
@@ -95,7 +121,7 @@ phc_particles_options phc_particles_options_default(void)
 /* ---- small linear algebra (row-major 3x3) -------------------------------- */
 
 
-static void quat_mul(const double a[4], const double b[4], double c[4])
+static inline void quat_mul(const double a[4], const double b[4], double c[4])
 {
     const double w = a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3];
     const double x = a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2];
@@ -107,15 +133,15 @@ static void quat_mul(const double a[4], const double b[4], double c[4])
     c[3] = z;
 }
 
-static void quat_normalize(double q[4])
+static inline void quat_normalize(double q[4])
 {
-    const double r = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    const double r = 1.0 / sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     for (int k = 0; k < 4; ++k)
-        q[k] /= r;
+        q[k] *= r;
 }
 
 /* Unit quaternion of the rotation vector phi (rad): exp(phi/2). */
-static void quat_exp(const double phi[3], double q[4])
+static inline void quat_exp(const double phi[3], double q[4])
 {
     const double a = sqrt(phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2]);
     if (a < 1e-300) {
@@ -130,7 +156,7 @@ static void quat_exp(const double phi[3], double q[4])
     q[3] = phi[2] * sh;
 }
 
-static void mat_vec(const double R[9], const double a[3], double b[3])
+static inline void mat_vec(const double R[9], const double a[3], double b[3])
 {
     b[0] = R[0] * a[0] + R[1] * a[1] + R[2] * a[2];
     b[1] = R[3] * a[0] + R[4] * a[1] + R[5] * a[2];
@@ -157,6 +183,35 @@ static int polar_svd(const double A[9], double R[9])
             R[3 * i + j] = u[3 * i] * d[0] * vt[j] + u[3 * i + 1] * d[1] * vt[3 + j] +
                            u[3 * i + 2] * d[2] * vt[6 + j];
     return 0;
+}
+
+/* The Newton terms of tr(Rᵀ A) at R along a left turn exp([ω]×) R:
+ * gradient g = Σ_c r_c × a_c = axial(B − Bᵀ) and T = tr(B) I − sym(B)
+ * (the Hessian is −T), B = A Rᵀ (rows of A against rows of R); T as
+ * T00, T11, T22, T01, T02, T12.  Returns tr(B) = Σ_c r_c · a_c. */
+static inline double newton_terms(const double A[9], const double R[9], double g[3], double T[6])
+{
+    double dot = 0, B[9];
+    g[0] = g[1] = g[2] = 0;
+    for (int c = 0; c < 3; ++c) {
+        const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
+        const double a0 = A[c], a1 = A[3 + c], a2 = A[6 + c];
+        g[0] += r1 * a2 - r2 * a1;
+        g[1] += r2 * a0 - r0 * a2;
+        g[2] += r0 * a1 - r1 * a0;
+        dot += r0 * a0 + r1 * a1 + r2 * a2;
+    }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            B[3 * i + j] =
+                A[3 * i] * R[3 * j] + A[3 * i + 1] * R[3 * j + 1] + A[3 * i + 2] * R[3 * j + 2];
+    T[0] = dot - B[0];
+    T[1] = dot - B[4];
+    T[2] = dot - B[8];
+    T[3] = -0.5 * (B[1] + B[3]);
+    T[4] = -0.5 * (B[2] + B[6]);
+    T[5] = -0.5 * (B[5] + B[7]);
+    return dot;
 }
 
 int phc_particles_polar_rotation(const double A[9], double q[4])
@@ -193,23 +248,10 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     int converged = 0, slow = 0;
     for (int it = 0; it < 100; ++it) {
         phc_quat_to_matrix(q, R);
-        double om[3] = {0, 0, 0}, dot = 0, B[9];
-        for (int c = 0; c < 3; ++c) {
-            const double r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
-            const double a0 = a[c], a1 = a[3 + c], a2 = a[6 + c];
-            om[0] += r1 * a2 - r2 * a1;
-            om[1] += r2 * a0 - r0 * a2;
-            om[2] += r0 * a1 - r1 * a0;
-            dot += r0 * a0 + r1 * a1 + r2 * a2;
-        }
-        /* T = tr(B) I − sym(B), B = A Rᵀ (rows of A against rows of R) */
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                B[3 * i + j] = a[3 * i] * R[3 * j] + a[3 * i + 1] * R[3 * j + 1] +
-                               a[3 * i + 2] * R[3 * j + 2];
-        const double T00 = dot - B[0], T11 = dot - B[4], T22 = dot - B[8];
-        const double T01 = -0.5 * (B[1] + B[3]), T02 = -0.5 * (B[2] + B[6]),
-                     T12 = -0.5 * (B[5] + B[7]);
+        double om[3], Tm[6];
+        const double dot = newton_terms(a, R, om, Tm);
+        const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2];
+        const double T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
         /* Cholesky of T; pivots must stay above 1e-10 (|a|_F = 1). */
         int newton = 0;
         double nw[3];
@@ -297,6 +339,81 @@ int phc_particles_polar_rotation(const double A[9], double q[4])
     return 1;
 }
 
+/* Newton steps phc_particles_polar_rotation_warm takes before it hands
+ * over to the full routine (a warm start needs 1 to 3). */
+#define POLAR_WARM_MAX_STEPS 8
+
+int phc_particles_polar_rotation_warm(const double A[9], double q[4], double R[9], int *steps)
+{
+    double n2 = 0;
+    for (int k = 0; k < 9; ++k)
+        n2 += A[k] * A[k];
+    int it = 0;
+    if (n2 > 0 && isfinite(n2)) {
+        /* the Newton step of phc_particles_polar_rotation on the unscaled
+         * A: gradient g = Σ_c r_c × a_c, T = tr(B) I − sym(B), B = A Rᵀ,
+         * ω = T⁻¹ g by T = L D Lᵀ (pivots above 1e-10 |A|_F: T positive
+         * definite), cut to 1 rad */
+        const double piv_min = 1e-10 * sqrt(n2);
+        while (it < POLAR_WARM_MAX_STEPS) {
+            phc_quat_to_matrix(q, R);
+            double g[3], Tm[6];
+            newton_terms(A, R, g, Tm);
+            const double T00 = Tm[0], T11 = Tm[1], T22 = Tm[2];
+            const double T01 = Tm[3], T02 = Tm[4], T12 = Tm[5];
+            const double d0 = T00;
+            if (!(d0 > piv_min))
+                break;
+            const double l10 = T01 / d0, l20 = T02 / d0;
+            const double d1 = T11 - l10 * T01;
+            if (!(d1 > piv_min))
+                break;
+            const double l21 = (T12 - l20 * T01) / d1;
+            const double d2 = T22 - l20 * T02 - l21 * l21 * d1;
+            if (!(d2 > piv_min))
+                break;
+            const double y0 = g[0], y1 = g[1] - l10 * y0, y2 = g[2] - l20 * y0 - l21 * y1;
+            double w[3];
+            w[2] = y2 / d2;
+            w[1] = y1 / d1 - l21 * w[2];
+            w[0] = y0 / d0 - l10 * w[1] - l20 * w[2];
+            double wn2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            ++it;
+            if (wn2 < 1e-28) /* at the maximum: R = R(q) */
+                goto done;
+            if (wn2 > 1.0) {
+                const double sc = 1.0 / sqrt(wn2);
+                for (int k = 0; k < 3; ++k)
+                    w[k] *= sc;
+            }
+            /* q ← (1, ω/2) ⊗ q, normalised: the turn about ω by 2 atan(|ω|/2)
+             * = |ω| − |ω|³/12 + ..., exact to rounding near the maximum */
+            const double h[4] = {1, 0.5 * w[0], 0.5 * w[1], 0.5 * w[2]};
+            double t[4];
+            quat_mul(h, q, t);
+            const double inv = 1.0 / sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2] + t[3] * t[3]);
+            for (int k = 0; k < 4; ++k)
+                q[k] = t[k] * inv;
+            if (wn2 < 1e-18) { /* a Newton step below 1e-9 rad: the next is below rounding */
+                phc_quat_to_matrix(q, R);
+                goto done;
+            }
+        }
+    }
+    {
+        const int how = phc_particles_polar_rotation(A, q);
+        if (how >= 0)
+            phc_quat_to_matrix(q, R);
+        if (steps)
+            *steps = -1;
+        return how;
+    }
+done:
+    if (steps)
+        *steps = it;
+    return 0;
+}
+
 /* ---- construction ------------------------------------------------------- */
 
 static const char *opt_problem(const phc_particles_options *o, char *buf, size_t size)
@@ -340,6 +457,9 @@ void phc_particles_free(phc_particles *p)
     free(p->m);
     free(p->ax);
     free(p->age);
+    free(p->vn);
+    free(p->wn);
+    free(p->agen);
     free(p->s);
     free(p->f);
     free(p->anchored);
@@ -352,15 +472,27 @@ void phc_particles_free(phc_particles *p)
     free(p->child_start);
     free(p->child);
     free(p->topo);
-    free(p->link_depth);
-    free(p->level);
-    free(p->level_start);
+    free(p->follow_order);
+    free(p->follow_start);
+    free(p->subtree);
+    free(p->fstack);
+    free(p->plist);
+    free(p->gmatch);
+    free(p->plev);
+    free(p->glev);
+    free(p->pcount);
+    free(p->pins);
+    free(p->gcount);
     free(p->gq);
     free(p->stress);
     free(p->source_id);
     free(p->child_index);
     free(p->ell0);
-    free(p->Rq);
+    free(p->ell);
+    free(p->om);
+    free(p->d0);
+    free(p->gM);
+    free(p->gden);
     free(p->goff);
     free(p->mem);
     free(p->mu);
@@ -402,6 +534,9 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(m, n);
     ALLOC(ax, 3 * n);
     ALLOC(age, n);
+    ALLOC(vn, 3 * n);
+    ALLOC(wn, 3 * n);
+    ALLOC(agen, n);
     ALLOC(s, n);
     ALLOC(f, 3 * n);
     ALLOC(anchored, n);
@@ -414,19 +549,31 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(child_start, n + 1);
     ALLOC(child, n);
     ALLOC(topo, n);
-    ALLOC(link_depth, n);
-    ALLOC(level, n);
-    ALLOC(level_start, n + 1);
+    ALLOC(follow_order, n);
+    ALLOC(follow_start, n + 1);
+    ALLOC(subtree, n);
+    ALLOC(fstack, n);
+    ALLOC(plist, n);
+    ALLOC(gmatch, n);
+    ALLOC(plev, n);
+    ALLOC(glev, n);
+    ALLOC(pcount, o.iterations + 1);
+    ALLOC(pins, n);
+    ALLOC(gcount, o.iterations + 1);
     ALLOC(gq, 4 * n);
     ALLOC(stress, n);
     ALLOC(source_id, n);
     ALLOC(child_index, n);
     ALLOC(ell0, 9 * n);
-    ALLOC(Rq, 9 * n);
+    ALLOC(ell, 9 * n);
     ALLOC(goff, n + 1);
     ALLOC(mem, slots);
     ALLOC(mu, slots);
     ALLOC(goal, 3 * slots);
+    ALLOC(om, slots);
+    ALLOC(d0, 3 * slots);
+    ALLOC(gM, n);
+    ALLOC(gden, n);
 #undef ALLOC
     memcpy(p->child_start, g->child_start, (n + 1) * sizeof *p->child_start);
     memcpy(p->topo, g->order, n * sizeof *p->topo); /* breadth-first: parents first */
@@ -495,6 +642,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     }
     memcpy(p->xp, p->x, 3 * n * sizeof(double));
     memcpy(p->qp, p->q, 4 * n * sizeof(double));
+    p->follow_dirty = 1;
     return p;
 nomem:
     phc_error_set(err, PHC_ERR_NOMEM, "particles: out of memory for %zu particles", g->n);
@@ -535,6 +683,9 @@ static int reserve(phc_particles *p, size_t want)
     GROW(m, 1);
     GROW(ax, 3);
     GROW(age, 1);
+    GROW(vn, 3);
+    GROW(wn, 3);
+    GROW(agen, 1);
     GROW(s, 1);
     GROW(f, 3);
     GROW(anchored, 1);
@@ -546,26 +697,36 @@ static int reserve(phc_particles *p, size_t want)
     GROW(linked, 1);
     GROW(child, 1);
     GROW(topo, 1);
-    GROW(link_depth, 1);
-    GROW(level, 1);
+    GROW(follow_order, 1);
+    GROW(subtree, 1);
+    GROW(fstack, 1);
+    GROW(plist, 1);
+    GROW(gmatch, 1);
+    GROW(plev, 1);
+    GROW(glev, 1);
+    GROW(pins, 1);
     GROW(gq, 4);
     GROW(stress, 1);
     GROW(source_id, 1);
     GROW(child_index, 1);
     GROW(ell0, 9);
-    GROW(Rq, 9);
+    GROW(ell, 9);
     GROW(mem, 3);
     GROW(mu, 3);
     GROW(goal, 9);
+    GROW(om, 3);
+    GROW(d0, 9);
+    GROW(gM, 1);
+    GROW(gden, 1);
 #undef GROW
     void *t = realloc(p->child_start, (cap + 1) * sizeof *p->child_start);
     if (!t)
         return -1;
     p->child_start = t;
-    t = realloc(p->level_start, (cap + 1) * sizeof *p->level_start);
+    t = realloc(p->follow_start, (cap + 1) * sizeof *p->follow_start);
     if (!t)
         return -1;
-    p->level_start = t;
+    p->follow_start = t;
     t = realloc(p->goff, (cap + 1) * sizeof *p->goff);
     if (!t)
         return -1;
@@ -603,6 +764,7 @@ static void relayout(phc_particles *p)
             p->child_index[p->child[c]] = c - p->child_start[k];
     }
     p->layout_dirty = 0;
+    p->follow_dirty = 1;
 }
 
 /* Rest state of particle i from its segment head → tail (m) and radius r
@@ -668,7 +830,7 @@ int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
         return phc_error_set(err, PHC_ERR_INVALID,
                              "particles: append: parent %zu does not exist (%zu particles)",
                              parent, p->n);
-    double L;
+    double L = 0;
     if (check_segment(p, p->n, head, tail, radius, &L, err))
         return err ? err->status : PHC_ERR_INPUT;
     if (reserve(p, p->n + 1))
@@ -708,7 +870,7 @@ int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], con
         return phc_error_set(err, PHC_ERR_INVALID,
                              "particles: rest: particle %zu does not exist (%zu particles)", i,
                              p ? p->n : 0);
-    double L;
+    double L = 0;
     if (check_segment(p, i, head, tail, radius, &L, err))
         return err ? err->status : PHC_ERR_INPUT;
     rest_from_segment(p, i, head, tail, radius, L);
@@ -1067,108 +1229,111 @@ static double weight_sum(const phc_particles *p, size_t i)
     return W;
 }
 
-/* Fills the slots of group k with their members and blend weights ω_jk
- * (in p->mu, still to be multiplied by the masses; 0 for a broken link). */
-static void group_members(const phc_particles *p, size_t k)
+/* What the step keeps of group k while the rest state, the masses and the
+ * links stay as they are: its slots' members, blend weights ω_jk (0 for a
+ * broken link), masses μ_jk = ω_jk m_j, rest offsets x̄_j − c̄_k, the group's
+ * mass Σ μ and Σ μ |x̄_j − c̄_k|².  Writes group k's slots only. */
+static void group_statics(phc_particles *p, size_t k)
 {
-    const size_t o = p->goff[k];
+    const size_t o = p->goff[k], e = p->goff[k + 1];
     p->mem[o] = k;
-    p->mu[o] = 1.0 / weight_sum(p, k);
+    p->om[o] = 1.0 / weight_sum(p, k);
     p->mem[o + 1] = p->linked[k] ? p->parent[k] : k;
-    p->mu[o + 1] = p->linked[k] ? 1.0 / weight_sum(p, p->parent[k]) : 0.0;
+    p->om[o + 1] = p->linked[k] ? 1.0 / weight_sum(p, p->parent[k]) : 0.0;
     for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c) {
         const size_t ch = p->child[c], sl = o + 2 + (c - p->child_start[k]);
         p->mem[sl] = ch;
-        p->mu[sl] = p->linked[ch] ? p->o.parent_weight / weight_sum(p, ch) : 0.0;
+        p->om[sl] = p->linked[ch] ? p->o.parent_weight / weight_sum(p, ch) : 0.0;
     }
+    double M = 0, c0[3] = {0, 0, 0};
+    for (size_t a = o; a < e; ++a) {
+        const size_t j = p->mem[a];
+        p->mu[a] = p->om[a] * p->m[j];
+        M += p->mu[a];
+        for (int d = 0; d < 3; ++d)
+            c0[d] += p->mu[a] * p->x0[3 * j + d];
+    }
+    for (int d = 0; d < 3; ++d)
+        c0[d] /= M;
+    double den = 0;
+    for (size_t a = o; a < e; ++a) {
+        const size_t j = p->mem[a];
+        for (int d = 0; d < 3; ++d) {
+            p->d0[3 * a + d] = p->x0[3 * j + d] - c0[d];
+            den += p->mu[a] * p->d0[3 * a + d] * p->d0[3 * a + d];
+        }
+    }
+    p->gM[k] = M;
+    p->gden[k] = den;
 }
 
-/* R(q_j) of every particle into p->Rq. */
-static void orientation_matrices(phc_particles *p, const double *Q)
+/* The ellipsoid term of particle j turned to the orientation Q_j:
+ * R_j D_j R̄_jᵀ / 5 = R(Q_j) · ell0_j into p->ell (m²). */
+static void ellipsoid_term(phc_particles *p, size_t j, const double *Q)
 {
-    const long n = (long)p->n;
-    if (!team(n)) {
-        for (long j = 0; j < n; ++j)
-            phc_quat_to_matrix(Q + 4 * j, p->Rq + 9 * j);
-        return;
-    }
-#pragma omp parallel for schedule(static)
-    for (long j = 0; j < n; ++j)
-        phc_quat_to_matrix(Q + 4 * j, p->Rq + 9 * j);
+    double Rj[9];
+    phc_quat_to_matrix(Q + 4 * j, Rj);
+    const double *E = p->ell0 + 9 * j;
+    double *F = p->ell + 9 * j;
+    for (int r = 0; r < 3; ++r)
+        for (int s = 0; s < 3; ++s)
+            F[3 * r + s] = Rj[3 * r] * E[s] + Rj[3 * r + 1] * E[3 + s] + Rj[3 * r + 2] * E[6 + s];
 }
 
-/* Shape matching of group k against positions X (3n), the orientations
- * whose matrices are in p->Rq: fills group k's slots (p->mem, p->mu = μ_jk,
- * p->goal) and R (row-major); *stress gets σ_k.  Touches only group k's
- * slots and rotation, so distinct groups may run concurrently.  Returns 0,
- * or −1 when the moment matrix is not finite. */
+/* Shape matching of group k against positions X (3n) and the ellipsoid
+ * terms in p->ell, with the statics of group_statics: its goals into its
+ * slots (p->goal), its rotation into p->gq (warm-started there) and R
+ * (row-major); *stress (may be NULL) gets σ_k.  Touches only group k's
+ * slots and rotation, so distinct groups may run concurrently.  Returns
+ * 0, or −1 when the moment matrix is not finite. */
 static int match_group(phc_particles *p, size_t k, const double *X, double R[9],
                        double *stress, size_t *polar_total, size_t *polar_fallbacks)
 {
-    group_members(p, k);
     const size_t o = p->goff[k], e = p->goff[k + 1];
-    double M = 0, c[3] = {0, 0, 0}, c0[3] = {0, 0, 0};
+    const double *xk = X + 3 * k;
+    /* A = Σ μ (x − c)(x̄ − c̄)ᵀ + Σ μ R_j D_j R̄_jᵀ / 5 (Müller & Chentanez
+     * eq. 9 with the ellipsoid moment of eq. 10), summed as Σ μ (x − x_k)
+     * (x̄ − c̄)ᵀ: the same, since Σ μ (x̄ − c̄) = 0, and no pass for c first */
+    double A[9] = {0}, cs[3] = {0, 0, 0};
     for (size_t a = o; a < e; ++a) {
-        if (p->mu[a] == 0)
-            continue;
-        const size_t j = p->mem[a];
-        p->mu[a] *= p->m[j];
-        M += p->mu[a];
-        for (int d = 0; d < 3; ++d) {
-            c[d] += p->mu[a] * X[3 * j + d];
-            c0[d] += p->mu[a] * p->x0[3 * j + d];
-        }
-    }
-    for (int d = 0; d < 3; ++d) {
-        c[d] /= M;
-        c0[d] /= M;
-    }
-    /* A = Σ μ (x − c)(x̄ − c̄)ᵀ + Σ (μ/5) R_j D_j R̄_jᵀ (Müller & Chentanez
-     * eq. 9 with the ellipsoid moment of eq. 10; D R̄ᵀ/5 is p->ell0). */
-    double A[9] = {0};
-    for (size_t a = o; a < e; ++a) {
-        if (p->mu[a] == 0)
-            continue;
-        const size_t j = p->mem[a];
-        const double *Rj = p->Rq + 9 * j, *E = p->ell0 + 9 * j;
-        double dx[3], d0[3];
-        for (int d = 0; d < 3; ++d) {
-            dx[d] = X[3 * j + d] - c[d];
-            d0[d] = p->x0[3 * j + d] - c0[d];
-        }
         const double mu = p->mu[a];
+        if (mu == 0)
+            continue;
+        const size_t j = p->mem[a];
+        const double *F = p->ell + 9 * j, *d0 = p->d0 + 3 * a;
+        const double dx[3] = {X[3 * j] - xk[0], X[3 * j + 1] - xk[1], X[3 * j + 2] - xk[2]};
+        const double md[3] = {mu * d0[0], mu * d0[1], mu * d0[2]};
+        for (int d = 0; d < 3; ++d)
+            cs[d] += mu * dx[d];
         for (int r = 0; r < 3; ++r)
             for (int s = 0; s < 3; ++s)
-                A[3 * r + s] += mu * (dx[r] * d0[s] + Rj[3 * r] * E[s] + Rj[3 * r + 1] * E[3 + s] +
-                                      Rj[3 * r + 2] * E[6 + s]);
+                A[3 * r + s] += dx[r] * md[s] + mu * F[3 * r + s];
     }
-    double *gq = p->gq + 4 * k;
-    const int how = phc_particles_polar_rotation(A, gq);
+    double c[3];
+    for (int d = 0; d < 3; ++d)
+        c[d] = xk[d] + cs[d] / p->gM[k];
+    const int how = phc_particles_polar_rotation_warm(A, p->gq + 4 * k, R, NULL);
     if (how < 0)
         return -1;
     ++*polar_total;
     *polar_fallbacks += how == 1;
-    phc_quat_to_matrix(gq, R);
-    double num = 0, den = 0;
+    double num = 0;
     size_t members = 0;
     for (size_t a = o; a < e; ++a) {
         if (p->mu[a] == 0)
             continue;
         ++members;
-        const size_t j = p->mem[a];
-        double d0[3], rd[3];
-        for (int d = 0; d < 3; ++d)
-            d0[d] = p->x0[3 * j + d] - c0[d];
-        mat_vec(R, d0, rd);
+        double rd[3];
+        mat_vec(R, p->d0 + 3 * a, rd);
+        double *g = p->goal + 3 * a;
+        const double *xj = X + 3 * p->mem[a];
         for (int d = 0; d < 3; ++d) {
-            p->goal[3 * a + d] = rd[d] + c[d];
-            const double ed = X[3 * j + d] - p->goal[3 * a + d];
-            num += p->mu[a] * ed * ed;
-            den += p->mu[a] * d0[d] * d0[d];
+            g[d] = rd[d] + c[d];
+            num += p->mu[a] * (xj[d] - g[d]) * (xj[d] - g[d]);
         }
     }
-    if (stress)
-        *stress = members > 1 && den > 0 ? sqrt(num / den) : 0.0; /* one particle: 0 */
+    if (stress) /* one particle: 0 */
+        *stress = members > 1 && p->gden[k] > 0 ? sqrt(num / p->gden[k]) : 0.0;
     return 0;
 }
 
@@ -1185,9 +1350,9 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, s
     double Rl[9], st;
     size_t tot = 0, fb = 0;
     const size_t o = p->goff[k], e = p->goff[k + 1];
-    group_members(pm, k);
-    for (size_t a = o; a < e; ++a) /* the members' orientation matrices */
-        phc_quat_to_matrix(p->q + 4 * p->mem[a], pm->Rq + 9 * p->mem[a]);
+    group_statics(pm, k);
+    for (size_t a = o; a < e; ++a) /* the members' ellipsoid terms */
+        ellipsoid_term(pm, p->mem[a], p->q);
     const int rc = match_group(pm, k, p->x, Rl, &st, &tot, &fb);
     memcpy(pm->gq + 4 * k, gq_keep, sizeof gq_keep);
     if (rc < 0)
@@ -1214,10 +1379,9 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, s
     return n;
 }
 
-double phc_particles_stiffness(const phc_particles *p, size_t i)
+/* s_i in effect: own, or min(1, t_l / t_m) with a maturity age. */
+static inline double stiffness_of(const phc_particles *p, size_t i)
 {
-    if (!p || i >= p->n)
-        return NAN;
     if (p->o.maturity_age > 0) {
         const double s = p->age[i] / p->o.maturity_age; /* t_l / t_m */
         return s < 1 ? s : 1;
@@ -1225,78 +1389,171 @@ double phc_particles_stiffness(const phc_particles *p, size_t i)
     return p->s[i];
 }
 
+double phc_particles_stiffness(const phc_particles *p, size_t i)
+{
+    if (!p || i >= p->n)
+        return NAN;
+    return stiffness_of(p, i);
+}
+
 /* ---- the time step ------------------------------------------------------ */
 
-/* Group k matched against X; with `stress`, σ_k into p->stress[k]. */
-static void match_one(phc_particles *p, long k, const double *X, int stress, size_t *tot,
-                      size_t *fb, long *bad)
+/* The threads of a step: a large plant runs its step in one OpenMP
+ * region, each thread taking a fixed share of every particle loop (static
+ * chunks) with barriers between the passes; a small one runs it on the
+ * calling thread (nth = 1, no barriers, no region). */
+typedef struct crew {
+    int tid, nth;
+} crew;
+
+static void share(const crew *c, size_t n, size_t *lo, size_t *hi)
 {
-    double R[9], st = 0;
-    if (match_group(p, (size_t)k, X, R, stress ? &st : NULL, tot, fb) < 0 && k > *bad)
-        *bad = k;
-    if (stress)
-        p->stress[k] = st;
+    *lo = n * (size_t)c->tid / (size_t)c->nth;
+    *hi = n * (size_t)(c->tid + 1) / (size_t)c->nth;
 }
 
-/* Every group matched against X (3n), side by side for large plants;
- * counts the polar decompositions and their SVD fallbacks. */
-static int match_all(phc_particles *p, const double *X, int stress, phc_error *err)
+static void crew_barrier(const crew *c)
 {
-    const long n = (long)p->n;
-    long bad = -1;
-    size_t tot = 0, fb = 0;
-    if (!team(n)) {
-        for (long k = 0; k < n; ++k)
-            match_one(p, k, X, stress, &tot, &fb, &bad);
-    } else {
-#pragma omp parallel for schedule(static) reduction(+ : tot, fb) reduction(max : bad)
-        for (long k = 0; k < n; ++k)
-            match_one(p, k, X, stress, &tot, &fb, &bad);
+    if (c->nth > 1) {
+#pragma omp barrier
     }
-    p->polar_total += tot;
-    p->polar_fallbacks += fb;
-    if (bad >= 0)
-        return phc_error_set(err, PHC_ERR_NUMERIC,
-                             "particles: particle %ld (segment %ld): the moment matrix of its "
-                             "group is not finite",
-                             bad, p->source_id[bad]);
-    return PHC_OK;
 }
 
-static void blend(phc_particles *p, size_t i);
-
-static int project(phc_particles *p, phc_error *err)
+/* Marks particle j as needed at iteration t (its last) and lists it. */
+static void need_particle(phc_particles *p, size_t j, int t, size_t *np)
 {
-    const long n = (long)p->n;
-    orientation_matrices(p, p->qp);
-    if (match_all(p, p->xp, 0, err))
-        return -1;
-    if (!team(n)) {
-        for (long i = 0; i < n; ++i)
-            blend(p, (size_t)i);
-        return PHC_OK;
+    if (p->plev[j] < 0) {
+        p->plev[j] = t;
+        p->plist[(*np)++] = j;
     }
-#pragma omp parallel for schedule(static)
-    for (long i = 0; i < n; ++i)
-        blend(p, (size_t)i);
-    return PHC_OK;
+}
+
+/* Group k is matched up to iteration t; its members are needed at t − 1. */
+static void need_group(phc_particles *p, size_t k, int t, size_t *ng, size_t *np)
+{
+    if (p->glev[k] >= 0)
+        return;
+    p->glev[k] = t;
+    p->gmatch[(*ng)++] = k;
+    need_particle(p, k, t - 1, np);
+    if (p->parent[k] != PHC_PLANT_NO_PARENT)
+        need_particle(p, p->parent[k], t - 1, np);
+    for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c)
+        need_particle(p, p->child[c], t - 1, np);
+}
+
+/* Which projections can change the step's result (ours; exact).  With the
+ * joint pass, a linked particle with s > 0 gets its final x_p and q_p from
+ * follow_one, which reads its parent's final state, its rest state and its
+ * last orientation q, never what the projections gave it; a pinned
+ * particle (anchor k_a = 1, orientation held) ends at its anchor after any
+ * blend.  The others (the "free" particles: roots, broken links, s = 0,
+ * not pinned) keep their projected
+ * state, which after N Jacobi iterations depends only on the groups near
+ * them: with need_N = the free particles, iteration t must match the groups
+ * with a member in need_t (M_t) and blend need_t, and need_{t−1} = the
+ * members of M_t.  need_0 is predicted; everything else is left to the
+ * joint pass.  Fills p->plist / p->gmatch (ordered by the last iteration
+ * they are needed at, so each iteration's set is a prefix) and the prefix
+ * lengths; all particles (use_lists = 0) when nearly all are needed. */
+static void plan_projections(phc_particles *p)
+{
+    const size_t n = p->n;
+    const int N = (int)p->o.iterations;
+    p->use_lists = 0;
+    for (int t = 0; t <= N; ++t)
+        p->pcount[t] = p->gcount[t] = n;
+    if (!p->o.follow_parent || p->project_all)
+        return;
+    size_t np = 0, ng = 0;
+    for (size_t i = 0; i < n; ++i)
+        p->plev[i] = p->glev[i] = -1;
+    p->npins = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
+            p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
+        else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)))
+            need_particle(p, i, N, &np);
+        if (np > n / 4)
+            return; /* many free particles: project everything */
+        /* (s_i > 0 read without the division: age > 0 when t_m > 0) */
+    }
+    /* need_t = plist[0 .. pcount[t]); M_t = gmatch[0 .. gcount[t]) */
+    p->pcount[N] = np;
+    for (int t = N; t >= 1; --t) {
+        /* the groups of every particle needed at t: its own, its parent's,
+         * its children's (the slots where it is a member) */
+        const size_t upto = np;
+        for (size_t a = 0; a < upto; ++a) {
+            const size_t i = p->plist[a];
+            if (p->plev[i] < t)
+                continue;
+            need_group(p, i, t, &ng, &np);
+            if (p->parent[i] != PHC_PLANT_NO_PARENT)
+                need_group(p, p->parent[i], t, &ng, &np);
+            for (size_t c = p->child_start[i]; c < p->child_start[i + 1]; ++c)
+                need_group(p, p->child[c], t, &ng, &np);
+        }
+        p->gcount[t] = ng;
+        p->pcount[t - 1] = np;
+        if (np > n / 2)
+            return; /* most of the plant: project everything */
+    }
+    p->gcount[0] = 0;
+    p->use_lists = 1;
+}
+
+void phc_particles_project_all(phc_particles *p, int on)
+{
+    if (p)
+        p->project_all = on != 0;
+}
+
+/* The anchor of particle i (eq. 5) on its predicted state: x_p ← x_p +
+ * k_a (a − x_p), exactly a when k_a = 1; q_p ← the held orientation when
+ * it is held. */
+static void apply_anchor(phc_particles *p, size_t i)
+{
+    const double ka = p->anchor_k[i], *a = p->anchor_at + 3 * i;
+    double *x = p->xp + 3 * i;
+    for (int d = 0; d < 3; ++d)
+        x[d] = ka == 1 ? a[d] : x[d] + ka * (a[d] - x[d]);
+    if (p->hold_q[i])
+        memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
+}
+
+/* Predict (symplectic Euler) particle i: x_p = x + Δt (v + Δt a),
+ * q_p = exp(ω Δt) q, and its ellipsoid term at q_p. */
+static void predict(phc_particles *p, size_t i, double dt)
+{
+    for (int d = 0; d < 3; ++d) {
+        const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
+        p->xp[3 * i + d] = p->x[3 * i + d] + dt * (p->v[3 * i + d] + dt * a);
+    }
+    double phi[3], dq[4];
+    for (int d = 0; d < 3; ++d)
+        phi[d] = p->w[3 * i + d] * dt;
+    quat_exp(phi, dq);
+    quat_mul(dq, p->q + 4 * i, p->qp + 4 * i);
+    quat_normalize(p->qp + 4 * i);
+    ellipsoid_term(p, i, p->qp);
 }
 
 /* Particle i's new predicted state: the blend of its groups' goals, its
- * own group's rotation, and its anchor.  Touches only particle i. */
-static void blend(phc_particles *p, size_t i)
+ * own group's rotation, and its anchor; with `next`, its ellipsoid term
+ * for the next projection.  Touches only particle i. */
+static void blend(phc_particles *p, size_t i, int next)
 {
     /* x_g,i = Σ_k ω_ik g_i^k over i's own group, its parent's group and
-     * its children's groups, always in this order (ω = μ / m) */
+     * its children's groups, always in this order */
     double gs[3];
     const size_t own = p->goff[i];
-    const double mi = p->m[i];
     for (int d = 0; d < 3; ++d)
-        gs[d] = p->mu[own] / mi * p->goal[3 * own + d];
+        gs[d] = p->om[own] * p->goal[3 * own + d];
     if (p->linked[i]) {
         const size_t sl = p->goff[p->parent[i]] + 2 + p->child_index[i];
         for (int d = 0; d < 3; ++d)
-            gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
+            gs[d] += p->om[sl] * p->goal[3 * sl + d];
     }
     for (size_t c = p->child_start[i]; c < p->child_start[i + 1]; ++c) {
         const size_t ch = p->child[c];
@@ -1304,21 +1561,79 @@ static void blend(phc_particles *p, size_t i)
             continue;
         const size_t sl = p->goff[ch] + 1;
         for (int d = 0; d < 3; ++d)
-            gs[d] += p->mu[sl] / mi * p->goal[3 * sl + d];
+            gs[d] += p->om[sl] * p->goal[3 * sl + d];
     }
-    const double s = phc_particles_stiffness(p, i);
+    const double s = stiffness_of(p, i);
     for (int d = 0; d < 3; ++d) /* x' = x_p + s (x_g − x_p) */
         p->xp[3 * i + d] += s * (gs[d] - p->xp[3 * i + d]);
     /* q_i = R_i q̄_i: own group's rotation applied to the rest pose. */
     quat_mul(p->gq + 4 * i, p->q0 + 4 * i, p->qp + 4 * i);
     quat_normalize(p->qp + 4 * i);
-    if (p->anchored[i]) { /* eq. 5 */
-        const double ka = p->anchor_k[i];
-        for (int d = 0; d < 3; ++d)
-            p->xp[3 * i + d] += ka * (p->anchor_at[3 * i + d] - p->xp[3 * i + d]);
-        if (p->hold_q[i])
-            memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
+    if (p->anchored[i])
+        apply_anchor(p, i);
+    if (next)
+        ellipsoid_term(p, i, p->qp);
+}
+
+/* Largest group index whose moment matrix was not finite (−1: none),
+ * raised by any thread. */
+static void raise_bad(long *bad, long k)
+{
+#pragma omp critical(phc_particles_bad)
+    if (k > *bad)
+        *bad = k;
+}
+
+/* The smallest failing particle index (n: none), lowered by any thread. */
+static void lower_to(size_t *shared, size_t i)
+{
+#pragma omp critical(phc_particles_bad)
+    if (i < *shared)
+        *shared = i;
+}
+
+/* Entry t of a plan list (all particles without one). */
+static inline size_t pick(const size_t *list, size_t t) { return list ? list[t] : t; }
+
+/* Groups list[0 .. count) (list NULL: 0 .. count) matched against X; with
+ * `stress`, σ_k into p->stress.  Barrier after the pass. */
+static void match_pass(phc_particles *p, const crew *c, const size_t *list, size_t count,
+                       const double *X, int stress, long *bad, size_t *tot, size_t *fb)
+{
+    size_t lo, hi;
+    share(c, count, &lo, &hi);
+    for (size_t t = lo; t < hi; ++t) {
+        const size_t k = pick(list, t);
+        double R[9], st = 0;
+        if (match_group(p, k, X, R, stress ? &st : NULL, tot, fb) < 0)
+            raise_bad(bad, (long)k);
+        if (stress)
+            p->stress[k] = st;
     }
+    crew_barrier(c);
+}
+
+/* R(q) u (phc_quat_rotate: u + 2w (v × u) + 2 v × (v × u), v = Im q), and
+ * R(q)(0, 0, h), the same with the zeros left out (the same numbers), here
+ * so that the joint pass inlines them. */
+static inline void rotate(const double q[4], const double u[3], double out[3])
+{
+    const double w = q[0], vx = q[1], vy = q[2], vz = q[3];
+    const double tx = 2.0 * (vy * u[2] - vz * u[1]);
+    const double ty = 2.0 * (vz * u[0] - vx * u[2]);
+    const double tz = 2.0 * (vx * u[1] - vy * u[0]);
+    out[0] = u[0] + w * tx + (vy * tz - vz * ty);
+    out[1] = u[1] + w * ty + (vz * tx - vx * tz);
+    out[2] = u[2] + w * tz + (vx * ty - vy * tx);
+}
+
+static inline void rotate_z(const double q[4], double h, double out[3])
+{
+    const double w = q[0], vx = q[1], vy = q[2], vz = q[3];
+    const double tx = 2.0 * (vy * h), ty = 2.0 * -(vx * h);
+    out[0] = w * tx - vz * ty;
+    out[1] = w * ty + vz * tx;
+    out[2] = h + (vx * ty - vy * tx);
 }
 
 /* The joint pass (particles.h, "Shoots that bend"), parents first.  For
@@ -1337,126 +1652,351 @@ static void blend(phc_particles *p, size_t i)
  *              compliance α̃ = (1 − s) T² / (s Δt²) per unit inverse inertia,
  *              λ reset every substep);
  *   centre     x_i = J + R(q_i)(0, 0, L_i/2) (the segment hangs from J);
- * then its anchor.  Each particle reads only its parent's new state: small
- * plants run in topological order, large ones level by level (all
- * particles of one depth at once), with the same numbers, so the result
- * does not depend on the thread count. */
+ * then its anchor.  Each particle reads only its parent's new state: a
+ * small plant runs in the pass's order on one thread, a large one hands
+ * whole subtrees to the threads (follow_parents), with the same numbers,
+ * so the result does not depend on the thread count. */
 /* follow_parents' step for one linked particle i: reads its parent's
- * final xp, qp and its own state, writes its own xp, qp only, so the
- * particles of one depth may run in any order or at once. */
-static void follow_one(phc_particles *p, size_t i, double dt, double dt2, double T2)
+ * final xp, qp and its own state, writes its own xp, qp only, so
+ * particles whose parents are placed may run in any order or at once. */
+static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
 {
     const size_t u = p->parent[i];
-    const double s = phc_particles_stiffness(p, i);
+    const double s = stiffness_of(p, i);
     const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
     if (!(s > 0))
         return; /* s = 0: no hold */
     const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
-    const double half[3] = {0, 0, p->ax[3 * i + 2]};
+    const double half = p->ax[3 * i + 2];
     /* the joint J in u's current frame */
     double hr[3], hb[3], ju[3], J[3];
-    phc_quat_rotate(q0i, half, hr);
+    const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+    rotate_z(q0i, half, hr);
     for (int d = 0; d < 3; ++d)
         hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-    phc_quat_rotate_inverse(q0u, hb, ju);
-    phc_quat_rotate(qu, ju, J);
+    rotate(q0u_inv, hb, ju);
+    rotate(qu, ju, J);
     for (int d = 0; d < 3; ++d)
         J[d] += p->xp[3 * u + d];
     /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
-    double q0u_inv[4], rel[4], qs[4];
-    phc_quat_conj(q0u, q0u_inv);
+    double rel[4], qs[4];
     quat_mul(q0u_inv, q0i, rel);
     quat_mul(qu, rel, qs);
     double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
     if (k >= 1) {
         memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
     } else {
-        /* the free turn: the segment as it was, hung from J, its
-         * centre moved by its load from rest, a Δt² */
-        double dq[4], axis[3], dir[3], qf[4];
-        const double *qt = p->q + 4 * i;
-        phc_quat_rotate(qt, half, axis);
-        for (int d = 0; d < 3; ++d) {
-            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
-            dir[d] = axis[d] + dt * dt * a;
-            axis[d] /= half[2];
-        }
-        const double dn = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-        if (dn > 0) {
+        /* the free turn: the segment as it was, hung from J, its centre
+         * moved by its load from rest, a Δt²: the shortest turn from its
+         * axis e to the direction of (L/2) e + a Δt² (phc_quat_from_two_vectors,
+         * (1 + e·d, e × d) normalised; a half turn there when they oppose) */
+        double axis[3], dir[3], dq[4], qf[4];
+        const double *qt = p->q + 4 * i, *f = p->f + 3 * i;
+        rotate_z(qt, 1.0, axis);
+        const int loaded = f[0] != 0 || f[1] != 0 || f[2] != 0;
+        for (int d = 0; d < 3; ++d)
+            dir[d] = half * axis[d] + dt2 * (p->o.gravity[d] + (loaded ? f[d] / p->m[i] : 0.0));
+        const double dn2 = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
+        if (dn2 > 0) {
+            const double inv = 1.0 / sqrt(dn2);
             for (int d = 0; d < 3; ++d)
-                dir[d] /= dn;
-            phc_quat_from_two_vectors(axis, dir, dq);
+                dir[d] *= inv;
+            const double c = axis[0] * dir[0] + axis[1] * dir[1] + axis[2] * dir[2];
+            if (c < -1.0 + 1e-12) {
+                phc_quat_from_two_vectors(axis, dir, dq);
+            } else {
+                dq[0] = 1.0 + c;
+                dq[1] = axis[1] * dir[2] - axis[2] * dir[1];
+                dq[2] = axis[2] * dir[0] - axis[0] * dir[2];
+                dq[3] = axis[0] * dir[1] - axis[1] * dir[0];
+                quat_normalize(dq);
+            }
             quat_mul(dq, qt, qf);
         } else {
             memcpy(qf, qt, sizeof qf);
         }
-        /* the joint's spring: turn q_f by the fraction k toward q* */
-        double qf_inv[4], dev[4], rv[3];
-        phc_quat_conj(qf, qf_inv);
+        /* the joint's spring: turn q_f by the fraction k toward q*,
+         * exp(k log δ) δ = q* q_f⁻¹ = (cos φ, sin φ n): (cos kφ, sin kφ n) */
+        const double qf_inv[4] = {qf[0], -qf[1], -qf[2], -qf[3]};
+        double dev[4];
         quat_mul(qs, qf_inv, dev);
         if (dev[0] < 0)
             for (int d = 0; d < 4; ++d)
                 dev[d] = -dev[d];
-        phc_quat_log(dev, rv);
-        for (int d = 0; d < 3; ++d)
-            rv[d] *= k;
-        quat_exp(rv, dq);
+        const double sn = sqrt(dev[1] * dev[1] + dev[2] * dev[2] + dev[3] * dev[3]);
+        const double phi = atan2(sn, dev[0]);
+        const double sk = sin(k * phi), ck = cos(k * phi); /* one sincos call (GCC) */
+        /* sin(kφ)/sin φ, by its limit k/cos φ below 1e-8 (error ~ sn²) */
+        const double fac = sn > 1e-8 ? sk / sn : k / dev[0];
+        dq[0] = ck;
+        for (int d = 1; d < 4; ++d)
+            dq[d] = fac * dev[d];
         quat_mul(dq, qf, q);
     }
     quat_normalize(q);
-    phc_quat_rotate(q, half, hr);
+    rotate_z(q, half, hr);
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];
-    if (p->anchored[i]) { /* eq. 5, as after every projection */
-        const double ka = p->anchor_k[i];
-        for (int d = 0; d < 3; ++d)
-            x[d] += ka * (p->anchor_at[3 * i + d] - x[d]);
-        if (p->hold_q[i])
-            memcpy(q, p->anchor_q + 4 * i, 4 * sizeof(double));
+    if (p->anchored[i]) /* as after every projection */
+        apply_anchor(p, i);
+}
+
+/* The joint pass's order (see struct phc_particles): subtree sizes, the
+ * top of the tree (subtrees of more than n/32 + 1 particles, a set closed
+ * upwards, in topological order), then each subtree hanging from the top
+ * in preorder (parents before children).  O(n), from p->parent and the
+ * children; the links may break later without changing it (an unlinked
+ * particle is skipped). */
+static void follow_order_build(phc_particles *p)
+{
+    const size_t n = p->n, limit = n / 32 + 1;
+    size_t *sz = p->subtree, *order = p->follow_order, *stack = p->fstack;
+    for (size_t i = 0; i < n; ++i)
+        sz[i] = 1;
+    for (size_t t = n; t-- > 0;) {
+        const size_t i = p->topo[t];
+        if (p->parent[i] != PHC_PLANT_NO_PARENT)
+            sz[p->parent[i]] += sz[i];
+    }
+    size_t m = 0, items = 0;
+    for (size_t t = 0; t < n; ++t)
+        if (sz[p->topo[t]] > limit)
+            order[m++] = p->topo[t];
+    p->follow_top = m;
+    for (size_t t = 0; t < n; ++t) {
+        const size_t r = p->topo[t], u = p->parent[r];
+        if (sz[r] > limit || (u != PHC_PLANT_NO_PARENT && sz[u] <= limit))
+            continue; /* in the top, or inside another item */
+        p->follow_start[items++] = m;
+        size_t top = 0;
+        stack[top++] = r;
+        while (top) {
+            const size_t i = stack[--top];
+            order[m++] = i;
+            for (size_t c = p->child_start[i + 1]; c-- > p->child_start[i];)
+                stack[top++] = p->child[c];
+        }
+    }
+    p->follow_start[items] = m;
+    p->follow_items = items;
+    p->follow_dirty = 0;
+}
+
+/* follow_one over the order: the top on thread 0, then the subtrees, each
+ * on one thread, taken in turn from a shared counter (each particle reads
+ * only its parent's final state, so any order of the subtrees gives the
+ * same numbers). */
+/* 1 when particle i's predicted state is finite (x_p, and q_p's first
+ * three components as always checked). */
+static inline int state_finite(const phc_particles *p, size_t i)
+{
+    return isfinite(p->xp[3 * i]) && isfinite(p->xp[3 * i + 1]) && isfinite(p->xp[3 * i + 2]) &&
+           isfinite(p->qp[4 * i]) && isfinite(p->qp[4 * i + 1]) && isfinite(p->qp[4 * i + 2]);
+}
+
+/* atan2(s, c) for s >= 0, c > 0 (a unit quaternion's half angle): by the
+ * series t − t³/3 + ... − t¹¹/11 of atan t, t = s/c, when t < 0.03 (the
+ * next term is below 4e-20 of the sum: rounding), else atan2.  A step's
+ * turn of a particle is small (all of the 29569 particles' turns in the
+ * bench's 0.25 s frames had t < 0.03). */
+static inline double half_angle(double s, double c)
+{
+    if (!(s < 0.03 * c))
+        return atan2(s, c);
+    const double t = s / c, t2 = t * t;
+    return t * (1 + t2 * (-1.0 / 3 + t2 * (1.0 / 5 + t2 * (-1.0 / 7 + t2 * (1.0 / 9 - t2 / 11)))));
+}
+
+/* Particle i's new velocity from its positions (PBD), then damping, its
+ * new angular velocity from its turn, its new age: into p->vn, p->wn,
+ * p->agen (the step swaps them in when it succeeds). */
+static inline void finish_one(phc_particles *p, size_t i, double keep_dt, double dt)
+{
+    for (int d = 0; d < 3; ++d)
+        p->vn[3 * i + d] = keep_dt * (p->xp[3 * i + d] - p->x[3 * i + d]);
+    /* ω = (1 − damping) θ n / Δt, q_p q⁻¹ = (cos θ/2, sin θ/2 n) */
+    const double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
+    double dq[4];
+    quat_mul(p->qp + 4 * i, inv, dq);
+    if (dq[0] < 0)
+        for (int d = 0; d < 4; ++d)
+            dq[d] = -dq[d];
+    const double sn = sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3]);
+    const double fac = sn > 0 ? keep_dt * 2 * half_angle(sn, dq[0]) / sn : 0.0;
+    for (int d = 0; d < 3; ++d)
+        p->wn[3 * i + d] = fac * dq[1 + d];
+    p->agen[i] = p->age[i] + dt;
+}
+
+/* follow_one on order[lo .. hi) (the linked ones); with `check`, each
+ * particle's new state is checked there, while it is in the cache (the
+ * smallest non-finite index lowers *bad). */
+static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, double T2, int check,
+                         size_t *bad)
+{
+    const size_t *order = p->follow_order;
+    const double dt2 = dt * dt;
+    for (size_t t = lo; t < hi; ++t) {
+        const size_t i = order[t];
+        if (p->linked[i])
+            follow_one(p, i, dt2, T2);
+        if (check && i < *bad && !state_finite(p, i))
+            *bad = i;
     }
 }
 
-static void follow_parents(phc_particles *p, double dt)
+/* The joint pass over the order (from the top's end when `top_done`: the
+ * caller placed the top before the threads started); with `check` (no
+ * collision pass after it), every particle's new state is checked by the
+ * thread that placed it (the smallest non-finite index lowers
+ * *bad_state).  Ends with a barrier. */
+static void follow_parents(phc_particles *p, const crew *c, double dt, size_t *next_item,
+                           int top_done, int check, size_t *bad_state)
 {
-    const double T2 = p->o.stiffness_step * p->o.stiffness_step, dt2 = dt * dt;
-    const size_t n = p->n;
-    if (!team((long)n)) {
-        for (size_t t = 0; t < n; ++t)
-            if (p->linked[p->topo[t]])
-                follow_one(p, p->topo[t], dt, dt2, T2);
+    const double T2 = p->o.stiffness_step * p->o.stiffness_step;
+    size_t bad = p->n;
+    if (c->nth == 1) {
+        follow_range(p, top_done ? p->follow_top : 0, p->n, dt, T2, check, &bad);
+        if (bad < p->n)
+            lower_to(bad_state, bad);
         return;
     }
-    /* Levels by depth (a counting sort in topological order, O(n)): a
-     * particle depends only on its parent, one level up, so each level runs
-     * in parallel with the same numbers as the sequential pass. */
-    size_t max_depth = 0;
-    for (size_t t = 0; t < n; ++t) {
-        const size_t i = p->topo[t];
-        const size_t d = p->linked[i] ? p->link_depth[p->parent[i]] + 1 : 0;
-        p->link_depth[i] = d;
-        if (d > max_depth)
-            max_depth = d;
+    if (!top_done) {
+        if (c->tid == 0)
+            follow_range(p, 0, p->follow_top, dt, T2, check, &bad);
+        crew_barrier(c);
     }
-    size_t *start = p->level_start;
-    memset(start, 0, (max_depth + 2) * sizeof *start);
-    for (size_t i = 0; i < n; ++i)
-        ++start[p->link_depth[i] + 1];
-    for (size_t d = 0; d <= max_depth; ++d)
-        start[d + 1] += start[d];
-    for (size_t t = 0; t < n; ++t) { /* stable: each level in topological order */
-        const size_t i = p->topo[t];
-        p->level[start[p->link_depth[i]]++] = i;
+    for (;;) {
+        size_t item;
+#pragma omp atomic capture
+        item = (*next_item)++;
+        if (item >= p->follow_items)
+            break;
+        follow_range(p, p->follow_start[item], p->follow_start[item + 1], dt, T2, check, &bad);
     }
-    for (size_t d = max_depth + 1; d > 0; --d)
-        start[d] = start[d - 1];
-    start[0] = 0;
-#pragma omp parallel
-    for (size_t d = 1; d <= max_depth; ++d) { /* level 0: the roots, not linked */
-        const long lo = (long)start[d], hi = (long)start[d + 1];
-#pragma omp for schedule(static)
-        for (long t = lo; t < hi; ++t)
-            follow_one(p, p->level[t], dt, dt2, T2);
+    if (bad < p->n)
+        lower_to(bad_state, bad);
+    crew_barrier(c);
+}
+
+/* The step up to the collision pass, on one thread of the crew: the
+ * groups' statics and the prediction, the N projections (the planned
+ * groups' goals from the current x_p, then the planned particles'
+ * blends), the joint pass.  *bad: a group whose moment matrix was not
+ * finite (the step stops there). */
+static void step_body(phc_particles *p, const crew *c, double dt, long *bad, size_t *next_item,
+                      int top_done, size_t *bad_state, size_t *tot, size_t *fb)
+{
+    const size_t N = p->o.iterations;
+    const size_t *plist = p->use_lists ? p->plist : NULL;
+    const size_t *glist = p->use_lists ? p->gmatch : NULL;
+    size_t lo, hi;
+    share(c, p->gcount[1], &lo, &hi);
+    for (size_t t = lo; t < hi; ++t)
+        group_statics(p, pick(glist, t));
+    share(c, p->pcount[0], &lo, &hi);
+    for (size_t t = lo; t < hi; ++t)
+        predict(p, pick(plist, t), dt);
+    for (size_t it = 1; it <= N; ++it) {
+        if (p->gcount[it] == 0)
+            break; /* nothing planned from here on (the sets shrink with it) */
+        crew_barrier(c);
+        match_pass(p, c, glist, p->gcount[it], p->xp, 0, bad, tot, fb);
+        if (*bad >= 0)
+            return;
+        share(c, p->pcount[it], &lo, &hi);
+        for (size_t t = lo; t < hi; ++t)
+            blend(p, pick(plist, t), it < N);
     }
+    if (p->gcount[1] > 0) /* (no group: nothing was predicted either) */
+        crew_barrier(c);
+    if (p->use_lists && c->tid == 0 && !top_done) /* the pinned particles no blend reached */
+        for (size_t t = 0; t < p->npins; ++t)
+            apply_anchor(p, p->pins[t]);
+    if (p->o.follow_parent)
+        follow_parents(p, c, dt, next_item, top_done, !p->collide, bad_state);
+}
+
+/* What the threads of a step share: the first particle with a non-finite
+ * position (n: none), the largest group with a non-finite moment matrix
+ * (−1: none), the first particle with a non-finite new state (n: none),
+ * the joint pass's next subtree. */
+typedef struct step_shared {
+    long bad;
+    size_t bad_x, bad_state;
+    size_t next_item;
+    int top_done; /* the pins and the joint pass's top placed before the threads started */
+} step_shared;
+
+/* The whole step on one thread of the crew: positions checked, step_body,
+ * the collision pass (one thread, index order), the new state checked,
+ * then (nothing non-finite) velocities and the new state (finish).  The
+ * checks' verdicts are read after a barrier, by all threads alike; a
+ * non-finite position is judged with the new state (what runs before
+ * writes only the predicted state and the warm starts, and a group's
+ * non-finite moment matrix stops the projections). */
+static void whole_step(phc_particles *p, const crew *c, double dt, step_shared *sh, size_t *tot,
+                       size_t *fb)
+{
+    size_t lo, hi;
+    share(c, p->n, &lo, &hi);
+    for (size_t i = lo; i < hi; ++i)
+        if (!isfinite(p->x[3 * i]) || !isfinite(p->x[3 * i + 1]) || !isfinite(p->x[3 * i + 2])) {
+            lower_to(&sh->bad_x, i);
+            break;
+        }
+    step_body(p, c, dt, &sh->bad, &sh->next_item, sh->top_done, &sh->bad_state, tot, fb);
+    if (sh->bad >= 0)
+        return;
+    if (p->collide) { /* (step_body ended with a barrier: every check of x is in) */
+        if (c->tid == 0 && sh->bad_x == p->n)
+            collide(p);
+        crew_barrier(c);
+    } else if (c->tid == 0) {
+        p->pushed = 0;
+        p->depth = INFINITY;
+    }
+    /* velocities in index order (streams; the joint pass's order jumps),
+     * the new state checked here unless the joint pass did */
+    const int checked = p->o.follow_parent && !p->collide;
+    const double keep_dt = (1 - p->o.damping) / dt;
+    size_t bad = p->n;
+    for (size_t i = lo; i < hi; ++i) {
+        if (!checked && i < bad && !state_finite(p, i))
+            bad = i;
+        finish_one(p, i, keep_dt, dt);
+    }
+    if (bad < p->n)
+        lower_to(&sh->bad_state, bad);
+}
+
+static void swap_arrays(double **a, double **b)
+{
+    double *t = *a;
+    *a = *b;
+    *b = t;
+}
+
+/* Every group matched against the new state with its stress (§4.3), on
+ * one thread of the crew. */
+static void stress_pass(phc_particles *p, const crew *c, long *bad, size_t *tot, size_t *fb)
+{
+    size_t lo, hi;
+    share(c, p->n, &lo, &hi);
+    for (size_t j = lo; j < hi; ++j) {
+        group_statics(p, j);
+        ellipsoid_term(p, j, p->q);
+    }
+    crew_barrier(c);
+    match_pass(p, c, NULL, p->n, p->x, 1, bad, tot, fb);
+}
+
+static int bad_group(const phc_particles *p, long bad, phc_error *err)
+{
+    return phc_error_set(err, PHC_ERR_NUMERIC,
+                         "particles: particle %ld (segment %ld): the moment matrix of its "
+                         "group is not finite",
+                         bad, p->source_id[bad]);
 }
 
 int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report, phc_error *err)
@@ -1480,61 +2020,55 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         relayout(p);
     const size_t n = p->n;
     p->polar_total = p->polar_fallbacks = 0;
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d)
-            if (!isfinite(p->x[3 * i + d]))
-                return phc_error_set(err, PHC_ERR_INPUT,
-                                     "particles: particle %zu (segment %ld): position %c is not "
-                                     "finite (%g m)",
-                                     i, p->source_id[i], "xyz"[d], p->x[3 * i + d]);
-    /* Predict (symplectic Euler). */
-    for (size_t i = 0; i < n; ++i) {
-        for (int d = 0; d < 3; ++d) {
-            const double a = p->o.gravity[d] + p->f[3 * i + d] / p->m[i];
-            p->xp[3 * i + d] = p->x[3 * i + d] + dt * (p->v[3 * i + d] + dt * a);
+    if (p->o.follow_parent && p->follow_dirty)
+        follow_order_build(p);
+    plan_projections(p);
+    step_shared sh = {-1, n, n, 0, 0};
+    size_t tot = 0, fb = 0;
+    if (p->use_lists && p->gcount[1] == 0 && p->o.follow_parent && team((long)n)) {
+        /* nothing projected (the climbing plants): the pins and the joint
+         * pass's top here, so that the threads meet once (one barrier) */
+        const double T2 = p->o.stiffness_step * p->o.stiffness_step;
+        size_t bad = n;
+        for (size_t t = 0; t < p->npins; ++t)
+            apply_anchor(p, p->pins[t]);
+        follow_range(p, 0, p->follow_top, dt, T2, !p->collide, &bad);
+        sh.bad_state = bad;
+        sh.top_done = 1;
+    }
+    if (!team((long)n)) {
+        const crew one = {0, 1};
+        whole_step(p, &one, dt, &sh, &tot, &fb);
+    } else {
+#pragma omp parallel reduction(+ : tot, fb)
+        {
+            const crew c = {omp_get_thread_num(), omp_get_num_threads()};
+            whole_step(p, &c, dt, &sh, &tot, &fb);
         }
-        double phi[3], dq[4];
-        for (int d = 0; d < 3; ++d)
-            phi[d] = p->w[3 * i + d] * dt;
-        quat_exp(phi, dq);
-        quat_mul(dq, p->q + 4 * i, p->qp + 4 * i);
-        quat_normalize(p->qp + 4 * i);
     }
-    for (size_t it = 0; it < p->o.iterations; ++it) {
-        const int rc = project(p, err);
-        if (rc)
-            return rc;
+    p->polar_total += tot;
+    p->polar_fallbacks += fb;
+    if (sh.bad_x < n) {
+        const size_t i = sh.bad_x;
+        const int d = !isfinite(p->x[3 * i]) ? 0 : !isfinite(p->x[3 * i + 1]) ? 1 : 2;
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): position %c is not finite "
+                             "(%g m)",
+                             i, p->source_id[i], "xyz"[d], p->x[3 * i + d]);
     }
-    if (p->o.follow_parent)
-        follow_parents(p, dt);
-    collide(p);
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d)
-            if (!isfinite(p->xp[3 * i + d]) || !isfinite(p->qp[4 * i + d]))
-                return phc_error_set(err, PHC_ERR_NUMERIC,
-                                     "particles: particle %zu (segment %ld): the step of %g s gave "
-                                     "a non-finite state; nothing was changed",
-                                     i, p->source_id[i], dt);
-    /* Velocities from the positions (PBD), then damping. */
-    const double keep = 1 - p->o.damping;
-    for (size_t i = 0; i < n; ++i) {
-        for (int d = 0; d < 3; ++d) {
-            p->v[3 * i + d] = keep * (p->xp[3 * i + d] - p->x[3 * i + d]) / dt;
-            p->x[3 * i + d] = p->xp[3 * i + d];
-        }
-        double inv[4] = {p->q[4 * i], -p->q[4 * i + 1], -p->q[4 * i + 2], -p->q[4 * i + 3]};
-        double dq[4];
-        quat_mul(p->qp + 4 * i, inv, dq);
-        if (dq[0] < 0)
-            for (int d = 0; d < 4; ++d)
-                dq[d] = -dq[d];
-        const double sn = sqrt(dq[1] * dq[1] + dq[2] * dq[2] + dq[3] * dq[3]);
-        const double ang = 2 * atan2(sn, dq[0]);
-        for (int d = 0; d < 3; ++d)
-            p->w[3 * i + d] = sn > 0 ? keep * dq[1 + d] / sn * ang / dt : 0.0;
-        memcpy(p->q + 4 * i, p->qp + 4 * i, 4 * sizeof(double));
-        p->age[i] += dt;
-    }
+    if (sh.bad >= 0)
+        return bad_group(p, sh.bad, err);
+    if (sh.bad_state < n)
+        return phc_error_set(err, PHC_ERR_NUMERIC,
+                             "particles: particle %zu (segment %ld): the step of %g s gave a "
+                             "non-finite state; nothing was changed",
+                             sh.bad_state, p->source_id[sh.bad_state], dt);
+    /* the step succeeded: its new state becomes the current one */
+    swap_arrays(&p->x, &p->xp);
+    swap_arrays(&p->q, &p->qp);
+    swap_arrays(&p->v, &p->vn);
+    swap_arrays(&p->w, &p->wn);
+    swap_arrays(&p->age, &p->agen);
 
     /* Stress of every group on the new state (§4.3), and breaking. */
     if (p->no_stress && !(p->o.break_threshold > 0)) {
@@ -1544,9 +2078,22 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         }
         return PHC_OK;
     }
-    orientation_matrices(p, p->q);
-    if (match_all(p, p->x, 1, err))
-        return -1;
+    tot = fb = 0;
+    long bad = -1;
+    if (!team((long)n)) {
+        const crew one = {0, 1};
+        stress_pass(p, &one, &bad, &tot, &fb);
+    } else {
+#pragma omp parallel reduction(+ : tot, fb)
+        {
+            const crew c = {omp_get_thread_num(), omp_get_num_threads()};
+            stress_pass(p, &c, &bad, &tot, &fb);
+        }
+    }
+    p->polar_total += tot;
+    p->polar_fallbacks += fb;
+    if (bad >= 0)
+        return bad_group(p, bad, err);
     double smax = 0, bmax = -1;
     size_t gmax = PHC_PARTICLES_NONE, bk = PHC_PARTICLES_NONE;
     for (size_t k = 0; k < n; ++k) {

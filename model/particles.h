@@ -32,8 +32,10 @@
  * With R̄ = I this is the paper's Σ m x x̄ᵀ − M c c̄ᵀ + Σ (1/5) m R diag(a²,b²,c²).
  * The ellipsoid term makes A_k of full rank for a single particle or a
  * straight chain, so the rotation is defined.  R_k = rotational factor of
- * the polar decomposition A_k = R_k S_k (Müller, Bender, Chentanez, Macklin
- * 2016 iteration, warm-started, certified, LAPACK SVD fallback).  Goals
+ * the polar decomposition A_k = R_k S_k (Newton steps warm-started from
+ * the group's last rotation, phc_particles_polar_rotation_warm; the Müller,
+ * Bender, Chentanez, Macklin 2016 iteration with its certificate and
+ * LAPACK SVD fallback when they do not converge).  Goals
  * g_j^k = R_k (x̄_j − c̄_k) + c_k.
  *
  * Stiffness blend (climbing §4.1): x ← x_p + s_i (x_g − x_p).  s_i is the
@@ -46,10 +48,10 @@
  *
  * Anchors (climbing eq. 5): an anchored particle is pulled to its anchor
  * point a after every projection, x ← x + k_a (a − x), 0 < k_a <= 1
- * (k_a = 1 pins it); optionally its orientation is held too (a clamp).
- * phc_particles_attach applies the paper's rule: a free particle attaches
- * to its closest support point when that point is within the attach
- * distance.
+ * (k_a = 1 pins it: x = a exactly); optionally its orientation is held
+ * too (a clamp).  phc_particles_attach applies the paper's rule: a free
+ * particle attaches to its closest support point when that point is
+ * within the attach distance.
  *
  * Time step (position-based dynamics): predict v += Δt (g + f/m),
  * x_p = x + Δt v, q_p = exp(ω Δt) q; N iterations of {all groups' goals
@@ -193,6 +195,17 @@ int phc_particles_set_gravity(phc_particles *p, const double g[3], phc_error *er
  * values and the report's max_stress stays 0 (group NONE).  Default on. */
 void phc_particles_measure_stress(phc_particles *p, int on);
 
+/* Projections that cannot change the result are skipped (ours; exact):
+ * with follow_parent, the joint pass sets the final state of every linked
+ * particle with s > 0 from its parent's final state and its own last
+ * orientation, and a pinned particle (anchor strength 1, orientation
+ * held) ends at its anchor, so the N projections are computed only where
+ * they reach the other particles (roots, broken links, s = 0): the groups
+ * within two links per remaining iteration.  on = 1: every group is
+ * projected anyway (for tests comparing the two; the state differs by
+ * rounding only, through the polar warm starts).  Default off. */
+void phc_particles_project_all(phc_particles *p, int on);
+
 /* Collisions with supports (ours; the climbing paper's particles only
  * attach to them).  fn gives the closest support point c (m) to x and the
  * unit outward face normal n there (0; nonzero: no support).  With a
@@ -316,6 +329,19 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap,
  * dgesvd gives R = U diag(1, 1, det(UVᵀ)) Vᵀ.  Returns 0 with the
  * iteration, 1 with the SVD fallback, -1 when A is not finite or zero. */
 int phc_particles_polar_rotation(const double A[9], double q[4]);
+
+/* The same rotation for a warm start (the time step's path, ours): only
+ * the Newton steps of phc_particles_polar_rotation, ω = T⁻¹ g with
+ * T = tr(B) I − sym(B) factored as L D Lᵀ (no square roots), each applied
+ * as q ← (1, ω/2) ⊗ q normalised (a turn by 2 atan(|ω|/2) about ω: no sine
+ * or cosine), until a step shorter than 1e-9 rad.  T positive definite at
+ * the last step certifies the maximum (tr(Rᵀ A) has no other local
+ * maximum on the rotations).  When T is not positive definite (far from
+ * the maximum) or after 8 steps, phc_particles_polar_rotation finishes
+ * from where the steps got.  R (row-major) gets R(q); *steps (may be NULL)
+ * the Newton steps taken, −1 when the full routine finished.  Returns as
+ * phc_particles_polar_rotation. */
+int phc_particles_polar_rotation_warm(const double A[9], double q[4], double R[9], int *steps);
 
 /* Quaternions to and from matrices: model/quaternion.h. */
 

@@ -20,7 +20,11 @@
  *     at the first step whose stress exceeds the threshold, never before.
  *  7. Anchors (eq. 5) and the attachment rule, age-dependent stiffness,
  *     free fall of the centre of mass: exact one-step answers.
- *  8. Bad input: messages name the particle. */
+ *  8. Bad input: messages name the particle.
+ *  9. The step's warm-started polar path: error and Newton steps against
+ *     the start's distance from the exact rotation.
+ * 10. Projections skipped where the joint pass overwrites them: the same
+ *     state as with every projection. */
 #include "model/particles.h"
 #include "model/quaternion.h"
 #include "model/plant_graph.h"
@@ -94,25 +98,33 @@ static void svd_rotation(const double A[9], double R[9])
     matmul(u, vt, R);
 }
 
+/* A = Q S with Q = R(q) a random rotation and S = V diag(λ) Vᵀ, V random:
+ * λ in [1e-3, 1], or rod-like (1, ~1e-3, ~1e-3). */
+static void random_qs(double q[4], double Q[9], double A[9], int rodlike)
+{
+    double v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9];
+    random_quat(q);
+    random_quat(v);
+    phc_quat_to_matrix(q, Q);
+    phc_quat_to_matrix(v, V);
+    for (int i = 0; i < 3; ++i) {
+        L[4 * i] = rodlike ? (i == 0 ? 1 : 1e-3 * (1 + 0.5 * urand())) : 1e-3 + fabs(urand());
+        for (int j = 0; j < 3; ++j)
+            Vt[3 * i + j] = V[3 * j + i];
+    }
+    matmul(V, L, T);
+    matmul(T, Vt, S);
+    matmul(Q, S, A);
+}
+
 static void test_polar(void)
 {
     double worst_exact = 0, worst_svd = 0, worst_bad = 0;
     int fallbacks = 0, negdet = 0;
     for (int t = 0; t < 2000; ++t) {
         /* exact: A = Q S, S = V diag(λ) Vᵀ with λ in [1e-3, 1] */
-        double q[4], Q[9], v[4], V[9], Vt[9], S[9], L[9] = {0}, T[9], A[9];
-        random_quat(q);
-        random_quat(v);
-        phc_quat_to_matrix(q, Q);
-        phc_quat_to_matrix(v, V);
-        for (int i = 0; i < 3; ++i) {
-            L[4 * i] = 1e-3 + fabs(urand());
-            for (int j = 0; j < 3; ++j)
-                Vt[3 * i + j] = V[3 * j + i];
-        }
-        matmul(V, L, T);
-        matmul(T, Vt, S);
-        matmul(Q, S, A);
+        double q[4], Q[9], A[9];
+        random_qs(q, Q, A, 0);
         double start[4] = {1, 0, 0, 0}, R[9];
         fallbacks += phc_particles_polar_rotation(A, start) == 1;
         phc_quat_to_matrix(start, R);
@@ -246,6 +258,27 @@ static void test_polar_rodlike(void)
 /* The projection matches the groups in parallel and blends in a fixed
  * order: one and two OpenMP threads give bit-identical states (1500
  * segments: above PHC_PARTICLES_PARALLEL_MIN, so the loops do run in parallel). */
+/* `steps` steps of 0.01 s of p (each checked), their polar decompositions
+ * and SVD fallbacks added to *polar and *fallbacks (may be NULL), then
+ * positions and orientations into state (7 per particle); frees p. */
+static void run_and_keep(phc_particles *p, int steps, size_t *polar, size_t *fallbacks,
+                         double *state)
+{
+    phc_error err;
+    for (int s = 0; s < steps; ++s) {
+        phc_particles_report rep;
+        CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
+        *polar += rep.polar_total;
+        if (fallbacks)
+            *fallbacks += rep.polar_fallbacks;
+    }
+    for (size_t i = 0; i < phc_particles_count(p); ++i) {
+        phc_particles_position(p, i, state + 7 * i);
+        phc_particles_orientation(p, i, state + 7 * i + 3);
+    }
+    phc_particles_free(p);
+}
+
 static void test_threads(void)
 {
     phc_plant_graph *g = phc_plant_graph_random(1500, 11);
@@ -265,17 +298,7 @@ static void test_threads(void)
         if (!p || !x[th])
             break;
         phc_particles_set_age(p, 0, 1, &err);
-        for (int s = 0; s < 50; ++s) {
-            phc_particles_report rep;
-            CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
-            polar[th] += rep.polar_total;
-            fallbacks[th] += rep.polar_fallbacks;
-        }
-        for (size_t i = 0; i < n; ++i) {
-            phc_particles_position(p, i, x[th] + 7 * i);
-            phc_particles_orientation(p, i, x[th] + 7 * i + 3);
-        }
-        phc_particles_free(p);
+        run_and_keep(p, 50, &polar[th], &fallbacks[th], x[th]);
     }
     omp_set_num_threads(keep);
     size_t differ = 0;
@@ -1228,6 +1251,154 @@ static void test_grow_in_place(void)
     phc_plant_graph_free(g1);
 }
 
+/* 9. The time step's polar path (phc_particles_polar_rotation_warm): from
+ * a start turned δ away from the exact rotation Q of A = Q S (S random
+ * positive definite, and rod-like: σ2, σ3 = 1e-3 σ1), the Newton steps
+ * reach Q to rounding; how many they take for each δ; the full routine
+ * finishes far starts (δ = 3 rad) and agrees with it from the identity. */
+static void test_polar_warm(void)
+{
+    const double delta[5] = {0, 1e-6, 1e-3, 0.1, 3.0};
+    printf("polar warm: start delta (rad), max |R - Q| over 2000 A = Q S (half rod-like), Newton "
+           "steps (mean, max), handed to the full routine\n");
+    for (int d = 0; d < 5; ++d) {
+        double worst = 0;
+        int most = 0, full = 0, refused = 0;
+        long total = 0;
+        for (int t = 0; t < 2000; ++t) {
+            double q[4], Q[9], A[9];
+            random_qs(q, Q, A, t % 2);
+            /* start: q turned by delta about a random axis */
+            double ax[3] = {urand(), urand(), urand()}, an = 0, dq[4], start[4], R[9];
+            for (int k = 0; k < 3; ++k)
+                an += ax[k] * ax[k];
+            an = sqrt(an);
+            dq[0] = cos(0.5 * delta[d]);
+            for (int k = 0; k < 3; ++k)
+                dq[k + 1] = sin(0.5 * delta[d]) * ax[k] / an;
+            phc_quat_mul(dq, q, start);
+            int steps = 0;
+            refused += phc_particles_polar_rotation_warm(A, start, R, &steps) < 0;
+            double Rq[9];
+            phc_quat_to_matrix(start, Rq);
+            worst = fmax(worst, fmax(maxdiff(R, Q, 9), maxdiff(Rq, Q, 9)));
+            if (steps < 0)
+                ++full;
+            else {
+                total += steps;
+                if (steps > most)
+                    most = steps;
+            }
+        }
+        printf("polar warm: delta %-6g max |R - Q| = %.3g, steps mean %.2f max %d, full routine %d "
+               "of 2000\n",
+               delta[d], worst, full < 2000 ? (double)total / (2000 - full) : 0.0, most, full);
+        CHECK(worst < 1e-12 && refused == 0);
+        if (delta[d] <= 1e-3)
+            CHECK(full == 0 && most <= 3);
+    }
+    /* cold starts on random matrices: the same rotation as the full routine */
+    double worst = 0;
+    int refused = 0;
+    for (int t = 0; t < 2000; ++t) {
+        double B[9], qa[4] = {1, 0, 0, 0}, qb[4] = {1, 0, 0, 0}, Ra[9], Rb[9];
+        for (int k = 0; k < 9; ++k)
+            B[k] = urand();
+        phc_particles_polar_rotation(B, qa);
+        phc_quat_to_matrix(qa, Ra);
+        refused += phc_particles_polar_rotation_warm(B, qb, Rb, NULL) < 0;
+        worst = fmax(worst, maxdiff(Ra, Rb, 9));
+    }
+    CHECK(refused == 0);
+    printf("polar warm: 2000 random A from the identity vs phc_particles_polar_rotation: max |R - "
+           "R_full| = %.3g\n",
+           worst);
+    CHECK(worst < 1e-10);
+    double Z[9] = {0}, qz[4] = {1, 0, 0, 0}, Rz[9], Nn[9] = {0, 0, NAN, 0, 0, 0, 0, 0, 0};
+    CHECK(phc_particles_polar_rotation_warm(Z, qz, Rz, NULL) == -1);
+    CHECK(phc_particles_polar_rotation_warm(Nn, qz, Rz, NULL) == -1);
+}
+
+/* 10. Skipped projections (phc_particles_project_all): with the joint pass
+ * a plant stepped with only the projections that reach its free
+ * particles (s = 0 at age 0, a root left free) ends where the same plant
+ * stepped with every projection ends (rounding: the warm starts of the
+ * skipped groups differ), and a plant whose root is pinned and whose links
+ * all hold projects no group at all. */
+static void test_projection_plan(void)
+{
+    phc_plant_graph *g = phc_plant_graph_random(1500, 13);
+    phc_error err;
+    const size_t n = g->n;
+    /* runs: planned on 1 thread, planned on 2 (a plant this large runs its
+     * step in an OpenMP team), every projection */
+    double *x[3] = {malloc(7 * n * sizeof(double)), malloc(7 * n * sizeof(double)),
+                    malloc(7 * n * sizeof(double))};
+    size_t polar[3] = {0, 0, 0};
+    const int keep = omp_get_max_threads();
+    for (int run = 0; run < 3; ++run) {
+        const int all = run == 2;
+        omp_set_num_threads(run == 1 ? 2 : 1);
+        phc_particles_options opt = phc_particles_options_default();
+        opt.follow_parent = 1;
+        opt.maturity_age = 0.5;
+        phc_particles *p = phc_particles_new(g, &opt, &err);
+        CHECK(p != NULL);
+        if (!p || !x[run])
+            break;
+        phc_particles_project_all(p, all);
+        phc_particles_measure_stress(p, 0); /* count the projections' decompositions only */
+        /* mostly held (ages up to 1 s), every 17th particle at age 0
+         * (s = 0: free for its first step), root 0 free (not anchored) */
+        for (size_t i = 0; i < n; ++i)
+            phc_particles_set_age(p, i, i % 17 == 5 ? 0.0 : 0.05 + 0.95 * (double)(i % 7) / 6, &err);
+        run_and_keep(p, 40, &polar[run], NULL, x[run]);
+    }
+    omp_set_num_threads(keep);
+    double dmax = 0;
+    size_t differ = 0;
+    for (size_t i = 0; x[0] && x[1] && x[2] && i < 7 * n; ++i) {
+        dmax = fmax(dmax, fabs(x[0][i] - x[2][i]));
+        differ += x[0][i] != x[1][i];
+    }
+    printf("projection plan: %zu-segment random plant with the joint pass, 40 steps: max |state "
+           "planned - state with every projection| = %.3g; polar decompositions %zu vs %zu; "
+           "planned on 1 vs 2 threads: %zu coordinates differ\n",
+           n, dmax, polar[0], polar[2], differ);
+    CHECK(dmax < 1e-12 && differ == 0 && polar[1] == polar[0]);
+    CHECK(polar[2] == 40 * 4 * n && polar[0] > 0 && polar[0] < polar[2]);
+    /* the climbing plants' case: root pinned, every link held */
+    phc_particles_options opt = phc_particles_options_default();
+    opt.follow_parent = 1;
+    opt.maturity_age = 0.5;
+    phc_particles *p = phc_particles_new(g, &opt, &err);
+    size_t none = 0, moved = 0;
+    if (p) {
+        phc_particles_measure_stress(p, 0);
+        double a[3];
+        phc_particles_position(p, 0, a);
+        phc_particles_anchor(p, 0, a, 1, 1, &err);
+        for (size_t i = 0; i < n; ++i)
+            phc_particles_set_age(p, i, 0.3, &err);
+        for (int s = 0; s < 10; ++s) {
+            phc_particles_report rep;
+            CHECK(phc_particles_step(p, 0.01, &rep, &err) == PHC_OK);
+            none += rep.polar_total;
+        }
+        double b[3];
+        phc_particles_position(p, 0, b);
+        moved = (size_t)(a[0] != b[0]) + (a[1] != b[1]) + (a[2] != b[2]);
+    }
+    printf("projection plan: root pinned, all links held, 10 steps: %zu polar decompositions; the "
+           "pinned root's coordinates that moved: %zu\n",
+           none, moved);
+    CHECK(p != NULL && none == 0 && moved == 0);
+    phc_particles_free(p);
+    for (int run = 0; run < 3; ++run)
+        free(x[run]);
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_polar();
@@ -1242,5 +1413,7 @@ int main(void)
     test_anchor_age_fall();
     test_bad_input();
     test_grow_in_place();
+    test_polar_warm();
+    test_projection_plan();
     return check_finish("test_particles");
 }
