@@ -43,6 +43,9 @@ struct phc_soil_work {
     size_t ring_per_thread, ring_threads;
     double *plane;             /* nz partial sums (or minima) */
     size_t *plane_at;          /* nz: the voxel of each plane's minimum (stable_dt_prepared) */
+    unsigned char *uniform;    /* nz: 1 when plane k has one 1/c, one p and one permeability per
+                                  face direction (plane_uniform) */
+    double *uniform_of;        /* 5 nz: those values of plane k: 1/c, p, kx, ky, kz */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
@@ -90,6 +93,8 @@ static void work_free(phc_soil_work *wk)
     free(wk->ring);
     free(wk->plane);
     free(wk->plane_at);
+    free(wk->uniform);
+    free(wk->uniform_of);
     free(wk->top);
     free(wk->damp_x);
     free(wk->damp_y);
@@ -163,12 +168,14 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->kz = field_alloc(n, 0);
     wk->plane = malloc(nz * sizeof(double));
     wk->plane_at = malloc(nz * sizeof(size_t));
+    wk->uniform = malloc(nz);
+    wk->uniform_of = malloc(5 * nz * sizeof(double));
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
     if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane || !wk->plane_at ||
-        !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
+        !wk->uniform || !wk->uniform_of || !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
     }
@@ -587,6 +594,41 @@ static void face_permeabilities(size_t m, const double *restrict a, const double
             k[i] = 0;
 }
 
+/* 1 when the doubles a[0..m) all have the bits of *v (m = 0: yes). */
+static int all_bits(const double *a, size_t m, const double *v)
+{
+    for (size_t i = 0; i < m; ++i)
+        if (memcmp(a + i, v, sizeof *v))
+            return 0;
+    return 1;
+}
+
+/* Whether z-plane k (its 1/c, p and face permeabilities prepared) is
+ * uniform: one 1/c and one p over the plane, one kx over the faces
+ * inside its rows (not the +x face of a row's last voxel), one ky over
+ * the faces between its rows (not the +y faces of the last row) and one
+ * kz over the plane; those values in u (1/c, p, kx, ky, kz).  A soil made
+ * of horizontal layers (phc_soil_set_layers) has only uniform planes; the
+ * water sweep then takes these five numbers instead of streaming five
+ * planes of them (water_rows_uniform). */
+static int plane_uniform(const phc_soil *s, size_t k, double u[5])
+{
+    const phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, kq = nx * ny * k;
+    u[0] = wk->ic[kq];
+    u[1] = s->p[kq];
+    u[2] = wk->kx[kq];
+    u[3] = wk->ky[kq];
+    u[4] = wk->kz[kq];
+    if (!all_bits(wk->ic + kq, nx * ny, u) || !all_bits(s->p + kq, nx * ny, u + 1) ||
+        !all_bits(wk->kz + kq, nx * ny, u + 4) || !all_bits(wk->ky + kq, nx * (ny - 1), u + 3))
+        return 0;
+    for (size_t j = 0; j < ny; ++j)
+        if (!all_bits(wk->kx + kq + nx * j, nx - 1, u + 2))
+            return 0;
+    return 1;
+}
+
 /* 1/c, face permeabilities, surface voxels of every column. */
 static void prepare_fields(phc_soil *s)
 {
@@ -613,6 +655,7 @@ static void prepare_fields(phc_soil *s)
         }
         face_permeabilities(plane, p + kq, p + (k + 1 < nz ? kq + plane : 0), k + 1 < nz || per[2],
                             wk->kz + kq);
+        wk->uniform[k] = (unsigned char)plane_uniform(s, k, wk->uniform_of + 5 * k);
     }
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
@@ -821,6 +864,14 @@ static inline double gravity_face(double lower, double upper, double kz, double 
  * flux is computed once per sub-step instead of twice, by the same
  * expression on the same numbers (gravity_face).  The row ends, computed
  * again, take f7 from gd and kzd as water_voxel_pre does. */
+static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
+                                  const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                                  const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                                  const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                                  const double *restrict kys, const double *restrict kzc,
+                                  const double *restrict kzd, double *restrict gf, double *restrict out, double cd,
+                                  double cg, double lw, int up);
+
 PHC_SOIL_CLONES
 static void water_rows(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
                        const double *restrict lc, const double *restrict lu, const double *restrict ln,
@@ -837,6 +888,48 @@ static void water_rows(size_t nx, size_t rows, const double *restrict wc, const 
         out[r] = water_voxel_faces(wc, ld, lc, lu, ln, ls, kx, ky, kys, kzc, kzd, r, r + 1, r - 1, cd, cg, f6, gf[r]);
         gf[r] = f6;
     }
+    water_row_ends(nx, m, wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, gf, out, cd, cg, lw, up);
+}
+
+/* water_rows for `rows` (>= 1) inner rows of a uniform plane
+ * (plane_uniform) over a plane whose kz is one value too: the face
+ * permeabilities are the numbers kxu, kyu, kzu (the plane's) and kzdu (the
+ * plane below's) instead of arrays: the same numbers, so the same results
+ * to the last bit, with five streams fewer.  The row ends take the arrays,
+ * as in water_rows (the +x face of a row's last voxel may differ). */
+PHC_SOIL_CLONES
+static void water_rows_uniform(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
+                               const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                               const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                               const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                               const double *restrict kys, const double *restrict kzc, const double *restrict kzd,
+                               double kxu, double kyu, double kzu, double kzdu, double *restrict gf,
+                               double *restrict out, double cd, double cg, double lw, int up)
+{
+    const size_t m = nx * rows;
+#pragma omp simd
+    for (size_t r = 0; r < m; ++r) {
+        const double l0 = lc[r];
+        const double f0 = kxu * (lc[r + 1] - l0), f1 = kxu * (lc[r - 1] - l0);
+        const double f2 = kyu * (ln[r] - l0), f3 = kyu * (ls[r] - l0);
+        const double f4 = kzu * (lu[r] - l0), f5 = kzdu * (ld[r] - l0);
+        const double f6 = gravity_face(gc[r], gu[r], kzu, lw, up);
+        out[r] = wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - gf[r]);
+        gf[r] = f6;
+    }
+    water_row_ends(nx, m, wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, gf, out, cd, cg, lw, up);
+}
+
+/* The first and last voxel of each of the m / nx rows of water_rows,
+ * computed again with the x neighbour wrapped around the row. */
+static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
+                                  const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                                  const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                                  const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                                  const double *restrict kys, const double *restrict kzc,
+                                  const double *restrict kzd, double *restrict gf, double *restrict out, double cd,
+                                  double cg, double lw, int up)
+{
     for (size_t row = 0; row < m; row += nx) {
         const size_t last = row + nx - 1;
         out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
@@ -864,7 +957,8 @@ static void gravity_faces(size_t m, const double *restrict lower, const double *
 /* One z-plane of a water-only sub-step into `out` (pointers at the
  * plane's first voxel; ld, gd of the plane below, lu, gu of the plane
  * above, kzd the +z faces of the plane below): the rows 1 .. ny - 2 as
- * one run of water_rows, whose -y and +y neighbours are the rows before
+ * one run of water_rows (water_rows_uniform when uc and ud, the
+ * plane_uniform values of this plane and the plane below, are given), whose -y and +y neighbours are the rows before
  * and after in memory, then rows 0 and ny - 1, whose -y or +y neighbour
  * wraps around the plane (as the one-voxel stencil has it: across a
  * closed face the face permeability is 0 and the wrapped value is
@@ -872,9 +966,13 @@ static void gravity_faces(size_t m, const double *restrict lower, const double *
 static void water_plane(size_t nx, size_t ny, const double *wc, const double *ld, const double *lc,
                         const double *lu, const double *gd, const double *gc, const double *gu,
                         const double *kx, const double *ky, const double *kzc, const double *kzd, double *gf,
-                        double *out, double cd, double cg, double lw, int up)
+                        double *out, double cd, double cg, double lw, int up, const double *uc, const double *ud)
 {
-    if (ny > 2)
+    if (ny > 2 && uc && ud)
+        water_rows_uniform(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx,
+                           gu + nx, kx + nx, ky + nx, ky, kzc + nx, kzd + nx, uc[2], uc[3], uc[4], ud[4], gf + nx,
+                           out + nx, cd, cg, lw, up);
+    else if (ny > 2)
         water_rows(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx, gu + nx,
                    kx + nx, ky + nx, ky, kzc + nx, kzd + nx, gf + nx, out + nx, cd, cg, lw, up, 1);
     for (size_t j = 0; j < ny; j += ny > 1 ? ny - 1 : 1) {
@@ -894,6 +992,30 @@ static void fill_plane(size_t m, const double *restrict w, const double *restric
         l[q] = w[q] * ic[q];
         g[q] = a * p[q] * w[q];
     }
+}
+
+/* fill_plane for a plane of one 1/c (icu) and one p (pu): the same
+ * products, so the same numbers. */
+PHC_SOIL_CLONES
+static void fill_plane_uniform(size_t m, const double *restrict w, double icu, double pu, double a,
+                               double *restrict l, double *restrict g)
+{
+    const double ap = a * pu;
+    for (size_t q = 0; q < m; ++q) {
+        l[q] = w[q] * icu;
+        g[q] = ap * w[q];
+    }
+}
+
+/* The fill of plane k (at offset km) of w into l and g, uniform or not. */
+static void fill_plane_of(const phc_soil *s, size_t k, size_t km, const double *w, double a, double *l, double *g)
+{
+    const phc_soil_work *wk = s->work;
+    const size_t P = s->nx * s->ny;
+    if (wk->uniform[k])
+        fill_plane_uniform(P, w, wk->uniform_of[5 * k], wk->uniform_of[5 * k + 1], a, l, g);
+    else
+        fill_plane(P, w, wk->ic + km, s->p + km, a, l, g);
 }
 
 /* The stride of the ring's planes of P voxels (doubles): P rounded up to
@@ -940,12 +1062,13 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
 #define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
-        fill_plane(P, s->w + km, wk->ic + km, s->p + km, a, RING(0, m, 1), RING(0, m, 2));
+        fill_plane_of(s, wrap_plane(m, nz), km, s->w + km, a, RING(0, m, 1), RING(0, m, 2));
         for (size_t t = 1; t <= T; ++t) {
             const long k = m - (long)t;
             if (k < k0 - (long)(T - t))
                 break; /* and so for every later t */
-            const size_t kk = wrap_plane(k, nz) * P, kd = wrap_plane(k - 1, nz) * P;
+            const size_t ik = wrap_plane(k, nz), id = wrap_plane(k - 1, nz), kk = ik * P, kd = id * P;
+            const int uni = wk->uniform[ik] && wk->uniform[id];
             const double *wc = t == 1 ? s->w + kk : RING(t - 1, k, 0);
             double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
             double *gf = ring + (9 * T + t - 1) * S; /* sub-step t's gravity fluxes through the faces below */
@@ -953,9 +1076,10 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
                 gravity_faces(P, RING(t - 1, k - 1, 2), RING(t - 1, k, 2), wk->kz + kd, lw, up, gf);
             water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
                         RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
-                        wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up);
+                        wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up,
+                        uni ? wk->uniform_of + 5 * ik : NULL, uni ? wk->uniform_of + 5 * id : NULL);
             if (t < T)
-                fill_plane(P, out, wk->ic + kk, s->p + kk, a, RING(t, k, 1), RING(t, k, 2));
+                fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
         }
     }
 #undef RING

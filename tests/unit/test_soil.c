@@ -380,19 +380,35 @@ static void ref_steps(const phc_soil *s, double *w, double h, size_t steps)
 }
 
 /* A random water-only field: c and p per voxel from a seeded generator,
- * about 1 voxel in 8 rock (p = 0) and 1 in 16 dry (w = 0). */
-static phc_soil *random_soil(size_t nx, size_t ny, size_t nz, uint64_t seed)
+ * about 1 voxel in 8 rock (p = 0) and 1 in 16 dry (w = 0).  With
+ * `layered`, c and p are drawn per z-plane instead (random layers: the
+ * planes the sweep takes as uniform, soil.c plane_uniform), every fourth
+ * plane has rocks (p = 0 in about 1 voxel in 8: not uniform) and every
+ * seventh is rock throughout. */
+static phc_soil *random_soil(size_t nx, size_t ny, size_t nz, uint64_t seed, int layered)
 {
     phc_soil *s = new_soil(nx, ny, nz, 0.01);
     uint64_t x = seed;
+    const size_t P = nx * ny;
+    double ck = 0, pk = 0;
     for (size_t q = 0; q < s->n; ++q) {
         double u[4];
         for (int e = 0; e < 4; ++e) {
             x = x * 6364136223846793005ull + 1442695040888963407ull;
             u[e] = (double)(x >> 11) * 0x1.0p-53;
         }
-        s->c[q] = 2 + 18 * u[0];
-        s->p[q] = u[1] < 0.125 ? 0 : 0.005 + 0.1 * u[2];
+        if (!layered) {
+            s->c[q] = 2 + 18 * u[0];
+            s->p[q] = u[1] < 0.125 ? 0 : 0.005 + 0.1 * u[2];
+        } else {
+            const size_t k = q / P;
+            if (q % P == 0) {
+                ck = 2 + 18 * u[0];
+                pk = k % 7 == 5 ? 0 : 0.005 + 0.1 * u[2];
+            }
+            s->c[q] = ck;
+            s->p[q] = k % 4 == 3 && u[1] < 0.125 ? 0 : pk;
+        }
         s->w[q] = u[3] < 0.0625 ? 0 : s->c[q] * u[3];
     }
     s->params.f_diff = 1;
@@ -407,9 +423,11 @@ static void test_blocked_vs_steps(void)
        one; planes of one row or one column and of two rows, where every
        voxel is at a row's end or in the first or last row (water_plane
        computes those apart from the rest) */
-    static const struct { int upwind, periodic, yperiodic; size_t nx, ny; } C[] = {
-        {0, 0, 0, 13, 11}, {1, 0, 0, 13, 11}, {0, 1, 0, 13, 11}, {1, 1, 0, 13, 11}, {0, 1, 1, 13, 11},
-        {0, 0, 1, 1, 9},   {1, 1, 0, 7, 1},   {0, 1, 1, 6, 2}};
+    static const struct { int upwind, periodic, yperiodic; size_t nx, ny; int layered; } C[] = {
+        {0, 0, 0, 13, 11, 0}, {1, 0, 0, 13, 11, 0}, {0, 1, 0, 13, 11, 0}, {1, 1, 0, 13, 11, 0},
+        {0, 1, 1, 13, 11, 0}, {0, 0, 1, 1, 9, 0},   {1, 1, 0, 7, 1, 0},   {0, 1, 1, 6, 2, 0},
+        {0, 0, 0, 13, 11, 1}, {1, 0, 0, 13, 11, 1}, {0, 1, 0, 13, 11, 1}, {1, 1, 1, 13, 11, 1},
+        {0, 0, 1, 1, 9, 1},   {0, 1, 1, 6, 3, 1}};
     const size_t nz = 40, K = 23;
     int saved = omp_get_max_threads();
     for (size_t c = 0; c < sizeof C / sizeof C[0]; ++c)
@@ -418,7 +436,7 @@ static void test_blocked_vs_steps(void)
             const size_t nx = C[c].nx, ny = C[c].ny;
             phc_soil *s[2];
             for (int r = 0; r < 2; ++r) {
-                s[r] = random_soil(nx, ny, nz, 2026 + c);
+                s[r] = random_soil(nx, ny, nz, 2026 + c, C[c].layered);
                 s[r]->params.gravity = C[c].upwind ? PHC_SOIL_GRAVITY_UPWIND : PHC_SOIL_GRAVITY_LAX_WENDROFF;
                 if (C[c].periodic)
                     s[r]->params.boundary[PHC_SOIL_XMIN] = s[r]->params.boundary[PHC_SOIL_XMAX] = PHC_SOIL_PERIODIC;
@@ -451,10 +469,10 @@ static void test_blocked_vs_steps(void)
                 moved = fmax(moved, fabs(s[0]->w[q] - w0[q]));
             }
             const size_t T = phc_soil_block_steps(s[0]);
-            printf("4c. random %zux%zux%zu%s%s%s, %d thread%s: %zu steps in one run (%zu per sweep) vs %zu runs of "
+            printf("4c. random%s %zux%zux%zu%s%s%s, %d thread%s: %zu steps in one run (%zu per sweep) vs %zu runs of "
                    "one step: bit-identical %s (max |dw| %.1e); vs the plain one-voxel stencil: bit-identical %s "
                    "(max |dw| %.1e); sub-steps %zu vs %zu; largest change of w %.3g\n",
-                   nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "",
+                   C[c].layered ? " layers" : "", nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "",
                    C[c].yperiodic ? ", y periodic" : "", th,
                    th > 1 ? "s" : "", K, T, K, same_steps ? "yes" : "NO", d1, same_ref ? "yes" : "NO", d2,
                    s[0]->budget.substeps, s[1]->budget.substeps, moved);
