@@ -892,11 +892,20 @@ static void water_rows(size_t nx, size_t rows, const double *restrict wc, const 
 }
 
 /* water_rows for `rows` (>= 1) inner rows of a uniform plane
- * (plane_uniform) over a plane whose kz is one value too: the face
- * permeabilities are the numbers kxu, kyu, kzu (the plane's) and kzdu (the
- * plane below's) instead of arrays: the same numbers, so the same results
- * to the last bit, with five streams fewer.  The row ends take the arrays,
- * as in water_rows (the +x face of a row's last voxel may differ). */
+ * (plane_uniform) over a uniform plane: the face permeabilities are the
+ * numbers kyu, kzu (the plane's) and kzdu (the plane below's) instead of
+ * arrays, the same numbers, so the same results, with five streams fewer.
+ * Along x, every row of the plane has the faces of the first row given
+ * (kx): kx[i] to the east neighbour, kx[i - 1] to the west one (kx[-1],
+ * the previous row's last face, is the face across the row's ends).  With
+ * closed x faces (not `xper`) that face is 0, and the loop, row by row,
+ * gives a row's first and last voxel their values without computing them
+ * again: the neighbour across the row end (the previous or next row's
+ * voxel instead of the wrapped one) is multiplied by 0.  (The term is then
+ * a zero of either sign, and the sum the same number; only a voxel whose
+ * w is -0 with all its other terms zero could come out +0 instead.)  With
+ * periodic x faces the rows run as one loop with kxu, and the row ends are
+ * computed again with the wrapped neighbour, as in water_rows. */
 PHC_SOIL_CLONES
 static void water_rows_uniform(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
                                const double *restrict lc, const double *restrict lu, const double *restrict ln,
@@ -904,9 +913,25 @@ static void water_rows_uniform(size_t nx, size_t rows, const double *restrict wc
                                const double *restrict gu, const double *restrict kx, const double *restrict ky,
                                const double *restrict kys, const double *restrict kzc, const double *restrict kzd,
                                double kxu, double kyu, double kzu, double kzdu, double *restrict gf,
-                               double *restrict out, double cd, double cg, double lw, int up)
+                               double *restrict out, double cd, double cg, double lw, int up, int xper)
 {
     const size_t m = nx * rows;
+    if (!xper) {
+        for (size_t row = 0; row < m; row += nx) {
+#pragma omp simd
+            for (size_t i = 0; i < nx; ++i) {
+                const size_t r = row + i;
+                const double l0 = lc[r];
+                const double f0 = kx[i] * (lc[r + 1] - l0), f1 = kx[i - 1] * (lc[r - 1] - l0);
+                const double f2 = kyu * (ln[r] - l0), f3 = kyu * (ls[r] - l0);
+                const double f4 = kzu * (lu[r] - l0), f5 = kzdu * (ld[r] - l0);
+                const double f6 = gravity_face(gc[r], gu[r], kzu, lw, up);
+                out[r] = wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - gf[r]);
+                gf[r] = f6;
+            }
+        }
+        return;
+    }
 #pragma omp simd
     for (size_t r = 0; r < m; ++r) {
         const double l0 = lc[r];
@@ -966,12 +991,13 @@ static void gravity_faces(size_t m, const double *restrict lower, const double *
 static void water_plane(size_t nx, size_t ny, const double *wc, const double *ld, const double *lc,
                         const double *lu, const double *gd, const double *gc, const double *gu,
                         const double *kx, const double *ky, const double *kzc, const double *kzd, double *gf,
-                        double *out, double cd, double cg, double lw, int up, const double *uc, const double *ud)
+                        double *out, double cd, double cg, double lw, int up, const double *uc, const double *ud,
+                        int xper)
 {
     if (ny > 2 && uc && ud)
         water_rows_uniform(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx,
                            gu + nx, kx + nx, ky + nx, ky, kzc + nx, kzd + nx, uc[2], uc[3], uc[4], ud[4], gf + nx,
-                           out + nx, cd, cg, lw, up);
+                           out + nx, cd, cg, lw, up, xper);
     else if (ny > 2)
         water_rows(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx, gu + nx,
                    kx + nx, ky + nx, ky, kzc + nx, kzd + nx, gf + nx, out + nx, cd, cg, lw, up, 1);
@@ -1059,6 +1085,7 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
+    const int xper = s->params.boundary[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC;
 #define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
@@ -1077,7 +1104,7 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
             water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
                         RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
                         wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up,
-                        uni ? wk->uniform_of + 5 * ik : NULL, uni ? wk->uniform_of + 5 * id : NULL);
+                        uni ? wk->uniform_of + 5 * ik : NULL, uni ? wk->uniform_of + 5 * id : NULL, xper);
             if (t < T)
                 fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
         }
