@@ -46,6 +46,10 @@ struct phc_soil_work {
     unsigned char *uniform;    /* nz: 1 when plane k has one 1/c, one p and one permeability per
                                   face direction (plane_uniform) */
     double *uniform_of;        /* 5 nz: those values of plane k: 1/c, p, kx, ky, kz */
+    unsigned char *from_w;     /* nz: 1 when plane k and both its neighbours are uniform, x faces closed,
+                                  ny >= 2: its water sub-steps take w alone (water_plane_from_w) */
+    unsigned char *fill;       /* nz: 1 when a neighbour or plane k itself is not from_w: the sweep
+                                  makes plane k's fill l and g (fill_plane) */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
@@ -95,6 +99,8 @@ static void work_free(phc_soil_work *wk)
     free(wk->plane_at);
     free(wk->uniform);
     free(wk->uniform_of);
+    free(wk->from_w);
+    free(wk->fill);
     free(wk->top);
     free(wk->damp_x);
     free(wk->damp_y);
@@ -170,12 +176,14 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->plane_at = malloc(nz * sizeof(size_t));
     wk->uniform = malloc(nz);
     wk->uniform_of = malloc(5 * nz * sizeof(double));
+    wk->from_w = malloc(nz);
+    wk->fill = malloc(nz);
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
     if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane || !wk->plane_at ||
-        !wk->uniform || !wk->uniform_of || !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
+        !wk->uniform || !wk->uniform_of || !wk->from_w || !wk->fill || !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
     }
@@ -657,6 +665,11 @@ static void prepare_fields(phc_soil *s)
                             wk->kz + kq);
         wk->uniform[k] = (unsigned char)plane_uniform(s, k, wk->uniform_of + 5 * k);
     }
+    for (size_t k = 0; k < nz; ++k)
+        wk->from_w[k] = !per[0] && ny >= 2 && wk->uniform[k] && wk->uniform[(k + nz - 1) % nz] &&
+                        wk->uniform[(k + 1) % nz];
+    for (size_t k = 0; k < nz; ++k)
+        wk->fill[k] = !wk->from_w[k] || !wk->from_w[(k + nz - 1) % nz] || !wk->from_w[(k + 1) % nz];
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
         for (long k = (long)nz - 1; k >= 0; --k)
@@ -945,6 +958,98 @@ static void water_rows_uniform(size_t nx, size_t rows, const double *restrict wc
     water_row_ends(nx, m, wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, gf, out, cd, cg, lw, up);
 }
 
+/* The water update of a voxel of a from_w plane (see water_plane_from_w)
+ * from w: wc, we, ww, wn, ws its own and its east, west, north and south
+ * neighbours' (in the plane, of 1/c icc), wu and wd above and below (1/c
+ * icu, icd), apc and apu f_grav p of the plane and the plane above; kxe,
+ * kxw, kyn, kys, kzu, kzd the face permeabilities; gf the gravity flux
+ * through the bottom face on entry, through the top face on return.  The
+ * fill l = w/c and g = f_grav p w are the products fill_plane forms, and
+ * the rest is water_voxel_faces: the same numbers. */
+static inline double water_voxel_from_w(double wc, double we, double ww, double wn, double ws, double wu,
+                                        double wd, double icc, double icu, double icd, double apc, double apu,
+                                        double kxe, double kxw, double kyn, double kys, double kzu, double kzd,
+                                        double *gf, double cd, double cg, double lw, int up)
+{
+    const double l0 = wc * icc;
+    const double f0 = kxe * (we * icc - l0), f1 = kxw * (ww * icc - l0);
+    const double f2 = kyn * (wn * icc - l0), f3 = kys * (ws * icc - l0);
+    const double f4 = kzu * (wu * icu - l0), f5 = kzd * (wd * icd - l0);
+    const double f6 = gravity_face(apc * wc, apu * wu, kzu, lw, up);
+    const double r = wc + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - *gf);
+    *gf = f6;
+    return r;
+}
+
+/* Voxels i0 .. i1 - 1 of a row of a from_w plane (water_voxel_from_w):
+ * pointers at the row's first voxel (wn, ws: the rows north and south,
+ * wrapped around the plane), kx the x faces of the plane's second row
+ * (kx[i] east of voxel i; kx[i - 1] west, kx[-1] across the row's ends,
+ * 0 as x faces are closed).  A voxel at a row end reads the voxel across
+ * the row end, in the previous or next row, and multiplies its term by
+ * that 0 (a zero of either sign: the sum is the same number; only a voxel
+ * whose w is -0 with all its other terms zero could come out +0); the
+ * caller keeps i0 .. i1 inside the plane's voxels. */
+PHC_SOIL_CLONES
+static void water_row_from_w(size_t i0, size_t i1, const double *restrict wc, const double *restrict wn,
+                             const double *restrict ws, const double *restrict wu, const double *restrict wd,
+                             const double *restrict kx, const double *restrict u, const double *restrict uu,
+                             const double *restrict ud, double kyn, double kys, double *restrict gf,
+                             double *restrict out, double a, double cd, double cg, double lw, int up)
+{
+    const double icc = u[0], icu = uu[0], icd = ud[0], apc = a * u[1], apu = a * uu[1], kzu = u[4], kzd = ud[4];
+#pragma omp simd
+    for (size_t i = i0; i < i1; ++i)
+        out[i] = water_voxel_from_w(wc[i], wc[i + 1], wc[i - 1], wn[i], ws[i], wu[i], wd[i], icc, icu, icd, apc, apu,
+                                    kx[i], kx[i - 1], kyn, kys, kzu, kzd, gf + i, cd, cg, lw, up);
+}
+
+/* One z-plane of a water-only sub-step of a from_w plane (prepare_fields:
+ * it and the planes above and below uniform, closed x faces, ny >= 2)
+ * from w alone: wc, wu, wd the planes of w, u, uu, ud the uniform values
+ * (plane_uniform) of the plane, the plane above and below, kx and ky the
+ * plane's faces; gf and out as in water_plane.  The fill l = w/c and the
+ * gravity flux g = f_grav p w are formed where they are used (2 + 7
+ * multiplications a voxel instead of a pass over the plane that writes
+ * two planes and seven loads of them).  Rows one at a time, north and
+ * south wrapped as the one-voxel stencil has them; the plane's first and
+ * last voxel, whose neighbours across the row end lie outside the plane,
+ * on their own with the wrapped neighbour. */
+static void water_plane_from_w(size_t nx, size_t ny, const double *wc, const double *wu, const double *wd,
+                               const double *u, const double *uu, const double *ud, const double *kx,
+                               const double *ky, double *gf, double *out, double a, double cd, double cg,
+                               double lw, int up)
+{
+    const double *kxr = kx + nx; /* the second row's x faces; kxr[-1] the first row's last */
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t o = nx * j, on = j + 1 < ny ? o + nx : 0, os = j > 0 ? o - nx : nx * (ny - 1);
+        const size_t i0 = j == 0, i1 = j + 1 == ny ? nx - 1 : nx;
+        if (i1 > i0)
+            water_row_from_w(i0, i1, wc + o, wc + on, wc + os, wu + o, wd + o, kxr, u, uu, ud, ky[o], ky[os], gf + o,
+                             out + o, a, cd, cg, lw, up);
+    }
+    /* the first voxel (west neighbour wrapped to the end of row 0) and the
+       last (east neighbour wrapped to the start of the last row) */
+    const size_t e0 = nx > 1 ? 1 : 0, L = nx * ny - 1, Lr = nx * (ny - 1), Le = nx > 1 ? L - 1 : L;
+    out[0] = water_voxel_from_w(wc[0], wc[e0], wc[nx - 1], wc[nx], wc[Lr], wu[0], wd[0], u[0], uu[0], ud[0],
+                                a * u[1], a * uu[1], kx[0], kx[nx - 1], ky[0], ky[Lr], u[4], ud[4], gf, cd, cg, lw,
+                                up);
+    if (L > 0)
+        out[L] = water_voxel_from_w(wc[L], wc[Lr], wc[Le], wc[nx - 1], wc[L - nx], wu[L], wd[L], u[0], uu[0], ud[0],
+                                    a * u[1], a * uu[1], kx[L], kx[Le], ky[L], ky[L - nx], u[4], ud[4], gf + L, cd,
+                                    cg, lw, up);
+}
+
+/* gravity_faces of a from_w plane over the plane below, from w: g of
+ * each formed as fill_plane forms it. */
+PHC_SOIL_CLONES
+static void gravity_faces_from_w(size_t m, const double *restrict lower, const double *restrict upper, double apl,
+                                 double apu, double kz, double lw, int up, double *restrict gf)
+{
+    for (size_t q = 0; q < m; ++q)
+        gf[q] = gravity_face(apl * lower[q], apu * upper[q], kz, lw, up);
+}
+
 /* The first and last voxel of each of the m / nx rows of water_rows,
  * computed again with the x neighbour wrapped around the row. */
 static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
@@ -1087,28 +1192,43 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
     const int xper = s->params.boundary[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC;
 #define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
+/* w after sub-step t (0: the state s->w) of plane k */
+#define WPLANE(t, k) ((t) == 0 ? s->w + wrap_plane(k, nz) * P : RING(t, k, 0))
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
-        fill_plane_of(s, wrap_plane(m, nz), km, s->w + km, a, RING(0, m, 1), RING(0, m, 2));
+        if (wk->fill[wrap_plane(m, nz)])
+            fill_plane_of(s, wrap_plane(m, nz), km, s->w + km, a, RING(0, m, 1), RING(0, m, 2));
         for (size_t t = 1; t <= T; ++t) {
             const long k = m - (long)t;
             if (k < k0 - (long)(T - t))
                 break; /* and so for every later t */
             const size_t ik = wrap_plane(k, nz), id = wrap_plane(k - 1, nz), kk = ik * P, kd = id * P;
             const int uni = wk->uniform[ik] && wk->uniform[id];
-            const double *wc = t == 1 ? s->w + kk : RING(t - 1, k, 0);
+            const double *wc = WPLANE(t - 1, k);
             double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
             double *gf = ring + (9 * T + t - 1) * S; /* sub-step t's gravity fluxes through the faces below */
+            const double *u = wk->uniform_of + 5 * ik, *ud = wk->uniform_of + 5 * id;
+            if (wk->from_w[ik]) {
+                const double *uu = wk->uniform_of + 5 * wrap_plane(k + 1, nz);
+                if (k == k0 - (long)(T - t))
+                    gravity_faces_from_w(P, WPLANE(t - 1, k - 1), wc, a * ud[1], a * u[1], ud[4], lw, up, gf);
+                water_plane_from_w(nx, ny, wc, WPLANE(t - 1, k + 1), WPLANE(t - 1, k - 1), u, uu, ud, wk->kx + kk,
+                                   wk->ky + kk, gf, out, a, cd, cg, lw, up);
+                if (t < T && wk->fill[ik])
+                    fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
+                continue;
+            }
             if (k == k0 - (long)(T - t))
                 gravity_faces(P, RING(t - 1, k - 1, 2), RING(t - 1, k, 2), wk->kz + kd, lw, up, gf);
             water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
                         RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
                         wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up,
-                        uni ? wk->uniform_of + 5 * ik : NULL, uni ? wk->uniform_of + 5 * id : NULL, xper);
+                        uni ? u : NULL, uni ? ud : NULL, xper);
             if (t < T)
                 fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
         }
     }
+#undef WPLANE
 #undef RING
 }
 
