@@ -26,6 +26,10 @@
 #ifndef PHC_SOIL_BLOCK_STEPS
 #define PHC_SOIL_BLOCK_STEPS 4
 #endif
+/* The same when every plane is swept from w alone (block_levels). */
+#ifndef PHC_SOIL_BLOCK_STEPS_FROM_W
+#define PHC_SOIL_BLOCK_STEPS_FROM_W 8
+#endif
 
 /* The bytes of cache a sweep's planes should fit in (block_levels): 3/4 of
  * the 1 MiB L2 cache per core of the machine the bench runs on. */
@@ -57,6 +61,7 @@ struct phc_soil_work {
     double *src_w;             /* per source: normalised weights over its voxels */
     size_t *src_idx, *src_first, src_total;
     int nutrients;             /* 1 when nutrients move */
+    int all_from_w;            /* 1 when every plane is from_w */
 };
 
 static size_t idx3(const phc_soil *s, size_t i, size_t j, size_t k)
@@ -668,8 +673,11 @@ static void prepare_fields(phc_soil *s)
     for (size_t k = 0; k < nz; ++k)
         wk->from_w[k] = !per[0] && ny >= 2 && wk->uniform[k] && wk->uniform[(k + nz - 1) % nz] &&
                         wk->uniform[(k + 1) % nz];
-    for (size_t k = 0; k < nz; ++k)
+    wk->all_from_w = 1;
+    for (size_t k = 0; k < nz; ++k) {
         wk->fill[k] = !wk->from_w[k] || !wk->from_w[(k + nz - 1) % nz] || !wk->from_w[(k + 1) % nz];
+        wk->all_from_w &= wk->from_w[k];
+    }
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
         for (long k = (long)nz - 1; k >= 0; --k)
@@ -845,14 +853,23 @@ static inline double gravity_face(double lower, double upper, double kz, double 
  * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
  * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
  * a * b + c, so both copies round every operation alike: the same numbers
- * to the last bit.  An AVX-512F copy (8 doubles) measured the same as AVX2
- * on the bench's machine (AMD EPYC, 1 thread, CPU time, 3 alternating runs,
- * load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel updates/s against
- * 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8) and is not built. */
+ * to the last bit.  An AVX-512F copy (8 doubles) of these loops measured
+ * the same as AVX2 on the bench's machine (AMD EPYC, 1 thread, CPU time, 3
+ * alternating runs, load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel
+ * updates/s against 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8)
+ * and is not built for them.  The loops of the planes swept from w alone
+ * (water_row_from_w) stream two fields instead of ten and are bound by
+ * arithmetic, not by the caches: they have an AVX-512F copy too
+ * (PHC_SOIL_CLONES_512; AVX-512F does not bring FMA either).  Measured on
+ * the same machine (1 thread, CPU time, 3 alternating runs, the bench
+ * soil): 64^3 1.84e9-1.93e9 voxel updates/s against 1.05e9-1.09e9 with
+ * AVX2, 128^3 1.20e9-1.24e9 against 8.8e8-9.0e8. */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
 #define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
+#define PHC_SOIL_CLONES_512 __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define PHC_SOIL_CLONES
+#define PHC_SOIL_CLONES_512
 #endif
 
 /* `rows` consecutive full rows (nx voxels each) of a z-plane's water
@@ -990,7 +1007,7 @@ static inline double water_voxel_from_w(double wc, double we, double ww, double 
  * that 0 (a zero of either sign: the sum is the same number; only a voxel
  * whose w is -0 with all its other terms zero could come out +0); the
  * caller keeps i0 .. i1 inside the plane's voxels. */
-PHC_SOIL_CLONES
+PHC_SOIL_CLONES_512
 static void water_row_from_w(size_t i0, size_t i1, const double *restrict wc, const double *restrict wn,
                              const double *restrict ws, const double *restrict wu, const double *restrict wd,
                              const double *restrict kx, const double *restrict u, const double *restrict uu,
@@ -1042,7 +1059,7 @@ static void water_plane_from_w(size_t nx, size_t ny, const double *wc, const dou
 
 /* gravity_faces of a from_w plane over the plane below, from w: g of
  * each formed as fill_plane forms it. */
-PHC_SOIL_CLONES
+PHC_SOIL_CLONES_512
 static void gravity_faces_from_w(size_t m, const double *restrict lower, const double *restrict upper, double apl,
                                  double apu, double kz, double lw, int up, double *restrict gf)
 {
@@ -1275,13 +1292,30 @@ static void transport_water(phc_soil *s, double h, size_t T)
  * huge pages (same measure, 2 runs each, load average 5.8 on 2 CPUs):
  * 64^3 6.1e8-6.7e8 with 1, 6.2e8-6.5e8 with 2, 5.2e8-5.6e8 with 4;
  * 128^3 4.3e8-4.4e8 with 2, 5.0e8-5.1e8 with 4, 5.3e8 with 6, 5.1e8-5.2e8
- * with 8: the rule stands.  At most nz / 8 either way (the planes each
- * thread recomputes next to its range grow with T) and at least 1.  The
- * numbers do not depend on T. */
+ * with 8: the rule stands.  When every plane is swept from w alone
+ * (prepare_fields' all_from_w: layers, closed x faces) a sub-step works on
+ * 4 planes of rings (w of three planes and the gravity fluxes) and the
+ * sweep on (4 T + 2) planes: 2 sub-steps per sweep where their 10 planes
+ * fit in PHC_SOIL_CACHE_BYTES, else PHC_SOIL_BLOCK_STEPS_FROM_W (8).
+ * Measured on the bench soil (AVX-512 copy, CPU time, 2 runs each, load
+ * average 1.2-1.8 on 2 CPUs): 64^3 1.87e9-1.89e9 voxel updates/s with 1
+ * sub-step per sweep, 1.82e9-1.94e9 with 2, 1.84e9-1.92e9 with 4,
+ * 1.56e9-1.71e9 with 8 (with 2 threads, wall clock: 2.9e9-3.6e9,
+ * 3.2e9-3.7e9, 2.8e9-3.5e9, 2.3e9-3.0e9); 128^3 9.7e8-1.0e9 with 2,
+ * 1.22e9-1.23e9 with 4, 1.27e9-1.52e9 with 6, 1.52e9-1.54e9 with 8,
+ * 1.55e9-1.56e9 with 16 (2 threads: 2.37e9-2.42e9 with 4, 2.36e9-2.79e9
+ * with 6, 1.6e9-2.83e9 with 8, 2.73e9-2.77e9 with 12, 2.57e9-2.63e9 with
+ * 16).  At
+ * most nz / 8 either way (the planes each thread recomputes next to its
+ * range grow with T) and at least 1.  The numbers do not depend on T.
+ * Needs prepare_fields. */
 static size_t block_levels(const phc_soil *s)
 {
     size_t T = s->params.block_steps;
-    if (!T) {
+    if (!T && s->work->all_from_w) {
+        const double plane = (double)(s->nx * s->ny) * sizeof(double);
+        T = (4.0 * 2 + 2) * plane <= PHC_SOIL_CACHE_BYTES ? 2 : PHC_SOIL_BLOCK_STEPS_FROM_W;
+    } else if (!T) {
         const double plane = (double)(s->nx * s->ny) * sizeof(double);
         T = PHC_SOIL_BLOCK_STEPS;
         if ((15.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
@@ -1295,6 +1329,8 @@ static size_t block_levels(const phc_soil *s)
 
 size_t phc_soil_block_steps(const phc_soil *s)
 {
+    /* the work arrays are scratch, not state (as in phc_soil_stable_dt) */
+    prepare_fields((phc_soil *)s);
     return block_levels(s);
 }
 
