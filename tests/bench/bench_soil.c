@@ -28,7 +28,14 @@
  * (w and 1/c at +-1, +-nx, +-nx ny; kx, ky, kz at -1, -nx, -nx ny; p at
  * +-nx ny) are counted as cache hits.  Not counted: the step's
  * memcpy(v_new, v) when nutrients are off (+16 B, +24 B with
- * write-allocate), printed as a separate line.
+ * write-allocate), printed as a separate line.  The bench soil is two
+ * layers: its z-planes are uniform (one c and one p each), and the sweep
+ * takes 1/c, p and the face permeabilities as numbers (model/soil.c
+ * plane_uniform, water_plane_from_w): it streams w and w_new alone, 24 B
+ * with the write-allocate, once per T sub-steps
+ * (soil_bytes_moved_per_update_N says so beside the 64 B nominal count,
+ * which the bandwidth and fraction lines keep, so that they compare with
+ * earlier runs).
  *
  * STREAM-like copy in the same run: b[i] = a[i] over n = N^3 doubles with
  * OpenMP (static schedule, same thread count), best of 10 timings.
@@ -50,7 +57,10 @@
  * MAX_OTHER_LOAD the 2-thread targets are reported as not measurable.
  *
  * Nutrients on (once): the same soil with v = 1 (silt_loam) and 0.5 (clay)
- * units/m^3, 2 threads.
+ * units/m^3, 2 threads.  Rocks (once): the same soil with rocks in 10% of
+ * the voxels (phc_soil_add_rocks, features of 5 cm), so that no plane is
+ * uniform and every plane streams 1/c, p and the face permeabilities:
+ * the speed of a soil that is not made of layers, 2 threads.
  *
  * Today's stencil vs the previous one: reference_step below is the
  * stencil as it was before time blocking (one sub-step per sweep, the
@@ -84,6 +94,7 @@
 #define COPY_REPEAT 10
 #define BYTES_SOIL 64.0        /* 7 doubles + write-allocate of w_new */
 #define BYTES_SOIL_NO_WA 56.0
+#define BYTES_UNIFORM 24.0     /* uniform planes: w read, w_new written + write-allocate */
 #define BYTES_V_COPY 16.0      /* memcpy(v_new, v) per step, nutrients off */
 #define BYTES_NUT 88.0         /* + v read, v_new written and allocated */
 #define BYTES_COPY 16.0
@@ -94,7 +105,7 @@
 #define MAX_OTHER_LOAD 0.25  /* CPUs used by others above which 2-thread numbers are void */
 
 /* The benchmark soil (see the header comment); NULL on failure. */
-static phc_soil *make_soil(size_t N, int nutrients)
+static phc_soil *make_soil(size_t N, int nutrients, int rocks)
 {
     phc_soil *s = phc_soil_new(N, N, N, DX);
     if (!s)
@@ -126,6 +137,8 @@ static phc_soil *make_soil(size_t N, int nutrients)
                 double fill = 0.3 + 0.2 * (double)m / 16.0;
                 s->w[q] = s->c[q] * fill;
             }
+    if (rocks)
+        phc_soil_add_rocks(s, 7, 0.05, 0.1);
     s->params.f_diff = 1.0;
     s->params.f_grav = 1.0;
     for (int f = 0; f < PHC_SOIL_FACES; ++f)
@@ -277,10 +290,17 @@ static result measure(phc_soil *s, int threads)
         if (t < ov)
             ov = t;
     }
-    size_t trial = n >= (size_t)1 << 21 ? 4 : 20;
-    double tt = timed_run(s, w0, v0, trial);
-    if (isnan(tt))
-        goto out;
+    /* the trial twice, the second warm: with 8 sub-steps per sweep at 128^3
+       a first trial of 4 steps (one sweep) took 3-4 times the time per step
+       of the timings, which then lasted 0.1 s instead of 1 s */
+    size_t trial = n >= (size_t)1 << 21 ? 16 : 40;
+    double tt = INFINITY;
+    for (int i = 0; i < 2; ++i) {
+        double ti = timed_run(s, w0, v0, trial);
+        if (isnan(ti))
+            goto out;
+        tt = fmin(tt, ti);
+    }
     double per_step = (tt - ov) / (double)trial;
     size_t steps = (size_t)ceil((TARGET_SECONDS - ov) / (per_step > 0 ? per_step : 1e-6));
     if (steps < 10)
@@ -446,7 +466,7 @@ int main(void)
 
     for (int g = 0; g < 2; ++g) {
         size_t N = sizes[g];
-        phc_soil *s = make_soil(N, 0);
+        phc_soil *s = make_soil(N, 0, 0);
         if (!s) {
             printf("soil_%zu: cannot build the soil\n", N);
             return 1;
@@ -456,8 +476,11 @@ int main(void)
             size_t T = phc_soil_block_steps(s);
             printf("soil_block_steps_%zu: %zu sub-step%s per sweep (phc_soil_block_steps: as many as keep a "
                    "sweep's planes in cache)\n", N, T, T > 1 ? "s" : "");
-            printf("soil_bytes_moved_per_update_%zu: %.0f B (the %.0f B stream once per %zu sub-step%s)\n", N,
-                   BYTES_SOIL / (double)T, BYTES_SOIL, T, T > 1 ? "s" : "");
+            printf("soil_bytes_moved_per_update_%zu: %.0f B (w read, w_new written and allocated, %.0f B, once "
+                   "per %zu sub-step%s: the soil's z-planes are uniform (two layers), so 1/c, p and the face "
+                   "permeabilities are numbers, not streamed; the %.0f B nominal stream once per %zu would be "
+                   "%.0f B)\n", N, BYTES_UNIFORM / (double)T, BYTES_UNIFORM, T, T > 1 ? "s" : "", BYTES_SOIL, T,
+                   BYTES_SOIL / (double)T);
         }
         for (int th = 0; th < 2; ++th) {
             int T = threads[th];
@@ -570,7 +593,7 @@ int main(void)
     double nut[2];
     for (int g = 0; g < 2; ++g) {
         size_t N = sizes[g];
-        phc_soil *s = make_soil(N, 1);
+        phc_soil *s = make_soil(N, 1, 0);
         if (!s)
             return 1;
         result r = measure(s, 2);
@@ -584,11 +607,36 @@ int main(void)
         phc_soil_free(s);
     }
 
+    /* rocks (p = 0 in 10% of the voxels, in every plane): no plane is
+       uniform, every plane streams 1/c, p and the face permeabilities */
+    double rock[2];
+    for (int g = 0; g < 2; ++g) {
+        size_t N = sizes[g];
+        phc_soil *s = make_soil(N, 0, 1);
+        if (!s)
+            return 1;
+        result r = measure(s, 2);
+        rock[g] = r.best;
+        size_t uniform = 0; /* planes of one p and one c */
+        for (size_t k = 0; k < N; ++k) {
+            size_t q0 = N * N * k, q = q0;
+            while (q < q0 + N * N && s->p[q] == s->p[q0] && s->c[q] == s->c[q0])
+                ++q;
+            uniform += q == q0 + N * N;
+        }
+        printf("soil_vups_rocks_%zu_2t: %.4e voxel/s (best of %d; median %.4e; %.0f steps; %zu sub-step%s per "
+               "sweep; 10%% of the voxels rock, %zu of %zu planes uniform)\n", N, r.best, REPEAT, r.median,
+               r.steps, phc_soil_block_steps(s), phc_soil_block_steps(s) > 1 ? "s" : "", uniform, N);
+        printf("machine_other_load_rocks_%zu_2t: %.2f CPUs\n", N, r.other);
+        printf("soil_rock_cost_%zu_2t: %.2f x the layered soil's step time\n", N, vups[g][1] / r.best);
+        phc_soil_free(s);
+    }
+
     printf("---- summary ----\n");
     for (int g = 0; g < 2; ++g) {
         size_t N = sizes[g];
-        printf("soil_vups_%zu: %.3e voxel/s (1t), %.3e voxel/s (2t), %.3e voxel/s (2t, nutrients)\n", N,
-               vups[g][0], vups[g][1], nut[g]);
+        printf("soil_vups_%zu: %.3e voxel/s (1t), %.3e voxel/s (2t), %.3e voxel/s (2t, nutrients), %.3e voxel/s "
+               "(2t, rocks)\n", N, vups[g][0], vups[g][1], nut[g], rock[g]);
         printf("soil_fraction_of_copy_bw_%zu_2t: %.2f\n", N,
                (vups[g][1] * BYTES_SOIL) / (copy[g][1] * BYTES_COPY_WA));
         printf("soil_speedup_vs_numpy_%zu_2t: %.1f x (peer agrees: %s)\n", N, vups[g][1] / peer_vups[g],
