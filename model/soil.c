@@ -37,6 +37,30 @@
 #define PHC_SOIL_CACHE_BYTES (768.0 * 1024.0)
 #endif
 
+/* GCC function multiversioning for the water sweep's row loops: the build
+ * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
+ * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
+ * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
+ * a * b + c, so both copies round every operation alike: the same numbers
+ * to the last bit.  An AVX-512F copy (8 doubles) of these loops measured
+ * the same as AVX2 on the bench's machine (AMD EPYC, 1 thread, CPU time, 3
+ * alternating runs, load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel
+ * updates/s against 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8)
+ * and is not built for them.  The loops of the planes swept from w alone
+ * (water_row_from_w) stream two fields instead of ten and are bound by
+ * arithmetic, not by the caches: they have an AVX-512F copy too
+ * (PHC_SOIL_CLONES_512; AVX-512F does not bring FMA either).  Measured on
+ * the same machine (1 thread, CPU time, 3 alternating runs, the bench
+ * soil): 64^3 1.84e9-1.93e9 voxel updates/s against 1.05e9-1.09e9 with
+ * AVX2, 128^3 1.20e9-1.24e9 against 8.8e8-9.0e8. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
+#define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
+#define PHC_SOIL_CLONES_512 __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define PHC_SOIL_CLONES
+#define PHC_SOIL_CLONES_512
+#endif
+
 struct phc_soil_work {
     double *w_new, *v_new;     /* next state */
     double *ic;                /* 1 / c */
@@ -531,6 +555,35 @@ static double overlap(double a, double b, double c, double d)
 
 /* ---- checks and set-up ------------------------------------------------- */
 
+/* 1 when every voxel passes check_impl's tests (c finite and > 0, p
+ * finite and >= 0, w and v finite, and >= 0 when `strict`): one pass
+ * without branches per plane, so that it vectorises; check_impl looks for
+ * the voxel to name only when one fails.  (x - x is 0 for finite x and NaN
+ * for an infinity or NaN, so x - x == 0 tests finiteness.) */
+PHC_SOIL_CLONES_512
+static int plane_valid(size_t m, const double *restrict c, const double *restrict p, const double *restrict w,
+                       const double *restrict v, int strict)
+{
+    /* w and v compared with 0 only when strict: lo = -inf accepts any
+       finite value */
+    const double lo = strict ? 0.0 : -INFINITY;
+    long bad = 0;
+    for (size_t q = 0; q < m; ++q)
+        bad += !(c[q] > 0) | !(c[q] - c[q] == 0) | !(p[q] >= 0) | !(p[q] - p[q] == 0) | !(w[q] - w[q] == 0) |
+               !(v[q] - v[q] == 0) | !(w[q] >= lo) | !(v[q] >= lo);
+    return bad == 0;
+}
+
+static int fields_valid(const phc_soil *s, int strict)
+{
+    const size_t plane = s->nx * s->ny;
+    int bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : bad) if (s->n >= PHC_SOIL_PARALLEL_MIN)
+    for (size_t k = 0; k < s->nz; ++k)
+        bad |= !plane_valid(plane, s->c + plane * k, s->p + plane * k, s->w + plane * k, s->v + plane * k, strict);
+    return !bad;
+}
+
 static int check_impl(const phc_soil *s, int strict, phc_error *err)
 {
     const phc_soil_params *pr = &s->params;
@@ -563,6 +616,8 @@ static int check_impl(const phc_soil *s, int strict, phc_error *err)
         if ((pr->boundary[2 * a] == PHC_SOIL_PERIODIC) != (pr->boundary[2 * a + 1] == PHC_SOIL_PERIODIC))
             return phc_error_set(err, PHC_ERR_INPUT, "soil: periodic boundaries come in pairs: both %c faces "
                                  "or neither", axis[a]);
+    if (fields_valid(s, strict))
+        return PHC_OK;
     for (size_t k = 0; k < s->nz; ++k)
         for (size_t j = 0; j < s->ny; ++j)
             for (size_t i = 0; i < s->nx; ++i) {
@@ -607,13 +662,18 @@ static void face_permeabilities(size_t m, const double *restrict a, const double
             k[i] = 0;
 }
 
-/* 1 when the doubles a[0..m) all have the bits of *v (m = 0: yes). */
-static int all_bits(const double *a, size_t m, const double *v)
+/* 1 when the doubles a[0..m) all have the bits of *v (m = 0: yes); one
+ * pass without branches, so that it vectorises. */
+static inline int all_bits(const double *restrict a, size_t m, const double *restrict v)
 {
-    for (size_t i = 0; i < m; ++i)
-        if (memcmp(a + i, v, sizeof *v))
-            return 0;
-    return 1;
+    uint64_t x, diff = 0;
+    memcpy(&x, v, sizeof x);
+    for (size_t i = 0; i < m; ++i) {
+        uint64_t y;
+        memcpy(&y, a + i, sizeof y);
+        diff |= y ^ x;
+    }
+    return diff == 0;
 }
 
 /* Whether z-plane k (its 1/c, p and face permeabilities prepared) is
@@ -624,6 +684,7 @@ static int all_bits(const double *a, size_t m, const double *v)
  * of horizontal layers (phc_soil_set_layers) has only uniform planes; the
  * water sweep then takes these five numbers instead of streaming five
  * planes of them (water_rows_uniform). */
+PHC_SOIL_CLONES_512
 static int plane_uniform(const phc_soil *s, size_t k, double u[5])
 {
     const phc_soil_work *wk = s->work;
@@ -642,6 +703,31 @@ static int plane_uniform(const phc_soil *s, size_t k, double u[5])
     return 1;
 }
 
+/* 1/c and the face permeabilities of one z-plane (c, p, ic, kx, ky, kz
+ * at its first voxel; p_up at the first voxel of the plane above,
+ * wrapped): the +x faces of a row's last voxel, the +y faces of the last
+ * row and the +z faces lead to the first voxel, row or plane (wrapped) and
+ * are 0 unless that axis is periodic (xper, yper) or the z face open
+ * (zopen).  By rows and planes, so that the divisions vectorise; with an
+ * AVX-512F copy (PHC_SOIL_CLONES_512: run_call overhead, see
+ * stable_dt_prepared). */
+PHC_SOIL_CLONES_512
+static void plane_fields(size_t nx, size_t ny, const double *restrict c, const double *restrict p,
+                         const double *restrict p_up, int xper, int yper, int zopen, double *restrict ic,
+                         double *restrict kx, double *restrict ky, double *restrict kz)
+{
+    const size_t plane = nx * ny;
+    for (size_t q = 0; q < plane; ++q)
+        ic[q] = 1.0 / c[q];
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t r = nx * j, last = r + nx - 1;
+        face_permeabilities(nx - 1, p + r, p + r + 1, 1, kx + r);
+        kx[last] = xper ? harmonic(p[last], p[r]) : 0;
+        face_permeabilities(nx, p + r, p + (j + 1 < ny ? r + nx : 0), j + 1 < ny || yper, ky + r);
+    }
+    face_permeabilities(plane, p, p_up, zopen, kz);
+}
+
 /* 1/c, face permeabilities, surface voxels of every column. */
 static void prepare_fields(phc_soil *s)
 {
@@ -650,24 +736,12 @@ static void prepare_fields(phc_soil *s)
     const phc_soil_boundary *b = s->params.boundary;
     int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
                   b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
-    /* by rows and planes, so that the divisions vectorise: the +x face of a
-       row's last voxel, the +y faces of a plane's last row and the +z faces
-       of the top plane lead to the first voxel, row or plane (wrapped), and
-       are 0 unless that axis is periodic */
     const double *p = s->p;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         const size_t kq = plane * k;
-        for (size_t q = kq; q < kq + plane; ++q)
-            wk->ic[q] = 1.0 / s->c[q];
-        for (size_t j = 0; j < ny; ++j) {
-            const size_t r = kq + nx * j, last = r + nx - 1;
-            face_permeabilities(nx - 1, p + r, p + r + 1, 1, wk->kx + r);
-            wk->kx[last] = per[0] ? harmonic(p[last], p[r]) : 0;
-            face_permeabilities(nx, p + r, p + (j + 1 < ny ? r + nx : kq), j + 1 < ny || per[1], wk->ky + r);
-        }
-        face_permeabilities(plane, p + kq, p + (k + 1 < nz ? kq + plane : 0), k + 1 < nz || per[2],
-                            wk->kz + kq);
+        plane_fields(nx, ny, s->c + kq, p + kq, p + (k + 1 < nz ? kq + plane : 0), per[0], per[1],
+                     k + 1 < nz || per[2], wk->ic + kq, wk->kx + kq, wk->ky + kq, wk->kz + kq);
         wk->uniform[k] = (unsigned char)plane_uniform(s, k, wk->uniform_of + 5 * k);
     }
     for (size_t k = 0; k < nz; ++k)
@@ -698,45 +772,78 @@ static void prepare_fields(phc_soil *s)
     wk->damp_h = -1;
 }
 
-/* The stability limit from the prepared face permeabilities and 1/c:
- * for every permeable voxel the positive root of a h^2 + b h = 1 with
- * b = f_diff (sum of its faces' p_f) / (c dx^2), a = (f_grav p / dx)^2
- * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux. */
+/* The stability limit of voxel q (p its permeability, ic its 1/c, sum
+ * the sum of its six faces' permeabilities): the positive root of
+ * a h^2 + b h = 1 with b = f_diff sum / (c dx^2), a = (f_grav p / dx)^2
+ * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux; +inf
+ * where p = 0 or nothing moves. */
+static inline double voxel_stable_dt(double p, double ic, double sum, double fd, double fg, double dx, double dx2,
+                                     int up)
+{
+    const double bb = fd * sum * ic / dx2;
+    const double g = fg * p / dx, a = g * g;
+    const double h = up ? ((g > 0 || bb > 0) ? 1.0 / (bb + g) : INFINITY)
+                        : ((a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY);
+    return p > 0 ? h : INFINITY;
+}
+
+/* The smallest stability limit of z-plane k and its first voxel (*at):
+ * the limits of up to 256 voxels of a row at a time into a buffer, in a
+ * loop that vectorises (the first voxel of a row, whose -x neighbour
+ * wraps, on its own), then the first smallest.  The -x, -y, -z faces are
+ * the +faces of the wrapped neighbours (0 across closed box faces).  With
+ * an AVX-512F copy: 128^3 bench soil, a zero-length phc_soil_run (set-up:
+ * check, plane_fields, this) 1 thread, best of 5: see README. */
+PHC_SOIL_CLONES_512
+static double plane_stable_dt(const phc_soil *s, size_t k, size_t *at)
+{
+    double h[256];
+    const phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, plane = nx * ny, kq = plane * k;
+    const double *restrict kx = wk->kx, *restrict ky = wk->ky, *restrict kz = wk->kz, *restrict ic = wk->ic,
+                           *restrict p = s->p;
+    const double fd = s->params.f_diff, fg = s->params.f_grav, dx = s->dx, dx2 = dx * dx;
+    const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
+    double best = INFINITY;
+    *at = kq;
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t r = kq + nx * j, rs = j > 0 ? r - nx : r + plane - nx;
+        const size_t rd = k > 0 ? r - plane : r + s->n - plane;
+        for (size_t i0 = 0; i0 < nx; i0 += 256) {
+            const size_t i1 = nx - i0 < 256 ? nx : i0 + 256;
+            size_t i = i0;
+            if (i0 == 0) {
+                h[0] = voxel_stable_dt(p[r], ic[r], kx[r] + kx[r + nx - 1] + ky[r] + ky[rs] + kz[r] + kz[rd], fd, fg,
+                                       dx, dx2, up);
+                i = 1;
+            }
+#pragma omp simd
+            for (size_t e = i; e < i1; ++e)
+                h[e - i0] = voxel_stable_dt(p[r + e], ic[r + e],
+                                            kx[r + e] + kx[r + e - 1] + ky[r + e] + ky[rs + e] + kz[r + e] +
+                                                kz[rd + e],
+                                            fd, fg, dx, dx2, up);
+            for (size_t e = i0; e < i1; ++e)
+                if (h[e - i0] < best) {
+                    best = h[e - i0];
+                    *at = r + e;
+                }
+        }
+    }
+    return best;
+}
+
+/* The stability limit from the prepared face permeabilities and 1/c
+ * (voxel_stable_dt), and the voxel that sets it: the smallest limit of
+ * each z-plane and its first voxel, in parallel; then the first plane
+ * holding the smallest: the voxel a scan in index order finds. */
 static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
 {
     phc_soil_work *wk = s->work;
-    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
-    const double dx2 = s->dx * s->dx;
-    /* the smallest limit of each z-plane and its first voxel, in parallel;
-       then the first plane holding the smallest: the voxel a scan in index
-       order finds */
+    const size_t nz = s->nz;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
-    for (size_t k = 0; k < nz; ++k) {
-        double best = INFINITY;
-        size_t at = 0;
-        for (size_t j = 0; j < ny; ++j)
-            for (size_t i = 0; i < nx; ++i) {
-                size_t q = idx3(s, i, j, k);
-                if (!(s->p[q] > 0))
-                    continue;
-                /* the -x, -y, -z faces are the +faces of the wrapped neighbours
-                   (0 across closed box faces) */
-                size_t qw = i > 0 ? q - 1 : q + nx - 1, qs = j > 0 ? q - nx : q + plane - nx;
-                size_t qd = k > 0 ? q - plane : q + s->n - plane;
-                double sum = wk->kx[q] + wk->kx[qw] + wk->ky[q] + wk->ky[qs] + wk->kz[q] + wk->kz[qd];
-                double bb = s->params.f_diff * sum * wk->ic[q] / dx2;
-                double g = s->params.f_grav * s->p[q] / s->dx, a = g * g;
-                double h = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND
-                               ? ((g > 0 || bb > 0) ? 1.0 / (bb + g) : INFINITY)
-                               : ((a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY);
-                if (h < best) {
-                    best = h;
-                    at = q;
-                }
-            }
-        wk->plane[k] = best;
-        wk->plane_at[k] = at;
-    }
+    for (size_t k = 0; k < nz; ++k)
+        wk->plane[k] = plane_stable_dt(s, k, &wk->plane_at[k]);
     double best = INFINITY;
     size_t at = 0;
     for (size_t k = 0; k < nz; ++k)
@@ -848,29 +955,6 @@ static inline double gravity_face(double lower, double upper, double kz, double 
     return kz > 0 ? 0.5 * (upper + lower) - (up ? 0.5 : lw * kz) * (lower - upper) : 0;
 }
 
-/* GCC function multiversioning for the water sweep's row loops: the build
- * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
- * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
- * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
- * a * b + c, so both copies round every operation alike: the same numbers
- * to the last bit.  An AVX-512F copy (8 doubles) of these loops measured
- * the same as AVX2 on the bench's machine (AMD EPYC, 1 thread, CPU time, 3
- * alternating runs, load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel
- * updates/s against 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8)
- * and is not built for them.  The loops of the planes swept from w alone
- * (water_row_from_w) stream two fields instead of ten and are bound by
- * arithmetic, not by the caches: they have an AVX-512F copy too
- * (PHC_SOIL_CLONES_512; AVX-512F does not bring FMA either).  Measured on
- * the same machine (1 thread, CPU time, 3 alternating runs, the bench
- * soil): 64^3 1.84e9-1.93e9 voxel updates/s against 1.05e9-1.09e9 with
- * AVX2, 128^3 1.20e9-1.24e9 against 8.8e8-9.0e8. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
-#define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
-#define PHC_SOIL_CLONES_512 __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define PHC_SOIL_CLONES
-#define PHC_SOIL_CLONES_512
-#endif
 
 /* `rows` consecutive full rows (nx voxels each) of a z-plane's water
  * sub-step into `out`.  Every pointer points at the first row's first
