@@ -301,8 +301,12 @@ static result measure(phc_soil *s, int threads)
             goto out;
         tt = fmin(tt, ti);
     }
-    double per_step = (tt - ov) / (double)trial;
-    size_t steps = (size_t)ceil((TARGET_SECONDS - ov) / (per_step > 0 ? per_step : 1e-6));
+    /* the trial's time per step with the per-call work shared out: with
+       other processes on the CPUs, a zero-length run (ov) was once slower
+       than the trial itself, and (tt - ov) / trial, negative, asked for a
+       million steps per timing */
+    double per_step = tt / (double)trial;
+    size_t steps = (size_t)ceil(TARGET_SECONDS / (per_step > 0 ? per_step : 1e-6));
     if (steps < 10)
         steps = 10;
     double t[REPEAT];
