@@ -290,17 +290,18 @@ static result measure(phc_soil *s, int threads)
         if (t < ov)
             ov = t;
     }
-    /* the trial twice, the second warm: with 8 sub-steps per sweep at 128^3
-       a first trial of 4 steps (one sweep) took 3-4 times the time per step
-       of the timings, which then lasted 0.1 s instead of 1 s */
-    size_t trial = n >= (size_t)1 << 21 ? 16 : 40;
-    double tt = INFINITY;
-    for (int i = 0; i < 2; ++i) {
-        double ti = timed_run(s, w0, v0, trial);
-        if (isnan(ti))
-            goto out;
-        tt = fmin(tt, ti);
-    }
+    /* a short trial, then one of about 0.1 s from its time per step: with 8
+       sub-steps per sweep at 128^3 a lone trial of 4 steps (one sweep,
+       cold) took 3-4 times the time per step of the timings, which then
+       lasted 0.1 s instead of 1 s */
+    size_t trial = n >= (size_t)1 << 21 ? 4 : 20;
+    double tt = timed_run(s, w0, v0, trial);
+    if (isnan(tt))
+        goto out;
+    trial = (size_t)fmax((double)trial, ceil(0.1 / (tt / (double)trial)));
+    tt = timed_run(s, w0, v0, trial);
+    if (isnan(tt))
+        goto out;
     /* the trial's time per step with the per-call work shared out: with
        other processes on the CPUs, a zero-length run (ov) was once slower
        than the trial itself, and (tt - ov) / trial, negative, asked for a
