@@ -290,16 +290,8 @@ static result measure(phc_soil *s, int threads)
         if (t < ov)
             ov = t;
     }
-    /* a short trial, then one of about 0.1 s from its time per step: with 8
-       sub-steps per sweep at 128^3 a lone trial of 4 steps (one sweep,
-       cold) took 3-4 times the time per step of the timings, which then
-       lasted 0.1 s instead of 1 s */
     size_t trial = n >= (size_t)1 << 21 ? 4 : 20;
     double tt = timed_run(s, w0, v0, trial);
-    if (isnan(tt))
-        goto out;
-    trial = (size_t)fmax((double)trial, ceil(0.1 / (tt / (double)trial)));
-    tt = timed_run(s, w0, v0, trial);
     if (isnan(tt))
         goto out;
     /* the trial's time per step with the per-call work shared out: with
@@ -312,9 +304,19 @@ static result measure(phc_soil *s, int threads)
         steps = 10;
     double t[REPEAT];
     cpu_mark m0 = cpu_now();
-    for (int i = 0; i < REPEAT; ++i)
+    /* a first timing shorter than half the target (the trial's steps ran
+       slower than the timings': at 128^3, with 8 sub-steps per sweep, the
+       first steps on a new soil took up to 10 times as long, and timings
+       lasted 0.25 s) sets the step count again and is not kept */
+    for (int i = 0, again = 0; i < REPEAT; ++i) {
         if (isnan(t[i] = timed_run(s, w0, v0, steps)))
             goto out;
+        if (i == 0 && again < 3 && t[0] < 0.5 * TARGET_SECONDS) {
+            steps = (size_t)ceil((double)steps * TARGET_SECONDS / t[0]);
+            ++again;
+            --i;
+        }
+    }
     r.other = other_load(m0, cpu_now());
     qsort(t, REPEAT, sizeof t[0], cmp_double);
     double vox = (double)n * (double)steps;
