@@ -47,7 +47,7 @@
  * alternating runs, load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel
  * updates/s against 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8)
  * and is not built for them.  The loops of the planes swept from w alone
- * (water_row_from_w) stream two fields instead of ten and are bound by
+ * (water_plane_from_w) stream two fields instead of ten and are bound by
  * arithmetic, not by the caches: they have an AVX-512F copy too
  * (PHC_SOIL_CLONES_512; AVX-512F does not bring FMA either).  Measured on
  * the same machine (1 thread, CPU time, 3 alternating runs, the bench
@@ -1091,8 +1091,7 @@ static inline double water_voxel_from_w(double wc, double we, double ww, double 
  * that 0 (a zero of either sign: the sum is the same number; only a voxel
  * whose w is -0 with all its other terms zero could come out +0); the
  * caller keeps i0 .. i1 inside the plane's voxels. */
-PHC_SOIL_CLONES_512
-static void water_row_from_w(size_t i0, size_t i1, const double *restrict wc, const double *restrict wn,
+static inline void water_row_from_w(size_t i0, size_t i1, const double *restrict wc, const double *restrict wn,
                              const double *restrict ws, const double *restrict wu, const double *restrict wd,
                              const double *restrict kx, const double *restrict u, const double *restrict uu,
                              const double *restrict ud, double kyn, double kys, double *restrict gf,
@@ -1116,6 +1115,7 @@ static void water_row_from_w(size_t i0, size_t i1, const double *restrict wc, co
  * south wrapped as the one-voxel stencil has them; the plane's first and
  * last voxel, whose neighbours across the row end lie outside the plane,
  * on their own with the wrapped neighbour. */
+PHC_SOIL_CLONES_512
 static void water_plane_from_w(size_t nx, size_t ny, const double *wc, const double *wu, const double *wd,
                                const double *u, const double *uu, const double *ud, const double *kx,
                                const double *ky, double *gf, double *out, double a, double cd, double cg,
