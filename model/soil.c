@@ -955,6 +955,28 @@ static inline double gravity_face(double lower, double upper, double kz, double 
     return kz > 0 ? 0.5 * (upper + lower) - (up ? 0.5 : lw * kz) * (lower - upper) : 0;
 }
 
+/* The first and last voxel of each of the m / nx rows of water_rows,
+ * computed again with the x neighbour wrapped around the row. */
+static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
+                                  const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                                  const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                                  const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                                  const double *restrict kys, const double *restrict kzc,
+                                  const double *restrict kzd, double *restrict gf, double *restrict out, double cd,
+                                  double cg, double lw, int up)
+{
+    for (size_t row = 0; row < m; row += nx) {
+        const size_t last = row + nx - 1;
+        out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
+                                   nx > 1 ? row + 1 : row, last, cd, cg, lw, up);
+        gf[row] = gravity_face(gc[row], gu[row], kzc[row], lw, up);
+        if (nx > 1) {
+            out[last] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, last, row,
+                                        last - 1, cd, cg, lw, up);
+            gf[last] = gravity_face(gc[last], gu[last], kzc[last], lw, up);
+        }
+    }
+}
 
 /* `rows` consecutive full rows (nx voxels each) of a z-plane's water
  * sub-step into `out`.  Every pointer points at the first row's first
@@ -978,14 +1000,6 @@ static inline double gravity_face(double lower, double upper, double kz, double 
  * flux is computed once per sub-step instead of twice, by the same
  * expression on the same numbers (gravity_face).  The row ends, computed
  * again, take f7 from gd and kzd as water_voxel_pre does. */
-static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
-                                  const double *restrict lc, const double *restrict lu, const double *restrict ln,
-                                  const double *restrict ls, const double *restrict gd, const double *restrict gc,
-                                  const double *restrict gu, const double *restrict kx, const double *restrict ky,
-                                  const double *restrict kys, const double *restrict kzc,
-                                  const double *restrict kzd, double *restrict gf, double *restrict out, double cd,
-                                  double cg, double lw, int up);
-
 PHC_SOIL_CLONES
 static void water_rows(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
                        const double *restrict lc, const double *restrict lu, const double *restrict ln,
@@ -1149,29 +1163,6 @@ static void gravity_faces_from_w(size_t m, const double *restrict lower, const d
 {
     for (size_t q = 0; q < m; ++q)
         gf[q] = gravity_face(apl * lower[q], apu * upper[q], kz, lw, up);
-}
-
-/* The first and last voxel of each of the m / nx rows of water_rows,
- * computed again with the x neighbour wrapped around the row. */
-static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
-                                  const double *restrict lc, const double *restrict lu, const double *restrict ln,
-                                  const double *restrict ls, const double *restrict gd, const double *restrict gc,
-                                  const double *restrict gu, const double *restrict kx, const double *restrict ky,
-                                  const double *restrict kys, const double *restrict kzc,
-                                  const double *restrict kzd, double *restrict gf, double *restrict out, double cd,
-                                  double cg, double lw, int up)
-{
-    for (size_t row = 0; row < m; row += nx) {
-        const size_t last = row + nx - 1;
-        out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
-                                   nx > 1 ? row + 1 : row, last, cd, cg, lw, up);
-        gf[row] = gravity_face(gc[row], gu[row], kzc[row], lw, up);
-        if (nx > 1) {
-            out[last] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, last, row,
-                                        last - 1, cd, cg, lw, up);
-            gf[last] = gravity_face(gc[last], gu[last], kzc[last], lw, up);
-        }
-    }
 }
 
 /* gf = the gravity fluxes through the z faces between two planes (g of

@@ -335,6 +335,16 @@ out:
     return r;
 }
 
+/* The bench soil of N^3 with nutrients or rocks (make_soil) timed with 2
+ * threads into *r; the soil, or NULL when it cannot be built. */
+static phc_soil *measure_variant(size_t N, int nutrients, int rocks, result *r)
+{
+    phc_soil *s = make_soil(N, nutrients, rocks);
+    if (s)
+        *r = measure(s, 2);
+    return s;
+}
+
 /* Copy: elements per second, best of COPY_REPEAT timings of enough copies
  * to take >= 20 ms (a -> b, then b -> a). */
 static double copy_rate(size_t n, int threads)
@@ -600,10 +610,10 @@ int main(void)
     double nut[2];
     for (int g = 0; g < 2; ++g) {
         size_t N = sizes[g];
-        phc_soil *s = make_soil(N, 1, 0);
+        result r;
+        phc_soil *s = measure_variant(N, 1, 0, &r);
         if (!s)
             return 1;
-        result r = measure(s, 2);
         nut[g] = r.best;
         printf("soil_vups_nutrients_%zu_2t: %.4e voxel/s (best of %d; median %.4e; %.0f steps)\n", N,
                r.best, REPEAT, r.median, r.steps);
@@ -619,10 +629,10 @@ int main(void)
     double rock[2];
     for (int g = 0; g < 2; ++g) {
         size_t N = sizes[g];
-        phc_soil *s = make_soil(N, 0, 1);
+        result r;
+        phc_soil *s = measure_variant(N, 0, 1, &r);
         if (!s)
             return 1;
-        result r = measure(s, 2);
         rock[g] = r.best;
         size_t uniform = 0; /* planes of one p and one c */
         for (size_t k = 0; k < N; ++k) {
