@@ -425,12 +425,12 @@ static void test_blocked_vs_steps(void)
        one; planes of one row or one column and of two rows, where every
        voxel is at a row's end or in the first or last row (water_plane
        computes those apart from the rest) */
-    static const struct { int upwind, periodic, yperiodic; size_t nx, ny; int layered; } C[] = {
-        {0, 0, 0, 13, 11, 0}, {1, 0, 0, 13, 11, 0}, {0, 1, 0, 13, 11, 0}, {1, 1, 0, 13, 11, 0},
-        {0, 1, 1, 13, 11, 0}, {0, 0, 1, 1, 9, 0},   {1, 1, 0, 7, 1, 0},   {0, 1, 1, 6, 2, 0},
-        {0, 0, 0, 13, 11, 1}, {1, 0, 0, 13, 11, 1}, {0, 1, 0, 13, 11, 1}, {1, 1, 1, 13, 11, 1},
-        {0, 0, 1, 1, 9, 1},   {0, 1, 1, 6, 3, 1},   {0, 0, 0, 13, 11, 2}, {1, 0, 1, 13, 11, 2},
-        {0, 0, 0, 1, 2, 2}};
+    static const struct { int upwind, periodic, yperiodic; size_t nx, ny; int layered, zperiodic; } C[] = {
+        {0, 0, 0, 13, 11, 0, 0}, {1, 0, 0, 13, 11, 0, 0}, {0, 1, 0, 13, 11, 0, 0}, {1, 1, 0, 13, 11, 0, 0},
+        {0, 1, 1, 13, 11, 0, 0}, {0, 0, 1, 1, 9, 0, 0},   {1, 1, 0, 7, 1, 0, 0},   {0, 1, 1, 6, 2, 0, 0},
+        {0, 0, 0, 13, 11, 1, 0}, {1, 0, 0, 13, 11, 1, 0}, {0, 1, 0, 13, 11, 1, 0}, {1, 1, 1, 13, 11, 1, 0},
+        {0, 0, 1, 1, 9, 1, 0},   {0, 1, 1, 6, 3, 1, 0},   {0, 0, 0, 13, 11, 2, 0}, {1, 0, 1, 13, 11, 2, 0},
+        {0, 0, 0, 1, 2, 2, 0},   {0, 0, 0, 13, 11, 2, 1}, {1, 0, 1, 13, 11, 1, 1}};
     const size_t nz = 40, K = 23;
     int saved = omp_get_max_threads();
     for (size_t c = 0; c < sizeof C / sizeof C[0]; ++c)
@@ -445,6 +445,8 @@ static void test_blocked_vs_steps(void)
                     s[r]->params.boundary[PHC_SOIL_XMIN] = s[r]->params.boundary[PHC_SOIL_XMAX] = PHC_SOIL_PERIODIC;
                 if (C[c].yperiodic)
                     s[r]->params.boundary[PHC_SOIL_YMIN] = s[r]->params.boundary[PHC_SOIL_YMAX] = PHC_SOIL_PERIODIC;
+                if (C[c].zperiodic)
+                    s[r]->params.boundary[PHC_SOIL_ZMIN] = s[r]->params.boundary[PHC_SOIL_ZMAX] = PHC_SOIL_PERIODIC;
                 s[r]->params.substep = 0;
             }
             /* a power of 2 below half the limit: the times k h, and their
@@ -476,7 +478,9 @@ static void test_blocked_vs_steps(void)
                    "one step: bit-identical %s (max |dw| %.1e); vs the plain one-voxel stencil: bit-identical %s "
                    "(max |dw| %.1e); sub-steps %zu vs %zu; largest change of w %.3g\n",
                    C[c].layered == 2 ? " layers only" : C[c].layered ? " layers" : "", nx, ny, nz, C[c].upwind ? ", upwind" : "", C[c].periodic ? ", x periodic" : "",
-                   C[c].yperiodic ? ", y periodic" : "", th,
+                   C[c].yperiodic ? (C[c].zperiodic ? ", y z periodic" : ", y periodic")
+                                  : C[c].zperiodic ? ", z periodic" : "",
+                   th,
                    th > 1 ? "s" : "", K, T, K, same_steps ? "yes" : "NO", d1, same_ref ? "yes" : "NO", d2,
                    s[0]->budget.substeps, s[1]->budget.substeps, moved);
             CHECK(same_steps);
