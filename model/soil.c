@@ -74,8 +74,12 @@ struct phc_soil_work {
     unsigned char *uniform;    /* nz: 1 when plane k has one 1/c, one p and one permeability per
                                   face direction (plane_uniform) */
     double *uniform_of;        /* 5 nz: those values of plane k: 1/c, p, kx, ky, kz */
-    unsigned char *from_w;     /* nz: 1 when plane k and both its neighbours are uniform, x faces closed,
-                                  ny >= 2: its water sub-steps take w alone (water_plane_from_w) */
+    unsigned char *layer;      /* nz: 1 when plane k has one 1/c and p in {0, one value} (plane_layer) */
+    double *layer_of;          /* 4 nz: 1/c, the nonzero p (or 0), harmonic(p, p) and the +z face
+                                  permeability between two such voxels (0 across a closed face) */
+    unsigned char *from_w;     /* nz: 1 when plane k and both its neighbours are uniform, 2 when they are
+                                  layer planes and not all uniform; x faces closed, ny >= 2: its water
+                                  sub-steps take w (and p for 2) alone (water_plane_from_w) */
     unsigned char *fill;       /* nz: 1 when a neighbour or plane k itself is not from_w: the sweep
                                   makes plane k's fill l and g (fill_plane) */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
@@ -129,6 +133,8 @@ static void work_free(phc_soil_work *wk)
     free(wk->uniform);
     free(wk->uniform_of);
     free(wk->from_w);
+    free(wk->layer);
+    free(wk->layer_of);
     free(wk->fill);
     free(wk->top);
     free(wk->damp_x);
@@ -206,13 +212,15 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->uniform = malloc(nz);
     wk->uniform_of = malloc(5 * nz * sizeof(double));
     wk->from_w = malloc(nz);
+    wk->layer = malloc(nz);
+    wk->layer_of = malloc(4 * nz * sizeof(double));
     wk->fill = malloc(nz);
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
     if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane || !wk->plane_at ||
-        !wk->uniform || !wk->uniform_of || !wk->from_w || !wk->fill || !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
+        !wk->uniform || !wk->uniform_of || !wk->from_w || !wk->layer || !wk->layer_of || !wk->fill || !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
     }
@@ -703,6 +711,33 @@ static int plane_uniform(const phc_soil *s, size_t k, double u[5])
     return 1;
 }
 
+/* Whether z-plane k is a layer plane: one 1/c (the bits of the first
+ * voxel's) and p either 0 or one value pu (a layer with rocks,
+ * phc_soil_add_rocks); then u[0] = 1/c, u[1] = pu (0 when the plane is
+ * all rock) and u[2] = harmonic(pu, pu), the permeability of every face
+ * between two of its voxels that are not rock (prepare_fields makes the
+ * faces from the same harmonic on the same numbers, 0 where either voxel
+ * is rock). */
+PHC_SOIL_CLONES_512
+static int plane_layer(const phc_soil *s, size_t k, double u[4])
+{
+    const size_t m = s->nx * s->ny, kq = m * k;
+    const double *restrict p = s->p + kq;
+    double pu = 0;
+    for (size_t q = 0; q < m && pu == 0; ++q)
+        pu = p[q];
+    u[0] = s->work->ic[kq];
+    u[1] = pu;
+    u[2] = harmonic(pu, pu);
+    long bad = 0;
+    for (size_t q = 0; q < m; ++q)
+        bad += p[q] != 0 && p[q] != pu;
+    /* (pu > 0, so p == pu means the same bits; a rock's p may be -0, which
+       every use treats as 0: harmonic, and f_grav p w only across faces
+       with kz > 0) */
+    return bad == 0 && all_bits(s->work->ic + kq, m, u);
+}
+
 /* 1/c and the face permeabilities of one z-plane (c, p, ic, kx, ky, kz
  * at its first voxel; p_up at the first voxel of the plane above,
  * wrapped): the +x faces of a row's last voxel, the +y faces of the last
@@ -745,12 +780,22 @@ static void prepare_fields(phc_soil *s)
         wk->uniform[k] = (unsigned char)plane_uniform(s, k, wk->uniform_of + 5 * k);
     }
     for (size_t k = 0; k < nz; ++k)
-        wk->from_w[k] = !per[0] && ny >= 2 && wk->uniform[k] && wk->uniform[(k + nz - 1) % nz] &&
-                        wk->uniform[(k + 1) % nz];
+        wk->layer[k] = (unsigned char)plane_layer(s, k, wk->layer_of + 4 * k);
+    for (size_t k = 0; k < nz; ++k) {
+        double *lo = wk->layer_of + 4 * k;
+        lo[3] = k + 1 < nz || per[2] ? harmonic(lo[1], wk->layer_of[4 * ((k + 1) % nz) + 1]) : 0;
+    }
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kd = (k + nz - 1) % nz, ku = (k + 1) % nz;
+        const int xy = !per[0] && ny >= 2;
+        wk->from_w[k] = xy && wk->uniform[k] && wk->uniform[kd] && wk->uniform[ku]     ? 1
+                        : xy && wk->layer[k] && wk->layer[kd] && wk->layer[ku] ? 2
+                                                                                : 0;
+    }
     wk->all_from_w = 1;
     for (size_t k = 0; k < nz; ++k) {
         wk->fill[k] = !wk->from_w[k] || !wk->from_w[(k + nz - 1) % nz] || !wk->from_w[(k + 1) % nz];
-        wk->all_from_w &= wk->from_w[k];
+        wk->all_from_w &= wk->from_w[k] != 0;
     }
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
@@ -1155,6 +1200,74 @@ static void water_plane_from_w(size_t nx, size_t ny, const double *wc, const dou
                                     cg, lw, up);
 }
 
+/* The water update of voxel q of a plane swept from w and p
+ * (water_plane_from_w_rocks): wc, wu, wd the planes of w, pc, pu, pd of p
+ * (this plane, above, below); qe, qw, qn, qs the x and y neighbours in
+ * the plane; the face permeabilities are the *_pair values (a layer
+ * plane's, plane_layer, or 0 across a closed face) where both voxels are
+ * not rock and 0 where either is, which are the numbers prepare_fields
+ * makes; f_grav p w is formed as fill_plane forms it.  Then
+ * water_voxel_from_w. */
+static inline double water_voxel_rocks(const double *restrict wc, const double *restrict wu,
+                                       const double *restrict wd, const double *restrict pc,
+                                       const double *restrict pu, const double *restrict pd, size_t q, size_t qe,
+                                       size_t qw, size_t qn, size_t qs, double kxe_pair, double kxw_pair,
+                                       double kyn_pair, double kys_pair, double kzu_pair, double kzd_pair,
+                                       double icc, double icu, double icd, double a, double *gf, double cd,
+                                       double cg, double lw, int up)
+{
+    const double p0 = pc[q];
+    const int in = p0 > 0;
+    const double kxe = in & (pc[qe] > 0) ? kxe_pair : 0, kxw = (pc[qw] > 0) & in ? kxw_pair : 0;
+    const double kyn = in & (pc[qn] > 0) ? kyn_pair : 0, kys = (pc[qs] > 0) & in ? kys_pair : 0;
+    const double kzu = in & (pu[q] > 0) ? kzu_pair : 0, kzd = (pd[q] > 0) & in ? kzd_pair : 0;
+    return water_voxel_from_w(wc[q], wc[qe], wc[qw], wc[qn], wc[qs], wu[q], wd[q], icc, icu, icd, a * p0, a * pu[q],
+                              kxe, kxw, kyn, kys, kzu, kzd, gf + q, cd, cg, lw, up);
+}
+
+/* water_plane_from_w for a plane whose planes k - 1, k, k + 1 are layer
+ * planes (plane_layer: one 1/c, p either 0 or one value; a layer with
+ * rocks), not all uniform: the same sweep, with p read to tell rock from
+ * soil (water_voxel_rocks); the plane's first and last voxel on their
+ * own with the wrapped neighbours.  lc, lu, ld: layer_of of the plane,
+ * the plane above and below; yper: periodic y faces. */
+PHC_SOIL_CLONES_512
+static void water_plane_from_w_rocks(size_t nx, size_t ny, const double *wc, const double *wu, const double *wd,
+                                     const double *pc, const double *pu, const double *pd, const double *lc,
+                                     const double *lu, const double *ld, int yper, double *gf, double *out,
+                                     double a, double cd, double cg, double lw, int up)
+{
+    const double kxy = lc[2], icc = lc[0], icu = lu[0], icd = ld[0], kzu = lc[3], kzd = ld[3];
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t o = nx * j, on = j + 1 < ny ? o + nx : 0, os = j > 0 ? o - nx : nx * (ny - 1);
+        const size_t i0 = j == 0, i1 = j + 1 == ny ? nx - 1 : nx;
+        const double kyn = j + 1 < ny || yper ? kxy : 0, kys = j > 0 || yper ? kxy : 0;
+#pragma omp simd
+        for (size_t i = i0; i < i1; ++i)
+            out[o + i] = water_voxel_rocks(wc, wu, wd, pc, pu, pd, o + i, o + i + 1, o + i - 1, on + i, os + i,
+                                           i + 1 < nx ? kxy : 0, i > 0 ? kxy : 0, kyn, kys, kzu, kzd, icc, icu,
+                                           icd, a, gf, cd, cg, lw, up);
+    }
+    const size_t e0 = nx > 1 ? 1 : 0, L = nx * ny - 1, Lr = nx * (ny - 1), Le = nx > 1 ? L - 1 : L;
+    out[0] = water_voxel_rocks(wc, wu, wd, pc, pu, pd, 0, e0, nx - 1, nx, Lr, nx > 1 ? kxy : 0, 0, kxy,
+                               yper ? kxy : 0, kzu, kzd, icc, icu, icd, a, gf, cd, cg, lw, up);
+    out[L] = water_voxel_rocks(wc, wu, wd, pc, pu, pd, L, Lr, Le, nx - 1, L - nx, 0, nx > 1 ? kxy : 0,
+                               yper ? kxy : 0, kxy, kzu, kzd, icc, icu, icd, a, gf, cd, cg, lw, up);
+}
+
+/* gravity_faces_from_w for a plane of water_plane_from_w_rocks: the face
+ * permeability kz between two voxels that are not rock, 0 where either
+ * is; f_grav p w as fill_plane forms it. */
+PHC_SOIL_CLONES_512
+static void gravity_faces_rocks(size_t m, const double *restrict lower, const double *restrict upper,
+                                const double *restrict pl, const double *restrict pu, double a, double kz, double lw,
+                                int up, double *restrict gf)
+{
+    for (size_t q = 0; q < m; ++q)
+        gf[q] = gravity_face((a * pl[q]) * lower[q], (a * pu[q]) * upper[q], (pl[q] > 0) & (pu[q] > 0) ? kz : 0,
+                             lw, up);
+}
+
 /* gravity_faces of a from_w plane over the plane below, from w: g of
  * each formed as fill_plane forms it. */
 PHC_SOIL_CLONES_512
@@ -1283,6 +1396,7 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
     const int xper = s->params.boundary[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC;
+    const int yper = s->params.boundary[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC;
 #define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
 /* w after sub-step t (0: the state s->w) of plane k */
 #define WPLANE(t, k) ((t) == 0 ? s->w + wrap_plane(k, nz) * P : RING(t, k, 0))
@@ -1300,6 +1414,18 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
             double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
             double *gf = ring + (9 * T + t - 1) * S; /* sub-step t's gravity fluxes through the faces below */
             const double *u = wk->uniform_of + 5 * ik, *ud = wk->uniform_of + 5 * id;
+            if (wk->from_w[ik] == 2) {
+                const size_t iu = wrap_plane(k + 1, nz);
+                if (k == k0 - (long)(T - t))
+                    gravity_faces_rocks(P, WPLANE(t - 1, k - 1), wc, s->p + kd, s->p + kk, a, wk->layer_of[4 * id + 3],
+                                        lw, up, gf);
+                water_plane_from_w_rocks(nx, ny, wc, WPLANE(t - 1, k + 1), WPLANE(t - 1, k - 1), s->p + kk,
+                                         s->p + iu * P, s->p + kd, wk->layer_of + 4 * ik, wk->layer_of + 4 * iu,
+                                         wk->layer_of + 4 * id, yper, gf, out, a, cd, cg, lw, up);
+                if (t < T && wk->fill[ik])
+                    fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
+                continue;
+            }
             if (wk->from_w[ik]) {
                 const double *uu = wk->uniform_of + 5 * wrap_plane(k + 1, nz);
                 if (k == k0 - (long)(T - t))
