@@ -58,9 +58,12 @@
  *
  * Nutrients on (once): the same soil with v = 1 (silt_loam) and 0.5 (clay)
  * units/m^3, 2 threads.  Rocks (once): the same soil with rocks in 10% of
- * the voxels (phc_soil_add_rocks, features of 5 cm), so that no plane is
- * uniform and every plane streams 1/c, p and the face permeabilities:
- * the speed of a soil that is not made of layers, 2 threads.
+ * the voxels (phc_soil_add_rocks, features of 5 cm): no plane is uniform,
+ * every plane is a layer plane (one c, p either 0 or the layer's) and is
+ * swept from w and p (soil.c water_plane_from_w_rocks); and with p varied
+ * by +-25% per voxel too (seeded noise), so that no plane is a layer plane
+ * and every plane streams 1/c, p and the face permeabilities: the speed
+ * of a soil that is not made of layers.  Both with 2 threads.
  *
  * Today's stencil vs the previous one: reference_step below is the
  * stencil as it was before time blocking (one sub-step per sweep, the
@@ -105,7 +108,7 @@
 #define MAX_OTHER_LOAD 0.25  /* CPUs used by others above which 2-thread numbers are void */
 
 /* The benchmark soil (see the header comment); NULL on failure. */
-static phc_soil *make_soil(size_t N, int nutrients, int rocks)
+static phc_soil *make_soil(size_t N, int nutrients, int rocks /* 1: rocks, 2: and p varied */)
 {
     phc_soil *s = phc_soil_new(N, N, N, DX);
     if (!s)
@@ -139,6 +142,10 @@ static phc_soil *make_soil(size_t N, int nutrients, int rocks)
             }
     if (rocks)
         phc_soil_add_rocks(s, 7, 0.05, 0.1);
+    if (rocks > 1) /* p varied by +-25% per voxel (seeded noise): no layer plane */
+        for (size_t q = 0; q < s->n; ++q)
+            s->p[q] *= 0.75 + 0.5 * phc_soil_noise(9, 0.03, (double)(q % N) * DX, (double)(q / N % N) * DX,
+                                                   (double)(q / (N * N)) * DX);
     s->params.f_diff = 1.0;
     s->params.f_grav = 1.0;
     for (int f = 0; f < PHC_SOIL_FACES; ++f)
@@ -624,36 +631,48 @@ int main(void)
         phc_soil_free(s);
     }
 
-    /* rocks (p = 0 in 10% of the voxels, in every plane): no plane is
-       uniform, every plane streams 1/c, p and the face permeabilities */
-    double rock[2];
-    for (int g = 0; g < 2; ++g) {
-        size_t N = sizes[g];
-        result r;
-        phc_soil *s = measure_variant(N, 0, 1, &r);
-        if (!s)
-            return 1;
-        rock[g] = r.best;
-        size_t uniform = 0; /* planes of one p and one c */
-        for (size_t k = 0; k < N; ++k) {
-            size_t q0 = N * N * k, q = q0;
-            while (q < q0 + N * N && s->p[q] == s->p[q0] && s->c[q] == s->c[q0])
-                ++q;
-            uniform += q == q0 + N * N;
+    /* rocks (p = 0 in 10% of the voxels, in every plane): layer planes
+       (one c, p either 0 or the layer's), swept from w and p; then with p
+       varied per voxel: no layer plane, every plane streams 1/c, p and the
+       face permeabilities */
+    double rock[2][2];
+    static const char *variant[2] = {"rocks", "varied"};
+    for (int v = 0; v < 2; ++v)
+        for (int g = 0; g < 2; ++g) {
+            size_t N = sizes[g];
+            result r;
+            phc_soil *s = measure_variant(N, 0, 1 + v, &r);
+            if (!s)
+                return 1;
+            rock[v][g] = r.best;
+            size_t layer = 0; /* planes of one c and p either 0 or one value */
+            for (size_t k = 0; k < N; ++k) {
+                const size_t q0 = N * N * k;
+                double pu = 0;
+                size_t q = q0;
+                while (q < q0 + N * N && s->c[q] == s->c[q0] && (s->p[q] == 0 || pu == 0 || s->p[q] == pu)) {
+                    if (pu == 0)
+                        pu = s->p[q];
+                    ++q;
+                }
+                layer += q == q0 + N * N;
+            }
+            const size_t T = phc_soil_block_steps(s);
+            printf("soil_vups_%s_%zu_2t: %.4e voxel/s (best of %d; median %.4e; %.0f steps; %zu sub-step%s per "
+                   "sweep; 10%% of the voxels rock%s, %zu of %zu planes layer planes)\n", variant[v], N, r.best,
+                   REPEAT, r.median, r.steps, T, T > 1 ? "s" : "", v ? ", p varied by +-25% per voxel" : "", layer,
+                   N);
+            printf("machine_other_load_%s_%zu_2t: %.2f CPUs\n", variant[v], N, r.other);
+            printf("soil_%s_cost_%zu_2t: %.2f x the layered soil's step time\n", variant[v], N, vups[g][1] / r.best);
+            phc_soil_free(s);
         }
-        printf("soil_vups_rocks_%zu_2t: %.4e voxel/s (best of %d; median %.4e; %.0f steps; %zu sub-step%s per "
-               "sweep; 10%% of the voxels rock, %zu of %zu planes uniform)\n", N, r.best, REPEAT, r.median,
-               r.steps, phc_soil_block_steps(s), phc_soil_block_steps(s) > 1 ? "s" : "", uniform, N);
-        printf("machine_other_load_rocks_%zu_2t: %.2f CPUs\n", N, r.other);
-        printf("soil_rock_cost_%zu_2t: %.2f x the layered soil's step time\n", N, vups[g][1] / r.best);
-        phc_soil_free(s);
-    }
 
     printf("---- summary ----\n");
     for (int g = 0; g < 2; ++g) {
         size_t N = sizes[g];
         printf("soil_vups_%zu: %.3e voxel/s (1t), %.3e voxel/s (2t), %.3e voxel/s (2t, nutrients), %.3e voxel/s "
-               "(2t, rocks)\n", N, vups[g][0], vups[g][1], nut[g], rock[g]);
+               "(2t, rocks), %.3e voxel/s (2t, rocks and p varied)\n", N, vups[g][0], vups[g][1], nut[g], rock[0][g],
+               rock[1][g]);
         printf("soil_fraction_of_copy_bw_%zu_2t: %.2f\n", N,
                (vups[g][1] * BYTES_SOIL) / (copy[g][1] * BYTES_COPY_WA));
         printf("soil_speedup_vs_numpy_%zu_2t: %.1f x (peer agrees: %s)\n", N, vups[g][1] / peer_vups[g],
