@@ -1493,8 +1493,9 @@ static void transport_water(phc_soil *s, double h, size_t T)
  * huge pages (same measure, 2 runs each, load average 5.8 on 2 CPUs):
  * 64^3 6.1e8-6.7e8 with 1, 6.2e8-6.5e8 with 2, 5.2e8-5.6e8 with 4;
  * 128^3 4.3e8-4.4e8 with 2, 5.0e8-5.1e8 with 4, 5.3e8 with 6, 5.1e8-5.2e8
- * with 8: the rule stands.  When every plane is swept from w alone
- * (prepare_fields' all_from_w: layers, closed x faces) a sub-step works on
+ * with 8: the rule stands.  When every plane is swept from w (and p)
+ * (prepare_fields' all_from_w: layers, with or without rocks, closed x
+ * faces) a sub-step works on
  * 4 planes of rings (w of three planes and the gravity fluxes) and the
  * sweep on (4 T + 2) planes: 2 sub-steps per sweep where their 10 planes
  * fit in PHC_SOIL_CACHE_BYTES, else PHC_SOIL_BLOCK_STEPS_FROM_W (8).
@@ -1506,7 +1507,10 @@ static void transport_water(phc_soil *s, double h, size_t T)
  * 1.22e9-1.23e9 with 4, 1.27e9-1.52e9 with 6, 1.52e9-1.54e9 with 8,
  * 1.55e9-1.56e9 with 16 (2 threads: 2.37e9-2.42e9 with 4, 2.36e9-2.79e9
  * with 6, 1.6e9-2.83e9 with 8, 2.73e9-2.77e9 with 12, 2.57e9-2.63e9 with
- * 16).  At
+ * 16).  With 10% rocks (layer planes swept from w and p, 1 thread, 2
+ * runs): 64^3 1.25e9-1.28e9 with 1, 1.22e9-1.24e9 with 2, 1.21e9-1.23e9
+ * with 4; 128^3 7.1e8-7.2e8 with 2, 8.4e8-8.5e8 with 4, 9.9e8-1.02e9 with
+ * 8.  At
  * most nz / 8 either way (the planes each thread recomputes next to its
  * range grow with T) and at least 1.  The numbers do not depend on T.
  * Needs prepare_fields. */
