@@ -1385,7 +1385,11 @@ static size_t wrap_plane(long k, long nz)
  * permeabilities, 1/c and p stream from memory once per
  * T sub-steps instead of once per sub-step.  (Outside the box the planes
  * wrap around as the one-step stencil does: across a closed z face the
- * face permeability is 0 and the wrapped values are multiplied by it.) */
+ * face permeability is 0 and the wrapped values are multiplied by it.)
+ * Planes swept from w (prepare_fields' from_w: 1 uniform, 2 layer planes
+ * with rocks) read w (and p) of the ring's or the state's planes and no
+ * fill; a plane's fill is made only where it or a neighbour is not swept
+ * so (prepare_fields' fill). */
 static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1, double *ring)
 {
     const phc_soil_work *wk = s->work;
