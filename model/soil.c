@@ -26,11 +26,39 @@
 #ifndef PHC_SOIL_BLOCK_STEPS
 #define PHC_SOIL_BLOCK_STEPS 4
 #endif
+/* The same when every plane is swept from w alone (block_levels). */
+#ifndef PHC_SOIL_BLOCK_STEPS_FROM_W
+#define PHC_SOIL_BLOCK_STEPS_FROM_W 8
+#endif
 
 /* The bytes of cache a sweep's planes should fit in (block_levels): 3/4 of
  * the 1 MiB L2 cache per core of the machine the bench runs on. */
 #ifndef PHC_SOIL_CACHE_BYTES
 #define PHC_SOIL_CACHE_BYTES (768.0 * 1024.0)
+#endif
+
+/* GCC function multiversioning for the water sweep's row loops: the build
+ * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
+ * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
+ * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
+ * a * b + c, so both copies round every operation alike: the same numbers
+ * to the last bit.  An AVX-512F copy (8 doubles) of these loops measured
+ * the same as AVX2 on the bench's machine (AMD EPYC, 1 thread, CPU time, 3
+ * alternating runs, load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel
+ * updates/s against 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8)
+ * and is not built for them.  The loops of the planes swept from w alone
+ * (water_plane_from_w) stream two fields instead of ten and are bound by
+ * arithmetic, not by the caches: they have an AVX-512F copy too
+ * (PHC_SOIL_CLONES_512; AVX-512F does not bring FMA either).  Measured on
+ * the same machine (1 thread, CPU time, 3 alternating runs, the bench
+ * soil): 64^3 1.84e9-1.93e9 voxel updates/s against 1.05e9-1.09e9 with
+ * AVX2, 128^3 1.20e9-1.24e9 against 8.8e8-9.0e8. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
+#define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
+#define PHC_SOIL_CLONES_512 __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define PHC_SOIL_CLONES
+#define PHC_SOIL_CLONES_512
 #endif
 
 struct phc_soil_work {
@@ -43,6 +71,17 @@ struct phc_soil_work {
     size_t ring_per_thread, ring_threads;
     double *plane;             /* nz partial sums (or minima) */
     size_t *plane_at;          /* nz: the voxel of each plane's minimum (stable_dt_prepared) */
+    unsigned char *uniform;    /* nz: 1 when plane k has one 1/c, one p and one permeability per
+                                  face direction (plane_uniform) */
+    double *uniform_of;        /* 5 nz: those values of plane k: 1/c, p, kx, ky, kz */
+    unsigned char *layer;      /* nz: 1 when plane k has one 1/c and p in {0, one value} (plane_layer) */
+    double *layer_of;          /* 4 nz: 1/c, the nonzero p (or 0), harmonic(p, p) and the +z face
+                                  permeability between two such voxels (0 across a closed face) */
+    unsigned char *from_w;     /* nz: 1 when plane k and both its neighbours are uniform, 2 when they are
+                                  layer planes and not all uniform; x faces closed, ny >= 2: its water
+                                  sub-steps take w (and p for 2) alone (water_plane_from_w) */
+    unsigned char *fill;       /* nz: 1 when a neighbour or plane k itself is not from_w: the sweep
+                                  makes plane k's fill l and g (fill_plane) */
     long *top;                 /* nx ny: highest permeable k of each column, -1 none */
     double *damp_x, *damp_y, *damp_z; /* absorbing factor per index at the current h */
     double damp_h;             /* h the damping factors were raised for */
@@ -50,6 +89,7 @@ struct phc_soil_work {
     double *src_w;             /* per source: normalised weights over its voxels */
     size_t *src_idx, *src_first, src_total;
     int nutrients;             /* 1 when nutrients move */
+    int all_from_w;            /* 1 when every plane is from_w */
 };
 
 static size_t idx3(const phc_soil *s, size_t i, size_t j, size_t k)
@@ -90,6 +130,12 @@ static void work_free(phc_soil_work *wk)
     free(wk->ring);
     free(wk->plane);
     free(wk->plane_at);
+    free(wk->uniform);
+    free(wk->uniform_of);
+    free(wk->from_w);
+    free(wk->layer);
+    free(wk->layer_of);
+    free(wk->fill);
     free(wk->top);
     free(wk->damp_x);
     free(wk->damp_y);
@@ -163,12 +209,18 @@ phc_soil *phc_soil_new(size_t nx, size_t ny, size_t nz, double dx)
     wk->kz = field_alloc(n, 0);
     wk->plane = malloc(nz * sizeof(double));
     wk->plane_at = malloc(nz * sizeof(size_t));
+    wk->uniform = malloc(nz);
+    wk->uniform_of = malloc(5 * nz * sizeof(double));
+    wk->from_w = malloc(nz);
+    wk->layer = malloc(nz);
+    wk->layer_of = malloc(4 * nz * sizeof(double));
+    wk->fill = malloc(nz);
     wk->top = malloc(nx * ny * sizeof(long));
     wk->damp_x = malloc(nx * sizeof(double));
     wk->damp_y = malloc(ny * sizeof(double));
     wk->damp_z = malloc(nz * sizeof(double));
     if (!wk->w_new || !wk->v_new || !wk->ic || !wk->kx || !wk->ky || !wk->kz || !wk->plane || !wk->plane_at ||
-        !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
+        !wk->uniform || !wk->uniform_of || !wk->from_w || !wk->layer || !wk->layer_of || !wk->fill || !wk->top || !wk->damp_x || !wk->damp_y || !wk->damp_z) {
         phc_soil_free(s);
         return NULL;
     }
@@ -511,6 +563,35 @@ static double overlap(double a, double b, double c, double d)
 
 /* ---- checks and set-up ------------------------------------------------- */
 
+/* 1 when every voxel passes check_impl's tests (c finite and > 0, p
+ * finite and >= 0, w and v finite, and >= 0 when `strict`): one pass
+ * without branches per plane, so that it vectorises; check_impl looks for
+ * the voxel to name only when one fails.  (x - x is 0 for finite x and NaN
+ * for an infinity or NaN, so x - x == 0 tests finiteness.) */
+PHC_SOIL_CLONES_512
+static int plane_valid(size_t m, const double *restrict c, const double *restrict p, const double *restrict w,
+                       const double *restrict v, int strict)
+{
+    /* w and v compared with 0 only when strict: lo = -inf accepts any
+       finite value */
+    const double lo = strict ? 0.0 : -INFINITY;
+    long bad = 0;
+    for (size_t q = 0; q < m; ++q)
+        bad += !(c[q] > 0) | !(c[q] - c[q] == 0) | !(p[q] >= 0) | !(p[q] - p[q] == 0) | !(w[q] - w[q] == 0) |
+               !(v[q] - v[q] == 0) | !(w[q] >= lo) | !(v[q] >= lo);
+    return bad == 0;
+}
+
+static int fields_valid(const phc_soil *s, int strict)
+{
+    const size_t plane = s->nx * s->ny;
+    int bad = 0;
+#pragma omp parallel for schedule(static) reduction(| : bad) if (s->n >= PHC_SOIL_PARALLEL_MIN)
+    for (size_t k = 0; k < s->nz; ++k)
+        bad |= !plane_valid(plane, s->c + plane * k, s->p + plane * k, s->w + plane * k, s->v + plane * k, strict);
+    return !bad;
+}
+
 static int check_impl(const phc_soil *s, int strict, phc_error *err)
 {
     const phc_soil_params *pr = &s->params;
@@ -543,6 +624,8 @@ static int check_impl(const phc_soil *s, int strict, phc_error *err)
         if ((pr->boundary[2 * a] == PHC_SOIL_PERIODIC) != (pr->boundary[2 * a + 1] == PHC_SOIL_PERIODIC))
             return phc_error_set(err, PHC_ERR_INPUT, "soil: periodic boundaries come in pairs: both %c faces "
                                  "or neither", axis[a]);
+    if (fields_valid(s, strict))
+        return PHC_OK;
     for (size_t k = 0; k < s->nz; ++k)
         for (size_t j = 0; j < s->ny; ++j)
             for (size_t i = 0; i < s->nx; ++i) {
@@ -587,6 +670,99 @@ static void face_permeabilities(size_t m, const double *restrict a, const double
             k[i] = 0;
 }
 
+/* 1 when the doubles a[0..m) all have the bits of *v (m = 0: yes); one
+ * pass without branches, so that it vectorises. */
+static inline int all_bits(const double *restrict a, size_t m, const double *restrict v)
+{
+    uint64_t x, diff = 0;
+    memcpy(&x, v, sizeof x);
+    for (size_t i = 0; i < m; ++i) {
+        uint64_t y;
+        memcpy(&y, a + i, sizeof y);
+        diff |= y ^ x;
+    }
+    return diff == 0;
+}
+
+/* Whether z-plane k (its 1/c, p and face permeabilities prepared) is
+ * uniform: one 1/c and one p over the plane, one kx over the faces
+ * inside its rows (not the +x face of a row's last voxel), one ky over
+ * the faces between its rows (not the +y faces of the last row) and one
+ * kz over the plane; those values in u (1/c, p, kx, ky, kz).  A soil made
+ * of horizontal layers (phc_soil_set_layers) has only uniform planes; the
+ * water sweep then takes these five numbers instead of streaming five
+ * planes of them (water_rows_uniform). */
+PHC_SOIL_CLONES_512
+static int plane_uniform(const phc_soil *s, size_t k, double u[5])
+{
+    const phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, kq = nx * ny * k;
+    u[0] = wk->ic[kq];
+    u[1] = s->p[kq];
+    u[2] = wk->kx[kq];
+    u[3] = wk->ky[kq];
+    u[4] = wk->kz[kq];
+    if (!all_bits(wk->ic + kq, nx * ny, u) || !all_bits(s->p + kq, nx * ny, u + 1) ||
+        !all_bits(wk->kz + kq, nx * ny, u + 4) || !all_bits(wk->ky + kq, nx * (ny - 1), u + 3))
+        return 0;
+    for (size_t j = 0; j < ny; ++j)
+        if (!all_bits(wk->kx + kq + nx * j, nx - 1, u + 2))
+            return 0;
+    return 1;
+}
+
+/* Whether z-plane k is a layer plane: one 1/c (the bits of the first
+ * voxel's) and p either 0 or one value pu (a layer with rocks,
+ * phc_soil_add_rocks); then u[0] = 1/c, u[1] = pu (0 when the plane is
+ * all rock) and u[2] = harmonic(pu, pu), the permeability of every face
+ * between two of its voxels that are not rock (prepare_fields makes the
+ * faces from the same harmonic on the same numbers, 0 where either voxel
+ * is rock). */
+PHC_SOIL_CLONES_512
+static int plane_layer(const phc_soil *s, size_t k, double u[4])
+{
+    const size_t m = s->nx * s->ny, kq = m * k;
+    const double *restrict p = s->p + kq;
+    double pu = 0;
+    for (size_t q = 0; q < m && pu == 0; ++q)
+        pu = p[q];
+    u[0] = s->work->ic[kq];
+    u[1] = pu;
+    u[2] = harmonic(pu, pu);
+    long bad = 0;
+    for (size_t q = 0; q < m; ++q)
+        bad += p[q] != 0 && p[q] != pu;
+    /* (pu > 0, so p == pu means the same bits; a rock's p may be -0, which
+       every use treats as 0: harmonic, and f_grav p w only across faces
+       with kz > 0) */
+    return bad == 0 && all_bits(s->work->ic + kq, m, u);
+}
+
+/* 1/c and the face permeabilities of one z-plane (c, p, ic, kx, ky, kz
+ * at its first voxel; p_up at the first voxel of the plane above,
+ * wrapped): the +x faces of a row's last voxel, the +y faces of the last
+ * row and the +z faces lead to the first voxel, row or plane (wrapped) and
+ * are 0 unless that axis is periodic (xper, yper) or the z face open
+ * (zopen).  By rows and planes, so that the divisions vectorise; with an
+ * AVX-512F copy (PHC_SOIL_CLONES_512: run_call overhead, see
+ * stable_dt_prepared). */
+PHC_SOIL_CLONES_512
+static void plane_fields(size_t nx, size_t ny, const double *restrict c, const double *restrict p,
+                         const double *restrict p_up, int xper, int yper, int zopen, double *restrict ic,
+                         double *restrict kx, double *restrict ky, double *restrict kz)
+{
+    const size_t plane = nx * ny;
+    for (size_t q = 0; q < plane; ++q)
+        ic[q] = 1.0 / c[q];
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t r = nx * j, last = r + nx - 1;
+        face_permeabilities(nx - 1, p + r, p + r + 1, 1, kx + r);
+        kx[last] = xper ? harmonic(p[last], p[r]) : 0;
+        face_permeabilities(nx, p + r, p + (j + 1 < ny ? r + nx : 0), j + 1 < ny || yper, ky + r);
+    }
+    face_permeabilities(plane, p, p_up, zopen, kz);
+}
+
 /* 1/c, face permeabilities, surface voxels of every column. */
 static void prepare_fields(phc_soil *s)
 {
@@ -595,24 +771,31 @@ static void prepare_fields(phc_soil *s)
     const phc_soil_boundary *b = s->params.boundary;
     int per[3] = {b[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC, b[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC,
                   b[PHC_SOIL_ZMIN] == PHC_SOIL_PERIODIC};
-    /* by rows and planes, so that the divisions vectorise: the +x face of a
-       row's last voxel, the +y faces of a plane's last row and the +z faces
-       of the top plane lead to the first voxel, row or plane (wrapped), and
-       are 0 unless that axis is periodic */
     const double *p = s->p;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
     for (size_t k = 0; k < nz; ++k) {
         const size_t kq = plane * k;
-        for (size_t q = kq; q < kq + plane; ++q)
-            wk->ic[q] = 1.0 / s->c[q];
-        for (size_t j = 0; j < ny; ++j) {
-            const size_t r = kq + nx * j, last = r + nx - 1;
-            face_permeabilities(nx - 1, p + r, p + r + 1, 1, wk->kx + r);
-            wk->kx[last] = per[0] ? harmonic(p[last], p[r]) : 0;
-            face_permeabilities(nx, p + r, p + (j + 1 < ny ? r + nx : kq), j + 1 < ny || per[1], wk->ky + r);
-        }
-        face_permeabilities(plane, p + kq, p + (k + 1 < nz ? kq + plane : 0), k + 1 < nz || per[2],
-                            wk->kz + kq);
+        plane_fields(nx, ny, s->c + kq, p + kq, p + (k + 1 < nz ? kq + plane : 0), per[0], per[1],
+                     k + 1 < nz || per[2], wk->ic + kq, wk->kx + kq, wk->ky + kq, wk->kz + kq);
+        wk->uniform[k] = (unsigned char)plane_uniform(s, k, wk->uniform_of + 5 * k);
+    }
+    for (size_t k = 0; k < nz; ++k)
+        wk->layer[k] = (unsigned char)plane_layer(s, k, wk->layer_of + 4 * k);
+    for (size_t k = 0; k < nz; ++k) {
+        double *lo = wk->layer_of + 4 * k;
+        lo[3] = k + 1 < nz || per[2] ? harmonic(lo[1], wk->layer_of[4 * ((k + 1) % nz) + 1]) : 0;
+    }
+    for (size_t k = 0; k < nz; ++k) {
+        const size_t kd = (k + nz - 1) % nz, ku = (k + 1) % nz;
+        const int xy = !per[0] && ny >= 2;
+        wk->from_w[k] = xy && wk->uniform[k] && wk->uniform[kd] && wk->uniform[ku]     ? 1
+                        : xy && wk->layer[k] && wk->layer[kd] && wk->layer[ku] ? 2
+                                                                                : 0;
+    }
+    wk->all_from_w = 1;
+    for (size_t k = 0; k < nz; ++k) {
+        wk->fill[k] = !wk->from_w[k] || !wk->from_w[(k + nz - 1) % nz] || !wk->from_w[(k + 1) % nz];
+        wk->all_from_w &= wk->from_w[k] != 0;
     }
     for (size_t q = 0; q < plane; ++q) {
         long top = -1;
@@ -634,45 +817,78 @@ static void prepare_fields(phc_soil *s)
     wk->damp_h = -1;
 }
 
-/* The stability limit from the prepared face permeabilities and 1/c:
- * for every permeable voxel the positive root of a h^2 + b h = 1 with
- * b = f_diff (sum of its faces' p_f) / (c dx^2), a = (f_grav p / dx)^2
- * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux. */
+/* The stability limit of voxel q (p its permeability, ic its 1/c, sum
+ * the sum of its six faces' permeabilities): the positive root of
+ * a h^2 + b h = 1 with b = f_diff sum / (c dx^2), a = (f_grav p / dx)^2
+ * (Lax-Wendroff), or 1 / (b + f_grav p / dx) with the upwind flux; +inf
+ * where p = 0 or nothing moves. */
+static inline double voxel_stable_dt(double p, double ic, double sum, double fd, double fg, double dx, double dx2,
+                                     int up)
+{
+    const double bb = fd * sum * ic / dx2;
+    const double g = fg * p / dx, a = g * g;
+    const double h = up ? ((g > 0 || bb > 0) ? 1.0 / (bb + g) : INFINITY)
+                        : ((a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY);
+    return p > 0 ? h : INFINITY;
+}
+
+/* The smallest stability limit of z-plane k and its first voxel (*at):
+ * the limits of up to 256 voxels of a row at a time into a buffer, in a
+ * loop that vectorises (the first voxel of a row, whose -x neighbour
+ * wraps, on its own), then the first smallest.  The -x, -y, -z faces are
+ * the +faces of the wrapped neighbours (0 across closed box faces).  With
+ * an AVX-512F copy: 128^3 bench soil, a zero-length phc_soil_run (set-up:
+ * check, plane_fields, this) 1 thread, best of 5: see README. */
+PHC_SOIL_CLONES_512
+static double plane_stable_dt(const phc_soil *s, size_t k, size_t *at)
+{
+    double h[256];
+    const phc_soil_work *wk = s->work;
+    const size_t nx = s->nx, ny = s->ny, plane = nx * ny, kq = plane * k;
+    const double *restrict kx = wk->kx, *restrict ky = wk->ky, *restrict kz = wk->kz, *restrict ic = wk->ic,
+                           *restrict p = s->p;
+    const double fd = s->params.f_diff, fg = s->params.f_grav, dx = s->dx, dx2 = dx * dx;
+    const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
+    double best = INFINITY;
+    *at = kq;
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t r = kq + nx * j, rs = j > 0 ? r - nx : r + plane - nx;
+        const size_t rd = k > 0 ? r - plane : r + s->n - plane;
+        for (size_t i0 = 0; i0 < nx; i0 += 256) {
+            const size_t i1 = nx - i0 < 256 ? nx : i0 + 256;
+            size_t i = i0;
+            if (i0 == 0) {
+                h[0] = voxel_stable_dt(p[r], ic[r], kx[r] + kx[r + nx - 1] + ky[r] + ky[rs] + kz[r] + kz[rd], fd, fg,
+                                       dx, dx2, up);
+                i = 1;
+            }
+#pragma omp simd
+            for (size_t e = i; e < i1; ++e)
+                h[e - i0] = voxel_stable_dt(p[r + e], ic[r + e],
+                                            kx[r + e] + kx[r + e - 1] + ky[r + e] + ky[rs + e] + kz[r + e] +
+                                                kz[rd + e],
+                                            fd, fg, dx, dx2, up);
+            for (size_t e = i0; e < i1; ++e)
+                if (h[e - i0] < best) {
+                    best = h[e - i0];
+                    *at = r + e;
+                }
+        }
+    }
+    return best;
+}
+
+/* The stability limit from the prepared face permeabilities and 1/c
+ * (voxel_stable_dt), and the voxel that sets it: the smallest limit of
+ * each z-plane and its first voxel, in parallel; then the first plane
+ * holding the smallest: the voxel a scan in index order finds. */
 static double stable_dt_prepared(const phc_soil *s, size_t *voxel)
 {
     phc_soil_work *wk = s->work;
-    const size_t nx = s->nx, ny = s->ny, nz = s->nz, plane = nx * ny;
-    const double dx2 = s->dx * s->dx;
-    /* the smallest limit of each z-plane and its first voxel, in parallel;
-       then the first plane holding the smallest: the voxel a scan in index
-       order finds */
+    const size_t nz = s->nz;
 #pragma omp parallel for schedule(static) if (s->n >= PHC_SOIL_PARALLEL_MIN)
-    for (size_t k = 0; k < nz; ++k) {
-        double best = INFINITY;
-        size_t at = 0;
-        for (size_t j = 0; j < ny; ++j)
-            for (size_t i = 0; i < nx; ++i) {
-                size_t q = idx3(s, i, j, k);
-                if (!(s->p[q] > 0))
-                    continue;
-                /* the -x, -y, -z faces are the +faces of the wrapped neighbours
-                   (0 across closed box faces) */
-                size_t qw = i > 0 ? q - 1 : q + nx - 1, qs = j > 0 ? q - nx : q + plane - nx;
-                size_t qd = k > 0 ? q - plane : q + s->n - plane;
-                double sum = wk->kx[q] + wk->kx[qw] + wk->ky[q] + wk->ky[qs] + wk->kz[q] + wk->kz[qd];
-                double bb = s->params.f_diff * sum * wk->ic[q] / dx2;
-                double g = s->params.f_grav * s->p[q] / s->dx, a = g * g;
-                double h = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND
-                               ? ((g > 0 || bb > 0) ? 1.0 / (bb + g) : INFINITY)
-                               : ((a > 0 || bb > 0) ? 2.0 / (bb + sqrt(bb * bb + 4 * a)) : INFINITY);
-                if (h < best) {
-                    best = h;
-                    at = q;
-                }
-            }
-        wk->plane[k] = best;
-        wk->plane_at[k] = at;
-    }
+    for (size_t k = 0; k < nz; ++k)
+        wk->plane[k] = plane_stable_dt(s, k, &wk->plane_at[k]);
     double best = INFINITY;
     size_t at = 0;
     for (size_t k = 0; k < nz; ++k)
@@ -784,20 +1000,28 @@ static inline double gravity_face(double lower, double upper, double kz, double 
     return kz > 0 ? 0.5 * (upper + lower) - (up ? 0.5 : lw * kz) * (lower - upper) : 0;
 }
 
-/* GCC function multiversioning for the water sweep's row loops: the build
- * targets baseline x86-64 (SSE2, 2 doubles per instruction); on x86-64 an
- * AVX2 copy (4 doubles) is compiled beside it and chosen at load time by
- * the CPU.  AVX2 does not imply FMA and the C11 build does not contract
- * a * b + c, so both copies round every operation alike: the same numbers
- * to the last bit.  An AVX-512F copy (8 doubles) measured the same as AVX2
- * on the bench's machine (AMD EPYC, 1 thread, CPU time, 3 alternating runs,
- * load average 5.9 on 2 CPUs: 64^3 5.2e8-6.0e8 voxel updates/s against
- * 5.3e8-6.5e8, 128^3 4.7e8-4.8e8 against 4.6e8-4.9e8) and is not built. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(PHC_SOIL_NO_CLONES)
-#define PHC_SOIL_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define PHC_SOIL_CLONES
-#endif
+/* The first and last voxel of each of the m / nx rows of water_rows,
+ * computed again with the x neighbour wrapped around the row. */
+static inline void water_row_ends(size_t nx, size_t m, const double *restrict wc, const double *restrict ld,
+                                  const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                                  const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                                  const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                                  const double *restrict kys, const double *restrict kzc,
+                                  const double *restrict kzd, double *restrict gf, double *restrict out, double cd,
+                                  double cg, double lw, int up)
+{
+    for (size_t row = 0; row < m; row += nx) {
+        const size_t last = row + nx - 1;
+        out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
+                                   nx > 1 ? row + 1 : row, last, cd, cg, lw, up);
+        gf[row] = gravity_face(gc[row], gu[row], kzc[row], lw, up);
+        if (nx > 1) {
+            out[last] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, last, row,
+                                        last - 1, cd, cg, lw, up);
+            gf[last] = gravity_face(gc[last], gu[last], kzc[last], lw, up);
+        }
+    }
+}
 
 /* `rows` consecutive full rows (nx voxels each) of a z-plane's water
  * sub-step into `out`.  Every pointer points at the first row's first
@@ -837,17 +1061,221 @@ static void water_rows(size_t nx, size_t rows, const double *restrict wc, const 
         out[r] = water_voxel_faces(wc, ld, lc, lu, ln, ls, kx, ky, kys, kzc, kzd, r, r + 1, r - 1, cd, cg, f6, gf[r]);
         gf[r] = f6;
     }
-    for (size_t row = 0; row < m; row += nx) {
-        const size_t last = row + nx - 1;
-        out[row] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, row,
-                                   nx > 1 ? row + 1 : row, last, cd, cg, lw, up);
-        gf[row] = gravity_face(gc[row], gu[row], kzc[row], lw, up);
-        if (nx > 1) {
-            out[last] = water_voxel_pre(wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, last, row,
-                                        last - 1, cd, cg, lw, up);
-            gf[last] = gravity_face(gc[last], gu[last], kzc[last], lw, up);
+    water_row_ends(nx, m, wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, gf, out, cd, cg, lw, up);
+}
+
+/* water_rows for `rows` (>= 1) inner rows of a uniform plane
+ * (plane_uniform) over a uniform plane: the face permeabilities are the
+ * numbers kyu, kzu (the plane's) and kzdu (the plane below's) instead of
+ * arrays, the same numbers, so the same results, with five streams fewer.
+ * Along x, every row of the plane has the faces of the first row given
+ * (kx): kx[i] to the east neighbour, kx[i - 1] to the west one (kx[-1],
+ * the previous row's last face, is the face across the row's ends).  With
+ * closed x faces (not `xper`) that face is 0, and the loop, row by row,
+ * gives a row's first and last voxel their values without computing them
+ * again: the neighbour across the row end (the previous or next row's
+ * voxel instead of the wrapped one) is multiplied by 0.  (The term is then
+ * a zero of either sign, and the sum the same number; only a voxel whose
+ * w is -0 with all its other terms zero could come out +0 instead.)  With
+ * periodic x faces the rows run as one loop with kxu, and the row ends are
+ * computed again with the wrapped neighbour, as in water_rows. */
+PHC_SOIL_CLONES
+static void water_rows_uniform(size_t nx, size_t rows, const double *restrict wc, const double *restrict ld,
+                               const double *restrict lc, const double *restrict lu, const double *restrict ln,
+                               const double *restrict ls, const double *restrict gd, const double *restrict gc,
+                               const double *restrict gu, const double *restrict kx, const double *restrict ky,
+                               const double *restrict kys, const double *restrict kzc, const double *restrict kzd,
+                               double kxu, double kyu, double kzu, double kzdu, double *restrict gf,
+                               double *restrict out, double cd, double cg, double lw, int up, int xper)
+{
+    const size_t m = nx * rows;
+    if (!xper) {
+        for (size_t row = 0; row < m; row += nx) {
+#pragma omp simd
+            for (size_t i = 0; i < nx; ++i) {
+                const size_t r = row + i;
+                const double l0 = lc[r];
+                const double f0 = kx[i] * (lc[r + 1] - l0), f1 = kx[i - 1] * (lc[r - 1] - l0);
+                const double f2 = kyu * (ln[r] - l0), f3 = kyu * (ls[r] - l0);
+                const double f4 = kzu * (lu[r] - l0), f5 = kzdu * (ld[r] - l0);
+                const double f6 = gravity_face(gc[r], gu[r], kzu, lw, up);
+                out[r] = wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - gf[r]);
+                gf[r] = f6;
+            }
         }
+        return;
     }
+#pragma omp simd
+    for (size_t r = 0; r < m; ++r) {
+        const double l0 = lc[r];
+        const double f0 = kxu * (lc[r + 1] - l0), f1 = kxu * (lc[r - 1] - l0);
+        const double f2 = kyu * (ln[r] - l0), f3 = kyu * (ls[r] - l0);
+        const double f4 = kzu * (lu[r] - l0), f5 = kzdu * (ld[r] - l0);
+        const double f6 = gravity_face(gc[r], gu[r], kzu, lw, up);
+        out[r] = wc[r] + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - gf[r]);
+        gf[r] = f6;
+    }
+    water_row_ends(nx, m, wc, ld, lc, lu, ln, ls, gd, gc, gu, kx, ky, kys, kzc, kzd, gf, out, cd, cg, lw, up);
+}
+
+/* The water update of a voxel of a from_w plane (see water_plane_from_w)
+ * from w: wc, we, ww, wn, ws its own and its east, west, north and south
+ * neighbours' (in the plane, of 1/c icc), wu and wd above and below (1/c
+ * icu, icd), apc and apu f_grav p of the plane and the plane above; kxe,
+ * kxw, kyn, kys, kzu, kzd the face permeabilities; gf the gravity flux
+ * through the bottom face on entry, through the top face on return.  The
+ * fill l = w/c and g = f_grav p w are the products fill_plane forms, and
+ * the rest is water_voxel_faces: the same numbers. */
+static inline double water_voxel_from_w(double wc, double we, double ww, double wn, double ws, double wu,
+                                        double wd, double icc, double icu, double icd, double apc, double apu,
+                                        double kxe, double kxw, double kyn, double kys, double kzu, double kzd,
+                                        double *gf, double cd, double cg, double lw, int up)
+{
+    const double l0 = wc * icc;
+    const double f0 = kxe * (we * icc - l0), f1 = kxw * (ww * icc - l0);
+    const double f2 = kyn * (wn * icc - l0), f3 = kys * (ws * icc - l0);
+    const double f4 = kzu * (wu * icu - l0), f5 = kzd * (wd * icd - l0);
+    const double f6 = gravity_face(apc * wc, apu * wu, kzu, lw, up);
+    const double r = wc + cd * (f0 + f1 + f2 + f3 + f4 + f5) + cg * (f6 - *gf);
+    *gf = f6;
+    return r;
+}
+
+/* Voxels i0 .. i1 - 1 of a row of a from_w plane (water_voxel_from_w):
+ * pointers at the row's first voxel (wn, ws: the rows north and south,
+ * wrapped around the plane), kx the x faces of the plane's second row
+ * (kx[i] east of voxel i; kx[i - 1] west, kx[-1] across the row's ends,
+ * 0 as x faces are closed).  A voxel at a row end reads the voxel across
+ * the row end, in the previous or next row, and multiplies its term by
+ * that 0 (a zero of either sign: the sum is the same number; only a voxel
+ * whose w is -0 with all its other terms zero could come out +0); the
+ * caller keeps i0 .. i1 inside the plane's voxels. */
+static inline void water_row_from_w(size_t i0, size_t i1, const double *restrict wc, const double *restrict wn,
+                             const double *restrict ws, const double *restrict wu, const double *restrict wd,
+                             const double *restrict kx, const double *restrict u, const double *restrict uu,
+                             const double *restrict ud, double kyn, double kys, double *restrict gf,
+                             double *restrict out, double a, double cd, double cg, double lw, int up)
+{
+    const double icc = u[0], icu = uu[0], icd = ud[0], apc = a * u[1], apu = a * uu[1], kzu = u[4], kzd = ud[4];
+#pragma omp simd
+    for (size_t i = i0; i < i1; ++i)
+        out[i] = water_voxel_from_w(wc[i], wc[i + 1], wc[i - 1], wn[i], ws[i], wu[i], wd[i], icc, icu, icd, apc, apu,
+                                    kx[i], kx[i - 1], kyn, kys, kzu, kzd, gf + i, cd, cg, lw, up);
+}
+
+/* One z-plane of a water-only sub-step of a from_w plane (prepare_fields:
+ * it and the planes above and below uniform, closed x faces, ny >= 2)
+ * from w alone: wc, wu, wd the planes of w, u, uu, ud the uniform values
+ * (plane_uniform) of the plane, the plane above and below, kx and ky the
+ * plane's faces; gf and out as in water_plane.  The fill l = w/c and the
+ * gravity flux g = f_grav p w are formed where they are used (2 + 7
+ * multiplications a voxel instead of a pass over the plane that writes
+ * two planes and seven loads of them).  Rows one at a time, north and
+ * south wrapped as the one-voxel stencil has them; the plane's first and
+ * last voxel, whose neighbours across the row end lie outside the plane,
+ * on their own with the wrapped neighbour. */
+PHC_SOIL_CLONES_512
+static void water_plane_from_w(size_t nx, size_t ny, const double *wc, const double *wu, const double *wd,
+                               const double *u, const double *uu, const double *ud, const double *kx,
+                               const double *ky, double *gf, double *out, double a, double cd, double cg,
+                               double lw, int up)
+{
+    const double *kxr = kx + nx; /* the second row's x faces; kxr[-1] the first row's last */
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t o = nx * j, on = j + 1 < ny ? o + nx : 0, os = j > 0 ? o - nx : nx * (ny - 1);
+        const size_t i0 = j == 0, i1 = j + 1 == ny ? nx - 1 : nx;
+        if (i1 > i0)
+            water_row_from_w(i0, i1, wc + o, wc + on, wc + os, wu + o, wd + o, kxr, u, uu, ud, ky[o], ky[os], gf + o,
+                             out + o, a, cd, cg, lw, up);
+    }
+    /* the first voxel (west neighbour wrapped to the end of row 0) and the
+       last (east neighbour wrapped to the start of the last row) */
+    const size_t e0 = nx > 1 ? 1 : 0, L = nx * ny - 1, Lr = nx * (ny - 1), Le = nx > 1 ? L - 1 : L;
+    out[0] = water_voxel_from_w(wc[0], wc[e0], wc[nx - 1], wc[nx], wc[Lr], wu[0], wd[0], u[0], uu[0], ud[0],
+                                a * u[1], a * uu[1], kx[0], kx[nx - 1], ky[0], ky[Lr], u[4], ud[4], gf, cd, cg, lw,
+                                up);
+    if (L > 0)
+        out[L] = water_voxel_from_w(wc[L], wc[Lr], wc[Le], wc[nx - 1], wc[L - nx], wu[L], wd[L], u[0], uu[0], ud[0],
+                                    a * u[1], a * uu[1], kx[L], kx[Le], ky[L], ky[L - nx], u[4], ud[4], gf + L, cd,
+                                    cg, lw, up);
+}
+
+/* The water update of voxel q of a plane swept from w and p
+ * (water_plane_from_w_rocks): wc, wu, wd the planes of w, pc, pu, pd of p
+ * (this plane, above, below); qe, qw, qn, qs the x and y neighbours in
+ * the plane; the face permeabilities are the *_pair values (a layer
+ * plane's, plane_layer, or 0 across a closed face) where both voxels are
+ * not rock and 0 where either is, which are the numbers prepare_fields
+ * makes; f_grav p w is formed as fill_plane forms it.  Then
+ * water_voxel_from_w. */
+static inline double water_voxel_rocks(const double *restrict wc, const double *restrict wu,
+                                       const double *restrict wd, const double *restrict pc,
+                                       const double *restrict pu, const double *restrict pd, size_t q, size_t qe,
+                                       size_t qw, size_t qn, size_t qs, double kxe_pair, double kxw_pair,
+                                       double kyn_pair, double kys_pair, double kzu_pair, double kzd_pair,
+                                       double icc, double icu, double icd, double a, double *gf, double cd,
+                                       double cg, double lw, int up)
+{
+    const double p0 = pc[q];
+    const int in = p0 > 0;
+    const double kxe = in & (pc[qe] > 0) ? kxe_pair : 0, kxw = (pc[qw] > 0) & in ? kxw_pair : 0;
+    const double kyn = in & (pc[qn] > 0) ? kyn_pair : 0, kys = (pc[qs] > 0) & in ? kys_pair : 0;
+    const double kzu = in & (pu[q] > 0) ? kzu_pair : 0, kzd = (pd[q] > 0) & in ? kzd_pair : 0;
+    return water_voxel_from_w(wc[q], wc[qe], wc[qw], wc[qn], wc[qs], wu[q], wd[q], icc, icu, icd, a * p0, a * pu[q],
+                              kxe, kxw, kyn, kys, kzu, kzd, gf + q, cd, cg, lw, up);
+}
+
+/* water_plane_from_w for a plane whose planes k - 1, k, k + 1 are layer
+ * planes (plane_layer: one 1/c, p either 0 or one value; a layer with
+ * rocks), not all uniform: the same sweep, with p read to tell rock from
+ * soil (water_voxel_rocks); the plane's first and last voxel on their
+ * own with the wrapped neighbours.  lc, lu, ld: layer_of of the plane,
+ * the plane above and below; yper: periodic y faces. */
+PHC_SOIL_CLONES_512
+static void water_plane_from_w_rocks(size_t nx, size_t ny, const double *wc, const double *wu, const double *wd,
+                                     const double *pc, const double *pu, const double *pd, const double *lc,
+                                     const double *lu, const double *ld, int yper, double *gf, double *out,
+                                     double a, double cd, double cg, double lw, int up)
+{
+    const double kxy = lc[2], icc = lc[0], icu = lu[0], icd = ld[0], kzu = lc[3], kzd = ld[3];
+    for (size_t j = 0; j < ny; ++j) {
+        const size_t o = nx * j, on = j + 1 < ny ? o + nx : 0, os = j > 0 ? o - nx : nx * (ny - 1);
+        const size_t i0 = j == 0, i1 = j + 1 == ny ? nx - 1 : nx;
+        const double kyn = j + 1 < ny || yper ? kxy : 0, kys = j > 0 || yper ? kxy : 0;
+#pragma omp simd
+        for (size_t i = i0; i < i1; ++i)
+            out[o + i] = water_voxel_rocks(wc, wu, wd, pc, pu, pd, o + i, o + i + 1, o + i - 1, on + i, os + i,
+                                           i + 1 < nx ? kxy : 0, i > 0 ? kxy : 0, kyn, kys, kzu, kzd, icc, icu,
+                                           icd, a, gf, cd, cg, lw, up);
+    }
+    const size_t e0 = nx > 1 ? 1 : 0, L = nx * ny - 1, Lr = nx * (ny - 1), Le = nx > 1 ? L - 1 : L;
+    out[0] = water_voxel_rocks(wc, wu, wd, pc, pu, pd, 0, e0, nx - 1, nx, Lr, nx > 1 ? kxy : 0, 0, kxy,
+                               yper ? kxy : 0, kzu, kzd, icc, icu, icd, a, gf, cd, cg, lw, up);
+    out[L] = water_voxel_rocks(wc, wu, wd, pc, pu, pd, L, Lr, Le, nx - 1, L - nx, 0, nx > 1 ? kxy : 0,
+                               yper ? kxy : 0, kxy, kzu, kzd, icc, icu, icd, a, gf, cd, cg, lw, up);
+}
+
+/* gravity_faces_from_w for a plane of water_plane_from_w_rocks: the face
+ * permeability kz between two voxels that are not rock, 0 where either
+ * is; f_grav p w as fill_plane forms it. */
+PHC_SOIL_CLONES_512
+static void gravity_faces_rocks(size_t m, const double *restrict lower, const double *restrict upper,
+                                const double *restrict pl, const double *restrict pu, double a, double kz, double lw,
+                                int up, double *restrict gf)
+{
+    for (size_t q = 0; q < m; ++q)
+        gf[q] = gravity_face((a * pl[q]) * lower[q], (a * pu[q]) * upper[q], (pl[q] > 0) & (pu[q] > 0) ? kz : 0,
+                             lw, up);
+}
+
+/* gravity_faces of a from_w plane over the plane below, from w: g of
+ * each formed as fill_plane forms it. */
+PHC_SOIL_CLONES_512
+static void gravity_faces_from_w(size_t m, const double *restrict lower, const double *restrict upper, double apl,
+                                 double apu, double kz, double lw, int up, double *restrict gf)
+{
+    for (size_t q = 0; q < m; ++q)
+        gf[q] = gravity_face(apl * lower[q], apu * upper[q], kz, lw, up);
 }
 
 /* gf = the gravity fluxes through the z faces between two planes (g of
@@ -864,7 +1292,8 @@ static void gravity_faces(size_t m, const double *restrict lower, const double *
 /* One z-plane of a water-only sub-step into `out` (pointers at the
  * plane's first voxel; ld, gd of the plane below, lu, gu of the plane
  * above, kzd the +z faces of the plane below): the rows 1 .. ny - 2 as
- * one run of water_rows, whose -y and +y neighbours are the rows before
+ * one run of water_rows (water_rows_uniform when uc and ud, the
+ * plane_uniform values of this plane and the plane below, are given), whose -y and +y neighbours are the rows before
  * and after in memory, then rows 0 and ny - 1, whose -y or +y neighbour
  * wraps around the plane (as the one-voxel stencil has it: across a
  * closed face the face permeability is 0 and the wrapped value is
@@ -872,9 +1301,14 @@ static void gravity_faces(size_t m, const double *restrict lower, const double *
 static void water_plane(size_t nx, size_t ny, const double *wc, const double *ld, const double *lc,
                         const double *lu, const double *gd, const double *gc, const double *gu,
                         const double *kx, const double *ky, const double *kzc, const double *kzd, double *gf,
-                        double *out, double cd, double cg, double lw, int up)
+                        double *out, double cd, double cg, double lw, int up, const double *uc, const double *ud,
+                        int xper)
 {
-    if (ny > 2)
+    if (ny > 2 && uc && ud)
+        water_rows_uniform(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx,
+                           gu + nx, kx + nx, ky + nx, ky, kzc + nx, kzd + nx, uc[2], uc[3], uc[4], ud[4], gf + nx,
+                           out + nx, cd, cg, lw, up, xper);
+    else if (ny > 2)
         water_rows(nx, ny - 2, wc + nx, ld + nx, lc + nx, lu + nx, lc + 2 * nx, lc, gd + nx, gc + nx, gu + nx,
                    kx + nx, ky + nx, ky, kzc + nx, kzd + nx, gf + nx, out + nx, cd, cg, lw, up, 1);
     for (size_t j = 0; j < ny; j += ny > 1 ? ny - 1 : 1) {
@@ -894,6 +1328,30 @@ static void fill_plane(size_t m, const double *restrict w, const double *restric
         l[q] = w[q] * ic[q];
         g[q] = a * p[q] * w[q];
     }
+}
+
+/* fill_plane for a plane of one 1/c (icu) and one p (pu): the same
+ * products, so the same numbers. */
+PHC_SOIL_CLONES
+static void fill_plane_uniform(size_t m, const double *restrict w, double icu, double pu, double a,
+                               double *restrict l, double *restrict g)
+{
+    const double ap = a * pu;
+    for (size_t q = 0; q < m; ++q) {
+        l[q] = w[q] * icu;
+        g[q] = ap * w[q];
+    }
+}
+
+/* The fill of plane k (at offset km) of w into l and g, uniform or not. */
+static void fill_plane_of(const phc_soil *s, size_t k, size_t km, const double *w, double a, double *l, double *g)
+{
+    const phc_soil_work *wk = s->work;
+    const size_t P = s->nx * s->ny;
+    if (wk->uniform[k])
+        fill_plane_uniform(P, w, wk->uniform_of[5 * k], wk->uniform_of[5 * k + 1], a, l, g);
+    else
+        fill_plane(P, w, wk->ic + km, s->p + km, a, l, g);
 }
 
 /* The stride of the ring's planes of P voxels (doubles): P rounded up to
@@ -927,7 +1385,11 @@ static size_t wrap_plane(long k, long nz)
  * permeabilities, 1/c and p stream from memory once per
  * T sub-steps instead of once per sub-step.  (Outside the box the planes
  * wrap around as the one-step stencil does: across a closed z face the
- * face permeability is 0 and the wrapped values are multiplied by it.) */
+ * face permeability is 0 and the wrapped values are multiplied by it.)
+ * Planes swept from w (prepare_fields' from_w: 1 uniform, 2 layer planes
+ * with rocks) read w (and p) of the ring's or the state's planes and no
+ * fill; a plane's fill is made only where it or a neighbour is not swept
+ * so (prepare_fields' fill). */
 static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1, double *ring)
 {
     const phc_soil_work *wk = s->work;
@@ -937,27 +1399,58 @@ static void sweep_chunk(const phc_soil *s, double h, size_t T, long k0, long k1,
     const double dx = s->dx, fd = s->params.f_diff, a = s->params.f_grav;
     const double cd = h * fd / (dx * dx), cg = h / dx, lw = h * a / (2 * dx);
     const int up = s->params.gravity == PHC_SOIL_GRAVITY_UPWIND;
+    const int xper = s->params.boundary[PHC_SOIL_XMIN] == PHC_SOIL_PERIODIC;
+    const int yper = s->params.boundary[PHC_SOIL_YMIN] == PHC_SOIL_PERIODIC;
 #define RING(t, k, arr) (ring + (((size_t)(t) * 3 + (size_t)(((k) - base) % 3)) * 3 + (arr)) * S)
+/* w after sub-step t (0: the state s->w) of plane k */
+#define WPLANE(t, k) ((t) == 0 ? s->w + wrap_plane(k, nz) * P : RING(t, k, 0))
     for (long m = base; m < k1 + (long)T; ++m) {
         const size_t km = wrap_plane(m, nz) * P;
-        fill_plane(P, s->w + km, wk->ic + km, s->p + km, a, RING(0, m, 1), RING(0, m, 2));
+        if (wk->fill[wrap_plane(m, nz)])
+            fill_plane_of(s, wrap_plane(m, nz), km, s->w + km, a, RING(0, m, 1), RING(0, m, 2));
         for (size_t t = 1; t <= T; ++t) {
             const long k = m - (long)t;
             if (k < k0 - (long)(T - t))
                 break; /* and so for every later t */
-            const size_t kk = wrap_plane(k, nz) * P, kd = wrap_plane(k - 1, nz) * P;
-            const double *wc = t == 1 ? s->w + kk : RING(t - 1, k, 0);
+            const size_t ik = wrap_plane(k, nz), id = wrap_plane(k - 1, nz), kk = ik * P, kd = id * P;
+            const int uni = wk->uniform[ik] && wk->uniform[id];
+            const double *wc = WPLANE(t - 1, k);
             double *out = t == T ? wk->w_new + kk : RING(t, k, 0);
             double *gf = ring + (9 * T + t - 1) * S; /* sub-step t's gravity fluxes through the faces below */
+            const double *u = wk->uniform_of + 5 * ik, *ud = wk->uniform_of + 5 * id;
+            if (wk->from_w[ik] == 2) {
+                const size_t iu = wrap_plane(k + 1, nz);
+                if (k == k0 - (long)(T - t))
+                    gravity_faces_rocks(P, WPLANE(t - 1, k - 1), wc, s->p + kd, s->p + kk, a, wk->layer_of[4 * id + 3],
+                                        lw, up, gf);
+                water_plane_from_w_rocks(nx, ny, wc, WPLANE(t - 1, k + 1), WPLANE(t - 1, k - 1), s->p + kk,
+                                         s->p + iu * P, s->p + kd, wk->layer_of + 4 * ik, wk->layer_of + 4 * iu,
+                                         wk->layer_of + 4 * id, yper, gf, out, a, cd, cg, lw, up);
+                if (t < T && wk->fill[ik])
+                    fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
+                continue;
+            }
+            if (wk->from_w[ik]) {
+                const double *uu = wk->uniform_of + 5 * wrap_plane(k + 1, nz);
+                if (k == k0 - (long)(T - t))
+                    gravity_faces_from_w(P, WPLANE(t - 1, k - 1), wc, a * ud[1], a * u[1], ud[4], lw, up, gf);
+                water_plane_from_w(nx, ny, wc, WPLANE(t - 1, k + 1), WPLANE(t - 1, k - 1), u, uu, ud, wk->kx + kk,
+                                   wk->ky + kk, gf, out, a, cd, cg, lw, up);
+                if (t < T && wk->fill[ik])
+                    fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
+                continue;
+            }
             if (k == k0 - (long)(T - t))
                 gravity_faces(P, RING(t - 1, k - 1, 2), RING(t - 1, k, 2), wk->kz + kd, lw, up, gf);
             water_plane(nx, ny, wc, RING(t - 1, k - 1, 1), RING(t - 1, k, 1), RING(t - 1, k + 1, 1),
                         RING(t - 1, k - 1, 2), RING(t - 1, k, 2), RING(t - 1, k + 1, 2), wk->kx + kk,
-                        wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up);
+                        wk->ky + kk, wk->kz + kk, wk->kz + kd, gf, out, cd, cg, lw, up,
+                        uni ? u : NULL, uni ? ud : NULL, xper);
             if (t < T)
-                fill_plane(P, out, wk->ic + kk, s->p + kk, a, RING(t, k, 1), RING(t, k, 2));
+                fill_plane_of(s, ik, kk, out, a, RING(t, k, 1), RING(t, k, 2));
         }
     }
+#undef WPLANE
 #undef RING
 }
 
@@ -1004,13 +1497,34 @@ static void transport_water(phc_soil *s, double h, size_t T)
  * huge pages (same measure, 2 runs each, load average 5.8 on 2 CPUs):
  * 64^3 6.1e8-6.7e8 with 1, 6.2e8-6.5e8 with 2, 5.2e8-5.6e8 with 4;
  * 128^3 4.3e8-4.4e8 with 2, 5.0e8-5.1e8 with 4, 5.3e8 with 6, 5.1e8-5.2e8
- * with 8: the rule stands.  At most nz / 8 either way (the planes each
- * thread recomputes next to its range grow with T) and at least 1.  The
- * numbers do not depend on T. */
+ * with 8: the rule stands.  When every plane is swept from w (and p)
+ * (prepare_fields' all_from_w: layers, with or without rocks, closed x
+ * faces) a sub-step works on
+ * 4 planes of rings (w of three planes and the gravity fluxes) and the
+ * sweep on (4 T + 2) planes: 2 sub-steps per sweep where their 10 planes
+ * fit in PHC_SOIL_CACHE_BYTES, else PHC_SOIL_BLOCK_STEPS_FROM_W (8).
+ * Measured on the bench soil (AVX-512 copy, CPU time, 2 runs each, load
+ * average 1.2-1.8 on 2 CPUs): 64^3 1.87e9-1.89e9 voxel updates/s with 1
+ * sub-step per sweep, 1.82e9-1.94e9 with 2, 1.84e9-1.92e9 with 4,
+ * 1.56e9-1.71e9 with 8 (with 2 threads, wall clock: 2.9e9-3.6e9,
+ * 3.2e9-3.7e9, 2.8e9-3.5e9, 2.3e9-3.0e9); 128^3 9.7e8-1.0e9 with 2,
+ * 1.22e9-1.23e9 with 4, 1.27e9-1.52e9 with 6, 1.52e9-1.54e9 with 8,
+ * 1.55e9-1.56e9 with 16 (2 threads: 2.37e9-2.42e9 with 4, 2.36e9-2.79e9
+ * with 6, 1.6e9-2.83e9 with 8, 2.73e9-2.77e9 with 12, 2.57e9-2.63e9 with
+ * 16).  With 10% rocks (layer planes swept from w and p, 1 thread, 2
+ * runs): 64^3 1.25e9-1.28e9 with 1, 1.22e9-1.24e9 with 2, 1.21e9-1.23e9
+ * with 4; 128^3 7.1e8-7.2e8 with 2, 8.4e8-8.5e8 with 4, 9.9e8-1.02e9 with
+ * 8.  At
+ * most nz / 8 either way (the planes each thread recomputes next to its
+ * range grow with T) and at least 1.  The numbers do not depend on T.
+ * Needs prepare_fields. */
 static size_t block_levels(const phc_soil *s)
 {
     size_t T = s->params.block_steps;
-    if (!T) {
+    if (!T && s->work->all_from_w) {
+        const double plane = (double)(s->nx * s->ny) * sizeof(double);
+        T = (4.0 * 2 + 2) * plane <= PHC_SOIL_CACHE_BYTES ? 2 : PHC_SOIL_BLOCK_STEPS_FROM_W;
+    } else if (!T) {
         const double plane = (double)(s->nx * s->ny) * sizeof(double);
         T = PHC_SOIL_BLOCK_STEPS;
         if ((15.0 + 7.0) * plane <= PHC_SOIL_CACHE_BYTES)
@@ -1024,6 +1538,8 @@ static size_t block_levels(const phc_soil *s)
 
 size_t phc_soil_block_steps(const phc_soil *s)
 {
+    /* the work arrays are scratch, not state (as in phc_soil_stable_dt) */
+    prepare_fields((phc_soil *)s);
     return block_levels(s);
 }
 

@@ -76,9 +76,15 @@
  * sweep over the grid (a wavefront in z), so the per-voxel constants
  * stream from memory once per sweep; with block_steps 0 as many (up to 4)
  * as keep a sweep's planes in a core's cache (1 at 64 x 64 voxels per
- * plane, 4 at 128 x 128, where the planes come from memory anyway).  The
- * arithmetic is that of one voxel and one sub-step at a time: the result
- * is bit-identical for any block_steps (test_soil 4b, 4c).
+ * plane, 4 at 128 x 128, where the planes come from memory anyway).
+ * Layer planes: where a z-plane and the planes above and below each have
+ * one c, one p (horizontal layers) and the x faces are closed, the sweep
+ * reads only w there (the face permeabilities are numbers, not planes);
+ * where p is either 0 or one value (layers with rocks) it reads w and p.
+ * When every plane is so, block_steps 0 takes 2 sub-steps per sweep at 64
+ * x 64 voxels per plane and 8 at 128 x 128.  The arithmetic is that of one
+ * voxel and one sub-step at a time: the result is bit-identical for any
+ * block_steps (test_soil 4b, 4c), uniform planes or not.
  *
  * Layout: voxel (i, j, k) is element i + nx (j + ny k); x east, y north,
  * z up; k = nz - 1 is the surface layer.  Voxel centres are at
@@ -129,7 +135,7 @@ typedef struct phc_soil_params {
     double safety;                          /* fraction of the limit used when sub-stepping, 0.9 */
     size_t max_substeps;                    /* most sub-steps per step of dt; 0 (default) = no limit */
     phc_soil_gravity gravity;               /* gravity and nutrient face fluxes; default LAX_WENDROFF */
-    size_t block_steps;                     /* water-only sub-steps per sweep (time blocking); 0 (default) = up to 4, by the cache (soil.c block_levels), 1 = none */
+    size_t block_steps;                     /* water-only sub-steps per sweep (time blocking); 0 (default) = up to 4 (8 on layer planes), by the cache (soil.c block_levels), 1 = none */
     double absorb_dt;                       /* h, the step the absorbing factors a(i) apply per; 0 (default) = dt */
 } phc_soil_params;
 
@@ -266,8 +272,8 @@ double phc_soil_stable_dt(const phc_soil *s, size_t *voxel);
 void phc_soil_budget_reset(phc_soil *s);
 
 /* The water-only sub-steps one sweep over the grid takes with the current
- * size and params.block_steps (time blocking; see above): 1 to 4 for
- * block_steps 0. */
+ * size, fields and params.block_steps (time blocking; see above): 1 to 8
+ * for block_steps 0. */
 size_t phc_soil_block_steps(const phc_soil *s);
 
 /* Advances from s->t to t_end (h) in steps of params.dt (the last one
