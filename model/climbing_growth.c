@@ -688,7 +688,48 @@ static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
     return p;
 }
 
-/* Hands the grown plant to c->sys (made at the first call). */
+/* Particle i's part of the hand-over (i < the system's count): its rest
+ * segment when its rest changed, its current place when the growth moved
+ * it, its age and its anchor; the seed clamped.  Touches only particle i
+ * (in the plant's record and in the system), so the particles may be
+ * handed over in any order or at once. */
+static int sync_one(phc_climbing *c, size_t i, phc_error *err)
+{
+    phc_particles *p = c->sys;
+    double now[SEEN], head[3], tail[3], q[4];
+    seen_now(c, i, now);
+    double *was = c->sys_seen + SEEN * i;
+    const int rest = memcmp(now, was, 8 * sizeof(double)) != 0;
+    const int moved = memcmp(now + 8, was + 8, 6 * sizeof(double)) != 0;
+    if (rest) {
+        rest_segment(c, i, head, tail);
+        if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
+            return -1;
+    }
+    if (i > 0 && moved) {
+        phc_quat_from_z(c->d + 3 * i, q);
+        if (phc_particles_place(p, i, c->x + 3 * i, q, err))
+            return -1;
+    }
+    if (rest || moved) /* (written only then: most particles are as they were) */
+        memcpy(was, now, sizeof now);
+    if (i == 0) { /* the seed: clamped at its rest place and orientation */
+        phc_quat_from_z(c->dr, q);
+        return phc_particles_set_position(p, 0, c->xr, err) ||
+               phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
+               phc_particles_anchor(p, 0, c->xr, 1, 1, err);
+    }
+    if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
+        return -1;
+    const double k = c->anchored[i] ? phc_climbing_anchor_strength(c, i) : 0;
+    return k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
+                 : phc_particles_release(p, i, err);
+}
+
+/* Hands the grown plant to c->sys (made at the first call): the new
+ * particles appended in index order (each after its parent), then every
+ * particle's sync_one, on the threads for a large plant (the error
+ * reported is the one of the smallest failing index, as in index order). */
 static int dynamics_sync(phc_climbing *c, phc_error *err)
 {
     const size_t n = c->n;
@@ -718,46 +759,36 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
     if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
         return -1;
     phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
-    for (size_t i = 0; i < n; ++i) {
-        double now[SEEN], head[3], tail[3], q[4];
-        seen_now(c, i, now);
-        double *was = c->sys_seen + SEEN * i;
-        if (i >= known) { /* new: at its current place, at rest */
-            rest_segment(c, i, head, tail);
-            phc_quat_from_z(c->d + 3 * i, q);
-            if (phc_particles_append(p, c->parent[i], head, tail, c->radius[i], NULL, err) ||
-                phc_particles_set_position(p, i, c->x + 3 * i, err) ||
-                phc_particles_set_orientation(p, i, q, err))
-                return -1;
-        } else {
-            if (memcmp(now, was, 8 * sizeof(double)) != 0) { /* rest changed */
-                rest_segment(c, i, head, tail);
-                if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
-                    return -1;
-            }
-            if (i > 0 && memcmp(now + 8, was + 8, 6 * sizeof(double)) != 0) { /* moved */
-                phc_quat_from_z(c->d + 3 * i, q);
-                if (phc_particles_place(p, i, c->x + 3 * i, q, err))
-                    return -1;
-            }
-        }
-        memcpy(was, now, sizeof now);
-        if (i == 0) { /* the seed: clamped at its rest place and orientation */
-            phc_quat_from_z(c->dr, q);
-            if (phc_particles_set_position(p, 0, c->xr, err) ||
-                phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
-                phc_particles_anchor(p, 0, c->xr, 1, 1, err))
-                return -1;
-            continue;
-        }
-        if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
+    for (size_t i = known; i < n; ++i) { /* new: at its current place, at rest */
+        double head[3], tail[3], q[4];
+        rest_segment(c, i, head, tail);
+        phc_quat_from_z(c->d + 3 * i, q);
+        if (phc_particles_append(p, c->parent[i], head, tail, c->radius[i], NULL, err) ||
+            phc_particles_set_position(p, i, c->x + 3 * i, err) ||
+            phc_particles_set_orientation(p, i, q, err))
             return -1;
-        const double k = c->anchored[i] ? phc_climbing_anchor_strength(c, i) : 0;
-        if (k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
-                  : phc_particles_release(p, i, err))
-            return -1;
+        seen_now(c, i, c->sys_seen + SEEN * i); /* handed over as it is now */
     }
-    return 0;
+    if (!team(n)) {
+        for (size_t i = 0; i < n; ++i)
+            if (sync_one(c, i, err))
+                return -1;
+        return 0;
+    }
+    size_t first_bad = n;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; ++i) {
+        phc_error mine;
+        if (sync_one(c, i, &mine) == 0)
+            continue;
+#pragma omp critical(phc_climbing_sync)
+        if (i < first_bad) {
+            first_bad = i;
+            if (err)
+                *err = mine;
+        }
+    }
+    return first_bad < n ? -1 : 0;
 }
 
 /* Kinematic collisions (option collide): current centres pushed out of
@@ -793,6 +824,24 @@ void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *dept
         *depth = c->depth;
 }
 
+/* Particle i's current centre and direction from c->sys, into the plant
+ * and its record of what the system holds. */
+static void read_back(phc_climbing *c, size_t i)
+{
+    double q[4], R[9];
+    phc_particles_position(c->sys, i, c->x + 3 * i);
+    phc_particles_orientation(c->sys, i, q);
+    /* direction = R(q)·z: the third column of R */
+    const double w = q[0], a = q[1], b = q[2], cc = q[3];
+    R[2] = 2 * (a * cc + w * b);
+    R[5] = 2 * (b * cc - w * a);
+    R[8] = 1 - 2 * (a * a + b * b);
+    const double dz[3] = {R[2], R[5], R[8]};
+    unit(dz, c->d + 3 * i);
+    memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
+    memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
+}
+
 static int dynamics(phc_climbing *c, double dt, phc_error *err)
 {
     const size_t n = c->n;
@@ -811,19 +860,13 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         c->pushed += pushed;
         c->depth = fmin(c->depth, depth);
     }
-    for (size_t i = 1; i < n; ++i) {
-        double q[4], R[9];
-        phc_particles_position(p, i, c->x + 3 * i);
-        phc_particles_orientation(p, i, q);
-        /* direction = R(q)·z: the third column of R */
-        const double w = q[0], a = q[1], b = q[2], cc = q[3];
-        R[2] = 2 * (a * cc + w * b);
-        R[5] = 2 * (b * cc - w * a);
-        R[8] = 1 - 2 * (a * a + b * b);
-        const double dz[3] = {R[2], R[5], R[8]};
-        unit(dz, c->d + 3 * i);
-        memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
-        memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
+    if (team(n)) {
+#pragma omp parallel for schedule(static)
+        for (size_t i = 1; i < n; ++i)
+            read_back(c, i);
+    } else {
+        for (size_t i = 1; i < n; ++i)
+            read_back(c, i);
     }
     return 0;
 fail: /* the next dynamic step starts a fresh system from the plant */
