@@ -776,7 +776,9 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
         return 0;
     }
     size_t first_bad = n;
-#pragma omp parallel for schedule(static)
+    /* dynamic chunks: the growing tips (their rest segment and place
+       handed over) crowd the high indices */
+#pragma omp parallel for schedule(dynamic, 512)
     for (size_t i = 0; i < n; ++i) {
         phc_error mine;
         if (sync_one(c, i, &mine) == 0)
