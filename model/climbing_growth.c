@@ -603,12 +603,19 @@ static void rebuild_rest(phc_climbing *c)
     }
 }
 
-double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
+/* Anchor strength of i now (eq. 5), 0 when not anchored (here, so that
+ * the hand-over inlines it). */
+static inline double anchor_strength(const phc_climbing *c, size_t i)
 {
     if (!c->anchored[i])
         return 0;
     const double ramp = fmin(1, (c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
     return c->o.anchor_strength * c->sigma[i] * ramp;
+}
+
+double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
+{
+    return anchor_strength(c, i);
 }
 
 /* Step 9's stiffening: (r/r0)^4, 1 without secondary growth. */
@@ -642,6 +649,20 @@ static void seen_now(const phc_climbing *c, size_t i, double out[SEEN])
     out[7] = c->sigma[i];
     memcpy(out + 8, c->x + 3 * i, 3 * sizeof(double));
     memcpy(out + 11, c->d + 3 * i, 3 * sizeof(double));
+}
+
+/* 1 when the k doubles a and b hold the same bits (memcmp's equality,
+ * without the call). */
+static inline int same_bits(const double *a, const double *b, int k)
+{
+    for (int j = 0; j < k; ++j) {
+        uint64_t u, v;
+        memcpy(&u, a + j, sizeof u);
+        memcpy(&v, b + j, sizeof v);
+        if (u != v)
+            return 0;
+    }
+    return 1;
 }
 
 static void rest_segment(const phc_climbing *c, size_t i, double head[3], double tail[3])
@@ -696,11 +717,11 @@ static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
 static int sync_one(phc_climbing *c, size_t i, phc_error *err)
 {
     phc_particles *p = c->sys;
-    double now[SEEN], head[3], tail[3], q[4];
-    seen_now(c, i, now);
+    double head[3], tail[3], q[4];
     double *was = c->sys_seen + SEEN * i;
-    const int rest = memcmp(now, was, 8 * sizeof(double)) != 0;
-    const int moved = memcmp(now + 8, was + 8, 6 * sizeof(double)) != 0;
+    const int rest = !same_bits(was, c->xr + 3 * i, 3) || !same_bits(was + 3, c->dr + 3 * i, 3) ||
+                     !same_bits(was + 6, c->radius + i, 1) || !same_bits(was + 7, c->sigma + i, 1);
+    const int moved = !same_bits(was + 8, c->x + 3 * i, 3) || !same_bits(was + 11, c->d + 3 * i, 3);
     if (rest) {
         rest_segment(c, i, head, tail);
         if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
@@ -712,7 +733,7 @@ static int sync_one(phc_climbing *c, size_t i, phc_error *err)
             return -1;
     }
     if (rest || moved) /* (written only then: most particles are as they were) */
-        memcpy(was, now, sizeof now);
+        seen_now(c, i, was);
     if (i == 0) { /* the seed: clamped at its rest place and orientation */
         phc_quat_from_z(c->dr, q);
         return phc_particles_set_position(p, 0, c->xr, err) ||
@@ -721,7 +742,7 @@ static int sync_one(phc_climbing *c, size_t i, phc_error *err)
     }
     if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
         return -1;
-    const double k = c->anchored[i] ? phc_climbing_anchor_strength(c, i) : 0;
+    const double k = anchor_strength(c, i);
     return k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
                  : phc_particles_release(p, i, err);
 }
@@ -844,9 +865,10 @@ static void read_back(phc_climbing *c, size_t i)
     memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
 }
 
+/* Step 6: the hand-over and the substeps (the shape is read back in step
+ * 7's loop, anchors()). */
 static int dynamics(phc_climbing *c, double dt, phc_error *err)
 {
-    const size_t n = c->n;
     if (dynamics_sync(c, err))
         goto fail;
     phc_particles *p = c->sys;
@@ -861,14 +883,6 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         phc_particles_collisions(p, &pushed, &depth);
         c->pushed += pushed;
         c->depth = fmin(c->depth, depth);
-    }
-    if (team(n)) {
-#pragma omp parallel for schedule(static)
-        for (size_t i = 1; i < n; ++i)
-            read_back(c, i);
-    } else {
-        for (size_t i = 1; i < n; ++i)
-            read_back(c, i);
     }
     return 0;
 fail: /* the next dynamic step starts a fresh system from the plant */
@@ -906,19 +920,31 @@ static void anchor(phc_climbing *c, size_t i, size_t *made, size_t *released)
     }
 }
 
-/* Step 7: anchors; each particle's anchor is its own. */
-static void anchors(phc_climbing *c)
+/* Step 7 for particle i: with `read`, first its current shape from the
+ * dynamics (read_back; the seed's is its rest), then its anchor. */
+static void read_and_anchor(phc_climbing *c, size_t i, int read, size_t *made, size_t *released)
 {
-    if (!c->o.closest)
+    if (read && i > 0)
+        read_back(c, i);
+    if (c->o.closest)
+        anchor(c, i, made, released);
+}
+
+/* Step 7: anchors; each particle's anchor is its own.  With `read` (after
+ * a dynamics step), each particle's current shape is read back from the
+ * particles first, in the same loop (one pass, one parallel region). */
+static void anchors(phc_climbing *c, int read)
+{
+    if (!c->o.closest && !read)
         return;
     size_t made = 0, released = 0;
     if (team(c->n)) {
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released)
         for (size_t i = 0; i < c->n; ++i)
-            anchor(c, i, &made, &released);
+            read_and_anchor(c, i, read, &made, &released);
     } else {
         for (size_t i = 0; i < c->n; ++i)
-            anchor(c, i, &made, &released);
+            read_and_anchor(c, i, read, &made, &released);
     }
     c->stats.anchors_made += made;
     c->stats.anchors_released += released;
@@ -1202,8 +1228,8 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         memcpy(c->d, c->dr, 3 * c->n * sizeof *c->d);
         collide_kinematic(c);
     }
-    /* 7. anchors */
-    anchors(c);
+    /* 7. anchors (after a dynamics step, with the read-back of the shape) */
+    anchors(c, o->dynamics_substeps > 0);
     /* 8. leaves */
     if (o->leaf_step > 0)
         leaves_update(c);
