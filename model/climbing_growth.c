@@ -387,13 +387,13 @@ nomem:
     return NULL;
 }
 
-static double seg_half(const phc_climbing *c, size_t i)
+static inline double seg_half(const phc_climbing *c, size_t i)
 {
     return 0.5 * c->sigma[i] * c->o.max_length;
 }
 
 /* Base of i's current (rest when rest != 0) segment. */
-static void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
+static inline void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
 {
     const double *x = rest ? c->xr : c->x, *d = rest ? c->dr : c->d;
     const double h = seg_half(c, i);
@@ -401,7 +401,7 @@ static void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
         b[k] = x[3 * i + k] - h * d[3 * i + k];
 }
 
-static void seg_tip(const phc_climbing *c, size_t i, int rest, double t[3])
+static inline void seg_tip(const phc_climbing *c, size_t i, int rest, double t[3])
 {
     const double *x = rest ? c->xr : c->x, *d = rest ? c->dr : c->d;
     const double h = seg_half(c, i);
