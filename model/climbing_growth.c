@@ -963,20 +963,32 @@ static void count(phc_climbing *c)
     c->stats.anchored = anchored;
 }
 
+/* Step 1's shading point of particle i: its centre and volume. */
+static void light_point(phc_climbing *c, size_t i)
+{
+    const double L = c->sigma[i] * c->o.max_length;
+    c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
+    memcpy(c->sx + 3 * i, c->x + 3 * i, 3 * sizeof *c->sx);
+    c->sv[i] = c->vol[i];
+}
+
 /* Step 1: light at the particles and the leaves (model/climbing_light.h);
  * leaves add their volumes s²·thickness to the grid. */
 static int light_step(phc_climbing *c, size_t n0)
 {
     const phc_climbing_options *o = &c->o;
-    size_t m = 0;
-    for (size_t i = 0; i < n0; ++i) {
-        const double L = c->sigma[i] * o->max_length;
-        c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
-        memcpy(c->sx + 3 * m, c->x + 3 * i, 3 * sizeof *c->sx);
-        c->sv[m++] = c->vol[i];
+    /* the particles' points: point i is particle i (each its own) */
+    if (team(n0)) {
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n0; ++i)
+            light_point(c, i);
+    } else {
+        for (size_t i = 0; i < n0; ++i)
+            light_point(c, i);
     }
+    size_t m = n0;
     const double leaf_vol = o->leaf_size * o->leaf_size * o->leaf_thickness;
-    for (size_t i = 0; i < n0; ++i)
+    for (size_t i = 0; i < n0 && o->leaf_step > 0; ++i) /* (leaves only with a leaf_step) */
         if (c->has_leaf[i]) {
             memcpy(c->sx + 3 * m, c->leaf_c + 3 * i, 3 * sizeof *c->sx);
             c->sv[m++] = leaf_vol;
@@ -986,7 +998,7 @@ static int light_step(phc_climbing *c, size_t n0)
     memcpy(c->light, c->sI, n0 * sizeof *c->light);
     const size_t points = m;
     m = n0;
-    for (size_t i = 0; i < n0; ++i)
+    for (size_t i = 0; i < n0 && o->leaf_step > 0; ++i)
         if (c->has_leaf[i])
             c->leaf_light[i] = c->sI[m++];
     /* seek_light: the light field from the same shading points */
