@@ -85,6 +85,9 @@ struct phc_particles {
     long *source_id;         /* n: segment ids for messages */
     size_t *child_index;     /* n: position of i among its parent's children */
     double *ell0;            /* 9n: D_j R̄_jᵀ / 5 (kg-free ellipsoid term, m²) */
+    unsigned char *ell0_stale; /* n: 1 when ell0 awaits its rest change (made when next
+                                  needed: a climbing plant's growing tips change their rest
+                                  every step, and nothing matches their groups) */
     double *ell;             /* 9n: R_j D_j R̄_jᵀ / 5 of the orientations being matched (m²) */
     /* Group slots: group k owns slots goff[k] .. goff[k+1]−1: slot 0 = k,
      * slot 1 = its parent, slot 2 + c = its c-th child; a slot whose link
@@ -414,6 +417,18 @@ done:
     return 0;
 }
 
+/* ell0_k = D R̄ᵀ / 5, D = diag(r², r², (L/2)²): the rest half of the
+ * ellipsoid moment R D R̄ᵀ / 5 (Müller & Chentanez eq. 10), m², from
+ * particle k's rest orientation and radii. */
+static void rest_moment(phc_particles *p, size_t k)
+{
+    double R0[9];
+    phc_quat_to_matrix(p->q0 + 4 * k, R0);
+    for (int t = 0; t < 3; ++t)
+        for (int c = 0; c < 3; ++c)
+            p->ell0[9 * k + 3 * t + c] = 0.2 * p->ax[3 * k + t] * p->ax[3 * k + t] * R0[3 * c + t];
+}
+
 /* ---- construction ------------------------------------------------------- */
 
 static const char *opt_problem(const phc_particles_options *o, char *buf, size_t size)
@@ -488,6 +503,7 @@ void phc_particles_free(phc_particles *p)
     free(p->source_id);
     free(p->child_index);
     free(p->ell0);
+    free(p->ell0_stale);
     free(p->ell);
     free(p->om);
     free(p->d0);
@@ -565,6 +581,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(source_id, n);
     ALLOC(child_index, n);
     ALLOC(ell0, 9 * n);
+    ALLOC(ell0_stale, n);
     ALLOC(ell, 9 * n);
     ALLOC(goff, n + 1);
     ALLOC(mem, slots);
@@ -632,13 +649,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
         p->goff[k + 1] = p->goff[k] + 2 + (p->child_start[k + 1] - p->child_start[k]);
         for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c)
             p->child_index[p->child[c]] = c - p->child_start[k];
-        /* ell0 = D R̄ᵀ / 5, D = diag(r², r², (L/2)²): the rest half of the
-         * ellipsoid moment R D R̄ᵀ / 5 (Müller & Chentanez eq. 10) */
-        double R0[9];
-        phc_quat_to_matrix(p->q0 + 4 * k, R0);
-        for (int t = 0; t < 3; ++t)
-            for (int c = 0; c < 3; ++c)
-                p->ell0[9 * k + 3 * t + c] = 0.2 * p->ax[3 * k + t] * p->ax[3 * k + t] * R0[3 * c + t];
+        rest_moment(p, k);
     }
     memcpy(p->xp, p->x, 3 * n * sizeof(double));
     memcpy(p->qp, p->q, 4 * n * sizeof(double));
@@ -710,6 +721,7 @@ static int reserve(phc_particles *p, size_t want)
     GROW(source_id, 1);
     GROW(child_index, 1);
     GROW(ell0, 9);
+    GROW(ell0_stale, 1);
     GROW(ell, 9);
     GROW(mem, 3);
     GROW(mu, 3);
@@ -783,11 +795,7 @@ static void rest_from_segment(phc_particles *p, size_t i, const double head[3],
     p->m[i] = p->o.density * PI * r * r * L;
     p->ax[3 * i] = p->ax[3 * i + 1] = r;
     p->ax[3 * i + 2] = 0.5 * L;
-    double R0[9];
-    phc_quat_to_matrix(p->q0 + 4 * i, R0);
-    for (int t = 0; t < 3; ++t)
-        for (int c = 0; c < 3; ++c)
-            p->ell0[9 * i + 3 * t + c] = 0.2 * p->ax[3 * i + t] * p->ax[3 * i + t] * R0[3 * c + t];
+    p->ell0_stale[i] = 1; /* rest_moment when ellipsoid_term next needs it */
 }
 
 /* Checks a segment for particle i (or the one to be appended); its length
@@ -1271,6 +1279,10 @@ static void group_statics(phc_particles *p, size_t k)
  * R_j D_j R̄_jᵀ / 5 = R(Q_j) · ell0_j into p->ell (m²). */
 static void ellipsoid_term(phc_particles *p, size_t j, const double *Q)
 {
+    if (p->ell0_stale[j]) { /* (only j's own data: safe on j's thread) */
+        rest_moment(p, j);
+        p->ell0_stale[j] = 0;
+    }
     double Rj[9];
     phc_quat_to_matrix(Q + 4 * j, Rj);
     const double *E = p->ell0 + 9 * j;
