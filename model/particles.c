@@ -85,6 +85,14 @@ struct phc_particles {
     long *source_id;         /* n: segment ids for messages */
     size_t *child_index;     /* n: position of i among its parent's children */
     double *ell0;            /* 9n: D_j R̄_jᵀ / 5 (kg-free ellipsoid term, m²) */
+    /* The joint pass's rest terms of linked particle i (follow_one): j_i =
+     * R(q̄_u)ᵀ (h̄_i − x̄_u) and q̄_u⁻¹ q̄_i, u its parent, kept while neither
+     * rest changes: joint[7i .. 7i+7) was made at step joint_epoch[i],
+     * valid while that is later than rest_epoch[i] and rest_epoch[u] (the
+     * epoch of their last rest change; epoch counts the steps). */
+    double *joint;           /* 7n */
+    size_t *joint_epoch, *rest_epoch; /* n each */
+    size_t epoch;
     unsigned char *ell0_stale; /* n: 1 when ell0 awaits its rest change (made when next
                                   needed: a climbing plant's growing tips change their rest
                                   every step, and nothing matches their groups) */
@@ -504,6 +512,9 @@ void phc_particles_free(phc_particles *p)
     free(p->child_index);
     free(p->ell0);
     free(p->ell0_stale);
+    free(p->joint);
+    free(p->joint_epoch);
+    free(p->rest_epoch);
     free(p->ell);
     free(p->om);
     free(p->d0);
@@ -536,6 +547,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     p->n = n;
     p->cap = n;
     p->o = o;
+    p->epoch = 1; /* (rest_epoch 1 for every particle: made before any step) */
     const size_t slots = 3 * n; /* Σ_k (2 + children(k)) = 2n + (n − roots) <= 3n */
 #define ALLOC(field, count) \
     if (!(p->field = calloc((count), sizeof *p->field))) goto nomem
@@ -582,6 +594,9 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(child_index, n);
     ALLOC(ell0, 9 * n);
     ALLOC(ell0_stale, n);
+    ALLOC(joint, 7 * n);
+    ALLOC(joint_epoch, n);
+    ALLOC(rest_epoch, n);
     ALLOC(ell, 9 * n);
     ALLOC(goff, n + 1);
     ALLOC(mem, slots);
@@ -599,6 +614,12 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     for (size_t i = 0; i < n; ++i) {
         const long id = g->source_id ? g->source_id[i] : (long)i;
         p->source_id[i] = id;
+        /* joint terms to be made (joint_epoch <= rest_epoch), written here
+           as non-zero values: calloc's untouched pages, read first in the
+           step's parallel joint pass and written there, cost each a
+           copy-on-write fault with a TLB shootdown to the other threads
+           (~40 ms for a 25k plant's first steps on two threads in a VM) */
+        p->rest_epoch[i] = p->joint_epoch[i] = 1;
         const double r = g->radius[i], L = g->length[i];
         if (!(r > 0) || !isfinite(r) || !(L > 0) || !isfinite(L)) {
             phc_error_set(err, PHC_ERR_INPUT,
@@ -722,6 +743,9 @@ static int reserve(phc_particles *p, size_t want)
     GROW(child_index, 1);
     GROW(ell0, 9);
     GROW(ell0_stale, 1);
+    GROW(joint, 7);
+    GROW(joint_epoch, 1);
+    GROW(rest_epoch, 1);
     GROW(ell, 9);
     GROW(mem, 3);
     GROW(mu, 3);
@@ -796,6 +820,7 @@ static void rest_from_segment(phc_particles *p, size_t i, const double head[3],
     p->ax[3 * i] = p->ax[3 * i + 1] = r;
     p->ax[3 * i + 2] = 0.5 * L;
     p->ell0_stale[i] = 1; /* rest_moment when ellipsoid_term next needs it */
+    p->rest_epoch[i] = p->epoch; /* its joint terms and its children's to be made again */
 }
 
 /* Checks a segment for particle i (or the one to be appended); its length
@@ -861,6 +886,7 @@ int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
     p->linked[i] = parent != PHC_PARTICLES_NONE;
     p->child_index[i] = 0;
     p->topo[i] = i; /* after its parent, which exists already */
+    p->joint_epoch[i] = 0; /* its joint terms not made yet */
     p->gq[4 * i] = 1; /* at rest: its group has not turned */
     p->gq[4 * i + 1] = p->gq[4 * i + 2] = p->gq[4 * i + 3] = 0;
     p->stress[i] = 0;
@@ -1678,21 +1704,28 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
     const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
     if (!(s > 0))
         return; /* s = 0: no hold */
-    const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
+    const double *qu = p->qp + 4 * u;
     const double half = p->ax[3 * i + 2];
+    /* the rest terms (p->joint): j_i, and q̄_u⁻¹ q̄_i */
+    double *ju = p->joint + 7 * i, *rel = ju + 3;
+    if (p->joint_epoch[i] <= p->rest_epoch[i] || p->joint_epoch[i] <= p->rest_epoch[u]) {
+        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
+        double hr[3], hb[3];
+        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+        rotate_z(q0i, half, hr);
+        for (int d = 0; d < 3; ++d)
+            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
+        rotate(q0u_inv, hb, ju);
+        quat_mul(q0u_inv, q0i, rel);
+        p->joint_epoch[i] = p->epoch;
+    }
     /* the joint J in u's current frame */
-    double hr[3], hb[3], ju[3], J[3];
-    const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
-    rotate_z(q0i, half, hr);
-    for (int d = 0; d < 3; ++d)
-        hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-    rotate(q0u_inv, hb, ju);
+    double hr[3], J[3];
     rotate(qu, ju, J);
     for (int d = 0; d < 3; ++d)
         J[d] += p->xp[3 * u + d];
     /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
-    double rel[4], qs[4];
-    quat_mul(q0u_inv, q0i, rel);
+    double qs[4];
     quat_mul(qu, rel, qs);
     double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
     if (k >= 1) {
@@ -2031,6 +2064,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (p->layout_dirty)
         relayout(p);
     const size_t n = p->n;
+    ++p->epoch; /* (the joint terms made in this step carry it) */
     p->polar_total = p->polar_fallbacks = 0;
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);
