@@ -1399,6 +1399,19 @@ static void test_projection_plan(void)
     phc_plant_graph_free(g);
 }
 
+/* Centre and unit direction (out[0..3), out[3..6)) of a segment head → tail. */
+static void segment_pose(const double head[3], const double tail[3], double out[6])
+{
+    double L = 0;
+    for (int d = 0; d < 3; ++d) {
+        out[d] = 0.5 * (head[d] + tail[d]); /* centre */
+        out[3 + d] = tail[d] - head[d];     /* unit direction, below */
+        L += out[3 + d] * out[3 + d];
+    }
+    for (int d = 0; d < 3; ++d)
+        out[3 + d] /= sqrt(L);
+}
+
 /* The joint pass keeps each linked particle's rest terms (its joint in its
  * parent's rest frame, the rest relative rotation) across steps while
  * neither rest changes.  A bent 3-particle chain, seed clamped, s = 1 (the
@@ -1439,18 +1452,9 @@ static void test_joint_rest_change(void)
     phc_plant_graph_free(g);
     if (!p)
         return;
-    /* centre and unit direction of a segment */
     double want[3][6];
-    for (size_t i = 0; i < 3; ++i) {
-        double L = 0;
-        for (int d = 0; d < 3; ++d) {
-            want[i][d] = 0.5 * (pts[i][d] + pts[i + 1][d]);
-            want[i][3 + d] = pts[i + 1][d] - pts[i][d];
-            L += want[i][3 + d] * want[i][3 + d];
-        }
-        for (int d = 0; d < 3; ++d)
-            want[i][3 + d] /= sqrt(L);
-    }
+    for (size_t i = 0; i < 3; ++i)
+        segment_pose(pts[i], pts[i + 1], want[i]);
     double worst[4] = {0, 0, 0, 0};
     /* rounds: 0 at rest; 1 particle 1 moved and turned; 2 particle 2
      * turned; 3 particle 1 again after 5 steps with nothing changed */
@@ -1461,25 +1465,11 @@ static void test_joint_rest_change(void)
         if (round == 1 || round == 3) {
             const double(*sg)[3] = seg1[round == 3];
             CHECK(phc_particles_set_rest(p, 1, sg[0], sg[1], 0.002, &err) == PHC_OK);
-            double L = 0;
-            for (int d = 0; d < 3; ++d) {
-                want[1][d] = 0.5 * (sg[0][d] + sg[1][d]);
-                want[1][3 + d] = sg[1][d] - sg[0][d];
-                L += want[1][3 + d] * want[1][3 + d];
-            }
-            for (int d = 0; d < 3; ++d)
-                want[1][3 + d] /= sqrt(L);
+            segment_pose(sg[0], sg[1], want[1]);
         }
         if (round == 2) {
             CHECK(phc_particles_set_rest(p, 2, seg2[0], seg2[1], 0.002, &err) == PHC_OK);
-            double L = 0;
-            for (int d = 0; d < 3; ++d) {
-                want[2][d] = 0.5 * (seg2[0][d] + seg2[1][d]);
-                want[2][3 + d] = seg2[1][d] - seg2[0][d];
-                L += want[2][3 + d] * want[2][3 + d];
-            }
-            for (int d = 0; d < 3; ++d)
-                want[2][3 + d] /= sqrt(L);
+            segment_pose(seg2[0], seg2[1], want[2]);
         }
         for (int s = 0; s < (round == 3 ? 6 : 1); ++s)
             CHECK(phc_particles_step(p, 0.01, NULL, &err) == PHC_OK);
