@@ -48,6 +48,7 @@ struct phc_climbing {
     double *r0;              /* n: primary radius, m */
     unsigned char *has_child;/* n scratch */
     double *target;          /* n scratch: pipe-model target areas, m^2 */
+    size_t *grown;           /* n scratch: the tips of this step (step 5 rebuilds their rest) */
     double *sx, *sv, *sI;    /* 6n, 2n, 2n scratch: light points, volumes, light */
     unsigned char *opaque;   /* light-grid cells holding occluders, NULL: none */
     double *occ_v;           /* occluding triangles' vertices, m (3 per vertex) */
@@ -149,6 +150,7 @@ void phc_climbing_free(phc_climbing *c)
     free(c->r0);
     free(c->has_child);
     free(c->target);
+    free(c->grown);
     phc_climbing_light_field_free(&c->field);
     free(c->sx);
     free(c->sv);
@@ -201,6 +203,7 @@ static int reserve(phc_climbing *c, size_t want)
     GROW(r0, 1);
     GROW(has_child, 1);
     GROW(target, 1);
+    GROW(grown, 1);
     GROW(sx, 6);
     GROW(sv, 2);
     GROW(sI, 2);
@@ -587,20 +590,34 @@ static int grow(phc_climbing *c, size_t i, double dsig)
     return 0;
 }
 
-/* Step 5: rest centres from rest directions, parents first (indices grow
- * away from the seed). */
-static void rebuild_rest(phc_climbing *c)
+/* Step 5 for particle i: its rest centre at its parent's rest tip (the
+ * seed's at the base) plus L_i/2 along its rest direction. */
+static void rest_at(phc_climbing *c, size_t i)
 {
-    for (size_t i = 0; i < c->n; ++i) {
-        double b[3];
-        if (c->parent[i] == PHC_CLIMBING_NONE)
-            memcpy(b, c->base, sizeof b);
-        else
-            seg_tip(c, c->parent[i], 1, b);
-        const double h = seg_half(c, i);
-        for (int k = 0; k < 3; ++k)
-            c->xr[3 * i + k] = b[k] + h * c->dr[3 * i + k];
-    }
+    double b[3];
+    if (c->parent[i] == PHC_CLIMBING_NONE)
+        memcpy(b, c->base, sizeof b);
+    else
+        seg_tip(c, c->parent[i], 1, b);
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        c->xr[3 * i + k] = b[k] + h * c->dr[3 * i + k];
+}
+
+/* Step 5: the rest centres that can have changed: those of this step's
+ * tips (grown[0 .. ngrown), the tips at its start: only they turn, by
+ * their tropisms and keep_outside, and change size), then of the new
+ * particles n0 .. n−1 in index order (each after its parent, an old tip
+ * or a new particle).  Every other particle has a rest direction and size
+ * it had before and a parent that is no tip (a particle with children
+ * stopped growing), so its rest centre, computed alike, is the one it
+ * has. */
+static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
+{
+    for (size_t t = 0; t < ngrown; ++t)
+        rest_at(c, c->grown[t]);
+    for (size_t i = n0; i < c->n; ++i)
+        rest_at(c, i);
 }
 
 /* Anchor strength of i now (eq. 5), 0 when not anchored (here, so that
@@ -1208,9 +1225,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
             turn_tip(c, i, dt);
     }
     /* 3.–4. growth and branching, in index order (the random numbers) */
+    size_t ngrown = 0;
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])
             continue;
+        c->grown[ngrown++] = i; /* (c->grown may move as grow appends) */
         /* apical dominance (ours): a tip of order k grows at r·a^k */
         const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
         if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
@@ -1228,7 +1247,7 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     if (o->cambium_rate > 0)
         cambium(c, dt);
     /* 5. rest shape */
-    rebuild_rest(c);
+    rebuild_rest(c, ngrown, n0);
     /* 6. dynamics, or kinematic: current = rest */
     if (o->dynamics_substeps > 0) {
         if (dynamics(c, dt, err)) {
