@@ -37,7 +37,8 @@ struct phc_climbing {
     double *xr, *dr;         /* 3n rest centre, rest direction */
     double *anchor_at;       /* 3n, m */
     double *anchor_t0;       /* n, s: when the anchor was made */
-    double *vol;             /* n scratch: particle volumes, m^3 */
+    double *vol;             /* n: particle volumes π r² L, m^3 (kept: made again when σ or r
+                                changes, in add_particle, step 5 and step 9) */
     double *phi;             /* light grid scratch */
     phc_climbing_stats stats;
     /* leaves, secondary growth, shadows of the supports */
@@ -296,6 +297,13 @@ static int unit(const double v[3], double u[3])
     return 0;
 }
 
+/* Particle i's volume π r² L (m³), a light-grid point's shading volume. */
+static void volume_at(phc_climbing *c, size_t i)
+{
+    const double L = c->sigma[i] * c->o.max_length;
+    c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
+}
+
 /* Appends a particle of size sigma whose base is at b along direction dir
  * (current and rest alike); returns its index or NONE (out of memory). */
 static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int lateral,
@@ -319,6 +327,7 @@ static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int l
     c->has_leaf[i] = 0;
     c->leaf_light[i] = 0;
     c->r0[i] = radius;
+    volume_at(c, i);
     const double h = 0.5 * sigma * c->o.max_length;
     for (int k = 0; k < 3; ++k) {
         c->d[3 * i + k] = c->dr[3 * i + k] = dir[k];
@@ -604,18 +613,20 @@ static void rest_at(phc_climbing *c, size_t i)
         c->xr[3 * i + k] = b[k] + h * c->dr[3 * i + k];
 }
 
-/* Step 5: the rest centres that can have changed: those of this step's
- * tips (grown[0 .. ngrown), the tips at its start: only they turn, by
- * their tropisms and keep_outside, and change size), then of the new
- * particles n0 .. n−1 in index order (each after its parent, an old tip
- * or a new particle).  Every other particle has a rest direction and size
- * it had before and a parent that is no tip (a particle with children
- * stopped growing), so its rest centre, computed alike, is the one it
- * has. */
+/* Step 5: the rest centres (and volumes) that can have changed: those of
+ * this step's tips (grown[0 .. ngrown), the tips at its start: only they
+ * turn, by their tropisms and keep_outside, and change size), then of the
+ * new particles n0 .. n−1 in index order (each after its parent, an old
+ * tip or a new particle).  Every other particle has a rest direction and
+ * size it had before and a parent that is no tip (a particle with
+ * children stopped growing), so its rest centre, computed alike, is the
+ * one it has. */
 static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
 {
-    for (size_t t = 0; t < ngrown; ++t)
+    for (size_t t = 0; t < ngrown; ++t) {
         rest_at(c, c->grown[t]);
+        volume_at(c, c->grown[t]);
+    }
     for (size_t i = n0; i < c->n; ++i)
         rest_at(c, i);
 }
@@ -983,8 +994,6 @@ static void count(phc_climbing *c)
 /* Step 1's shading point of particle i: its centre and volume. */
 static void light_point(phc_climbing *c, size_t i)
 {
-    const double L = c->sigma[i] * c->o.max_length;
-    c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
     memcpy(c->sx + 3 * i, c->x + 3 * i, 3 * sizeof *c->sx);
     c->sv[i] = c->vol[i];
 }
@@ -994,7 +1003,19 @@ static void light_point(phc_climbing *c, size_t i)
 static int light_step(phc_climbing *c, size_t n0)
 {
     const phc_climbing_options *o = &c->o;
-    /* the particles' points: point i is particle i (each its own) */
+    const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
+    if (o->leaf_step == 0) { /* no leaves: the points are the particles' centres, as they are */
+        phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->x, c->vol, n0, c->phi,
+                                  c->light);
+        if (c->field.value) { /* seek_light: the light field from the same points */
+            if (phc_climbing_light_field_update(&c->field, c->opaque ? &occ : NULL, c->x, c->vol,
+                                                n0))
+                return -1;
+            c->field_ready = 1;
+        }
+        return 0;
+    }
+    /* the particles' points, then the leaves': point i is particle i */
     if (team(n0)) {
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n0; ++i)
@@ -1005,17 +1026,16 @@ static int light_step(phc_climbing *c, size_t n0)
     }
     size_t m = n0;
     const double leaf_vol = o->leaf_size * o->leaf_size * o->leaf_thickness;
-    for (size_t i = 0; i < n0 && o->leaf_step > 0; ++i) /* (leaves only with a leaf_step) */
+    for (size_t i = 0; i < n0; ++i)
         if (c->has_leaf[i]) {
             memcpy(c->sx + 3 * m, c->leaf_c + 3 * i, 3 * sizeof *c->sx);
             c->sv[m++] = leaf_vol;
         }
-    const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
     phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi, c->sI);
     memcpy(c->light, c->sI, n0 * sizeof *c->light);
     const size_t points = m;
     m = n0;
-    for (size_t i = 0; i < n0 && o->leaf_step > 0; ++i)
+    for (size_t i = 0; i < n0; ++i)
         if (c->has_leaf[i])
             c->leaf_light[i] = c->sI[m++];
     /* seek_light: the light field from the same shading points */
@@ -1033,8 +1053,10 @@ static void cambium(phc_climbing *c, double dt)
 {
     phc_climbing_pipe_targets(c->n, c->parent, c->radius, c->r0, c->has_leaf,
                               c->o.leaf_pipe_area, c->has_child, c->target);
-    for (size_t i = 0; i < c->n; ++i)
+    for (size_t i = 0; i < c->n; ++i) {
         c->radius[i] = phc_climbing_cambium_step(c->radius[i], c->target[i], c->o.cambium_rate, dt);
+        volume_at(c, i);
+    }
 }
 
 /* Step 8 for particle i: a new leaf when its node is grown and due one;
