@@ -1504,10 +1504,11 @@ static void plan_projections(phc_particles *p)
     if (!p->o.follow_parent || p->project_all)
         return;
     size_t np = 0, ng = 0;
-    for (size_t i = 0; i < n; ++i)
-        p->plev[i] = p->glev[i] = -1;
     p->npins = 0;
     for (size_t i = 0; i < n; ++i) {
+        /* (reset here, in the same pass: below, only i's own are read
+           before the pass ends; an early return leaves the lists unused) */
+        p->plev[i] = p->glev[i] = -1;
         if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
             p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
         else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)))
