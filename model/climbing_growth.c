@@ -737,12 +737,12 @@ static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
     return p;
 }
 
-/* Particle i's part of the hand-over (i < the system's count): its rest
- * segment when its rest changed, its current place when the growth moved
- * it, its age and its anchor; the seed clamped.  Touches only particle i
- * (in the plant's record and in the system), so the particles may be
- * handed over in any order or at once. */
-static int sync_one(phc_climbing *c, size_t i, phc_error *err)
+/* Particle i's changes for the hand-over (i < the system's count): its
+ * rest segment when its rest changed, its current place when the growth
+ * moved it (velocities kept), as the record of what the system holds
+ * tells.  Touches only particle i (in the plant's record and in the
+ * system). */
+static int hand_change(phc_climbing *c, size_t i, phc_error *err)
 {
     phc_particles *p = c->sys;
     double head[3], tail[3], q[4];
@@ -760,9 +760,18 @@ static int sync_one(phc_climbing *c, size_t i, phc_error *err)
         if (phc_particles_place(p, i, c->x + 3 * i, q, err))
             return -1;
     }
-    if (rest || moved) /* (written only then: most particles are as they were) */
+    if (rest || moved)
         seen_now(c, i, was);
-    if (i == 0) { /* the seed: clamped at its rest place and orientation */
+    return 0;
+}
+
+/* Particle i's age and anchor for the hand-over; the seed clamped at its
+ * rest place and orientation.  Touches only particle i. */
+static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
+{
+    phc_particles *p = c->sys;
+    if (i == 0) {
+        double q[4];
         phc_quat_from_z(c->dr, q);
         return phc_particles_set_position(p, 0, c->xr, err) ||
                phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
@@ -775,11 +784,37 @@ static int sync_one(phc_climbing *c, size_t i, phc_error *err)
                  : phc_particles_release(p, i, err);
 }
 
+/* The particles whose rest or place the growth can have changed since the
+ * last hand-over: this step's tips (grown[0 .. ngrown): only they turn and
+ * change size; the read-back keeps the record of every tip's place), or
+ * all of them when secondary growth changes every radius. */
+static size_t changed_count(const phc_climbing *c, size_t ngrown, size_t known)
+{
+    return c->o.cambium_rate > 0 ? known : ngrown;
+}
+
+static size_t changed_at(const phc_climbing *c, size_t t)
+{
+    return c->o.cambium_rate > 0 ? t : c->grown[t];
+}
+
+/* Records the smallest failing index i and its error (any thread). */
+static void first_error(size_t i, const phc_error *mine, size_t *first_bad, phc_error *err)
+{
+#pragma omp critical(phc_climbing_sync)
+    if (i < *first_bad) {
+        *first_bad = i;
+        if (err)
+            *err = *mine;
+    }
+}
+
 /* Hands the grown plant to c->sys (made at the first call): the new
- * particles appended in index order (each after its parent), then every
- * particle's sync_one, on the threads for a large plant (the error
- * reported is the one of the smallest failing index, as in index order). */
-static int dynamics_sync(phc_climbing *c, phc_error *err)
+ * particles appended in index order (each after its parent), the changes
+ * of the particles the growth can have changed (hand_change), then every
+ * particle's age and anchor (hand_age_anchor); on the threads for a large
+ * plant (the error reported is that of the smallest failing index). */
+static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
 {
     const size_t n = c->n;
     if (n > c->sys_seen_cap) { /* amortised: doubling */
@@ -793,16 +828,17 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
         c->sys_seen = t;
         c->sys_seen_cap = cap;
     }
-    size_t known = 0;
+    size_t known = 0, nchanged = 0;
     if (!c->sys) {
         if (!(c->sys = dynamics_new(c, err)))
             return -1;
         phc_particles_measure_stress(c->sys, 0); /* nothing reads it here */
         known = n;
         for (size_t i = 0; i < n; ++i)
-            seen_now(c, i, c->sys_seen + SEEN * i);
+            seen_now(c, i, c->sys_seen + SEEN * i); /* made as it is: nothing changed */
     } else {
         known = phc_particles_count(c->sys);
+        nchanged = changed_count(c, ngrown, known);
     }
     phc_particles *p = c->sys;
     if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
@@ -818,26 +854,30 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
             return -1;
         seen_now(c, i, c->sys_seen + SEEN * i); /* handed over as it is now */
     }
-    if (!team(n)) {
+    if (!team(n)) { /* (each particle's change before its age: as in index order) */
+        for (size_t t = 0; t < nchanged; ++t)
+            if (hand_change(c, changed_at(c, t), err))
+                return -1;
         for (size_t i = 0; i < n; ++i)
-            if (sync_one(c, i, err))
+            if (hand_age_anchor(c, i, err))
                 return -1;
         return 0;
     }
     size_t first_bad = n;
-    /* dynamic chunks: the growing tips (their rest segment and place
-       handed over) crowd the high indices */
-#pragma omp parallel for schedule(dynamic, 512)
-    for (size_t i = 0; i < n; ++i) {
+#pragma omp parallel
+    {
         phc_error mine;
-        if (sync_one(c, i, &mine) == 0)
-            continue;
-#pragma omp critical(phc_climbing_sync)
-        if (i < first_bad) {
-            first_bad = i;
-            if (err)
-                *err = mine;
+#pragma omp for schedule(dynamic, 256)
+        for (size_t t = 0; t < nchanged; ++t) {
+            const size_t i = changed_at(c, t);
+            if (hand_change(c, i, &mine))
+                first_error(i, &mine, &first_bad, err);
         }
+        /* (the barrier: the seed's orientation after its rest) */
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; ++i)
+            if (hand_age_anchor(c, i, &mine))
+                first_error(i, &mine, &first_bad, err);
     }
     return first_bad < n ? -1 : 0;
 }
@@ -889,15 +929,17 @@ static void read_back(phc_climbing *c, size_t i)
     R[8] = 1 - 2 * (a * a + b * b);
     const double dz[3] = {R[2], R[5], R[8]};
     unit(dz, c->d + 3 * i);
-    memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
-    memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
+    if (c->apical[i] || c->o.cambium_rate > 0) { /* (the next hand-over compares only these) */
+        memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
+        memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
+    }
 }
 
 /* Step 6: the hand-over and the substeps (the shape is read back in step
  * 7's loop, anchors()). */
-static int dynamics(phc_climbing *c, double dt, phc_error *err)
+static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
 {
-    if (dynamics_sync(c, err))
+    if (dynamics_sync(c, ngrown, err))
         goto fail;
     phc_particles *p = c->sys;
     const double h = dt / (double)c->o.dynamics_substeps;
@@ -1272,7 +1314,7 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     rebuild_rest(c, ngrown, n0);
     /* 6. dynamics, or kinematic: current = rest */
     if (o->dynamics_substeps > 0) {
-        if (dynamics(c, dt, err)) {
+        if (dynamics(c, dt, ngrown, err)) {
             count(c);
             return -1;
         }
