@@ -65,6 +65,8 @@ struct phc_climbing {
     phc_particles *sys;
     double *sys_seen;
     size_t sys_seen_cap;
+    int handed, sync_all;    /* the last step handed its growth to c->sys; else (sync_all)
+                                this step's hand-over compares every particle */
     size_t pushed;           /* collisions of the last step (option collide) */
     double depth;            /* smallest δ − r before the pushes, m */
 };
@@ -786,16 +788,19 @@ static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
 
 /* The particles whose rest or place the growth can have changed since the
  * last hand-over: this step's tips (grown[0 .. ngrown): only they turn and
- * change size; the read-back keeps the record of every tip's place), or
- * all of them when secondary growth changes every radius. */
+ * change size), or all of them when secondary growth changes every radius
+ * or the last step stopped (an error) between its growth and its
+ * hand-over. */
+static int compare_all(const phc_climbing *c) { return c->o.cambium_rate > 0 || c->sync_all; }
+
 static size_t changed_count(const phc_climbing *c, size_t ngrown, size_t known)
 {
-    return c->o.cambium_rate > 0 ? known : ngrown;
+    return compare_all(c) ? known : ngrown;
 }
 
 static size_t changed_at(const phc_climbing *c, size_t t)
 {
-    return c->o.cambium_rate > 0 ? t : c->grown[t];
+    return compare_all(c) ? t : c->grown[t];
 }
 
 /* Records the smallest failing index i and its error (any thread). */
@@ -929,10 +934,8 @@ static void read_back(phc_climbing *c, size_t i)
     R[8] = 1 - 2 * (a * a + b * b);
     const double dz[3] = {R[2], R[5], R[8]};
     unit(dz, c->d + 3 * i);
-    if (c->apical[i] || c->o.cambium_rate > 0) { /* (the next hand-over compares only these) */
-        memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
-        memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
-    }
+    memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
+    memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
 }
 
 /* Step 6: the hand-over and the substeps (the shape is read back in step
@@ -941,6 +944,7 @@ static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
 {
     if (dynamics_sync(c, ngrown, err))
         goto fail;
+    c->handed = 1;
     phc_particles *p = c->sys;
     const double h = dt / (double)c->o.dynamics_substeps;
     c->pushed = 0;
@@ -1271,6 +1275,8 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
                              "climbing: growth_rate * dt = %g must be below 1 - bud_fraction = "
                              "%g (one successor per tip and step)",
                              o->growth_rate * dt, 1 - o->bud_fraction);
+    c->sync_all = !c->handed; /* (an error below leaves handed 0) */
+    c->handed = 0;
     c->stats.time += dt;
     const size_t n0 = c->n;
     for (size_t i = 0; i < n0; ++i)
