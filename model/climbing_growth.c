@@ -37,7 +37,8 @@ struct phc_climbing {
     double *xr, *dr;         /* 3n rest centre, rest direction */
     double *anchor_at;       /* 3n, m */
     double *anchor_t0;       /* n, s: when the anchor was made */
-    double *vol;             /* n scratch: particle volumes, m^3 */
+    double *vol;             /* n: particle volumes π r² L, m^3 (kept: made again when σ or r
+                                changes, in add_particle, step 5 and step 9) */
     double *phi;             /* light grid scratch */
     phc_climbing_stats stats;
     /* leaves, secondary growth, shadows of the supports */
@@ -48,6 +49,7 @@ struct phc_climbing {
     double *r0;              /* n: primary radius, m */
     unsigned char *has_child;/* n scratch */
     double *target;          /* n scratch: pipe-model target areas, m^2 */
+    size_t *grown;           /* n scratch: the tips of this step (step 5 rebuilds their rest) */
     double *sx, *sv, *sI;    /* 6n, 2n, 2n scratch: light points, volumes, light */
     unsigned char *opaque;   /* light-grid cells holding occluders, NULL: none */
     double *occ_v;           /* occluding triangles' vertices, m (3 per vertex) */
@@ -63,6 +65,8 @@ struct phc_climbing {
     phc_particles *sys;
     double *sys_seen;
     size_t sys_seen_cap;
+    int handed, sync_all;    /* the last step handed its growth to c->sys; else (sync_all)
+                                this step's hand-over compares every particle */
     size_t pushed;           /* collisions of the last step (option collide) */
     double depth;            /* smallest δ − r before the pushes, m */
 };
@@ -149,6 +153,7 @@ void phc_climbing_free(phc_climbing *c)
     free(c->r0);
     free(c->has_child);
     free(c->target);
+    free(c->grown);
     phc_climbing_light_field_free(&c->field);
     free(c->sx);
     free(c->sv);
@@ -201,6 +206,7 @@ static int reserve(phc_climbing *c, size_t want)
     GROW(r0, 1);
     GROW(has_child, 1);
     GROW(target, 1);
+    GROW(grown, 1);
     GROW(sx, 6);
     GROW(sv, 2);
     GROW(sI, 2);
@@ -293,6 +299,13 @@ static int unit(const double v[3], double u[3])
     return 0;
 }
 
+/* Particle i's volume π r² L (m³), a light-grid point's shading volume. */
+static void volume_at(phc_climbing *c, size_t i)
+{
+    const double L = c->sigma[i] * c->o.max_length;
+    c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
+}
+
 /* Appends a particle of size sigma whose base is at b along direction dir
  * (current and rest alike); returns its index or NONE (out of memory). */
 static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int lateral,
@@ -316,6 +329,7 @@ static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int l
     c->has_leaf[i] = 0;
     c->leaf_light[i] = 0;
     c->r0[i] = radius;
+    volume_at(c, i);
     const double h = 0.5 * sigma * c->o.max_length;
     for (int k = 0; k < 3; ++k) {
         c->d[3 * i + k] = c->dr[3 * i + k] = dir[k];
@@ -387,13 +401,13 @@ nomem:
     return NULL;
 }
 
-static double seg_half(const phc_climbing *c, size_t i)
+static inline double seg_half(const phc_climbing *c, size_t i)
 {
     return 0.5 * c->sigma[i] * c->o.max_length;
 }
 
 /* Base of i's current (rest when rest != 0) segment. */
-static void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
+static inline void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
 {
     const double *x = rest ? c->xr : c->x, *d = rest ? c->dr : c->d;
     const double h = seg_half(c, i);
@@ -401,7 +415,7 @@ static void seg_base(const phc_climbing *c, size_t i, int rest, double b[3])
         b[k] = x[3 * i + k] - h * d[3 * i + k];
 }
 
-static void seg_tip(const phc_climbing *c, size_t i, int rest, double t[3])
+static inline void seg_tip(const phc_climbing *c, size_t i, int rest, double t[3])
 {
     const double *x = rest ? c->xr : c->x, *d = rest ? c->dr : c->d;
     const double h = seg_half(c, i);
@@ -587,28 +601,51 @@ static int grow(phc_climbing *c, size_t i, double dsig)
     return 0;
 }
 
-/* Step 5: rest centres from rest directions, parents first (indices grow
- * away from the seed). */
-static void rebuild_rest(phc_climbing *c)
+/* Step 5 for particle i: its rest centre at its parent's rest tip (the
+ * seed's at the base) plus L_i/2 along its rest direction. */
+static void rest_at(phc_climbing *c, size_t i)
 {
-    for (size_t i = 0; i < c->n; ++i) {
-        double b[3];
-        if (c->parent[i] == PHC_CLIMBING_NONE)
-            memcpy(b, c->base, sizeof b);
-        else
-            seg_tip(c, c->parent[i], 1, b);
-        const double h = seg_half(c, i);
-        for (int k = 0; k < 3; ++k)
-            c->xr[3 * i + k] = b[k] + h * c->dr[3 * i + k];
-    }
+    double b[3];
+    if (c->parent[i] == PHC_CLIMBING_NONE)
+        memcpy(b, c->base, sizeof b);
+    else
+        seg_tip(c, c->parent[i], 1, b);
+    const double h = seg_half(c, i);
+    for (int k = 0; k < 3; ++k)
+        c->xr[3 * i + k] = b[k] + h * c->dr[3 * i + k];
 }
 
-double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
+/* Step 5: the rest centres (and volumes) that can have changed: those of
+ * this step's tips (grown[0 .. ngrown), the tips at its start: only they
+ * turn, by their tropisms and keep_outside, and change size), then of the
+ * new particles n0 .. n−1 in index order (each after its parent, an old
+ * tip or a new particle).  Every other particle has a rest direction and
+ * size it had before and a parent that is no tip (a particle with
+ * children stopped growing), so its rest centre, computed alike, is the
+ * one it has. */
+static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
+{
+    for (size_t t = 0; t < ngrown; ++t) {
+        rest_at(c, c->grown[t]);
+        volume_at(c, c->grown[t]);
+    }
+    for (size_t i = n0; i < c->n; ++i)
+        rest_at(c, i);
+}
+
+/* Anchor strength of i now (eq. 5), 0 when not anchored (here, so that
+ * the hand-over inlines it). */
+static inline double anchor_strength(const phc_climbing *c, size_t i)
 {
     if (!c->anchored[i])
         return 0;
     const double ramp = fmin(1, (c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
     return c->o.anchor_strength * c->sigma[i] * ramp;
+}
+
+double phc_climbing_anchor_strength(const phc_climbing *c, size_t i)
+{
+    return anchor_strength(c, i);
 }
 
 /* Step 9's stiffening: (r/r0)^4, 1 without secondary growth. */
@@ -642,6 +679,20 @@ static void seen_now(const phc_climbing *c, size_t i, double out[SEEN])
     out[7] = c->sigma[i];
     memcpy(out + 8, c->x + 3 * i, 3 * sizeof(double));
     memcpy(out + 11, c->d + 3 * i, 3 * sizeof(double));
+}
+
+/* 1 when the k doubles a and b hold the same bits (memcmp's equality,
+ * without the call). */
+static inline int same_bits(const double *a, const double *b, int k)
+{
+    for (int j = 0; j < k; ++j) {
+        uint64_t u, v;
+        memcpy(&u, a + j, sizeof u);
+        memcpy(&v, b + j, sizeof v);
+        if (u != v)
+            return 0;
+    }
+    return 1;
 }
 
 static void rest_segment(const phc_climbing *c, size_t i, double head[3], double tail[3])
@@ -688,8 +739,87 @@ static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
     return p;
 }
 
-/* Hands the grown plant to c->sys (made at the first call). */
-static int dynamics_sync(phc_climbing *c, phc_error *err)
+/* Particle i's changes for the hand-over (i < the system's count): its
+ * rest segment when its rest changed, its current place when the growth
+ * moved it (velocities kept), as the record of what the system holds
+ * tells.  Touches only particle i (in the plant's record and in the
+ * system). */
+static int hand_change(phc_climbing *c, size_t i, phc_error *err)
+{
+    phc_particles *p = c->sys;
+    double head[3], tail[3], q[4];
+    double *was = c->sys_seen + SEEN * i;
+    const int rest = !same_bits(was, c->xr + 3 * i, 3) || !same_bits(was + 3, c->dr + 3 * i, 3) ||
+                     !same_bits(was + 6, c->radius + i, 1) || !same_bits(was + 7, c->sigma + i, 1);
+    const int moved = !same_bits(was + 8, c->x + 3 * i, 3) || !same_bits(was + 11, c->d + 3 * i, 3);
+    if (rest) {
+        rest_segment(c, i, head, tail);
+        if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
+            return -1;
+    }
+    if (i > 0 && moved) {
+        phc_quat_from_z(c->d + 3 * i, q);
+        if (phc_particles_place(p, i, c->x + 3 * i, q, err))
+            return -1;
+    }
+    if (rest || moved)
+        seen_now(c, i, was);
+    return 0;
+}
+
+/* Particle i's age and anchor for the hand-over; the seed clamped at its
+ * rest place and orientation.  Touches only particle i. */
+static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
+{
+    phc_particles *p = c->sys;
+    if (i == 0) {
+        double q[4];
+        phc_quat_from_z(c->dr, q);
+        return phc_particles_set_position(p, 0, c->xr, err) ||
+               phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
+               phc_particles_anchor(p, 0, c->xr, 1, 1, err);
+    }
+    if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
+        return -1;
+    const double k = anchor_strength(c, i);
+    return k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
+                 : phc_particles_release(p, i, err);
+}
+
+/* The particles whose rest or place the growth can have changed since the
+ * last hand-over: this step's tips (grown[0 .. ngrown): only they turn and
+ * change size), or all of them when secondary growth changes every radius
+ * or the last step stopped (an error) between its growth and its
+ * hand-over. */
+static int compare_all(const phc_climbing *c) { return c->o.cambium_rate > 0 || c->sync_all; }
+
+static size_t changed_count(const phc_climbing *c, size_t ngrown, size_t known)
+{
+    return compare_all(c) ? known : ngrown;
+}
+
+static size_t changed_at(const phc_climbing *c, size_t t)
+{
+    return compare_all(c) ? t : c->grown[t];
+}
+
+/* Records the smallest failing index i and its error (any thread). */
+static void first_error(size_t i, const phc_error *mine, size_t *first_bad, phc_error *err)
+{
+#pragma omp critical(phc_climbing_sync)
+    if (i < *first_bad) {
+        *first_bad = i;
+        if (err)
+            *err = *mine;
+    }
+}
+
+/* Hands the grown plant to c->sys (made at the first call): the new
+ * particles appended in index order (each after its parent), the changes
+ * of the particles the growth can have changed (hand_change), then every
+ * particle's age and anchor (hand_age_anchor); on the threads for a large
+ * plant (the error reported is that of the smallest failing index). */
+static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
 {
     const size_t n = c->n;
     if (n > c->sys_seen_cap) { /* amortised: doubling */
@@ -703,61 +833,58 @@ static int dynamics_sync(phc_climbing *c, phc_error *err)
         c->sys_seen = t;
         c->sys_seen_cap = cap;
     }
-    size_t known = 0;
+    size_t known = 0, nchanged = 0;
     if (!c->sys) {
         if (!(c->sys = dynamics_new(c, err)))
             return -1;
         phc_particles_measure_stress(c->sys, 0); /* nothing reads it here */
         known = n;
         for (size_t i = 0; i < n; ++i)
-            seen_now(c, i, c->sys_seen + SEEN * i);
+            seen_now(c, i, c->sys_seen + SEEN * i); /* made as it is: nothing changed */
     } else {
         known = phc_particles_count(c->sys);
+        nchanged = changed_count(c, ngrown, known);
     }
     phc_particles *p = c->sys;
     if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
         return -1;
     phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
-    for (size_t i = 0; i < n; ++i) {
-        double now[SEEN], head[3], tail[3], q[4];
-        seen_now(c, i, now);
-        double *was = c->sys_seen + SEEN * i;
-        if (i >= known) { /* new: at its current place, at rest */
-            rest_segment(c, i, head, tail);
-            phc_quat_from_z(c->d + 3 * i, q);
-            if (phc_particles_append(p, c->parent[i], head, tail, c->radius[i], NULL, err) ||
-                phc_particles_set_position(p, i, c->x + 3 * i, err) ||
-                phc_particles_set_orientation(p, i, q, err))
-                return -1;
-        } else {
-            if (memcmp(now, was, 8 * sizeof(double)) != 0) { /* rest changed */
-                rest_segment(c, i, head, tail);
-                if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
-                    return -1;
-            }
-            if (i > 0 && memcmp(now + 8, was + 8, 6 * sizeof(double)) != 0) { /* moved */
-                phc_quat_from_z(c->d + 3 * i, q);
-                if (phc_particles_place(p, i, c->x + 3 * i, q, err))
-                    return -1;
-            }
-        }
-        memcpy(was, now, sizeof now);
-        if (i == 0) { /* the seed: clamped at its rest place and orientation */
-            phc_quat_from_z(c->dr, q);
-            if (phc_particles_set_position(p, 0, c->xr, err) ||
-                phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
-                phc_particles_anchor(p, 0, c->xr, 1, 1, err))
-                return -1;
-            continue;
-        }
-        if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
+    for (size_t i = known; i < n; ++i) { /* new: at its current place, at rest */
+        double head[3], tail[3], q[4];
+        rest_segment(c, i, head, tail);
+        phc_quat_from_z(c->d + 3 * i, q);
+        if (phc_particles_append(p, c->parent[i], head, tail, c->radius[i], NULL, err) ||
+            phc_particles_set_position(p, i, c->x + 3 * i, err) ||
+            phc_particles_set_orientation(p, i, q, err))
             return -1;
-        const double k = c->anchored[i] ? phc_climbing_anchor_strength(c, i) : 0;
-        if (k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
-                  : phc_particles_release(p, i, err))
-            return -1;
+        seen_now(c, i, c->sys_seen + SEEN * i); /* handed over as it is now */
     }
-    return 0;
+    if (!team(n)) { /* (each particle's change before its age: as in index order) */
+        for (size_t t = 0; t < nchanged; ++t)
+            if (hand_change(c, changed_at(c, t), err))
+                return -1;
+        for (size_t i = 0; i < n; ++i)
+            if (hand_age_anchor(c, i, err))
+                return -1;
+        return 0;
+    }
+    size_t first_bad = n;
+#pragma omp parallel
+    {
+        phc_error mine;
+#pragma omp for schedule(dynamic, 256)
+        for (size_t t = 0; t < nchanged; ++t) {
+            const size_t i = changed_at(c, t);
+            if (hand_change(c, i, &mine))
+                first_error(i, &mine, &first_bad, err);
+        }
+        /* (the barrier: the seed's orientation after its rest) */
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; ++i)
+            if (hand_age_anchor(c, i, &mine))
+                first_error(i, &mine, &first_bad, err);
+    }
+    return first_bad < n ? -1 : 0;
 }
 
 /* Kinematic collisions (option collide): current centres pushed out of
@@ -793,11 +920,31 @@ void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *dept
         *depth = c->depth;
 }
 
-static int dynamics(phc_climbing *c, double dt, phc_error *err)
+/* Particle i's current centre and direction from c->sys, into the plant
+ * and its record of what the system holds. */
+static void read_back(phc_climbing *c, size_t i)
 {
-    const size_t n = c->n;
-    if (dynamics_sync(c, err))
+    double q[4], R[9];
+    phc_particles_position(c->sys, i, c->x + 3 * i);
+    phc_particles_orientation(c->sys, i, q);
+    /* direction = R(q)·z: the third column of R */
+    const double w = q[0], a = q[1], b = q[2], cc = q[3];
+    R[2] = 2 * (a * cc + w * b);
+    R[5] = 2 * (b * cc - w * a);
+    R[8] = 1 - 2 * (a * a + b * b);
+    const double dz[3] = {R[2], R[5], R[8]};
+    unit(dz, c->d + 3 * i);
+    memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
+    memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
+}
+
+/* Step 6: the hand-over and the substeps (the shape is read back in step
+ * 7's loop, anchors()). */
+static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
+{
+    if (dynamics_sync(c, ngrown, err))
         goto fail;
+    c->handed = 1;
     phc_particles *p = c->sys;
     const double h = dt / (double)c->o.dynamics_substeps;
     c->pushed = 0;
@@ -810,20 +957,6 @@ static int dynamics(phc_climbing *c, double dt, phc_error *err)
         phc_particles_collisions(p, &pushed, &depth);
         c->pushed += pushed;
         c->depth = fmin(c->depth, depth);
-    }
-    for (size_t i = 1; i < n; ++i) {
-        double q[4], R[9];
-        phc_particles_position(p, i, c->x + 3 * i);
-        phc_particles_orientation(p, i, q);
-        /* direction = R(q)·z: the third column of R */
-        const double w = q[0], a = q[1], b = q[2], cc = q[3];
-        R[2] = 2 * (a * cc + w * b);
-        R[5] = 2 * (b * cc - w * a);
-        R[8] = 1 - 2 * (a * a + b * b);
-        const double dz[3] = {R[2], R[5], R[8]};
-        unit(dz, c->d + 3 * i);
-        memcpy(c->sys_seen + SEEN * i + 8, c->x + 3 * i, 3 * sizeof(double));
-        memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
     }
     return 0;
 fail: /* the next dynamic step starts a fresh system from the plant */
@@ -861,19 +994,31 @@ static void anchor(phc_climbing *c, size_t i, size_t *made, size_t *released)
     }
 }
 
-/* Step 7: anchors; each particle's anchor is its own. */
-static void anchors(phc_climbing *c)
+/* Step 7 for particle i: with `read`, first its current shape from the
+ * dynamics (read_back; the seed's is its rest), then its anchor. */
+static void read_and_anchor(phc_climbing *c, size_t i, int read, size_t *made, size_t *released)
 {
-    if (!c->o.closest)
+    if (read && i > 0)
+        read_back(c, i);
+    if (c->o.closest)
+        anchor(c, i, made, released);
+}
+
+/* Step 7: anchors; each particle's anchor is its own.  With `read` (after
+ * a dynamics step), each particle's current shape is read back from the
+ * particles first, in the same loop (one pass, one parallel region). */
+static void anchors(phc_climbing *c, int read)
+{
+    if (!c->o.closest && !read)
         return;
     size_t made = 0, released = 0;
     if (team(c->n)) {
 #pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released)
         for (size_t i = 0; i < c->n; ++i)
-            anchor(c, i, &made, &released);
+            read_and_anchor(c, i, read, &made, &released);
     } else {
         for (size_t i = 0; i < c->n; ++i)
-            anchor(c, i, &made, &released);
+            read_and_anchor(c, i, read, &made, &released);
     }
     c->stats.anchors_made += made;
     c->stats.anchors_released += released;
@@ -892,25 +1037,46 @@ static void count(phc_climbing *c)
     c->stats.anchored = anchored;
 }
 
+/* Step 1's shading point of particle i: its centre and volume. */
+static void light_point(phc_climbing *c, size_t i)
+{
+    memcpy(c->sx + 3 * i, c->x + 3 * i, 3 * sizeof *c->sx);
+    c->sv[i] = c->vol[i];
+}
+
 /* Step 1: light at the particles and the leaves (model/climbing_light.h);
  * leaves add their volumes s²·thickness to the grid. */
 static int light_step(phc_climbing *c, size_t n0)
 {
     const phc_climbing_options *o = &c->o;
-    size_t m = 0;
-    for (size_t i = 0; i < n0; ++i) {
-        const double L = c->sigma[i] * o->max_length;
-        c->vol[i] = PI * c->radius[i] * c->radius[i] * L;
-        memcpy(c->sx + 3 * m, c->x + 3 * i, 3 * sizeof *c->sx);
-        c->sv[m++] = c->vol[i];
+    const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
+    if (o->leaf_step == 0) { /* no leaves: the points are the particles' centres, as they are */
+        phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->x, c->vol, n0, c->phi,
+                                  c->light);
+        if (c->field.value) { /* seek_light: the light field from the same points */
+            if (phc_climbing_light_field_update(&c->field, c->opaque ? &occ : NULL, c->x, c->vol,
+                                                n0))
+                return -1;
+            c->field_ready = 1;
+        }
+        return 0;
     }
+    /* the particles' points, then the leaves': point i is particle i */
+    if (team(n0)) {
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n0; ++i)
+            light_point(c, i);
+    } else {
+        for (size_t i = 0; i < n0; ++i)
+            light_point(c, i);
+    }
+    size_t m = n0;
     const double leaf_vol = o->leaf_size * o->leaf_size * o->leaf_thickness;
     for (size_t i = 0; i < n0; ++i)
         if (c->has_leaf[i]) {
             memcpy(c->sx + 3 * m, c->leaf_c + 3 * i, 3 * sizeof *c->sx);
             c->sv[m++] = leaf_vol;
         }
-    const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
     phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi, c->sI);
     memcpy(c->light, c->sI, n0 * sizeof *c->light);
     const size_t points = m;
@@ -933,8 +1099,10 @@ static void cambium(phc_climbing *c, double dt)
 {
     phc_climbing_pipe_targets(c->n, c->parent, c->radius, c->r0, c->has_leaf,
                               c->o.leaf_pipe_area, c->has_child, c->target);
-    for (size_t i = 0; i < c->n; ++i)
+    for (size_t i = 0; i < c->n; ++i) {
         c->radius[i] = phc_climbing_cambium_step(c->radius[i], c->target[i], c->o.cambium_rate, dt);
+        volume_at(c, i);
+    }
 }
 
 /* Step 8 for particle i: a new leaf when its node is grown and due one;
@@ -1107,6 +1275,8 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
                              "climbing: growth_rate * dt = %g must be below 1 - bud_fraction = "
                              "%g (one successor per tip and step)",
                              o->growth_rate * dt, 1 - o->bud_fraction);
+    c->sync_all = !c->handed; /* (an error below leaves handed 0) */
+    c->handed = 0;
     c->stats.time += dt;
     const size_t n0 = c->n;
     for (size_t i = 0; i < n0; ++i)
@@ -1125,9 +1295,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
             turn_tip(c, i, dt);
     }
     /* 3.–4. growth and branching, in index order (the random numbers) */
+    size_t ngrown = 0;
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])
             continue;
+        c->grown[ngrown++] = i; /* (c->grown may move as grow appends) */
         /* apical dominance (ours): a tip of order k grows at r·a^k */
         const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
         if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
@@ -1145,10 +1317,10 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     if (o->cambium_rate > 0)
         cambium(c, dt);
     /* 5. rest shape */
-    rebuild_rest(c);
+    rebuild_rest(c, ngrown, n0);
     /* 6. dynamics, or kinematic: current = rest */
     if (o->dynamics_substeps > 0) {
-        if (dynamics(c, dt, err)) {
+        if (dynamics(c, dt, ngrown, err)) {
             count(c);
             return -1;
         }
@@ -1157,8 +1329,8 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         memcpy(c->d, c->dr, 3 * c->n * sizeof *c->d);
         collide_kinematic(c);
     }
-    /* 7. anchors */
-    anchors(c);
+    /* 7. anchors (after a dynamics step, with the read-back of the shape) */
+    anchors(c, o->dynamics_substeps > 0);
     /* 8. leaves */
     if (o->leaf_step > 0)
         leaves_update(c);

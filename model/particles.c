@@ -85,6 +85,17 @@ struct phc_particles {
     long *source_id;         /* n: segment ids for messages */
     size_t *child_index;     /* n: position of i among its parent's children */
     double *ell0;            /* 9n: D_j R̄_jᵀ / 5 (kg-free ellipsoid term, m²) */
+    /* The joint pass's rest terms of linked particle i (follow_one): j_i =
+     * R(q̄_u)ᵀ (h̄_i − x̄_u) and q̄_u⁻¹ q̄_i, u its parent, kept while neither
+     * rest changes: joint[7i .. 7i+7) was made at step joint_epoch[i],
+     * valid while that is later than rest_epoch[i] and rest_epoch[u] (the
+     * epoch of their last rest change; epoch counts the steps). */
+    double *joint;           /* 7n */
+    size_t *joint_epoch, *rest_epoch; /* n each */
+    size_t epoch;
+    unsigned char *ell0_stale; /* n: 1 when ell0 awaits its rest change (made when next
+                                  needed: a climbing plant's growing tips change their rest
+                                  every step, and nothing matches their groups) */
     double *ell;             /* 9n: R_j D_j R̄_jᵀ / 5 of the orientations being matched (m²) */
     /* Group slots: group k owns slots goff[k] .. goff[k+1]−1: slot 0 = k,
      * slot 1 = its parent, slot 2 + c = its c-th child; a slot whose link
@@ -414,6 +425,18 @@ done:
     return 0;
 }
 
+/* ell0_k = D R̄ᵀ / 5, D = diag(r², r², (L/2)²): the rest half of the
+ * ellipsoid moment R D R̄ᵀ / 5 (Müller & Chentanez eq. 10), m², from
+ * particle k's rest orientation and radii. */
+static void rest_moment(phc_particles *p, size_t k)
+{
+    double R0[9];
+    phc_quat_to_matrix(p->q0 + 4 * k, R0);
+    for (int t = 0; t < 3; ++t)
+        for (int c = 0; c < 3; ++c)
+            p->ell0[9 * k + 3 * t + c] = 0.2 * p->ax[3 * k + t] * p->ax[3 * k + t] * R0[3 * c + t];
+}
+
 /* ---- construction ------------------------------------------------------- */
 
 static const char *opt_problem(const phc_particles_options *o, char *buf, size_t size)
@@ -488,6 +511,10 @@ void phc_particles_free(phc_particles *p)
     free(p->source_id);
     free(p->child_index);
     free(p->ell0);
+    free(p->ell0_stale);
+    free(p->joint);
+    free(p->joint_epoch);
+    free(p->rest_epoch);
     free(p->ell);
     free(p->om);
     free(p->d0);
@@ -520,6 +547,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     p->n = n;
     p->cap = n;
     p->o = o;
+    p->epoch = 1; /* (rest_epoch 1 for every particle: made before any step) */
     const size_t slots = 3 * n; /* Σ_k (2 + children(k)) = 2n + (n − roots) <= 3n */
 #define ALLOC(field, count) \
     if (!(p->field = calloc((count), sizeof *p->field))) goto nomem
@@ -565,6 +593,10 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(source_id, n);
     ALLOC(child_index, n);
     ALLOC(ell0, 9 * n);
+    ALLOC(ell0_stale, n);
+    ALLOC(joint, 7 * n);
+    ALLOC(joint_epoch, n);
+    ALLOC(rest_epoch, n);
     ALLOC(ell, 9 * n);
     ALLOC(goff, n + 1);
     ALLOC(mem, slots);
@@ -582,6 +614,12 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     for (size_t i = 0; i < n; ++i) {
         const long id = g->source_id ? g->source_id[i] : (long)i;
         p->source_id[i] = id;
+        /* joint terms to be made (joint_epoch <= rest_epoch), written here
+           as non-zero values: calloc's untouched pages, read first in the
+           step's parallel joint pass and written there, cost each a
+           copy-on-write fault with a TLB shootdown to the other threads
+           (~40 ms for a 25k plant's first steps on two threads in a VM) */
+        p->rest_epoch[i] = p->joint_epoch[i] = 1;
         const double r = g->radius[i], L = g->length[i];
         if (!(r > 0) || !isfinite(r) || !(L > 0) || !isfinite(L)) {
             phc_error_set(err, PHC_ERR_INPUT,
@@ -632,13 +670,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
         p->goff[k + 1] = p->goff[k] + 2 + (p->child_start[k + 1] - p->child_start[k]);
         for (size_t c = p->child_start[k]; c < p->child_start[k + 1]; ++c)
             p->child_index[p->child[c]] = c - p->child_start[k];
-        /* ell0 = D R̄ᵀ / 5, D = diag(r², r², (L/2)²): the rest half of the
-         * ellipsoid moment R D R̄ᵀ / 5 (Müller & Chentanez eq. 10) */
-        double R0[9];
-        phc_quat_to_matrix(p->q0 + 4 * k, R0);
-        for (int t = 0; t < 3; ++t)
-            for (int c = 0; c < 3; ++c)
-                p->ell0[9 * k + 3 * t + c] = 0.2 * p->ax[3 * k + t] * p->ax[3 * k + t] * R0[3 * c + t];
+        rest_moment(p, k);
     }
     memcpy(p->xp, p->x, 3 * n * sizeof(double));
     memcpy(p->qp, p->q, 4 * n * sizeof(double));
@@ -710,6 +742,10 @@ static int reserve(phc_particles *p, size_t want)
     GROW(source_id, 1);
     GROW(child_index, 1);
     GROW(ell0, 9);
+    GROW(ell0_stale, 1);
+    GROW(joint, 7);
+    GROW(joint_epoch, 1);
+    GROW(rest_epoch, 1);
     GROW(ell, 9);
     GROW(mem, 3);
     GROW(mu, 3);
@@ -783,11 +819,8 @@ static void rest_from_segment(phc_particles *p, size_t i, const double head[3],
     p->m[i] = p->o.density * PI * r * r * L;
     p->ax[3 * i] = p->ax[3 * i + 1] = r;
     p->ax[3 * i + 2] = 0.5 * L;
-    double R0[9];
-    phc_quat_to_matrix(p->q0 + 4 * i, R0);
-    for (int t = 0; t < 3; ++t)
-        for (int c = 0; c < 3; ++c)
-            p->ell0[9 * i + 3 * t + c] = 0.2 * p->ax[3 * i + t] * p->ax[3 * i + t] * R0[3 * c + t];
+    p->ell0_stale[i] = 1; /* rest_moment when ellipsoid_term next needs it */
+    p->rest_epoch[i] = p->epoch; /* its joint terms and its children's to be made again */
 }
 
 /* Checks a segment for particle i (or the one to be appended); its length
@@ -853,6 +886,7 @@ int phc_particles_append(phc_particles *p, size_t parent, const double head[3],
     p->linked[i] = parent != PHC_PARTICLES_NONE;
     p->child_index[i] = 0;
     p->topo[i] = i; /* after its parent, which exists already */
+    p->joint_epoch[i] = 0; /* its joint terms not made yet */
     p->gq[4 * i] = 1; /* at rest: its group has not turned */
     p->gq[4 * i + 1] = p->gq[4 * i + 2] = p->gq[4 * i + 3] = 0;
     p->stress[i] = 0;
@@ -1271,6 +1305,10 @@ static void group_statics(phc_particles *p, size_t k)
  * R_j D_j R̄_jᵀ / 5 = R(Q_j) · ell0_j into p->ell (m²). */
 static void ellipsoid_term(phc_particles *p, size_t j, const double *Q)
 {
+    if (p->ell0_stale[j]) { /* (only j's own data: safe on j's thread) */
+        rest_moment(p, j);
+        p->ell0_stale[j] = 0;
+    }
     double Rj[9];
     phc_quat_to_matrix(Q + 4 * j, Rj);
     const double *E = p->ell0 + 9 * j;
@@ -1466,10 +1504,11 @@ static void plan_projections(phc_particles *p)
     if (!p->o.follow_parent || p->project_all)
         return;
     size_t np = 0, ng = 0;
-    for (size_t i = 0; i < n; ++i)
-        p->plev[i] = p->glev[i] = -1;
     p->npins = 0;
     for (size_t i = 0; i < n; ++i) {
+        /* (reset here, in the same pass: below, only i's own are read
+           before the pass ends; an early return leaves the lists unused) */
+        p->plev[i] = p->glev[i] = -1;
         if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
             p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
         else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)))
@@ -1666,21 +1705,28 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
     const double k = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
     if (!(s > 0))
         return; /* s = 0: no hold */
-    const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u, *qu = p->qp + 4 * u;
+    const double *qu = p->qp + 4 * u;
     const double half = p->ax[3 * i + 2];
+    /* the rest terms (p->joint): j_i, and q̄_u⁻¹ q̄_i */
+    double *ju = p->joint + 7 * i, *rel = ju + 3;
+    if (p->joint_epoch[i] <= p->rest_epoch[i] || p->joint_epoch[i] <= p->rest_epoch[u]) {
+        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
+        double hr[3], hb[3];
+        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+        rotate_z(q0i, half, hr);
+        for (int d = 0; d < 3; ++d)
+            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
+        rotate(q0u_inv, hb, ju);
+        quat_mul(q0u_inv, q0i, rel);
+        p->joint_epoch[i] = p->epoch;
+    }
     /* the joint J in u's current frame */
-    double hr[3], hb[3], ju[3], J[3];
-    const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
-    rotate_z(q0i, half, hr);
-    for (int d = 0; d < 3; ++d)
-        hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-    rotate(q0u_inv, hb, ju);
+    double hr[3], J[3];
     rotate(qu, ju, J);
     for (int d = 0; d < 3; ++d)
         J[d] += p->xp[3 * u + d];
     /* the rest turn q* = q_u q̄_u⁻¹ q̄_i */
-    double rel[4], qs[4];
-    quat_mul(q0u_inv, q0i, rel);
+    double qs[4];
     quat_mul(qu, rel, qs);
     double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
     if (k >= 1) {
@@ -2019,6 +2065,7 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (p->layout_dirty)
         relayout(p);
     const size_t n = p->n;
+    ++p->epoch; /* (the joint terms made in this step carry it) */
     p->polar_total = p->polar_fallbacks = 0;
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);

@@ -1399,6 +1399,94 @@ static void test_projection_plan(void)
     phc_plant_graph_free(g);
 }
 
+/* Centre and unit direction (out[0..3), out[3..6)) of a segment head → tail. */
+static void segment_pose(const double head[3], const double tail[3], double out[6])
+{
+    double L = 0;
+    for (int d = 0; d < 3; ++d) {
+        out[d] = 0.5 * (head[d] + tail[d]); /* centre */
+        out[3 + d] = tail[d] - head[d];     /* unit direction, below */
+        L += out[3 + d] * out[3 + d];
+    }
+    for (int d = 0; d < 3; ++d)
+        out[3 + d] /= sqrt(L);
+}
+
+/* The joint pass keeps each linked particle's rest terms (its joint in its
+ * parent's rest frame, the rest relative rotation) across steps while
+ * neither rest changes.  A bent 3-particle chain, seed clamped, s = 1 (the
+ * joint pass holds every link at its rest angle: x_i = J + R(q_i)(0, 0,
+ * L_i/2), J = x_u + R(q_u) R(q̄_u)ᵀ (h̄_i − x̄_u), q_i = q_u q̄_u⁻¹ q̄_i), stays
+ * at rest; then particle 1's rest is moved and turned (set_rest): after
+ * one step particle 1 must sit at its new rest (its own terms made again)
+ * and particle 2 at its old rest (its terms made again from its parent's
+ * new rest: h̄_2 − x̄_1 in the new frame of 1); then particle 2's rest
+ * changes alone, and once more after steps with nothing changed. */
+static void test_joint_rest_change(void)
+{
+    const double pts[4][3] = {{0, 0, 0}, {0, 0, 0.1}, {0.05, 0, 0.18}, {0.05, 0.06, 0.25}};
+    phc_error err;
+    phc_plant_graph *g = phc_plant_graph_new(3);
+    CHECK(g != NULL);
+    if (!g)
+        return;
+    for (size_t i = 0; i < 3; ++i) {
+        double L = 0;
+        for (int d = 0; d < 3; ++d) {
+            g->head[3 * i + d] = pts[i][d];
+            g->tail[3 * i + d] = pts[i + 1][d];
+            L += (pts[i + 1][d] - pts[i][d]) * (pts[i + 1][d] - pts[i][d]);
+        }
+        g->radius[i] = 0.002;
+        g->length[i] = sqrt(L);
+        g->parent[i] = i == 0 ? PHC_PLANT_NO_PARENT : i - 1;
+    }
+    g->fixed[0] = 1;
+    phc_particles_options opt = phc_particles_options_default();
+    opt.follow_parent = 1;
+    opt.stiffness = 1;
+    opt.maturity_age = 0;
+    phc_particles *p = NULL;
+    CHECK(phc_plant_graph_finish(g, "bent", &err) == PHC_OK &&
+          (p = phc_particles_new(g, &opt, &err)) != NULL);
+    phc_plant_graph_free(g);
+    if (!p)
+        return;
+    double want[3][6];
+    for (size_t i = 0; i < 3; ++i)
+        segment_pose(pts[i], pts[i + 1], want[i]);
+    double worst[4] = {0, 0, 0, 0};
+    /* rounds: 0 at rest; 1 particle 1 moved and turned; 2 particle 2
+     * turned; 3 particle 1 again after 5 steps with nothing changed */
+    const double seg1[2][2][3] = {{{0.01, -0.005, 0.11}, {0.07, 0.01, 0.19}},
+                                  {{-0.01, 0.01, 0.105}, {0.03, 0.05, 0.17}}};
+    const double seg2[2][3] = {{0.05, 0, 0.18}, {0.09, 0.05, 0.24}};
+    for (int round = 0; round < 4; ++round) {
+        if (round == 1 || round == 3) {
+            const double(*sg)[3] = seg1[round == 3];
+            CHECK(phc_particles_set_rest(p, 1, sg[0], sg[1], 0.002, &err) == PHC_OK);
+            segment_pose(sg[0], sg[1], want[1]);
+        }
+        if (round == 2) {
+            CHECK(phc_particles_set_rest(p, 2, seg2[0], seg2[1], 0.002, &err) == PHC_OK);
+            segment_pose(seg2[0], seg2[1], want[2]);
+        }
+        for (int s = 0; s < (round == 3 ? 6 : 1); ++s)
+            CHECK(phc_particles_step(p, 0.01, NULL, &err) == PHC_OK);
+        for (size_t i = 0; i < 3; ++i) {
+            double x[3], q[4], R[9];
+            phc_particles_position(p, i, x);
+            phc_particles_orientation(p, i, q);
+            phc_quat_to_matrix(q, R);
+            const double dz[3] = {R[2], R[5], R[8]};
+            worst[round] = fmax(worst[round], fmax(maxdiff(x, want[i], 3), maxdiff(dz, want[i] + 3, 3)));
+        }
+    }
+    for (int round = 0; round < 4; ++round)
+        CHECK(worst[round] < 1e-15);
+    phc_particles_free(p);
+}
+
 int main(void)
 {
     test_polar();
@@ -1415,5 +1503,6 @@ int main(void)
     test_grow_in_place();
     test_polar_warm();
     test_projection_plan();
+    test_joint_rest_change();
     return check_finish("test_particles");
 }
