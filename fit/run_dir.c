@@ -135,7 +135,8 @@ static void entries_sort(entry_list *l)
             free(l->paths[i]);
             l->paths[i] = marked;
         }
-    qsort(l->paths, l->n, sizeof *l->paths, by_path);
+    if (l->n > 1) /* an empty list has no array (qsort wants one) */
+        qsort(l->paths, l->n, sizeof *l->paths, by_path);
     for (size_t i = 0; i < l->n; ++i) {
         const size_t len = strlen(l->paths[i]);
         l->is_dir[i] = len > 0 && l->paths[i][len - 1] == '/';
