@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "bench/bench_machine.h"
+#include "climbing_bushy_plant.h"
 #include "model/climbing_growth.h"
 #include "model/particles.h"
 #include "model/plant_graph.h"
@@ -41,26 +42,9 @@
 #define FRAMES 5
 #define DT 0.25
 
-static int floor_closest(void *user, const double x[3], double c[3], double n[3])
-{
-    (void)user;
-    c[0] = x[0];
-    c[1] = x[1];
-    c[2] = 0;
-    n[0] = n[1] = 0;
-    n[2] = 1;
-    return 0;
-}
-
 static phc_climbing_options options(size_t substeps)
 {
-    phc_climbing_options o = phc_climbing_options_default();
-    o.seed = 3;
-    o.growth_rate = 0.2;
-    o.branch_probability = 0.9;
-    o.max_buds = 2;
-    o.direction_variance = 0.8;
-    o.max_order = 6;
+    phc_climbing_options o = climbing_bushy_options(3);
     o.max_particles = 1000000;
     o.light.origin[0] = o.light.origin[1] = -2;
     o.light.origin[2] = 0;
@@ -69,7 +53,7 @@ static phc_climbing_options options(size_t substeps)
     o.light.dims[2] = 40;
     o.light.extinction = 40;
     o.surface_adaption = 0.2;
-    o.closest = floor_closest;
+    o.closest = climbing_floor_closest;
     o.dynamics_substeps = substeps;
     o.particles.maturity_age = 20;
     o.min_stiffness = 0.3;

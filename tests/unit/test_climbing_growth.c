@@ -52,34 +52,9 @@
 #include <string.h>
 
 #include "check.h"
+#include "climbing_bushy_plant.h"
 
 static const double PI = 3.14159265358979323846;
-
-/* The plane z = 0 (normal +z). */
-static int floor_closest(void *user, const double x[3], double c[3], double n[3])
-{
-    (void)user;
-    c[0] = x[0];
-    c[1] = x[1];
-    c[2] = 0;
-    n[0] = n[1] = 0;
-    n[2] = 1;
-    return 0;
-}
-
-/* A bushy plant: growth 0.2 s⁻¹, BP 0.9, B 2, V 0.8, orders up to 6 (the
- * bench's plant). */
-static phc_climbing_options bushy_options(uint64_t seed)
-{
-    phc_climbing_options o = phc_climbing_options_default();
-    o.seed = seed;
-    o.growth_rate = 0.2;
-    o.branch_probability = 0.9;
-    o.max_buds = 2;
-    o.direction_variance = 0.8;
-    o.max_order = 6;
-    return o;
-}
 
 static phc_climbing *grow(const phc_climbing_options *o, const double base[3],
                           const double dir[3], size_t steps, double dt)
@@ -225,7 +200,7 @@ int main(void)
 
     /* 1b. the same plant on 1 and 2 threads */
     {
-        phc_climbing_options o = bushy_options(3);
+        phc_climbing_options o = climbing_bushy_options(3);
         o.max_particles = 20000;
         o.light.origin[0] = o.light.origin[1] = -2;
         o.light.cell = 0.05;
@@ -235,7 +210,7 @@ int main(void)
         o.light.direction[0] = 1; /* from the side: the flat plant shades itself */
         o.light.direction[2] = 0;
         o.surface_adaption = 0.2;
-        o.closest = floor_closest;
+        o.closest = climbing_floor_closest;
         o.leaf_step = 3;
         const double seed[3] = {0, 0, 0.01};
         const int keep = omp_get_max_threads();
@@ -796,7 +771,7 @@ int main(void)
        then 6 dynamic steps; 1 and 2 OpenMP threads, and the same seed
        twice, give the same plant bit for bit. */
     {
-        phc_climbing_options o = bushy_options(5);
+        phc_climbing_options o = climbing_bushy_options(5);
         o.particles.maturity_age = 20;
         o.min_stiffness = 0.3;
         const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
