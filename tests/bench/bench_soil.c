@@ -664,6 +664,9 @@ int main(void)
                    N);
             printf("machine_other_load_%s_%zu_2t: %.2f CPUs\n", variant[v], N, r.other);
             printf("soil_%s_cost_%zu_2t: %.2f x the layered soil's step time\n", variant[v], N, vups[g][1] / r.best);
+            if (peer_vups[g] > 0) /* NumPy's array operations take the same time whatever the values */
+                printf("soil_speedup_vs_numpy_%s_%zu_2t: %.1f x (against the NumPy stencil's speed on the layered "
+                       "soil)\n", variant[v], N, r.best / peer_vups[g]);
             phc_soil_free(s);
         }
 
