@@ -1,7 +1,7 @@
 /* The bushy climbing plant shared by test_climbing_growth and the climbing
  * bench (tests/bench/bench_climbing.c): growth 0.2 s⁻¹, BP 0.9, B 2, V 0.8,
- * orders up to 6 (model/climbing_growth.h), and the floor plane z = 0 as
- * its support's closest-point query. */
+ * orders up to 6 (model/climbing_growth.h), the floor plane z = 0 as its
+ * support's closest-point query, and the bench's scene around it. */
 #ifndef PHC_TESTS_CLIMBING_BUSHY_PLANT_H
 #define PHC_TESTS_CLIMBING_BUSHY_PLANT_H
 
@@ -31,6 +31,22 @@ static inline phc_climbing_options climbing_bushy_options(uint64_t seed)
     o.direction_variance = 0.8;
     o.max_order = 6;
     return o;
+}
+
+/* The bench's scene for it (tests/bench/bench_climbing.c): a light grid of
+ * 80 x 80 x 40 cells of 5 cm from (-2, -2, 0) m with extinction 40 m⁻¹
+ * (light from above unless the caller turns it), surface adaption 0.2 s⁻¹
+ * toward the floor z = 0. */
+static inline void climbing_floor_scene(phc_climbing_options *o)
+{
+    o->light.origin[0] = o->light.origin[1] = -2;
+    o->light.origin[2] = 0;
+    o->light.cell = 0.05;
+    o->light.dims[0] = o->light.dims[1] = 80;
+    o->light.dims[2] = 40;
+    o->light.extinction = 40;
+    o->surface_adaption = 0.2;
+    o->closest = climbing_floor_closest;
 }
 
 #endif

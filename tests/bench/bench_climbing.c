@@ -46,14 +46,7 @@ static phc_climbing_options options(size_t substeps)
 {
     phc_climbing_options o = climbing_bushy_options(3);
     o.max_particles = 1000000;
-    o.light.origin[0] = o.light.origin[1] = -2;
-    o.light.origin[2] = 0;
-    o.light.cell = 0.05;
-    o.light.dims[0] = o.light.dims[1] = 80;
-    o.light.dims[2] = 40;
-    o.light.extinction = 40;
-    o.surface_adaption = 0.2;
-    o.closest = climbing_floor_closest;
+    climbing_floor_scene(&o);
     o.dynamics_substeps = substeps;
     o.particles.maturity_age = 20;
     o.min_stiffness = 0.3;

@@ -202,15 +202,9 @@ int main(void)
     {
         phc_climbing_options o = climbing_bushy_options(3);
         o.max_particles = 20000;
-        o.light.origin[0] = o.light.origin[1] = -2;
-        o.light.cell = 0.05;
-        o.light.dims[0] = o.light.dims[1] = 80;
-        o.light.dims[2] = 40;
-        o.light.extinction = 40;
+        climbing_floor_scene(&o);
         o.light.direction[0] = 1; /* from the side: the flat plant shades itself */
         o.light.direction[2] = 0;
-        o.surface_adaption = 0.2;
-        o.closest = climbing_floor_closest;
         o.leaf_step = 3;
         const double seed[3] = {0, 0, 0.01};
         const int keep = omp_get_max_threads();
