@@ -130,8 +130,8 @@ int main(void)
             differ += memcmp(&near.value[k], &full.value[k], sizeof(double)) != 0;
         }
     printf("plant: seed 3, BP 0.9, B 2, orders <= 6, %zu particles, %zu tips; light grid 80x80x40 of 0.05 m, "
-           "extinction 40 1/m, light from above, spread 30 deg (7 directions); 1 thread, median of %d calls\n",
-           n, ns, repeats);
+           "extinction 40 1/m, light from above, spread 30 deg (7 directions); 1 thread, the median of repeated calls\n",
+           n, ns);
     printf("field_ms_every_cell: %.2f ms (peer: our previous field, %zu probes; other load %.2f CPUs)\n", ms_full,
            cells, load_full);
     printf("field_ms_near_tips: %.2f ms (ours: the nodes read at the tips, %zu probes; other load %.2f CPUs)\n",
