@@ -53,9 +53,10 @@ int phc_climbing_light_field_init(phc_climbing_light_field *f, const phc_climbin
                                   double spread_deg);
 void phc_climbing_light_field_free(phc_climbing_light_field *f); /* accepts a zeroed f */
 
-/* Recomputes F from the n shading points x (3n, m) of volumes vol (n, m³)
- * and the occluders occ (NULL: none).  Returns 0, or −1 out of memory
- * (F unchanged). */
+/* Recomputes F at every node from the n shading points x (3n, m) of
+ * volumes vol (n, m³) and the occluders occ (NULL: none); the points enter
+ * only through their shade, so with extinction 0 they are not used.
+ * Returns 0, or −1 out of memory (F unchanged). */
 int phc_climbing_light_field_update(phc_climbing_light_field *f, const phc_climbing_occluders *occ,
                                     const double *x, const double *vol, size_t n);
 
