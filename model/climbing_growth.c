@@ -1044,6 +1044,22 @@ static void light_point(phc_climbing *c, size_t i)
     c->sv[i] = c->vol[i];
 }
 
+/* seek_light: the light field from the shading points, at the nodes
+ * step 2 reads at the tips of the apical particles (their tips do not
+ * move before step 2 reads them). */
+static int field_update(phc_climbing *c, const phc_climbing_occluders *occ, const double *x,
+                        const double *vol, size_t points, size_t n0)
+{
+    double *tips = phc_climbing_light_field_sites(&c->field, n0);
+    if (!tips)
+        return -1;
+    size_t nt = 0;
+    for (size_t i = 0; i < n0; ++i)
+        if (c->apical[i])
+            seg_tip(c, i, 0, tips + 3 * nt++);
+    return phc_climbing_light_field_update_near(&c->field, occ, x, vol, points, tips, nt);
+}
+
 /* Step 1: light at the particles and the leaves (model/climbing_light.h);
  * leaves add their volumes s²·thickness to the grid. */
 static int light_step(phc_climbing *c, size_t n0)
@@ -1054,8 +1070,7 @@ static int light_step(phc_climbing *c, size_t n0)
         phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->x, c->vol, n0, c->phi,
                                   c->light);
         if (c->field.value) { /* seek_light: the light field from the same points */
-            if (phc_climbing_light_field_update(&c->field, c->opaque ? &occ : NULL, c->x, c->vol,
-                                                n0))
+            if (field_update(c, c->opaque ? &occ : NULL, c->x, c->vol, n0, n0))
                 return -1;
             c->field_ready = 1;
         }
@@ -1086,8 +1101,7 @@ static int light_step(phc_climbing *c, size_t n0)
             c->leaf_light[i] = c->sI[m++];
     /* seek_light: the light field from the same shading points */
     if (c->field.value) {
-        if (phc_climbing_light_field_update(&c->field, c->opaque ? &occ : NULL, c->sx, c->sv,
-                                            points))
+        if (field_update(c, c->opaque ? &occ : NULL, c->sx, c->sv, points, n0))
             return -1;
         c->field_ready = 1;
     }

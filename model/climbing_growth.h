@@ -73,7 +73,8 @@
  *     particles' age law is ours), r0 its primary radius.
  * With seek_light, step 1 also builds the light field of
  * model/climbing_light_field.h (only when the light varies: extinction > 0
- * or shadows), and step 2's phototropism turns toward its gradient.
+ * or shadows) at the nodes around the apical tips, and step 2's
+ * phototropism turns toward its gradient there.
  * Supports may cast shadows (phc_climbing_set_shadow_triangles: the mesh
  * rasterised into the light grid's opaque mask, model/climbing_light.h).
  *

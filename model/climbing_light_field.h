@@ -40,6 +40,11 @@ typedef struct phc_climbing_light_field {
     double *value;                /* F at the cell centres, phc_climbing_light_cells(&grid) */
     double *px, *pv, *pl, *phi;   /* scratch: points, volumes, light, grid */
     size_t cap;                   /* points the scratch holds */
+    double *sum;                  /* scratch per cell: a probe's light summed over the sky */
+    size_t *probe;                /* scratch per cell: the cell of each probe */
+    unsigned char *wanted;        /* scratch per cell: 1 = a node read at a site */
+    double *sites;                /* phc_climbing_light_field_sites: 3·sites_cap, m */
+    size_t sites_cap;
 } phc_climbing_light_field;
 
 /* Initialises f for grid g and spread ψ (degrees, [0, 89]); values all 1.
@@ -48,11 +53,29 @@ int phc_climbing_light_field_init(phc_climbing_light_field *f, const phc_climbin
                                   double spread_deg);
 void phc_climbing_light_field_free(phc_climbing_light_field *f); /* accepts a zeroed f */
 
-/* Recomputes F from the n shading points x (3n, m) of volumes vol (n, m³)
- * and the occluders occ (NULL: none).  Returns 0, or −1 out of memory
- * (F unchanged). */
+/* Recomputes F at every node from the n shading points x (3n, m) of
+ * volumes vol (n, m³) and the occluders occ (NULL: none); the points enter
+ * only through their shade, so with extinction 0 they are not used.
+ * Returns 0, or −1 out of memory (F unchanged). */
 int phc_climbing_light_field_update(phc_climbing_light_field *f, const phc_climbing_occluders *occ,
                                     const double *x, const double *vol, size_t n);
+
+/* As phc_climbing_light_field_update, at the nodes the trilinear
+ * interpolation reads at the ns sites (3·ns, m; up to 8 nodes each, the
+ * clamping of phc_climbing_light_field_at included) only; every other node
+ * is NAN.  The nodes computed hold the same numbers, bit for bit, as the
+ * full update gives them (each probe's light depends on the plant's points
+ * and the occluders only, not on the other probes).  Phototropism reads
+ * the field at the tips only, so with the tips as sites a step of a few
+ * shoots computes a few dozen nodes instead of the whole grid. */
+int phc_climbing_light_field_update_near(phc_climbing_light_field *f,
+                                         const phc_climbing_occluders *occ, const double *x,
+                                         const double *vol, size_t n, const double *sites,
+                                         size_t ns);
+
+/* Scratch for ns sites (3·ns doubles, m) that f owns (freed with it), or
+ * NULL out of memory. */
+double *phc_climbing_light_field_sites(phc_climbing_light_field *f, size_t ns);
 
 /* F at x (m), trilinear, and its exact gradient (m⁻¹; NULL: not wanted). */
 double phc_climbing_light_field_at(const phc_climbing_light_field *f, const double x[3],

@@ -10,7 +10,13 @@
  *     very directions of the fixed-direction model at every step.
  *  3. A shoot under an opaque plate with a gap, light from above: with
  *     seek_light it turns toward the gap and crosses the plate's plane in
- *     it; with the fixed direction it grows straight into the plate. */
+ *     it; with the fixed direction it grows straight into the plate.
+ *  4. The field at the nodes read at some sites only
+ *     (phc_climbing_light_field_update_near, what a growth step uses):
+ *     under the plate with 400 shading points (extinction 30 m⁻¹), oblique
+ *     light and a spread of 20°, those nodes equal the full update's bit
+ *     for bit, every other node is NAN, and the value and gradient at each
+ *     site are the full field's exactly; with extinction 0 too. */
 #include "model/climbing_growth.h"
 #include "model/climbing_light.h"
 #include "model/climbing_light_field.h"
@@ -254,6 +260,62 @@ int main(void)
         CHECK(fabs(fixed.cross_x) < 1e-9);
         CHECK(seek.cross_x >= 0.2 && seek.cross_x <= 0.3);
         CHECK(seek.gap_dist < fixed.gap_dist);
+    }
+    /* 4. the field near sites against the whole field */
+    for (int ext = 0; ext < 2; ++ext) {
+        phc_climbing_light_grid g = {{-0.45, -0.3, -0.05}, 0.05, {19, 12, 11}, ext ? 30 : 0, {0, 0, 0}, 0.5};
+        const double l[3] = {0.3, -0.1, 1}, nl = sqrt(l[0] * l[0] + l[1] * l[1] + l[2] * l[2]);
+        for (int d = 0; d < 3; ++d)
+            g.direction[d] = l[d] / nl;
+        const size_t cells = phc_climbing_light_cells(&g);
+        unsigned char *mask = calloc(cells, 1);
+        for (size_t t = 0; t < 4; ++t)
+            phc_climbing_light_mark_triangle(&g, PLATE_V + 3 * PLATE_T[3 * t], PLATE_V + 3 * PLATE_T[3 * t + 1],
+                                             PLATE_V + 3 * PLATE_T[3 * t + 2], mask);
+        const phc_climbing_occluders occ = {PLATE_V, 8, PLATE_T, 4, mask};
+        enum { NP = 400, NS = 12 };
+        double x[3 * NP], vol[NP], sites[3 * NS];
+        phc_climbing_rng rng;
+        phc_climbing_rng_seed(&rng, 5);
+        for (size_t i = 0; i < NP; ++i) {
+            for (int d = 0; d < 3; ++d)
+                x[3 * i + d] = g.origin[d] + phc_climbing_rng_uniform(&rng) * g.cell * (double)g.dims[d];
+            vol[i] = 2e-5 * phc_climbing_rng_uniform(&rng);
+        }
+        for (size_t s = 0; s < NS; ++s) /* some beyond the grid's faces (clamped) */
+            for (int d = 0; d < 3; ++d)
+                sites[3 * s + d] = g.origin[d] + (1.4 * phc_climbing_rng_uniform(&rng) - 0.2) * g.cell * (double)g.dims[d];
+        phc_climbing_light_field full, near;
+        CHECK(phc_climbing_light_field_init(&full, &g, 20) == 0);
+        CHECK(phc_climbing_light_field_init(&near, &g, 20) == 0);
+        CHECK(phc_climbing_light_field_update(&full, &occ, x, vol, NP) == 0);
+        CHECK(phc_climbing_light_field_update_near(&near, &occ, x, vol, NP, sites, NS) == 0);
+        size_t computed = 0, differ = 0, shaded = 0;
+        for (size_t c = 0; c < cells; ++c) {
+            if (isnan(near.value[c]))
+                continue;
+            ++computed;
+            differ += memcmp(&near.value[c], &full.value[c], sizeof(double)) != 0;
+        }
+        for (size_t c = 0; c < cells; ++c)
+            shaded += full.value[c] < 1;
+        size_t site_differ = 0;
+        for (size_t s = 0; s < NS; ++s) {
+            double g0[3], g1[3];
+            const double v0 = phc_climbing_light_field_at(&full, sites + 3 * s, g0);
+            const double v1 = phc_climbing_light_field_at(&near, sites + 3 * s, g1);
+            site_differ += v0 != v1 || g0[0] != g1[0] || g0[1] != g1[1] || g0[2] != g1[2];
+        }
+        printf("field near %d sites, extinction %g 1/m: %zu of %zu nodes computed (%zu shaded in the whole field), "
+               "nodes that differ from the whole field: %zu, sites whose value or gradient differ: %zu\n",
+               NS, g.extinction, computed, cells, shaded, differ, site_differ);
+        CHECK(computed > 0 && computed <= 8 * NS);
+        CHECK(shaded > 0);
+        CHECK(differ == 0);
+        CHECK(site_differ == 0);
+        phc_climbing_light_field_free(&full);
+        phc_climbing_light_field_free(&near);
+        free(mask);
     }
     return check_finish("test_climbing_light_field");
 }
