@@ -91,6 +91,12 @@ struct phc_particles {
      * valid while that is later than rest_epoch[i] and rest_epoch[u] (the
      * epoch of their last rest change; epoch counts the steps). */
     double *joint;           /* 7n */
+    /* bending = BEAM: each particle's subtree sums at the step's start
+     * (beam_sums): mass (kg), Σ m x (kg m), Σ m x xᵀ + the cylinders' own
+     * second moments (kg m², xx xy xz yy yz zz), Σ f (N), Σ x × f (N m);
+     * BEAM_SUMS doubles each, allocated at the first beam step. */
+    double *beam;
+    size_t beam_cap;
     size_t *joint_epoch, *rest_epoch; /* n each */
     size_t epoch;
     unsigned char *ell0_stale; /* n: 1 when ell0 awaits its rest change (made when next
@@ -126,6 +132,8 @@ phc_particles_options phc_particles_options_default(void)
     o.break_threshold = 0.0;
     o.follow_parent = 0;
     o.stiffness_step = 0.01;
+    o.bending = PHC_PARTICLES_OWN_WEIGHT;
+    o.beam_modulus = 1e7;
     return o;
 }
 
@@ -456,6 +464,11 @@ static const char *opt_problem(const phc_particles_options *o, char *buf, size_t
     else if (!(o->stiffness_step > 0) || !isfinite(o->stiffness_step))
         snprintf(buf, size, "stiffness step must be positive and finite, found %g s",
                  o->stiffness_step);
+    else if (o->bending != PHC_PARTICLES_OWN_WEIGHT && o->bending != PHC_PARTICLES_BEAM)
+        snprintf(buf, size, "bending must be own_weight (%d) or beam (%d), found %d",
+                 PHC_PARTICLES_OWN_WEIGHT, PHC_PARTICLES_BEAM, o->bending);
+    else if (!(o->beam_modulus > 0) || !isfinite(o->beam_modulus))
+        snprintf(buf, size, "beam modulus must be positive and finite, found %g Pa", o->beam_modulus);
     else if (!isfinite(o->break_threshold))
         snprintf(buf, size, "break threshold must be finite, found %g", o->break_threshold);
     else if (!isfinite(o->gravity[0]) || !isfinite(o->gravity[1]) || !isfinite(o->gravity[2]))
@@ -513,6 +526,7 @@ void phc_particles_free(phc_particles *p)
     free(p->ell0);
     free(p->ell0_stale);
     free(p->joint);
+    free(p->beam);
     free(p->joint_epoch);
     free(p->rest_epoch);
     free(p->ell);
@@ -1675,6 +1689,26 @@ static inline void rotate_z(const double q[4], double h, double out[3])
     out[2] = h + (vx * ty - vy * tx);
 }
 
+/* The joint pass's rest terms of linked particle i with parent u
+ * (p->joint, made again after a rest change): j_i = R(q̄_u)ᵀ (h̄_i − x̄_u)
+ * (m) and q̄_u⁻¹ q̄_i, h̄_i its rest head, half = L_i/2 (m). */
+static inline const double *joint_terms(phc_particles *p, size_t i, size_t u, double half)
+{
+    double *ju = p->joint + 7 * i, *rel = ju + 3;
+    if (p->joint_epoch[i] <= p->rest_epoch[i] || p->joint_epoch[i] <= p->rest_epoch[u]) {
+        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
+        double hr[3], hb[3];
+        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+        rotate_z(q0i, half, hr);
+        for (int d = 0; d < 3; ++d)
+            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
+        rotate(q0u_inv, hb, ju);
+        quat_mul(q0u_inv, q0i, rel);
+        p->joint_epoch[i] = p->epoch;
+    }
+    return ju;
+}
+
 /* The joint pass (particles.h, "Shoots that bend"), parents first.  For
  * each linked particle i with parent u (already placed this substep):
  *   joint      J  = x_u + R(q_u) j_i,   j_i = R(q̄_u)ᵀ (h̄_i − x̄_u) (m),
@@ -1707,19 +1741,7 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
         return; /* s = 0: no hold */
     const double *qu = p->qp + 4 * u;
     const double half = p->ax[3 * i + 2];
-    /* the rest terms (p->joint): j_i, and q̄_u⁻¹ q̄_i */
-    double *ju = p->joint + 7 * i, *rel = ju + 3;
-    if (p->joint_epoch[i] <= p->rest_epoch[i] || p->joint_epoch[i] <= p->rest_epoch[u]) {
-        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
-        double hr[3], hb[3];
-        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
-        rotate_z(q0i, half, hr);
-        for (int d = 0; d < 3; ++d)
-            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-        rotate(q0u_inv, hb, ju);
-        quat_mul(q0u_inv, q0i, rel);
-        p->joint_epoch[i] = p->epoch;
-    }
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
     /* the joint J in u's current frame */
     double hr[3], J[3];
     rotate(qu, ju, J);
@@ -1784,6 +1806,158 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];
     if (p->anchored[i]) /* as after every projection */
+        apply_anchor(p, i);
+}
+
+
+/* ---- the beam joint pass (particles.h, "Shoots that bend like beams") -- */
+
+enum { BEAM_SUMS = 16 };
+
+/* Subtree sums at the step's start, children before parents (p->topo
+ * backwards), only over links: p->beam (see struct phc_particles).  One
+ * thread, O(n).  -1 when out of memory. */
+static int beam_sums(phc_particles *p)
+{
+    const size_t n = p->n;
+    if (p->beam_cap < n) {
+        double *t = realloc(p->beam, BEAM_SUMS * p->cap * sizeof *t);
+        if (!t)
+            return -1;
+        p->beam = t;
+        p->beam_cap = p->cap;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        double *b = p->beam + BEAM_SUMS * i, e[3];
+        const double m = p->m[i], *x = p->x + 3 * i, *f = p->f + 3 * i;
+        const double r2 = p->ax[3 * i] * p->ax[3 * i], h = p->ax[3 * i + 2];
+        rotate_z(p->q + 4 * i, 1.0, e);
+        /* a cylinder's own second moments Σ m ξ ξᵀ about its centre: r²/4
+         * across, L²/12 = h²/3 along its axis e (its inertia tensor is
+         * tr(C) 1 − C: m r²/2 about e, m (3r² + L²)/12 across) */
+        const double across = r2 / 4, along = h * h / 3 - r2 / 4;
+        b[0] = m;
+        for (int d = 0; d < 3; ++d)
+            b[1 + d] = m * x[d];
+        b[4] = m * (x[0] * x[0] + across + along * e[0] * e[0]);
+        b[5] = m * (x[0] * x[1] + along * e[0] * e[1]);
+        b[6] = m * (x[0] * x[2] + along * e[0] * e[2]);
+        b[7] = m * (x[1] * x[1] + across + along * e[1] * e[1]);
+        b[8] = m * (x[1] * x[2] + along * e[1] * e[2]);
+        b[9] = m * (x[2] * x[2] + across + along * e[2] * e[2]);
+        for (int d = 0; d < 3; ++d)
+            b[10 + d] = f[d];
+        b[13] = x[1] * f[2] - x[2] * f[1];
+        b[14] = x[2] * f[0] - x[0] * f[2];
+        b[15] = x[0] * f[1] - x[1] * f[0];
+    }
+    for (size_t t = n; t-- > 0;) {
+        const size_t i = p->topo[t];
+        if (!p->linked[i])
+            continue;
+        const double *b = p->beam + BEAM_SUMS * i;
+        double *bu = p->beam + BEAM_SUMS * p->parent[i];
+        for (int k = 0; k < BEAM_SUMS; ++k)
+            bu[k] += b[k];
+    }
+    return 0;
+}
+
+/* The rotation vector θ (rad) of the unit quaternion a b⁻¹ (the shorter
+ * way round). */
+static inline void rotation_between(const double a[4], const double b[4], double th[3])
+{
+    const double binv[4] = {b[0], -b[1], -b[2], -b[3]};
+    double d[4];
+    quat_mul(a, binv, d);
+    if (d[0] < 0)
+        for (int k = 0; k < 4; ++k)
+            d[k] = -d[k];
+    const double sn = sqrt(d[1] * d[1] + d[2] * d[2] + d[3] * d[3]);
+    const double fac = sn > 0 ? 2 * atan2(sn, d[0]) / sn : 2.0;
+    for (int k = 0; k < 3; ++k)
+        th[k] = fac * d[1 + k];
+}
+
+/* The beam joint of linked particle i (s_i < 1; particles.h): reads its
+ * parent's final xp, qp, the step-start state and the subtree sums,
+ * writes its own xp, qp only (as follow_one). */
+static void beam_one(phc_particles *p, size_t i, double dt, double T2)
+{
+    const double s = stiffness_of(p, i);
+    if (!(s > 0))
+        return; /* s = 0: no hold */
+    if (s >= 1) {
+        follow_one(p, i, dt * dt, T2); /* held at the rest angle, exactly */
+        return;
+    }
+    const size_t u = p->parent[i];
+    const double half = p->ax[3 * i + 2], r = p->ax[3 * i];
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
+    /* the step's start: joint J, rest turn q* and bend θ = log(q q*⁻¹) */
+    double J[3], qs[4], th[3];
+    rotate(p->q + 4 * u, ju, J);
+    for (int d = 0; d < 3; ++d)
+        J[d] += p->x[3 * u + d];
+    quat_mul(p->q + 4 * u, rel, qs);
+    rotation_between(p->q + 4 * i, qs, th);
+    /* the subtree's moment M about J (N m) and inertia I about J (kg m²) */
+    const double *b = p->beam + BEAM_SUMS * i, *g = p->o.gravity;
+    const double m = b[0];
+    double c1[3], M[3];
+    for (int d = 0; d < 3; ++d)
+        c1[d] = b[1 + d] - m * J[d]; /* Σ m (x − J) */
+    M[0] = c1[1] * g[2] - c1[2] * g[1] + b[13] - (J[1] * b[12] - J[2] * b[11]);
+    M[1] = c1[2] * g[0] - c1[0] * g[2] + b[14] - (J[2] * b[10] - J[0] * b[12]);
+    M[2] = c1[0] * g[1] - c1[1] * g[0] + b[15] - (J[0] * b[11] - J[1] * b[10]);
+    /* C = Σ m (x − J)(x − J)ᵀ (+ own moments) = S2 − S1 Jᵀ − J S1ᵀ + m J Jᵀ */
+    double C[6];
+    {
+        const int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
+        for (int k = 0; k < 6; ++k) {
+            const int a = row[k], c = col[k];
+            C[k] = b[4 + k] - b[1 + a] * J[c] - J[a] * b[1 + c] + m * J[a] * J[c];
+        }
+    }
+    const double tr = C[0] + C[3] + C[5];
+    /* I = tr(C) 1 − C */
+    const double In[6] = {tr - C[0], -C[1], -C[2], tr - C[3], -C[4], tr - C[5]};
+    /* κ = E(s) π r⁴ / (4 L), L = 2 half */
+    const double kappa = p->o.beam_modulus * s / (1 - s) * PI * r * r * r * r / (8 * half);
+    /* (I + Δt² κ 1) ω⁺ = I ω_rel + Δt (M − κ θ), by Cholesky */
+    const double *wi = p->w + 3 * i, *wu = p->w + 3 * u;
+    const double wr[3] = {wi[0] - wu[0], wi[1] - wu[1], wi[2] - wu[2]};
+    double rhs[3];
+    rhs[0] = In[0] * wr[0] + In[1] * wr[1] + In[2] * wr[2] + dt * (M[0] - kappa * th[0]);
+    rhs[1] = In[1] * wr[0] + In[3] * wr[1] + In[4] * wr[2] + dt * (M[1] - kappa * th[1]);
+    rhs[2] = In[2] * wr[0] + In[4] * wr[1] + In[5] * wr[2] + dt * (M[2] - kappa * th[2]);
+    const double kd = dt * dt * kappa;
+    const double l00 = sqrt(In[0] + kd), l10 = In[1] / l00, l20 = In[2] / l00;
+    const double l11 = sqrt(In[3] + kd - l10 * l10), l21 = (In[4] - l20 * l10) / l11;
+    const double l22 = sqrt(In[5] + kd - l20 * l20 - l21 * l21);
+    const double y0 = rhs[0] / l00, y1 = (rhs[1] - l10 * y0) / l11;
+    const double y2 = (rhs[2] - l20 * y0 - l21 * y1) / l22;
+    double om[3];
+    om[2] = y2 / l22;
+    om[1] = (y1 - l21 * om[2]) / l11;
+    om[0] = (y0 - l10 * om[1] - l20 * om[2]) / l00;
+    for (int d = 0; d < 3; ++d)
+        th[d] += dt * om[d];
+    /* the new state from the parent's: q = exp(θ⁺) q*, x = J + R(q)(0, 0, L/2) */
+    const double *qu = p->qp + 4 * u;
+    double dq[4], hr[3];
+    quat_exp(th, dq);
+    rotate(qu, ju, J);
+    for (int d = 0; d < 3; ++d)
+        J[d] += p->xp[3 * u + d];
+    quat_mul(qu, rel, qs);
+    double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
+    quat_mul(dq, qs, q);
+    quat_normalize(q);
+    rotate_z(q, half, hr);
+    for (int d = 0; d < 3; ++d)
+        x[d] = J[d] + hr[d];
+    if (p->anchored[i])
         apply_anchor(p, i);
 }
 
@@ -1882,6 +2056,16 @@ static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, doub
 {
     const size_t *order = p->follow_order;
     const double dt2 = dt * dt;
+    if (p->o.bending == PHC_PARTICLES_BEAM) {
+        for (size_t t = lo; t < hi; ++t) {
+            const size_t i = order[t];
+            if (p->linked[i])
+                beam_one(p, i, dt, T2);
+            if (check && i < *bad && !state_finite(p, i))
+                *bad = i;
+        }
+        return;
+    }
     for (size_t t = lo; t < hi; ++t) {
         const size_t i = order[t];
         if (p->linked[i])
@@ -2070,6 +2254,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);
     plan_projections(p);
+    if (p->o.follow_parent && p->o.bending == PHC_PARTICLES_BEAM && beam_sums(p))
+        return phc_error_set(err, PHC_ERR_NOMEM, "particles: step: out of memory (beam sums of %zu particles)", n);
     step_shared sh = {-1, n, n, 0, 0};
     size_t tot = 0, fb = 0;
     if (p->use_lists && p->gcount[1] == 0 && p->o.follow_parent && team((long)n)) {

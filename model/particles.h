@@ -96,6 +96,46 @@
  * does not conserve momentum (a parent does not feel its children): meant
  * for plants held at their root.  A particle with s = 0 is not held.
  *
+ * Shoots that bend like beams (follow_parent with bending = BEAM; ours).
+ * Each linked particle i with s < 1 is a rigid link on a joint J_i at its
+ * head, its bend θ_i = log(q_i q*_i⁻¹) (rad, a rotation vector in world
+ * axes) about the rest turn q*_i above, and its subtree (i and every
+ * particle linked below it) turns with it.  Per substep, from the state
+ * at its start (x, q, ω, and the parent's J and q*):
+ *   M_i = Σ_{j in subtree(i)} (x_j − J_i) × (m_j g + f_j)  (N m), the
+ *         moment of the whole subtree about the joint;
+ *   I_i = Σ_j [m_j (|d_j|² 1 − d_j d_jᵀ) + I_c,j], d_j = x_j − J_i (kg m²),
+ *         I_c,j the cylinder's own inertia (m r²/2 about its axis,
+ *         m (3r² + L²)/12 across): the subtree as one rigid body;
+ *   κ_i = E(s_i) π r_i⁴ / (4 L_i)  (N m rad⁻¹), E(s) = E_1/2 s / (1 − s):
+ *         the Euler–Bernoulli bending moment M = E I_a ∂φ/∂x (I_a = π r⁴/4,
+ *         the circular section's second moment of area, m⁴) lumped over the
+ *         link's length, as in discrete elastic rods (Bergou, Wardetzky,
+ *         Robinson, Audoly, Grinspun, SIGGRAPH 2008, bending energy
+ *         Σ E I_a θ² / (2 ℓ)); s = 1/2 is E_1/2, s → 1 rigid, s → 0 free;
+ *   (I_i + Δt² κ_i 1) ω⁺ = I_i (ω_i − ω_u) + Δt (M_i − κ_i θ_i),
+ *   θ_i⁺ = θ_i + Δt ω⁺,  q_i ← exp(θ_i⁺) q*_i(new parent),
+ *   x_i ← J_i(new parent) + R(q_i)(0, 0, L_i/2)
+ * (semi-implicit Euler in the joint angle: the spring implicit, the load
+ * explicit; the angular velocities then come from the positions, damped
+ * by (1 − damping) as every velocity).  Statics: κ_i θ_i = M_i at every
+ * joint, the exact balance of a chain of rigid links on angular springs,
+ * so a uniform cantilever bends most at its base; with the links refined
+ * its tip deflection tends to Euler–Bernoulli's q L⁴ / (8 E I_a)
+ * (tests/unit/test_particles.c 5e).  Dynamics: each joint sees its subtree
+ * as rigid (the diagonal of the chain's mass matrix, the "composite rigid
+ * body" inertia), exact for one link on a fixed parent: it swings with
+ * period 2π sqrt(I / (κ + m g L/2)) hanging down, and its velocity loses
+ * the fraction `damping` per substep.  The stiffness comes from E I_a and
+ * not from T, so that refining the links leaves the shape unchanged.
+ * Anchored particles pull their links as in the own-weight pass, but
+ * their anchors' reactions do not enter M_i.  s = 1 links keep their rest
+ * angle exactly (the own-weight pass with k = 1).  The subtree sums (mass,
+ * first and second moments, forces and their moments) come from one
+ * children-before-parents pass on one thread (O(n)); the joints are then
+ * placed as in the own-weight pass (subtrees on threads, the same numbers
+ * for any thread count).
+ *
  * Breaking (climbing §4.3; our definition of the stress): after the step,
  * each group's stress is its relative RMS misfit to the best rigid motion,
  *   σ_k = sqrt( Σ_j μ_jk |x_j − g_j^k|² / Σ_j μ_jk |x̄_j − c̄_k|² )
@@ -138,7 +178,16 @@ typedef struct phc_particles_options {
                               (see "Shoots that bend" above); default 0 */
     double stiffness_step; /* T, s, > 0: the time step at which the joint
                               pass turns by the fraction s; default 0.01 */
+    int bending;           /* the joint pass's load (see "Shoots that bend
+                              like beams"): PHC_PARTICLES_OWN_WEIGHT (each
+                              link its own weight; default) or
+                              PHC_PARTICLES_BEAM */
+    double beam_modulus;   /* E_1/2, Pa, > 0: with PHC_PARTICLES_BEAM, the
+                              Young's modulus of a link with s = 1/2;
+                              default 1e7 */
 } phc_particles_options;
+
+enum { PHC_PARTICLES_OWN_WEIGHT = 0, PHC_PARTICLES_BEAM = 1 };
 
 phc_particles_options phc_particles_options_default(void);
 
