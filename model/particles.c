@@ -91,10 +91,8 @@ struct phc_particles {
      * valid while that is later than rest_epoch[i] and rest_epoch[u] (the
      * epoch of their last rest change; epoch counts the steps). */
     double *joint;           /* 7n */
-    /* bending = BEAM: each particle's subtree sums at the step's start
-     * (beam_sums): mass (kg), Σ m x (kg m), Σ m x xᵀ + the cylinders' own
-     * second moments (kg m², xx xy xz yy yz zz), Σ f (N), Σ x × f (N m);
-     * BEAM_SUMS doubles each, allocated at the first beam step. */
+    /* bending = BEAM: each particle's articulated-body terms (BEAM_PER
+     * doubles, see beam_articulate), allocated at the first beam step. */
     double *beam;
     size_t beam_cap;
     size_t *joint_epoch, *rest_epoch; /* n each */
@@ -1812,55 +1810,61 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
 
 /* ---- the beam joint pass (particles.h, "Shoots that bend like beams") -- */
 
-enum { BEAM_SUMS = 16 };
+/* p->beam, per particle (BEAM_PER doubles): the articulated-body terms of
+ * its joint, made by beam_articulate, read by beam_one.  Spatial vectors
+ * are 6-vectors in world axes about the step's reference point O (particle
+ * 0's centre at the step's start, so that the sums stay well conditioned):
+ * motion (ω; v_O), force (n_O; f) (Featherstone, "Rigid Body Dynamics
+ * Algorithms", 2008, ch. 2 and 7). */
+enum {
+    BEAM_IA = 0,    /* 36: articulated inertia I^A (6x6, row-major; kg m², kg m, kg) */
+    BEAM_PA = 36,   /* 6: articulated bias force p^A (N m, N) */
+    BEAM_U = 42,    /* 18: U = I^A S (6x3) */
+    BEAM_DINV = 60, /* 9: D⁻¹, D = Sᵀ U + Δt² κ 1 (3x3) */
+    BEAM_UU = 69,   /* 3: u = τ − Sᵀ p^A (N m) */
+    BEAM_TH = 72,   /* 3: the bend θ at the step's start (rad) */
+    BEAM_WR = 75,   /* 3: the joint's angular velocity ω_i − ω_u (rad/s) */
+    BEAM_J = 78,    /* 3: the joint J − O at the step's start (m) */
+    BEAM_ACC = 81,  /* 6: the body's spatial acceleration (rad s⁻², m s⁻²) */
+    BEAM_PER = 87
+};
+enum { BEAM_BASE, BEAM_WELD, BEAM_BALL };
 
-/* Subtree sums at the step's start, children before parents (p->topo
- * backwards), only over links: p->beam (see struct phc_particles).  One
- * thread, O(n).  -1 when out of memory. */
-static int beam_sums(phc_particles *p)
+/* How particle i hangs in the beam pass: BALL (linked, 0 < s < 1: a
+ * spherical joint with a spring), WELD (linked, s = 1: held at its rest
+ * angle, part of its parent's body), BASE (not linked, or s = 0: not
+ * held; its motion is the projections', its children hang from it). */
+static inline int beam_kind(const phc_particles *p, size_t i)
 {
-    const size_t n = p->n;
-    if (p->beam_cap < n) {
-        double *t = realloc(p->beam, BEAM_SUMS * p->cap * sizeof *t);
-        if (!t)
-            return -1;
-        p->beam = t;
-        p->beam_cap = p->cap;
+    if (!p->linked[i])
+        return BEAM_BASE;
+    const double s = stiffness_of(p, i);
+    return !(s > 0) ? BEAM_BASE : s >= 1 ? BEAM_WELD : BEAM_BALL;
+}
+
+/* y = A x, A 6x6 row-major. */
+static inline void mv6(const double *A, const double *x, double *y)
+{
+    for (int r = 0; r < 6; ++r) {
+        double t = 0;
+        for (int c = 0; c < 6; ++c)
+            t += A[6 * r + c] * x[c];
+        y[r] = t;
     }
-    for (size_t i = 0; i < n; ++i) {
-        double *b = p->beam + BEAM_SUMS * i, e[3];
-        const double m = p->m[i], *x = p->x + 3 * i, *f = p->f + 3 * i;
-        const double r2 = p->ax[3 * i] * p->ax[3 * i], h = p->ax[3 * i + 2];
-        rotate_z(p->q + 4 * i, 1.0, e);
-        /* a cylinder's own second moments Σ m ξ ξᵀ about its centre: r²/4
-         * across, L²/12 = h²/3 along its axis e (its inertia tensor is
-         * tr(C) 1 − C: m r²/2 about e, m (3r² + L²)/12 across) */
-        const double across = r2 / 4, along = h * h / 3 - r2 / 4;
-        b[0] = m;
-        for (int d = 0; d < 3; ++d)
-            b[1 + d] = m * x[d];
-        b[4] = m * (x[0] * x[0] + across + along * e[0] * e[0]);
-        b[5] = m * (x[0] * x[1] + along * e[0] * e[1]);
-        b[6] = m * (x[0] * x[2] + along * e[0] * e[2]);
-        b[7] = m * (x[1] * x[1] + across + along * e[1] * e[1]);
-        b[8] = m * (x[1] * x[2] + along * e[1] * e[2]);
-        b[9] = m * (x[2] * x[2] + across + along * e[2] * e[2]);
-        for (int d = 0; d < 3; ++d)
-            b[10 + d] = f[d];
-        b[13] = x[1] * f[2] - x[2] * f[1];
-        b[14] = x[2] * f[0] - x[0] * f[2];
-        b[15] = x[0] * f[1] - x[1] * f[0];
-    }
-    for (size_t t = n; t-- > 0;) {
-        const size_t i = p->topo[t];
-        if (!p->linked[i])
-            continue;
-        const double *b = p->beam + BEAM_SUMS * i;
-        double *bu = p->beam + BEAM_SUMS * p->parent[i];
-        for (int k = 0; k < BEAM_SUMS; ++k)
-            bu[k] += b[k];
-    }
-    return 0;
+}
+
+/* The inverse of a symmetric positive definite 3x3 matrix (adjugate). */
+static inline void inv3_sym(const double *D, double *Di)
+{
+    const double c00 = D[4] * D[8] - D[5] * D[7], c01 = D[5] * D[6] - D[3] * D[8];
+    const double c02 = D[3] * D[7] - D[4] * D[6];
+    const double det = D[0] * c00 + D[1] * c01 + D[2] * c02, inv = 1 / det;
+    Di[0] = c00 * inv;
+    Di[1] = Di[3] = c01 * inv;
+    Di[2] = Di[6] = c02 * inv;
+    Di[4] = (D[0] * D[8] - D[2] * D[6]) * inv;
+    Di[5] = Di[7] = (D[2] * D[3] - D[0] * D[5]) * inv;
+    Di[8] = (D[0] * D[4] - D[1] * D[3]) * inv;
 }
 
 /* The rotation vector θ (rad) of the unit quaternion a b⁻¹ (the shorter
@@ -1879,73 +1883,191 @@ static inline void rotation_between(const double a[4], const double b[4], double
         th[k] = fac * d[1 + k];
 }
 
-/* The beam joint of linked particle i (s_i < 1; particles.h): reads its
- * parent's final xp, qp, the step-start state and the subtree sums,
- * writes its own xp, qp only (as follow_one). */
+/* Joint i's spring κ (N m rad⁻¹; particles.h): E(s) π r⁴ / (4 ℓ̄), ℓ̄ =
+ * (L_i + L_u)/2 when its parent u bends (BALL), else L_i/2. */
+static inline double beam_kappa(const phc_particles *p, size_t i, size_t u, double s)
+{
+    const double r = p->ax[3 * i];
+    const double lbar = p->ax[3 * i + 2] + (beam_kind(p, u) == BEAM_BALL ? p->ax[3 * u + 2] : 0.0);
+    return p->o.beam_modulus * s / (1 - s) * PI * r * r * r * r / (4 * lbar);
+}
+
+/* The articulated-body pass (Featherstone's ABA, its second sweep, over
+ * p->topo backwards: children before parents; one thread, O(n)) at the
+ * step's start: every body's spatial inertia about O and its external
+ * force, every BALL joint's U, D⁻¹ and u with the joint's armature Δt² κ
+ * and force τ = −κ (θ + Δt ω_rel) (the implicit spring), the subtree
+ * folded into its parent (a WELD wholly, a BALL through its joint).  The
+ * velocity-product terms are left out (slow shoots).  -1 when out of
+ * memory. */
+static int beam_articulate(phc_particles *p, double dt)
+{
+    const size_t n = p->n;
+    if (p->beam_cap < n) {
+        double *t = realloc(p->beam, BEAM_PER * p->cap * sizeof *t);
+        if (!t)
+            return -1;
+        p->beam = t;
+        p->beam_cap = p->cap;
+    }
+    const double *O = p->x;
+    for (size_t i = 0; i < n; ++i) {
+        double *b = p->beam + BEAM_PER * i, *Ib = b + BEAM_IA, e[3], c[3];
+        const double m = p->m[i], *f = p->f + 3 * i;
+        const double r2 = p->ax[3 * i] * p->ax[3 * i], h = p->ax[3 * i + 2];
+        for (int d = 0; d < 3; ++d)
+            c[d] = p->x[3 * i + d] - O[d];
+        rotate_z(p->q + 4 * i, 1.0, e);
+        /* the cylinder about its centre: m r²/2 about e, m (3r² + L²)/12 across,
+         * I_c = m (a 1 + (b − a) e eᵀ), a = r²/4 + L²/12, b = r²/2 */
+        const double a = r2 / 4 + h * h / 3, ba = r2 / 2 - a;
+        const double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) {
+                /* top left: I_c + m ([c]× [c]×ᵀ = |c|² 1 − c cᵀ) */
+                Ib[6 * r + k] = m * ((r == k ? a + cc : 0.0) + ba * e[r] * e[k] - c[r] * c[k]);
+                Ib[6 * (r + 3) + k + 3] = r == k ? m : 0.0;
+            }
+        /* top right m [c]×, bottom left its transpose */
+        const double mc[3] = {m * c[0], m * c[1], m * c[2]};
+        const double sk[9] = {0, -mc[2], mc[1], mc[2], 0, -mc[0], -mc[1], mc[0], 0};
+        for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) {
+                Ib[6 * r + k + 3] = sk[3 * r + k];
+                Ib[6 * (k + 3) + r] = sk[3 * r + k];
+            }
+        /* bias: minus the external force f at the centre, (c × f; f) */
+        double *pa = b + BEAM_PA;
+        pa[0] = -(c[1] * f[2] - c[2] * f[1]);
+        pa[1] = -(c[2] * f[0] - c[0] * f[2]);
+        pa[2] = -(c[0] * f[1] - c[1] * f[0]);
+        for (int d = 0; d < 3; ++d)
+            pa[3 + d] = -f[d];
+    }
+    for (size_t t = n; t-- > 0;) {
+        const size_t i = p->topo[t];
+        const int kind = beam_kind(p, i);
+        if (kind == BEAM_BASE)
+            continue;
+        const size_t u = p->parent[i];
+        double *b = p->beam + BEAM_PER * i, *bu = p->beam + BEAM_PER * u;
+        double *IA = b + BEAM_IA, *pA = b + BEAM_PA;
+        if (kind == BEAM_WELD) {
+            for (int k = 0; k < 36; ++k)
+                bu[BEAM_IA + k] += IA[k];
+            for (int k = 0; k < 6; ++k)
+                bu[BEAM_PA + k] += pA[k];
+            continue;
+        }
+        /* the joint at the step's start: J, the rest turn q*, the bend θ */
+        const double half = p->ax[3 * i + 2], s = stiffness_of(p, i);
+        const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
+        double *J = b + BEAM_J, *th = b + BEAM_TH, *wr = b + BEAM_WR, qs[4];
+        rotate(p->q + 4 * u, ju, J);
+        for (int d = 0; d < 3; ++d)
+            J[d] += p->x[3 * u + d] - O[d];
+        quat_mul(p->q + 4 * u, rel, qs);
+        rotation_between(p->q + 4 * i, qs, th);
+        for (int d = 0; d < 3; ++d)
+            wr[d] = p->w[3 * i + d] - p->w[3 * u + d];
+        const double kappa = beam_kappa(p, i, u, s);
+        /* S = [1; [J]×] (a turn about J moves O by J × ω); U = I^A S */
+        const double Jx[9] = {0, -J[2], J[1], J[2], 0, -J[0], -J[1], J[0], 0};
+        double *U = b + BEAM_U, D[9];
+        for (int r = 0; r < 6; ++r)
+            for (int k = 0; k < 3; ++k) {
+                double sum = IA[6 * r + k];
+                for (int l = 0; l < 3; ++l)
+                    sum += IA[6 * r + 3 + l] * Jx[3 * l + k];
+                U[3 * r + k] = sum;
+            }
+        /* D = Sᵀ U + Δt² κ 1, u = τ − Sᵀ p^A, τ = −κ (θ + Δt ω_rel) */
+        double *uu = b + BEAM_UU;
+        for (int r = 0; r < 3; ++r) {
+            for (int k = 0; k < 3; ++k) {
+                double sum = U[3 * r + k];
+                for (int l = 0; l < 3; ++l)
+                    sum += Jx[3 * l + r] * U[3 * (3 + l) + k];
+                D[3 * r + k] = sum + (r == k ? dt * dt * kappa : 0.0);
+            }
+            double sp = pA[r];
+            for (int l = 0; l < 3; ++l)
+                sp += Jx[3 * l + r] * pA[3 + l];
+            uu[r] = -kappa * (th[r] + dt * wr[r]) - sp;
+        }
+        /* (symmetrised: D is symmetric up to rounding) */
+        D[1] = D[3] = 0.5 * (D[1] + D[3]);
+        D[2] = D[6] = 0.5 * (D[2] + D[6]);
+        D[5] = D[7] = 0.5 * (D[5] + D[7]);
+        double *Di = b + BEAM_DINV;
+        inv3_sym(D, Di);
+        /* into the parent: I^A − U D⁻¹ Uᵀ and p^A + U D⁻¹ u */
+        double UD[18], Dv[3];
+        for (int r = 0; r < 6; ++r)
+            for (int k = 0; k < 3; ++k)
+                UD[3 * r + k] = U[3 * r] * Di[k] + U[3 * r + 1] * Di[3 + k] + U[3 * r + 2] * Di[6 + k];
+        for (int k = 0; k < 3; ++k)
+            Dv[k] = Di[3 * k] * uu[0] + Di[3 * k + 1] * uu[1] + Di[3 * k + 2] * uu[2];
+        for (int r = 0; r < 6; ++r) {
+            for (int k = 0; k < 6; ++k)
+                bu[BEAM_IA + 6 * r + k] +=
+                    IA[6 * r + k] - (UD[3 * r] * U[3 * k] + UD[3 * r + 1] * U[3 * k + 1] + UD[3 * r + 2] * U[3 * k + 2]);
+            bu[BEAM_PA + r] += pA[r] + U[3 * r] * Dv[0] + U[3 * r + 1] * Dv[1] + U[3 * r + 2] * Dv[2];
+        }
+    }
+    return 0;
+}
+
+/* The beam joint of linked particle i (particles.h; the ABA's third sweep,
+ * parents first): its parent's spatial acceleration a_u (gravity's
+ * (0; −g) for a BASE parent), α = D⁻¹ (u − Uᵀ a_u), its own a = a_u + S α;
+ * ω⁺ = ω_rel + Δt α, θ⁺ = θ + Δt ω⁺, then q = exp(θ⁺) q*, x = J +
+ * R(q)(0, 0, L/2) from its parent's final state.  Reads its parent's
+ * final xp, qp and acceleration, writes its own xp, qp and acceleration
+ * only (as follow_one). */
 static void beam_one(phc_particles *p, size_t i, double dt, double T2)
 {
-    const double s = stiffness_of(p, i);
-    if (!(s > 0))
+    const int kind = beam_kind(p, i);
+    if (kind == BEAM_BASE)
         return; /* s = 0: no hold */
-    if (s >= 1) {
+    const size_t u = p->parent[i];
+    double *b = p->beam + BEAM_PER * i, *acc = b + BEAM_ACC;
+    double au[6];
+    if (beam_kind(p, u) == BEAM_BASE) {
+        for (int d = 0; d < 3; ++d) {
+            au[d] = 0;
+            au[3 + d] = -p->o.gravity[d];
+        }
+    } else {
+        memcpy(au, p->beam + BEAM_PER * u + BEAM_ACC, sizeof au);
+    }
+    if (kind == BEAM_WELD) {
+        memcpy(acc, au, sizeof au);
         follow_one(p, i, dt * dt, T2); /* held at the rest angle, exactly */
         return;
     }
-    const size_t u = p->parent[i];
-    const double half = p->ax[3 * i + 2], r = p->ax[3 * i];
-    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
-    /* the step's start: joint J, rest turn q* and bend θ = log(q q*⁻¹) */
-    double J[3], qs[4], th[3];
-    rotate(p->q + 4 * u, ju, J);
-    for (int d = 0; d < 3; ++d)
-        J[d] += p->x[3 * u + d];
-    quat_mul(p->q + 4 * u, rel, qs);
-    rotation_between(p->q + 4 * i, qs, th);
-    /* the subtree's moment M about J (N m) and inertia I about J (kg m²) */
-    const double *b = p->beam + BEAM_SUMS * i, *g = p->o.gravity;
-    const double m = b[0];
-    double c1[3], M[3];
-    for (int d = 0; d < 3; ++d)
-        c1[d] = b[1 + d] - m * J[d]; /* Σ m (x − J) */
-    M[0] = c1[1] * g[2] - c1[2] * g[1] + b[13] - (J[1] * b[12] - J[2] * b[11]);
-    M[1] = c1[2] * g[0] - c1[0] * g[2] + b[14] - (J[2] * b[10] - J[0] * b[12]);
-    M[2] = c1[0] * g[1] - c1[1] * g[0] + b[15] - (J[0] * b[11] - J[1] * b[10]);
-    /* C = Σ m (x − J)(x − J)ᵀ (+ own moments) = S2 − S1 Jᵀ − J S1ᵀ + m J Jᵀ */
-    double C[6];
-    {
-        const int row[6] = {0, 0, 0, 1, 1, 2}, col[6] = {0, 1, 2, 1, 2, 2};
-        for (int k = 0; k < 6; ++k) {
-            const int a = row[k], c = col[k];
-            C[k] = b[4 + k] - b[1 + a] * J[c] - J[a] * b[1 + c] + m * J[a] * J[c];
-        }
+    const double *U = b + BEAM_U, *Di = b + BEAM_DINV, *uu = b + BEAM_UU, *J0 = b + BEAM_J;
+    double rhs[3], alpha[3], th[3];
+    for (int k = 0; k < 3; ++k) {
+        double sum = uu[k];
+        for (int r = 0; r < 6; ++r)
+            sum -= U[3 * r + k] * au[r];
+        rhs[k] = sum;
     }
-    const double tr = C[0] + C[3] + C[5];
-    /* I = tr(C) 1 − C */
-    const double In[6] = {tr - C[0], -C[1], -C[2], tr - C[3], -C[4], tr - C[5]};
-    /* κ = E(s) π r⁴ / (4 L), L = 2 half */
-    const double kappa = p->o.beam_modulus * s / (1 - s) * PI * r * r * r * r / (8 * half);
-    /* (I + Δt² κ 1) ω⁺ = I ω_rel + Δt (M − κ θ), by Cholesky */
-    const double *wi = p->w + 3 * i, *wu = p->w + 3 * u;
-    const double wr[3] = {wi[0] - wu[0], wi[1] - wu[1], wi[2] - wu[2]};
-    double rhs[3];
-    rhs[0] = In[0] * wr[0] + In[1] * wr[1] + In[2] * wr[2] + dt * (M[0] - kappa * th[0]);
-    rhs[1] = In[1] * wr[0] + In[3] * wr[1] + In[4] * wr[2] + dt * (M[1] - kappa * th[1]);
-    rhs[2] = In[2] * wr[0] + In[4] * wr[1] + In[5] * wr[2] + dt * (M[2] - kappa * th[2]);
-    const double kd = dt * dt * kappa;
-    const double l00 = sqrt(In[0] + kd), l10 = In[1] / l00, l20 = In[2] / l00;
-    const double l11 = sqrt(In[3] + kd - l10 * l10), l21 = (In[4] - l20 * l10) / l11;
-    const double l22 = sqrt(In[5] + kd - l20 * l20 - l21 * l21);
-    const double y0 = rhs[0] / l00, y1 = (rhs[1] - l10 * y0) / l11;
-    const double y2 = (rhs[2] - l20 * y0 - l21 * y1) / l22;
-    double om[3];
-    om[2] = y2 / l22;
-    om[1] = (y1 - l21 * om[2]) / l11;
-    om[0] = (y0 - l10 * om[1] - l20 * om[2]) / l00;
+    for (int k = 0; k < 3; ++k)
+        alpha[k] = Di[3 * k] * rhs[0] + Di[3 * k + 1] * rhs[1] + Di[3 * k + 2] * rhs[2];
+    /* a = a_u + S α = (α_u + α; a_O,u + J × α) */
     for (int d = 0; d < 3; ++d)
-        th[d] += dt * om[d];
+        acc[d] = au[d] + alpha[d];
+    acc[3] = au[3] + J0[1] * alpha[2] - J0[2] * alpha[1];
+    acc[4] = au[4] + J0[2] * alpha[0] - J0[0] * alpha[2];
+    acc[5] = au[5] + J0[0] * alpha[1] - J0[1] * alpha[0];
+    for (int d = 0; d < 3; ++d)
+        th[d] = b[BEAM_TH + d] + dt * (b[BEAM_WR + d] + dt * alpha[d]);
     /* the new state from the parent's: q = exp(θ⁺) q*, x = J + R(q)(0, 0, L/2) */
-    const double *qu = p->qp + 4 * u;
-    double dq[4], hr[3];
+    const double half = p->ax[3 * i + 2];
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3, *qu = p->qp + 4 * u;
+    double dq[4], hr[3], J[3], qs[4];
     quat_exp(th, dq);
     rotate(qu, ju, J);
     for (int d = 0; d < 3; ++d)
@@ -2254,8 +2376,9 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);
     plan_projections(p);
-    if (p->o.follow_parent && p->o.bending == PHC_PARTICLES_BEAM && beam_sums(p))
-        return phc_error_set(err, PHC_ERR_NOMEM, "particles: step: out of memory (beam sums of %zu particles)", n);
+    if (p->o.follow_parent && p->o.bending == PHC_PARTICLES_BEAM && beam_articulate(p, dt))
+        return phc_error_set(err, PHC_ERR_NOMEM, "particles: step: out of memory (the beam pass of %zu particles)",
+                             n);
     step_shared sh = {-1, n, n, 0, 0};
     size_t tot = 0, fb = 0;
     if (p->use_lists && p->gcount[1] == 0 && p->o.follow_parent && team((long)n)) {

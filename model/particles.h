@@ -107,12 +107,14 @@
  *   I_i = Σ_j [m_j (|d_j|² 1 − d_j d_jᵀ) + I_c,j], d_j = x_j − J_i (kg m²),
  *         I_c,j the cylinder's own inertia (m r²/2 about its axis,
  *         m (3r² + L²)/12 across): the subtree as one rigid body;
- *   κ_i = E(s_i) π r_i⁴ / (4 L_i)  (N m rad⁻¹), E(s) = E_1/2 s / (1 − s):
+ *   κ_i = E(s_i) π r_i⁴ / (4 ℓ̄_i)  (N m rad⁻¹), E(s) = E_1/2 s / (1 − s):
  *         the Euler–Bernoulli bending moment M = E I_a ∂φ/∂x (I_a = π r⁴/4,
  *         the circular section's second moment of area, m⁴) lumped over the
- *         link's length, as in discrete elastic rods (Bergou, Wardetzky,
- *         Robinson, Audoly, Grinspun, SIGGRAPH 2008, bending energy
- *         Σ E I_a θ² / (2 ℓ)); s = 1/2 is E_1/2, s → 1 rigid, s → 0 free;
+ *         joint's share of the bending links, ℓ̄_i = (L_i + L_u)/2 (L_i/2
+ *         when the parent does not bend: a root or s_u = 1), the Voronoi
+ *         length of discrete elastic rods (Bergou, Wardetzky, Robinson,
+ *         Audoly, Grinspun, SIGGRAPH 2008, bending energy Σ E I_a θ² /
+ *         (2 ℓ̄)); s = 1/2 is E_1/2, s → 1 rigid, s → 0 free;
  *   (I_i + Δt² κ_i 1) ω⁺ = I_i (ω_i − ω_u) + Δt (M_i − κ_i θ_i),
  *   θ_i⁺ = θ_i + Δt ω⁺,  q_i ← exp(θ_i⁺) q*_i(new parent),
  *   x_i ← J_i(new parent) + R(q_i)(0, 0, L_i/2)
@@ -121,8 +123,9 @@
  * by (1 − damping) as every velocity).  Statics: κ_i θ_i = M_i at every
  * joint, the exact balance of a chain of rigid links on angular springs,
  * so a uniform cantilever bends most at its base; with the links refined
- * its tip deflection tends to Euler–Bernoulli's q L⁴ / (8 E I_a)
- * (tests/unit/test_particles.c 5e).  Dynamics: each joint sees its subtree
+ * its tip deflection tends to Euler–Bernoulli's q L⁴ / (8 E I_a) in the
+ * square of the link length (the trapezoid rule of the deflection
+ * integral; tests/unit/test_particles_beam.c).  Dynamics: each joint sees its subtree
  * as rigid (the diagonal of the chain's mass matrix, the "composite rigid
  * body" inertia), exact for one link on a fixed parent: it swings with
  * period 2π sqrt(I / (κ + m g L/2)) hanging down, and its velocity loses
