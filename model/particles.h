@@ -89,7 +89,7 @@
  * its parent at φ_u, rest angle 0 between them):
  *   φ − φ_u = c cos φ,   c = 2 g T² (1 − s) / (s L)  (rad),
  * the same for every Δt in that limit; each link carries its own weight
- * only (not the moment of its subtree).  The pass reads the last
+ * only (not the moment of its subtree: bending = BEAM below does).  The pass reads the last
  * orientation and the load, not the velocity, so a soft link relaxes to
  * its balance in geometric steps of 1 − k without overshoot (a version
  * predicting with x + vΔt whipped a 0.5 m cantilever to 19 m/s).  The pass
@@ -97,48 +97,54 @@
  * for plants held at their root.  A particle with s = 0 is not held.
  *
  * Shoots that bend like beams (follow_parent with bending = BEAM; ours).
- * Each linked particle i with s < 1 is a rigid link on a joint J_i at its
- * head, its bend θ_i = log(q_i q*_i⁻¹) (rad, a rotation vector in world
- * axes) about the rest turn q*_i above, and its subtree (i and every
- * particle linked below it) turns with it.  Per substep, from the state
- * at its start (x, q, ω, and the parent's J and q*):
- *   M_i = Σ_{j in subtree(i)} (x_j − J_i) × (m_j g + f_j)  (N m), the
- *         moment of the whole subtree about the joint;
- *   I_i = Σ_j [m_j (|d_j|² 1 − d_j d_jᵀ) + I_c,j], d_j = x_j − J_i (kg m²),
- *         I_c,j the cylinder's own inertia (m r²/2 about its axis,
- *         m (3r² + L²)/12 across): the subtree as one rigid body;
- *   κ_i = E(s_i) π r_i⁴ / (4 ℓ̄_i)  (N m rad⁻¹), E(s) = E_1/2 s / (1 − s):
- *         the Euler–Bernoulli bending moment M = E I_a ∂φ/∂x (I_a = π r⁴/4,
- *         the circular section's second moment of area, m⁴) lumped over the
- *         joint's share of the bending links, ℓ̄_i = (L_i + L_u)/2 (L_i/2
- *         when the parent does not bend: a root or s_u = 1), the Voronoi
- *         length of discrete elastic rods (Bergou, Wardetzky, Robinson,
- *         Audoly, Grinspun, SIGGRAPH 2008, bending energy Σ E I_a θ² /
- *         (2 ℓ̄)); s = 1/2 is E_1/2, s → 1 rigid, s → 0 free;
- *   (I_i + Δt² κ_i 1) ω⁺ = I_i (ω_i − ω_u) + Δt (M_i − κ_i θ_i),
- *   θ_i⁺ = θ_i + Δt ω⁺,  q_i ← exp(θ_i⁺) q*_i(new parent),
- *   x_i ← J_i(new parent) + R(q_i)(0, 0, L_i/2)
- * (semi-implicit Euler in the joint angle: the spring implicit, the load
- * explicit; the angular velocities then come from the positions, damped
- * by (1 − damping) as every velocity).  Statics: κ_i θ_i = M_i at every
- * joint, the exact balance of a chain of rigid links on angular springs,
- * so a uniform cantilever bends most at its base; with the links refined
- * its tip deflection tends to Euler–Bernoulli's q L⁴ / (8 E I_a) in the
- * square of the link length (the trapezoid rule of the deflection
- * integral; tests/unit/test_particles_beam.c).  Dynamics: each joint sees its subtree
- * as rigid (the diagonal of the chain's mass matrix, the "composite rigid
- * body" inertia), exact for one link on a fixed parent: it swings with
- * period 2π sqrt(I / (κ + m g L/2)) hanging down, and its velocity loses
- * the fraction `damping` per substep.  The stiffness comes from E I_a and
- * not from T, so that refining the links leaves the shape unchanged.
- * Anchored particles pull their links as in the own-weight pass, but
- * their anchors' reactions do not enter M_i.  s = 1 links keep their rest
- * angle exactly (the own-weight pass with k = 1).  The subtree sums (mass,
- * first and second moments, forces and their moments) come from one
- * children-before-parents pass on one thread (O(n)); the joints are then
- * placed as in the own-weight pass (subtrees on threads, the same numbers
- * for any thread count).
- *
+ * The linked particles are rigid links of an articulated tree: a BALL
+ * joint (0 < s_i < 1) at i's head J_i (as above) with a spring, a WELD
+ * (s_i = 1: i held at its rest angle, part of its parent's body), and the
+ * particles without a hold (roots, broken links, s = 0) are bases whose
+ * motion the projections give.  The bend of a BALL joint is θ_i = log(q_i
+ * q*_i⁻¹) (rad, a rotation vector in world axes) about the rest turn q*_i
+ * above; its spring
+ *   κ_i = E(s_i) π r_i⁴ / (4 ℓ̄_i)  (N m rad⁻¹), E(s) = E_1/2 s / (1 − s),
+ * the Euler–Bernoulli bending moment M = E I_a ∂φ/∂x (I_a = π r⁴/4, the
+ * circular section's second moment of area, m⁴) lumped over the joint's
+ * share of the bending links, ℓ̄_i = (L_i + L_u)/2, or L_i/2 when the
+ * parent does not bend (a base or a WELD): the Voronoi length of discrete
+ * elastic rods (Bergou, Wardetzky, Robinson, Audoly, Grinspun, SIGGRAPH
+ * 2008, bending energy Σ E I_a θ² / (2 ℓ̄)).  s = 1/2 gives E_1/2 (the
+ * option beam_modulus), s → 1 rigid, s → 0 free.  The stiffness comes from
+ * E I_a, not from T, so that refining the links leaves the shape alone.
+ * One step, from the state at its start (x, q, ω; the joints' J, θ and
+ * ω_rel = ω_i − ω_u), is semi-implicit Euler in the joint angles with the
+ * spring implicit:
+ *   (H + Δt² K) α = Q_g + Q_f − K (θ + Δt ω_rel),  ω⁺ = ω_rel + Δt α,
+ *   θ⁺ = θ + Δt ω⁺,  q_i ← exp(θ⁺_i) q*_i,  x_i ← J_i + R(q_i)(0, 0, L_i/2)
+ * (q* and J from the parent's final state, parents first, then i's
+ * anchor), H the tree's joint-space mass matrix (each link a cylinder: m
+ * r²/2 about its axis, m (3r² + L²)/12 across), K = diag(κ_i), Q_g and Q_f
+ * the moments of gravity and of the external forces on each joint's whole
+ * subtree.  α comes from Featherstone's articulated-body algorithm
+ * (Featherstone, "Rigid Body Dynamics Algorithms", Springer 2008, ch. 7:
+ * spatial vectors in world axes about one point, gravity as the bases'
+ * acceleration −g, the implicit spring's Δt² κ as the joint's armature),
+ * O(n): one sweep children before parents on one thread (articulated
+ * inertias and biases), one parents first on the joint pass's order
+ * (subtrees on threads; the same numbers for any thread count).  The
+ * velocity-product (Coriolis) terms and the bases' own accelerations are
+ * left out (slow shoots on held bases).  Velocities then come from the
+ * positions, damped by (1 − damping) as every velocity.
+ * Statics: K θ = Q at every joint, the exact balance of the links on
+ * their springs: a uniform cantilever bends most at its base, and its
+ * small-angle tip deflection is the trapezoid rule of Euler–Bernoulli's:
+ * q L⁴ / (8 E I_a) (1 + 1/n²) for n equal links.  Dynamics: exact for the
+ * linearised tree (with the implicit spring's numerical damping, O(Δt));
+ * one link on a held parent swings with period 2π / sqrt((κ + m g L/2)/I)
+ * hanging down, a 22-link cantilever within 0.5% of its first
+ * Euler–Bernoulli mode (tests/unit/test_particles_beam.c,
+ * notebooks_c/climbing_beam_shoot.c).  The anchors' reactions are not in
+ * Q (an anchor still pulls its particle after the joint places it).
+ * A WELD (s = 1) is placed as in the own-weight pass with k = 1: the same
+ * numbers.
+
  * Breaking (climbing §4.3; our definition of the stress): after the step,
  * each group's stress is its relative RMS misfit to the best rigid motion,
  *   σ_k = sqrt( Σ_j μ_jk |x_j − g_j^k|² / Σ_j μ_jk |x̄_j − c̄_k|² )
