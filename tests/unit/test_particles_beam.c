@@ -23,6 +23,7 @@
 #include "model/plant_graph.h"
 #include "model/quaternion.h"
 
+#include <lapacke.h>
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -151,35 +152,12 @@ static int newton_balance(size_t n, double ell, double w, double kappa, double *
             for (size_t k = 0; k < n; ++k)
                 Jm[k * n + c] = (rp[k] - rm[k]) / (2 * h);
         }
-        /* Gaussian elimination with partial pivoting: Jm d = −r */
+        /* Jm d = −r (LAPACK) */
+        lapack_int piv[64];
         for (size_t k = 0; k < n; ++k)
             r[k] = -r[k];
-        for (size_t c = 0; c < n; ++c) {
-            size_t piv = c;
-            for (size_t k = c + 1; k < n; ++k)
-                if (fabs(Jm[k * n + c]) > fabs(Jm[piv * n + c]))
-                    piv = k;
-            for (size_t j = 0; j < n; ++j) {
-                const double t = Jm[c * n + j];
-                Jm[c * n + j] = Jm[piv * n + j];
-                Jm[piv * n + j] = t;
-            }
-            const double t = r[c];
-            r[c] = r[piv];
-            r[piv] = t;
-            for (size_t k = c + 1; k < n; ++k) {
-                const double f = Jm[k * n + c] / Jm[c * n + c];
-                for (size_t j = c; j < n; ++j)
-                    Jm[k * n + j] -= f * Jm[c * n + j];
-                r[k] -= f * r[c];
-            }
-        }
-        for (size_t c = n; c-- > 0;) {
-            double sum = r[c];
-            for (size_t j = c + 1; j < n; ++j)
-                sum -= Jm[c * n + j] * r[j];
-            r[c] = sum / Jm[c * n + c];
-        }
+        if (LAPACKE_dgesv(LAPACK_ROW_MAJOR, (lapack_int)n, 1, Jm, (lapack_int)n, piv, r, 1) != 0)
+            return -1;
         for (size_t k = 0; k < n; ++k)
             th[k] += r[k];
     }
@@ -364,17 +342,17 @@ static void swing(double dt, double damping, double th0, size_t steps, double *t
     }
     phc_particles_free(p);
     const double m = RHO * PI * r * r * ell;
-    const double I = m * (r * r / 4 + ell * ell / 3); /* about the joint, across */
+    const double Ij = m * (r * r / 4 + ell * ell / 3); /* about the joint, across */
     const double kappa = joint_kappa(e_half, s, r, ell / 2), K = kappa + m * G * ell / 2; /* ℓ̄ = ℓ/2: the clamp does not bend */
-    /* the damped oscillator θ'' + 2γ θ' + (K/I) θ = 0, the velocity losing
+    /* the damped oscillator θ'' + 2γ θ' + (K/I) θ = 0 (I = Ij), the velocity losing
      * the fraction d per step: e^{−2γ Δt} = 1 − d */
     const double gamma = -log(1 - damping) / (2 * dt) + 0.0; /* (+0 for d = 0) */
-    *period_formula = 2 * PI / sqrt(K / I - gamma * gamma);
+    *period_formula = 2 * PI / sqrt(K / Ij - gamma * gamma);
     /* the scheme's linear step on (θ, ω): ω̃ = (I ω − Δt K θ)/(I + Δt² κ),
      * θ⁺ = θ + Δt ω̃, ω⁺ = (1 − d) ω̃ */
-    const double den = I + dt * dt * kappa;
-    const double a11 = 1 - dt * dt * K / den, a12 = dt * I / den;
-    const double a21 = -(1 - damping) * dt * K / den, a22 = (1 - damping) * I / den;
+    const double den = Ij + dt * dt * kappa;
+    const double a11 = 1 - dt * dt * K / den, a12 = dt * Ij / den;
+    const double a21 = -(1 - damping) * dt * K / den, a22 = (1 - damping) * Ij / den;
     const double tr = a11 + a22, det = a11 * a22 - a12 * a21;
     const double psi = atan2(sqrt(det - tr * tr / 4), tr / 2); /* complex pair ρ e^{±iψ} */
     *period_discrete = 2 * PI * dt / psi;
