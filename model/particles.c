@@ -1971,30 +1971,32 @@ static int beam_articulate(phc_particles *p, double dt)
         for (int d = 0; d < 3; ++d)
             wr[d] = p->w[3 * i + d] - p->w[3 * u + d];
         const double kappa = beam_kappa(p, i, u, s);
-        /* S = [1; [J]×] (a turn about J moves O by J × ω); U = I^A S */
-        const double Jx[9] = {0, -J[2], J[1], J[2], 0, -J[0], -J[1], J[0], 0};
+        /* S = [1; [J]×] (a turn about J moves O by J × ω), so for a row a =
+         * (a₁; a₂) of I^A, (a S) = a₁ + a₂ × J (a₂ · (J × e_k) = e_k · (a₂ × J));
+         * U = I^A S row by row */
         double *U = b + BEAM_U, D[9];
-        for (int r = 0; r < 6; ++r)
-            for (int k = 0; k < 3; ++k) {
-                double sum = IA[6 * r + k];
-                for (int l = 0; l < 3; ++l)
-                    sum += IA[6 * r + 3 + l] * Jx[3 * l + k];
-                U[3 * r + k] = sum;
-            }
-        /* D = Sᵀ U + Δt² κ 1, u = τ − Sᵀ p^A, τ = −κ (θ + Δt ω_rel) */
-        double *uu = b + BEAM_UU;
-        for (int r = 0; r < 3; ++r) {
-            for (int k = 0; k < 3; ++k) {
-                double sum = U[3 * r + k];
-                for (int l = 0; l < 3; ++l)
-                    sum += Jx[3 * l + r] * U[3 * (3 + l) + k];
-                D[3 * r + k] = sum + (r == k ? dt * dt * kappa : 0.0);
-            }
-            double sp = pA[r];
-            for (int l = 0; l < 3; ++l)
-                sp += Jx[3 * l + r] * pA[3 + l];
-            uu[r] = -kappa * (th[r] + dt * wr[r]) - sp;
+        for (int r = 0; r < 6; ++r) {
+            const double *a = IA + 6 * r;
+            U[3 * r] = a[0] + a[4] * J[2] - a[5] * J[1];
+            U[3 * r + 1] = a[1] + a[5] * J[0] - a[3] * J[2];
+            U[3 * r + 2] = a[2] + a[3] * J[1] - a[4] * J[0];
         }
+        /* D = Sᵀ U + Δt² κ 1 (column k: U₁ₖ + U₂ₖ × J by the same rule),
+         * u = τ − Sᵀ p^A, τ = −κ (θ + Δt ω_rel) */
+        for (int k = 0; k < 3; ++k) {
+            const double u0 = U[9 + k], u1 = U[12 + k], u2 = U[15 + k];
+            D[k] = U[k] + u1 * J[2] - u2 * J[1];
+            D[3 + k] = U[3 + k] + u2 * J[0] - u0 * J[2];
+            D[6 + k] = U[6 + k] + u0 * J[1] - u1 * J[0];
+        }
+        D[0] += dt * dt * kappa;
+        D[4] += dt * dt * kappa;
+        D[8] += dt * dt * kappa;
+        double *uu = b + BEAM_UU;
+        const double sp[3] = {pA[0] + pA[4] * J[2] - pA[5] * J[1], pA[1] + pA[5] * J[0] - pA[3] * J[2],
+                              pA[2] + pA[3] * J[1] - pA[4] * J[0]};
+        for (int r = 0; r < 3; ++r)
+            uu[r] = -kappa * (th[r] + dt * wr[r]) - sp[r];
         /* (symmetrised: D is symmetric up to rounding) */
         D[1] = D[3] = 0.5 * (D[1] + D[3]);
         D[2] = D[6] = 0.5 * (D[2] + D[6]);
@@ -2009,9 +2011,14 @@ static int beam_articulate(phc_particles *p, double dt)
         for (int k = 0; k < 3; ++k)
             Dv[k] = Di[3 * k] * uu[0] + Di[3 * k + 1] * uu[1] + Di[3 * k + 2] * uu[2];
         for (int r = 0; r < 6; ++r) {
-            for (int k = 0; k < 6; ++k)
-                bu[BEAM_IA + 6 * r + k] +=
+            /* (symmetric: the upper triangle, mirrored) */
+            for (int k = r; k < 6; ++k) {
+                const double v =
                     IA[6 * r + k] - (UD[3 * r] * U[3 * k] + UD[3 * r + 1] * U[3 * k + 1] + UD[3 * r + 2] * U[3 * k + 2]);
+                bu[BEAM_IA + 6 * r + k] += v;
+                if (k != r)
+                    bu[BEAM_IA + 6 * k + r] += v;
+            }
             bu[BEAM_PA + r] += pA[r] + U[3 * r] * Dv[0] + U[3 * r + 1] * Dv[1] + U[3 * r + 2] * Dv[2];
         }
     }
