@@ -1892,14 +1892,133 @@ static inline double beam_kappa(const phc_particles *p, size_t i, size_t u, doub
     return p->o.beam_modulus * s / (1 - s) * PI * r * r * r * r / (4 * lbar);
 }
 
-/* The articulated-body pass (Featherstone's ABA, its second sweep, over
- * p->topo backwards: children before parents; one thread, O(n)) at the
- * step's start: every body's spatial inertia about O and its external
- * force, every BALL joint's U, D⁻¹ and u with the joint's armature Δt² κ
- * and force τ = −κ (θ + Δt ω_rel) (the implicit spring), the subtree
- * folded into its parent (a WELD wholly, a BALL through its joint).  The
- * velocity-product terms are left out (slow shoots).  -1 when out of
- * memory. */
+/* The articulated-body pass (Featherstone's ABA, its second sweep:
+ * children before parents) at the step's start: every body's spatial
+ * inertia about O and its external force (beam_body), then every BALL
+ * joint's U, D⁻¹ and u with the joint's armature Δt² κ and force τ = −κ
+ * (θ + Δt ω_rel) (the implicit spring), the subtree folded into its
+ * parent (beam_fold: a WELD wholly, a BALL through its joint).  The
+ * velocity-product terms are left out (slow shoots). */
+static void beam_body(phc_particles *p, size_t i, const double O[3])
+{
+    double *b = p->beam + BEAM_PER * i, *Ib = b + BEAM_IA, e[3], c[3];
+    const double m = p->m[i], *f = p->f + 3 * i;
+    const double r2 = p->ax[3 * i] * p->ax[3 * i], h = p->ax[3 * i + 2];
+    for (int d = 0; d < 3; ++d)
+        c[d] = p->x[3 * i + d] - O[d];
+    rotate_z(p->q + 4 * i, 1.0, e);
+    /* the cylinder about its centre: m r²/2 about e, m (3r² + L²)/12 across,
+     * I_c = m (a 1 + (b − a) e eᵀ), a = r²/4 + L²/12, b = r²/2 */
+    const double a = r2 / 4 + h * h / 3, ba = r2 / 2 - a;
+    const double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+            /* top left: I_c + m ([c]× [c]×ᵀ = |c|² 1 − c cᵀ) */
+            Ib[6 * r + k] = m * ((r == k ? a + cc : 0.0) + ba * e[r] * e[k] - c[r] * c[k]);
+            Ib[6 * (r + 3) + k + 3] = r == k ? m : 0.0;
+        }
+    /* top right m [c]×, bottom left its transpose */
+    const double mc[3] = {m * c[0], m * c[1], m * c[2]};
+    const double sk[9] = {0, -mc[2], mc[1], mc[2], 0, -mc[0], -mc[1], mc[0], 0};
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+            Ib[6 * r + k + 3] = sk[3 * r + k];
+            Ib[6 * (k + 3) + r] = sk[3 * r + k];
+        }
+    /* bias: minus the external force f at the centre, (c × f; f) */
+    double *pa = b + BEAM_PA;
+    pa[0] = -(c[1] * f[2] - c[2] * f[1]);
+    pa[1] = -(c[2] * f[0] - c[0] * f[2]);
+    pa[2] = -(c[0] * f[1] - c[1] * f[0]);
+    for (int d = 0; d < 3; ++d)
+        pa[3 + d] = -f[d];
+}
+
+static void beam_fold(phc_particles *p, size_t i, double dt, const double O[3])
+{
+    const int kind = beam_kind(p, i);
+    if (kind == BEAM_BASE)
+        return;
+    const size_t u = p->parent[i];
+    double *b = p->beam + BEAM_PER * i, *bu = p->beam + BEAM_PER * u;
+    double *IA = b + BEAM_IA, *pA = b + BEAM_PA;
+    if (kind == BEAM_WELD) {
+        for (int k = 0; k < 36; ++k)
+            bu[BEAM_IA + k] += IA[k];
+        for (int k = 0; k < 6; ++k)
+            bu[BEAM_PA + k] += pA[k];
+        return;
+    }
+    /* the joint at the step's start: J, the rest turn q*, the bend θ */
+    const double half = p->ax[3 * i + 2], s = stiffness_of(p, i);
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
+    double *J = b + BEAM_J, *th = b + BEAM_TH, *wr = b + BEAM_WR, qs[4];
+    rotate(p->q + 4 * u, ju, J);
+    for (int d = 0; d < 3; ++d)
+        J[d] += p->x[3 * u + d] - O[d];
+    quat_mul(p->q + 4 * u, rel, qs);
+    rotation_between(p->q + 4 * i, qs, th);
+    for (int d = 0; d < 3; ++d)
+        wr[d] = p->w[3 * i + d] - p->w[3 * u + d];
+    const double kappa = beam_kappa(p, i, u, s);
+    /* S = [1; [J]×] (a turn about J moves O by J × ω), so for a row a =
+     * (a₁; a₂) of I^A, (a S) = a₁ + a₂ × J (a₂ · (J × e_k) = e_k · (a₂ × J));
+     * U = I^A S row by row */
+    double *U = b + BEAM_U, D[9];
+    for (int r = 0; r < 6; ++r) {
+        const double *a = IA + 6 * r;
+        U[3 * r] = a[0] + a[4] * J[2] - a[5] * J[1];
+        U[3 * r + 1] = a[1] + a[5] * J[0] - a[3] * J[2];
+        U[3 * r + 2] = a[2] + a[3] * J[1] - a[4] * J[0];
+    }
+    /* D = Sᵀ U + Δt² κ 1 (column k: U₁ₖ + U₂ₖ × J by the same rule),
+     * u = τ − Sᵀ p^A, τ = −κ (θ + Δt ω_rel) */
+    for (int k = 0; k < 3; ++k) {
+        const double u0 = U[9 + k], u1 = U[12 + k], u2 = U[15 + k];
+        D[k] = U[k] + u1 * J[2] - u2 * J[1];
+        D[3 + k] = U[3 + k] + u2 * J[0] - u0 * J[2];
+        D[6 + k] = U[6 + k] + u0 * J[1] - u1 * J[0];
+    }
+    D[0] += dt * dt * kappa;
+    D[4] += dt * dt * kappa;
+    D[8] += dt * dt * kappa;
+    double *uu = b + BEAM_UU;
+    const double sp[3] = {pA[0] + pA[4] * J[2] - pA[5] * J[1], pA[1] + pA[5] * J[0] - pA[3] * J[2],
+                          pA[2] + pA[3] * J[1] - pA[4] * J[0]};
+    for (int r = 0; r < 3; ++r)
+        uu[r] = -kappa * (th[r] + dt * wr[r]) - sp[r];
+    /* (symmetrised: D is symmetric up to rounding) */
+    D[1] = D[3] = 0.5 * (D[1] + D[3]);
+    D[2] = D[6] = 0.5 * (D[2] + D[6]);
+    D[5] = D[7] = 0.5 * (D[5] + D[7]);
+    double *Di = b + BEAM_DINV;
+    inv3_sym(D, Di);
+    /* into the parent: I^A − U D⁻¹ Uᵀ and p^A + U D⁻¹ u */
+    double UD[18], Dv[3];
+    for (int r = 0; r < 6; ++r)
+        for (int k = 0; k < 3; ++k)
+            UD[3 * r + k] = U[3 * r] * Di[k] + U[3 * r + 1] * Di[3 + k] + U[3 * r + 2] * Di[6 + k];
+    for (int k = 0; k < 3; ++k)
+        Dv[k] = Di[3 * k] * uu[0] + Di[3 * k + 1] * uu[1] + Di[3 * k + 2] * uu[2];
+    for (int r = 0; r < 6; ++r) {
+        /* (symmetric: the upper triangle, mirrored) */
+        for (int k = r; k < 6; ++k) {
+            const double v =
+                IA[6 * r + k] - (UD[3 * r] * U[3 * k] + UD[3 * r + 1] * U[3 * k + 1] + UD[3 * r + 2] * U[3 * k + 2]);
+            bu[BEAM_IA + 6 * r + k] += v;
+            if (k != r)
+                bu[BEAM_IA + 6 * k + r] += v;
+        }
+        bu[BEAM_PA + r] += pA[r] + U[3 * r] * Dv[0] + U[3 * r + 1] * Dv[1] + U[3 * r + 2] * Dv[2];
+    }
+}
+
+/* The second sweep over the joint pass's order: the bodies (by index),
+ * then each subtree item from its end to its second particle (children
+ * before parents, inside the item), the items on the threads of a team;
+ * then on one thread the items' roots (folding into the top) and the top
+ * backwards.  Every parent gets its children's folds in the same order
+ * for any thread count.  -1 when out of memory. */
 static int beam_articulate(phc_particles *p, double dt)
 {
     const size_t n = p->n;
@@ -1910,118 +2029,36 @@ static int beam_articulate(phc_particles *p, double dt)
         p->beam = t;
         p->beam_cap = p->cap;
     }
-    const double *O = p->x;
-    for (size_t i = 0; i < n; ++i) {
-        double *b = p->beam + BEAM_PER * i, *Ib = b + BEAM_IA, e[3], c[3];
-        const double m = p->m[i], *f = p->f + 3 * i;
-        const double r2 = p->ax[3 * i] * p->ax[3 * i], h = p->ax[3 * i + 2];
-        for (int d = 0; d < 3; ++d)
-            c[d] = p->x[3 * i + d] - O[d];
-        rotate_z(p->q + 4 * i, 1.0, e);
-        /* the cylinder about its centre: m r²/2 about e, m (3r² + L²)/12 across,
-         * I_c = m (a 1 + (b − a) e eᵀ), a = r²/4 + L²/12, b = r²/2 */
-        const double a = r2 / 4 + h * h / 3, ba = r2 / 2 - a;
-        const double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-        for (int r = 0; r < 3; ++r)
-            for (int k = 0; k < 3; ++k) {
-                /* top left: I_c + m ([c]× [c]×ᵀ = |c|² 1 − c cᵀ) */
-                Ib[6 * r + k] = m * ((r == k ? a + cc : 0.0) + ba * e[r] * e[k] - c[r] * c[k]);
-                Ib[6 * (r + 3) + k + 3] = r == k ? m : 0.0;
+    const double O[3] = {p->x[0], p->x[1], p->x[2]};
+    const size_t *order = p->follow_order, *start = p->follow_start;
+    size_t next = 0;
+    if (team((long)n)) {
+#pragma omp parallel
+        {
+#pragma omp for schedule(static)
+            for (long i = 0; i < (long)n; ++i)
+                beam_body(p, (size_t)i, O);
+            for (;;) {
+                size_t item;
+#pragma omp atomic capture
+                item = next++;
+                if (item >= p->follow_items)
+                    break;
+                for (size_t t = start[item + 1]; t-- > start[item] + 1;)
+                    beam_fold(p, order[t], dt, O);
             }
-        /* top right m [c]×, bottom left its transpose */
-        const double mc[3] = {m * c[0], m * c[1], m * c[2]};
-        const double sk[9] = {0, -mc[2], mc[1], mc[2], 0, -mc[0], -mc[1], mc[0], 0};
-        for (int r = 0; r < 3; ++r)
-            for (int k = 0; k < 3; ++k) {
-                Ib[6 * r + k + 3] = sk[3 * r + k];
-                Ib[6 * (k + 3) + r] = sk[3 * r + k];
-            }
-        /* bias: minus the external force f at the centre, (c × f; f) */
-        double *pa = b + BEAM_PA;
-        pa[0] = -(c[1] * f[2] - c[2] * f[1]);
-        pa[1] = -(c[2] * f[0] - c[0] * f[2]);
-        pa[2] = -(c[0] * f[1] - c[1] * f[0]);
-        for (int d = 0; d < 3; ++d)
-            pa[3 + d] = -f[d];
+        }
+    } else {
+        for (size_t i = 0; i < n; ++i)
+            beam_body(p, i, O);
+        for (size_t item = 0; item < p->follow_items; ++item)
+            for (size_t t = start[item + 1]; t-- > start[item] + 1;)
+                beam_fold(p, order[t], dt, O);
     }
-    for (size_t t = n; t-- > 0;) {
-        const size_t i = p->topo[t];
-        const int kind = beam_kind(p, i);
-        if (kind == BEAM_BASE)
-            continue;
-        const size_t u = p->parent[i];
-        double *b = p->beam + BEAM_PER * i, *bu = p->beam + BEAM_PER * u;
-        double *IA = b + BEAM_IA, *pA = b + BEAM_PA;
-        if (kind == BEAM_WELD) {
-            for (int k = 0; k < 36; ++k)
-                bu[BEAM_IA + k] += IA[k];
-            for (int k = 0; k < 6; ++k)
-                bu[BEAM_PA + k] += pA[k];
-            continue;
-        }
-        /* the joint at the step's start: J, the rest turn q*, the bend θ */
-        const double half = p->ax[3 * i + 2], s = stiffness_of(p, i);
-        const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
-        double *J = b + BEAM_J, *th = b + BEAM_TH, *wr = b + BEAM_WR, qs[4];
-        rotate(p->q + 4 * u, ju, J);
-        for (int d = 0; d < 3; ++d)
-            J[d] += p->x[3 * u + d] - O[d];
-        quat_mul(p->q + 4 * u, rel, qs);
-        rotation_between(p->q + 4 * i, qs, th);
-        for (int d = 0; d < 3; ++d)
-            wr[d] = p->w[3 * i + d] - p->w[3 * u + d];
-        const double kappa = beam_kappa(p, i, u, s);
-        /* S = [1; [J]×] (a turn about J moves O by J × ω), so for a row a =
-         * (a₁; a₂) of I^A, (a S) = a₁ + a₂ × J (a₂ · (J × e_k) = e_k · (a₂ × J));
-         * U = I^A S row by row */
-        double *U = b + BEAM_U, D[9];
-        for (int r = 0; r < 6; ++r) {
-            const double *a = IA + 6 * r;
-            U[3 * r] = a[0] + a[4] * J[2] - a[5] * J[1];
-            U[3 * r + 1] = a[1] + a[5] * J[0] - a[3] * J[2];
-            U[3 * r + 2] = a[2] + a[3] * J[1] - a[4] * J[0];
-        }
-        /* D = Sᵀ U + Δt² κ 1 (column k: U₁ₖ + U₂ₖ × J by the same rule),
-         * u = τ − Sᵀ p^A, τ = −κ (θ + Δt ω_rel) */
-        for (int k = 0; k < 3; ++k) {
-            const double u0 = U[9 + k], u1 = U[12 + k], u2 = U[15 + k];
-            D[k] = U[k] + u1 * J[2] - u2 * J[1];
-            D[3 + k] = U[3 + k] + u2 * J[0] - u0 * J[2];
-            D[6 + k] = U[6 + k] + u0 * J[1] - u1 * J[0];
-        }
-        D[0] += dt * dt * kappa;
-        D[4] += dt * dt * kappa;
-        D[8] += dt * dt * kappa;
-        double *uu = b + BEAM_UU;
-        const double sp[3] = {pA[0] + pA[4] * J[2] - pA[5] * J[1], pA[1] + pA[5] * J[0] - pA[3] * J[2],
-                              pA[2] + pA[3] * J[1] - pA[4] * J[0]};
-        for (int r = 0; r < 3; ++r)
-            uu[r] = -kappa * (th[r] + dt * wr[r]) - sp[r];
-        /* (symmetrised: D is symmetric up to rounding) */
-        D[1] = D[3] = 0.5 * (D[1] + D[3]);
-        D[2] = D[6] = 0.5 * (D[2] + D[6]);
-        D[5] = D[7] = 0.5 * (D[5] + D[7]);
-        double *Di = b + BEAM_DINV;
-        inv3_sym(D, Di);
-        /* into the parent: I^A − U D⁻¹ Uᵀ and p^A + U D⁻¹ u */
-        double UD[18], Dv[3];
-        for (int r = 0; r < 6; ++r)
-            for (int k = 0; k < 3; ++k)
-                UD[3 * r + k] = U[3 * r] * Di[k] + U[3 * r + 1] * Di[3 + k] + U[3 * r + 2] * Di[6 + k];
-        for (int k = 0; k < 3; ++k)
-            Dv[k] = Di[3 * k] * uu[0] + Di[3 * k + 1] * uu[1] + Di[3 * k + 2] * uu[2];
-        for (int r = 0; r < 6; ++r) {
-            /* (symmetric: the upper triangle, mirrored) */
-            for (int k = r; k < 6; ++k) {
-                const double v =
-                    IA[6 * r + k] - (UD[3 * r] * U[3 * k] + UD[3 * r + 1] * U[3 * k + 1] + UD[3 * r + 2] * U[3 * k + 2]);
-                bu[BEAM_IA + 6 * r + k] += v;
-                if (k != r)
-                    bu[BEAM_IA + 6 * k + r] += v;
-            }
-            bu[BEAM_PA + r] += pA[r] + U[3 * r] * Dv[0] + U[3 * r + 1] * Dv[1] + U[3 * r + 2] * Dv[2];
-        }
-    }
+    for (size_t item = 0; item < p->follow_items; ++item)
+        beam_fold(p, order[start[item]], dt, O);
+    for (size_t t = p->follow_top; t-- > 0;)
+        beam_fold(p, order[t], dt, O);
     return 0;
 }
 
