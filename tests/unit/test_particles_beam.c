@@ -79,6 +79,19 @@ static phc_particles *straight_chain(size_t n, const double origin[3], const dou
     return p;
 }
 
+/* The options of a beam pass: follow_parent, bending = beam, E_1/2 (Pa),
+ * stiffness s and damping for every particle. */
+static phc_particles_options beam_options(double e_half, double s, double damping)
+{
+    phc_particles_options o = phc_particles_options_default();
+    o.follow_parent = 1;
+    o.bending = PHC_PARTICLES_BEAM;
+    o.beam_modulus = e_half;
+    o.stiffness = s;
+    o.damping = damping;
+    return o;
+}
+
 /* Steps until every speed is below vtol (or cap steps); returns the steps. */
 static size_t settle(phc_particles *p, double dt, double vtol, size_t cap)
 {
@@ -202,12 +215,7 @@ static void test_statics(void)
     /* two loads: E_1/2 = 1e9 Pa (tip ~ 1 mm: small angles) and 2e6 Pa (large) */
     const double moduli[2] = {1e9, 2e6};
     for (int c = 0; c < 2; ++c) {
-        phc_particles_options opt = phc_particles_options_default();
-        opt.follow_parent = 1;
-        opt.bending = PHC_PARTICLES_BEAM;
-        opt.beam_modulus = moduli[c];
-        opt.stiffness = s;
-        opt.damping = 0.05;
+        const phc_particles_options opt = beam_options(moduli[c], s, 0.05);
         phc_particles *p = straight_chain(n, o, dx, ell, r, &opt);
         CHECK(p != NULL);
         if (!p)
@@ -265,12 +273,7 @@ static void test_euler_bernoulli(void)
            L, r, E, q, 1e3 * want);
     printf("  %4s %14s %12s %8s %7s\n", "n", "tip (mm)", "rel. error", "order", "steps");
     for (int a = 0; a < 5; ++a) {
-        phc_particles_options opt = phc_particles_options_default();
-        opt.follow_parent = 1;
-        opt.bending = PHC_PARTICLES_BEAM;
-        opt.beam_modulus = e_half;
-        opt.stiffness = s;
-        opt.damping = 0.05;
+        const phc_particles_options opt = beam_options(e_half, s, 0.05);
         const double ell = L / (double)ns[a];
         phc_particles *p = straight_chain(ns[a], o, dx, ell, r, &opt);
         CHECK(p != NULL);
@@ -312,12 +315,7 @@ static void swing(double dt, double damping, double th0, size_t steps, double *t
 {
     const double ell = 0.1, r = 0.002, s = 0.5, e_half = 1e7;
     const double o[3] = {0, 0, 0}, down[3] = {0, 0, -1};
-    phc_particles_options opt = phc_particles_options_default();
-    opt.follow_parent = 1;
-    opt.bending = PHC_PARTICLES_BEAM;
-    opt.beam_modulus = e_half;
-    opt.stiffness = s;
-    opt.damping = damping;
+    const phc_particles_options opt = beam_options(e_half, s, damping);
     phc_particles *p = straight_chain(1, o, down, ell, r, &opt);
     CHECK(p != NULL);
     if (!p)
@@ -447,12 +445,7 @@ static void test_chain_mode(void)
     CHECK(info == 0);
     const double period_mode = 2 * PI / sqrt(w2[0]);
     /* the simulation: released straight, undamped, dt = period / 2000 */
-    phc_particles_options opt = phc_particles_options_default();
-    opt.follow_parent = 1;
-    opt.bending = PHC_PARTICLES_BEAM;
-    opt.beam_modulus = e_half;
-    opt.stiffness = s;
-    opt.damping = 0;
+    const phc_particles_options opt = beam_options(e_half, s, 0);
     phc_particles *p = straight_chain(NL, o, dx, ell, r, &opt);
     CHECK(p != NULL);
     if (!p)
