@@ -126,9 +126,9 @@
  * (Featherstone, "Rigid Body Dynamics Algorithms", Springer 2008, ch. 7:
  * spatial vectors in world axes about one point, gravity as the bases'
  * acceleration −g, the implicit spring's Δt² κ as the joint's armature),
- * O(n): one sweep children before parents on one thread (articulated
- * inertias and biases), one parents first on the joint pass's order
- * (subtrees on threads; the same numbers for any thread count).  The
+ * O(n): one sweep children before parents (articulated inertias and
+ * biases), one parents first, both on the joint pass's order (subtrees on
+ * threads; the same numbers for any thread count).  The
  * velocity-product (Coriolis) terms and the bases' own accelerations are
  * left out (slow shoots on held bases).  Velocities then come from the
  * positions, damped by (1 − damping) as every velocity.
