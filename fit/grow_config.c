@@ -11,7 +11,8 @@
 #include "fit/config/yaml_keys.h"
 #include "measurements/yaml_doc.h"
 
-typedef enum key_type { K_NUM, K_SIZE, K_UINT, K_U64, K_VEC, K_BOOL } key_type;
+typedef enum key_type { K_NUM, K_SIZE, K_UINT, K_U64, K_VEC, K_BOOL, K_WORD } key_type;
+
 
 /* One key: where it goes (offset into phc_grow_config), its range
  * [lo, hi] (open ends where said), unit and meaning. */
@@ -124,6 +125,11 @@ static const key_spec KEYS[] = {
      "shape, s < 1 lets a link bend down under its load (model/particles.h)"},
     {"dynamics", "stiffness_step", K_NUM, OPT(particles.stiffness_step), 0, INF, 1, 1, "s",
      "T: the substep at which follow_parent's joint turns by the fraction s toward its rest angle"},
+    {"dynamics", "bending", K_WORD, OPT(particles.bending), 0, 0, 0, 0, "",
+     "follow_parent's load: own_weight (each link turns under its own weight, creeping to rest) or beam (each "
+     "link under the moment of its whole subtree, on a spring of stiffness E I / L, swinging; model/particles.h)"},
+    {"dynamics", "beam_modulus", K_NUM, OPT(particles.beam_modulus), 0, INF, 1, 1, "Pa",
+     "E_1/2: with bending beam, the Young's modulus of a link of stiffness s = 1/2 (E = E_1/2 s/(1 - s))"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 
@@ -133,11 +139,36 @@ static const char *const TOP_KEYS[] = {"name",   "support", "seed",      "durati
                                        "plant",  "growth",  "branching", "light",    "tropisms",  "anchors",
                                        "dynamics", "leaves", "cambium", NULL};
 
+/* The words of a K_WORD key (its value is stored as the word's index, an
+ * int), NULL-ended. */
+static const char *const BENDING_WORDS[] = {"own_weight", "beam", NULL}; /* PHC_PARTICLES_OWN_WEIGHT, _BEAM */
+static const struct {
+    size_t offset;
+    const char *const *words;
+} WORD_KEYS[] = {{OPT(particles.bending), BENDING_WORDS}};
+
+static const char *const *key_words(const key_spec *k)
+{
+    for (size_t i = 0; i < sizeof WORD_KEYS / sizeof WORD_KEYS[0]; ++i)
+        if (WORD_KEYS[i].offset == k->offset)
+            return WORD_KEYS[i].words;
+    return NULL;
+}
+
 static void range_text(const key_spec *k, char *buf, size_t size)
 {
     char lo[24], hi[24];
     if (k->type == K_BOOL) {
         snprintf(buf, size, "true or false");
+        return;
+    }
+    if (k->type == K_WORD) {
+        const char *const *words = key_words(k);
+        size_t used = 0;
+        buf[0] = 0;
+        for (size_t w = 0; words[w] && used < size; ++w)
+            used += (size_t)snprintf(buf + used, size - used, "%s%s", w ? (words[w + 1] ? ", " : " or ") : "",
+                                     words[w]);
         return;
     }
     if (isinf(k->lo))
@@ -199,6 +230,19 @@ static int read_key(const phc_yaml_doc *doc, const phc_yaml_node *map, const key
         *(int *)field = b;
         return PHC_OK;
     }
+    if (k->type == K_WORD) {
+        const char *word;
+        if ((rc = phc_yaml_string(doc, v, name, &word, err)))
+            return rc;
+        const char *const *words = key_words(k);
+        for (int w = 0; words[w]; ++w)
+            if (strcmp(word, words[w]) == 0) {
+                *(int *)field = w;
+                return PHC_OK;
+            }
+        return phc_error_set(err, PHC_ERR_INPUT, "%s:%zu: %s: '%s' is not one of %s", doc->path, line, name, word,
+                             range);
+    }
     double x;
     if (k->type == K_NUM) {
         if ((rc = phc_yaml_number(doc, v, name, &x, err)))
@@ -219,7 +263,8 @@ static int read_key(const phc_yaml_doc *doc, const phc_yaml_node *map, const key
     case K_UINT: *(unsigned *)field = (unsigned)x; break;
     case K_U64: *(uint64_t *)field = (uint64_t)x; break;
     case K_VEC:
-    case K_BOOL: break;
+    case K_BOOL:
+    case K_WORD: break;
     }
     return PHC_OK;
 }
@@ -445,6 +490,7 @@ void phc_grow_config_help(FILE *out)
         case K_UINT: snprintf(def, sizeof def, "%u", *(const unsigned *)field); break;
         case K_U64: snprintf(def, sizeof def, "%llu", (unsigned long long)*(const uint64_t *)field); break;
         case K_BOOL: snprintf(def, sizeof def, "%s", *(const int *)field ? "true" : "false"); break;
+        case K_WORD: snprintf(def, sizeof def, "%s", key_words(k)[*(const int *)field]); break;
         case K_VEC: {
             const double *v = (const double *)field;
             snprintf(def, sizeof def, "[%g, %g, %g]", v[0], v[1], v[2]);

@@ -91,6 +91,10 @@ struct phc_particles {
      * valid while that is later than rest_epoch[i] and rest_epoch[u] (the
      * epoch of their last rest change; epoch counts the steps). */
     double *joint;           /* 7n */
+    /* bending = BEAM: each particle's articulated-body terms (BEAM_PER
+     * doubles, see beam_articulate), allocated at the first beam step. */
+    double *beam;
+    size_t beam_cap;
     size_t *joint_epoch, *rest_epoch; /* n each */
     size_t epoch;
     unsigned char *ell0_stale; /* n: 1 when ell0 awaits its rest change (made when next
@@ -126,6 +130,8 @@ phc_particles_options phc_particles_options_default(void)
     o.break_threshold = 0.0;
     o.follow_parent = 0;
     o.stiffness_step = 0.01;
+    o.bending = PHC_PARTICLES_OWN_WEIGHT;
+    o.beam_modulus = 1e7;
     return o;
 }
 
@@ -456,6 +462,11 @@ static const char *opt_problem(const phc_particles_options *o, char *buf, size_t
     else if (!(o->stiffness_step > 0) || !isfinite(o->stiffness_step))
         snprintf(buf, size, "stiffness step must be positive and finite, found %g s",
                  o->stiffness_step);
+    else if (o->bending != PHC_PARTICLES_OWN_WEIGHT && o->bending != PHC_PARTICLES_BEAM)
+        snprintf(buf, size, "bending must be own_weight (%d) or beam (%d), found %d",
+                 PHC_PARTICLES_OWN_WEIGHT, PHC_PARTICLES_BEAM, o->bending);
+    else if (!(o->beam_modulus > 0) || !isfinite(o->beam_modulus))
+        snprintf(buf, size, "beam modulus must be positive and finite, found %g Pa", o->beam_modulus);
     else if (!isfinite(o->break_threshold))
         snprintf(buf, size, "break threshold must be finite, found %g", o->break_threshold);
     else if (!isfinite(o->gravity[0]) || !isfinite(o->gravity[1]) || !isfinite(o->gravity[2]))
@@ -513,6 +524,7 @@ void phc_particles_free(phc_particles *p)
     free(p->ell0);
     free(p->ell0_stale);
     free(p->joint);
+    free(p->beam);
     free(p->joint_epoch);
     free(p->rest_epoch);
     free(p->ell);
@@ -1675,6 +1687,26 @@ static inline void rotate_z(const double q[4], double h, double out[3])
     out[2] = h + (vx * ty - vy * tx);
 }
 
+/* The joint pass's rest terms of linked particle i with parent u
+ * (p->joint, made again after a rest change): j_i = R(q̄_u)ᵀ (h̄_i − x̄_u)
+ * (m) and q̄_u⁻¹ q̄_i, h̄_i its rest head, half = L_i/2 (m). */
+static inline const double *joint_terms(phc_particles *p, size_t i, size_t u, double half)
+{
+    double *ju = p->joint + 7 * i, *rel = ju + 3;
+    if (p->joint_epoch[i] <= p->rest_epoch[i] || p->joint_epoch[i] <= p->rest_epoch[u]) {
+        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
+        double hr[3], hb[3];
+        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+        rotate_z(q0i, half, hr);
+        for (int d = 0; d < 3; ++d)
+            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
+        rotate(q0u_inv, hb, ju);
+        quat_mul(q0u_inv, q0i, rel);
+        p->joint_epoch[i] = p->epoch;
+    }
+    return ju;
+}
+
 /* The joint pass (particles.h, "Shoots that bend"), parents first.  For
  * each linked particle i with parent u (already placed this substep):
  *   joint      J  = x_u + R(q_u) j_i,   j_i = R(q̄_u)ᵀ (h̄_i − x̄_u) (m),
@@ -1707,19 +1739,7 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
         return; /* s = 0: no hold */
     const double *qu = p->qp + 4 * u;
     const double half = p->ax[3 * i + 2];
-    /* the rest terms (p->joint): j_i, and q̄_u⁻¹ q̄_i */
-    double *ju = p->joint + 7 * i, *rel = ju + 3;
-    if (p->joint_epoch[i] <= p->rest_epoch[i] || p->joint_epoch[i] <= p->rest_epoch[u]) {
-        const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
-        double hr[3], hb[3];
-        const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
-        rotate_z(q0i, half, hr);
-        for (int d = 0; d < 3; ++d)
-            hb[d] = p->x0[3 * i + d] - hr[d] - p->x0[3 * u + d];
-        rotate(q0u_inv, hb, ju);
-        quat_mul(q0u_inv, q0i, rel);
-        p->joint_epoch[i] = p->epoch;
-    }
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
     /* the joint J in u's current frame */
     double hr[3], J[3];
     rotate(qu, ju, J);
@@ -1784,6 +1804,326 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];
     if (p->anchored[i]) /* as after every projection */
+        apply_anchor(p, i);
+}
+
+
+/* ---- the beam joint pass (particles.h, "Shoots that bend like beams") -- */
+
+/* p->beam, per particle (BEAM_PER doubles): the articulated-body terms of
+ * its joint, made by beam_articulate, read by beam_one.  Spatial vectors
+ * are 6-vectors in world axes about the step's reference point O (particle
+ * 0's centre at the step's start, so that the sums stay well conditioned):
+ * motion (ω; v_O), force (n_O; f) (Featherstone, "Rigid Body Dynamics
+ * Algorithms", 2008, ch. 2 and 7). */
+enum {
+    BEAM_IA = 0,    /* 36: articulated inertia I^A (6x6, row-major; kg m², kg m, kg) */
+    BEAM_PA = 36,   /* 6: articulated bias force p^A (N m, N) */
+    BEAM_U = 42,    /* 18: U = I^A S (6x3) */
+    BEAM_DINV = 60, /* 9: D⁻¹, D = Sᵀ U + Δt² κ 1 (3x3) */
+    BEAM_UU = 69,   /* 3: u = τ − Sᵀ p^A (N m) */
+    BEAM_TH = 72,   /* 3: the bend θ at the step's start (rad) */
+    BEAM_WR = 75,   /* 3: the joint's angular velocity ω_i − ω_u (rad/s) */
+    BEAM_J = 78,    /* 3: the joint J − O at the step's start (m) */
+    BEAM_ACC = 81,  /* 6: the body's spatial acceleration (rad s⁻², m s⁻²) */
+    BEAM_PER = 87
+};
+enum { BEAM_BASE, BEAM_WELD, BEAM_BALL };
+
+/* How particle i hangs in the beam pass: BALL (linked, 0 < s < 1: a
+ * spherical joint with a spring), WELD (linked, s = 1: held at its rest
+ * angle, part of its parent's body), BASE (not linked, or s = 0: not
+ * held; its motion is the projections', its children hang from it). */
+static inline int beam_kind(const phc_particles *p, size_t i)
+{
+    if (!p->linked[i])
+        return BEAM_BASE;
+    const double s = stiffness_of(p, i);
+    return !(s > 0) ? BEAM_BASE : s >= 1 ? BEAM_WELD : BEAM_BALL;
+}
+
+/* y = A x, A 6x6 row-major. */
+static inline void mv6(const double *A, const double *x, double *y)
+{
+    for (int r = 0; r < 6; ++r) {
+        double t = 0;
+        for (int c = 0; c < 6; ++c)
+            t += A[6 * r + c] * x[c];
+        y[r] = t;
+    }
+}
+
+/* The inverse of a symmetric positive definite 3x3 matrix (adjugate). */
+static inline void inv3_sym(const double *D, double *Di)
+{
+    const double c00 = D[4] * D[8] - D[5] * D[7], c01 = D[5] * D[6] - D[3] * D[8];
+    const double c02 = D[3] * D[7] - D[4] * D[6];
+    const double det = D[0] * c00 + D[1] * c01 + D[2] * c02, inv = 1 / det;
+    Di[0] = c00 * inv;
+    Di[1] = Di[3] = c01 * inv;
+    Di[2] = Di[6] = c02 * inv;
+    Di[4] = (D[0] * D[8] - D[2] * D[6]) * inv;
+    Di[5] = Di[7] = (D[2] * D[3] - D[0] * D[5]) * inv;
+    Di[8] = (D[0] * D[4] - D[1] * D[3]) * inv;
+}
+
+/* The rotation vector θ (rad) of the unit quaternion a b⁻¹ (the shorter
+ * way round). */
+static inline void rotation_between(const double a[4], const double b[4], double th[3])
+{
+    const double binv[4] = {b[0], -b[1], -b[2], -b[3]};
+    double d[4];
+    quat_mul(a, binv, d);
+    if (d[0] < 0)
+        for (int k = 0; k < 4; ++k)
+            d[k] = -d[k];
+    const double sn = sqrt(d[1] * d[1] + d[2] * d[2] + d[3] * d[3]);
+    const double fac = sn > 0 ? 2 * atan2(sn, d[0]) / sn : 2.0;
+    for (int k = 0; k < 3; ++k)
+        th[k] = fac * d[1 + k];
+}
+
+/* Joint i's spring κ (N m rad⁻¹; particles.h): E(s) π r⁴ / (4 ℓ̄), ℓ̄ =
+ * (L_i + L_u)/2 when its parent u bends (BALL), else L_i/2. */
+static inline double beam_kappa(const phc_particles *p, size_t i, size_t u, double s)
+{
+    const double r = p->ax[3 * i];
+    const double lbar = p->ax[3 * i + 2] + (beam_kind(p, u) == BEAM_BALL ? p->ax[3 * u + 2] : 0.0);
+    return p->o.beam_modulus * s / (1 - s) * PI * r * r * r * r / (4 * lbar);
+}
+
+/* The articulated-body pass (Featherstone's ABA, its second sweep:
+ * children before parents) at the step's start: every body's spatial
+ * inertia about O and its external force (beam_body), then every BALL
+ * joint's U, D⁻¹ and u with the joint's armature Δt² κ and force τ = −κ
+ * (θ + Δt ω_rel) (the implicit spring), the subtree folded into its
+ * parent (beam_fold: a WELD wholly, a BALL through its joint).  The
+ * velocity-product terms are left out (slow shoots). */
+static void beam_body(phc_particles *p, size_t i, const double O[3])
+{
+    double *b = p->beam + BEAM_PER * i, *Ib = b + BEAM_IA, e[3], c[3];
+    const double m = p->m[i], *f = p->f + 3 * i;
+    const double r2 = p->ax[3 * i] * p->ax[3 * i], h = p->ax[3 * i + 2];
+    for (int d = 0; d < 3; ++d)
+        c[d] = p->x[3 * i + d] - O[d];
+    rotate_z(p->q + 4 * i, 1.0, e);
+    /* the cylinder about its centre: m r²/2 about e, m (3r² + L²)/12 across,
+     * I_c = m (a 1 + (b − a) e eᵀ), a = r²/4 + L²/12, b = r²/2 */
+    const double a = r2 / 4 + h * h / 3, ba = r2 / 2 - a;
+    const double cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+            /* top left: I_c + m ([c]× [c]×ᵀ = |c|² 1 − c cᵀ) */
+            Ib[6 * r + k] = m * ((r == k ? a + cc : 0.0) + ba * e[r] * e[k] - c[r] * c[k]);
+            Ib[6 * (r + 3) + k + 3] = r == k ? m : 0.0;
+        }
+    /* top right m [c]×, bottom left its transpose */
+    const double mc[3] = {m * c[0], m * c[1], m * c[2]};
+    const double sk[9] = {0, -mc[2], mc[1], mc[2], 0, -mc[0], -mc[1], mc[0], 0};
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+            Ib[6 * r + k + 3] = sk[3 * r + k];
+            Ib[6 * (k + 3) + r] = sk[3 * r + k];
+        }
+    /* bias: minus the external force f at the centre, (c × f; f) */
+    double *pa = b + BEAM_PA;
+    pa[0] = -(c[1] * f[2] - c[2] * f[1]);
+    pa[1] = -(c[2] * f[0] - c[0] * f[2]);
+    pa[2] = -(c[0] * f[1] - c[1] * f[0]);
+    for (int d = 0; d < 3; ++d)
+        pa[3 + d] = -f[d];
+}
+
+static void beam_fold(phc_particles *p, size_t i, double dt, const double O[3])
+{
+    const int kind = beam_kind(p, i);
+    if (kind == BEAM_BASE)
+        return;
+    const size_t u = p->parent[i];
+    double *b = p->beam + BEAM_PER * i, *bu = p->beam + BEAM_PER * u;
+    double *IA = b + BEAM_IA, *pA = b + BEAM_PA;
+    if (kind == BEAM_WELD) {
+        for (int k = 0; k < 36; ++k)
+            bu[BEAM_IA + k] += IA[k];
+        for (int k = 0; k < 6; ++k)
+            bu[BEAM_PA + k] += pA[k];
+        return;
+    }
+    /* the joint at the step's start: J, the rest turn q*, the bend θ */
+    const double half = p->ax[3 * i + 2], s = stiffness_of(p, i);
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3;
+    double *J = b + BEAM_J, *th = b + BEAM_TH, *wr = b + BEAM_WR, qs[4];
+    rotate(p->q + 4 * u, ju, J);
+    for (int d = 0; d < 3; ++d)
+        J[d] += p->x[3 * u + d] - O[d];
+    quat_mul(p->q + 4 * u, rel, qs);
+    rotation_between(p->q + 4 * i, qs, th);
+    for (int d = 0; d < 3; ++d)
+        wr[d] = p->w[3 * i + d] - p->w[3 * u + d];
+    const double kappa = beam_kappa(p, i, u, s);
+    /* S = [1; [J]×] (a turn about J moves O by J × ω), so for a row a =
+     * (a₁; a₂) of I^A, (a S) = a₁ + a₂ × J (a₂ · (J × e_k) = e_k · (a₂ × J));
+     * U = I^A S row by row */
+    double *U = b + BEAM_U, D[9];
+    for (int r = 0; r < 6; ++r) {
+        const double *a = IA + 6 * r;
+        U[3 * r] = a[0] + a[4] * J[2] - a[5] * J[1];
+        U[3 * r + 1] = a[1] + a[5] * J[0] - a[3] * J[2];
+        U[3 * r + 2] = a[2] + a[3] * J[1] - a[4] * J[0];
+    }
+    /* D = Sᵀ U + Δt² κ 1 (column k: U₁ₖ + U₂ₖ × J by the same rule),
+     * u = τ − Sᵀ p^A, τ = −κ (θ + Δt ω_rel) */
+    for (int k = 0; k < 3; ++k) {
+        const double u0 = U[9 + k], u1 = U[12 + k], u2 = U[15 + k];
+        D[k] = U[k] + u1 * J[2] - u2 * J[1];
+        D[3 + k] = U[3 + k] + u2 * J[0] - u0 * J[2];
+        D[6 + k] = U[6 + k] + u0 * J[1] - u1 * J[0];
+    }
+    D[0] += dt * dt * kappa;
+    D[4] += dt * dt * kappa;
+    D[8] += dt * dt * kappa;
+    double *uu = b + BEAM_UU;
+    const double sp[3] = {pA[0] + pA[4] * J[2] - pA[5] * J[1], pA[1] + pA[5] * J[0] - pA[3] * J[2],
+                          pA[2] + pA[3] * J[1] - pA[4] * J[0]};
+    for (int r = 0; r < 3; ++r)
+        uu[r] = -kappa * (th[r] + dt * wr[r]) - sp[r];
+    /* (symmetrised: D is symmetric up to rounding) */
+    D[1] = D[3] = 0.5 * (D[1] + D[3]);
+    D[2] = D[6] = 0.5 * (D[2] + D[6]);
+    D[5] = D[7] = 0.5 * (D[5] + D[7]);
+    double *Di = b + BEAM_DINV;
+    inv3_sym(D, Di);
+    /* into the parent: I^A − U D⁻¹ Uᵀ and p^A + U D⁻¹ u */
+    double UD[18], Dv[3];
+    for (int r = 0; r < 6; ++r)
+        for (int k = 0; k < 3; ++k)
+            UD[3 * r + k] = U[3 * r] * Di[k] + U[3 * r + 1] * Di[3 + k] + U[3 * r + 2] * Di[6 + k];
+    for (int k = 0; k < 3; ++k)
+        Dv[k] = Di[3 * k] * uu[0] + Di[3 * k + 1] * uu[1] + Di[3 * k + 2] * uu[2];
+    for (int r = 0; r < 6; ++r) {
+        /* (symmetric: the upper triangle, mirrored) */
+        for (int k = r; k < 6; ++k) {
+            const double v =
+                IA[6 * r + k] - (UD[3 * r] * U[3 * k] + UD[3 * r + 1] * U[3 * k + 1] + UD[3 * r + 2] * U[3 * k + 2]);
+            bu[BEAM_IA + 6 * r + k] += v;
+            if (k != r)
+                bu[BEAM_IA + 6 * k + r] += v;
+        }
+        bu[BEAM_PA + r] += pA[r] + U[3 * r] * Dv[0] + U[3 * r + 1] * Dv[1] + U[3 * r + 2] * Dv[2];
+    }
+}
+
+/* The second sweep over the joint pass's order: the bodies (by index),
+ * then each subtree item from its end to its second particle (children
+ * before parents, inside the item), the items on the threads of a team;
+ * then on one thread the items' roots (folding into the top) and the top
+ * backwards.  Every parent gets its children's folds in the same order
+ * for any thread count.  -1 when out of memory. */
+static int beam_articulate(phc_particles *p, double dt)
+{
+    const size_t n = p->n;
+    if (p->beam_cap < n) {
+        double *t = realloc(p->beam, BEAM_PER * p->cap * sizeof *t);
+        if (!t)
+            return -1;
+        p->beam = t;
+        p->beam_cap = p->cap;
+    }
+    const double O[3] = {p->x[0], p->x[1], p->x[2]};
+    const size_t *order = p->follow_order, *start = p->follow_start;
+    size_t next = 0;
+    if (team((long)n)) {
+#pragma omp parallel
+        {
+#pragma omp for schedule(static)
+            for (long i = 0; i < (long)n; ++i)
+                beam_body(p, (size_t)i, O);
+            for (;;) {
+                size_t item;
+#pragma omp atomic capture
+                item = next++;
+                if (item >= p->follow_items)
+                    break;
+                for (size_t t = start[item + 1]; t-- > start[item] + 1;)
+                    beam_fold(p, order[t], dt, O);
+            }
+        }
+    } else {
+        for (size_t i = 0; i < n; ++i)
+            beam_body(p, i, O);
+        for (size_t item = 0; item < p->follow_items; ++item)
+            for (size_t t = start[item + 1]; t-- > start[item] + 1;)
+                beam_fold(p, order[t], dt, O);
+    }
+    for (size_t item = 0; item < p->follow_items; ++item)
+        beam_fold(p, order[start[item]], dt, O);
+    for (size_t t = p->follow_top; t-- > 0;)
+        beam_fold(p, order[t], dt, O);
+    return 0;
+}
+
+/* The beam joint of linked particle i (particles.h; the ABA's third sweep,
+ * parents first): its parent's spatial acceleration a_u (gravity's
+ * (0; −g) for a BASE parent), α = D⁻¹ (u − Uᵀ a_u), its own a = a_u + S α;
+ * ω⁺ = ω_rel + Δt α, θ⁺ = θ + Δt ω⁺, then q = exp(θ⁺) q*, x = J +
+ * R(q)(0, 0, L/2) from its parent's final state.  Reads its parent's
+ * final xp, qp and acceleration, writes its own xp, qp and acceleration
+ * only (as follow_one). */
+static void beam_one(phc_particles *p, size_t i, double dt, double T2)
+{
+    const int kind = beam_kind(p, i);
+    if (kind == BEAM_BASE)
+        return; /* s = 0: no hold */
+    const size_t u = p->parent[i];
+    double *b = p->beam + BEAM_PER * i, *acc = b + BEAM_ACC;
+    double au[6];
+    if (beam_kind(p, u) == BEAM_BASE) {
+        for (int d = 0; d < 3; ++d) {
+            au[d] = 0;
+            au[3 + d] = -p->o.gravity[d];
+        }
+    } else {
+        memcpy(au, p->beam + BEAM_PER * u + BEAM_ACC, sizeof au);
+    }
+    if (kind == BEAM_WELD) {
+        memcpy(acc, au, sizeof au);
+        follow_one(p, i, dt * dt, T2); /* held at the rest angle, exactly */
+        return;
+    }
+    const double *U = b + BEAM_U, *Di = b + BEAM_DINV, *uu = b + BEAM_UU, *J0 = b + BEAM_J;
+    double rhs[3], alpha[3], th[3];
+    for (int k = 0; k < 3; ++k) {
+        double sum = uu[k];
+        for (int r = 0; r < 6; ++r)
+            sum -= U[3 * r + k] * au[r];
+        rhs[k] = sum;
+    }
+    for (int k = 0; k < 3; ++k)
+        alpha[k] = Di[3 * k] * rhs[0] + Di[3 * k + 1] * rhs[1] + Di[3 * k + 2] * rhs[2];
+    /* a = a_u + S α = (α_u + α; a_O,u + J × α) */
+    for (int d = 0; d < 3; ++d)
+        acc[d] = au[d] + alpha[d];
+    acc[3] = au[3] + J0[1] * alpha[2] - J0[2] * alpha[1];
+    acc[4] = au[4] + J0[2] * alpha[0] - J0[0] * alpha[2];
+    acc[5] = au[5] + J0[0] * alpha[1] - J0[1] * alpha[0];
+    for (int d = 0; d < 3; ++d)
+        th[d] = b[BEAM_TH + d] + dt * (b[BEAM_WR + d] + dt * alpha[d]);
+    /* the new state from the parent's: q = exp(θ⁺) q*, x = J + R(q)(0, 0, L/2) */
+    const double half = p->ax[3 * i + 2];
+    const double *ju = joint_terms(p, i, u, half), *rel = ju + 3, *qu = p->qp + 4 * u;
+    double dq[4], hr[3], J[3], qs[4];
+    quat_exp(th, dq);
+    rotate(qu, ju, J);
+    for (int d = 0; d < 3; ++d)
+        J[d] += p->xp[3 * u + d];
+    quat_mul(qu, rel, qs);
+    double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
+    quat_mul(dq, qs, q);
+    quat_normalize(q);
+    rotate_z(q, half, hr);
+    for (int d = 0; d < 3; ++d)
+        x[d] = J[d] + hr[d];
+    if (p->anchored[i])
         apply_anchor(p, i);
 }
 
@@ -1882,6 +2222,16 @@ static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, doub
 {
     const size_t *order = p->follow_order;
     const double dt2 = dt * dt;
+    if (p->o.bending == PHC_PARTICLES_BEAM) {
+        for (size_t t = lo; t < hi; ++t) {
+            const size_t i = order[t];
+            if (p->linked[i])
+                beam_one(p, i, dt, T2);
+            if (check && i < *bad && !state_finite(p, i))
+                *bad = i;
+        }
+        return;
+    }
     for (size_t t = lo; t < hi; ++t) {
         const size_t i = order[t];
         if (p->linked[i])
@@ -2070,6 +2420,9 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     if (p->o.follow_parent && p->follow_dirty)
         follow_order_build(p);
     plan_projections(p);
+    if (p->o.follow_parent && p->o.bending == PHC_PARTICLES_BEAM && beam_articulate(p, dt))
+        return phc_error_set(err, PHC_ERR_NOMEM, "particles: step: out of memory (the beam pass of %zu particles)",
+                             n);
     step_shared sh = {-1, n, n, 0, 0};
     size_t tot = 0, fb = 0;
     if (p->use_lists && p->gcount[1] == 0 && p->o.follow_parent && team((long)n)) {

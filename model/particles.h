@@ -89,13 +89,63 @@
  * its parent at φ_u, rest angle 0 between them):
  *   φ − φ_u = c cos φ,   c = 2 g T² (1 − s) / (s L)  (rad),
  * the same for every Δt in that limit; each link carries its own weight
- * only (not the moment of its subtree).  The pass reads the last
+ * only (not the moment of its subtree: bending = BEAM below does).  The pass reads the last
  * orientation and the load, not the velocity, so a soft link relaxes to
  * its balance in geometric steps of 1 − k without overshoot (a version
  * predicting with x + vΔt whipped a 0.5 m cantilever to 19 m/s).  The pass
  * does not conserve momentum (a parent does not feel its children): meant
  * for plants held at their root.  A particle with s = 0 is not held.
  *
+ * Shoots that bend like beams (follow_parent with bending = BEAM; ours).
+ * The linked particles are rigid links of an articulated tree: a BALL
+ * joint (0 < s_i < 1) at i's head J_i (as above) with a spring, a WELD
+ * (s_i = 1: i held at its rest angle, part of its parent's body), and the
+ * particles without a hold (roots, broken links, s = 0) are bases whose
+ * motion the projections give.  The bend of a BALL joint is θ_i = log(q_i
+ * q*_i⁻¹) (rad, a rotation vector in world axes) about the rest turn q*_i
+ * above; its spring
+ *   κ_i = E(s_i) π r_i⁴ / (4 ℓ̄_i)  (N m rad⁻¹), E(s) = E_1/2 s / (1 − s),
+ * the Euler–Bernoulli bending moment M = E I_a ∂φ/∂x (I_a = π r⁴/4, the
+ * circular section's second moment of area, m⁴) lumped over the joint's
+ * share of the bending links, ℓ̄_i = (L_i + L_u)/2, or L_i/2 when the
+ * parent does not bend (a base or a WELD): the Voronoi length of discrete
+ * elastic rods (Bergou, Wardetzky, Robinson, Audoly, Grinspun, SIGGRAPH
+ * 2008, bending energy Σ E I_a θ² / (2 ℓ̄)).  s = 1/2 gives E_1/2 (the
+ * option beam_modulus), s → 1 rigid, s → 0 free.  The stiffness comes from
+ * E I_a, not from T, so that refining the links leaves the shape alone.
+ * One step, from the state at its start (x, q, ω; the joints' J, θ and
+ * ω_rel = ω_i − ω_u), is semi-implicit Euler in the joint angles with the
+ * spring implicit:
+ *   (H + Δt² K) α = Q_g + Q_f − K (θ + Δt ω_rel),  ω⁺ = ω_rel + Δt α,
+ *   θ⁺ = θ + Δt ω⁺,  q_i ← exp(θ⁺_i) q*_i,  x_i ← J_i + R(q_i)(0, 0, L_i/2)
+ * (q* and J from the parent's final state, parents first, then i's
+ * anchor), H the tree's joint-space mass matrix (each link a cylinder: m
+ * r²/2 about its axis, m (3r² + L²)/12 across), K = diag(κ_i), Q_g and Q_f
+ * the moments of gravity and of the external forces on each joint's whole
+ * subtree.  α comes from Featherstone's articulated-body algorithm
+ * (Featherstone, "Rigid Body Dynamics Algorithms", Springer 2008, ch. 7:
+ * spatial vectors in world axes about one point, gravity as the bases'
+ * acceleration −g, the implicit spring's Δt² κ as the joint's armature),
+ * O(n): one sweep children before parents (articulated inertias and
+ * biases), one parents first, both on the joint pass's order (subtrees on
+ * threads; the same numbers for any thread count).  The
+ * velocity-product (Coriolis) terms and the bases' own accelerations are
+ * left out (slow shoots on held bases).  Velocities then come from the
+ * positions, damped by (1 − damping) as every velocity.
+ * Statics: K θ = Q at every joint, the exact balance of the links on
+ * their springs: a uniform cantilever bends most at its base, and its
+ * small-angle tip deflection is the trapezoid rule of Euler–Bernoulli's:
+ * q L⁴ / (8 E I_a) (1 + 1/n²) for n equal links.  Dynamics: exact for the
+ * linearised tree (with the implicit spring's numerical damping, O(Δt));
+ * one link on a held parent swings with period 2π / sqrt((κ + m g L/2)/I)
+ * hanging down, an 8-link chain with the period of its linearised first
+ * eigenmode to 3e-4 (tests/unit/test_particles_beam.c), a 22-link
+ * cantilever within 0.5% of its first Euler–Bernoulli mode
+ * (notebooks_c/climbing_beam_shoot.c).  The anchors' reactions are not in
+ * Q (an anchor still pulls its particle after the joint places it).
+ * A WELD (s = 1) is placed as in the own-weight pass with k = 1: the same
+ * numbers.
+
  * Breaking (climbing §4.3; our definition of the stress): after the step,
  * each group's stress is its relative RMS misfit to the best rigid motion,
  *   σ_k = sqrt( Σ_j μ_jk |x_j − g_j^k|² / Σ_j μ_jk |x̄_j − c̄_k|² )
@@ -138,7 +188,16 @@ typedef struct phc_particles_options {
                               (see "Shoots that bend" above); default 0 */
     double stiffness_step; /* T, s, > 0: the time step at which the joint
                               pass turns by the fraction s; default 0.01 */
+    int bending;           /* the joint pass's load (see "Shoots that bend
+                              like beams"): PHC_PARTICLES_OWN_WEIGHT (each
+                              link its own weight; default) or
+                              PHC_PARTICLES_BEAM */
+    double beam_modulus;   /* E_1/2, Pa, > 0: with PHC_PARTICLES_BEAM, the
+                              Young's modulus of a link with s = 1/2;
+                              default 1e7 */
 } phc_particles_options;
+
+enum { PHC_PARTICLES_OWN_WEIGHT = 0, PHC_PARTICLES_BEAM = 1 };
 
 phc_particles_options phc_particles_options_default(void);
 

@@ -1531,6 +1531,15 @@ gr_config gr_collide_ends.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
   collide_ends: 2
 '
 grow_case "grow: collide_ends neither true nor false" "$C/gr_collide_ends.yaml" "gr_collide_ends.yaml:7" "dynamics.collide_ends" "expected a boolean"
+gr_config gr_bending.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  bending: springy
+'
+grow_case "grow: bending neither own_weight nor beam" "$C/gr_bending.yaml" "gr_bending.yaml:7" "dynamics.bending" "'springy'" "own_weight or beam"
+gr_config gr_beam_modulus.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  bending: beam
+  beam_modulus: 0
+'
+grow_case "grow: beam modulus zero" "$C/gr_beam_modulus.yaml" "gr_beam_modulus.yaml:8" "dynamics.beam_modulus" "(0, inf) Pa"
 # ---- end grow ----------------------------------------------------------------
 
 # ---- shoot_traces (traced shoots of a climbing plant) ------------------------
