@@ -124,6 +124,11 @@ static const key_spec KEYS[] = {
      "shape, s < 1 lets a link bend down under its load (model/particles.h)"},
     {"dynamics", "stiffness_step", K_NUM, OPT(particles.stiffness_step), 0, INF, 1, 1, "s",
      "T: the substep at which follow_parent's joint turns by the fraction s toward its rest angle"},
+    {"dynamics", "break_threshold", K_NUM, OPT(particles.break_threshold), 0, INF, 0, 1, "",
+     "a link whose group stress (the misfit to its best rigid motion) passes it breaks and the shoot below falls "
+     "(0: no breaking; model/climbing_breaking.h)"},
+    {"dynamics", "fall_time", K_NUM, OPT(fall_time), 0, INF, 0, 1, "s",
+     "a broken piece falls this long as free particles, then leaves the plant"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 
