@@ -1030,7 +1030,7 @@ static void read_and_anchor(phc_climbing *c, size_t i, int read, size_t *made, s
 {
     if (read && i > 0)
         read_back(c, i);
-    if (c->o.closest && !c->falling[i])
+    if (c->o.closest && !(c->stats.falling && c->falling[i])) /* (no anchors on a falling piece) */
         anchor(c, i, made, released);
 }
 

@@ -53,6 +53,9 @@
  *     next dynamic step starts afresh, at rest).  With collide, every
  *     particle is pushed out of the supports (see the option).  With
  *     dynamics_substeps = 0 the plant is kinematic: current = rest.
+ *     With particles.break_threshold > 0 a substep may break a link: the
+ *     subtree below it falls as free particles for fall_time and then
+ *     leaves the plant (model/climbing_breaking.h; indices close up).
  *  7. anchors (eq. 5): a particle without an anchor whose closest support
  *     point lies within attach_distance is anchored there; its strength
  *     k = k_max·σ_i·min(1, (t − t_anchor)/anchor_time) rises with the

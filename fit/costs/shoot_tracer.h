@@ -9,8 +9,9 @@
  * frame (the tip of a particle that stopped growing), and the apex (the
  * tip of the growing particle) at every frame.  A shoot is the particle
  * chain from a particle without parent or a lateral start to its apex;
- * its name is "s<stable id of its first particle>" (its index while no piece broke off), its parent the shoot of
- * the particle it leaves.  A point's time is the frame's.
+ * its name is "s<stable id of its first particle>" (phc_climbing_id: its
+ * index while no piece broke off), its parent the shoot of the particle it
+ * leaves.  A point's time is the frame's.
  *
  * So the traces record where an apex was at each frame and where each node
  * was when first seen, not the plant's final shape: a growing internode
