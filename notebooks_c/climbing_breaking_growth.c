@@ -32,6 +32,7 @@
 
 #include "fit/shape_plots.h"
 #include "model/climbing_growth.h"
+#include "tests/climbing_breaking_measures.h"
 
 #include "notebook_plot.h"
 
@@ -82,31 +83,6 @@ static void release(snapshot *s)
     free(s->mark);
 }
 
-static double max_linked_stress(const phc_climbing *c)
-{
-    double m = 0;
-    for (size_t i = 1; i < phc_climbing_count(c); ++i)
-        if (!phc_climbing_is_falling(c, i))
-            m = fmax(m, phc_climbing_stress(c, i));
-    return m;
-}
-
-static double falling_com_z(const phc_climbing *c, size_t *count)
-{
-    double w = 0, z = 0;
-    *count = 0;
-    for (size_t i = 0; i < phc_climbing_count(c); ++i)
-        if (phc_climbing_is_falling(c, i)) {
-            double x[3];
-            phc_climbing_position(c, i, x);
-            const double r = phc_climbing_radius(c, i), m = r * r * phc_climbing_length(c, i);
-            w += m;
-            z += m * x[2];
-            ++*count;
-        }
-    return w > 0 ? z / w : NAN;
-}
-
 int main(int argc, char **argv)
 {
     const char *out = NULL;
@@ -147,7 +123,7 @@ int main(int argc, char **argv)
         phc_climbing_stats st;
         phc_climbing_get_stats(c, &st);
         size_t m;
-        const double z = falling_com_z(c, &m);
+        const double z = climbing_falling_centre_z(c, &m);
         if (!broke && st.breaks > 0) {
             broke = 1;
             break_step = k;
@@ -177,7 +153,7 @@ int main(int argc, char **argv)
             release(&prev_snap);
             bad |= take(c, &prev_snap, "before the break");
         }
-        prev_max = max_linked_stress(c);
+        prev_max = climbing_max_linked_stress(c, NULL);
     }
     release(&prev_snap);
     if (bad || !broke || !dropped) {

@@ -32,6 +32,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "climbing_breaking_measures.h"
 #include "climbing_bushy_plant.h"
 
 #define THRESHOLD 0.07
@@ -65,36 +66,6 @@ fail:
     return NULL;
 }
 
-/* Largest stress over the linked groups of the plant (not falling). */
-static double max_linked_stress(const phc_climbing *c, size_t *at)
-{
-    double m = 0;
-    *at = 0;
-    for (size_t i = 1; i < phc_climbing_count(c); ++i)
-        if (!phc_climbing_is_falling(c, i) && phc_climbing_stress(c, i) > m) {
-            m = phc_climbing_stress(c, i);
-            *at = i;
-        }
-    return m;
-}
-
-/* Centre of mass height of the falling particles (weights r² L), m. */
-static double falling_com_z(const phc_climbing *c, size_t *count)
-{
-    double w = 0, z = 0;
-    *count = 0;
-    for (size_t i = 0; i < phc_climbing_count(c); ++i)
-        if (phc_climbing_is_falling(c, i)) {
-            double x[3];
-            phc_climbing_position(c, i, x);
-            const double r = phc_climbing_radius(c, i), m = r * r * phc_climbing_length(c, i);
-            w += m;
-            z += m * x[2];
-            ++*count;
-        }
-    return w > 0 ? z / w : NAN;
-}
-
 int main(void)
 {
     phc_error err;
@@ -115,7 +86,7 @@ int main(void)
         size_t last_falling = 0;
         for (size_t s = 1; s <= 2000; ++s) {
             size_t at;
-            const double prev = max_linked_stress(c, &at);
+            const double prev = climbing_max_linked_stress(c, &at);
             if (phc_climbing_step(c, DT, &err)) {
                 CHECK(0);
                 break;
@@ -123,7 +94,7 @@ int main(void)
             phc_climbing_stats st;
             phc_climbing_get_stats(c, &st);
             if (!broke && st.breaks == 0)
-                worst_before = fmax(worst_before, max_linked_stress(c, &at));
+                worst_before = fmax(worst_before, climbing_max_linked_stress(c, &at));
             if (!broke && st.breaks > 0) {
                 broke = 1;
                 step_break = s;
@@ -139,7 +110,7 @@ int main(void)
                     }
                 CHECK(phc_climbing_id(c, k_at) == st.last_break_id);
                 n_before = phc_climbing_count(c);
-                z0 = falling_com_z(c, &piece);
+                z0 = climbing_falling_centre_z(c, &piece);
                 /* the piece: a whole subtree, no tips, no anchors */
                 for (size_t i = 0; i < n_before; ++i) {
                     if (!phc_climbing_is_falling(c, i))
@@ -157,7 +128,7 @@ int main(void)
             }
             if (broke && !dropped) {
                 size_t m;
-                const double z = falling_com_z(c, &m);
+                const double z = climbing_falling_centre_z(c, &m);
                 if (m > 0) {
                     z_end = z;
                     last_falling = m;
