@@ -16,6 +16,9 @@
  *     t_break + 1 s, the parents stay in index order, the ids increase; the
  *     plant grows on from its other tips; a shoot tracer that looked at the
  *     plant all along gives valid traces.
+ *  3b. Dynamics switched off while a piece falls: it leaves at once, the
+ *     plant grows on kinematically and with dynamics again; fall_time 0:
+ *     the piece leaves at the end of the step that broke it.
  *  4. Threshold 0: no break, and the plant is the same bit for bit as with
  *     a threshold no stress reaches (1e9).
  *  5. A bushy plant of > 2000 particles with breaking on 1 and 2 OpenMP
@@ -195,6 +198,54 @@ int main(void)
         CHECK(traces && traces->n_shoots > 1);
         phc_shoot_traces_free(traces);
         phc_shoot_tracer_clear(&tr);
+        phc_climbing_free(c);
+    }
+
+    /* 3b. the dynamics switched off while a piece falls drop it at once;
+       fall_time 0 drops a piece at the end of the step that broke it */
+    {
+        phc_climbing *c = shoot(THRESHOLD, &err);
+        phc_climbing_stats st = {0};
+        size_t n_broken = 0, n_off = 0, n_on = 0;
+        for (int s = 0; c && s < 100 && st.breaks == 0; ++s) {
+            CHECK(phc_climbing_step(c, DT, &err) == 0);
+            phc_climbing_get_stats(c, &st);
+        }
+        const size_t falling = st.falling;
+        if (c) {
+            n_broken = phc_climbing_count(c);
+            CHECK(phc_climbing_set_dynamics_substeps(c, 0, &err) == 0);
+            phc_climbing_get_stats(c, &st);
+            n_off = phc_climbing_count(c);
+            CHECK(st.falling == 0 && n_off == n_broken - falling && st.particles_dropped == falling);
+            for (int s = 0; s < 40; ++s)
+                CHECK(phc_climbing_step(c, DT, &err) == 0);
+            CHECK(phc_climbing_set_dynamics_substeps(c, 1, &err) == 0);
+            for (int s = 0; s < 40; ++s)
+                CHECK(phc_climbing_step(c, DT, &err) == 0);
+            n_on = phc_climbing_count(c);
+        }
+        printf("dynamics off while %zu particles fall: %zu -> %zu particles, then 40 kinematic and "
+               "40 dynamic steps: %zu\n",
+               falling, n_broken, n_off, n_on);
+        CHECK(falling > 0 && n_on >= n_off);
+        phc_climbing_free(c);
+
+        phc_climbing_options o = shoot_options(THRESHOLD);
+        o.fall_time = 0;
+        const double base[3] = {0, 0, 0}, east[3] = {1, 0, 0};
+        c = phc_climbing_new(base, east, &o, &err);
+        for (int s = 0; c && s < 240; ++s)
+            CHECK(phc_climbing_step(c, 0.25, &err) == 0);
+        CHECK(c && phc_climbing_set_dynamics_substeps(c, 1, &err) == 0);
+        memset(&st, 0, sizeof st);
+        for (int s = 0; c && s < 100 && st.breaks == 0; ++s) {
+            CHECK(phc_climbing_step(c, DT, &err) == 0);
+            phc_climbing_get_stats(c, &st);
+        }
+        printf("fall_time 0: breaks %zu, falling after the step %zu, dropped %zu\n", st.breaks,
+               st.falling, st.particles_dropped);
+        CHECK(st.breaks == 1 && st.falling == 0 && st.particles_dropped > 0);
         phc_climbing_free(c);
     }
 
