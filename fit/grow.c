@@ -51,10 +51,18 @@ void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_gr
     s->anchored = st.anchored;
     s->anchors_made = st.anchors_made;
     s->anchors_released = st.anchors_released;
-    s->attached_fraction = st.particles ? (double)st.anchored / (double)st.particles : 0;
+    /* broken pieces that still fall are not the plant (model/climbing_breaking.h) */
+    s->breaks = st.breaks;
+    s->falling = st.falling;
+    s->pieces_dropped = st.pieces_dropped;
+    s->particles_dropped = st.particles_dropped;
+    s->particles = st.particles - st.falling;
+    s->attached_fraction = s->particles ? (double)st.anchored / (double)s->particles : 0;
     double top = seed_base[2];
     for (size_t i = 0; i < st.particles; ++i) {
         double b[3], t[3];
+        if (st.falling && phc_climbing_is_falling(c, i))
+            continue;
         phc_climbing_segment(c, i, b, t);
         top = fmax(top, fmax(b[2], t[2]));
         s->total_length += phc_climbing_length(c, i);
@@ -70,6 +78,8 @@ void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_gr
     double sum_cos = 0;
     for (size_t i = 0; i < st.particles; ++i) {
         double nrm[3];
+        if (st.falling && phc_climbing_is_falling(c, i))
+            continue;
         s->max_radius = fmax(s->max_radius, phc_climbing_radius(c, i));
         if (phc_climbing_leaf(c, i, NULL, nrm, NULL)) {
             s->leaves++;
@@ -308,6 +318,13 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
                              "plant", summary_json_full(s), "frames", frames);
     if (!root)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    if (cfg->options.particles.break_threshold > 0) { /* breaking on: what broke */
+        json_t *plant = json_object_get(root, "plant");
+        json_object_set_new(plant, "breaks", json_integer((json_int_t)s->breaks));
+        json_object_set_new(plant, "falling_particles", json_integer((json_int_t)s->falling));
+        json_object_set_new(plant, "pieces_dropped", json_integer((json_int_t)s->pieces_dropped));
+        json_object_set_new(plant, "particles_dropped", json_integer((json_int_t)s->particles_dropped));
+    }
     if (pv)
         json_object_set_new(root, "provenance", phc_provenance_to_json(pv));
     int rc = phc_json_file_write(root, path, err);

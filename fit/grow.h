@@ -47,6 +47,11 @@ typedef struct phc_grow_summary {
     size_t leaves;             /* leaves on the plant */
     double mean_leaf_cos;      /* mean cosine between leaf normals and the light direction */
     double max_radius;         /* m: thickest particle (after secondary growth) */
+    /* breaking (dynamics.break_threshold > 0): the counts above are of the plant
+       without its falling pieces */
+    size_t breaks;             /* links broken since the seed (one piece each) */
+    size_t falling;            /* particles of broken pieces still falling */
+    size_t pieces_dropped, particles_dropped; /* pieces that left the plant, their particles */
 } phc_grow_summary;
 
 /* Sets up o's light grid (origin and dims) when the plant needs one: light

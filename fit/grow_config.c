@@ -130,6 +130,11 @@ static const key_spec KEYS[] = {
      "link under the moment of its whole subtree, on a spring of stiffness E I / L, swinging; model/particles.h)"},
     {"dynamics", "beam_modulus", K_NUM, OPT(particles.beam_modulus), 0, INF, 1, 1, "Pa",
      "E_1/2: with bending beam, the Young's modulus of a link of stiffness s = 1/2 (E = E_1/2 s/(1 - s))"},
+    {"dynamics", "break_threshold", K_NUM, OPT(particles.break_threshold), 0, INF, 0, 1, "",
+     "a link whose group stress (the misfit to its best rigid motion) passes it breaks and the shoot below falls "
+     "(0: no breaking; model/climbing_breaking.h)"},
+    {"dynamics", "fall_time", K_NUM, OPT(fall_time), 0, INF, 0, 1, "s",
+     "a broken piece falls this long as free particles, then leaves the plant"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model/climbing_breaking.h"
 #include "model/climbing_cambium.h"
 #include "model/climbing_leaves.h"
 #include "model/climbing_light_field.h"
@@ -69,6 +70,12 @@ struct phc_climbing {
                                 this step's hand-over compares every particle */
     size_t pushed;           /* collisions of the last step (option collide) */
     double depth;            /* smallest δ − r before the pushes, m */
+    /* breaking (model/climbing_breaking.h) */
+    unsigned char *falling;  /* n: 1 in a broken piece that still falls */
+    unsigned char *cut;      /* n: 1 when its link to its parent broke */
+    double *fell_at;         /* n: when its piece broke, s; -1 while attached */
+    size_t *id;              /* n: stable id (birth number) */
+    size_t born;             /* particles made since the seed */
 };
 
 static double dot(const double a[3], const double b[3])
@@ -120,6 +127,7 @@ phc_climbing_options phc_climbing_options_default(void)
     o.leaf_max_angle_deg = 80;
     o.cambium_rate = 0;
     o.leaf_pipe_area = 0;
+    o.fall_time = 1;
     return o;
 }
 
@@ -163,6 +171,10 @@ void phc_climbing_free(phc_climbing *c)
     free(c->occ_t);
     phc_particles_free(c->sys);
     free(c->sys_seen);
+    free(c->falling);
+    free(c->cut);
+    free(c->fell_at);
+    free(c->id);
     free(c);
 }
 
@@ -210,6 +222,10 @@ static int reserve(phc_climbing *c, size_t want)
     GROW(sx, 6);
     GROW(sv, 2);
     GROW(sI, 2);
+    GROW(falling, 1);
+    GROW(cut, 1);
+    GROW(fell_at, 1);
+    GROW(id, 1);
 #undef GROW
     c->cap = cap;
     return 0;
@@ -285,6 +301,7 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
          "[0, inf) 1/s");
     NEED(o->leaf_pipe_area >= 0 && isfinite(o->leaf_pipe_area), "leaf_pipe_area",
          o->leaf_pipe_area, "[0, inf) m^2");
+    NEED(o->fall_time >= 0 && isfinite(o->fall_time), "fall_time", o->fall_time, "[0, inf) s");
 #undef NEED
     return 0;
 }
@@ -329,6 +346,10 @@ static size_t add_particle(phc_climbing *c, size_t parent, unsigned order, int l
     c->has_leaf[i] = 0;
     c->leaf_light[i] = 0;
     c->r0[i] = radius;
+    c->falling[i] = 0;
+    c->cut[i] = 0;
+    c->fell_at[i] = -1; /* attached */
+    c->id[i] = c->born++;
     volume_at(c, i);
     const double h = 0.5 * sigma * c->o.max_length;
     for (int k = 0; k < 3; ++k) {
@@ -938,6 +959,9 @@ static void read_back(phc_climbing *c, size_t i)
     memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
 }
 
+static void break_link(phc_climbing *c, size_t k, double stress);
+static int drop_fallen(phc_climbing *c, int all, phc_error *err);
+
 /* Step 6: the hand-over and the substeps (the shape is read back in step
  * 7's loop, anchors()). */
 static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
@@ -949,9 +973,13 @@ static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
     const double h = dt / (double)c->o.dynamics_substeps;
     c->pushed = 0;
     c->depth = INFINITY;
+    const int breaking = c->o.particles.break_threshold > 0;
     for (size_t s = 0; s < c->o.dynamics_substeps; ++s) {
-        if (phc_particles_step(p, h, NULL, err))
+        phc_particles_report rep;
+        if (phc_particles_step(p, h, breaking ? &rep : NULL, err))
             goto fail;
+        if (breaking && rep.broken)
+            break_link(c, rep.broken_particle, rep.broken_stress);
         size_t pushed;
         double depth;
         phc_particles_collisions(p, &pushed, &depth);
@@ -962,6 +990,8 @@ static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
 fail: /* the next dynamic step starts a fresh system from the plant */
     phc_particles_free(c->sys);
     c->sys = NULL;
+    if (c->stats.falling) /* (without the system its pieces cannot fall) */
+        drop_fallen(c, 1, NULL);
     return -1;
 }
 
@@ -1000,7 +1030,7 @@ static void read_and_anchor(phc_climbing *c, size_t i, int read, size_t *made, s
 {
     if (read && i > 0)
         read_back(c, i);
-    if (c->o.closest)
+    if (c->o.closest && !(c->stats.falling && c->falling[i])) /* (no anchors on a falling piece) */
         anchor(c, i, made, released);
 }
 
@@ -1035,6 +1065,12 @@ static void count(phc_climbing *c)
     c->stats.particles = c->n;
     c->stats.apical = apical;
     c->stats.anchored = anchored;
+    if (c->stats.falling) { /* (only after a break) */
+        size_t falling = 0;
+        for (size_t i = 0; i < c->n; ++i)
+            falling += c->falling[i];
+        c->stats.falling = falling;
+    }
 }
 
 /* Step 1's shading point of particle i: its centre and volume. */
@@ -1125,7 +1161,7 @@ static int leaf_update(phc_climbing *c, size_t i, double alpha, double tmax)
 {
     const phc_climbing_options *o = &c->o;
     if (!c->has_leaf[i]) {
-        if (c->apical[i] || c->node_k[i] % o->leaf_step != 0)
+        if (c->apical[i] || c->node_k[i] % o->leaf_step != 0 || c->falling[i])
             return 0;
         c->has_leaf[i] = 1; /* its first light: the stem's at the node */
         c->leaf_light[i] = c->light[i];
@@ -1345,6 +1381,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     }
     /* 7. anchors (after a dynamics step, with the read-back of the shape) */
     anchors(c, o->dynamics_substeps > 0);
+    /* broken pieces that fell long enough leave the plant */
+    if (c->stats.falling && drop_fallen(c, 0, err)) {
+        count(c);
+        return -1;
+    }
     /* 8. leaves */
     if (o->leaf_step > 0)
         leaves_update(c);
@@ -1368,6 +1409,8 @@ int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_err
         return phc_error_set(err, PHC_ERR_INVALID,
                              "climbing: dynamics need particles.maturity_age > 0 (it is %g s)",
                              c->o.particles.maturity_age);
+    if (substeps == 0 && c->stats.falling && drop_fallen(c, 1, err))
+        return -1;
     c->o.dynamics_substeps = substeps;
     if (substeps == 0) { /* kinematic from now on: a later dynamic step starts afresh */
         phc_particles_free(c->sys);
@@ -1417,4 +1460,142 @@ int phc_climbing_anchor(const phc_climbing *c, size_t i, double a[3])
         return 0;
     memcpy(a, c->anchor_at + 3 * i, 3 * sizeof *a);
     return 1;
+}
+
+/* ---- breaking (model/climbing_breaking.h) ------------------------------- */
+
+int phc_climbing_is_falling(const phc_climbing *c, size_t i) { return c->falling[i]; }
+size_t phc_climbing_id(const phc_climbing *c, size_t i) { return c->id[i]; }
+
+double phc_climbing_stress(const phc_climbing *c, size_t i)
+{
+    return c->sys && i < phc_particles_count(c->sys) ? phc_particles_stress(c->sys, i) : 0;
+}
+
+/* The particles broke the link of k to its parent (group stress `stress`)
+ * in a substep: k's subtree falls from now on, its tips stop, its anchors
+ * let go at once (also in the system, for the rest of the step).  A link
+ * inside a piece that already falls only splits it. */
+static void break_link(phc_climbing *c, size_t k, double stress)
+{
+    c->cut[k] = 1;
+    if (c->falling[k])
+        return;
+    phc_climbing_subtree_tag(c->parent, c->n, k, c->falling, 2);
+    size_t m = 0;
+    for (size_t i = k; i < c->n; ++i) {
+        if (c->falling[i] != 2)
+            continue;
+        if (c->fell_at[i] < 0) { /* (an older piece below k keeps its time) */
+            c->fell_at[i] = c->stats.time;
+            ++m;
+        }
+        c->falling[i] = 1;
+        c->apical[i] = 0;
+        if (c->anchored[i]) {
+            c->anchored[i] = 0;
+            c->stats.anchors_released++;
+            phc_particles_release(c->sys, i, NULL);
+        }
+    }
+    c->stats.breaks++;
+    c->stats.falling += m;
+    c->stats.last_break_id = c->id[k];
+    c->stats.last_break_stress = stress;
+}
+
+/* Drops the falling pieces whose fall_time is over (all of them with
+ * `all`): the plant's arrays close up (parents renumbered), the system is
+ * rebuilt from the rest with its state carried over. */
+static int drop_fallen(phc_climbing *c, int all, phc_error *err)
+{
+    const size_t n = c->n;
+    unsigned char *drop = c->has_child; /* (scratch, n) */
+    size_t *map = c->grown;             /* (scratch, n; the step's tips are done with) */
+    size_t pieces = 0, dropped = 0;
+    for (size_t i = 0; i < n; ++i) {
+        drop[i] = c->falling[i] &&
+                  (all || c->stats.time - c->fell_at[i] >= c->o.fall_time * (1 - 1e-12));
+        dropped += drop[i];
+        pieces += drop[i] && (c->parent[i] == PHC_CLIMBING_NONE || !drop[c->parent[i]]);
+    }
+    if (!dropped)
+        return 0;
+    const size_t m = phc_climbing_keep_map(drop, n, map);
+    phc_particles *sys = NULL;
+    if (c->sys) { /* the new system first: on failure nothing changed */
+        size_t *from = malloc(m * sizeof *from), *par = malloc(m * sizeof *par);
+        double *head = malloc(3 * m * sizeof *head), *tail = malloc(3 * m * sizeof *tail),
+               *rad = malloc(m * sizeof *rad);
+        if (from && par && head && tail && rad) {
+            for (size_t i = 0; i < n; ++i) {
+                const size_t j = map[i];
+                if (j == PHC_CLIMBING_NONE)
+                    continue;
+                from[j] = i;
+                par[j] = c->parent[i] == PHC_CLIMBING_NONE || c->cut[i] ? PHC_PARTICLES_NONE
+                                                                         : map[c->parent[i]];
+                rest_segment(c, i, head + 3 * j, tail + 3 * j);
+                rad[j] = c->radius[i];
+            }
+            sys = phc_climbing_system_rebuild(c->sys, &c->o.particles, m, from, par, head, tail,
+                                              rad, err);
+        } else {
+            phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for %zu particles", m);
+        }
+        free(from);
+        free(par);
+        free(head);
+        free(tail);
+        free(rad);
+        if (!sys)
+            return -1;
+        phc_particles_measure_stress(sys, 0);
+        phc_particles_free(c->sys);
+        c->sys = sys;
+    }
+    for (size_t i = 0; i < n; ++i) /* parents renumbered (kept: a piece is a whole subtree) */
+        if (!drop[i] && c->parent[i] != PHC_CLIMBING_NONE)
+            c->parent[i] = map[c->parent[i]];
+#define CLOSE_UP(field, per) phc_climbing_compact(c->field, (per) * sizeof *c->field, drop, n)
+    CLOSE_UP(parent, 1);
+    CLOSE_UP(order, 1);
+    CLOSE_UP(apical, 1);
+    CLOSE_UP(lateral, 1);
+    CLOSE_UP(anchored, 1);
+    CLOSE_UP(sigma, 1);
+    CLOSE_UP(radius, 1);
+    CLOSE_UP(age, 1);
+    CLOSE_UP(light, 1);
+    CLOSE_UP(x, 3);
+    CLOSE_UP(d, 3);
+    CLOSE_UP(xr, 3);
+    CLOSE_UP(dr, 3);
+    CLOSE_UP(anchor_at, 3);
+    CLOSE_UP(anchor_t0, 1);
+    CLOSE_UP(vol, 1);
+    CLOSE_UP(node_k, 1);
+    CLOSE_UP(has_leaf, 1);
+    CLOSE_UP(leaf_c, 3);
+    CLOSE_UP(leaf_n, 3);
+    CLOSE_UP(leaf_p, 3);
+    CLOSE_UP(leaf_light, 1);
+    CLOSE_UP(r0, 1);
+    CLOSE_UP(falling, 1);
+    CLOSE_UP(cut, 1);
+    CLOSE_UP(fell_at, 1);
+    CLOSE_UP(id, 1); /* (last: drop is c->has_child, scratch, not closed up) */
+#undef CLOSE_UP
+    c->n = m;
+    if (c->sys) /* what the system holds: the plant as it is now */
+        for (size_t j = 0; j < m; ++j)
+            seen_now(c, j, c->sys_seen + SEEN * j);
+    size_t leaves = 0;
+    for (size_t j = 0; j < m; ++j)
+        leaves += c->has_leaf[j];
+    c->leaves = leaves;
+    c->stats.pieces_dropped += pieces;
+    c->stats.particles_dropped += dropped;
+    c->stats.falling -= dropped;
+    return 0;
 }

@@ -53,6 +53,9 @@
  *     next dynamic step starts afresh, at rest).  With collide, every
  *     particle is pushed out of the supports (see the option).  With
  *     dynamics_substeps = 0 the plant is kinematic: current = rest.
+ *     With particles.break_threshold > 0 a substep may break a link: the
+ *     subtree below it falls as free particles for fall_time and then
+ *     leaves the plant (model/climbing_breaking.h; indices close up).
  *  7. anchors (eq. 5): a particle without an anchor whose closest support
  *     point lies within attach_distance is anchored there; its strength
  *     k = k_max·σ_i·min(1, (t − t_anchor)/anchor_time) rises with the
@@ -214,6 +217,11 @@ typedef struct phc_climbing_options {
                                    need not join (as with the centre push alone).  Not needed
                                    with dynamics (collide pushes the ends there).  0 (default):
                                    off */
+    /* breaking (§4.3; model/climbing_breaking.h): with dynamics and
+       particles.break_threshold > 0 (default 0: off) a link whose group
+       stress passes the threshold breaks and the subtree below it falls */
+    double fall_time;           /* s, >= 0: a broken piece falls this long as free particles,
+                                   then leaves the plant; default 1 */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -266,6 +274,13 @@ typedef struct phc_climbing_stats {
     size_t anchors_made;    /* anchors created */
     size_t anchors_released;
     size_t max_order;       /* highest branch order present */
+    /* breaking (model/climbing_breaking.h) */
+    size_t breaks;          /* links of the plant broken (each one a piece) */
+    size_t falling;         /* particles falling now (counted in particles) */
+    size_t pieces_dropped;  /* pieces that left the plant */
+    size_t particles_dropped; /* their particles */
+    size_t last_break_id;   /* stable id (phc_climbing_id) of the child of the last broken link */
+    double last_break_stress; /* its group stress when it broke (1) */
 } phc_climbing_stats;
 
 void phc_climbing_get_stats(const phc_climbing *c, phc_climbing_stats *s);
@@ -321,6 +336,14 @@ unsigned phc_climbing_node_index(const phc_climbing *c, size_t i);
 /* The primary radius r0 (m) i was born with (phc_climbing_radius is the
  * radius now, after secondary growth). */
 double phc_climbing_primary_radius(const phc_climbing *c, size_t i);
+/* 1 when i belongs to a broken piece that still falls (model/climbing_breaking.h). */
+int phc_climbing_is_falling(const phc_climbing *c, size_t i);
+/* i's stable id: its birth number (the index it had when it was made),
+ * kept when broken pieces leave the plant and the indices close up. */
+size_t phc_climbing_id(const phc_climbing *c, size_t i);
+/* Group stress of i in the last dynamics substep (model/particles.h,
+ * measured with particles.break_threshold > 0; else 0). */
+double phc_climbing_stress(const phc_climbing *c, size_t i);
 
 #ifdef __cplusplus
 }

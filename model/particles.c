@@ -2569,3 +2569,22 @@ void phc_particles_momentum(const phc_particles *p, double P[3])
         for (int d = 0; d < 3; ++d)
             P[d] += p->m[i] * p->v[3 * i + d];
 }
+
+/* ---- velocities (a system rebuilt from another, model/climbing_breaking.h) */
+
+void phc_particles_angular_velocity(const phc_particles *p, size_t i, double w[3])
+{
+    memcpy(w, p->w + 3 * i, 3 * sizeof(double));
+}
+
+int phc_particles_set_velocities(phc_particles *p, size_t i, const double v[3], const double w[3],
+                                 phc_error *err)
+{
+    if (check_index(p, i, "velocity", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (check_vec(p, i, v, "velocity", "m/s", err) || check_vec(p, i, w, "angular velocity", "rad/s", err))
+        return err ? err->status : PHC_ERR_INPUT;
+    memcpy(p->v + 3 * i, v, 3 * sizeof(double));
+    memcpy(p->w + 3 * i, w, 3 * sizeof(double));
+    return PHC_OK;
+}

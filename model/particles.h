@@ -366,6 +366,12 @@ size_t phc_particles_parent(const phc_particles *p, size_t i); /* linked parent 
 void phc_particles_segment_ends(const phc_particles *p, double *head, double *tail);
 /* Total linear momentum Σ m v, kg m s^-1. */
 void phc_particles_momentum(const phc_particles *p, double P[3]);
+/* Angular velocity of particle i (rad s^-1), and both velocities set at
+ * once (m s^-1, rad s^-1; finite), e.g. to carry a state over into a
+ * system rebuilt without some particles (model/climbing_breaking.h). */
+void phc_particles_angular_velocity(const phc_particles *p, size_t i, double w[3]);
+int phc_particles_set_velocities(phc_particles *p, size_t i, const double v[3], const double w[3],
+                                 phc_error *err);
 
 /* Goals of group k from the current positions and orientations: members
  * (up to cap) and their goal positions (3·cap), the rotation R (row-major

@@ -979,6 +979,10 @@ static int cmd_grow(int full_argc, char **full_argv, int argc, char **argv)
                s.particles, s.attached_fraction, s.anchors_made, s.anchors_released);
         if (s.leaves)
             printf("leaves %zu, mean cos(leaf normal, light direction) %.3f\n", s.leaves, s.mean_leaf_cos);
+        if (cfg->options.particles.break_threshold > 0)
+            printf("broken links %zu (pieces dropped %zu with %zu particles; %zu particles still falling, not "
+                   "counted above)\n",
+                   s.breaks, s.pieces_dropped, s.particles_dropped, s.falling);
         if (cfg->options.cambium_rate > 0)
             printf("secondary growth: thickest radius %.4g mm (primary %.4g mm)\n", 1e3 * s.max_radius,
                    1e3 * cfg->options.radius);

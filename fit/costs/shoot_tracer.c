@@ -58,17 +58,23 @@ static int grow_particle_arrays(phc_shoot_tracer *tr, size_t n)
 int phc_shoot_tracer_look(phc_shoot_tracer *tr, const phc_climbing *c, double time, phc_error *err)
 {
     const size_t n = phc_climbing_count(c);
-    if (grow_particle_arrays(tr, n)) return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    /* particles and shoots by their stable ids (phc_climbing_id: the indices close up when a broken
+       piece leaves the plant; ids increase with the index); pieces that fall are not traced */
+    if (grow_particle_arrays(tr, n ? phc_climbing_id(c, n - 1) + 1 : 0))
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     /* particles of one shoot come in chain order (a successor or lateral is appended after its parent) */
     for (size_t i = 0; i < n; ++i) {
-        const size_t p = phc_climbing_parent(c, i);
+        if (phc_climbing_is_falling(c, i)) continue;
+        const size_t p = phc_climbing_parent(c, i), id = phc_climbing_id(c, i);
+        const size_t pid = p == PHC_CLIMBING_NONE ? PHC_CLIMBING_NONE : phc_climbing_id(c, p);
         const int starts = p == PHC_CLIMBING_NONE || phc_climbing_is_lateral(c, i);
-        tr->shoot_of[i] = starts ? i : tr->shoot_of[p];
-        if (starts) tr->parent_shoot[i] = p == PHC_CLIMBING_NONE ? PHC_CLIMBING_NONE : tr->shoot_of[p];
-        tr->seen[i] = 0;
+        tr->shoot_of[id] = starts ? id : tr->shoot_of[pid];
+        if (starts) tr->parent_shoot[id] = p == PHC_CLIMBING_NONE ? PHC_CLIMBING_NONE : tr->shoot_of[pid];
+        tr->seen[id] = 0;
     }
     for (size_t i = 0; i < n; ++i) {
-        const size_t s = tr->shoot_of[i], pos = tr->seen[s]++;
+        if (phc_climbing_is_falling(c, i)) continue;
+        const size_t s = tr->shoot_of[phc_climbing_id(c, i)], pos = tr->seen[s]++;
         double base[3], tip[3];
         phc_climbing_segment(c, i, base, tip);
         int bad = 0;

@@ -9,8 +9,9 @@
  * frame (the tip of a particle that stopped growing), and the apex (the
  * tip of the growing particle) at every frame.  A shoot is the particle
  * chain from a particle without parent or a lateral start to its apex;
- * its name is "s<index of its first particle>", its parent the shoot of
- * the particle it leaves.  A point's time is the frame's.
+ * its name is "s<stable id of its first particle>" (phc_climbing_id: its
+ * index while no piece broke off), its parent the shoot of the particle it
+ * leaves.  A point's time is the frame's.
  *
  * So the traces record where an apex was at each frame and where each node
  * was when first seen, not the plant's final shape: a growing internode
@@ -21,7 +22,8 @@
  * node with the time it was laid down and records apexes every frame (as
  * tests/climbing/shoot_traces_generator.py) gives the same polylines at
  * every frame time in a kinematic plant (a grown particle neither turns
- * nor moves). */
+ * nor moves).  A piece that broke off (model/climbing_breaking.h) is not
+ * traced while it falls; what was recorded of it before stays. */
 #ifndef PHC_COSTS_SHOOT_TRACER_H
 #define PHC_COSTS_SHOOT_TRACER_H
 
@@ -35,7 +37,7 @@ typedef struct phc_shoot_tracer {
     size_t n, cap;           /* recorded points */
     double *t, *x;           /* s; m, 3 per point */
     size_t *shoot;           /* shoot of each point: index of its first particle */
-    size_t *shoot_of;        /* per particle: its shoot */
+    size_t *shoot_of;        /* per particle (by its stable id, phc_climbing_id): its shoot */
     size_t *written;         /* per shoot (by its first particle): points recorded so far */
     size_t *seen;            /* per shoot: particles met in the current frame */
     size_t *parent_shoot;    /* per shoot: the shoot it leaves, or PHC_CLIMBING_NONE */

@@ -1515,6 +1515,18 @@ gr_config gr_camb.yaml gr_wall.obj '[0, 0.03, 0]' 'cambium:
   rate: -1
 '
 grow_case "grow: negative cambium rate" "$C/gr_camb.yaml" "gr_camb.yaml:7" "cambium.rate"
+gr_config gr_break.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  break_threshold: -0.1
+'
+grow_case "grow: negative break threshold" "$C/gr_break.yaml" "gr_break.yaml:7" "dynamics.break_threshold" "[0, inf)"
+gr_config gr_breaktext.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  break_threshold: strong
+'
+grow_case "grow: break threshold not a number" "$C/gr_breaktext.yaml" "gr_breaktext.yaml:7" "dynamics.break_threshold"
+gr_config gr_fall.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  fall_time: -1
+'
+grow_case "grow: negative fall time" "$C/gr_fall.yaml" "gr_fall.yaml:7" "dynamics.fall_time" "[0, inf)"
 gr_config gr_shadow.yaml gr_wall.obj '[0, 0.03, 0]' 'light:
   supports_cast_shadows: maybe
 '
