@@ -488,8 +488,9 @@ int main(int argc, char **argv)
 
     /* the same seed grown with dynamics, in Fig. 12's 0.01 s substeps, with
        each of the two joint passes; without collide (with it the pushes of
-       every centre and segment end, up to 64 closest-point queries each per
-       substep, took 184 s CPU).  On one thread: the particles' threads
+       every centre and both segment ends, three or more closest-point
+       queries per particle per substep, took 127 s (own weight) and 130 s
+       (beam) CPU on one thread).  On one thread: the particles' threads
        start at 1024 particles (model/particles.c), and at this plant's
        1200–1400 their barriers in each of the 24,000 substeps cost more
        than they save on a shared machine (the beam run took 36.8 s CPU on
