@@ -157,11 +157,10 @@ static int run_phototropism(double eta, const char *out, plant_out *p)
 
 /* E_1/2 (Pa) of the beam shoots: with s from 0.3 to 0.8 the soft shoot's
  * E = E_1/2 s/(1 − s) runs from 4.3 to 40 MPa, the stiff one's young links
- * (s >= 0.9) have >= 90 MPa; a young green stem's modulus is of the order
- * of tens of MPa (Niklas, "Plant Biomechanics", U. Chicago Press 1992; the
- * flax stems of Methods Protoc. 8:32, 2025, from tens of MPa), against
- * 6–16 GPa for a dry mature maize rind (Al-Zube et al., Plant Methods 14:2,
- * 2018). */
+ * (s >= 0.9) have >= 90 MPa: a young green shoot between the few MPa of
+ * turgid parenchyma and the GPa of lignified tissue (Niklas, "Plant
+ * Biomechanics", U. Chicago Press 1992; a dry mature maize rind 6–16 GPa,
+ * Al-Zube et al., Plant Methods 14:2, 2018).  Ours, not calibrated. */
 static const double E_HALF = 1e7;
 
 /* Link i's stiffness s = max(s_min, min(1, age / t_m)) (model/climbing_growth.h). */
