@@ -169,6 +169,27 @@ static double link_stiffness(const phc_climbing *c, const phc_climbing_options *
     return fmax(o->min_stiffness, fmin(1, phc_climbing_age(c, i) / o->particles.maturity_age));
 }
 
+/* beam_balance's shooting step: links 1 .. nk (lengths L, masses m, springs
+ * kappa, INFINITY for a weld, rest angles to the parent drest; g m s⁻²),
+ * the tip link at angle `tip` (rad below the horizontal); each joint k,
+ * tip first, gives its parent's angle φ_{k−1} = φ_k − drest_k − M_k/κ_k
+ * from the moment M_k of the links beyond it.  Fills phi[0 .. nk] and
+ * returns phi[0], the held particle's angle that balances this tip. */
+static double chain_from_tip(size_t nk, const double *L, const double *m, const double *kappa, const double *drest,
+                             double g, double tip, double *phi)
+{
+    phi[nk] = tip;
+    for (size_t k = nk; k >= 1; --k) {
+        double moment = 0, reach = 0; /* Σ m_j g (x_j − x_Jk) (N m); reach = x_Jj − x_Jk (m) */
+        for (size_t j = k; j <= nk; ++j) {
+            moment += m[j] * g * (reach + 0.5 * L[j] * cos(phi[j]));
+            reach += L[j] * cos(phi[j]);
+        }
+        phi[k - 1] = phi[k] - drest[k] - (isfinite(kappa[k]) ? moment / kappa[k] : 0.0);
+    }
+    return phi[0];
+}
+
 /* The beam shoot's quasi-static balance (model/particles.h, "Shoots that
  * bend like beams": K θ = Q at every joint) in the x–z plane, from the
  * held particle (at its angle phi_held below the horizontal, its centre
@@ -216,16 +237,12 @@ static double beam_balance(const phc_climbing *c, const phc_climbing_options *o,
     }
     const size_t nk = n - held - 1; /* joints 1 .. nk */
     double phi[NJOINT + 1];
-    /* φ_held − phi_held for a tip angle */
-#define BASE_MISS(tip)                                                                                   do {                                                                                                     phi[nk] = (tip);                                                                                     for (size_t k = nk; k >= 1; --k) {                                                                       double moment = 0, reach = 0; /* Σ m_j g (x_j − x_Jk); reach = x_Jj − x_Jk */                      for (size_t j = k; j <= nk; ++j) {                                                                       moment += m[j] * g * (reach + 0.5 * L[j] * cos(phi[j]));                                             reach += L[j] * cos(phi[j]);                                                                     }                                                                                                    phi[k - 1] = phi[k] - drest[k] - (isfinite(kappa[k]) ? moment / kappa[k] : 0.0);                 }                                                                                                } while (0)
     const int steps = 4000;
-    double lo = NAN, hi = NAN, prev_tip = -PI / 2, prev_miss;
-    BASE_MISS(prev_tip);
-    prev_miss = phi[0] - phi_held;
+    double lo = NAN, hi = NAN, prev_tip = -PI / 2;
+    double prev_miss = chain_from_tip(nk, L, m, kappa, drest, g, prev_tip, phi) - phi_held;
     for (int k = 1; k <= steps && isnan(lo); ++k) {
         const double tip = -PI / 2 + PI * k / steps;
-        BASE_MISS(tip);
-        const double miss = phi[0] - phi_held;
+        const double miss = chain_from_tip(nk, L, m, kappa, drest, g, tip, phi) - phi_held;
         if ((miss > 0) != (prev_miss > 0)) {
             lo = prev_tip;
             hi = tip;
@@ -235,18 +252,15 @@ static double beam_balance(const phc_climbing *c, const phc_climbing_options *o,
     }
     if (isnan(lo))
         return NAN;
-    BASE_MISS(lo);
-    const int lo_positive = phi[0] - phi_held > 0;
+    const int lo_positive = chain_from_tip(nk, L, m, kappa, drest, g, lo, phi) - phi_held > 0;
     for (int it = 0; it < 200; ++it) {
         const double mid = 0.5 * (lo + hi);
-        BASE_MISS(mid);
-        if ((phi[0] - phi_held > 0) == lo_positive)
+        if ((chain_from_tip(nk, L, m, kappa, drest, g, mid, phi) - phi_held > 0) == lo_positive)
             lo = mid;
         else
             hi = mid;
     }
-    BASE_MISS(0.5 * (lo + hi));
-#undef BASE_MISS
+    chain_from_tip(nk, L, m, kappa, drest, g, 0.5 * (lo + hi), phi);
     double z = z_held - 0.5 * L[0] * sin(phi_held);
     for (size_t k = 1; k <= nk; ++k)
         z -= L[k] * sin(phi[k]);
@@ -309,7 +323,7 @@ static int run_stiffness(int stiff, int beam, const phc_support_mesh *table, con
     double phi = atan2(-d[2], d[0]), rphi = atan2(-rd[2], rd[0]);
     p->tip_z_qs = x[2] - 0.5 * phc_climbing_length(c, held) * sin(phi);
     for (size_t i = held + 1; i < n; ++i) {
-        const double si = fmax(o.min_stiffness, fmin(1, phc_climbing_age(c, i) / o.particles.maturity_age));
+        const double si = link_stiffness(c, &o, i);
         const double Li = phc_climbing_length(c, i), ci = 2 * g * T * T * (1 - si) / (si * Li);
         phc_climbing_rest_direction(c, i, rd);
         const double rphi_i = atan2(-rd[2], rd[0]), pu = phi + (rphi_i - rphi);
