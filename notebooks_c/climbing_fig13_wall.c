@@ -34,7 +34,14 @@
  *     radius (seed excluded) is larger than with the centre push alone,
  *     and the centres stay out (>= -1e-12 m);
  *   - the ledge shades: leaves within 30 cm under it get less light on
- *     average than the others.
+ *     average than the others;
+ *   - with dynamics: the same seed grown again with 25 substeps of 0.01 s
+ *     per step (Fig. 12's substep), gravity and anchors, once with each
+ *     joint pass (dynamics.bending own_weight, and beam with Fig. 12's
+ *     E_1/2 = 1e7 Pa), without collide (see main); printed: the CPU time,
+ *     particles, attached fraction, smallest signed distances, segments
+ *     clipping, and the free tips' sag (free_tip_sag); checked: attached
+ *     fraction > 0.8 and the free tips hang below their rest shape.
  *
  * Writes climbing_fig13_wall_front.png (the wall face, x–z),
  * climbing_fig13_wall_side.png (y–z: the plant's depth off the wall),
@@ -46,6 +53,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
+#include <omp.h>
 
 #include "fit/grow.h"
 #include "fit/grow_mesh.h"
@@ -164,6 +174,87 @@ static double smallest_end_depth(const phc_climbing *c, phc_support_mesh *wall)
         }
     }
     return m;
+}
+
+/* The free shoots' sag: for every tip (a particle without children) that
+ * holds no anchor, the drop of its centre below where its rest shape puts
+ * it relative to its closest anchored ancestor a, (z̄_tip − z̄_a) − (z_tip −
+ * z_a) (m; the kinematic plant, current = rest, has 0).  Their count, mean
+ * and largest drop and the mean number of links from a. */
+static void free_tip_sag(const phc_climbing *c, size_t *count, double *mean, double *largest, double *links)
+{
+    const size_t n = phc_climbing_count(c);
+    unsigned char *has_child = calloc(n ? n : 1, 1);
+    *count = 0;
+    *mean = *largest = *links = 0;
+    if (!has_child)
+        return;
+    for (size_t i = 0; i < n; ++i)
+        if (phc_climbing_parent(c, i) != PHC_CLIMBING_NONE)
+            has_child[phc_climbing_parent(c, i)] = 1;
+    for (size_t i = 0; i < n; ++i) {
+        double an[3];
+        if (has_child[i] || phc_climbing_anchor(c, i, an))
+            continue;
+        size_t a = i, hops = 0;
+        while (phc_climbing_parent(c, a) != PHC_CLIMBING_NONE && !phc_climbing_anchor(c, a, an)) {
+            a = phc_climbing_parent(c, a);
+            ++hops;
+        }
+        double x[3], xa[3], r[3], ra[3];
+        phc_climbing_position(c, i, x);
+        phc_climbing_position(c, a, xa);
+        phc_climbing_rest_position(c, i, r);
+        phc_climbing_rest_position(c, a, ra);
+        const double drop = (r[2] - ra[2]) - (x[2] - xa[2]);
+        *mean += drop;
+        *largest = fmax(*largest, drop);
+        *links += (double)hops;
+        ++*count;
+    }
+    if (*count) {
+        *mean /= (double)*count;
+        *links /= (double)*count;
+    }
+    free(has_child);
+}
+
+/* A plant grown with dynamics and the numbers printed of it. */
+typedef struct dynamic_run {
+    double cpu, wall;             /* s: the growth's process CPU time (all threads) and wall time */
+    size_t n, anchored, clips, free_tips;
+    double min_sd, depth, end_depth; /* m: smallest signed distance of a centre; minus the radius; of an end */
+    double sag_mean, sag_max, links; /* m, m, links (free_tip_sag) */
+} dynamic_run;
+
+static int grow_dynamic(const phc_climbing_options *o, phc_support_mesh *wall, const double seed[3],
+                        const double up[3], size_t steps, double dt, dynamic_run *r)
+{
+    const clock_t cpu0 = clock();
+    struct timespec w0, w1;
+    clock_gettime(CLOCK_MONOTONIC, &w0);
+    phc_climbing *c = grow_wall(o, wall, seed, up, steps, dt);
+    clock_gettime(CLOCK_MONOTONIC, &w1);
+    r->cpu = (double)(clock() - cpu0) / CLOCKS_PER_SEC;
+    r->wall = (double)(w1.tv_sec - w0.tv_sec) + 1e-9 * (double)(w1.tv_nsec - w0.tv_nsec);
+    if (!c)
+        return -1;
+    phc_climbing_stats st;
+    phc_climbing_get_stats(c, &st);
+    r->n = phc_climbing_count(c);
+    r->anchored = st.anchored;
+    r->depth = smallest_depth(c, wall, &r->clips);
+    r->end_depth = smallest_end_depth(c, wall);
+    r->min_sd = INFINITY;
+    for (size_t i = 0; i < r->n; ++i) {
+        double x[3], cp[3], nf[3];
+        phc_climbing_position(c, i, x);
+        if (phc_support_mesh_closest(wall, x, cp, nf) == 0)
+            r->min_sd = fmin(r->min_sd, (x[0] - cp[0]) * nf[0] + (x[1] - cp[1]) * nf[1] + (x[2] - cp[2]) * nf[2]);
+    }
+    free_tip_sag(c, &r->free_tips, &r->sag_mean, &r->sag_max, &r->links);
+    phc_climbing_free(c);
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -394,7 +485,53 @@ int main(int argc, char **argv)
            "out, %.3g m >= -1e-12 m: %s (%zu segments clip)\n",
            phc_climbing_count(cends), ends_after, ends_before, min_depth2, c7 ? "pass" : "FAIL", cross2);
     phc_climbing_free(cends);
-    const int ok = c1 && c2 && c3 && c4 && c5 && c6 && c7;
+
+    /* the same seed grown with dynamics, in Fig. 12's 0.01 s substeps, with
+       each of the two joint passes; without collide (with it the pushes of
+       every centre and both segment ends, three or more closest-point
+       queries per particle per substep, took 127 s (own weight) and 130 s
+       (beam) CPU on one thread).  On one thread: the particles' threads
+       start at 1024 particles (model/particles.c), and at this plant's
+       1200–1400 their barriers in each of the 24,000 substeps cost more
+       than they save on a shared machine (the beam run took 36.8 s CPU on
+       two threads under a load of 2.6, 1.5 s on one); the numbers are the
+       same on any thread count (model/climbing_growth.h). */
+    dynamic_run dyn[2];
+    int c8 = 1;
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    for (int k = 0; k < 2; ++k) {
+        phc_climbing_options od = o;
+        od.dynamics_substeps = (size_t)llround(dt / 0.01);
+        od.particles.bending = k ? PHC_PARTICLES_BEAM : PHC_PARTICLES_OWN_WEIGHT;
+        od.particles.beam_modulus = 1e7; /* Fig. 12's E_1/2 */
+        if (grow_dynamic(&od, wall, seed, up, steps, dt, &dyn[k]))
+            return 1;
+        const dynamic_run *r = &dyn[k];
+        printf("the same seed with dynamics (%zu substeps of %g s per step, gravity, anchors; bending %s%s): CPU "
+               "%.1f s, wall %.1f s\n",
+               od.dynamics_substeps, dt / (double)od.dynamics_substeps, k ? "beam" : "own_weight",
+               k ? ", E_1/2 1e7 Pa" : "", r->cpu, r->wall);
+        printf("  %zu particles, attached %zu (%.3f); smallest signed distance of a centre %.3g m, of a centre minus "
+               "its radius %.3g m, of a segment end minus its radius %.3g m; %zu segments clip\n",
+               r->n, r->anchored, (double)r->anchored / (double)r->n, r->min_sd, r->depth, r->end_depth, r->clips);
+        printf("  free tips (no anchor, no child): %zu, %.1f links from their closest anchored ancestor on average; "
+               "drop below their rest shape: mean %.2f cm, largest %.2f cm\n",
+               r->free_tips, r->links, 100 * r->sag_mean, 100 * r->sag_max);
+        c8 &= (double)r->anchored / (double)r->n > 0.8 && r->free_tips > 0 && r->sag_mean > 0;
+    }
+    omp_set_num_threads(threads);
+    {
+        size_t free_k;
+        double k_mean, k_max, k_links;
+        free_tip_sag(c, &free_k, &k_mean, &k_max, &k_links);
+        printf("  kinematic plant above: %zu free tips, drop below their rest shape largest %.2g cm\n", free_k,
+               100 * k_max);
+    }
+    printf("check: with dynamics (both passes) most particles stay attached (> 0.8) and the free tips hang below "
+           "their rest shape (mean drop > 0): %s\n",
+           c8 ? "pass" : "FAIL");
+    const int ok = c1 && c2 && c3 && c4 && c5 && c6 && c7 && c8;
 
     char md[1024], mdtmp[1024];
     FILE *f = nb_open_md(out, "climbing_fig13_wall.md", md, mdtmp, sizeof md);
@@ -412,8 +549,16 @@ int main(int argc, char **argv)
             "| quantity | value |\n|---|---|\n| particles | %zu |\n| leaves | %zu |\n"
             "| mean cos(leaf normal, light) | %.3f |\n| attached fraction | %.3f |\n| covered area (m²) | %.3f |\n"
             "| smallest signed distance to the wall (m) | %.3g |\n| smallest signed distance − radius (m) | %.3g |\n| segments clipping a convex edge | %zu |\n| leaf light under the ledge / elsewhere | %.3f / %.3f |\n\n"
+            "**With dynamics** (the same seed, 0.01 s substeps, gravity, anchors, no collisions):\n\n"
+            "| joint pass | particles | attached fraction | smallest signed distance (m) | segments clipping | "
+            "free tips | their mean / largest drop (cm) |\n|---|---|---|---|---|---|---|\n"
+            "| own_weight | %zu | %.3f | %.3g | %zu | %zu | %.2f / %.2f |\n"
+            "| beam (E_1/2 1e7 Pa) | %zu | %.3f | %.3g | %zu | %zu | %.2f / %.2f |\n\n"
             "**Checks**: %s.  The mesh `climbing_fig13_wall.obj` opens in any viewer.\n",
-            duration, n, nl, mean_cos, attached, area, min_sd, min_depth, crossing, lu, le,
+            duration, n, nl, mean_cos, attached, area, min_sd, min_depth, crossing, lu, le, dyn[0].n,
+            (double)dyn[0].anchored / (double)dyn[0].n, dyn[0].min_sd, dyn[0].clips, dyn[0].free_tips,
+            100 * dyn[0].sag_mean, 100 * dyn[0].sag_max, dyn[1].n, (double)dyn[1].anchored / (double)dyn[1].n,
+            dyn[1].min_sd, dyn[1].clips, dyn[1].free_tips, 100 * dyn[1].sag_mean, 100 * dyn[1].sag_max,
             ok ? "all pass" : "**some FAIL** (see the program's output)");
     if (nb_close_md(f, md, mdtmp) != 0) {
         fprintf(stderr, "%s: cannot write the page\n", md);
