@@ -30,7 +30,11 @@
  * fails: the pooled coverage of `fitted` is at least that of `start`, and
  * the Clopper–Pearson interval of `fitted`'s pooled coverage reaches 95%.
  *
- * Usage: notebook_shoot_traces_coverage OUTPUT_DIR [N] [K] */
+ * With `profile` or `bootstrap [B]` as the fourth argument (not run in
+ * CI: many fits per plant) the fitted way's profile-likelihood intervals or
+ * parametric-bootstrap intervals (fit_plant) and their coverage too.
+ *
+ * Usage: notebook_shoot_traces_coverage OUTPUT_DIR [N] [K] [profile | bootstrap [B]] */
 #include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <stdio.h>
@@ -39,6 +43,7 @@
 
 #include "fit/costs/shoot_traces.h"
 #include "fit/engine/fit.h"
+#include "fit/engine/profile.h"
 #include "fit/engine/problem.h"
 #include "measurements/shoot_traces.h"
 #include "notebook_plot.h"
@@ -89,20 +94,21 @@ static double chi2_at_truth(phc_dataset *ds)
     return c;
 }
 
+typedef enum { EXTRA_NONE, EXTRA_PROFILE, EXTRA_BOOTSTRAP } extra_kind;
+
 typedef struct fit_out {
     double est[NP], se[NP], ci[NP][2];
     size_t rounds;
     int settled;
     double chi2_start, chi2_truth; /* diagnostics (way start only) */
+    double xci[NP][2];             /* the extra intervals (profile or bootstrap), else NAN */
+    double bci[NP][2];             /* bootstrap: the interval about the bias-corrected estimate */
 } fit_out;
 
-/* Fits plant pl's traces (seed 1001 + pl) the given way into *r; 0 or 1 (failed). */
-static int fit_plant(int pl, size_t K, int fitted, fit_out *r)
+/* The plant set-up of the notebook: plant pl's model seeds, traced plant seed `trace_seed`. */
+static phc_shoot_traces_options plant_options(int pl, size_t K, int fitted, uint64_t trace_seed)
 {
-    phc_error err;
-    phc_error_clear(&err);
     phc_shoot_traces_options o = phc_shoot_traces_options_default();
-    set_values(&o.plant, truth);
     o.plant.apical_dominance = 0.6;
     o.plant.max_order = 2;
     o.plant.light.direction[0] = 0;
@@ -111,30 +117,42 @@ static int fit_plant(int pl, size_t K, int fitted, fit_out *r)
     o.plant.closest = wall_y0;
     o.position[1] = 0.03;
     o.time_step = 0.5;
-    o.plant.seed = 1001 + (uint64_t)pl;
-    const double times[6] = {10, 20, 30, 40, 50, 60};
+    o.plant.seed = trace_seed;
     o.seeds = K;
     o.first_seed = 100000 + 1000 * (uint64_t)pl;
     o.is_parameter = is_param;
     o.covariance_at_fitted = fitted;
+    return o;
+}
+
+/* Grows o's plant at values `at`, traces it every 10 s for 60 s and fits
+ * it from values s (the data set's Σ at s) into r (est, se, ci, rounds);
+ * with keep, *keep is the problem (owning the data set) for more work.
+ * 0 or 1 (failed, message on stderr). */
+static int fit_traces(phc_shoot_traces_options o, const double at[NP], const double s[NP], fit_out *r,
+                      phc_problem **keep)
+{
+    static const double times[6] = {10, 20, 30, 40, 50, 60};
+    phc_error err;
+    phc_error_clear(&err);
     phc_shoot_traces *traces = NULL; /* the data set takes them */
+    set_values(&o.plant, at);
     if (phc_shoot_traces_from_model(&o, times, 6, &traces, &err)) {
-        fprintf(stderr, "plant %d: %s\n", pl, err.message);
+        fprintf(stderr, "traces: %s\n", err.message);
         return 1;
     }
-    set_values(&o.plant, start); /* the fit knows only the starts */
+    set_values(&o.plant, s); /* the fit knows only the starts */
     phc_dataset *ds = NULL;
     if (phc_shoot_traces_new(traces, &o, &ds, &err)) {
-        fprintf(stderr, "plant %d: %s\n", pl, err.message);
+        fprintf(stderr, "data set: %s\n", err.message);
         return 1;
     }
     ds->name = strdup("model-traces");
-    r->chi2_start = r->chi2_truth = NAN;
-    if (!fitted) r->chi2_start = chi2_at_truth(ds);
+    r->chi2_start = chi2_at_truth(ds);
     phc_problem *pb = phc_problem_new("coverage");
     pb->options.absolute_sigma = 1;
     for (size_t j = 0; j < NP; ++j) {
-        phc_problem_add_parameter(pb, names[j], start[j], NULL, &err);
+        phc_problem_add_parameter(pb, names[j], s[j], NULL, &err);
         pb->params[j].lower = lo[j];
         pb->params[j].upper = hi[j];
     }
@@ -147,14 +165,76 @@ static int fit_plant(int pl, size_t K, int fitted, fit_out *r)
             r->se[j] = res->params[j].stderr_;
             r->ci[j][0] = res->params[j].ci_lo;
             r->ci[j][1] = res->params[j].ci_hi;
+            r->xci[j][0] = r->xci[j][1] = r->bci[j][0] = r->bci[j][1] = NAN;
         }
         phc_shoot_traces_covariance_rounds(ds, &r->rounds, NULL, &r->settled);
-        if (!fitted && !phc_shoot_traces_covariance_at(ds, truth, &err)) r->chi2_truth = chi2_at_truth(ds);
     } else {
-        fprintf(stderr, "plant %d: fit: %s\n", pl, err.message);
+        fprintf(stderr, "fit: %s\n", err.message);
     }
     phc_fit_result_free(res);
-    phc_problem_free(pb); /* frees ds */
+    if (keep && !bad)
+        *keep = pb;
+    else
+        phc_problem_free(pb); /* frees ds */
+    return bad;
+}
+
+/* Fits plant pl's traces (seed 1001 + pl) the given way into *r, with the
+ * extra intervals: profile likelihood (fit/engine/profile.h, at the final
+ * covariance), or a parametric bootstrap (B plants grown at the estimates,
+ * seeds 500000 + 1000 pl + b, each fitted as the plant was, from the same
+ * starts (fitted from the estimates, the solver stays where it starts):
+ * estimate ± 1.96 × the sd of their estimates, Efron's standard bootstrap
+ * interval).  0 or 1 (failed). */
+static int fit_plant(int pl, size_t K, int fitted, extra_kind extra, int B, fit_out *r)
+{
+    phc_problem *pb = NULL;
+    if (fit_traces(plant_options(pl, K, fitted, 1001 + (uint64_t)pl), truth, start, r, &pb)) return 1;
+    int bad = 0;
+    r->chi2_truth = NAN;
+    if (!fitted) {
+        phc_error err;
+        phc_error_clear(&err);
+        if (!phc_shoot_traces_covariance_at(pb->datasets[0], truth, &err)) r->chi2_truth = chi2_at_truth(pb->datasets[0]);
+    } else {
+        r->chi2_start = NAN;
+    }
+    if (extra == EXTRA_PROFILE) {
+        phc_error err;
+        phc_error_clear(&err);
+        phc_profile_options po = phc_profile_options_default();
+        po.points = 3;
+        phc_profile_result *pr = NULL;
+        if (phc_profile_run(pb, r->est, r->se, &po, &pr, &err)) {
+            fprintf(stderr, "plant %d: profile: %s\n", pl, err.message);
+            bad = 1;
+        }
+        for (size_t j = 0; !bad && j < pr->n_profiles; ++j) {
+            r->xci[pr->profiles[j].param][0] = pr->profiles[j].lo;
+            r->xci[pr->profiles[j].param][1] = pr->profiles[j].hi;
+        }
+        phc_profile_result_free(pr);
+    }
+    phc_problem_free(pb);
+    if (extra == EXTRA_BOOTSTRAP && !bad) {
+        double sum[NP] = {0}, sq[NP] = {0};
+        for (int b = 0; b < B && !bad; ++b) {
+            fit_out rb;
+            bad = fit_traces(plant_options(pl, K, fitted, 500000 + 1000 * (uint64_t)pl + (uint64_t)b), r->est,
+                             start, &rb, NULL);
+            for (size_t j = 0; !bad && j < NP; ++j) {
+                sum[j] += rb.est[j];
+                sq[j] += rb.est[j] * rb.est[j];
+            }
+        }
+        for (size_t j = 0; !bad && j < NP; ++j) {
+            const double m = sum[j] / B, sd = sqrt(fmax(0, (sq[j] - B * m * m) / (B - 1)));
+            r->xci[j][0] = r->est[j] - 1.96 * sd;
+            r->xci[j][1] = r->est[j] + 1.96 * sd;
+            r->bci[j][0] = 2 * r->est[j] - m - 1.96 * sd; /* the bias m - est taken off */
+            r->bci[j][1] = 2 * r->est[j] - m + 1.96 * sd;
+        }
+    }
     return bad;
 }
 
@@ -172,12 +252,21 @@ int main(int argc, char **argv)
     if (started) return started;
     const int n_plants = argc > 2 ? atoi(argv[2]) : 20;
     const int K = argc > 3 ? atoi(argv[3]) : 8;
+    const extra_kind extra = argc > 4 && !strcmp(argv[4], "profile")     ? EXTRA_PROFILE
+                             : argc > 4 && !strcmp(argv[4], "bootstrap") ? EXTRA_BOOTSTRAP
+                                                                         : EXTRA_NONE;
+    const int B = argc > 5 ? atoi(argv[5]) : 19;
+    if (argc > 4 && (extra == EXTRA_NONE || B < 2)) {
+        fprintf(stderr, "the fourth argument is profile or bootstrap (then B >= 2 plants)\n");
+        return 2;
+    }
     if (n_plants < 2 || n_plants > 1000 || K < 1 || K > 1000) {
         fprintf(stderr, "N must be 2..1000 and K 1..1000\n");
         return 2;
     }
-    int cover[NWAYS][NP] = {{0}}, fits = 0;
+    int cover[NWAYS][NP] = {{0}}, pcover[NP] = {0}, bcover[NP] = {0}, fits = 0;
     double zsum[NWAYS][NP] = {{0}}, zsq[NWAYS][NP] = {{0}}, c2s = 0, c2t = 0;
+    int zn[NWAYS][NP] = {{0}}; /* plants with a stderr (none at a bound) */
     size_t rounds_sum = 0, rounds_max = 0;
     int unsettled = 0, c2n = 0;
     char md[1024], mdtmp[1024];
@@ -195,7 +284,7 @@ int main(int argc, char **argv)
     for (int pl = 0; pl < n_plants; ++pl) {
         fit_out r[NWAYS];
         for (int w = 0; w < NWAYS; ++w)
-            if (fit_plant(pl, (size_t)K, w, &r[w])) {
+            if (fit_plant(pl, (size_t)K, w, w == 1 ? extra : EXTRA_NONE, B, &r[w])) {
                 fprintf(stderr, "plant %d: a fit failed\n", 1001 + pl);
                 return 1;
             }
@@ -215,13 +304,24 @@ int main(int argc, char **argv)
                 const int in = truth[j] >= r[w].ci[j][0] && truth[j] <= r[w].ci[j][1];
                 const double z = (r[w].est[j] - truth[j]) / r[w].se[j];
                 cover[w][j] += in;
-                zsum[w][j] += z;
-                zsq[w][j] += z * z;
+                if (isfinite(z)) {
+                    zn[w][j]++;
+                    zsum[w][j] += z;
+                    zsq[w][j] += z * z;
+                }
                 printf(" %.3g [%.3g, %.3g]%s", r[w].est[j], r[w].ci[j][0], r[w].ci[j][1], in ? "" : "*");
                 fprintf(f, " %.3g [%.3g, %.3g]%s |", r[w].est[j], r[w].ci[j][0], r[w].ci[j][1], in ? "" : " \\*");
             }
-            if (w == 1)
+            if (w == 1) {
                 printf(" (%zu round%s%s)", r[1].rounds, r[1].rounds == 1 ? "" : "s", r[1].settled ? "" : ", not settled");
+                for (size_t j = 0; extra && j < NP; ++j) {
+                    const int in = truth[j] >= r[1].xci[j][0] && truth[j] <= r[1].xci[j][1];
+                    pcover[j] += in;
+                    bcover[j] += truth[j] >= r[1].bci[j][0] && truth[j] <= r[1].bci[j][1];
+                    printf("%s [%.3g, %.3g]%s", j ? "" : extra == EXTRA_PROFILE ? " profile:" : " bootstrap:",
+                           r[1].xci[j][0], r[1].xci[j][1], in ? "" : "*");
+                }
+            }
             else
                 printf(" (chi2/n at the truth: %.3g with sigma at the start, %.3g at the truth)", r[0].chi2_start,
                        r[0].chi2_truth);
@@ -236,14 +336,22 @@ int main(int argc, char **argv)
         for (size_t j = 0; j < NP; ++j) {
             double l, u;
             binomial_ci(cover[w][j], fits, &l, &u);
-            const double zm = zsum[w][j] / fits, zsd = sqrt((zsq[w][j] - fits * zm * zm) / (fits - 1));
+            const int m = zn[w][j];
+            const double zm = m ? zsum[w][j] / m : NAN, zsd = m > 1 ? sqrt((zsq[w][j] - m * zm * zm) / (m - 1)) : NAN;
             total[w] += cover[w][j];
-            printf("coverage, covariance at %s, %s: %d of %d (%.2f, 95%% interval %.2f-%.2f), z mean %.2f sd %.2f\n",
-                   way[w], names[j], cover[w][j], fits, (double)cover[w][j] / fits, l, u, zm, zsd);
+            printf("coverage, covariance at %s, %s: %d of %d (%.2f, 95%% interval %.2f-%.2f), z mean %.2f sd %.2f "
+                   "(of %d)\n",
+                   way[w], names[j], cover[w][j], fits, (double)cover[w][j] / fits, l, u, zm, zsd, m);
             fprintf(f, "| %s | %s | %d of %d | %.2f-%.2f | %.2f | %.2f |\n", way[w], names[j], cover[w][j], fits, l,
                     u, zm, zsd);
         }
     }
+    for (size_t j = 0; extra && j < NP; ++j)
+        printf("coverage, covariance at fitted, %s intervals, %s: %d of %d\n",
+               extra == EXTRA_PROFILE ? "profile" : "bootstrap", names[j], pcover[j], fits);
+    for (size_t j = 0; extra == EXTRA_BOOTSTRAP && j < NP; ++j)
+        printf("coverage, covariance at fitted, bias-corrected bootstrap intervals, %s: %d of %d\n", names[j],
+               bcover[j], fits);
     printf("chi2/n at the truth, mean over %d plants: %.3g with sigma at the start values, %.3g with sigma at "
            "the truth (1 when sigma describes the traced plants' scatter)\n",
            c2n, c2s / (c2n ? c2n : 1), c2t / (c2n ? c2n : 1));
