@@ -34,9 +34,11 @@
  *
  * With `profile` or `bootstrap [B]` as the fourth argument (not run in
  * CI: many fits per plant) the fitted way's profile-likelihood intervals or
- * parametric-bootstrap intervals (fit_plant) and their coverage too.
+ * parametric-bootstrap intervals (fit_plant) and their coverage too; with
+ * `starts S` every fit is a multistart fit (S starts: the configured one
+ * and Sobol points in the box, the lowest cost kept).
  *
- * Usage: notebook_shoot_traces_coverage OUTPUT_DIR [N] [K] [profile | bootstrap [B]] */
+ * Usage: notebook_shoot_traces_coverage OUTPUT_DIR [N] [K] [profile | bootstrap [B] | starts S] */
 #include <gsl/gsl_cdf.h>
 #include <math.h>
 #include <stdio.h>
@@ -96,7 +98,9 @@ static double chi2_at_truth(phc_dataset *ds)
     return c;
 }
 
-typedef enum { EXTRA_NONE, EXTRA_PROFILE, EXTRA_BOOTSTRAP } extra_kind;
+typedef enum { EXTRA_NONE, EXTRA_PROFILE, EXTRA_BOOTSTRAP, EXTRA_MULTISTART } extra_kind;
+
+static size_t fit_starts = 1; /* starts per fit (multistart: the configured start and Sobol points in the box) */
 
 typedef struct fit_out {
     double est[NP], se[NP], ci[NP][2];
@@ -153,6 +157,7 @@ static int fit_traces(phc_shoot_traces_options o, const double at[NP], const dou
     r->chi2_start = chi2_at_truth(ds);
     phc_problem *pb = phc_problem_new("coverage");
     pb->options.absolute_sigma = 1;
+    pb->options.starts = fit_starts;
     for (size_t j = 0; j < NP; ++j) {
         phc_problem_add_parameter(pb, names[j], s[j], NULL, &err);
         pb->params[j].lower = lo[j];
@@ -256,12 +261,14 @@ int main(int argc, char **argv)
     const int K = argc > 3 ? atoi(argv[3]) : 8;
     const extra_kind extra = argc > 4 && !strcmp(argv[4], "profile")     ? EXTRA_PROFILE
                              : argc > 4 && !strcmp(argv[4], "bootstrap") ? EXTRA_BOOTSTRAP
+                             : argc > 4 && !strcmp(argv[4], "starts")    ? EXTRA_MULTISTART
                                                                          : EXTRA_NONE;
     const int B = argc > 5 ? atoi(argv[5]) : 19;
     if (argc > 4 && (extra == EXTRA_NONE || B < 2)) {
-        fprintf(stderr, "the fourth argument is profile or bootstrap (then B >= 2 plants)\n");
+        fprintf(stderr, "the fourth argument is profile, bootstrap B (B >= 2 plants) or starts S (S >= 2)\n");
         return 2;
     }
+    if (extra == EXTRA_MULTISTART) fit_starts = (size_t)B;
     if (n_plants < 2 || n_plants > 1000 || K < 1 || K > 1000) {
         fprintf(stderr, "N must be 2..1000 and K 1..1000\n");
         return 2;
@@ -316,7 +323,7 @@ int main(int argc, char **argv)
             }
             if (w == 1) {
                 printf(" (%zu round%s%s)", r[1].rounds, r[1].rounds == 1 ? "" : "s", r[1].settled ? "" : ", not settled");
-                for (size_t j = 0; extra && j < NP; ++j) {
+                for (size_t j = 0; (extra == EXTRA_PROFILE || extra == EXTRA_BOOTSTRAP) && j < NP; ++j) {
                     const int in = truth[j] >= r[1].xci[j][0] && truth[j] <= r[1].xci[j][1];
                     pcover[j] += in;
                     bcover[j] += truth[j] >= r[1].bci[j][0] && truth[j] <= r[1].bci[j][1];
@@ -348,7 +355,7 @@ int main(int argc, char **argv)
                     u, zm, zsd);
         }
     }
-    for (size_t j = 0; extra && j < NP; ++j)
+    for (size_t j = 0; (extra == EXTRA_PROFILE || extra == EXTRA_BOOTSTRAP) && j < NP; ++j)
         printf("coverage, covariance at fitted, %s intervals, %s: %d of %d\n",
                extra == EXTRA_PROFILE ? "profile" : "bootstrap", names[j], pcover[j], fits);
     for (size_t j = 0; extra == EXTRA_BOOTSTRAP && j < NP; ++j)
