@@ -51,22 +51,15 @@
 #include "fit/engine/problem.h"
 #include "measurements/shoot_traces.h"
 #include "notebook_plot.h"
+#include "tests/shoot_traces_wall_plant.h"
 
 #define NP 5
 #define NWAYS 2
 static const char *const names[NP + 1] = {"branch_probability", "direction_variance", "phototropism",
                                           "surface_adaption", "growth_rate", NULL};
-static const double truth[NP] = {0.3, 0.6, 0.02, 0.5, 0.15}, start[NP] = {0.45, 0.4, 0.03, 0.3, 0.1};
-static const double lo[NP] = {0.02, 0.05, 0, 0.01, 0.05}, hi[NP] = {0.9, 1, 0.5, 3, 0.5};
+static const double *const truth = shoot_traces_wall_truth, *const start = shoot_traces_wall_start;
+static const double *const lo = shoot_traces_wall_lower, *const hi = shoot_traces_wall_upper;
 static const char *const way[NWAYS] = {"start", "fitted"};
-
-static int wall_y0(void *user, const double x[3], double c[3], double n[3])
-{
-    (void)user;
-    c[0] = x[0]; c[1] = 0; c[2] = x[2] < 0 ? 0 : x[2];
-    n[0] = 0; n[1] = 1; n[2] = 0;
-    return 0;
-}
 
 static int is_param(const char *name, void *user)
 {
@@ -74,15 +67,6 @@ static int is_param(const char *name, void *user)
     for (const char *const *l = names; *l; ++l)
         if (!strcmp(*l, name)) return 1;
     return 0;
-}
-
-static void set_values(phc_climbing_options *p, const double v[NP])
-{
-    p->branch_probability = v[0];
-    p->direction_variance = v[1];
-    p->phototropism = v[2];
-    p->surface_adaption = v[3];
-    p->growth_rate = v[4];
 }
 
 /* |L⁻¹(traced − model at the true values)|² / n under ds's current Σ; NAN when the model fails. */
@@ -114,16 +98,7 @@ typedef struct fit_out {
 /* The plant set-up of the notebook: plant pl's model seeds, traced plant seed `trace_seed`. */
 static phc_shoot_traces_options plant_options(int pl, size_t K, int fitted, uint64_t trace_seed)
 {
-    phc_shoot_traces_options o = phc_shoot_traces_options_default();
-    o.plant.apical_dominance = 0.6;
-    o.plant.max_order = 2;
-    o.plant.light.direction[0] = 0;
-    o.plant.light.direction[1] = 1;
-    o.plant.light.direction[2] = 2;
-    o.plant.closest = wall_y0;
-    o.position[1] = 0.03;
-    o.time_step = 0.5;
-    o.plant.seed = trace_seed;
+    phc_shoot_traces_options o = shoot_traces_wall_options(trace_seed);
     o.seeds = K;
     o.first_seed = 100000 + 1000 * (uint64_t)pl;
     o.is_parameter = is_param;
@@ -142,12 +117,12 @@ static int fit_traces(phc_shoot_traces_options o, const double at[NP], const dou
     phc_error err;
     phc_error_clear(&err);
     phc_shoot_traces *traces = NULL; /* the data set takes them */
-    set_values(&o.plant, at);
+    shoot_traces_wall_set(&o.plant, at);
     if (phc_shoot_traces_from_model(&o, times, 6, &traces, &err)) {
         fprintf(stderr, "traces: %s\n", err.message);
         return 1;
     }
-    set_values(&o.plant, s); /* the fit knows only the starts */
+    shoot_traces_wall_set(&o.plant, s); /* the fit knows only the starts */
     phc_dataset *ds = NULL;
     if (phc_shoot_traces_new(traces, &o, &ds, &err)) {
         fprintf(stderr, "data set: %s\n", err.message);
