@@ -28,7 +28,8 @@
  * angles 5°.  C is the covariance of the statistics between M =
  * max(K, covariance_seeds) model plants at the start options (the grow
  * config's values; phc_shoot_traces_covariance_at recomputes it
- * elsewhere), C_g its diagonal plus `correlation` (g, default 0.5) times
+ * elsewhere, and with covariance_at_fitted the fit recomputes it at its
+ * fitted values in rounds, phc_dataset_ops.reweight), C_g its diagonal plus `correlation` (g, default 0.5) times
  * its off-diagonal part; (1 + 1/K) because the traced plant is one draw of
  * the random process (C) and the model value a mean over K (C/K).
  *
