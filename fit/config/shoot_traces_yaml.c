@@ -16,7 +16,8 @@
 #include "measurements/support_mesh.h"
 
 static const char *const shoot_traces_keys[] = {"file", "plant", "seeds", "first_seed", "times", "sigma",
-                                                "fd_step", "frame_interval", "covariance_seeds", "correlation", NULL};
+                                                "fd_step", "frame_interval", "covariance_seeds", "correlation",
+                                                "covariance_at", "covariance_rounds", "covariance_tolerance", NULL};
 static const phc_key_help shoot_traces_help[] = {
     {"file", "CSV of traced shoots: columns time (s), shoot, x, y, z (m) and optionally parent "
              "(measurements/shoot_traces.h), relative to the config file. Required."},
@@ -39,6 +40,16 @@ static const phc_key_help shoot_traces_help[] = {
                          "max(K, M) model plants at the start values, 0..100000. Default: 64."},
     {"correlation", "g in [0, 1]: the weight of the estimated correlations between the statistics "
                     "(0: independent sigmas; 1: the covariance as estimated). Default: 0.5."},
+    {"covariance_at", "start or fitted: where the statistics' covariance is computed. start: at the start "
+                      "values, once. fitted: after the fit it is recomputed at the fitted values and the "
+                      "fit solved again from there, until the estimates move by at most "
+                      "covariance_tolerance from the values of the last covariance or covariance_rounds "
+                      "recomputations were made (the report says which). Default: start."},
+    {"covariance_rounds", "With covariance_at: fitted, the most recomputations of the covariance, "
+                          "1..100. Default: 5."},
+    {"covariance_tolerance", "With covariance_at: fitted, the rounds stop when no estimate moved by more "
+                             "than this fraction of its value (of its scale when 0) from the values of the "
+                             "last covariance, > 0. Default: 0.02."},
     {"frame_interval", "s, > 0: the tracer looked at the plant every frame_interval seconds (each "
                        "apex recorded where it was then; nodes may carry the time they were laid "
                        "down). The model plants are traced at the same frames. Default: every "
@@ -66,14 +77,14 @@ static void support_owner_free(void *p)
 static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node, const char *base_dir,
                              phc_is_parameter_fn is_parameter, void *user_data, phc_dataset **out, phc_error *err)
 {
-    const char *ctx = "shoot_traces data set", *file = NULL, *plant = NULL;
+    const char *ctx = "shoot_traces data set", *file = NULL, *plant = NULL, *cov_at = NULL;
     char *path = NULL, *ppath = NULL;
     phc_grow_config *cfg = NULL;
     phc_support_mesh *mesh = NULL;
     support_owner *owner = NULL;
     phc_shoot_traces *tr = NULL;
     double *times = NULL;
-    long seeds = 8, first = -1, cov_seeds = 64;
+    long seeds = 8, first = -1, cov_seeds = 64, cov_rounds = 5;
     phc_shoot_traces_options o = phc_shoot_traces_options_default();
     int rc;
     *out = NULL;
@@ -84,8 +95,33 @@ static int shoot_traces_yaml(const phc_yaml_doc *doc, const phc_yaml_node *node,
         (rc = phc_yaml_map_number(doc, node, "fd_step", 0, ctx, &o.fd_step, err)) ||
         (rc = phc_yaml_map_number(doc, node, "frame_interval", 0, ctx, &o.frame_interval, err)) ||
         (rc = phc_yaml_map_integer(doc, node, "covariance_seeds", 0, ctx, &cov_seeds, err)) ||
-        (rc = phc_yaml_map_number(doc, node, "correlation", 0, ctx, &o.correlation, err)))
+        (rc = phc_yaml_map_number(doc, node, "correlation", 0, ctx, &o.correlation, err)) ||
+        (rc = phc_yaml_map_string(doc, node, "covariance_at", 0, ctx, &cov_at, err)) ||
+        (rc = phc_yaml_map_integer(doc, node, "covariance_rounds", 0, ctx, &cov_rounds, err)) ||
+        (rc = phc_yaml_map_number(doc, node, "covariance_tolerance", 0, ctx, &o.covariance_tolerance, err)))
         goto done;
+    if (cov_at && strcmp(cov_at, "start") && strcmp(cov_at, "fitted")) {
+        const phc_yaml_node *v = phc_yaml_get(node, "covariance_at");
+        rc = phc_error_set(err, PHC_ERR_INPUT, "%s:%zu:%zu: key 'covariance_at': expected start or fitted, found '%s'",
+                           doc->path, v->line, v->column, cov_at);
+        goto done;
+    }
+    o.covariance_at_fitted = cov_at && !strcmp(cov_at, "fitted");
+    if (cov_rounds < 1 || cov_rounds > 100) {
+        const phc_yaml_node *v = phc_yaml_get(node, "covariance_rounds");
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu:%zu: key 'covariance_rounds': expected a whole number in 1..100, found %ld",
+                           doc->path, v->line, v->column, cov_rounds);
+        goto done;
+    }
+    o.covariance_rounds = (size_t)cov_rounds;
+    if (!(o.covariance_tolerance > 0)) {
+        const phc_yaml_node *v = phc_yaml_get(node, "covariance_tolerance");
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu:%zu: key 'covariance_tolerance': expected a number > 0, found %g",
+                           doc->path, v->line, v->column, o.covariance_tolerance);
+        goto done;
+    }
     if (cov_seeds < 0 || cov_seeds > 100000) {
         rc = phc_error_set(err, PHC_ERR_INPUT,
                            "%s:%zu: key 'covariance_seeds': expected a whole number in 0..100000, found %ld",

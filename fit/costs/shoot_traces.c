@@ -58,6 +58,10 @@ typedef struct st_impl {
     size_t slot[N_SLOTS];         /* data-set slot j -> slot_names index */
     size_t k;
     unsigned long plants;         /* plants grown */
+    double *sigma_at;             /* k: the slot values Σ was last computed at */
+    size_t rounds;                /* recomputations of Σ at fitted values */
+    double change;                /* the last reweight call's largest relative change (NAN: none) */
+    int settled;                  /* the rounds stopped on the tolerance */
 } st_impl;
 
 phc_shoot_traces_options phc_shoot_traces_options_default(void)
@@ -77,6 +81,8 @@ phc_shoot_traces_options phc_shoot_traces_options_default(void)
     o.fd_step = 0.2;
     o.covariance_seeds = 64;
     o.correlation = 0.5;
+    o.covariance_rounds = 5;
+    o.covariance_tolerance = 0.02;
     return o;
 }
 
@@ -92,6 +98,7 @@ static void st_free(void *p)
     free(im->sigma_total);
     free(im->y_raw);
     free(im->L);
+    free(im->sigma_at);
     free(im->frame_steps);
     free(im->stat);
     free(im->tindex);
@@ -440,6 +447,14 @@ static int st_report_section(phc_dataset *ds, const double *p, char **markdown, 
             (unsigned long long)(im->o.first_seed + im->o.seeds - 1), im->o.time_step, im->n_frames,
             im->o.covariance_seeds > im->o.seeds ? im->o.covariance_seeds : im->o.seeds, im->o.correlation,
             im->o.fd_step, before);
+    if (im->o.covariance_at_fitted)
+        fprintf(f, "Covariance at the fitted values (`covariance_at: fitted`): recomputed %zu time%s, then the "
+                   "estimates moved by at most %.3g (relative) from the values of the last covariance: %s.\n\n",
+                im->rounds, im->rounds == 1 ? "" : "s", im->change,
+                im->settled ? "settled within covariance_tolerance"
+                            : "stopped at covariance_rounds, NOT settled within covariance_tolerance");
+    else
+        fprintf(f, "Covariance at the start values (`covariance_at: start`).\n\n");
     fprintf(f, "| time (s) | statistic | traced | model (mean of seeds) | seed sd | sigma |\n"
                "|---:|---|---:|---:|---:|---:|\n");
     for (size_t i = 0; i < n; ++i)
@@ -482,12 +497,57 @@ static int st_name_series2(phc_dataset *ds, phc_error *err)
     return phc_dataset_name_series(ds, "statistic", ST_N, st_series_name, err);
 }
 
+/* The magnitude a change of slot j is measured against: |value|, or the
+ * problem's scale of the parameter when the value is 0 (as fd_jacobian). */
+static double slot_scale(const phc_dataset *ds, const double *p, size_t j)
+{
+    if (fabs(p[j]) > 0) return fabs(p[j]);
+    if (ds->problem && ds->param_index && ds->problem->params[ds->param_index[j]].scale > 0)
+        return ds->problem->params[ds->param_index[j]].scale;
+    return 1;
+}
+
+/* covariance_at: fitted.  Σ depends on the values it is computed at
+ * (Wood 2010 recomputes it at every proposal); the fit makes Σ(θ̂) and θ̂
+ * agree by fixed-point rounds: Σ at the fitted values, solve again, until
+ * the estimates move by at most covariance_tolerance (relative) from the
+ * values of the last Σ, or covariance_rounds recomputations. */
+static int st_reweight(phc_dataset *ds, const double *p, int *again, phc_error *err)
+{
+    st_impl *im = ds->impl;
+    *again = 0;
+    if (!im->o.covariance_at_fitted) return PHC_OK;
+    double change = 0;
+    for (size_t j = 0; j < ds->k; ++j)
+        change = fmax(change, fabs(p[j] - im->sigma_at[j]) / slot_scale(ds, im->sigma_at, j));
+    im->change = change;
+    im->settled = change <= im->o.covariance_tolerance;
+    if (im->settled || im->rounds >= im->o.covariance_rounds) return PHC_OK;
+    phc_error e;
+    phc_error_clear(&e);
+    const int rc = phc_shoot_traces_covariance_at(ds, p, &e);
+    if (rc == PHC_ERR_NOMEM) return phc_error_set(err, rc, "%s", e.message);
+    if (rc) return PHC_OK; /* not growable at p: Σ stays where it was, the rounds stop */
+    im->rounds++;
+    *again = 1;
+    return PHC_OK;
+}
+
+void phc_shoot_traces_covariance_rounds(const phc_dataset *ds, size_t *rounds, double *change, int *settled)
+{
+    const st_impl *im = ds->impl;
+    if (rounds) *rounds = im->rounds;
+    if (change) *change = im->change;
+    if (settled) *settled = im->settled;
+}
+
 const phc_dataset_ops phc_shoot_traces_ops = {
     .kind = "shoot_traces",
     .predict = st_predict,
     .free_impl = st_free,
     .report_section = st_report_section,
     .name_series = st_name_series2,
+    .reweight = st_reweight,
 };
 
 static double sigma_for(const phc_shoot_traces_options *o, int stat, double v)
@@ -591,6 +651,7 @@ int phc_shoot_traces_covariance_at(phc_dataset *ds, const double *p, phc_error *
         free(im->L);
         im->L = L;
         L = NULL;
+        memcpy(im->sigma_at, p, ds->k * sizeof *p);
         for (size_t i = 0; i < n; ++i) {
             im->sigma_total[i] = sqrt(S[i * n + i]);
             ds->y[i] = im->y_raw[i];
@@ -618,10 +679,10 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
     }
     im->traces = traces;
     im->o = *o;
-    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->frame_interval >= 0) || o->covariance_seeds > 100000 || !(o->correlation >= 0 && o->correlation <= 1) || !(o->sigma_rel >= 0) ||
+    if (!(o->seeds >= 1) || !(o->time_step > 0) || !(o->fd_step > 0 && o->fd_step < 1) || !(o->frame_interval >= 0) || o->covariance_seeds > 100000 || !(o->correlation >= 0 && o->correlation <= 1) || !(o->covariance_rounds >= 1) || !(o->covariance_tolerance > 0) || !(o->sigma_rel >= 0) ||
         !(o->sigma_length > 0) || !(o->sigma_fraction > 0) || !(o->sigma_cosine > 0) || !(o->sigma_angle > 0)) {
         rc = phc_error_set(err, PHC_ERR_INPUT,
-                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1), frame_interval >= 0, covariance_seeds <= 1e5, correlation in [0, 1] and "
+                           "shoot_traces: seeds must be >= 1, time_step > 0, fd_step in (0, 1), frame_interval >= 0, covariance_seeds <= 1e5, correlation in [0, 1], covariance_rounds >= 1, covariance_tolerance > 0 and "
                            "every sigma > 0");
         goto fail;
     }
@@ -724,7 +785,9 @@ int phc_shoot_traces_new(phc_shoot_traces *traces, const phc_shoot_traces_option
     im->sigma_given = malloc(n * sizeof *im->sigma_given);
     im->sigma_total = malloc(n * sizeof *im->sigma_total);
     im->y_raw = malloc(n * sizeof *im->y_raw);
-    if (!im->sigma_given || !im->sigma_total || !im->y_raw) {
+    im->sigma_at = malloc(im->k * sizeof *im->sigma_at);
+    im->change = NAN;
+    if (!im->sigma_given || !im->sigma_total || !im->y_raw || !im->sigma_at) {
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
         goto fail_ds;
     }

@@ -28,7 +28,8 @@
  * angles 5°.  C is the covariance of the statistics between M =
  * max(K, covariance_seeds) model plants at the start options (the grow
  * config's values; phc_shoot_traces_covariance_at recomputes it
- * elsewhere), C_g its diagonal plus `correlation` (g, default 0.5) times
+ * elsewhere, and with covariance_at_fitted the fit recomputes it at its
+ * fitted values in rounds, phc_dataset_ops.reweight), C_g its diagonal plus `correlation` (g, default 0.5) times
  * its off-diagonal part; (1 + 1/K) because the traced plant is one draw of
  * the random process (C) and the model value a mean over K (C/K).
  *
@@ -74,6 +75,14 @@ typedef struct phc_shoot_traces_options {
                                     (max(K, M) plants; default 64) */
     double correlation;          /* g in [0, 1]: the weight of the estimated correlations
                                     between statistics (0: independent sigmas; default 0.5) */
+    int covariance_at_fitted;    /* 0 (default): Σ at the start values for the whole fit;
+                                    1: after each solve Σ is recomputed at the fitted values
+                                    and the fit solved again (phc_dataset_ops.reweight), until
+                                    the estimates move by at most covariance_tolerance or
+                                    covariance_rounds recomputations were made */
+    size_t covariance_rounds;    /* >= 1; default 5 */
+    double covariance_tolerance; /* > 0: largest relative change |p - p_Σ| / max(|p_Σ|, scale)
+                                    of an estimate from the values Σ was computed at; 0.02 */
     double frame_interval;       /* s, >= 0: the tracer looked at the plant every frame_interval;
                                     0 (default): at every distinct point time of the traces */
     /* Supports that cast shadows (the grow config's light.supports_cast_shadows):
@@ -122,6 +131,13 @@ const double *phc_shoot_traces_traced(const phc_dataset *ds);
  * with σ = 1, and predicts L⁻¹ŷ.  PHC_OK; PHC_ERR_DOMAIN (the model cannot
  * be grown at p: nothing changed), PHC_ERR_NOMEM. */
 int phc_shoot_traces_covariance_at(phc_dataset *ds, const double *p, phc_error *err);
+
+/* How Σ came to be where it is: the rounds of recomputation at fitted
+ * values made (0: Σ at the start values), the largest relative change of
+ * an estimate from the values Σ was last computed at, as seen by the last
+ * phc_dataset_ops.reweight call (NAN before one), and whether the rounds
+ * stopped on the tolerance (1) or on covariance_rounds (0). */
+void phc_shoot_traces_covariance_rounds(const phc_dataset *ds, size_t *rounds, double *change, int *settled);
 
 /* Traces of a plant grown by the model (for regression tests and
  * examples): the plant grown with o's options, looked at by the tracer of

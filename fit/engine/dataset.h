@@ -74,6 +74,14 @@ typedef struct phc_dataset_ops {
      * p; result.json stores it under the data set's "values".  *json is
      * malloc'd. */
     int (*report_values)(phc_dataset *ds, const double *p, char **json, phc_error *err);
+    /* Optional (NULL = none): weights that depend on the parameters (the
+     * shoot_traces kind's synthetic-likelihood covariance, first computed at
+     * the start values).  phc_fit_run calls it after each solve with the
+     * fitted slot values p: the kind either recomputes its weights (ds->y,
+     * ds->sigma) there and sets *again = 1, and the fit is solved again
+     * from p with them, or leaves them and sets *again = 0 (by its own
+     * tolerance and maximum of rounds).  PHC_OK or an error. */
+    int (*reweight)(phc_dataset *ds, const double *p, int *again, phc_error *err);
 } phc_dataset_ops;
 
 struct phc_dataset {

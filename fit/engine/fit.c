@@ -969,6 +969,58 @@ static int fit_solve(nls_memo *memo, const phc_problem *pb, phc_progress_fn prog
     return rc;
 }
 
+/* Weights that depend on the parameters (phc_dataset_ops.reweight): after
+ * the solve, every such data set may recompute its weights at the fitted
+ * values best; while one does, the problem is solved again from best with
+ * the new weights (one start, then the polish) and best, res->summary and
+ * res->total_time become the new solve's.  The kinds bound the rounds. */
+static int reweight_rounds(nls_memo *memo, const phc_problem *pb, phc_progress_fn progress, void *user_data,
+                           double *best, phc_fit_result *res, phc_error *err)
+{
+    const size_t np = pb->n_params;
+    int rc = PHC_OK;
+    double *p = NULL, *x = malloc(np * sizeof *x);
+    size_t kmax = 1;
+    for (size_t d = 0; d < pb->n_datasets; ++d)
+        kmax = pb->datasets[d]->k > kmax ? pb->datasets[d]->k : kmax;
+    if (!x || !(p = malloc(kmax * sizeof *p))) {
+        free(x);
+        return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
+    }
+    for (size_t round = 1; !rc; ++round) {
+        int again = 0;
+        for (size_t d = 0; d < pb->n_datasets && !rc; ++d) {
+            phc_dataset *ds = pb->datasets[d];
+            int a = 0;
+            if (!ds->ops->reweight)
+                continue;
+            slot_values(ds, best, p);
+            rc = ds->ops->reweight(ds, p, &a, err);
+            again |= a;
+        }
+        if (rc || !again)
+            break;
+        memo->valid = 0; /* the residuals changed with the weights */
+        if (phc_progress_report(progress, user_data, "reweighted solve", round, 0, -1, NAN, NULL)) {
+            rc = phc_error_set(err, PHC_ERR_INTERNAL, "cancelled");
+            break;
+        }
+        memcpy(x, best, np * sizeof *x);
+        phc_nls_summary sum;
+        if ((rc = phc_nls_solve(memo->nls, &pb->options.nls, x, &sum, err)))
+            break;
+        res->total_time += sum.wall_time;
+        res->summary = sum;
+        memcpy(best, x, np * sizeof *x);
+        if (sum.outcome != PHC_NLS_CONVERGED)
+            break;
+        rc = polish(memo, pb, best, phc_nls_residual_count(memo->nls), err);
+    }
+    free(x);
+    free(p);
+    return rc;
+}
+
 /* ---- the analyse stage: covariance, intervals, sensitivities, data sets -- */
 
 /* The result's frame at the solution: its name, the parameter and data-set
@@ -1230,6 +1282,8 @@ int phc_fit_run(phc_problem *pb, phc_progress_fn progress, void *user_data,
     else if (!res || !best)
         rc = phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
     else if (!(rc = fit_solve(&memo, pb, progress, user_data, best, res, err)) &&
+             (res->summary.outcome != PHC_NLS_CONVERGED ||
+              !(rc = reweight_rounds(&memo, pb, progress, user_data, best, res, err))) &&
              !(rc = fit_analyse(&memo, pb, best, progress, user_data, res, err))) {
         *out = res;
         res = NULL;

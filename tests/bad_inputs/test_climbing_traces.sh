@@ -4,7 +4,8 @@
 #   RSML without a time function; RSML whose time goes backwards along a
 #   root; RSML with a time function short of samples; RSML in pixels (no
 #   length unit); CSV naming an unknown parent shoot; seek_light's keys out
-#   of range in the model plant's grow config.
+#   of range in the model plant's grow config; covariance_at, _rounds and
+#   _tolerance out of range.
 #
 #   bash test_climbing_traces.sh PATH/TO/phytocal
 #
@@ -88,6 +89,18 @@ bad_case "correlation above 1" corr.yaml "corr.yaml:9" "key 'correlation'" "expe
 config covs.yaml ok.csv
 printf '    covariance_seeds: -3\n' >>covs.yaml
 bad_case "negative covariance_seeds" covs.yaml "covs.yaml:9" "key 'covariance_seeds'" "0..100000, found -3"
+
+config covat.yaml ok.csv
+printf '    covariance_at: fited\n' >>covat.yaml
+bad_case "covariance_at neither start nor fitted" covat.yaml "covat.yaml:9:20" "key 'covariance_at'" "expected start or fitted, found 'fited'"
+
+config covr.yaml ok.csv
+printf '    covariance_at: fitted\n    covariance_rounds: 0\n' >>covr.yaml
+bad_case "covariance_rounds of 0" covr.yaml "covr.yaml:10:24" "key 'covariance_rounds'" "1..100, found 0"
+
+config covt.yaml ok.csv
+printf '    covariance_at: fitted\n    covariance_tolerance: -0.1\n' >>covt.yaml
+bad_case "negative covariance_tolerance" covt.yaml "covt.yaml:10:27" "key 'covariance_tolerance'" "expected a number > 0, found -0.1"
 
 echo "$PASSED passed, $FAILED failed"
 [ "$FAILED" -eq 0 ]

@@ -6,7 +6,9 @@
 #  2. `phytocal fit` of growth_rate and surface_adaption (2 seeds) gives the
 #     same estimates, to every digit of result.json, from the CSV and from
 #     the RSML of the same traces;
-#  3. a real RSML file as it comes (../shared/data/rsml/lupin_aero.rsml, a
+#  3. covariance_at: fitted recomputes the covariance at the fitted values
+#     (the report says how many times; its sigma column changes);
+#  4. a real RSML file as it comes (../shared/data/rsml/lupin_aero.rsml, a
 #     SmartRoot root system without time) exits 2 naming the missing
 #     function 'time' and the file:line of its first root.
 #   bash test_shoot_traces_rsml.sh PATH/TO/phytocal [SHARED_DATA]
@@ -57,6 +59,24 @@ if grep -q 'supports_cast_shadows: true' "$T/plant_shadows.yaml" && [ "$RC" -eq 
     echo "ok - the wall's shadows change the fit (the kind honours light.supports_cast_shadows)"
 else
     echo "not ok - shadows on: exit $RC, $(head -c 300 "$T/err_shadows")"
+    FAILED=1
+fi
+# covariance_at: fitted: the covariance is recomputed at the fitted values
+# and the fit solved again; the report says how many times, and its sigma
+# column (the square root of the covariance's diagonal) is the new one.
+sed 's/frame_interval: 10/frame_interval: 10\n    covariance_at: fitted/' "$T/fit_csv.yaml" >"$T/fit_fitted.yaml"
+"$PHC" fit "$T/fit_fitted.yaml" -o "$T/run_fitted" >"$T/out_fitted" 2>"$T/err_fitted"
+RC=$?
+ROUNDS=$(grep -o 'recomputed [0-9]* time' "$T/run_fitted/report.md" 2>/dev/null | grep -o '[0-9]*')
+sigmas() { grep '^| [0-9.]* | ' "$1" | awk -F'|' '{print $7}'; }
+echo "csv, covariance at the fitted values: exit $RC, recomputed ${ROUNDS:-?} times, estimates $(grep -o '"value": [^,]*' "$T/run_fitted/result.json" 2>/dev/null | head -2 | tr '\n' ' ')"
+if [ "$RC" -eq 0 ] && [ "${ROUNDS:-0}" -ge 1 ] && grep -q 'covariance_at: fitted' "$T/fit_fitted.yaml" &&
+   grep -q 'Covariance at the start values' "$T/run_csv/report.md" &&
+   [ -n "$(sigmas "$T/run_fitted/report.md")" ] &&
+   ! cmp -s <(sigmas "$T/run_fitted/report.md") <(sigmas "$T/run_csv/report.md"); then
+    echo "ok - covariance_at: fitted recomputes the covariance at the fitted values (report: rounds, new sigmas)"
+else
+    echo "not ok - covariance_at: fitted: exit $RC, rounds '${ROUNDS:-}', $(head -c 300 "$T/err_fitted")"
     FAILED=1
 fi
 REAL="$DATA/rsml/lupin_aero.rsml"

@@ -27,14 +27,7 @@
 #include <string.h>
 
 #include "../check.h"
-
-static int plane_y0(void *user, const double x[3], double c[3], double n[3])
-{
-    (void)user;
-    c[0] = x[0]; c[1] = 0; c[2] = x[2] < 0 ? 0 : x[2];
-    n[0] = 0; n[1] = 1; n[2] = 0;
-    return 0;
-}
+#include "../shoot_traces_wall_plant.h"
 
 static const char *only;
 static int is_param(const char *name, void *user)
@@ -92,24 +85,9 @@ static void test_recovery(void)
     phc_error_clear(&err);
     static const char *const names[] = {"branch_probability", "direction_variance", "phototropism",
                                         "surface_adaption", "growth_rate", NULL};
-    const double truth[5] = {0.3, 0.6, 0.02, 0.5, 0.15};
-    const double start[5] = {0.45, 0.4, 0.03, 0.3, 0.1};
-    const double lo[5] = {0.02, 0.05, 0, 0.01, 0.05}, hi[5] = {0.9, 1, 0.5, 3, 0.5};
-    phc_shoot_traces_options o = phc_shoot_traces_options_default();
-    o.plant.branch_probability = truth[0];
-    o.plant.direction_variance = truth[1];
-    o.plant.phototropism = truth[2];
-    o.plant.surface_adaption = truth[3];
-    o.plant.growth_rate = truth[4];
-    o.plant.apical_dominance = 0.6;
-    o.plant.max_order = 2;
-    o.plant.light.direction[0] = 0;
-    o.plant.light.direction[1] = 1;
-    o.plant.light.direction[2] = 2;
-    o.plant.closest = plane_y0;
-    o.position[1] = 0.03;
-    o.time_step = 0.5;
-    o.plant.seed = 1001;
+    const double *truth = shoot_traces_wall_truth, *start = shoot_traces_wall_start;
+    const double *lo = shoot_traces_wall_lower, *hi = shoot_traces_wall_upper;
+    phc_shoot_traces_options o = shoot_traces_wall_options(1001);
     const double times[12] = {10, 20, 30, 40, 50, 60, 70, 80, 90, 100, 110, 120};
     phc_shoot_traces *tr = NULL;
     o.is_parameter = is_param;
@@ -136,11 +114,7 @@ static void test_recovery(void)
     }
     CHECK(phc_shoot_traces_from_model(&o, times, 12, &tr, &err) == PHC_OK);
     /* the fit knows only the starts (they also set the seed spread in sigma) */
-    o.plant.branch_probability = start[0];
-    o.plant.direction_variance = start[1];
-    o.plant.phototropism = start[2];
-    o.plant.surface_adaption = start[3];
-    o.plant.growth_rate = start[4];
+    shoot_traces_wall_set(&o.plant, start);
     if (!tr) { fprintf(stderr, "%s\n", err.message); return; }
     printf("model traces (seed 1001): %zu shoots, %zu points\n", tr->n_shoots, tr->n_points);
     o.seeds = 8;
