@@ -40,7 +40,7 @@ struct phc_climbing {
     double *anchor_t0;       /* n, s: when the anchor was made */
     double *vol;             /* n: particle volumes π r² L, m^3 (kept: made again when σ or r
                                 changes, in add_particle, step 5 and step 9) */
-    double *phi;             /* light grid scratch */
+    double *phi;             /* light grid scratch, all zero between the light steps */
     phc_climbing_stats stats;
     /* leaves, secondary growth, shadows of the supports */
     unsigned *node_k;        /* n: node index along the shoot */
@@ -403,7 +403,8 @@ phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
     phc_climbing_rng_seed(&c->rng, o.seed);
     memcpy(c->base, base, sizeof c->base);
     if (o.light.extinction > 0) {
-        c->phi = malloc(phc_climbing_light_cells(&o.light) * sizeof *c->phi);
+        /* all zero, and kept so by the light step (phc_climbing_light_shaded_zeroed) */
+        c->phi = calloc(phc_climbing_light_cells(&o.light), sizeof *c->phi);
         if (!c->phi)
             goto nomem;
     }
@@ -1103,8 +1104,8 @@ static int light_step(phc_climbing *c, size_t n0)
     const phc_climbing_options *o = &c->o;
     const phc_climbing_occluders occ = {c->occ_v, c->occ_nv, c->occ_t, c->occ_nt, c->opaque};
     if (o->leaf_step == 0) { /* no leaves: the points are the particles' centres, as they are */
-        phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->x, c->vol, n0, c->phi,
-                                  c->light);
+        phc_climbing_light_shaded_zeroed(&o->light, c->opaque ? &occ : NULL, c->x, c->vol, n0,
+                                         c->phi, c->light);
         if (c->field.value) { /* seek_light: the light field from the same points */
             if (field_update(c, c->opaque ? &occ : NULL, c->x, c->vol, n0, n0))
                 return -1;
@@ -1128,7 +1129,8 @@ static int light_step(phc_climbing *c, size_t n0)
             memcpy(c->sx + 3 * m, c->leaf_c + 3 * i, 3 * sizeof *c->sx);
             c->sv[m++] = leaf_vol;
         }
-    phc_climbing_light_shaded(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi, c->sI);
+    phc_climbing_light_shaded_zeroed(&o->light, c->opaque ? &occ : NULL, c->sx, c->sv, m, c->phi,
+                                     c->sI);
     memcpy(c->light, c->sI, n0 * sizeof *c->light);
     const size_t points = m;
     m = n0;

@@ -305,6 +305,8 @@ typedef struct light_run {
     unsigned char *wanted;
     double *sums;
     size_t *filled;
+    int keep_zero;          /* φ is all zero on entry and is left so (not cleared first) */
+    unsigned char *touched; /* with keep_zero: the lines holding a point that marched */
 } light_run;
 
 /* Point i of a light along the axis, before the lines: a point near a face
@@ -325,10 +327,24 @@ static void classify_point(const light_run *r, size_t i)
     }
     if (march) {
         r->light[i] = light_marched(r->g, r->occ, r->opaque, r->phi, xi, c);
+        if (r->touched) {
+#pragma omp atomic write
+            r->touched[line] = 1;
+        }
         return;
     }
 #pragma omp atomic write
     r->wanted[line] = 1;
+}
+
+/* φ = 0 in every cell, in blocks shared by the team (a worksharing loop,
+ * as light_passes' loops). */
+static void clear_grid(const phc_climbing_light_grid *g, double *phi)
+{
+    const size_t cells = phc_climbing_light_cells(g), block = 4096;
+#pragma omp for schedule(static)
+    for (size_t b = 0; b < cells; b += block)
+        memset(phi + b, 0, (cells - b < block ? cells - b : block) * sizeof *phi);
 }
 
 /* The passes of one light computation.  Its loops are OpenMP worksharing
@@ -348,10 +364,8 @@ static void light_passes(const light_run *r)
         light[i] = c == (size_t)-1 ? 1 : pending(c);
     }
     if (absorb) { /* φ: in the points' order, so the sums are reproducible */
-        const size_t cells = phc_climbing_light_cells(g), block = 4096;
-#pragma omp for schedule(static)
-        for (size_t b = 0; b < cells; b += block)
-            memset(phi + b, 0, (cells - b < block ? cells - b : block) * sizeof *phi);
+        if (!r->keep_zero)
+            clear_grid(g, phi);
 #pragma omp single
         {
             const double h3 = g->cell * g->cell * g->cell;
@@ -366,6 +380,8 @@ static void light_passes(const light_run *r)
             if (light[i] < 0)
                 light[i] = light_marched(g, r->occ, r->opaque, phi, r->x + 3 * i,
                                          pending_cell(light[i]));
+        if (absorb && r->keep_zero)
+            clear_grid(g, phi);
         return;
     }
     /* along the axis: 1. the points that march, the lines wanted */
@@ -388,11 +404,20 @@ static void light_passes(const light_run *r)
     for (size_t i = 0; i < n; ++i)
         if (light[i] < 0)
             light[i] = absorb ? phi[pending_cell(light[i])] : unshaded;
+    /* 4. φ left all zero: only the lines written (a point's deposit, the
+       light of a wanted line) hold non-zeros */
+    if (absorb && r->keep_zero) {
+#pragma omp for schedule(static)
+        for (size_t line = 0; line < r->L.count; ++line)
+            if (r->wanted[line] || r->touched[line])
+                for (size_t t = 0; t < r->L.n; ++t)
+                    phi[line_cell(&r->L, line, t)] = 0;
+    }
 }
 
-void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
-                               const double *x, const double *vol, size_t n, double *phi,
-                               double *light)
+static void light_shaded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
+                         const double *x, const double *vol, size_t n, double *phi, double *light,
+                         int keep_zero)
 {
     const unsigned char *opaque = occ && occ->nt ? occ->mask : NULL;
     if (!(g->extinction > 0) && !opaque) {
@@ -400,7 +425,8 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
             light[i] = 1;
         return;
     }
-    light_run r = {g, occ, opaque, x, vol, n, phi, light, light_axis(g), {0}, NULL, NULL, NULL};
+    light_run r = {g, occ, opaque, x, vol, n, phi, light, light_axis(g), {0}, NULL, NULL, NULL,
+                   keep_zero, NULL};
     if (!(g->cell > 0) || phc_climbing_light_cells(g) == 0)
         r.axis = -1; /* outside the header's preconditions: march as the definition does */
     if (r.axis >= 0) { /* its scratch; without it every point marches */
@@ -409,7 +435,9 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
         r.wanted = calloc(r.L.count, 1);
         r.sums = malloc(threads * (2 * r.L.n + 1) * sizeof *r.sums);
         r.filled = malloc(threads * r.L.n * sizeof *r.filled);
-        if (!r.wanted || !r.sums || !r.filled)
+        if (keep_zero)
+            r.touched = calloc(r.L.count, 1);
+        if (!r.wanted || !r.sums || !r.filled || (keep_zero && !r.touched))
             r.axis = -1;
     }
     /* a parallel region only for enough points: waking the threads costs
@@ -423,4 +451,19 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
     free(r.wanted);
     free(r.sums);
     free(r.filled);
+    free(r.touched);
+}
+
+void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
+                               const double *x, const double *vol, size_t n, double *phi,
+                               double *light)
+{
+    light_shaded(g, occ, x, vol, n, phi, light, 0);
+}
+
+void phc_climbing_light_shaded_zeroed(const phc_climbing_light_grid *g,
+                                      const phc_climbing_occluders *occ, const double *x,
+                                      const double *vol, size_t n, double *phi, double *light)
+{
+    light_shaded(g, occ, x, vol, n, phi, light, 1);
 }

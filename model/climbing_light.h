@@ -102,6 +102,15 @@ void phc_climbing_light_shaded(const phc_climbing_light_grid *g, const phc_climb
                                const double *x, const double *vol, size_t n, double *phi,
                                double *light);
 
+/* phc_climbing_light_shaded with phi all zero on entry (calloc), left all
+ * zero on return: the grid is not cleared first, only the cells written
+ * are cleared after (a plant that fills few of the grid's columns, as a
+ * climbing plant's light step each frame, skips a pass over every cell).
+ * The same light, bit for bit. */
+void phc_climbing_light_shaded_zeroed(const phc_climbing_light_grid *g,
+                                      const phc_climbing_occluders *occ, const double *x,
+                                      const double *vol, size_t n, double *phi, double *light);
+
 #ifdef __cplusplus
 }
 #endif

@@ -15,6 +15,9 @@
  *     triangles and their mask) across the grid: equal to the reference.
  *  3. One and two OpenMP threads give the same bits (17,293 points: above
  *     the count from which the light runs in parallel).
+ *  3b. phc_climbing_light_shaded_zeroed on a grid all zero at the start
+ *     (calloc), for every case of 1.–3.: the same light bit for bit, and
+ *     the grid all zero after each call.
  *  4. Limits: λ = 0 and no occluders gives 1 everywhere, and so does a
  *     grid with no cells (dims 0, outside the preconditions); a single column
  *     of 3 cells with φ = 0.2 per cell in the two upper cells gives the
@@ -179,6 +182,23 @@ static size_t mismatches(const double *a, const double *b, size_t n)
     return m;
 }
 
+/* 3b: the light of phc_climbing_light_shaded_zeroed on phi_zero (all zero
+ * on entry) into scratch, its differences from want and the cells it left
+ * non-zero added to *differ and *left. */
+static void zeroed_check(const phc_climbing_light_grid *g, const phc_climbing_occluders *occ,
+                         const double *x, const double *vol, size_t n, double *phi_zero,
+                         const double *want, double *scratch, size_t *calls, size_t *differ,
+                         size_t *left)
+{
+    phc_climbing_light_shaded_zeroed(g, occ, x, vol, n, phi_zero, scratch);
+    ++*calls;
+    *differ += mismatches(scratch, want, n);
+    const size_t cells = phc_climbing_light_cells(g);
+    for (size_t c = 0; c < cells; ++c)
+        *left += phi_zero[c] != 0;
+    memset(phi_zero, 0, cells * sizeof *phi_zero); /* a failure here does not carry on */
+}
+
 int main(void)
 {
     phc_climbing_light_grid g = {{-0.13, 0.21, -0.05}, 0.037, {9, 7, 11}, 25, {0, 0, 1}, 0};
@@ -189,8 +209,10 @@ int main(void)
     double *light = malloc(nmax * sizeof *light), *ref = malloc(nmax * sizeof *ref);
     double *light2 = malloc(nmax * sizeof *light2);
     unsigned char *mask = calloc(cells, 1);
-    if (!x || !vol || !phi || !phi_ref || !light || !ref || !light2 || !mask)
+    double *phi_zero = calloc(cells, sizeof *phi_zero);
+    if (!x || !vol || !phi || !phi_ref || !light || !ref || !light2 || !mask || !phi_zero)
         return 1;
+    size_t zeroed_calls = 0, zeroed_differ = 0, zeroed_left = 0;
     const size_t n = make_points(&g, x, vol);
 
     /* an opaque wall: the plane y = 0.35 m across the grid (two triangles) */
@@ -230,6 +252,8 @@ int main(void)
             if (k < 4)
                 CHECK(irregular > 0);
             CHECK(lo < 0.9); /* the shade is real */
+            zeroed_check(&gk, occ, x, vol, n, phi_zero, light, light2, &zeroed_calls,
+                         &zeroed_differ, &zeroed_left);
         }
 
     /* 3. one and two threads */
@@ -238,10 +262,21 @@ int main(void)
     phc_climbing_light_shaded(&g, &wall, x, vol, n, phi, light);
     omp_set_num_threads(2);
     phc_climbing_light_shaded(&g, &wall, x, vol, n, phi, light2);
-    omp_set_num_threads(threads);
     const size_t bad12 = mismatches(light, light2, n);
     printf("one vs two threads: %zu of %zu differ\n", bad12, n);
     CHECK(bad12 == 0);
+    for (int t = 1; t <= 2; ++t) {
+        omp_set_num_threads(t);
+        zeroed_check(&g, &wall, x, vol, n, phi_zero, light, light2, &zeroed_calls,
+                     &zeroed_differ, &zeroed_left);
+    }
+    omp_set_num_threads(threads);
+    printf("phc_climbing_light_shaded_zeroed, %zu calls on one grid: %zu lights differ, %zu cells "
+           "left non-zero\n",
+           zeroed_calls, zeroed_differ, zeroed_left);
+    CHECK(zeroed_calls == 12);
+    CHECK(zeroed_differ == 0);
+    CHECK(zeroed_left == 0);
 
     /* 4. limits */
     phc_climbing_light_grid clear = g;
@@ -280,5 +315,6 @@ int main(void)
     free(ref);
     free(light2);
     free(mask);
+    free(phi_zero);
     return check_finish("test_climbing_light");
 }
