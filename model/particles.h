@@ -308,6 +308,32 @@ int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, doub
  * first push (+INFINITY when none was measured). */
 void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth);
 
+/* Queries the collision pass skips (ours; exact).  The distance to the
+ * supports is 1-Lipschitz: a point x within d₀ − r of a point x₀ whose
+ * query found it in front at distance d₀ is still in front, farther than
+ * r, and its query would push nothing.  The pass keeps, for each
+ * particle's centre and two ends, the point of its last query and that
+ * distance, and does not query a point within d₀ − r − 1e-9·(1 + |x₀|∞)
+ * m of it (the margin covers rounding); the smallest δ − r of
+ * phc_particles_collisions is kept exact by querying, after the pass, the
+ * skipped points whose lower bound d₀ − |x − x₀| − r lies below the
+ * smallest measured.  So the state and the statistics are those of the
+ * pass without skips, bit for bit, provided the side a query reports
+ * (front: (x − c)·n >= 0) does not change along a path that keeps away
+ * from the supports: true for closed meshes with outward faces (inside
+ * and outside), not for an open sheet, where the side flips on the
+ * sheet's plane beyond its border (use on = 1 there).  What is kept are
+ * facts about points: set_position and the like need no reset; a
+ * different collider (set_collider with another fn or user) forgets
+ * them, and so does phc_particles_supports_moved (call it when the
+ * supports behind the same fn and user change).  on = 1: every point is
+ * queried (for tests comparing the two).  Default off. */
+void phc_particles_collide_all(phc_particles *p, int on);
+void phc_particles_supports_moved(phc_particles *p);
+/* Closest-point queries the collision passes made and skipped since the
+ * system was made (counts). */
+void phc_particles_collision_queries(const phc_particles *p, size_t *queries, size_t *skipped);
+
 /* Setters; each validates and names the particle in its message. */
 int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
                            phc_error *err);
