@@ -871,6 +871,7 @@ static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
         return -1;
     phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
     phc_particles_collide_all(p, c->o.collide_all);
+    phc_particles_supports_closed(p, c->o.supports_closed);
     for (size_t i = known; i < n; ++i) { /* new: at its current place, at rest */
         double head[3], tail[3], q[4];
         rest_segment(c, i, head, tail);

@@ -220,7 +220,12 @@ typedef struct phc_climbing_options {
     int collide_all;            /* with collide and dynamics, for tests: 1 makes every
                                    closest-point query of the collision pass, none skipped
                                    (model/particles.h phc_particles_collide_all; the same
-                                   numbers, bit for bit, on closed supports).  0 (default) */
+                                   numbers, bit for bit).  0 (default) */
+    int supports_closed;        /* 1: the supports behind `closest` are closed surfaces with
+                                   outward faces, so the dynamics' collision pass may skip the
+                                   queries of points too far off them to be pushed
+                                   (model/particles.h phc_particles_supports_closed; wrong
+                                   pushes on open sheets).  0 (default): only repeated points */
     /* breaking (§4.3; model/climbing_breaking.h): with dynamics and
        particles.break_threshold > 0 (default 0: off) a link whose group
        stress passes the threshold breaks and the subtree below it falls */

@@ -38,16 +38,18 @@ struct phc_particles {
     double depth;            /* smallest δ − r before the pushes, m */
     /* Closest-point queries the collision pass skips (exact, see
      * phc_particles_collide_all): per particle three points (centre, end
-     * x − h·axis, end x + h·axis), each its last queried point x₀ and the
+     * x − h·axis, end x + h·axis), each its last queried point x₀, the
      * unsigned distance d₀ (m) from it to the supports when it was in
-     * front, 0 otherwise (0: nothing known, no skip), 4 doubles each:
-     * reach[12i + 4s ..].  Facts about points, not particles: kept while
-     * the collider is the same; particles cache_n .. n−1 (appended since)
-     * start with 0.  skip: scratch of the skipped round-0 points (5
-     * doubles: the point, its radius, a lower bound of its δ − r). */
+     * front (0 otherwise: no skip by distance), the answer c, n and 1
+     * (0: nothing known), 12 doubles each: reach[36i + 12s ..].  Facts
+     * about points, not particles: kept while the collider is the same;
+     * particles reach_n .. n−1 (appended since) start with 0.  skip:
+     * scratch of the round-0 points skipped by distance (5 doubles: the
+     * point, its radius, a lower bound of its δ − r). */
     double *reach, *skip;
     size_t reach_cap, reach_n;
     int collide_all;         /* 1: every query made (phc_particles_collide_all) */
+    int supports_closed;     /* 1: skips by distance too (phc_particles_supports_closed) */
     size_t queries, skipped; /* closest-point queries made and skipped since creation */
     phc_particles_options o;
     double *x, *v, *xp;      /* 3n: position, velocity, predicted position (m, m/s) */
@@ -967,6 +969,12 @@ void phc_particles_supports_moved(phc_particles *p)
         p->reach_n = 0; /* every particle's points unknown again (zeroed at the next pass) */
 }
 
+void phc_particles_supports_closed(phc_particles *p, int on)
+{
+    if (p)
+        p->supports_closed = on != 0;
+}
+
 void phc_particles_collide_all(phc_particles *p, int on)
 {
     if (p)
@@ -982,9 +990,12 @@ void phc_particles_collision_queries(const phc_particles *p, size_t *queries, si
 }
 
 /* What the collision pass knows of one point (see struct phc_particles):
- * reach = {x₀, d₀} or NULL (nothing kept), and the pass's counters. */
+ * reach = {x₀, d₀, c, n, known} or NULL (nothing kept), whether a point
+ * far enough from x₀ may be skipped (closed supports), and the pass's
+ * counters. */
 typedef struct point_memory {
     double *reach;
+    int by_distance;
     size_t *queries, *skipped;
 } point_memory;
 
@@ -998,12 +1009,13 @@ static inline double skip_margin(const double x0[3])
 }
 
 /* phc_particles_push_out with a memory (mem may be NULL: the plain push).
- * A point within d₀ − r − margin of its x₀ is not queried: the distance to
- * a closed set is 1-Lipschitz, so its query would find δ > r and push
- * nothing (the side: see phc_particles_collide_all); *delta is then NAN
- * and *bound (may be NULL) gets d₀ − |x − x₀| − r > 0, a lower bound of
- * δ − r (m); NAN when the point was queried.  Every query made stores its
- * point and distance. */
+ * The point x₀ of the last query again (bit for bit): its answer is
+ * reused.  With by_distance, a point within d₀ − r − margin of its x₀ is
+ * not queried: the distance to a closed set is 1-Lipschitz, so its query
+ * would find δ > r and push nothing (the side: see
+ * phc_particles_supports_closed); *delta is then NAN and *bound (may be
+ * NULL) gets d₀ − |x − x₀| − r > 0, a lower bound of δ − r (m); NAN
+ * otherwise.  Every query made stores its point and answer. */
 static int push_point(phc_particles_closest_fn fn, void *user, double r, double x[3], double *delta,
                       const point_memory *mem, double *bound)
 {
@@ -1015,7 +1027,7 @@ static int push_point(phc_particles_closest_fn fn, void *user, double r, double 
     if (!fn)
         return 0;
     double *known = mem ? mem->reach : NULL;
-    if (known && known[3] > 0) {
+    if (known && mem->by_distance && known[3] > 0) {
         const double g[3] = {x[0] - known[0], x[1] - known[1], x[2] - known[2]};
         const double moved = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
         if (moved + r + skip_margin(known) < known[3]) { /* (NaN: no skip) */
@@ -1027,21 +1039,31 @@ static int push_point(phc_particles_closest_fn fn, void *user, double r, double 
             return 0;
         }
     }
-    if (mem)
-        ++*mem->queries;
-    if (fn(user, x, c, nf)) {
-        if (known)
-            known[3] = 0;
-        return 0;
+    if (known && known[10] != 0 && memcmp(x, known, 3 * sizeof(double)) == 0) {
+        ++*mem->skipped; /* the same point: the same answer (fn is a function of x) */
+        memcpy(c, known + 4, 3 * sizeof(double));
+        memcpy(nf, known + 7, 3 * sizeof(double));
+    } else {
+        if (mem)
+            ++*mem->queries;
+        if (fn(user, x, c, nf)) {
+            if (known)
+                known[3] = known[10] = 0;
+            return 0;
+        }
+        if (known) {
+            memcpy(known, x, 3 * sizeof(double));
+            memcpy(known + 4, c, 3 * sizeof(double));
+            memcpy(known + 7, nf, 3 * sizeof(double));
+            known[10] = 1;
+        }
     }
     const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
     const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     const int front = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0;
     const double d = front ? dist : -dist;
-    if (known) {
-        memcpy(known, x, 3 * sizeof(double));
+    if (known)
         known[3] = front && isfinite(dist) ? dist : 0;
-    }
     if (delta)
         *delta = d;
     if (!(d < r))
@@ -1137,7 +1159,7 @@ static int reach_ready(phc_particles *p)
 {
     if (p->reach_cap < p->n) {
         const size_t cap = p->cap > p->n ? p->cap : p->n;
-        double *a = realloc(p->reach, 12 * cap * sizeof *a);
+        double *a = realloc(p->reach, 36 * cap * sizeof *a);
         if (!a)
             return -1;
         p->reach = a;
@@ -1148,7 +1170,7 @@ static int reach_ready(phc_particles *p)
         p->reach_cap = cap;
     }
     if (p->reach_n < p->n)
-        memset(p->reach + 12 * p->reach_n, 0, 12 * (p->n - p->reach_n) * sizeof *p->reach);
+        memset(p->reach + 36 * p->reach_n, 0, 36 * (p->n - p->reach_n) * sizeof *p->reach);
     p->reach_n = p->n;
     return 0;
 }
@@ -1182,8 +1204,8 @@ static void collide(phc_particles *p)
         memcpy(axis, axis0, sizeof axis);
         point_memory mem[3];
         for (int k = 0; k < 3; ++k)
-            mem[k] = (point_memory){remember ? p->reach + 12 * i + 4 * k : NULL, &p->queries,
-                                    &p->skipped};
+            mem[k] = (point_memory){remember ? p->reach + 36 * i + 12 * k : NULL, p->supports_closed,
+                                    &p->queries, &p->skipped};
         p->pushed += (size_t)push_segment(p->collide, p->collide_user, p->ax[3 * i], p->ax[3 * i + 2], 64,
                                           p->xp + 3 * i, axis, &d, mem, p->skip, &nskip);
         p->depth = fmin(p->depth, d);

@@ -946,50 +946,58 @@ int main(void)
 
     /* 8f. The collision pass's skipped queries (model/particles.h
        phc_particles_collide_all): the shoot of 8e grown for 120 s with
-       dynamics and collide, once with the skips and once with every query
-       made; after every growth step the positions, directions, pushes and
-       the smallest δ − r are the same bit for bit.  The query counts of
-       both are printed; the skips must save some. */
+       dynamics and collide three times: every query made; repeated points
+       answered from memory; and with the box declared closed
+       (supports_closed), points too far off it skipped too.  After every
+       growth step the positions, segment ends, pushes and the smallest
+       δ − r are the same bit for bit.  The query counts are printed; each
+       memory must save some. */
     {
-        phc_climbing *c2[2];
-        size_t queries[2] = {0, 0}, skipped[2] = {0, 0}, differ = 0, pushes = 0;
-        for (int all = 0; all < 2; ++all) {
+        enum { RUNS = 3 };
+        phc_climbing *c2[RUNS];
+        size_t queries[RUNS] = {0}, skipped[RUNS] = {0}, differ = 0, pushes = 0;
+        for (int run = 0; run < RUNS; ++run) {
             phc_climbing_options o = box_shoot_options(1, 1);
-            o.collide_all = all;
+            o.collide_all = run == 0;
+            o.supports_closed = run == 2;
             const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
-            c2[all] = phc_climbing_new(seed, up, &o, &err);
-            CHECK(c2[all] != NULL);
+            c2[run] = phc_climbing_new(seed, up, &o, &err);
+            CHECK(c2[run] != NULL);
         }
-        for (int k = 0; c2[0] && c2[1] && k < 480; ++k) {
-            size_t pushed[2];
-            double depth[2];
-            for (int all = 0; all < 2; ++all) {
-                CHECK(phc_climbing_step(c2[all], 0.25, &err) == 0);
-                phc_climbing_collisions(c2[all], &pushed[all], &depth[all]);
+        for (int k = 0; c2[0] && c2[1] && c2[2] && k < 480; ++k) {
+            size_t pushed[RUNS];
+            double depth[RUNS];
+            for (int run = 0; run < RUNS; ++run) {
+                CHECK(phc_climbing_step(c2[run], 0.25, &err) == 0);
+                phc_climbing_collisions(c2[run], &pushed[run], &depth[run]);
             }
             pushes += pushed[0];
             const size_t n = phc_climbing_count(c2[0]);
-            differ += n != phc_climbing_count(c2[1]) || pushed[0] != pushed[1] ||
-                      memcmp(&depth[0], &depth[1], sizeof(double)) != 0;
-            for (size_t i = 0; n == phc_climbing_count(c2[1]) && i < n; ++i) {
-                double a[9], b[9];
-                phc_climbing_position(c2[0], i, a);
-                phc_climbing_segment(c2[0], i, a + 3, a + 6);
-                phc_climbing_position(c2[1], i, b);
-                phc_climbing_segment(c2[1], i, b + 3, b + 6);
-                differ += memcmp(a, b, sizeof a) != 0;
+            for (int run = 1; run < RUNS; ++run) {
+                differ += n != phc_climbing_count(c2[run]) || pushed[0] != pushed[run] ||
+                          memcmp(&depth[0], &depth[run], sizeof(double)) != 0;
+                for (size_t i = 0; n == phc_climbing_count(c2[run]) && i < n; ++i) {
+                    double a[9], b[9];
+                    phc_climbing_position(c2[0], i, a);
+                    phc_climbing_segment(c2[0], i, a + 3, a + 6);
+                    phc_climbing_position(c2[run], i, b);
+                    phc_climbing_segment(c2[run], i, b + 3, b + 6);
+                    differ += memcmp(a, b, sizeof a) != 0;
+                }
             }
         }
-        for (int all = 0; all < 2; ++all) {
-            phc_climbing_collision_queries(c2[all], &queries[all], &skipped[all]);
-            phc_climbing_free(c2[all]);
+        for (int run = 0; run < RUNS; ++run) {
+            phc_climbing_collision_queries(c2[run], &queries[run], &skipped[run]);
+            phc_climbing_free(c2[run]);
         }
-        printf("collision queries, dynamics, 120 s: with skips %zu made, %zu skipped; every query: %zu made, %zu "
-               "skipped; pushes %zu; growth steps or particles that differ: %zu\n",
-               queries[0], skipped[0], queries[1], skipped[1], pushes, differ);
+        printf("collision queries, dynamics, 120 s: every query %zu made, %zu skipped; repeated points from memory "
+               "%zu made, %zu skipped; closed box %zu made, %zu skipped; pushes %zu; growth steps or particles "
+               "that differ: %zu\n",
+               queries[0], skipped[0], queries[1], skipped[1], queries[2], skipped[2], pushes, differ);
         CHECK(differ == 0);
         CHECK(pushes > 0);
-        CHECK(skipped[1] == 0 && skipped[0] > 0 && queries[0] < queries[1]);
+        CHECK(skipped[0] == 0 && queries[1] < queries[0] && queries[2] < queries[1]);
+        CHECK(queries[1] + skipped[1] == queries[0]); /* (no skip by distance: one answer per point) */
     }
 
     return check_finish("test_climbing_growth");
