@@ -37,11 +37,12 @@ struct phc_particles {
     size_t pushed;           /* particles pushed out in the last step */
     double depth;            /* smallest δ − r before the pushes, m */
     /* Closest-point queries the collision pass skips (exact, see
-     * phc_particles_collide_all): per particle three points (centre, end
-     * x − h·axis, end x + h·axis), each its last queried point x₀, the
-     * unsigned distance d₀ (m) from it to the supports when it was in
-     * front (0 otherwise: no skip by distance), the answer c, n and 1
-     * (0: nothing known), 12 doubles each: reach[36i + 12s ..].  Facts
+     * phc_particles_collide_all): per particle six points (centre, end
+     * x − h·axis, end x + h·axis of the first round; the same of the later
+     * rounds: the centre pushed again, the ends), each its last queried
+     * point x₀, the unsigned distance d₀ (m) from it to the supports when
+     * it was in front (0 otherwise: no skip by distance), the answer c, n
+     * and 1 (0: nothing known), 12 doubles each: reach[72i + 12s ..].  Facts
      * about points, not particles: kept while the collider is the same;
      * particles reach_n .. n−1 (appended since) start with 0.  skip:
      * scratch of the round-0 points skipped by distance (5 doubles: the
@@ -1088,7 +1089,8 @@ void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *de
 }
 
 /* The capsule push (phc_particles_push_segment_out) with the memories of
- * its three points (mem: centre, end −, end +; NULL: none).  A skipped
+ * its points (mem: centre, end −, end + of round 0, then the centre pushed
+ * again and the ends of the later rounds; NULL: none).  A skipped
  * round-0 point is appended to skip (5 doubles: the point, r, the lower
  * bound of its δ − r; *nskip counted) and left out of *depth. */
 static int push_segment(phc_particles_closest_fn fn, void *user, double r, double h, int rounds,
@@ -1110,8 +1112,9 @@ static int push_segment(phc_particles_closest_fn fn, void *user, double r, doubl
             a[k] = x[k] - h * axis[k];
             b[k] = x[k] + h * axis[k];
         }
-        const int pa = push_point(fn, user, r, a, &da, mem ? mem + 1 : NULL, &la);
-        const int pb = push_point(fn, user, r, b, &db, mem ? mem + 2 : NULL, &lbb);
+        const point_memory *m = mem ? mem + (round ? 3 : 0) : NULL; /* round 0; later rounds */
+        const int pa = push_point(fn, user, r, a, &da, m ? m + 1 : NULL, &la);
+        const int pb = push_point(fn, user, r, b, &db, m ? m + 2 : NULL, &lbb);
         if (round == 0) {
             if (!isnan(la)) {
                 for (int k = 0; k < 3; ++k)
@@ -1139,7 +1142,7 @@ static int push_segment(phc_particles_closest_fn fn, void *user, double r, doubl
             x[k] = 0.5 * (a[k] + b[k]);
             axis[k] = e[k] / len;
         }
-        pushed += push_point(fn, user, r, x, NULL, mem, NULL);
+        pushed += push_point(fn, user, r, x, NULL, mem ? mem + 3 : NULL, NULL);
     }
     if (depth)
         *depth = first;
@@ -1159,7 +1162,7 @@ static int reach_ready(phc_particles *p)
 {
     if (p->reach_cap < p->n) {
         const size_t cap = p->cap > p->n ? p->cap : p->n;
-        double *a = realloc(p->reach, 36 * cap * sizeof *a);
+        double *a = realloc(p->reach, 72 * cap * sizeof *a);
         if (!a)
             return -1;
         p->reach = a;
@@ -1170,7 +1173,7 @@ static int reach_ready(phc_particles *p)
         p->reach_cap = cap;
     }
     if (p->reach_n < p->n)
-        memset(p->reach + 36 * p->reach_n, 0, 36 * (p->n - p->reach_n) * sizeof *p->reach);
+        memset(p->reach + 72 * p->reach_n, 0, 72 * (p->n - p->reach_n) * sizeof *p->reach);
     p->reach_n = p->n;
     return 0;
 }
@@ -1202,9 +1205,9 @@ static void collide(phc_particles *p)
         phc_quat_to_matrix(p->qp + 4 * i, R);
         const double axis0[3] = {R[2], R[5], R[8]}; /* R·(0, 0, 1) */
         memcpy(axis, axis0, sizeof axis);
-        point_memory mem[3];
-        for (int k = 0; k < 3; ++k)
-            mem[k] = (point_memory){remember ? p->reach + 36 * i + 12 * k : NULL, p->supports_closed,
+        point_memory mem[6];
+        for (int k = 0; k < 6; ++k)
+            mem[k] = (point_memory){remember ? p->reach + 72 * i + 12 * k : NULL, p->supports_closed,
                                     &p->queries, &p->skipped};
         p->pushed += (size_t)push_segment(p->collide, p->collide_user, p->ax[3 * i], p->ax[3 * i + 2], 64,
                                           p->xp + 3 * i, axis, &d, mem, p->skip, &nskip);

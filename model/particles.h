@@ -310,7 +310,8 @@ void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *de
 
 /* Queries the collision pass skips (ours; exact).  The pass keeps, for
  * each particle's centre and two ends, the point of its last query and
- * the answer (c, n).
+ * the answer (c, n), those of the first round and of the later rounds
+ * apart.
  *  - The same point again, bit for bit (a pinned or resting particle):
  *    the kept answer is used (fn must be a function of x).
  *  - With phc_particles_supports_closed(p, 1), also a point x within
