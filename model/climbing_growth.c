@@ -871,6 +871,8 @@ static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
     if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
         return -1;
     phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
+    phc_particles_collide_all(p, c->o.collide_all);
+    phc_particles_supports_closed(p, c->o.supports_closed);
     for (size_t i = known; i < n; ++i) { /* new: at its current place, at rest */
         double head[3], tail[3], q[4];
         rest_segment(c, i, head, tail);
@@ -940,6 +942,11 @@ void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *dept
         *pushed = c->pushed;
     if (depth)
         *depth = c->depth;
+}
+
+void phc_climbing_collision_queries(const phc_climbing *c, size_t *queries, size_t *skipped)
+{
+    phc_particles_collision_queries(c ? c->sys : NULL, queries, skipped);
 }
 
 /* Particle i's current centre and direction from c->sys, into the plant

@@ -217,6 +217,15 @@ typedef struct phc_climbing_options {
                                    need not join (as with the centre push alone).  Not needed
                                    with dynamics (collide pushes the ends there).  0 (default):
                                    off */
+    int collide_all;            /* with collide and dynamics, for tests: 1 makes every
+                                   closest-point query of the collision pass, none skipped
+                                   (model/particles.h phc_particles_collide_all; the same
+                                   numbers, bit for bit).  0 (default) */
+    int supports_closed;        /* 1: the supports behind `closest` are closed surfaces with
+                                   outward faces, so the dynamics' collision pass may skip the
+                                   queries of points too far off them to be pushed
+                                   (model/particles.h phc_particles_supports_closed; wrong
+                                   pushes on open sheets).  0 (default): only repeated points */
     /* breaking (§4.3; model/climbing_breaking.h): with dynamics and
        particles.break_threshold > 0 (default 0: off) a link whose group
        stress passes the threshold breaks and the subtree below it falls */
@@ -262,6 +271,11 @@ int phc_climbing_set_dynamics_substeps(phc_climbing *c, size_t substeps, phc_err
  * signed distance to the supports of a centre, and with dynamics or
  * collide_ends of a segment end too, model/particles.h). */
 void phc_climbing_collisions(const phc_climbing *c, size_t *pushed, double *depth);
+/* Closest-point queries the dynamics' collision passes made and skipped
+ * since the plant's particle system was made (it is made again after a
+ * break, or when the dynamics are switched off and on; 0, 0 without
+ * one; model/particles.h phc_particles_collision_queries). */
+void phc_climbing_collision_queries(const phc_climbing *c, size_t *queries, size_t *skipped);
 
 /* Counters since the seed. */
 typedef struct phc_climbing_stats {

@@ -36,6 +36,22 @@ struct phc_particles {
     void *collide_user;
     size_t pushed;           /* particles pushed out in the last step */
     double depth;            /* smallest δ − r before the pushes, m */
+    /* Closest-point queries the collision pass skips (exact, see
+     * phc_particles_collide_all): per particle six points (centre, end
+     * x − h·axis, end x + h·axis of the first round; the same of the later
+     * rounds: the centre pushed again, the ends), each its last queried
+     * point x₀, the unsigned distance d₀ (m) from it to the supports when
+     * it was in front (0 otherwise: no skip by distance), the answer c, n
+     * and 1 (0: nothing known), 12 doubles each: reach[72i + 12s ..].  Facts
+     * about points, not particles: kept while the collider is the same;
+     * particles reach_n .. n−1 (appended since) start with 0.  skip:
+     * scratch of the round-0 points skipped by distance (5 doubles: the
+     * point, its radius, a lower bound of its δ − r). */
+    double *reach, *skip;
+    size_t reach_cap, reach_n;
+    int collide_all;         /* 1: every query made (phc_particles_collide_all) */
+    int supports_closed;     /* 1: skips by distance too (phc_particles_supports_closed) */
+    size_t queries, skipped; /* closest-point queries made and skipped since creation */
     phc_particles_options o;
     double *x, *v, *xp;      /* 3n: position, velocity, predicted position (m, m/s) */
     double *x0;              /* 3n: rest position (m) */
@@ -536,6 +552,8 @@ void phc_particles_free(phc_particles *p)
     free(p->mem);
     free(p->mu);
     free(p->goal);
+    free(p->reach);
+    free(p->skip);
     free(p);
 }
 
@@ -940,22 +958,113 @@ void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, v
 {
     if (!p)
         return;
+    if (fn != p->collide || user != p->collide_user)
+        phc_particles_supports_moved(p);
     p->collide = fn;
     p->collide_user = user;
 }
 
-int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
-                           double *delta)
+void phc_particles_supports_moved(phc_particles *p)
+{
+    if (p)
+        p->reach_n = 0; /* every particle's points unknown again (zeroed at the next pass) */
+}
+
+void phc_particles_supports_closed(phc_particles *p, int on)
+{
+    if (p)
+        p->supports_closed = on != 0;
+}
+
+void phc_particles_collide_all(phc_particles *p, int on)
+{
+    if (p)
+        p->collide_all = on != 0;
+}
+
+void phc_particles_collision_queries(const phc_particles *p, size_t *queries, size_t *skipped)
+{
+    if (queries)
+        *queries = p ? p->queries : 0;
+    if (skipped)
+        *skipped = p ? p->skipped : 0;
+}
+
+/* What the collision pass knows of one point (see struct phc_particles):
+ * reach = {x₀, d₀, c, n, known} or NULL (nothing kept), whether a point
+ * far enough from x₀ may be skipped (closed supports), and the pass's
+ * counters. */
+typedef struct point_memory {
+    double *reach;
+    int by_distance;
+    size_t *queries, *skipped;
+} point_memory;
+
+/* A skip is certain when x lies within d₀ − r of x₀ by more than this (m):
+ * δ at x >= d₀ − |x − x₀| > r holds for the exact distances, and the
+ * margin covers the rounding of the query's closest point and of the
+ * distances (a few ulps of the coordinates; 1e-9 relative is generous). */
+static inline double skip_margin(const double x0[3])
+{
+    return 1e-9 * (1 + fmax(fabs(x0[0]), fmax(fabs(x0[1]), fabs(x0[2]))));
+}
+
+/* phc_particles_push_out with a memory (mem may be NULL: the plain push).
+ * The point x₀ of the last query again (bit for bit): its answer is
+ * reused.  With by_distance, a point within d₀ − r − margin of its x₀ is
+ * not queried: the distance to a closed set is 1-Lipschitz, so its query
+ * would find δ > r and push nothing (the side: see
+ * phc_particles_supports_closed); *delta is then NAN and *bound (may be
+ * NULL) gets d₀ − |x − x₀| − r > 0, a lower bound of δ − r (m); NAN
+ * otherwise.  Every query made stores its point and answer. */
+static int push_point(phc_particles_closest_fn fn, void *user, double r, double x[3], double *delta,
+                      const point_memory *mem, double *bound)
 {
     double c[3], nf[3];
     if (delta)
         *delta = INFINITY;
-    if (!fn || fn(user, x, c, nf))
+    if (bound)
+        *bound = NAN;
+    if (!fn)
         return 0;
+    double *known = mem ? mem->reach : NULL;
+    if (known && mem->by_distance && known[3] > 0) {
+        const double g[3] = {x[0] - known[0], x[1] - known[1], x[2] - known[2]};
+        const double moved = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (moved + r + skip_margin(known) < known[3]) { /* (NaN: no skip) */
+            ++*mem->skipped;
+            if (delta)
+                *delta = NAN;
+            if (bound)
+                *bound = known[3] - moved - r;
+            return 0;
+        }
+    }
+    if (known && known[10] != 0 && memcmp(x, known, 3 * sizeof(double)) == 0) {
+        ++*mem->skipped; /* the same point: the same answer (fn is a function of x) */
+        memcpy(c, known + 4, 3 * sizeof(double));
+        memcpy(nf, known + 7, 3 * sizeof(double));
+    } else {
+        if (mem)
+            ++*mem->queries;
+        if (fn(user, x, c, nf)) {
+            if (known)
+                known[3] = known[10] = 0;
+            return 0;
+        }
+        if (known) {
+            memcpy(known, x, 3 * sizeof(double));
+            memcpy(known + 4, c, 3 * sizeof(double));
+            memcpy(known + 7, nf, 3 * sizeof(double));
+            known[10] = 1;
+        }
+    }
     const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]};
     const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     const int front = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0;
     const double d = front ? dist : -dist;
+    if (known)
+        known[3] = front && isfinite(dist) ? dist : 0;
     if (delta)
         *delta = d;
     if (!(d < r))
@@ -963,6 +1072,12 @@ int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, do
     for (int k = 0; k < 3; ++k)
         x[k] = c[k] + r * (front && dist > 0 ? e[k] / dist : nf[k]);
     return 1;
+}
+
+int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, double x[3],
+                           double *delta)
+{
+    return push_point(fn, user, r, x, delta, NULL, NULL);
 }
 
 void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth)
@@ -973,22 +1088,49 @@ void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *de
         *depth = p ? p->depth : INFINITY;
 }
 
-int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
-                                   int rounds, double x[3], double axis[3], double *depth)
+/* The capsule push (phc_particles_push_segment_out) with the memories of
+ * its points (mem: centre, end −, end + of round 0, then the centre pushed
+ * again and the ends of the later rounds; NULL: none).  A skipped
+ * round-0 point is appended to skip (5 doubles: the point, r, the lower
+ * bound of its δ − r; *nskip counted) and left out of *depth. */
+static int push_segment(phc_particles_closest_fn fn, void *user, double r, double h, int rounds,
+                        double x[3], double axis[3], double *depth, const point_memory *mem,
+                        double *skip, size_t *nskip)
 {
-    double d;
-    int pushed = phc_particles_push_out(fn, user, r, x, &d);
-    double first = d - r;
+    double d, lb;
+    int pushed = push_point(fn, user, r, x, &d, mem, &lb);
+    double first = INFINITY;
+    if (!isnan(lb)) {
+        memcpy(skip + 5 * *nskip, x, 3 * sizeof(double));
+        skip[5 * *nskip + 3] = r;
+        skip[5 * (*nskip)++ + 4] = lb;
+    } else
+        first = d - r; /* (as the plain push: fmin below) */
     for (int round = 0; round < rounds; ++round) {
-        double a[3], b[3], da, db;
+        double a[3], b[3], da, db, la, lbb;
         for (int k = 0; k < 3; ++k) {
             a[k] = x[k] - h * axis[k];
             b[k] = x[k] + h * axis[k];
         }
-        const int pa = phc_particles_push_out(fn, user, r, a, &da);
-        const int pb = phc_particles_push_out(fn, user, r, b, &db);
-        if (round == 0)
-            first = fmin(first, fmin(da - r, db - r));
+        const point_memory *m = mem ? mem + (round ? 3 : 0) : NULL; /* round 0; later rounds */
+        const int pa = push_point(fn, user, r, a, &da, m ? m + 1 : NULL, &la);
+        const int pb = push_point(fn, user, r, b, &db, m ? m + 2 : NULL, &lbb);
+        if (round == 0) {
+            if (!isnan(la)) {
+                for (int k = 0; k < 3; ++k)
+                    skip[5 * *nskip + k] = x[k] - h * axis[k];
+                skip[5 * *nskip + 3] = r;
+                skip[5 * (*nskip)++ + 4] = la;
+            } else
+                first = fmin(first, da - r);
+            if (!isnan(lbb)) {
+                for (int k = 0; k < 3; ++k)
+                    skip[5 * *nskip + k] = x[k] + h * axis[k];
+                skip[5 * *nskip + 3] = r;
+                skip[5 * (*nskip)++ + 4] = lbb;
+            } else
+                first = fmin(first, db - r);
+        }
         pushed += pa + pb;
         if (!pa && !pb)
             break;
@@ -1000,22 +1142,62 @@ int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, doub
             x[k] = 0.5 * (a[k] + b[k]);
             axis[k] = e[k] / len;
         }
-        pushed += phc_particles_push_out(fn, user, r, x, NULL);
+        pushed += push_point(fn, user, r, x, NULL, mem ? mem + 3 : NULL, NULL);
     }
     if (depth)
         *depth = first;
     return pushed;
 }
 
+int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
+                                   int rounds, double x[3], double axis[3], double *depth)
+{
+    return push_segment(fn, user, r, h, rounds, x, axis, depth, NULL, NULL, NULL);
+}
+
+/* The memories of the collision pass for particles 0 .. n−1: grown and
+ * the new particles' points zeroed (nothing known).  0, or -1 when out of
+ * memory (the pass then queries every point). */
+static int reach_ready(phc_particles *p)
+{
+    if (p->reach_cap < p->n) {
+        const size_t cap = p->cap > p->n ? p->cap : p->n;
+        double *a = realloc(p->reach, 72 * cap * sizeof *a);
+        if (!a)
+            return -1;
+        p->reach = a;
+        double *b = realloc(p->skip, 15 * cap * sizeof *b);
+        if (!b)
+            return -1;
+        p->skip = b;
+        p->reach_cap = cap;
+    }
+    if (p->reach_n < p->n)
+        memset(p->reach + 72 * p->reach_n, 0, 72 * (p->n - p->reach_n) * sizeof *p->reach);
+    p->reach_n = p->n;
+    return 0;
+}
+
+static int by_bound(const void *a, const void *b)
+{
+    const double x = ((const double *)a)[4], y = ((const double *)b)[4];
+    return (x > y) - (x < y);
+}
+
 /* The collision pass on the predicted state (see particles.h): every
  * particle a capsule, its centre and its segment's ends pushed out, its
- * orientation turned with its axis. */
+ * orientation turned with its axis.  Points that cannot be pushed are not
+ * queried (phc_particles_collide_all); the smallest δ − r is then made
+ * exact by querying the skipped points whose lower bound is below the
+ * smallest measured, smallest bound first, until no bound is. */
 static void collide(phc_particles *p)
 {
     p->pushed = 0;
     p->depth = INFINITY;
     if (!p->collide)
         return;
+    const int remember = !p->collide_all && reach_ready(p) == 0;
+    size_t nskip = 0;
     for (size_t i = 0; i < p->n; ++i) {
         if (p->hold_q[i])
             continue;
@@ -1023,8 +1205,12 @@ static void collide(phc_particles *p)
         phc_quat_to_matrix(p->qp + 4 * i, R);
         const double axis0[3] = {R[2], R[5], R[8]}; /* R·(0, 0, 1) */
         memcpy(axis, axis0, sizeof axis);
-        p->pushed += (size_t)phc_particles_push_segment_out(p->collide, p->collide_user, p->ax[3 * i],
-                                                            p->ax[3 * i + 2], 64, p->xp + 3 * i, axis, &d);
+        point_memory mem[6];
+        for (int k = 0; k < 6; ++k)
+            mem[k] = (point_memory){remember ? p->reach + 72 * i + 12 * k : NULL, p->supports_closed,
+                                    &p->queries, &p->skipped};
+        p->pushed += (size_t)push_segment(p->collide, p->collide_user, p->ax[3 * i], p->ax[3 * i + 2], 64,
+                                          p->xp + 3 * i, axis, &d, mem, p->skip, &nskip);
         p->depth = fmin(p->depth, d);
         if (memcmp(axis, axis0, sizeof axis) == 0)
             continue;
@@ -1041,6 +1227,19 @@ static void collide(phc_particles *p)
         quat_mul(dq, p->qp + 4 * i, qn);
         quat_normalize(qn);
         memcpy(p->qp + 4 * i, qn, sizeof qn);
+    }
+    /* the skipped points that could hold the smallest δ − r */
+    size_t m = 0;
+    for (size_t t = 0; t < nskip; ++t)
+        if (p->skip[5 * t + 4] < p->depth)
+            memmove(p->skip + 5 * m++, p->skip + 5 * t, 5 * sizeof *p->skip);
+    qsort(p->skip, m, 5 * sizeof *p->skip, by_bound);
+    for (size_t t = 0; t < m && p->skip[5 * t + 4] < p->depth; ++t) {
+        double y[3], d;
+        memcpy(y, p->skip + 5 * t, sizeof y);
+        ++p->queries;
+        push_point(p->collide, p->collide_user, p->skip[5 * t + 3], y, &d, NULL, NULL);
+        p->depth = fmin(p->depth, d - p->skip[5 * t + 3]);
     }
 }
 

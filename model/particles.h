@@ -308,6 +308,37 @@ int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, doub
  * first push (+INFINITY when none was measured). */
 void phc_particles_collisions(const phc_particles *p, size_t *pushed, double *depth);
 
+/* Queries the collision pass skips (ours; exact).  The pass keeps, for
+ * each particle's centre and two ends, the point of its last query and
+ * the answer (c, n), those of the first round and of the later rounds
+ * apart.
+ *  - The same point again, bit for bit (a pinned or resting particle):
+ *    the kept answer is used (fn must be a function of x).
+ *  - With phc_particles_supports_closed(p, 1), also a point x within
+ *    d₀ − r − 1e-9·(1 + |x₀|∞) m of a point x₀ whose query found it in
+ *    front at distance d₀: the distance to the supports is 1-Lipschitz,
+ *    so x is still farther than r, and on closed surfaces with outward
+ *    faces (front = outside) still in front: its query would push nothing
+ *    (the margin covers rounding).  The smallest δ − r of
+ *    phc_particles_collisions is kept exact by querying, after the pass,
+ *    the skipped points whose lower bound d₀ − |x − x₀| − r lies below
+ *    the smallest measured.  Not on open surfaces: beyond a sheet's border
+ *    the side (x − c)·n flips on the sheet's plane far from the sheet
+ *    (Fig. 13's wall, open at its foot: points below it are behind).
+ * So the state and the statistics are those of the pass without skips,
+ * bit for bit.  What is kept are facts about points: set_position and the
+ * like need no reset; a different collider (set_collider with another fn
+ * or user) forgets them, and so does phc_particles_supports_moved (call it
+ * when the supports behind the same fn and user change).  collide_all
+ * on = 1: every point is queried (for tests comparing the two).  Default
+ * off; supports_closed default off. */
+void phc_particles_supports_closed(phc_particles *p, int on);
+void phc_particles_collide_all(phc_particles *p, int on);
+void phc_particles_supports_moved(phc_particles *p);
+/* Closest-point queries the collision passes made and skipped since the
+ * system was made (counts). */
+void phc_particles_collision_queries(const phc_particles *p, size_t *queries, size_t *skipped);
+
 /* Setters; each validates and names the particle in its message. */
 int phc_particles_set_mass(phc_particles *p, size_t i, double mass /* kg, > 0 */,
                            phc_error *err);

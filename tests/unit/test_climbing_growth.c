@@ -52,6 +52,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "climbing_same_state.h"
 #include "climbing_bushy_plant.h"
 
 static const double PI = 3.14159265358979323846;
@@ -942,6 +943,49 @@ int main(void)
         CHECK(ends_min[0] < -1e-4); /* without collisions the ends cut in */
         CHECK(ends_min[1] >= -1e-12 && centre_min[1] >= -1e-12);
         CHECK(vmax_late[1] < 0.01 && isfinite(vmax_late[1]));
+    }
+
+    /* 8f. The collision pass's skipped queries (model/particles.h
+       phc_particles_collide_all): the shoot of 8e grown for 120 s with
+       dynamics and collide three times: every query made; repeated points
+       answered from memory; and with the box declared closed
+       (supports_closed), points too far off it skipped too.  After every
+       growth step the positions, segment ends, pushes and the smallest
+       δ − r are the same bit for bit.  The query counts are printed; each
+       memory must save some. */
+    {
+        enum { RUNS = 3 };
+        phc_climbing *c2[RUNS];
+        size_t queries[RUNS] = {0}, skipped[RUNS] = {0}, differ = 0, pushes = 0;
+        for (int run = 0; run < RUNS; ++run) {
+            phc_climbing_options o = box_shoot_options(1, 1);
+            o.collide_all = run == 0;
+            o.supports_closed = run == 2;
+            const double seed[3] = {0, 0.055, 0.1}, up[3] = {0, 0, 1};
+            c2[run] = phc_climbing_new(seed, up, &o, &err);
+            CHECK(c2[run] != NULL);
+        }
+        for (int k = 0; c2[0] && c2[1] && c2[2] && k < 480; ++k) {
+            for (int run = 0; run < RUNS; ++run)
+                CHECK(phc_climbing_step(c2[run], 0.25, &err) == 0);
+            size_t pushed;
+            phc_climbing_collisions(c2[0], &pushed, NULL);
+            pushes += pushed;
+            for (int run = 1; run < RUNS; ++run)
+                differ += climbing_state_differs(c2[0], c2[run]);
+        }
+        for (int run = 0; run < RUNS; ++run) {
+            phc_climbing_collision_queries(c2[run], &queries[run], &skipped[run]);
+            phc_climbing_free(c2[run]);
+        }
+        printf("collision queries, dynamics, 120 s: every query %zu made, %zu skipped; repeated points from memory "
+               "%zu made, %zu skipped; closed box %zu made, %zu skipped; pushes %zu; growth steps or particles "
+               "that differ: %zu\n",
+               queries[0], skipped[0], queries[1], skipped[1], queries[2], skipped[2], pushes, differ);
+        CHECK(differ == 0);
+        CHECK(pushes > 0);
+        CHECK(skipped[0] == 0 && queries[1] < queries[0] && queries[2] < queries[1]);
+        CHECK(queries[1] + skipped[1] == queries[0]); /* (no skip by distance: one answer per point) */
     }
 
     return check_finish("test_climbing_growth");

@@ -1,0 +1,90 @@
+/* Unit test of the collision pass's memory (model/particles.h
+ * phc_particles_collide_all; climbing option collide_all): the answers of
+ * repeated query points are reused, never changing the plant.  Every
+ * checked number is printed.
+ *  1. Fig. 13's wall (measurements/examples/climbing/wall_window.obj, open
+ *     at its foot: no skips by distance), its seed and growth values, grown
+ *     30 s with dynamics (25 substeps of 0.01 s per 0.25 s step, own-weight
+ *     pass) and collide: every query made on one thread, the memory on one
+ *     thread and on two.  After every growth step all particles' centres
+ *     and segment ends, the pushes and the smallest δ − r are the same bit
+ *     for bit; the query counts are printed and the memory must save some.
+ *     (At this size, < 1024 particles, the particles' step runs on one
+ *     thread anyway; the collision pass always does.) */
+#include "measurements/support_mesh.h"
+#include "model/climbing_growth.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "climbing_same_state.h"
+
+int main(void)
+{
+    phc_error err;
+    const char *mesh_path = PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window.obj";
+    phc_support_mesh *wall = phc_support_mesh_read(mesh_path, &err);
+    CHECK(wall != NULL);
+    if (!wall)
+        return check_finish("test_collide_memory");
+
+    /* 1. Fig. 13's wall: memory against every query, 1 and 2 threads */
+    enum { RUNS = 3 };
+    const int threads[RUNS] = {1, 1, 2}, all[RUNS] = {1, 0, 0};
+    phc_climbing *c[RUNS];
+    const double seed[3] = {-0.1, 0.02, 0}, up[3] = {0, 0, 1};
+    for (int run = 0; run < RUNS; ++run) {
+        phc_climbing_options o = phc_climbing_options_default();
+        o.seed = 13; /* Fig. 13's values (notebooks_c/climbing_fig13_wall.c) */
+        o.growth_rate = 0.2;
+        o.apical_dominance = 0.6;
+        o.radius = 0.003;
+        o.branch_probability = 0.35;
+        o.direction_variance = 0.6;
+        o.max_order = 2;
+        o.surface_adaption = 0.5;
+        o.keep_outside = 1;
+        o.closest = phc_support_mesh_closest;
+        o.closest_user = wall;
+        o.dynamics_substeps = 25;
+        o.collide = 1;
+        o.collide_all = all[run];
+        c[run] = phc_climbing_new(seed, up, &o, &err);
+        CHECK(c[run] != NULL);
+    }
+    size_t differ = 0, pushes = 0, steps = 0;
+    const int max_threads = omp_get_max_threads();
+    for (int k = 0; c[0] && c[1] && c[2] && k < 120; ++k) {
+        for (int run = 0; run < RUNS; ++run) {
+            omp_set_num_threads(threads[run]);
+            CHECK(phc_climbing_step(c[run], 0.25, &err) == 0);
+        }
+        ++steps;
+        size_t pushed;
+        phc_climbing_collisions(c[0], &pushed, NULL);
+        pushes += pushed;
+        for (int run = 1; run < RUNS; ++run)
+            differ += climbing_state_differs(c[0], c[run]);
+    }
+    omp_set_num_threads(max_threads);
+    size_t queries[RUNS] = {0}, skipped[RUNS] = {0};
+    const size_t n = c[0] ? phc_climbing_count(c[0]) : 0;
+    for (int run = 0; run < RUNS; ++run) {
+        phc_climbing_collision_queries(c[run], &queries[run], &skipped[run]);
+        phc_climbing_free(c[run]);
+    }
+    printf("Fig. 13's wall, dynamics and collide, %zu steps of 0.25 s: %zu particles, %zu points pushed; queries: "
+           "every query %zu made (%zu skipped); memory, 1 thread %zu made, %zu answered from memory; 2 threads "
+           "%zu made, %zu from memory; growth steps or particles that differ: %zu\n",
+           steps, n, pushes, queries[0], skipped[0], queries[1], skipped[1], queries[2], skipped[2], differ);
+    CHECK(steps == 120 && differ == 0 && pushes > 0);
+    CHECK(skipped[0] == 0 && skipped[1] > 0 && queries[1] + skipped[1] == queries[0]);
+    CHECK(queries[2] == queries[1] && skipped[2] == skipped[1]);
+
+    phc_support_mesh_free(wall);
+    return check_finish("test_collide_memory");
+}
