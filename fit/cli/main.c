@@ -1442,9 +1442,10 @@ static int cmd_version(void)
 /* OpenMP's idle threads spin before they sleep (libgomp: GOMP_SPINCOUNT,
  * 300000 spins by default).  When another program holds a core, a thread
  * spinning at a barrier takes the CPU that the thread it waits for needs:
- * with one other CPU busy, a 25k-particle climbing frame took 76.0 ms on two
- * threads against 10.6 ms on one, and 10.2 ms on two with passive waiting
- * (README "Speed", the climbing plants).  libgomp reads its settings when
+ * while other multi-threaded work held a core, a 25k-particle climbing frame
+ * took 76.0 ms on two threads against 10.6 ms on one, and 10.2 ms on two
+ * with passive waiting; on a quiet machine passive waiting costs 5-25%
+ * (README "The command line", Threads).  libgomp reads its settings when
  * it loads, before main, so a command sets OMP_WAIT_POLICY=PASSIVE and runs
  * itself again, unless the user chose a policy (OMP_WAIT_POLICY or
  * GOMP_SPINCOUNT in the environment).  If the exec fails (no /proc), the
