@@ -157,11 +157,11 @@ size_t phc_climbing_find_id(const size_t *ids, size_t n, size_t id)
     return lo < n && ids[lo] == id ? lo : NONE;
 }
 
-int phc_climbing_has_attached_child(const size_t *parent, const unsigned char *falling, size_t n,
-                                    size_t p)
+int phc_climbing_has_attached_successor(const size_t *parent, const unsigned char *lateral,
+                                        const unsigned char *falling, size_t n, size_t p)
 {
     for (size_t i = p + 1; i < n; ++i)
-        if (parent[i] == p && !falling[i])
+        if (parent[i] == p && !lateral[i] && !falling[i])
             return 1;
     return 0;
 }

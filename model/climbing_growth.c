@@ -1522,15 +1522,14 @@ static void break_link(phc_climbing *c, size_t k, double stress)
     c->stats.falling += m;
     c->stats.last_break_id = c->id[k];
     c->stats.last_break_stress = stress;
-    const size_t p = c->parent[k]; /* the stump: remembered when k was its only shoot */
-    if (isfinite(c->o.resprout_delay) && p != PHC_CLIMBING_NONE &&
-        !phc_climbing_has_attached_child(c->parent, c->falling, c->n, p) &&
+    const size_t p = c->parent[k]; /* the stump: remembered when k continued its axis */
+    if (isfinite(c->o.resprout_delay) && p != PHC_CLIMBING_NONE && !c->lateral[k] &&
         phc_climbing_stumps_add(&c->stumps, c->id[p], c->stats.time))
         c->stumps_lost = 1;
 }
 
 /* The stumps due (resprout_delay after their break) that are still in the
- * plant, not falling and without an attached child grow a new tip at
+ * plant, not falling and without an attached successor grow a new tip at
  * their top: model/climbing_breaking.h, "Resprouting". */
 static int resprout(phc_climbing *c, phc_error *err)
 {
@@ -1547,7 +1546,7 @@ static int resprout(phc_climbing *c, phc_error *err)
         const double phi = 2 * PI * phc_climbing_rng_uniform(&c->rng);
         const size_t p = phc_climbing_find_id(c->id, c->n, due[t]);
         if (p == PHC_CLIMBING_NONE || c->falling[p] || c->apical[p] || c->n >= o->max_particles ||
-            phc_climbing_has_attached_child(c->parent, c->falling, c->n, p))
+            phc_climbing_has_attached_successor(c->parent, c->lateral, c->falling, c->n, p))
             continue;
         double tip[3], tipr[3], dir[3], dirr[3];
         seg_tip(c, p, 0, tip);
