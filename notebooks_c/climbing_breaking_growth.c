@@ -104,21 +104,6 @@ static phc_climbing_options plant_options(void)
     return o;
 }
 
-/* Length (m) of the axis from particle k (k and its successors, the
- * children that are not laterals); *m gets their count. */
-static double axis_length(const phc_climbing *c, size_t k, size_t *m)
-{
-    double L = phc_climbing_length(c, k);
-    *m = 1;
-    for (size_t i = k + 1; i < phc_climbing_count(c); ++i)
-        if (phc_climbing_parent(c, i) == k && !phc_climbing_is_lateral(c, i)) {
-            L += phc_climbing_length(c, i);
-            k = i;
-            ++*m;
-        }
-    return L;
-}
-
 /* The same plant with resprout_delay RESPROUT s (break_resprout.yaml): the
  * step of the first resprout after the first break and the new axis
  * AXIS_TIME s later against the growth rule (README, growth step 3: a shoot
@@ -165,7 +150,7 @@ static int resprout_run(size_t first_break_step)
             k = i;
     const double t = (double)grown_steps * DT, r = o.growth_rate, s0 = o.bud_fraction,
                  L = o.max_length;
-    const double length = k != PHC_CLIMBING_NONE ? axis_length(c, k, &m) : 0;
+    const double length = k != PHC_CLIMBING_NONE ? climbing_axis_length(c, k, &m) : 0;
     const double q = floor(r * t / (1 - s0));
     const double want = L * (s0 + r * t + s0 * q);
     const int ok_when = sprout_step == first_break_step + (size_t)llround(RESPROUT / DT);

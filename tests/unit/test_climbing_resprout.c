@@ -25,32 +25,17 @@
 #include "model/climbing_growth.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
+#include "climbing_breaking_measures.h"
 #include "climbing_bushy_plant.h"
 
 #define THRESHOLD 0.07
 #define DT 0.025 /* s: one substep per growth step */
 #define DELAY 2.0 /* s */
-
-/* Length (m) of the axis from particle k: k and its successors (the
- * children that are not laterals); *m gets their count. */
-static double axis_length(const phc_climbing *c, size_t k, size_t *m)
-{
-    double L = phc_climbing_length(c, k);
-    *m = 1;
-    for (size_t i = k + 1; i < phc_climbing_count(c); ++i)
-        if (phc_climbing_parent(c, i) == k && !phc_climbing_is_lateral(c, i)) {
-            L += phc_climbing_length(c, i);
-            k = i;
-            ++*m;
-        }
-    return L;
-}
 
 /* README, growth step 3: a shoot t s old in full light holds
  * 1 + ⌊r t/(1 − σ₀)⌋ particles and is L(σ₀ + r t + σ₀⌊r t/(1 − σ₀)⌋) long.
@@ -84,7 +69,7 @@ static phc_climbing *shoot(double delay, phc_error *err, double *l_main, size_t 
         if (phc_climbing_step(c, 0.25, err))
             goto fail;
         if (s == 238 && l_main) /* 59.75 s (60 s is a new internode's time) */
-            *l_main = axis_length(c, 0, m_main);
+            *l_main = climbing_axis_length(c, 0, m_main);
     }
     if (phc_climbing_set_dynamics_substeps(c, 1, err) == 0)
         return c;
@@ -207,7 +192,7 @@ int main(void)
             if (st.breaks != breaks) /* (the young shoot broke: stop measuring) */
                 break;
             steps = s;
-            grown = axis_length(c, index_of(c, kid), &m);
+            grown = climbing_axis_length(c, index_of(c, kid), &m);
             if (!shoot_rule(r, (double)s * DT, L, sigma0, &mw, &want))
                 continue;
             ++compared;
@@ -289,35 +274,14 @@ int main(void)
         o.particles.break_threshold = 0.0195;
         o.fall_time = 0.5;
         o.resprout_delay = 0.5;
-        const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
-        const int keep = omp_get_max_threads();
         double *xs[2] = {NULL, NULL};
         size_t ns[2] = {0, 0};
         phc_climbing_stats st[2];
         memset(st, 0, sizeof st);
         for (int run = 0; run < 2; ++run) {
-            omp_set_num_threads(run + 1);
-            phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
-            CHECK(c != NULL);
-            if (!c)
-                break;
-            while (phc_climbing_count(c) < 2000)
-                if (phc_climbing_step(c, 0.25, &err))
-                    break;
-            CHECK(phc_climbing_set_dynamics_substeps(c, 2, &err) == 0);
-            for (int k = 0; k < 20; ++k)
-                CHECK(phc_climbing_step(c, 0.25, &err) == 0);
-            phc_climbing_get_stats(c, &st[run]);
-            ns[run] = phc_climbing_count(c);
-            xs[run] = malloc(7 * ns[run] * sizeof(double));
-            for (size_t i = 0; xs[run] && i < ns[run]; ++i) {
-                phc_climbing_position(c, i, xs[run] + 7 * i);
-                phc_climbing_direction(c, i, xs[run] + 7 * i + 3);
-                xs[run][7 * i + 6] = (double)phc_climbing_id(c, i);
-            }
-            phc_climbing_free(c);
+            xs[run] = climbing_threads_run(&o, 20, run + 1, &ns[run], &st[run]);
+            CHECK(xs[run] != NULL);
         }
-        omp_set_num_threads(keep);
         size_t differ = 0;
         if (xs[0] && xs[1] && ns[0] == ns[1])
             for (size_t k = 0; k < 7 * ns[0]; ++k)
