@@ -56,6 +56,7 @@ void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_gr
     s->falling = st.falling;
     s->pieces_dropped = st.pieces_dropped;
     s->particles_dropped = st.particles_dropped;
+    s->resprouts = st.resprouts;
     s->particles = st.particles - st.falling;
     s->attached_fraction = s->particles ? (double)st.anchored / (double)s->particles : 0;
     double top = seed_base[2];
@@ -324,6 +325,8 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
         json_object_set_new(plant, "falling_particles", json_integer((json_int_t)s->falling));
         json_object_set_new(plant, "pieces_dropped", json_integer((json_int_t)s->pieces_dropped));
         json_object_set_new(plant, "particles_dropped", json_integer((json_int_t)s->particles_dropped));
+        if (isfinite(cfg->options.resprout_delay))
+            json_object_set_new(plant, "resprouts", json_integer((json_int_t)s->resprouts));
     }
     if (pv)
         json_object_set_new(root, "provenance", phc_provenance_to_json(pv));

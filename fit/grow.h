@@ -52,6 +52,7 @@ typedef struct phc_grow_summary {
     size_t breaks;             /* links broken since the seed (one piece each) */
     size_t falling;            /* particles of broken pieces still falling */
     size_t pieces_dropped, particles_dropped; /* pieces that left the plant, their particles */
+    size_t resprouts;          /* stumps that grew a new tip (dynamics.resprout_delay) */
 } phc_grow_summary;
 
 /* Sets up o's light grid (origin and dims) when the plant needs one: light

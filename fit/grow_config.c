@@ -135,6 +135,9 @@ static const key_spec KEYS[] = {
      "(0: no breaking; model/climbing_breaking.h)"},
     {"dynamics", "fall_time", K_NUM, OPT(fall_time), 0, INF, 0, 1, "s",
      "a broken piece falls this long as free particles, then leaves the plant"},
+    {"dynamics", "resprout_delay", K_NUM, OPT(resprout_delay), 0, INF, 0, 1, "s",
+     "a stump left without a shoot by a break grows a new tip at its top this long after the break (inf, the "
+     "default: never; model/climbing_breaking.h)"},
 };
 #define N_KEYS (sizeof KEYS / sizeof KEYS[0])
 

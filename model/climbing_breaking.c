@@ -2,6 +2,7 @@
 #include "model/climbing_breaking.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "model/plant_graph.h"
@@ -98,4 +99,69 @@ phc_particles *phc_climbing_system_rebuild(const phc_particles *old,
 fail:
     phc_particles_free(p);
     return NULL;
+}
+
+int phc_climbing_stumps_add(phc_climbing_stumps *s, size_t id, double t)
+{
+    if (s->n == s->cap) {
+        const size_t cap = s->cap ? 2 * s->cap : 8;
+        size_t *ids = realloc(s->id, cap * sizeof *ids);
+        if (!ids)
+            return -1;
+        s->id = ids;
+        double *at = realloc(s->broke_at, cap * sizeof *at);
+        if (!at)
+            return -1;
+        s->broke_at = at;
+        s->cap = cap;
+    }
+    s->id[s->n] = id;
+    s->broke_at[s->n] = t;
+    s->n++;
+    return 0;
+}
+
+size_t phc_climbing_stumps_take_due(phc_climbing_stumps *s, double now, double delay, size_t *due)
+{
+    size_t m = 0, kept = 0;
+    for (size_t i = 0; i < s->n; ++i) {
+        if (now - s->broke_at[i] >= delay * (1 - 1e-12)) {
+            due[m++] = s->id[i];
+        } else {
+            s->id[kept] = s->id[i];
+            s->broke_at[kept] = s->broke_at[i];
+            ++kept;
+        }
+    }
+    s->n = kept;
+    return m;
+}
+
+void phc_climbing_stumps_free(phc_climbing_stumps *s)
+{
+    free(s->id);
+    free(s->broke_at);
+    memset(s, 0, sizeof *s);
+}
+
+size_t phc_climbing_find_id(const size_t *ids, size_t n, size_t id)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        const size_t mid = lo + (hi - lo) / 2;
+        if (ids[mid] < id)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < n && ids[lo] == id ? lo : NONE;
+}
+
+int phc_climbing_has_attached_successor(const size_t *parent, const unsigned char *lateral,
+                                        const unsigned char *falling, size_t n, size_t p)
+{
+    for (size_t i = p + 1; i < n; ++i)
+        if (parent[i] == p && !lateral[i] && !falling[i])
+            return 1;
+    return 0;
 }

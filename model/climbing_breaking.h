@@ -29,8 +29,34 @@
  * or a failed dynamics step drops every falling piece at once (the
  * kinematic plant has no free particles).  A link that breaks inside a
  * piece that already falls only splits the piece (the parts drop with it).
- * The stump, the particle above the broken link, does not grow again: the
- * plant grows on from its other tips.
+ * The stump, the particle above the broken link, does not grow again
+ * unless resprout_delay is finite (below); the plant grows on from its
+ * other tips.
+ *
+ * Resprouting (reiteration).  The apex of a shoot keeps the buds below it
+ * dormant; removing it releases them and the highest grows out as the new
+ * leader (Cline 1991, "Apical dominance", Bot. Rev. 57:318–358;
+ * reiteration: Hallé, Oldeman & Tomlinson 1978, "Tropical trees and
+ * forests").  Ours: the model's buds are at the internode tips (a node's
+ * lateral buds are drawn when its internode reaches σ = 1, the ones that
+ * do not become shoots stay dormant), so the highest bud below a break is
+ * the stump's own tip.  When the link k–p breaks and k continued p's axis
+ * (k is p's successor, not a lateral: the axis lost its apex; a lateral
+ * that breaks off leaves the axis's apex and so the dominance in place),
+ * p is remembered with the time of the break.  At the end of the first
+ * growth step whose time is resprout_delay s or more after it (the same
+ * rule as fall_time's), if p is still in the plant, not falling, and has
+ * no attached successor, a new tip of size σ₀ starts at p's tip and
+ * continues p's axis: p's order (it takes over as the leader and grows at
+ * the stump's rate r·a^order), p's radius, not a lateral (a shoot tracer
+ * follows it as the same shoot), its direction drawn as a lateral's is
+ * (the cone of half-angle u·variance·π/2 about p's direction, azimuth
+ * 2πu: two uniform draws from the plant's generator whether or not
+ * anything sprouts, stumps in the order they broke, after the step's
+ * growth).  It then grows and branches as any tip; p's laterals, if any,
+ * grow on as before.  resprout_delay = ∞ (the default) remembers no stump
+ * and draws nothing: a plant grown without the option is the same bit for
+ * bit as before it.
  *
  * This file holds the index work of it on plain arrays; the plant's own
  * arrays are handled in model/climbing_growth.c. */
@@ -45,6 +71,33 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* The stumps waiting to resprout: stable id (phc_climbing_id) of the
+ * stump particle and the time of its break (s), in the order they broke. */
+typedef struct phc_climbing_stumps {
+    size_t n, cap;
+    size_t *id;
+    double *broke_at;
+} phc_climbing_stumps;
+
+/* Remembers stump `id`, broken at time t (s).  0 or -1 (out of memory). */
+int phc_climbing_stumps_add(phc_climbing_stumps *s, size_t id, double t);
+
+/* Moves the stumps due at time `now` (now − broke_at ≥ delay, with the
+ * fall_time tolerance) into due[0 .. return value), in the order they
+ * broke, and keeps the others; due has room for s->n. */
+size_t phc_climbing_stumps_take_due(phc_climbing_stumps *s, double now, double delay, size_t *due);
+
+void phc_climbing_stumps_free(phc_climbing_stumps *s);
+
+/* Index of the particle with stable id `id` in ids[0 .. n) (increasing:
+ * the plant's index order is its birth order), or (size_t)-1. */
+size_t phc_climbing_find_id(const size_t *ids, size_t n, size_t id);
+
+/* 1 when particle p has a successor (a child that is not a lateral) that
+ * is attached (not falling) among parent[p+1 .. n). */
+int phc_climbing_has_attached_successor(const size_t *parent, const unsigned char *lateral,
+                                        const unsigned char *falling, size_t n, size_t p);
 
 /* Sets tag[i] = value for k and every descendant of k (parent[i] < i for
  * every particle with a parent, (size_t)-1 for none: the plant's index

@@ -76,6 +76,8 @@ struct phc_climbing {
     double *fell_at;         /* n: when its piece broke, s; -1 while attached */
     size_t *id;              /* n: stable id (birth number) */
     size_t born;             /* particles made since the seed */
+    phc_climbing_stumps stumps; /* waiting to resprout (resprout_delay) */
+    int stumps_lost;         /* a stump could not be remembered (out of memory) */
 };
 
 static double dot(const double a[3], const double b[3])
@@ -128,6 +130,7 @@ phc_climbing_options phc_climbing_options_default(void)
     o.cambium_rate = 0;
     o.leaf_pipe_area = 0;
     o.fall_time = 1;
+    o.resprout_delay = INFINITY; /* never */
     return o;
 }
 
@@ -135,6 +138,7 @@ void phc_climbing_free(phc_climbing *c)
 {
     if (!c)
         return;
+    phc_climbing_stumps_free(&c->stumps);
     free(c->parent);
     free(c->order);
     free(c->apical);
@@ -302,6 +306,7 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
     NEED(o->leaf_pipe_area >= 0 && isfinite(o->leaf_pipe_area), "leaf_pipe_area",
          o->leaf_pipe_area, "[0, inf) m^2");
     NEED(o->fall_time >= 0 && isfinite(o->fall_time), "fall_time", o->fall_time, "[0, inf) s");
+    NEED(o->resprout_delay >= 0, "resprout_delay", o->resprout_delay, "[0, inf] s (inf: never)");
 #undef NEED
     return 0;
 }
@@ -969,6 +974,7 @@ static void read_back(phc_climbing *c, size_t i)
 
 static void break_link(phc_climbing *c, size_t k, double stress);
 static int drop_fallen(phc_climbing *c, int all, phc_error *err);
+static int resprout(phc_climbing *c, phc_error *err);
 
 /* Step 6: the hand-over and the substeps (the shape is read back in step
  * 7's loop, anchors()). */
@@ -1395,6 +1401,11 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
         count(c);
         return -1;
     }
+    /* stumps whose resprout_delay is over grow a new tip */
+    if ((c->stumps.n || c->stumps_lost) && resprout(c, err)) {
+        count(c);
+        return -1;
+    }
     /* 8. leaves */
     if (o->leaf_step > 0)
         leaves_update(c);
@@ -1511,6 +1522,54 @@ static void break_link(phc_climbing *c, size_t k, double stress)
     c->stats.falling += m;
     c->stats.last_break_id = c->id[k];
     c->stats.last_break_stress = stress;
+    const size_t p = c->parent[k]; /* the stump: remembered when k continued its axis */
+    if (isfinite(c->o.resprout_delay) && p != PHC_CLIMBING_NONE && !c->lateral[k] &&
+        phc_climbing_stumps_add(&c->stumps, c->id[p], c->stats.time))
+        c->stumps_lost = 1;
+}
+
+/* The stumps due (resprout_delay after their break) that are still in the
+ * plant, not falling and without an attached successor grow a new tip at
+ * their top: model/climbing_breaking.h, "Resprouting". */
+static int resprout(phc_climbing *c, phc_error *err)
+{
+    const phc_climbing_options *o = &c->o;
+    if (c->stumps_lost)
+        return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for a stump");
+    size_t *due = malloc(c->stumps.n * sizeof *due);
+    if (!due)
+        return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for a stump");
+    const size_t m = phc_climbing_stumps_take_due(&c->stumps, c->stats.time, o->resprout_delay, due);
+    for (size_t t = 0; t < m; ++t) {
+        /* the draws of a lateral bud, made whether or not it sprouts */
+        const double theta = phc_climbing_rng_uniform(&c->rng) * o->direction_variance * 0.5 * PI;
+        const double phi = 2 * PI * phc_climbing_rng_uniform(&c->rng);
+        const size_t p = phc_climbing_find_id(c->id, c->n, due[t]);
+        if (p == PHC_CLIMBING_NONE || c->falling[p] || c->apical[p] || c->n >= o->max_particles ||
+            phc_climbing_has_attached_successor(c->parent, c->lateral, c->falling, c->n, p))
+            continue;
+        double tip[3], tipr[3], dir[3], dirr[3];
+        seg_tip(c, p, 0, tip);
+        seg_tip(c, p, 1, tipr);
+        cone_direction(c->d + 3 * p, theta, phi, dir);
+        cone_direction(c->dr + 3 * p, theta, phi, dirr);
+        /* the axis goes on (not a lateral): p's order and radius */
+        const size_t k = add_particle(c, p, c->order[p], 0, o->bud_fraction, c->radius[p], tip,
+                                      dir, tipr);
+        if (k == PHC_CLIMBING_NONE) {
+            free(due);
+            return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory at %zu particles",
+                                 c->n);
+        }
+        memcpy(c->dr + 3 * k, dirr, sizeof dirr);
+        rest_at(c, k);
+        c->node_k[k] = c->node_k[p] + 1;
+        keep_outside(c, k);
+        c->stats.resprouts++;
+        c->stats.last_resprout_id = c->id[k];
+    }
+    free(due);
+    return 0;
 }
 
 /* Drops the falling pieces whose fall_time is over (all of them with

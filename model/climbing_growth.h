@@ -231,6 +231,10 @@ typedef struct phc_climbing_options {
        stress passes the threshold breaks and the subtree below it falls */
     double fall_time;           /* s, >= 0: a broken piece falls this long as free particles,
                                    then leaves the plant; default 1 */
+    double resprout_delay;      /* s, >= 0: a stump left without a shoot by a break grows a
+                                   new tip at its top this long after the break (Cline 1991;
+                                   model/climbing_breaking.h "Resprouting"); default INFINITY:
+                                   never */
 } phc_climbing_options;
 
 phc_climbing_options phc_climbing_options_default(void);
@@ -295,6 +299,8 @@ typedef struct phc_climbing_stats {
     size_t particles_dropped; /* their particles */
     size_t last_break_id;   /* stable id (phc_climbing_id) of the child of the last broken link */
     double last_break_stress; /* its group stress when it broke (1) */
+    size_t resprouts;       /* stumps that grew a new tip (resprout_delay) */
+    size_t last_resprout_id; /* stable id of the last such new tip */
 } phc_climbing_stats;
 
 void phc_climbing_get_stats(const phc_climbing *c, phc_climbing_stats *s);

@@ -19,7 +19,11 @@
  * the threshold and the previous step's largest is not; the piece fell at
  * least the free fall from rest; it left the plant fall_time after the
  * break; the plant grew on (more particles and tips at the end than after
- * the drop).  Writes climbing_breaking_growth.png (four side views: the
+ * the drop).  Then the same plant with resprout_delay 2 s
+ * (break_resprout.yaml): checks that the first break's stump sprouts
+ * exactly 2 s (8 steps) after the break and that its new axis, 4 s later,
+ * has the particles and length of the README's growth rule.  Writes
+ * climbing_breaking_growth.png (four side views: the
  * step before the break, the step of the break with the piece falling,
  * after the piece left, at 120 s; colour = group stress, the falling
  * piece marked) and climbing_breaking_growth.md.
@@ -83,12 +87,9 @@ static void release(snapshot *s)
     free(s->mark);
 }
 
-int main(int argc, char **argv)
+/* The options of break.yaml. */
+static phc_climbing_options plant_options(void)
 {
-    const char *out = NULL;
-    const int started = nb_begin(argc, argv, NULL, &out);
-    if (started != 0)
-        return started;
     phc_climbing_options o = phc_climbing_options_default();
     o.seed = 3;
     o.growth_rate = 0.2;
@@ -100,6 +101,81 @@ int main(int argc, char **argv)
     o.min_stiffness = 0.3;
     o.particles.break_threshold = THRESHOLD;
     o.fall_time = FALL_TIME;
+    return o;
+}
+
+/* The same plant with resprout_delay RESPROUT s (break_resprout.yaml): the
+ * step of the first resprout after the first break and the new axis
+ * AXIS_TIME s later against the growth rule (README, growth step 3: a shoot
+ * t s old in full light holds 1 + ⌊r t/(1 − σ₀)⌋ particles and is
+ * L(σ₀ + r t + σ₀⌊r t/(1 − σ₀)⌋) long).  Prints them; returns 1 when a
+ * check fails, 2 on an error. */
+#define RESPROUT 2.0   /* s */
+#define AXIS_TIME 4.0  /* s (before the plant's next break, 4.75 s after the sprout) */
+static int resprout_run(size_t first_break_step)
+{
+    phc_climbing_options o = plant_options();
+    o.resprout_delay = RESPROUT;
+    const double base[3] = {-0.25, 0, 0}, east[3] = {1, 0, 0};
+    phc_error err;
+    phc_climbing *c = phc_climbing_new(base, east, &o, &err);
+    if (!c) {
+        fprintf(stderr, "%s\n", err.message);
+        return 2;
+    }
+    size_t sprout_step = 0, breaks_then = 0, kid = 0, grown_steps = 0;
+    const size_t axis_steps = (size_t)llround(AXIS_TIME / DT);
+    phc_climbing_stats st;
+    for (size_t k = 1; k <= (size_t)llround(DURATION / DT); ++k) {
+        if (phc_climbing_step(c, DT, &err)) {
+            fprintf(stderr, "step %zu: %s\n", k, err.message);
+            phc_climbing_free(c);
+            return 2;
+        }
+        phc_climbing_get_stats(c, &st);
+        if (!sprout_step && st.resprouts > 0) {
+            sprout_step = k;
+            breaks_then = st.breaks;
+            kid = st.last_resprout_id;
+        } else if (sprout_step) {
+            if (st.breaks != breaks_then)
+                break; /* (another break: the axis is not measured, the check fails) */
+            if (++grown_steps == axis_steps)
+                break;
+        }
+    }
+    size_t k = PHC_CLIMBING_NONE, m = 0;
+    for (size_t i = 0; sprout_step && i < phc_climbing_count(c); ++i)
+        if (phc_climbing_id(c, i) == kid)
+            k = i;
+    const double t = (double)grown_steps * DT, r = o.growth_rate, s0 = o.bud_fraction,
+                 L = o.max_length;
+    const double length = k != PHC_CLIMBING_NONE ? climbing_axis_length(c, k, &m) : 0;
+    const double q = floor(r * t / (1 - s0));
+    const double want = L * (s0 + r * t + s0 * q);
+    const int ok_when = sprout_step == first_break_step + (size_t)llround(RESPROUT / DT);
+    const int ok_axis = k != PHC_CLIMBING_NONE && grown_steps == axis_steps &&
+                        m == 1 + (size_t)q && fabs(length - want) < 1e-12;
+    printf("resprout_delay %.1f s: the first break's stump sprouted at step %zu (%.2f s after the "
+           "break); %.2f s later its new axis: %zu particles, %.6f m; the growth rule %zu, %.6f m\n",
+           RESPROUT, sprout_step, (double)(sprout_step - first_break_step) * DT, t, m, length,
+           1 + (size_t)q, want);
+    printf("then (%.2f s): %zu particles, %zu growing tips; breaks %zu, resprouts %zu\n",
+           st.time, phc_climbing_count(c), st.apical, st.breaks, st.resprouts);
+    printf("check: the stump sprouted resprout_delay after the break: %s\n",
+           ok_when ? "pass" : "FAIL");
+    printf("check: the new axis grew by the growth rule: %s\n", ok_axis ? "pass" : "FAIL");
+    phc_climbing_free(c);
+    return !(ok_when && ok_axis);
+}
+
+int main(int argc, char **argv)
+{
+    const char *out = NULL;
+    const int started = nb_begin(argc, argv, NULL, &out);
+    if (started != 0)
+        return started;
+    const phc_climbing_options o = plant_options();
     const double base[3] = {-0.25, 0, 0}, east[3] = {1, 0, 0};
     phc_error err;
     phc_climbing *c = phc_climbing_new(base, east, &o, &err);
@@ -197,6 +273,9 @@ int main(int argc, char **argv)
     printf("check: the piece fell at least the free fall from rest: %s\n", ok_fall ? "pass" : "FAIL");
     printf("check: it left the plant fall_time after the break: %s\n", ok_drop ? "pass" : "FAIL");
     printf("check: the plant grew on: %s\n", ok_grow ? "pass" : "FAIL");
+    const int resprout = resprout_run(break_step);
+    if (resprout == 2)
+        return 1;
 
     phc_shape_panel pan[NPANEL];
     for (int k = 0; k < NPANEL; ++k) {
@@ -252,7 +331,7 @@ int main(int argc, char **argv)
     for (int k = 0; k < NPANEL; ++k)
         release(&snap[k]);
     phc_climbing_free(c);
-    const int fail = !(ok_break && ok_fall && ok_drop && ok_grow);
+    const int fail = !(ok_break && ok_fall && ok_drop && ok_grow) || resprout != 0;
     printf("%s: %s\n", fail ? "FAIL" : "ok", out);
     return fail;
 }

@@ -1,10 +1,13 @@
 /* Measures of a growing plant that breaks (model/climbing_breaking.h),
- * shared by tests/unit/test_climbing_breaking.c and
+ * shared by tests/unit/test_climbing_breaking.c,
+ * tests/unit/test_climbing_resprout.c and
  * notebooks_c/climbing_breaking_growth.c. */
 #ifndef PHC_TESTS_CLIMBING_BREAKING_MEASURES_H
 #define PHC_TESTS_CLIMBING_BREAKING_MEASURES_H
 
 #include <math.h>
+#include <omp.h>
+#include <stdlib.h>
 
 #include "model/climbing_growth.h"
 
@@ -40,6 +43,58 @@ static inline double climbing_falling_centre_z(const phc_climbing *c, size_t *co
             ++*count;
         }
     return w > 0 ? z / w : NAN;
+}
+
+/* Length (m) of the axis from particle k: k and its successors (the
+ * children that are not laterals); *m gets their count. */
+static inline double climbing_axis_length(const phc_climbing *c, size_t k, size_t *m)
+{
+    double L = phc_climbing_length(c, k);
+    *m = 1;
+    for (size_t i = k + 1; i < phc_climbing_count(c); ++i)
+        if (phc_climbing_parent(c, i) == k && !phc_climbing_is_lateral(c, i)) {
+            L += phc_climbing_length(c, i);
+            k = i;
+            ++*m;
+        }
+    return L;
+}
+
+/* The bushy plant of the thread tests on `threads` OpenMP threads: grown
+ * kinematically in steps of 0.25 s to 2000 particles from (0, 0, 0.01) m
+ * upward with options o, then `steps` steps with 2 dynamics substeps.
+ * Returns 7 numbers per particle (centre, direction, stable id; *n
+ * particles, malloc'd, NULL on failure), *st the plant's counters.  The
+ * thread count is restored. */
+static inline double *climbing_threads_run(const phc_climbing_options *o, int steps, int threads,
+                                           size_t *n, phc_climbing_stats *st)
+{
+    const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
+    const int keep = omp_get_max_threads();
+    phc_error err;
+    double *xs = NULL;
+    *n = 0;
+    omp_set_num_threads(threads);
+    phc_climbing *c = phc_climbing_new(seed, up, o, &err);
+    int bad = c == NULL;
+    while (!bad && phc_climbing_count(c) < 2000)
+        bad = phc_climbing_step(c, 0.25, &err) != 0;
+    bad = bad || phc_climbing_set_dynamics_substeps(c, 2, &err) != 0;
+    for (int k = 0; k < steps && !bad; ++k)
+        bad = phc_climbing_step(c, 0.25, &err) != 0;
+    if (!bad) {
+        phc_climbing_get_stats(c, st);
+        *n = phc_climbing_count(c);
+        xs = malloc(7 * *n * sizeof *xs);
+        for (size_t i = 0; xs && i < *n; ++i) {
+            phc_climbing_position(c, i, xs + 7 * i);
+            phc_climbing_direction(c, i, xs + 7 * i + 3);
+            xs[7 * i + 6] = (double)phc_climbing_id(c, i);
+        }
+    }
+    phc_climbing_free(c);
+    omp_set_num_threads(keep);
+    return xs;
 }
 
 #endif /* PHC_TESTS_CLIMBING_BREAKING_MEASURES_H */

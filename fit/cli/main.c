@@ -17,6 +17,7 @@
  * changed; 4 internal error. */
 #include <errno.h>
 #include <gsl/gsl_errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -983,6 +984,9 @@ static int cmd_grow(int full_argc, char **full_argv, int argc, char **argv)
             printf("broken links %zu (pieces dropped %zu with %zu particles; %zu particles still falling, not "
                    "counted above)\n",
                    s.breaks, s.pieces_dropped, s.particles_dropped, s.falling);
+        if (cfg->options.particles.break_threshold > 0 && isfinite(cfg->options.resprout_delay))
+            printf("resprouted stumps %zu (a new tip %g s after their axis broke)\n", s.resprouts,
+                   cfg->options.resprout_delay);
         if (cfg->options.cambium_rate > 0)
             printf("secondary growth: thickest radius %.4g mm (primary %.4g mm)\n", 1e3 * s.max_radius,
                    1e3 * cfg->options.radius);

@@ -1527,6 +1527,14 @@ gr_config gr_fall.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
   fall_time: -1
 '
 grow_case "grow: negative fall time" "$C/gr_fall.yaml" "gr_fall.yaml:7" "dynamics.fall_time" "[0, inf)"
+gr_config gr_resprout.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  resprout_delay: -2
+'
+grow_case "grow: negative resprout delay" "$C/gr_resprout.yaml" "gr_resprout.yaml:7" "dynamics.resprout_delay" "[0, inf)"
+gr_config gr_resprouttext.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  resprout_delay: soon
+'
+grow_case "grow: resprout delay not a number" "$C/gr_resprouttext.yaml" "gr_resprouttext.yaml:7" "dynamics.resprout_delay"
 gr_config gr_shadow.yaml gr_wall.obj '[0, 0.03, 0]' 'light:
   supports_cast_shadows: maybe
 '

@@ -29,7 +29,6 @@
 #include "fit/costs/shoot_tracer.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -285,35 +284,14 @@ int main(void)
         o.min_stiffness = 0.3;
         o.particles.break_threshold = 0.0195;
         o.fall_time = 0.5;
-        const double seed[3] = {0, 0, 0.01}, up[3] = {0, 0, 1};
-        const int keep = omp_get_max_threads();
         double *xs[2] = {NULL, NULL};
         size_t ns[2] = {0, 0};
         phc_climbing_stats st[2];
         memset(st, 0, sizeof st);
         for (int run = 0; run < 2; ++run) {
-            omp_set_num_threads(run + 1);
-            phc_climbing *c = phc_climbing_new(seed, up, &o, &err);
-            CHECK(c != NULL);
-            if (!c)
-                break;
-            while (phc_climbing_count(c) < 2000)
-                if (phc_climbing_step(c, 0.25, &err))
-                    break;
-            CHECK(phc_climbing_set_dynamics_substeps(c, 2, &err) == 0);
-            for (int k = 0; k < 12; ++k)
-                CHECK(phc_climbing_step(c, 0.25, &err) == 0);
-            phc_climbing_get_stats(c, &st[run]);
-            ns[run] = phc_climbing_count(c);
-            xs[run] = malloc(7 * ns[run] * sizeof(double));
-            for (size_t i = 0; xs[run] && i < ns[run]; ++i) {
-                phc_climbing_position(c, i, xs[run] + 7 * i);
-                phc_climbing_direction(c, i, xs[run] + 7 * i + 3);
-                xs[run][7 * i + 6] = (double)phc_climbing_id(c, i);
-            }
-            phc_climbing_free(c);
+            xs[run] = climbing_threads_run(&o, 12, run + 1, &ns[run], &st[run]);
+            CHECK(xs[run] != NULL);
         }
-        omp_set_num_threads(keep);
         size_t differ = 0;
         if (xs[0] && xs[1] && ns[0] == ns[1])
             for (size_t k = 0; k < 7 * ns[0]; ++k)
