@@ -769,23 +769,20 @@ static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
 static int hand_change(phc_climbing *c, size_t i, phc_error *err)
 {
     phc_particles *p = c->sys;
-    double head[3], tail[3], q[4];
+    double head[3], tail[3];
     double *was = c->sys_seen + SEEN * i;
     const int rest = !same_bits(was, c->xr + 3 * i, 3) || !same_bits(was + 3, c->dr + 3 * i, 3) ||
                      !same_bits(was + 6, c->radius + i, 1) || !same_bits(was + 7, c->sigma + i, 1);
     const int moved = !same_bits(was + 8, c->x + 3 * i, 3) || !same_bits(was + 11, c->d + 3 * i, 3);
-    if (rest) {
+    if (!rest && !moved)
+        return 0;
+    const int place = i > 0 && moved; /* (the seed stays clamped) */
+    if (rest)
         rest_segment(c, i, head, tail);
-        if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
-            return -1;
-    }
-    if (i > 0 && moved) {
-        phc_quat_from_z(c->d + 3 * i, q);
-        if (phc_particles_place(p, i, c->x + 3 * i, q, err))
-            return -1;
-    }
-    if (rest || moved)
-        seen_now(c, i, was);
+    if (phc_particles_set_rest_place(p, i, rest ? head : NULL, rest ? tail : NULL, c->radius[i],
+                                     place ? c->x + 3 * i : NULL, c->d + 3 * i, err))
+        return -1;
+    seen_now(c, i, was);
     return 0;
 }
 
@@ -801,11 +798,10 @@ static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
                phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
                phc_particles_anchor(p, 0, c->xr, 1, 1, err);
     }
-    if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
-        return -1;
     const double k = anchor_strength(c, i);
-    return k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
-                 : phc_particles_release(p, i, err);
+    return phc_particles_set_age_anchor(
+        p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i),
+        c->anchor_at + 3 * i, k > 0 ? fmin(1, k) : 0, err);
 }
 
 /* The particles whose rest or place the growth can have changed since the

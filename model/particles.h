@@ -243,6 +243,14 @@ int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], con
  * and _set_orientation zero them instead. */
 int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
                         phc_error *err);
+/* A growing tip's hand-over in one call (ours; the climbing step's): with
+ * head and tail, particle i's rest segment as phc_particles_set_rest; with
+ * x, then phc_particles_place at x turned to phc_quat_from_z(dz) (dz unit:
+ * the direction of its z axis).  The same checks, messages and numbers as
+ * those calls; head, tail or x NULL leaves that part out. */
+int phc_particles_set_rest_place(phc_particles *p, size_t i, const double head[3],
+                                 const double tail[3], double radius, const double x[3],
+                                 const double dz[3], phc_error *err);
 
 /* Gravity of a system from the next step (m s^-2, finite; e.g. a scene
  * turned while a persistent system lives on). */
@@ -362,6 +370,12 @@ int phc_particles_set_force(phc_particles *p, size_t i, const double f[3],
 int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
                          int hold_orientation, phc_error *err);
 int phc_particles_release(phc_particles *p, size_t i, phc_error *err);
+/* Particle i's age (s) and anchor in one call (ours; the climbing step's
+ * hand-over of every particle): phc_particles_set_age, then with k > 0
+ * phc_particles_anchor(p, i, a, k, 0), else phc_particles_release; the same
+ * checks and messages. */
+int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
+                                 double k, phc_error *err);
 /* The paper's attachment rule: every particle without an anchor whose
  * closest support point (points: 3·count, m) lies within `distance` (m, > 0)
  * is anchored there with strength k.  *attached (may be NULL) counts them. */
