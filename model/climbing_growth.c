@@ -786,6 +786,14 @@ static int hand_change(phc_climbing *c, size_t i, phc_error *err)
     return 0;
 }
 
+/* The age particle i is handed over with (s): its own, at least that of
+ * the least stiffness (min_stiffness of the maturity age), times its
+ * thickening's (r/r0)^4. */
+static inline double hand_age(const phc_climbing *c, size_t i)
+{
+    return fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i);
+}
+
 /* Particle i's age and anchor for the hand-over; the seed clamped at its
  * rest place and orientation.  Touches only particle i. */
 static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
@@ -799,9 +807,25 @@ static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
                phc_particles_anchor(p, 0, c->xr, 1, 1, err);
     }
     const double k = anchor_strength(c, i);
-    return phc_particles_set_age_anchor(
-        p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i),
-        c->anchor_at + 3 * i, k > 0 ? fmin(1, k) : 0, err);
+    return phc_particles_set_age_anchor(p, i, hand_age(c, i), c->anchor_at + 3 * i,
+                                        k > 0 ? fmin(1, k) : 0, err);
+}
+
+#define HAND_BLOCK 256 /* particles per call of phc_particles_set_ages_anchors */
+
+/* Ages and anchors of particles lo .. hi − 1 (hi − lo <= HAND_BLOCK, none
+ * the seed) in one call, as hand_age_anchor sets each; the failing index
+ * into *bad. */
+static int hand_ages_anchors(phc_climbing *c, size_t lo, size_t hi, size_t *bad, phc_error *err)
+{
+    double age[HAND_BLOCK], k[HAND_BLOCK];
+    for (size_t i = lo; i < hi; ++i) {
+        const double ki = anchor_strength(c, i);
+        age[i - lo] = hand_age(c, i);
+        k[i - lo] = ki > 0 ? fmin(1, ki) : 0;
+    }
+    return phc_particles_set_ages_anchors(c->sys, lo, hi - lo, age, c->anchor_at + 3 * lo, k, bad,
+                                          err);
 }
 
 /* The particles whose rest or place the growth can have changed since the
@@ -892,18 +916,27 @@ static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
 #pragma omp parallel
     {
         phc_error mine;
-#pragma omp for schedule(dynamic, 256)
+        /* (no barrier between the loops: a particle's change and its age
+           and anchor touch different fields of it, except the seed's,
+           whose orientation is set from its rest after the region) */
+#pragma omp for schedule(dynamic, 256) nowait
         for (size_t t = 0; t < nchanged; ++t) {
             const size_t i = changed_at(c, t);
             if (hand_change(c, i, &mine))
                 first_error(i, &mine, &first_bad, err);
         }
-        /* (the barrier: the seed's orientation after its rest) */
+        const size_t blocks = (n - 1 + HAND_BLOCK - 1) / HAND_BLOCK; /* (the seed's after) */
 #pragma omp for schedule(static)
-        for (size_t i = 0; i < n; ++i)
-            if (hand_age_anchor(c, i, &mine))
-                first_error(i, &mine, &first_bad, err);
+        for (size_t b = 0; b < blocks; ++b) {
+            const size_t lo = 1 + b * HAND_BLOCK, hi = lo + HAND_BLOCK < n ? lo + HAND_BLOCK : n;
+            size_t bad;
+            if (hand_ages_anchors(c, lo, hi, &bad, &mine))
+                first_error(bad, &mine, &first_bad, err);
+        }
     }
+    phc_error seed_err;
+    if (hand_age_anchor(c, 0, &seed_err))
+        first_error(0, &seed_err, &first_bad, err);
     return first_bad < n ? -1 : 0;
 }
 

@@ -1459,11 +1459,11 @@ int phc_particles_release(phc_particles *p, size_t i, phc_error *err)
     return PHC_OK;
 }
 
-int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
-                                 double k, phc_error *err)
+/* phc_particles_set_age_anchor of an existing particle i (its values
+ * checked here, i by the caller). */
+static inline int age_anchor_checked(phc_particles *p, size_t i, double age, const double a[3],
+                                     double k, phc_error *err)
 {
-    if (check_index(p, i, "age and anchor", err))
-        return err ? err->status : PHC_ERR_INVALID;
     if (check_age(p, i, age, err))
         return err ? err->status : PHC_ERR_INPUT;
     p->age[i] = age;
@@ -1480,6 +1480,40 @@ int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const d
     p->anchor_k[i] = k;
     memcpy(p->anchor_at + 3 * i, a, 3 * sizeof(double));
     p->hold_q[i] = 0;
+    return PHC_OK;
+}
+
+int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
+                                 double k, phc_error *err)
+{
+    if (check_index(p, i, "age and anchor", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    return age_anchor_checked(p, i, age, a, k, err);
+}
+
+int phc_particles_set_ages_anchors(phc_particles *p, size_t first, size_t count,
+                                   const double *age, const double *a, const double *k,
+                                   size_t *bad, phc_error *err)
+{
+    if (!p || first > p->n || count > p->n - first) {
+        if (bad)
+            *bad = first;
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: ages and anchors: particles %zu to %zu do not exist "
+                             "(%zu particles)",
+                             first, first + count, p ? p->n : 0);
+    }
+    if (count && (!age || !a || !k)) {
+        if (bad)
+            *bad = first;
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: ages and anchors: NULL array");
+    }
+    for (size_t j = 0; j < count; ++j)
+        if (age_anchor_checked(p, first + j, age[j], a + 3 * j, k[j], err)) {
+            if (bad)
+                *bad = first + j;
+            return err ? err->status : PHC_ERR_INPUT;
+        }
     return PHC_OK;
 }
 

@@ -376,6 +376,14 @@ int phc_particles_release(phc_particles *p, size_t i, phc_error *err);
  * checks and messages. */
 int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
                                  double k, phc_error *err);
+/* The same for particles first .. first + count − 1 in one call: particle
+ * first + j gets age[j], anchor point a[3j .. 3j + 2] and strength k[j].
+ * On bad input it stops at the first bad particle, whose index goes to
+ * *bad (may be NULL), and says what was wrong; the particles before it are
+ * set. */
+int phc_particles_set_ages_anchors(phc_particles *p, size_t first, size_t count,
+                                   const double *age, const double *a, const double *k,
+                                   size_t *bad, phc_error *err);
 /* The paper's attachment rule: every particle without an anchor whose
  * closest support point (points: 3·count, m) lies within `distance` (m, > 0)
  * is anchored there with strength k.  *attached (may be NULL) counts them. */
