@@ -978,13 +978,12 @@ void phc_climbing_collision_queries(const phc_climbing *c, size_t *queries, size
     phc_particles_collision_queries(c ? c->sys : NULL, queries, skipped);
 }
 
-/* Particle i's current centre and direction from c->sys, into the plant
- * and its record of what the system holds. */
-static void read_back(phc_climbing *c, size_t i)
+/* Particle i's current direction from its orientation q in c->sys (its
+ * centre is in c->x already), and both into the record of what the system
+ * holds. */
+static void read_back(phc_climbing *c, size_t i, const double q[4])
 {
-    double q[4], R[9];
-    phc_particles_position(c->sys, i, c->x + 3 * i);
-    phc_particles_orientation(c->sys, i, q);
+    double R[9];
     /* direction = R(q)·z: the third column of R */
     const double w = q[0], a = q[1], b = q[2], cc = q[3];
     R[2] = 2 * (a * cc + w * b);
@@ -1061,14 +1060,23 @@ static void anchor(phc_climbing *c, size_t i, size_t *made, size_t *released)
     }
 }
 
-/* Step 7 for particle i: with `read`, first its current shape from the
- * dynamics (read_back; the seed's is its rest), then its anchor. */
-static void read_and_anchor(phc_climbing *c, size_t i, int read, size_t *made, size_t *released)
+/* Step 7 for particles lo .. hi − 1 (hi − lo <= HAND_BLOCK): with `read`,
+ * first their current centres and orientations from the dynamics in one
+ * call and each one's direction (read_back; the seed's shape is its rest),
+ * then each one's anchor. */
+static void read_and_anchor(phc_climbing *c, size_t lo, size_t hi, int read, size_t *made,
+                            size_t *released)
 {
-    if (read && i > 0)
-        read_back(c, i);
-    if (c->o.closest && !(c->stats.falling && c->falling[i])) /* (no anchors on a falling piece) */
-        anchor(c, i, made, released);
+    double q[4 * HAND_BLOCK];
+    const size_t from = lo > 0 ? lo : 1;
+    if (read && hi > from)
+        phc_particles_poses(c->sys, from, hi - from, c->x + 3 * from, q + 4 * (from - lo));
+    for (size_t i = lo; i < hi; ++i) {
+        if (read && i > 0)
+            read_back(c, i, q + 4 * (i - lo));
+        if (c->o.closest && !(c->stats.falling && c->falling[i])) /* (none on a falling piece) */
+            anchor(c, i, made, released);
+    }
 }
 
 /* Step 7: anchors; each particle's anchor is its own.  With `read` (after
@@ -1079,13 +1087,16 @@ static void anchors(phc_climbing *c, int read)
     if (!c->o.closest && !read)
         return;
     size_t made = 0, released = 0;
-    if (team(c->n)) {
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released)
-        for (size_t i = 0; i < c->n; ++i)
-            read_and_anchor(c, i, read, &made, &released);
+    const size_t n = c->n, blocks = (n + HAND_BLOCK - 1) / HAND_BLOCK;
+    if (team(n)) {
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : made, released)
+        for (size_t b = 0; b < blocks; ++b)
+            read_and_anchor(c, b * HAND_BLOCK, b + 1 < blocks ? (b + 1) * HAND_BLOCK : n, read,
+                            &made, &released);
     } else {
-        for (size_t i = 0; i < c->n; ++i)
-            read_and_anchor(c, i, read, &made, &released);
+        for (size_t b = 0; b < blocks; ++b)
+            read_and_anchor(c, b * HAND_BLOCK, b + 1 < blocks ? (b + 1) * HAND_BLOCK : n, read,
+                            &made, &released);
     }
     c->stats.anchors_made += made;
     c->stats.anchors_released += released;

@@ -2844,6 +2844,13 @@ void phc_particles_orientation(const phc_particles *p, size_t i, double q[4])
     memcpy(q, p->q + 4 * i, 4 * sizeof(double));
 }
 
+void phc_particles_poses(const phc_particles *p, size_t first, size_t count, double *x,
+                         double *q)
+{
+    memcpy(x, p->x + 3 * first, 3 * count * sizeof(double));
+    memcpy(q, p->q + 4 * first, 4 * count * sizeof(double));
+}
+
 double phc_particles_mass(const phc_particles *p, size_t i) { return p->m[i]; }
 
 double phc_particles_stress(const phc_particles *p, size_t i) { return p->stress[i]; }

@@ -411,6 +411,10 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
 void phc_particles_position(const phc_particles *p, size_t i, double x[3]);        /* m */
 void phc_particles_velocity(const phc_particles *p, size_t i, double v[3]);        /* m s^-1 */
 void phc_particles_orientation(const phc_particles *p, size_t i, double q[4]);
+/* Centres (3 per particle, m) and orientations (4 per particle) of
+ * particles first .. first + count − 1 (all exist) in one call. */
+void phc_particles_poses(const phc_particles *p, size_t first, size_t count, double *x,
+                         double *q);
 double phc_particles_mass(const phc_particles *p, size_t i);                      /* kg */
 double phc_particles_stiffness(const phc_particles *p, size_t i);  /* s_i in effect */
 double phc_particles_stress(const phc_particles *p, size_t i); /* group i, last step */
