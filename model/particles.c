@@ -1499,9 +1499,9 @@ int phc_particles_set_ages_anchors(phc_particles *p, size_t first, size_t count,
         if (bad)
             *bad = first;
         return phc_error_set(err, PHC_ERR_INVALID,
-                             "particles: ages and anchors: particles %zu to %zu do not exist "
-                             "(%zu particles)",
-                             first, first + count, p ? p->n : 0);
+                             "particles: ages and anchors: %zu particles from particle %zu: "
+                             "not all exist (%zu particles)",
+                             count, first, p ? p->n : 0);
     }
     if (count && (!age || !a || !k)) {
         if (bad)
