@@ -1432,11 +1432,11 @@ int phc_particles_set_force(phc_particles *p, size_t i, const double f[3], phc_e
     return PHC_OK;
 }
 
-int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
-                         int hold_orientation, phc_error *err)
+/* phc_particles_anchor of an existing particle i (its values checked
+ * here, i by the caller). */
+static inline int anchor_checked(phc_particles *p, size_t i, const double a[3], double k,
+                                 int hold_orientation, phc_error *err)
 {
-    if (check_index(p, i, "anchor", err))
-        return err ? err->status : PHC_ERR_INVALID;
     if (check_vec(p, i, a, "anchor point", "m", err))
         return err ? err->status : PHC_ERR_INPUT;
     if (check_strength(p, i, k, err))
@@ -1448,6 +1448,14 @@ int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k
         memcpy(p->anchor_q + 4 * i, p->q + 4 * i, 4 * sizeof(double));
     p->hold_q[i] = hold_orientation != 0;
     return PHC_OK;
+}
+
+int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
+                         int hold_orientation, phc_error *err)
+{
+    if (check_index(p, i, "anchor", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    return anchor_checked(p, i, a, k, hold_orientation, err);
 }
 
 int phc_particles_release(phc_particles *p, size_t i, phc_error *err)
@@ -1472,15 +1480,7 @@ static inline int age_anchor_checked(phc_particles *p, size_t i, double age, con
         p->hold_q[i] = 0;
         return PHC_OK;
     }
-    if (check_vec(p, i, a, "anchor point", "m", err))
-        return err ? err->status : PHC_ERR_INPUT;
-    if (check_strength(p, i, k, err))
-        return err ? err->status : PHC_ERR_INPUT;
-    p->anchored[i] = 1;
-    p->anchor_k[i] = k;
-    memcpy(p->anchor_at + 3 * i, a, 3 * sizeof(double));
-    p->hold_q[i] = 0;
-    return PHC_OK;
+    return anchor_checked(p, i, a, k, 0, err);
 }
 
 int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
