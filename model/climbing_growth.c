@@ -655,13 +655,17 @@ static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
         rest_at(c, i);
 }
 
+/* fmin(1, x) for every x (NaN gives 1, −0 stays −0), without libm's call
+ * (which GCC makes when NaNs may occur). */
+static inline double at_most_1(double x) { return x < 1 ? x : 1; }
+
 /* Anchor strength of i now (eq. 5), 0 when not anchored (here, so that
  * the hand-over inlines it). */
 static inline double anchor_strength(const phc_climbing *c, size_t i)
 {
     if (!c->anchored[i])
         return 0;
-    const double ramp = fmin(1, (c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
+    const double ramp = at_most_1((c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
     return c->o.anchor_strength * c->sigma[i] * ramp;
 }
 
@@ -808,7 +812,7 @@ static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
     }
     const double k = anchor_strength(c, i);
     return phc_particles_set_age_anchor(p, i, hand_age(c, i), c->anchor_at + 3 * i,
-                                        k > 0 ? fmin(1, k) : 0, err);
+                                        k > 0 ? at_most_1(k) : 0, err);
 }
 
 #define HAND_BLOCK 256 /* particles per call of phc_particles_set_ages_anchors */
@@ -822,7 +826,7 @@ static int hand_ages_anchors(phc_climbing *c, size_t lo, size_t hi, size_t *bad,
     for (size_t i = lo; i < hi; ++i) {
         const double ki = anchor_strength(c, i);
         age[i - lo] = hand_age(c, i);
-        k[i - lo] = ki > 0 ? fmin(1, ki) : 0;
+        k[i - lo] = ki > 0 ? at_most_1(ki) : 0;
     }
     return phc_particles_set_ages_anchors(c->sys, lo, hi - lo, age, c->anchor_at + 3 * lo, k, bad,
                                           err);
