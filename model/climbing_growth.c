@@ -660,13 +660,17 @@ static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
         rest_at(c, i);
 }
 
+/* fmin(1, x) for every x (NaN gives 1, −0 stays −0), without libm's call
+ * (which GCC makes when NaNs may occur). */
+static inline double at_most_1(double x) { return x < 1 ? x : 1; }
+
 /* Anchor strength of i now (eq. 5), 0 when not anchored (here, so that
  * the hand-over inlines it). */
 static inline double anchor_strength(const phc_climbing *c, size_t i)
 {
     if (!c->anchored[i])
         return 0;
-    const double ramp = fmin(1, (c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
+    const double ramp = at_most_1((c->stats.time - c->anchor_t0[i]) / c->o.anchor_time);
     return c->o.anchor_strength * c->sigma[i] * ramp;
 }
 
@@ -774,24 +778,29 @@ static phc_particles *dynamics_new(phc_climbing *c, phc_error *err)
 static int hand_change(phc_climbing *c, size_t i, phc_error *err)
 {
     phc_particles *p = c->sys;
-    double head[3], tail[3], q[4];
+    double head[3], tail[3];
     double *was = c->sys_seen + SEEN * i;
     const int rest = !same_bits(was, c->xr + 3 * i, 3) || !same_bits(was + 3, c->dr + 3 * i, 3) ||
                      !same_bits(was + 6, c->radius + i, 1) || !same_bits(was + 7, c->sigma + i, 1);
     const int moved = !same_bits(was + 8, c->x + 3 * i, 3) || !same_bits(was + 11, c->d + 3 * i, 3);
-    if (rest) {
+    if (!rest && !moved)
+        return 0;
+    const int place = i > 0 && moved; /* (the seed stays clamped) */
+    if (rest)
         rest_segment(c, i, head, tail);
-        if (phc_particles_set_rest(p, i, head, tail, c->radius[i], err))
-            return -1;
-    }
-    if (i > 0 && moved) {
-        phc_quat_from_z(c->d + 3 * i, q);
-        if (phc_particles_place(p, i, c->x + 3 * i, q, err))
-            return -1;
-    }
-    if (rest || moved)
-        seen_now(c, i, was);
+    if (phc_particles_set_rest_place(p, i, rest ? head : NULL, rest ? tail : NULL, c->radius[i],
+                                     place ? c->x + 3 * i : NULL, c->d + 3 * i, err))
+        return -1;
+    seen_now(c, i, was);
     return 0;
+}
+
+/* The age particle i is handed over with (s): its own, at least that of
+ * the least stiffness (min_stiffness of the maturity age), times its
+ * thickening's (r/r0)^4. */
+static inline double hand_age(const phc_climbing *c, size_t i)
+{
+    return fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i);
 }
 
 /* Particle i's age and anchor for the hand-over; the seed clamped at its
@@ -806,11 +815,26 @@ static int hand_age_anchor(phc_climbing *c, size_t i, phc_error *err)
                phc_particles_set_orientation(p, 0, q, err) || phc_particles_release(p, 0, err) ||
                phc_particles_anchor(p, 0, c->xr, 1, 1, err);
     }
-    if (phc_particles_set_age(p, i, fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i), err))
-        return -1;
     const double k = anchor_strength(c, i);
-    return k > 0 ? phc_particles_anchor(p, i, c->anchor_at + 3 * i, fmin(1, k), 0, err)
-                 : phc_particles_release(p, i, err);
+    return phc_particles_set_age_anchor(p, i, hand_age(c, i), c->anchor_at + 3 * i,
+                                        k > 0 ? at_most_1(k) : 0, err);
+}
+
+#define HAND_BLOCK 256 /* particles per call of phc_particles_set_ages_anchors */
+
+/* Ages and anchors of particles lo .. hi − 1 (hi − lo <= HAND_BLOCK, none
+ * the seed) in one call, as hand_age_anchor sets each; the failing index
+ * into *bad. */
+static int hand_ages_anchors(phc_climbing *c, size_t lo, size_t hi, size_t *bad, phc_error *err)
+{
+    double age[HAND_BLOCK], k[HAND_BLOCK];
+    for (size_t i = lo; i < hi; ++i) {
+        const double ki = anchor_strength(c, i);
+        age[i - lo] = hand_age(c, i);
+        k[i - lo] = ki > 0 ? at_most_1(ki) : 0;
+    }
+    return phc_particles_set_ages_anchors(c->sys, lo, hi - lo, age, c->anchor_at + 3 * lo, k, bad,
+                                          err);
 }
 
 /* The particles whose rest or place the growth can have changed since the
@@ -901,18 +925,27 @@ static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
 #pragma omp parallel
     {
         phc_error mine;
-#pragma omp for schedule(dynamic, 256)
+        /* (no barrier between the loops: a particle's change and its age
+           and anchor touch different fields of it, except the seed's,
+           whose orientation is set from its rest after the region) */
+#pragma omp for schedule(dynamic, 256) nowait
         for (size_t t = 0; t < nchanged; ++t) {
             const size_t i = changed_at(c, t);
             if (hand_change(c, i, &mine))
                 first_error(i, &mine, &first_bad, err);
         }
-        /* (the barrier: the seed's orientation after its rest) */
+        const size_t blocks = (n - 1 + HAND_BLOCK - 1) / HAND_BLOCK; /* (the seed's after) */
 #pragma omp for schedule(static)
-        for (size_t i = 0; i < n; ++i)
-            if (hand_age_anchor(c, i, &mine))
-                first_error(i, &mine, &first_bad, err);
+        for (size_t b = 0; b < blocks; ++b) {
+            const size_t lo = 1 + b * HAND_BLOCK, hi = lo + HAND_BLOCK < n ? lo + HAND_BLOCK : n;
+            size_t bad;
+            if (hand_ages_anchors(c, lo, hi, &bad, &mine))
+                first_error(bad, &mine, &first_bad, err);
+        }
     }
+    phc_error seed_err;
+    if (hand_age_anchor(c, 0, &seed_err))
+        first_error(0, &seed_err, &first_bad, err);
     return first_bad < n ? -1 : 0;
 }
 
@@ -954,13 +987,12 @@ void phc_climbing_collision_queries(const phc_climbing *c, size_t *queries, size
     phc_particles_collision_queries(c ? c->sys : NULL, queries, skipped);
 }
 
-/* Particle i's current centre and direction from c->sys, into the plant
- * and its record of what the system holds. */
-static void read_back(phc_climbing *c, size_t i)
+/* Particle i's current direction from its orientation q in c->sys (its
+ * centre is in c->x already), and both into the record of what the system
+ * holds. */
+static void read_back(phc_climbing *c, size_t i, const double q[4])
 {
-    double q[4], R[9];
-    phc_particles_position(c->sys, i, c->x + 3 * i);
-    phc_particles_orientation(c->sys, i, q);
+    double R[9];
     /* direction = R(q)·z: the third column of R */
     const double w = q[0], a = q[1], b = q[2], cc = q[3];
     R[2] = 2 * (a * cc + w * b);
@@ -1038,14 +1070,23 @@ static void anchor(phc_climbing *c, size_t i, size_t *made, size_t *released)
     }
 }
 
-/* Step 7 for particle i: with `read`, first its current shape from the
- * dynamics (read_back; the seed's is its rest), then its anchor. */
-static void read_and_anchor(phc_climbing *c, size_t i, int read, size_t *made, size_t *released)
+/* Step 7 for particles lo .. hi − 1 (hi − lo <= HAND_BLOCK): with `read`,
+ * first their current centres and orientations from the dynamics in one
+ * call and each one's direction (read_back; the seed's shape is its rest),
+ * then each one's anchor. */
+static void read_and_anchor(phc_climbing *c, size_t lo, size_t hi, int read, size_t *made,
+                            size_t *released)
 {
-    if (read && i > 0)
-        read_back(c, i);
-    if (c->o.closest && !(c->stats.falling && c->falling[i])) /* (no anchors on a falling piece) */
-        anchor(c, i, made, released);
+    double q[4 * HAND_BLOCK];
+    const size_t from = lo > 0 ? lo : 1;
+    if (read && hi > from)
+        phc_particles_poses(c->sys, from, hi - from, c->x + 3 * from, q + 4 * (from - lo));
+    for (size_t i = lo; i < hi; ++i) {
+        if (read && i > 0)
+            read_back(c, i, q + 4 * (i - lo));
+        if (c->o.closest && !(c->stats.falling && c->falling[i])) /* (none on a falling piece) */
+            anchor(c, i, made, released);
+    }
 }
 
 /* Step 7: anchors; each particle's anchor is its own.  With `read` (after
@@ -1056,13 +1097,16 @@ static void anchors(phc_climbing *c, int read)
     if (!c->o.closest && !read)
         return;
     size_t made = 0, released = 0;
-    if (team(c->n)) {
-#pragma omp parallel for schedule(dynamic, 256) reduction(+ : made, released)
-        for (size_t i = 0; i < c->n; ++i)
-            read_and_anchor(c, i, read, &made, &released);
+    const size_t n = c->n, blocks = (n + HAND_BLOCK - 1) / HAND_BLOCK;
+    if (team(n)) {
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : made, released)
+        for (size_t b = 0; b < blocks; ++b)
+            read_and_anchor(c, b * HAND_BLOCK, b + 1 < blocks ? (b + 1) * HAND_BLOCK : n, read,
+                            &made, &released);
     } else {
-        for (size_t i = 0; i < c->n; ++i)
-            read_and_anchor(c, i, read, &made, &released);
+        for (size_t b = 0; b < blocks; ++b)
+            read_and_anchor(c, b * HAND_BLOCK, b + 1 < blocks ? (b + 1) * HAND_BLOCK : n, read,
+                            &made, &released);
     }
     c->stats.anchors_made += made;
     c->stats.anchors_released += released;

@@ -679,7 +679,7 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
         }
         for (int k = 0; k < 3; ++k)
             d[k] /= len;
-        phc_quat_from_z(d, p->q0 + 4 * i);
+        phc_quat_from_z_inline(d, p->q0 + 4 * i);
         memcpy(p->q + 4 * i, p->q0 + 4 * i, 4 * sizeof(double));
         p->gq[4 * i] = 1;
         p->m[i] = o.density * PI * r * r * L;
@@ -845,7 +845,7 @@ static void rest_from_segment(phc_particles *p, size_t i, const double head[3],
         p->x0[3 * i + k] = 0.5 * (head[k] + tail[k]);
         d[k] = (tail[k] - head[k]) / L;
     }
-    phc_quat_from_z(d, p->q0 + 4 * i);
+    phc_quat_from_z_inline(d, p->q0 + 4 * i);
     p->m[i] = p->o.density * PI * r * r * L;
     p->ax[3 * i] = p->ax[3 * i + 1] = r;
     p->ax[3 * i + 2] = 0.5 * L;
@@ -1249,13 +1249,11 @@ void phc_particles_measure_stress(phc_particles *p, int on)
         p->no_stress = !on;
 }
 
-int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
-                        phc_error *err)
+/* phc_particles_place of an existing particle i (the checks of its
+ * values here, of i the caller's). */
+static int place_checked(phc_particles *p, size_t i, const double x[3], const double q[4],
+                         phc_error *err)
 {
-    if (!p || i >= p->n)
-        return phc_error_set(err, PHC_ERR_INVALID,
-                             "particles: place: particle %zu does not exist (%zu particles)", i,
-                             p ? p->n : 0);
     const double r = q ? sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) : 0;
     if (!x || !q || !isfinite(x[0] + x[1] + x[2]) || !isfinite(r) || !(r > 0))
         return phc_error_set(err, PHC_ERR_INPUT,
@@ -1267,6 +1265,41 @@ int phc_particles_place(phc_particles *p, size_t i, const double x[3], const dou
     for (int k = 0; k < 4; ++k)
         p->q[4 * i + k] = p->qp[4 * i + k] = q[k] / r;
     return PHC_OK;
+}
+
+int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
+                        phc_error *err)
+{
+    if (!p || i >= p->n)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: place: particle %zu does not exist (%zu particles)", i,
+                             p ? p->n : 0);
+    return place_checked(p, i, x, q, err);
+}
+
+int phc_particles_set_rest_place(phc_particles *p, size_t i, const double head[3],
+                                 const double tail[3], double radius, const double x[3],
+                                 const double dz[3], phc_error *err)
+{
+    if (!p || i >= p->n)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: rest and place: particle %zu does not exist (%zu "
+                             "particles)",
+                             i, p ? p->n : 0);
+    if (head || tail) {
+        double L = 0;
+        if (check_segment(p, i, head, tail, radius, &L, err))
+            return err ? err->status : PHC_ERR_INPUT;
+        rest_from_segment(p, i, head, tail, radius, L);
+    }
+    if (!x)
+        return PHC_OK;
+    if (!dz)
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: particle %zu: rest and place: direction NULL", i);
+    double q[4];
+    phc_quat_from_z_inline(dz, q);
+    return place_checked(p, i, x, q, err);
 }
 
 /* ---- setters ------------------------------------------------------------ */
@@ -1308,15 +1341,32 @@ int phc_particles_set_stiffness(phc_particles *p, size_t i, double s, phc_error 
     return PHC_OK;
 }
 
-int phc_particles_set_age(phc_particles *p, size_t i, double age, phc_error *err)
+static int check_age(const phc_particles *p, size_t i, double age, phc_error *err)
 {
-    if (check_index(p, i, "age", err))
-        return err ? err->status : PHC_ERR_INVALID;
     if (!(age >= 0) || !isfinite(age))
         return phc_error_set(err, PHC_ERR_INPUT,
                              "particles: particle %zu (segment %ld): age must be >= 0 and "
                              "finite, found %g s",
                              i, p->source_id[i], age);
+    return PHC_OK;
+}
+
+static int check_strength(const phc_particles *p, size_t i, double k, phc_error *err)
+{
+    if (!(k > 0 && k <= 1))
+        return phc_error_set(err, PHC_ERR_INPUT,
+                             "particles: particle %zu (segment %ld): anchor strength must be in "
+                             "(0, 1], found %g",
+                             i, p->source_id[i], k);
+    return PHC_OK;
+}
+
+int phc_particles_set_age(phc_particles *p, size_t i, double age, phc_error *err)
+{
+    if (check_index(p, i, "age", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    if (check_age(p, i, age, err))
+        return err ? err->status : PHC_ERR_INPUT;
     p->age[i] = age;
     return PHC_OK;
 }
@@ -1382,18 +1432,15 @@ int phc_particles_set_force(phc_particles *p, size_t i, const double f[3], phc_e
     return PHC_OK;
 }
 
-int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
-                         int hold_orientation, phc_error *err)
+/* phc_particles_anchor of an existing particle i (its values checked
+ * here, i by the caller). */
+static inline int anchor_checked(phc_particles *p, size_t i, const double a[3], double k,
+                                 int hold_orientation, phc_error *err)
 {
-    if (check_index(p, i, "anchor", err))
-        return err ? err->status : PHC_ERR_INVALID;
     if (check_vec(p, i, a, "anchor point", "m", err))
         return err ? err->status : PHC_ERR_INPUT;
-    if (!(k > 0 && k <= 1))
-        return phc_error_set(err, PHC_ERR_INPUT,
-                             "particles: particle %zu (segment %ld): anchor strength must be in "
-                             "(0, 1], found %g",
-                             i, p->source_id[i], k);
+    if (check_strength(p, i, k, err))
+        return err ? err->status : PHC_ERR_INPUT;
     p->anchored[i] = 1;
     p->anchor_k[i] = k;
     memcpy(p->anchor_at + 3 * i, a, 3 * sizeof(double));
@@ -1403,12 +1450,70 @@ int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k
     return PHC_OK;
 }
 
+int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
+                         int hold_orientation, phc_error *err)
+{
+    if (check_index(p, i, "anchor", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    return anchor_checked(p, i, a, k, hold_orientation, err);
+}
+
 int phc_particles_release(phc_particles *p, size_t i, phc_error *err)
 {
     if (check_index(p, i, "release", err))
         return err ? err->status : PHC_ERR_INVALID;
     p->anchored[i] = 0;
     p->hold_q[i] = 0;
+    return PHC_OK;
+}
+
+/* phc_particles_set_age_anchor of an existing particle i (its values
+ * checked here, i by the caller). */
+static inline int age_anchor_checked(phc_particles *p, size_t i, double age, const double a[3],
+                                     double k, phc_error *err)
+{
+    if (check_age(p, i, age, err))
+        return err ? err->status : PHC_ERR_INPUT;
+    p->age[i] = age;
+    if (!(k > 0)) { /* released */
+        p->anchored[i] = 0;
+        p->hold_q[i] = 0;
+        return PHC_OK;
+    }
+    return anchor_checked(p, i, a, k, 0, err);
+}
+
+int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
+                                 double k, phc_error *err)
+{
+    if (check_index(p, i, "age and anchor", err))
+        return err ? err->status : PHC_ERR_INVALID;
+    return age_anchor_checked(p, i, age, a, k, err);
+}
+
+int phc_particles_set_ages_anchors(phc_particles *p, size_t first, size_t count,
+                                   const double *age, const double *a, const double *k,
+                                   size_t *bad, phc_error *err)
+{
+    if (!p || first > p->n || count > p->n - first) {
+        if (bad)
+            *bad = first;
+        return phc_error_set(err, PHC_ERR_INVALID,
+                             "particles: ages and anchors: %zu particles from particle %zu: "
+                             "not all exist (%zu particles)",
+                             count, first, p ? p->n : 0);
+    }
+    if (count && (!age || !a || !k)) {
+        if (bad)
+            *bad = first;
+        return phc_error_set(err, PHC_ERR_INVALID, "particles: ages and anchors: NULL array");
+    }
+    for (size_t j = 0; j < count; ++j)
+        if (age_anchor_checked(p, first + j, age[j], a + 3 * j, k[j], err)) {
+            if (bad)
+                *bad = first + j;
+            return err ? err->status : PHC_ERR_INPUT;
+        }
     return PHC_OK;
 }
 
@@ -2737,6 +2842,13 @@ void phc_particles_velocity(const phc_particles *p, size_t i, double v[3])
 void phc_particles_orientation(const phc_particles *p, size_t i, double q[4])
 {
     memcpy(q, p->q + 4 * i, 4 * sizeof(double));
+}
+
+void phc_particles_poses(const phc_particles *p, size_t first, size_t count, double *x,
+                         double *q)
+{
+    memcpy(x, p->x + 3 * first, 3 * count * sizeof(double));
+    memcpy(q, p->q + 4 * first, 4 * count * sizeof(double));
 }
 
 double phc_particles_mass(const phc_particles *p, size_t i) { return p->m[i]; }

@@ -243,6 +243,14 @@ int phc_particles_set_rest(phc_particles *p, size_t i, const double head[3], con
  * and _set_orientation zero them instead. */
 int phc_particles_place(phc_particles *p, size_t i, const double x[3], const double q[4],
                         phc_error *err);
+/* A growing tip's hand-over in one call (ours; the climbing step's): with
+ * head and tail, particle i's rest segment as phc_particles_set_rest; with
+ * x, then phc_particles_place at x turned to phc_quat_from_z(dz) (dz unit:
+ * the direction of its z axis).  The same checks, messages and numbers as
+ * those calls; head, tail or x NULL leaves that part out. */
+int phc_particles_set_rest_place(phc_particles *p, size_t i, const double head[3],
+                                 const double tail[3], double radius, const double x[3],
+                                 const double dz[3], phc_error *err);
 
 /* Gravity of a system from the next step (m s^-2, finite; e.g. a scene
  * turned while a persistent system lives on). */
@@ -362,6 +370,20 @@ int phc_particles_set_force(phc_particles *p, size_t i, const double f[3],
 int phc_particles_anchor(phc_particles *p, size_t i, const double a[3], double k,
                          int hold_orientation, phc_error *err);
 int phc_particles_release(phc_particles *p, size_t i, phc_error *err);
+/* Particle i's age (s) and anchor in one call (ours; the climbing step's
+ * hand-over of every particle): phc_particles_set_age, then with k > 0
+ * phc_particles_anchor(p, i, a, k, 0), else phc_particles_release; the same
+ * checks and messages. */
+int phc_particles_set_age_anchor(phc_particles *p, size_t i, double age, const double a[3],
+                                 double k, phc_error *err);
+/* The same for particles first .. first + count − 1 in one call: particle
+ * first + j gets age[j], anchor point a[3j .. 3j + 2] and strength k[j].
+ * On bad input it stops at the first bad particle, whose index goes to
+ * *bad (may be NULL), and says what was wrong; the particles before it are
+ * set. */
+int phc_particles_set_ages_anchors(phc_particles *p, size_t first, size_t count,
+                                   const double *age, const double *a, const double *k,
+                                   size_t *bad, phc_error *err);
 /* The paper's attachment rule: every particle without an anchor whose
  * closest support point (points: 3·count, m) lies within `distance` (m, > 0)
  * is anchored there with strength k.  *attached (may be NULL) counts them. */
@@ -389,6 +411,10 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
 void phc_particles_position(const phc_particles *p, size_t i, double x[3]);        /* m */
 void phc_particles_velocity(const phc_particles *p, size_t i, double v[3]);        /* m s^-1 */
 void phc_particles_orientation(const phc_particles *p, size_t i, double q[4]);
+/* Centres (3 per particle, m) and orientations (4 per particle) of
+ * particles first .. first + count − 1 (all exist) in one call. */
+void phc_particles_poses(const phc_particles *p, size_t first, size_t count, double *x,
+                         double *q);
 double phc_particles_mass(const phc_particles *p, size_t i);                      /* kg */
 double phc_particles_stiffness(const phc_particles *p, size_t i);  /* s_i in effect */
 double phc_particles_stress(const phc_particles *p, size_t i); /* group i, last step */

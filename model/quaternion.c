@@ -164,17 +164,4 @@ void phc_quat_from_matrix(const double R[9], double q[4])
             q[k] = -q[k];
 }
 
-void phc_quat_from_z(const double d[3], double q[4])
-{
-    if (d[2] < -1 + 1e-12) {
-        q[0] = 0;
-        q[1] = 1;
-        q[2] = q[3] = 0;
-        return;
-    }
-    q[0] = 1 + d[2];
-    q[1] = -d[1];
-    q[2] = d[0];
-    q[3] = 0;
-    phc_quat_normalize(q);
-}
+void phc_quat_from_z(const double d[3], double q[4]) { phc_quat_from_z_inline(d, q); }

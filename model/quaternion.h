@@ -9,6 +9,8 @@
 #ifndef PHC_QUATERNION_H
 #define PHC_QUATERNION_H
 
+#include <math.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -49,6 +51,26 @@ void phc_quat_from_two_vectors(const double a[3], const double b[3], double out[
  * d (the rest orientation of a particle or segment along d); z to -z turns
  * about x. */
 void phc_quat_from_z(const double d[3], double q[4]);
+/* phc_quat_from_z for inner loops in other files (the climbing hand-over):
+ * the same operations, so the same numbers to the bit, without a call. */
+static inline void phc_quat_from_z_inline(const double d[3], double q[4])
+{
+    if (d[2] < -1 + 1e-12) {
+        q[0] = 0;
+        q[1] = 1;
+        q[2] = q[3] = 0;
+        return;
+    }
+    q[0] = 1 + d[2];
+    q[1] = -d[1];
+    q[2] = d[0];
+    q[3] = 0;
+    /* phc_quat_normalize */
+    const double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (n > 0.0 && isfinite(n))
+        for (int k = 0; k < 4; ++k)
+            q[k] /= n;
+}
 
 #ifdef __cplusplus
 }

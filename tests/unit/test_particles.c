@@ -24,7 +24,8 @@
  *  9. The step's warm-started polar path: error and Newton steps against
  *     the start's distance from the exact rotation.
  * 10. Projections skipped where the joint pass overwrites them: the same
- *     state as with every projection. */
+ *     state as with every projection.
+ * 11. The climbing step's hand-over calls against the single setters. */
 #include "model/particles.h"
 #include "model/quaternion.h"
 #include "model/plant_graph.h"
@@ -1487,6 +1488,103 @@ static void test_joint_rest_change(void)
     phc_particles_free(p);
 }
 
+/* 11. The climbing step's hand-over calls (phc_particles_set_rest_place,
+ * _set_age_anchor, _set_ages_anchors, _poses) against the single setters
+ * and accessors: the same state bit for bit after 10 more steps, and bad
+ * input named by particle. */
+static void test_hand_over_calls(void)
+{
+    const double o3[3] = {0, 0, 0}, ex[3] = {1, 0, 0};
+    const size_t n = 6;
+    const double h = 0.03125, r = 0.002;
+    phc_error err;
+    phc_particles_options opt = phc_particles_options_default();
+    opt.stiffness = 0.5;
+    opt.follow_parent = 1;
+    phc_plant_graph *g = chain(n, o3, ex, h, r, 1);
+    phc_particles *a = phc_particles_new(g, &opt, &err), *b = phc_particles_new(g, &opt, &err);
+    CHECK(a && b);
+    if (!a || !b)
+        return;
+    for (int s = 0; s < 5; ++s) {
+        CHECK(phc_particles_step(a, 0.01, NULL, &err) == PHC_OK);
+        CHECK(phc_particles_step(b, 0.01, NULL, &err) == PHC_OK);
+    }
+    double age[6], k[6], at[18];
+    for (size_t i = 1; i < n; ++i) { /* the tips grow 10% longer and turn up a little */
+        const double dz[3] = {cos(0.1 * (double)i), 0.3 * urand(), sin(0.1 * (double)i)};
+        const double len = sqrt(dz[0] * dz[0] + dz[1] * dz[1] + dz[2] * dz[2]);
+        const double d[3] = {dz[0] / len, dz[1] / len, dz[2] / len};
+        const double hd[3] = {h * (double)i, 0, 0};
+        const double tl[3] = {hd[0] + 1.1 * h * d[0], 1.1 * h * d[1], 1.1 * h * d[2]};
+        double x[3], q[4];
+        phc_particles_position(a, i, x);
+        x[2] += 1e-3 * (double)i;
+        phc_quat_from_z(d, q);
+        CHECK(phc_particles_set_rest(a, i, hd, tl, 1.05 * r, &err) == PHC_OK);
+        if (i % 2) {
+            CHECK(phc_particles_place(a, i, x, q, &err) == PHC_OK);
+            CHECK(phc_particles_set_rest_place(b, i, hd, tl, 1.05 * r, x, d, &err) == PHC_OK);
+        } else {
+            CHECK(phc_particles_set_rest_place(b, i, hd, tl, 1.05 * r, NULL, d, &err) == PHC_OK);
+        }
+        age[i] = 2.5 * (double)i;
+        k[i] = i == 3 ? 0 : 0.2 * (double)i; /* 1.0 at the end; particle 3 released */
+        for (int m = 0; m < 3; ++m)
+            at[3 * i + m] = x[m] + 1e-3 * (m + 1);
+        CHECK(phc_particles_set_age(a, i, age[i], &err) == PHC_OK);
+        CHECK(k[i] > 0 ? phc_particles_anchor(a, i, at + 3 * i, k[i], 0, &err) == PHC_OK
+                       : phc_particles_release(a, i, &err) == PHC_OK);
+    }
+    size_t bad = 99;
+    CHECK(phc_particles_set_age_anchor(b, 1, age[1], at + 3, k[1], &err) == PHC_OK);
+    CHECK(phc_particles_set_ages_anchors(b, 2, n - 2, age + 2, at + 6, k + 2, &bad, &err) ==
+          PHC_OK);
+    for (int s = 0; s < 10; ++s) {
+        CHECK(phc_particles_step(a, 0.01, NULL, &err) == PHC_OK);
+        CHECK(phc_particles_step(b, 0.01, NULL, &err) == PHC_OK);
+    }
+    double xa[18], qa[24], xb[18], qb[24];
+    for (size_t i = 0; i < n; ++i) {
+        phc_particles_position(a, i, xa + 3 * i);
+        phc_particles_orientation(a, i, qa + 4 * i);
+    }
+    phc_particles_poses(b, 0, n, xb, qb);
+    const int same = !memcmp(xa, xb, sizeof xa) && !memcmp(qa, qb, sizeof qa);
+    printf("hand-over calls: 5 tips' rest, 3 places, ages and anchors (one released) in one "
+           "call each, 10 steps after: the same centres and orientations bit for bit as the "
+           "single setters: %s (max |x_a - x_b| = %.3g m)\n",
+           same ? "yes" : "NO", maxdiff(xa, xb, 18));
+    CHECK(same);
+    /* bad input: the failing particle named, the earlier ones set */
+    age[4] = NAN;
+    CHECK(phc_particles_set_ages_anchors(b, 2, n - 2, age + 2, at + 6, k + 2, &bad, &err) ==
+          PHC_ERR_INPUT);
+    printf("  NaN age of particle 4: bad = %zu: %s\n", bad, err.message);
+    CHECK(bad == 4 && strstr(err.message, "particle 4") != NULL);
+    age[4] = 10;
+    k[5] = 1.5;
+    CHECK(phc_particles_set_ages_anchors(b, 2, n - 2, age + 2, at + 6, k + 2, &bad, &err) ==
+          PHC_ERR_INPUT);
+    printf("  strength 1.5 of particle 5: bad = %zu: %s\n", bad, err.message);
+    CHECK(bad == 5 && strstr(err.message, "anchor strength") != NULL);
+    CHECK(phc_particles_set_ages_anchors(b, 2, n, age, at, k, &bad, &err) == PHC_ERR_INVALID);
+    printf("  6 particles from particle 2 of 6: %s\n", err.message);
+    CHECK(strstr(err.message, "not all exist") != NULL);
+    const double p1[3] = {0.1, 0, 0}, nan3[3] = {NAN, 0, 0}, up[3] = {0, 0, 1};
+    CHECK(phc_particles_set_rest_place(b, 2, p1, p1, r, NULL, NULL, &err) == PHC_ERR_INPUT);
+    printf("  rest head = tail: %s\n", err.message);
+    CHECK(strstr(err.message, "particle 2") != NULL);
+    CHECK(phc_particles_set_rest_place(b, 3, NULL, NULL, r, nan3, up, &err) == PHC_ERR_INPUT);
+    printf("  place at NaN: %s\n", err.message);
+    CHECK(strstr(err.message, "particle 3") != NULL);
+    CHECK(phc_particles_set_age_anchor(b, 6, 1, at, 0.5, &err) == PHC_ERR_INVALID);
+    printf("  particle 6 of 6: %s\n", err.message);
+    phc_particles_free(a);
+    phc_particles_free(b);
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_polar();
@@ -1504,5 +1602,6 @@ int main(void)
     test_polar_warm();
     test_projection_plan();
     test_joint_rest_change();
+    test_hand_over_calls();
     return check_finish("test_particles");
 }
