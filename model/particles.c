@@ -1233,7 +1233,8 @@ static void collide(phc_particles *p)
     for (size_t t = 0; t < nskip; ++t)
         if (p->skip[5 * t + 4] < p->depth)
             memmove(p->skip + 5 * m++, p->skip + 5 * t, 5 * sizeof *p->skip);
-    qsort(p->skip, m, 5 * sizeof *p->skip, by_bound);
+    if (m > 1) /* (qsort must not see a NULL array, even empty) */
+        qsort(p->skip, m, 5 * sizeof *p->skip, by_bound);
     for (size_t t = 0; t < m && p->skip[5 * t + 4] < p->depth; ++t) {
         double y[3], d;
         memcpy(y, p->skip + 5 * t, sizeof y);
