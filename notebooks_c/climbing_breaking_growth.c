@@ -1,8 +1,8 @@
 /* Climbing plants (Hädrich, Benes, Deussen, Pirk, CGF 36(2) 2017, §4.3):
  * a shoot that breaks while it grows (model/climbing_breaking.h).
  *
- * The plant of measurements/examples/climbing/break.yaml (the same options,
- * set here through the C API): a seed at (−0.25, 0, 0) m grows sideways
+ * The plant of measurements/examples/climbing/break.yaml, read by the grow
+ * config's own reader (fit/grow_config.h): a seed at (−0.25, 0, 0) m grows sideways
  * (+x) without support, growth rate 0.2 s⁻¹, BP 0.5, V 0.5, laterals of
  * order 1 only, dynamics with 10 substeps of 0.025 s per growth step of
  * 0.25 s, s_min 0.3, break threshold 0.048, fall_time 1 s.  Its young links
@@ -19,8 +19,8 @@
  * the threshold and the previous step's largest is not; the piece fell at
  * least the free fall from rest; it left the plant fall_time after the
  * break; the plant grew on (more particles and tips at the end than after
- * the drop).  Then the same plant with resprout_delay 2 s
- * (break_resprout.yaml): checks that the first break's stump sprouts
+ * the drop).  Then the same plant with resprout_delay 2 s (break.yaml's
+ * seed 3; the example break_resprout.yaml is seed 6): checks that the first break's stump sprouts
  * exactly 2 s (8 steps) after the break and that its new axis, 4 s later,
  * has the particles and length of the README's growth rule.  Writes
  * climbing_breaking_growth.png (four side views: the
@@ -34,17 +34,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fit/grow_config.h"
 #include "fit/shape_plots.h"
 #include "model/climbing_growth.h"
 #include "tests/climbing_breaking_measures.h"
 
 #include "notebook_plot.h"
 
-#define DT 0.25         /* s: growth step */
-#define SUBSTEPS 10
-#define THRESHOLD 0.048
-#define FALL_TIME 1.0   /* s */
-#define DURATION 120.0  /* s */
+/* break.yaml, loaded by main */
+static phc_grow_config *cfg;
+#define DT (cfg->time_step)                          /* s: growth step */
+#define SUBSTEPS ((int)cfg->options.dynamics_substeps)
+#define THRESHOLD (cfg->options.particles.break_threshold)
+#define FALL_TIME (cfg->options.fall_time)          /* s */
+#define DURATION (cfg->duration)                    /* s */
 #define NPANEL 4
 
 typedef struct snapshot {
@@ -88,23 +91,9 @@ static void release(snapshot *s)
 }
 
 /* The options of break.yaml. */
-static phc_climbing_options plant_options(void)
-{
-    phc_climbing_options o = phc_climbing_options_default();
-    o.seed = 3;
-    o.growth_rate = 0.2;
-    o.radius = 0.002;
-    o.branch_probability = 0.5;
-    o.direction_variance = 0.5;
-    o.max_order = 1;
-    o.dynamics_substeps = SUBSTEPS;
-    o.min_stiffness = 0.3;
-    o.particles.break_threshold = THRESHOLD;
-    o.fall_time = FALL_TIME;
-    return o;
-}
+static phc_climbing_options plant_options(void) { return cfg->options; }
 
-/* The same plant with resprout_delay RESPROUT s (break_resprout.yaml): the
+/* The same plant with resprout_delay RESPROUT s (break.yaml's seed): the
  * step of the first resprout after the first break and the new axis
  * AXIS_TIME s later against the growth rule (README, growth step 3: a shoot
  * t s old in full light holds 1 + ⌊r t/(1 − σ₀)⌋ particles and is
@@ -116,7 +105,7 @@ static int resprout_run(size_t first_break_step)
 {
     phc_climbing_options o = plant_options();
     o.resprout_delay = RESPROUT;
-    const double base[3] = {-0.25, 0, 0}, east[3] = {1, 0, 0};
+    const double *base = cfg->position, *east = cfg->direction;
     phc_error err;
     phc_climbing *c = phc_climbing_new(base, east, &o, &err);
     if (!c) {
@@ -175,9 +164,14 @@ int main(int argc, char **argv)
     const int started = nb_begin(argc, argv, NULL, &out);
     if (started != 0)
         return started;
-    const phc_climbing_options o = plant_options();
-    const double base[3] = {-0.25, 0, 0}, east[3] = {1, 0, 0};
     phc_error err;
+    if (phc_grow_config_load(PHC_SOURCE_DIR "/measurements/examples/climbing/break.yaml", &cfg,
+                             &err)) {
+        fprintf(stderr, "%s\n", err.message);
+        return 1;
+    }
+    const phc_climbing_options o = plant_options();
+    const double *base = cfg->position, *east = cfg->direction;
     phc_climbing *c = phc_climbing_new(base, east, &o, &err);
     if (!c) {
         fprintf(stderr, "%s\n", err.message);
@@ -254,9 +248,9 @@ int main(int argc, char **argv)
     const int ok_fall = fell >= free_fall * (1 - 1e-9);
     const int ok_drop = fabs((double)(drop_step - break_step) * DT - FALL_TIME) < 1e-9;
     const int ok_grow = phc_climbing_count(c) > n_after_drop && st.apical > 0;
-    printf("climbing, breaking during growth: seed 3 grown sideways, %d substeps of %.3f s per "
+    printf("climbing, breaking during growth: seed %llu grown sideways, %d substeps of %.3f s per "
            "step of %.2f s, s_min %.1f, threshold %.3f, fall_time %.1f s\n",
-           SUBSTEPS, h, DT, o.min_stiffness, THRESHOLD, FALL_TIME);
+           (unsigned long long)o.seed, SUBSTEPS, h, DT, o.min_stiffness, THRESHOLD, FALL_TIME);
     printf("first break: step %zu (t = %.2f s), stress %.6f; the step before: largest linked "
            "stress %.6f\n",
            break_step, t_break, at_break, before);
@@ -333,5 +327,6 @@ int main(int argc, char **argv)
     phc_climbing_free(c);
     const int fail = !(ok_break && ok_fall && ok_drop && ok_grow) || resprout != 0;
     printf("%s: %s\n", fail ? "FAIL" : "ok", out);
+    phc_grow_config_free(cfg);
     return fail;
 }
