@@ -148,6 +148,7 @@ phc_particles_options phc_particles_options_default(void)
     o.stiffness_step = 0.01;
     o.bending = PHC_PARTICLES_OWN_WEIGHT;
     o.beam_modulus = 1e7;
+    o.break_stress = 0.0;
     return o;
 }
 
@@ -485,6 +486,17 @@ static const char *opt_problem(const phc_particles_options *o, char *buf, size_t
         snprintf(buf, size, "beam modulus must be positive and finite, found %g Pa", o->beam_modulus);
     else if (!isfinite(o->break_threshold))
         snprintf(buf, size, "break threshold must be finite, found %g", o->break_threshold);
+    else if (!(o->break_stress >= 0) || !isfinite(o->break_stress))
+        snprintf(buf, size, "break stress must be >= 0 and finite, found %g Pa", o->break_stress);
+    else if (o->break_stress > 0 && !(o->follow_parent && o->bending == PHC_PARTICLES_BEAM))
+        snprintf(buf, size,
+                 "break stress %g Pa needs follow_parent with bending beam (the own-weight pass carries no "
+                 "bending moment)",
+                 o->break_stress);
+    else if (o->break_stress > 0 && o->break_threshold > 0)
+        snprintf(buf, size,
+                 "break stress %g Pa and break threshold %g are two rules for the same break: set one",
+                 o->break_stress, o->break_threshold);
     else if (!isfinite(o->gravity[0]) || !isfinite(o->gravity[1]) || !isfinite(o->gravity[2]))
         snprintf(buf, size, "gravity must be finite");
     else
@@ -2432,6 +2444,34 @@ static void beam_one(phc_particles *p, size_t i, double dt, double T2)
         apply_anchor(p, i);
 }
 
+/* The bending stress at the head joint of particle i in its current state
+ * (particles.h, "Breaking under a bending stress"): a BALL joint's moment
+ * M = κ |θ| (N m; θ = log(q_i q*⁻¹), q* = q_u q̄_u⁻¹ q̄_i its rest turn)
+ * at the surface of a circular section, σ = M r / I_a = 4 M / (π r³)
+ * (Pa); 0 for a WELD, a BASE or an unlinked particle. */
+static double bend_stress_of(const phc_particles *p, size_t i)
+{
+    if (beam_kind(p, i) != BEAM_BALL)
+        return 0.0;
+    const size_t u = p->parent[i];
+    const double *q0i = p->q0 + 4 * i, *q0u = p->q0 + 4 * u;
+    const double q0u_inv[4] = {q0u[0], -q0u[1], -q0u[2], -q0u[3]};
+    double rel[4], qs[4], th[3];
+    quat_mul(q0u_inv, q0i, rel);
+    quat_mul(p->q + 4 * u, rel, qs);
+    rotation_between(p->q + 4 * i, qs, th);
+    const double r = p->ax[3 * i];
+    const double M = beam_kappa(p, i, u, stiffness_of(p, i)) * sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2]);
+    return 4 * M / (PI * r * r * r);
+}
+
+double phc_particles_bend_stress(const phc_particles *p, size_t i)
+{
+    if (!p || i >= p->n || p->o.bending != PHC_PARTICLES_BEAM)
+        return 0.0;
+    return bend_stress_of(p, i);
+}
+
 /* The joint pass's order (see struct phc_particles): subtree sizes, the
  * top of the tree (subtrees of more than n/32 + 1 particles, a set closed
  * upwards, in topological order), then each subtree hanging from the top
@@ -2708,6 +2748,11 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         report->broken = 0;
         report->broken_particle = PHC_PARTICLES_NONE;
         report->broken_stress = 0;
+        report->max_bend_stress = 0;
+        report->max_bend_particle = PHC_PARTICLES_NONE;
+        report->broken_bend_stress = 0;
+        for (int d = 0; d < 3; ++d)
+            report->broken_joint[d] = NAN;
         report->polar_total = 0;
         report->polar_fallbacks = 0;
     }
@@ -2775,6 +2820,38 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
     swap_arrays(&p->w, &p->wn);
     swap_arrays(&p->age, &p->agen);
 
+    /* Breaking under a bending stress (the beam pass; particles.h): the
+     * link whose joint's σ passes break_stress by the most, at most one. */
+    if (p->o.break_stress > 0) {
+        double top = 0;
+        size_t kt = PHC_PARTICLES_NONE;
+        for (size_t k = 0; k < n; ++k) {
+            if (!p->linked[k])
+                continue;
+            const double sg = bend_stress_of(p, k);
+            if (sg > top) {
+                top = sg;
+                kt = k;
+            }
+        }
+        const int breaks = kt != PHC_PARTICLES_NONE && top > p->o.break_stress;
+        if (breaks)
+            p->linked[kt] = 0;
+        if (report) {
+            report->max_bend_stress = top;
+            report->max_bend_particle = kt;
+            if (breaks) {
+                double hr[3];
+                rotate_z(p->q + 4 * kt, p->ax[3 * kt + 2], hr);
+                report->broken = 1;
+                report->broken_particle = kt;
+                report->broken_bend_stress = top;
+                for (int d = 0; d < 3; ++d)
+                    report->broken_joint[d] = p->x[3 * kt + d] - hr[d];
+            }
+        }
+    }
+
     /* Stress of every group on the new state (§4.3), and breaking. */
     if (p->no_stress && !(p->o.break_threshold > 0)) {
         if (report) {
@@ -2820,9 +2897,13 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         report->max_stress = smax;
         report->max_stress_group = gmax;
         if (bk != PHC_PARTICLES_NONE) {
+            double hr[3];
+            rotate_z(p->q + 4 * bk, p->ax[3 * bk + 2], hr);
             report->broken = 1;
             report->broken_particle = bk;
             report->broken_stress = bmax;
+            for (int d = 0; d < 3; ++d)
+                report->broken_joint[d] = p->x[3 * bk + d] - hr[d];
         }
     }
     return PHC_OK;

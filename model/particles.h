@@ -155,6 +155,33 @@
  * becomes free.  At most one link breaks per step (the most stressed); the
  * others are judged again at the next step with the new topology.
  *
+ * Breaking under a bending stress (ours, on the beam pass; the break of
+ * climbing §4.3 with a stress in Pa).  With bending = BEAM the moment a
+ * BALL joint carries is its spring's, M_i = κ_i |θ_i| (N m), and the
+ * largest bending stress of the circular section there, at its surface,
+ * is Euler–Bernoulli's σ_i = M_i r_i / I_a = 4 M_i / (π r_i³) =
+ * E(s_i) r_i |θ_i| / ℓ̄_i (Pa; the flexure formula σ = M y / I of
+ * Euler–Bernoulli beams, e.g. Gere & Timoshenko, "Mechanics of
+ * Materials"; used for stems in Niklas 1992, "Plant Biomechanics"), r_i
+ * the radius of the link below the joint.  phc_particles_bend_stress
+ * reads σ_i of the current state (θ from the orientations after the step,
+ * anchors and collisions included; at rest κ θ = Q, the moment of the
+ * loads beyond the joint).  A link breaks when σ passes the modulus of
+ * rupture σ_R, the bending stress at which a stem fails (break_stress;
+ * e.g. medians of 35.0 to 49.8 MPa for the stems of young trees in
+ * "Mechanical properties of 'flexure wood'", Ann. For. Sci. 2020,
+ * doi:10.1007/s13595-020-0926-8, Table 2; young climbing shoots: not
+ * known to us, an example's value is an assumption): with break_stress
+ * > 0, after each step the linked particle whose σ_i is largest breaks
+ * its parent link when σ_i > break_stress (so the one that passes it by
+ * the most; at most one per step, as the group-stress rule).  A WELD (s =
+ * 1) is rigid, has no bend and reads 0: it does not break by this rule;
+ * nor does a link whose parent is not held (a BASE).  The two rules
+ * cannot be combined: break_stress > 0 with break_threshold > 0 is
+ * refused, and so is break_stress > 0 without follow_parent and bending =
+ * BEAM (the own-weight pass carries no moment).  break_stress = 0 (the
+ * default): nothing measured, the same numbers as before it, bit for bit.
+ *
  * Units: SI.  Positions m, time s, mass kg, density kg m⁻³, force N,
  * gravity m s⁻², angular velocity rad s⁻¹, stiffness and stress
  * dimensionless.  Quaternions (w, x, y, z), unit norm. */
@@ -195,6 +222,10 @@ typedef struct phc_particles_options {
     double beam_modulus;   /* E_1/2, Pa, > 0: with PHC_PARTICLES_BEAM, the
                               Young's modulus of a link with s = 1/2;
                               default 1e7 */
+    double break_stress;   /* σ_R, Pa, >= 0: with PHC_PARTICLES_BEAM, a link
+                              whose joint's bending stress passes it breaks
+                              (see "Breaking under a bending stress");
+                              0: off (default) */
 } phc_particles_options;
 
 enum { PHC_PARTICLES_OWN_WEIGHT = 0, PHC_PARTICLES_BEAM = 1 };
@@ -396,7 +427,11 @@ typedef struct phc_particles_report {
     size_t max_stress_group;/* its owner particle */
     size_t broken;          /* links broken this step: 0 or 1 */
     size_t broken_particle; /* the child whose parent link broke, else NONE */
-    double broken_stress;   /* its stress (1) */
+    double broken_stress;   /* its group stress (1; 0 with break_stress) */
+    double broken_bend_stress; /* with break_stress: its joint's σ (Pa) */
+    double broken_joint[3]; /* the broken joint: the child's head (m), else NaN */
+    double max_bend_stress; /* with break_stress: the largest joint σ (Pa) */
+    size_t max_bend_particle; /* its particle (the joint's child), else NONE */
     size_t polar_total;     /* polar decompositions done in the step */
     size_t polar_fallbacks; /* of which the SVD fallback finished */
 } phc_particles_report;
@@ -418,6 +453,11 @@ void phc_particles_poses(const phc_particles *p, size_t first, size_t count, dou
 double phc_particles_mass(const phc_particles *p, size_t i);                      /* kg */
 double phc_particles_stiffness(const phc_particles *p, size_t i);  /* s_i in effect */
 double phc_particles_stress(const phc_particles *p, size_t i); /* group i, last step */
+/* Bending stress σ (Pa) at the head joint of particle i in its current
+ * state (see "Breaking under a bending stress"): 4 κ_i |θ_i| / (π r_i³)
+ * for a BALL joint of the beam pass, 0 for a weld, an unlinked particle
+ * or without bending = BEAM. */
+double phc_particles_bend_stress(const phc_particles *p, size_t i);
 size_t phc_particles_parent(const phc_particles *p, size_t i); /* linked parent or NONE */
 /* Segment ends for drawing (fit/shape_plots.h): head/tail 3n each, m. */
 void phc_particles_segment_ends(const phc_particles *p, double *head, double *tail);
