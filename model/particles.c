@@ -149,6 +149,7 @@ phc_particles_options phc_particles_options_default(void)
     o.bending = PHC_PARTICLES_OWN_WEIGHT;
     o.beam_modulus = 1e7;
     o.break_stress = 0.0;
+    o.anchors_carry_moment = 0;
     return o;
 }
 
@@ -493,6 +494,9 @@ static const char *opt_problem(const phc_particles_options *o, char *buf, size_t
                  "break stress %g Pa needs follow_parent with bending beam (the own-weight pass carries no "
                  "bending moment)",
                  o->break_stress);
+    else if (o->anchors_carry_moment && !(o->follow_parent && o->bending == PHC_PARTICLES_BEAM))
+        snprintf(buf, size, "anchors carry moment needs follow_parent with bending beam (the own-weight pass "
+                            "carries no moment)");
     else if (o->break_stress > 0 && o->break_threshold > 0)
         snprintf(buf, size,
                  "break stress %g Pa and break threshold %g are two rules for the same break: set one",
@@ -1747,6 +1751,13 @@ size_t phc_particles_group_goals(const phc_particles *p, size_t k, size_t cap, s
 }
 
 /* s_i in effect: own, or min(1, t_l / t_m) with a maturity age. */
+/* 1 when anchored particle i is a base of the beam pass, held by its
+ * support (anchors_carry_moment; particles.h). */
+static inline int anchor_base(const phc_particles *p, size_t i)
+{
+    return p->o.anchors_carry_moment && p->anchored[i] && p->o.bending == PHC_PARTICLES_BEAM;
+}
+
 static inline double stiffness_of(const phc_particles *p, size_t i)
 {
     if (p->o.maturity_age > 0) {
@@ -1840,7 +1851,8 @@ static void plan_projections(phc_particles *p)
         p->plev[i] = p->glev[i] = -1;
         if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
             p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
-        else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)))
+        else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)) ||
+                 anchor_base(p, i))
             need_particle(p, i, N, &np);
         if (np > n / 4)
             return; /* many free particles: project everything */
@@ -2149,11 +2161,12 @@ enum { BEAM_BASE, BEAM_WELD, BEAM_BALL };
 
 /* How particle i hangs in the beam pass: BALL (linked, 0 < s < 1: a
  * spherical joint with a spring), WELD (linked, s = 1: held at its rest
- * angle, part of its parent's body), BASE (not linked, or s = 0: not
- * held; its motion is the projections', its children hang from it). */
+ * angle, part of its parent's body), BASE (not linked, or s = 0, or
+ * anchored with anchors_carry_moment: not held by its parent; its motion
+ * is the projections' and its anchor's, its children hang from it). */
 static inline int beam_kind(const phc_particles *p, size_t i)
 {
-    if (!p->linked[i])
+    if (!p->linked[i] || anchor_base(p, i))
         return BEAM_BASE;
     const double s = stiffness_of(p, i);
     return !(s > 0) ? BEAM_BASE : s >= 1 ? BEAM_WELD : BEAM_BALL;

@@ -182,6 +182,25 @@
  * BEAM (the own-weight pass carries no moment).  break_stress = 0 (the
  * default): nothing measured, the same numbers as before it, bit for bit.
  *
+ * Anchors that carry the moment (anchors_carry_moment; ours, beam pass
+ * only).  By default the beam pass places an anchored particle by its
+ * joint like any other and the anchor then pulls its centre only: the
+ * anchors' reactions are not in Q, so the moment of every link beyond an
+ * anchored stretch turns the stretch's orientations about the joints
+ * behind it (a shoot on a board with an overhang: each anchored joint
+ * bends, the most at the board's far end, and the overhang hangs down
+ * from orientations that no longer follow the anchored centres).  With
+ * anchors_carry_moment, an anchored particle is a BASE: it is not placed
+ * by a joint, its motion is the projections' and its anchor's (as a root's),
+ * its children hang from it, and nothing of its subtree folds into its
+ * parent: the support takes the load through the anchor, as a board
+ * carries a shoot lying on it.  The joint from an anchored particle to a
+ * free child is then a clamp (ℓ̄ = L/2), the overhang a cantilever
+ * clamped at the last anchor, and a joint between two anchored particles
+ * carries nothing (σ 0).  The projections are computed for the anchored
+ * particles (slower with many anchors).  Off by default: the same numbers
+ * as before it.
+ *
  * Units: SI.  Positions m, time s, mass kg, density kg m⁻³, force N,
  * gravity m s⁻², angular velocity rad s⁻¹, stiffness and stress
  * dimensionless.  Quaternions (w, x, y, z), unit norm. */
@@ -222,6 +241,10 @@ typedef struct phc_particles_options {
     double beam_modulus;   /* E_1/2, Pa, > 0: with PHC_PARTICLES_BEAM, the
                               Young's modulus of a link with s = 1/2;
                               default 1e7 */
+    int anchors_carry_moment; /* 1: with PHC_PARTICLES_BEAM, an anchored
+                              particle is a base of the beam pass, held by
+                              its support (see "Anchors that carry the
+                              moment"); default 0 */
     double break_stress;   /* σ_R, Pa, >= 0: with PHC_PARTICLES_BEAM, a link
                               whose joint's bending stress passes it breaks
                               (see "Breaking under a bending stress");

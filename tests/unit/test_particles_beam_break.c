@@ -185,8 +185,236 @@ static void test_cantilever(void)
     }
 }
 
+/* The shelf: a shoot of n links from a clamped seed along +x, links 1 ..
+ * na pinned by anchors at their rest centres (strength 1, orientation
+ * free) on a board, links na + 1 .. n over its edge; gravity ramped and
+ * held as in the cantilever.  carry: anchors_carry_moment; bend: break
+ * stress (Pa, 0 off); group: break threshold (0 off). */
+static phc_particles *shelf(size_t n, size_t na, double ell, double r, int carry, double bend, double group)
+{
+    phc_particles_options o = beam_options(2e7, 0.5, 0.02, bend);
+    o.anchors_carry_moment = carry;
+    o.break_threshold = group;
+    phc_particles *p = cantilever(n, ell, r, &o);
+    phc_error err;
+    for (size_t i = 1; p && i <= na; ++i) {
+        double x[3];
+        phc_particles_position(p, i, x);
+        if (phc_particles_anchor(p, i, x, 1.0, 0, &err)) {
+            fprintf(stderr, "%s\n", err.message);
+            phc_particles_free(p);
+            return NULL;
+        }
+    }
+    return p;
+}
+
+static void test_shelf(void)
+{
+    const size_t n = 16, na = 8, ramp = 3000, hold = 2000;
+    const double ell = 0.02, r = 0.002, g = 9.81, dt = 0.002;
+    /* the loads at rest, nothing breaking: default anchors and anchors
+       that carry the moment */
+    double sig[2][17], grp[2][17];
+    size_t top[2] = {0, 0}, gtop[2] = {0, 0};
+    for (int carry = 0; carry <= 1; ++carry) {
+        phc_particles *p = shelf(n, na, ell, r, carry, 0, 0);
+        CHECK(p != NULL);
+        if (!p)
+            return;
+        size_t broken;
+        double peak;
+        ramp_load(p, g, dt, ramp, hold, &broken, &peak);
+        double worst = 0;
+        for (size_t k = 1; k <= n; ++k) {
+            sig[carry][k] = phc_particles_bend_stress(p, k);
+            grp[carry][k] = phc_particles_stress(p, k);
+            if (sig[carry][k] > sig[carry][top[carry]] || top[carry] == 0)
+                top[carry] = k;
+            if (grp[carry][k] > grp[carry][gtop[carry]] || gtop[carry] == 0)
+                gtop[carry] = k;
+            if (carry && k > na) { /* the overhang: a cantilever clamped at the last anchor */
+                const double exact = 4 * static_moment(p, k, ell / 2, g) / (PI * r * r * r);
+                worst = fmax(worst, fabs(sig[carry][k] / exact - 1));
+            }
+        }
+        double tip[3];
+        phc_particles_position(p, n, tip);
+        printf("beam break, shelf (%zu links of %g m, r %g m, links 1-%zu anchored on the board, the edge at joint "
+               "%zu), anchors_carry_moment %d: tip z %.2f mm; largest sigma %.4e Pa at joint %zu (%s), edge joint "
+               "%.4e Pa; largest group stress %.5f at group %zu (%s)\n",
+               n, ell, r, na, na + 1, carry, 1e3 * tip[2], sig[carry][top[carry]], top[carry],
+               top[carry] <= na ? "anchored" : "overhang", sig[carry][na + 1], grp[carry][gtop[carry]], gtop[carry],
+               gtop[carry] <= na ? "anchored" : "overhang");
+        if (carry) {
+            printf("beam break, shelf: the overhang's sigma against 4M/(pi r^3) of its static moment: largest "
+                   "|ratio - 1| %.2e\n",
+                   worst);
+            CHECK(worst < 1e-6);
+            for (size_t k = 1; k <= na; ++k)
+                CHECK(sig[1][k] == 0); /* the support carries the anchored stretch */
+        }
+        phc_particles_free(p);
+    }
+    CHECK(top[1] == na + 1);    /* held anchors: the edge carries the most */
+    CHECK(gtop[0] <= na);       /* the group stress: an anchored group */
+    /* the rules, each just below its largest value of the scene */
+    struct {
+        int carry;
+        double bend, group;
+        const char *what;
+    } runs[] = {{1, 0.99 * sig[1][top[1]], 0, "bending stress, anchors carry the moment"},
+                {0, 0.99 * sig[0][top[0]], 0, "bending stress, default anchors"},
+                {0, 0, 0.99 * grp[0][gtop[0]], "group stress, default anchors"}};
+    size_t at[3];
+    for (int k = 0; k < 3; ++k) {
+        phc_particles *p = shelf(n, na, ell, r, runs[k].carry, runs[k].bend, runs[k].group);
+        CHECK(p != NULL);
+        if (!p)
+            return;
+        double peak;
+        const size_t steps = ramp_load(p, g, dt, ramp, hold, &at[k], &peak);
+        printf("beam break, shelf: %s, %s %.4g: ", runs[k].what, runs[k].bend > 0 ? "break_stress (Pa)" : "break_threshold",
+               runs[k].bend > 0 ? runs[k].bend : runs[k].group);
+        if (at[k] == PHC_PARTICLES_NONE)
+            printf("no break\n");
+        else
+            printf("broke link %zu-%zu (%s) in step %zu\n", at[k], at[k] - 1,
+                   at[k] <= na ? "anchored" : at[k] == na + 1 ? "at the edge" : "in the overhang", steps);
+        phc_particles_free(p);
+    }
+    CHECK(at[0] == na + 1);                        /* the edge */
+    CHECK(at[1] != PHC_PARTICLES_NONE && at[1] <= na); /* tears the anchored stretch */
+    CHECK(at[2] != PHC_PARTICLES_NONE && at[2] <= na); /* tears the anchored stretch */
+}
+
+/* A comb of 64 stem links along +x from a clamped seed, each bearing a
+ * side shoot of 16 links along +y (1089 particles: the threaded path),
+ * stiffness rising with the age over 2 s (every kind of joint). */
+static phc_particles *comb(double break_stress)
+{
+    phc_particles_options o = beam_options(1e7, 0.5, 0.02, break_stress);
+    o.maturity_age = 2;
+    const double ell = 0.01, r = 0.002;
+    phc_particles *p = cantilever(64, ell, r, &o);
+    phc_error err;
+    for (size_t k = 1; p && k <= 64; ++k) {
+        size_t parent = k, idx;
+        for (size_t j = 0; j < 16; ++j) {
+            const double h[3] = {ell * ((double)k + 0.5), ell * (double)j, 0};
+            const double t[3] = {h[0], h[1] + ell, 0};
+            if (phc_particles_append(p, parent, h, t, 0.8 * r, &idx, &err)) {
+                phc_particles_free(p);
+                return NULL;
+            }
+            parent = idx;
+        }
+    }
+    const size_t n = p ? phc_particles_count(p) : 0;
+    for (size_t i = 0; i < n; ++i)
+        if (phc_particles_set_age(p, i, 0.1 + 1.9 * (double)(i % 7) / 7, &err)) {
+            phc_particles_free(p);
+            return NULL;
+        }
+    return p;
+}
+
+/* 60 steps of 0.01 s: the state (7 numbers a particle) to st, the broken
+ * particle of each step (NONE) to br; returns the breaks. */
+static size_t comb_run(double break_stress, int threads, double **st, size_t *br, size_t *n)
+{
+    omp_set_num_threads(threads);
+    phc_particles *p = comb(break_stress);
+    CHECK(p != NULL);
+    if (!p)
+        return 0;
+    *n = phc_particles_count(p);
+    size_t breaks = 0;
+    phc_error err;
+    for (int k = 0; k < 60; ++k) {
+        phc_particles_report rep;
+        CHECK(phc_particles_step(p, 0.01, &rep, &err) == 0);
+        br[k] = rep.broken ? rep.broken_particle : PHC_PARTICLES_NONE;
+        breaks += rep.broken;
+    }
+    *st = malloc(7 * *n * sizeof(double));
+    for (size_t i = 0; i < *n; ++i) {
+        phc_particles_position(p, i, *st + 7 * i);
+        phc_particles_orientation(p, i, *st + 7 * i + 3);
+    }
+    phc_particles_free(p);
+    omp_set_num_threads(omp_get_num_procs());
+    return breaks;
+}
+
+static void test_off_and_threads(void)
+{
+    double *off, *high, *one, *two;
+    size_t b_off[60], b_high[60], b_one[60], b_two[60], n = 0;
+    const size_t k_off = comb_run(0, 1, &off, b_off, &n), k_high = comb_run(1e30, 1, &high, b_high, &n);
+    const int same_off = memcmp(off, high, 7 * n * sizeof(double)) == 0;
+    printf("beam break, comb of %zu particles, 60 steps of 0.01 s: break_stress 0 (off) and 1e30 Pa (never "
+           "reached): %zu and %zu breaks, the same numbers bit for bit: %s\n",
+           n, k_off, k_high, same_off ? "yes" : "no");
+    CHECK(k_off == 0 && k_high == 0);
+    CHECK(same_off);
+    const double thr = 2e5;
+    const size_t k1 = comb_run(thr, 1, &one, b_one, &n), k2 = comb_run(thr, 2, &two, b_two, &n);
+    const int same = memcmp(one, two, 7 * n * sizeof(double)) == 0 && memcmp(b_one, b_two, sizeof b_one) == 0;
+    size_t first = 0;
+    while (first < 59 && b_one[first] == PHC_PARTICLES_NONE)
+        ++first;
+    printf("beam break, comb, break_stress %g Pa: %zu breaks on 1 thread, %zu on 2 (the first in step %zu, particle "
+           "%zu), the same breaks and numbers bit for bit: %s\n",
+           thr, k1, k2, first + 1, b_one[first], same ? "yes" : "no");
+    CHECK(n >= 1024);
+    CHECK(k1 >= 2);
+    CHECK(same);
+    free(off);
+    free(high);
+    free(one);
+    free(two);
+}
+
+static void test_bad_options(void)
+{
+    phc_plant_graph *g = phc_plant_graph_new(1);
+    g->tail[2] = 0.1;
+    g->radius[0] = 0.01;
+    g->length[0] = 0.1;
+    g->parent[0] = PHC_PLANT_NO_PARENT;
+    phc_error err;
+    CHECK(phc_plant_graph_finish(g, "one", &err) == 0);
+    struct {
+        double bend, group;
+        int beam, carry;
+        const char *what, *says;
+    } bad[] = {{-1, 0, 1, 0, "break_stress -1", "break stress must be >= 0"},
+               {NAN, 0, 1, 0, "break_stress NaN", "break stress must be >= 0"},
+               {INFINITY, 0, 1, 0, "break_stress inf", "break stress must be >= 0"},
+               {1e6, 0, 0, 0, "break_stress with own_weight", "needs follow_parent with bending beam"},
+               {1e6, 0.05, 1, 0, "break_stress with break_threshold", "set one"},
+               {0, 0, 0, 1, "anchors_carry_moment with own_weight", "anchors carry moment needs"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        phc_particles_options o = beam_options(1e7, 0.5, 0.01, bad[k].bend);
+        o.break_threshold = bad[k].group;
+        o.anchors_carry_moment = bad[k].carry;
+        if (!bad[k].beam)
+            o.bending = PHC_PARTICLES_OWN_WEIGHT;
+        phc_particles *p = phc_particles_new(g, &o, &err);
+        CHECK(p == NULL);
+        phc_particles_free(p);
+        printf("beam break, bad options: %s: %s\n", bad[k].what, err.message);
+        CHECK_STR_CONTAINS(err.message, bad[k].says);
+    }
+    phc_plant_graph_free(g);
+}
+
 int main(void)
 {
     test_cantilever();
+    test_shelf();
+    test_off_and_threads();
+    test_bad_options();
     return check_finish("test_particles_beam_break");
 }
