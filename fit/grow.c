@@ -57,6 +57,10 @@ void phc_grow_summarise(const phc_climbing *c, const double seed_base[3], phc_gr
     s->pieces_dropped = st.pieces_dropped;
     s->particles_dropped = st.particles_dropped;
     s->resprouts = st.resprouts;
+    s->first_break_time = st.first_break_time;
+    s->first_break_stress = st.first_break_bend_stress;
+    memcpy(s->first_break_joint, st.first_break_joint, sizeof s->first_break_joint);
+    s->first_break_parent_anchored = st.first_break_parent_anchored;
     s->particles = st.particles - st.falling;
     s->attached_fraction = s->particles ? (double)st.anchored / (double)s->particles : 0;
     double top = seed_base[2];
@@ -319,7 +323,7 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
                              "plant", summary_json_full(s), "frames", frames);
     if (!root)
         return phc_error_set(err, PHC_ERR_NOMEM, "out of memory");
-    if (cfg->options.particles.break_threshold > 0) { /* breaking on: what broke */
+    if (cfg->options.particles.break_threshold > 0 || cfg->options.particles.break_stress > 0) { /* what broke */
         json_t *plant = json_object_get(root, "plant");
         json_object_set_new(plant, "breaks", json_integer((json_int_t)s->breaks));
         json_object_set_new(plant, "falling_particles", json_integer((json_int_t)s->falling));
@@ -327,6 +331,14 @@ static int write_result(const phc_grow_config *cfg, const phc_grow_summary *s, c
         json_object_set_new(plant, "particles_dropped", json_integer((json_int_t)s->particles_dropped));
         if (isfinite(cfg->options.resprout_delay))
             json_object_set_new(plant, "resprouts", json_integer((json_int_t)s->resprouts));
+        if (cfg->options.particles.break_stress > 0 && s->breaks) {
+            json_t *at = json_pack("[f, f, f]", s->first_break_joint[0], s->first_break_joint[1],
+                                   s->first_break_joint[2]);
+            json_object_set_new(plant, "first_break",
+                                json_pack("{s:f, s:f, s:o, s:b}", "time_s", s->first_break_time, "bending_stress_Pa",
+                                          s->first_break_stress, "joint_m", at, "parent_anchored",
+                                          s->first_break_parent_anchored));
+        }
     }
     if (pv)
         json_object_set_new(root, "provenance", phc_provenance_to_json(pv));

@@ -47,12 +47,17 @@ typedef struct phc_grow_summary {
     size_t leaves;             /* leaves on the plant */
     double mean_leaf_cos;      /* mean cosine between leaf normals and the light direction */
     double max_radius;         /* m: thickest particle (after secondary growth) */
-    /* breaking (dynamics.break_threshold > 0): the counts above are of the plant
+    /* breaking (dynamics.break_threshold or break_stress > 0): the counts above are of the plant
        without its falling pieces */
     size_t breaks;             /* links broken since the seed (one piece each) */
     size_t falling;            /* particles of broken pieces still falling */
     size_t pieces_dropped, particles_dropped; /* pieces that left the plant, their particles */
     size_t resprouts;          /* stumps that grew a new tip (dynamics.resprout_delay) */
+    /* the first break (NaN before one): its time (s), its joint's bending
+       stress (Pa, with dynamics.break_stress; else 0), the joint (m) and
+       whether the particle above it held an anchor */
+    double first_break_time, first_break_stress, first_break_joint[3];
+    int first_break_parent_anchored;
 } phc_grow_summary;
 
 /* Sets up o's light grid (origin and dims) when the plant needs one: light

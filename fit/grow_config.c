@@ -133,6 +133,12 @@ static const key_spec KEYS[] = {
     {"dynamics", "break_threshold", K_NUM, OPT(particles.break_threshold), 0, INF, 0, 1, "",
      "a link whose group stress (the misfit to its best rigid motion) passes it breaks and the shoot below falls "
      "(0: no breaking; model/climbing_breaking.h)"},
+    {"dynamics", "break_stress", K_NUM, OPT(particles.break_stress), 0, INF, 0, 1, "Pa",
+     "with bending beam: a link whose joint's bending stress 4M/(pi r^3) (M its spring's moment) passes this "
+     "modulus of rupture breaks and the shoot below falls (0: off; not with break_threshold; model/particles.h)"},
+    {"dynamics", "anchors_carry_moment", K_BOOL, OPT(particles.anchors_carry_moment), 0, 1, 0, 0, "",
+     "with bending beam: an anchored particle is held by its support and carries the moment of what lies beyond "
+     "it (its joint to its parent carries none; model/particles.h)"},
     {"dynamics", "fall_time", K_NUM, OPT(fall_time), 0, INF, 0, 1, "s",
      "a broken piece falls this long as free particles, then leaves the plant"},
     {"dynamics", "resprout_delay", K_NUM, OPT(resprout_delay), 0, INF, 0, 1, "s",
@@ -451,6 +457,30 @@ int phc_grow_config_load(const char *path, phc_grow_config **out, phc_error *err
                            : phc_yaml_get(an, "release_distance") ? phc_key_line(an, "release_distance")
                                                                   : phc_key_line(an, "attach_distance"), o->release_distance,
                            o->attach_distance);
+        goto fail;
+    }
+    const phc_yaml_node *dyn = phc_yaml_get(root, "dynamics");
+    const int beam = o->particles.follow_parent && o->particles.bending == PHC_PARTICLES_BEAM;
+    if (o->particles.break_stress > 0 && !beam) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu: dynamics.break_stress = %g Pa needs dynamics.bending: beam with follow_parent "
+                           "(the %s pass has no bending moment)",
+                           path, phc_key_line(dyn, "break_stress"), o->particles.break_stress,
+                           o->particles.follow_parent ? "own_weight" : "no joint");
+        goto fail;
+    }
+    if (o->particles.break_stress > 0 && o->particles.break_threshold > 0) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu: dynamics.break_stress = %g Pa and dynamics.break_threshold = %g are two rules "
+                           "of breaking: give one",
+                           path, phc_key_line(dyn, "break_stress"), o->particles.break_stress,
+                           o->particles.break_threshold);
+        goto fail;
+    }
+    if (o->particles.anchors_carry_moment && !beam) {
+        rc = phc_error_set(err, PHC_ERR_INPUT,
+                           "%s:%zu: dynamics.anchors_carry_moment needs dynamics.bending: beam with follow_parent",
+                           path, phc_key_line(dyn, "anchors_carry_moment"));
         goto fail;
     }
     if (c->duration / c->time_step > 1e8) {

@@ -7,7 +7,13 @@
  * plant (model/climbing_growth.h, step 6) measures each group's stress σ_k
  * (the relative RMS misfit to its best rigid motion, dimensionless) and
  * removes the link k–parent(k) of the most stressed group with σ_k above
- * the threshold, at most one per substep.
+ * the threshold, at most one per substep.  Or, with bending = beam,
+ * particles.break_stress > 0 (Pa; not both): the link whose joint carries
+ * the largest bending stress σ = 4M/(πr³) above it (model/particles.h,
+ * "Breaking under a bending stress"), at most one per substep; with
+ * particles.anchors_carry_moment the anchors hold what lies beyond them,
+ * so an overhang breaks at its support's edge.  What follows a break is
+ * the same for both rules.
  *
  * What a broken piece becomes in the plant (ours; the paper says only that
  * the branch breaks): the subtree below the broken link, k and all its

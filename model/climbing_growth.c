@@ -307,6 +307,16 @@ static int check_options(const phc_climbing_options *o, phc_error *err)
          o->leaf_pipe_area, "[0, inf) m^2");
     NEED(o->fall_time >= 0 && isfinite(o->fall_time), "fall_time", o->fall_time, "[0, inf) s");
     NEED(o->resprout_delay >= 0, "resprout_delay", o->resprout_delay, "[0, inf] s (inf: never)");
+    const phc_particles_options *po = &o->particles;
+    const int beam = po->follow_parent && po->bending == PHC_PARTICLES_BEAM;
+    NEED(po->break_stress >= 0 && isfinite(po->break_stress), "particles.break_stress", po->break_stress,
+         "[0, inf) Pa");
+    NEED(!(po->break_stress > 0) || beam, "particles.break_stress", po->break_stress,
+         "0 (off) unless follow_parent with bending beam (the own-weight pass has no bending moment)");
+    NEED(!(po->break_stress > 0 && po->break_threshold > 0), "particles.break_stress", po->break_stress,
+         "0 (off) when break_threshold > 0 (one rule of breaking at a time)");
+    NEED(!po->anchors_carry_moment || beam, "particles.anchors_carry_moment", po->anchors_carry_moment,
+         "0 (off) unless follow_parent with bending beam");
 #undef NEED
     return 0;
 }
@@ -421,6 +431,9 @@ phc_climbing *phc_climbing_new(const double base[3], const double direction[3],
         goto nomem;
     c->stats.particles = 1;
     c->stats.apical = 1;
+    c->stats.first_break_time = NAN;
+    for (int k = 0; k < 3; ++k)
+        c->stats.first_break_joint[k] = NAN;
     return c;
 nomem:
     phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory");
@@ -1004,7 +1017,7 @@ static void read_back(phc_climbing *c, size_t i, const double q[4])
     memcpy(c->sys_seen + SEEN * i + 11, c->d + 3 * i, 3 * sizeof(double));
 }
 
-static void break_link(phc_climbing *c, size_t k, double stress);
+static void break_link(phc_climbing *c, const phc_particles_report *rep);
 static int drop_fallen(phc_climbing *c, int all, phc_error *err);
 static int resprout(phc_climbing *c, phc_error *err);
 
@@ -1019,13 +1032,13 @@ static int dynamics(phc_climbing *c, double dt, size_t ngrown, phc_error *err)
     const double h = dt / (double)c->o.dynamics_substeps;
     c->pushed = 0;
     c->depth = INFINITY;
-    const int breaking = c->o.particles.break_threshold > 0;
+    const int breaking = c->o.particles.break_threshold > 0 || c->o.particles.break_stress > 0;
     for (size_t s = 0; s < c->o.dynamics_substeps; ++s) {
         phc_particles_report rep;
         if (phc_particles_step(p, h, breaking ? &rep : NULL, err))
             goto fail;
         if (breaking && rep.broken)
-            break_link(c, rep.broken_particle, rep.broken_stress);
+            break_link(c, &rep);
         size_t pushed;
         double depth;
         phc_particles_collisions(p, &pushed, &depth);
@@ -1536,15 +1549,29 @@ double phc_climbing_stress(const phc_climbing *c, size_t i)
     return c->sys && i < phc_particles_count(c->sys) ? phc_particles_stress(c->sys, i) : 0;
 }
 
-/* The particles broke the link of k to its parent (group stress `stress`)
- * in a substep: k's subtree falls from now on, its tips stop, its anchors
- * let go at once (also in the system, for the rest of the step).  A link
- * inside a piece that already falls only splits it. */
-static void break_link(phc_climbing *c, size_t k, double stress)
+double phc_climbing_bend_stress(const phc_climbing *c, size_t i)
 {
+    return c->sys && i < phc_particles_count(c->sys) ? phc_particles_bend_stress(c->sys, i) : 0;
+}
+
+/* The particles broke the link of k = rep->broken_particle to its parent
+ * in a substep (rep: its group stress or bending stress and joint): k's
+ * subtree falls from now on, its tips stop, its anchors let go at once
+ * (also in the system, for the rest of the step).  A link inside a piece
+ * that already falls only splits it. */
+static void break_link(phc_climbing *c, const phc_particles_report *rep)
+{
+    const size_t k = rep->broken_particle;
     c->cut[k] = 1;
     if (c->falling[k])
         return;
+    if (c->stats.breaks == 0) { /* the first break of the plant, where and how */
+        c->stats.first_break_time = c->stats.time;
+        c->stats.first_break_bend_stress = rep->broken_bend_stress;
+        memcpy(c->stats.first_break_joint, rep->broken_joint, sizeof c->stats.first_break_joint);
+        const size_t u = c->parent[k];
+        c->stats.first_break_parent_anchored = u != PHC_CLIMBING_NONE && c->anchored[u];
+    }
     phc_climbing_subtree_tag(c->parent, c->n, k, c->falling, 2);
     size_t m = 0;
     for (size_t i = k; i < c->n; ++i) {
@@ -1565,7 +1592,8 @@ static void break_link(phc_climbing *c, size_t k, double stress)
     c->stats.breaks++;
     c->stats.falling += m;
     c->stats.last_break_id = c->id[k];
-    c->stats.last_break_stress = stress;
+    c->stats.last_break_stress = rep->broken_stress;
+    c->stats.last_break_bend_stress = rep->broken_bend_stress;
     const size_t p = c->parent[k]; /* the stump: remembered when k continued its axis */
     if (isfinite(c->o.resprout_delay) && p != PHC_CLIMBING_NONE && !c->lateral[k] &&
         phc_climbing_stumps_add(&c->stumps, c->id[p], c->stats.time))

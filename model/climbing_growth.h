@@ -53,9 +53,11 @@
  *     next dynamic step starts afresh, at rest).  With collide, every
  *     particle is pushed out of the supports (see the option).  With
  *     dynamics_substeps = 0 the plant is kinematic: current = rest.
- *     With particles.break_threshold > 0 a substep may break a link: the
- *     subtree below it falls as free particles for fall_time and then
- *     leaves the plant (model/climbing_breaking.h; indices close up).
+ *     With particles.break_threshold > 0 (the group stress) or
+ *     particles.break_stress > 0 (the beam pass's bending stress in Pa,
+ *     model/particles.h) a substep may break a link: the subtree below it
+ *     falls as free particles for fall_time and then leaves the plant
+ *     (model/climbing_breaking.h; indices close up).
  *  7. anchors (eq. 5): a particle without an anchor whose closest support
  *     point lies within attach_distance is anchored there; its strength
  *     k = k_max·σ_i·min(1, (t − t_anchor)/anchor_time) rises with the
@@ -228,7 +230,9 @@ typedef struct phc_climbing_options {
                                    pushes on open sheets).  0 (default): only repeated points */
     /* breaking (§4.3; model/climbing_breaking.h): with dynamics and
        particles.break_threshold > 0 (default 0: off) a link whose group
-       stress passes the threshold breaks and the subtree below it falls */
+       stress passes the threshold breaks and the subtree below it falls;
+       or, with bending beam, particles.break_stress > 0 (Pa; one rule at
+       a time): a link whose joint's bending stress passes it */
     double fall_time;           /* s, >= 0: a broken piece falls this long as free particles,
                                    then leaves the plant; default 1 */
     double resprout_delay;      /* s, >= 0: a stump left without a shoot by a break grows a
@@ -298,7 +302,12 @@ typedef struct phc_climbing_stats {
     size_t pieces_dropped;  /* pieces that left the plant */
     size_t particles_dropped; /* their particles */
     size_t last_break_id;   /* stable id (phc_climbing_id) of the child of the last broken link */
-    double last_break_stress; /* its group stress when it broke (1) */
+    double last_break_stress; /* its group stress when it broke (1; 0 with break_stress) */
+    double last_break_bend_stress; /* with particles.break_stress: its joint's bending stress (Pa) */
+    double first_break_time;  /* s: the plant's first break (NaN before it) */
+    double first_break_bend_stress; /* its joint's bending stress (Pa; 0 with break_threshold) */
+    double first_break_joint[3]; /* its joint, the broken child's head (m) */
+    int first_break_parent_anchored; /* 1: the particle above the broken link held an anchor */
     size_t resprouts;       /* stumps that grew a new tip (resprout_delay) */
     size_t last_resprout_id; /* stable id of the last such new tip */
 } phc_climbing_stats;
@@ -364,6 +373,10 @@ size_t phc_climbing_id(const phc_climbing *c, size_t i);
 /* Group stress of i in the last dynamics substep (model/particles.h,
  * measured with particles.break_threshold > 0; else 0). */
 double phc_climbing_stress(const phc_climbing *c, size_t i);
+/* Bending stress (Pa) at i's head joint after the last dynamics substep
+ * (model/particles.h phc_particles_bend_stress: the beam pass's; 0
+ * without dynamics or bending beam). */
+double phc_climbing_bend_stress(const phc_climbing *c, size_t i);
 
 #ifdef __cplusplus
 }

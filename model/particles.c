@@ -1900,6 +1900,8 @@ static void apply_anchor(phc_particles *p, size_t i)
         x[d] = ka == 1 ? a[d] : x[d] + ka * (a[d] - x[d]);
     if (p->hold_q[i])
         memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
+    else if (anchor_base(p, i)) /* held by its support: its orientation too */
+        memcpy(p->qp + 4 * i, p->q + 4 * i, 4 * sizeof(double));
 }
 
 /* Predict (symplectic Euler) particle i: x_p = x + Δt (v + Δt a),

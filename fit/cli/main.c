@@ -980,11 +980,18 @@ static int cmd_grow(int full_argc, char **full_argv, int argc, char **argv)
                s.particles, s.attached_fraction, s.anchors_made, s.anchors_released);
         if (s.leaves)
             printf("leaves %zu, mean cos(leaf normal, light direction) %.3f\n", s.leaves, s.mean_leaf_cos);
-        if (cfg->options.particles.break_threshold > 0)
+        const int breaking = cfg->options.particles.break_threshold > 0 || cfg->options.particles.break_stress > 0;
+        if (breaking)
             printf("broken links %zu (pieces dropped %zu with %zu particles; %zu particles still falling, not "
                    "counted above)\n",
                    s.breaks, s.pieces_dropped, s.particles_dropped, s.falling);
-        if (cfg->options.particles.break_threshold > 0 && isfinite(cfg->options.resprout_delay))
+        if (cfg->options.particles.break_stress > 0 && s.breaks)
+            printf("first break at %g s: bending stress %.4g MPa (break_stress %.4g MPa) at the joint (%.4g, %.4g, "
+                   "%.4g) m, below %s particle\n",
+                   s.first_break_time, 1e-6 * s.first_break_stress, 1e-6 * cfg->options.particles.break_stress,
+                   s.first_break_joint[0], s.first_break_joint[1], s.first_break_joint[2],
+                   s.first_break_parent_anchored ? "an anchored" : "a free");
+        if (breaking && isfinite(cfg->options.resprout_delay))
             printf("resprouted stumps %zu (a new tip %g s after their axis broke)\n", s.resprouts,
                    cfg->options.resprout_delay);
         if (cfg->options.cambium_rate > 0)
