@@ -1560,6 +1560,31 @@ gr_config gr_beam_modulus.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
   beam_modulus: 0
 '
 grow_case "grow: beam modulus zero" "$C/gr_beam_modulus.yaml" "gr_beam_modulus.yaml:8" "dynamics.beam_modulus" "(0, inf) Pa"
+gr_config gr_break_stress.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  bending: beam
+  break_stress: -1e6
+'
+grow_case "grow: negative break stress" "$C/gr_break_stress.yaml" "gr_break_stress.yaml:8" "dynamics.break_stress" "[0, inf) Pa"
+gr_config gr_break_stress_nan.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  bending: beam
+  break_stress: .nan
+'
+grow_case "grow: break stress not a number" "$C/gr_break_stress_nan.yaml" "gr_break_stress_nan.yaml:8" "dynamics.break_stress"
+gr_config gr_break_stress_own.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  bending: own_weight
+  break_stress: 1e6
+'
+grow_case "grow: break stress with the own-weight pass" "$C/gr_break_stress_own.yaml" "gr_break_stress_own.yaml:8" "dynamics.break_stress" "bending: beam" "own_weight"
+gr_config gr_break_both.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  bending: beam
+  break_threshold: 0.05
+  break_stress: 1e6
+'
+grow_case "grow: break stress and break threshold both" "$C/gr_break_both.yaml" "gr_break_both.yaml:9" "dynamics.break_stress" "dynamics.break_threshold" "give one"
+gr_config gr_carry_own.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  anchors_carry_moment: true
+'
+grow_case "grow: anchors carry moment with the own-weight pass" "$C/gr_carry_own.yaml" "gr_carry_own.yaml:7" "dynamics.anchors_carry_moment" "bending: beam"
 # ---- end grow ----------------------------------------------------------------
 
 # ---- shoot_traces (traced shoots of a climbing plant) ------------------------
