@@ -985,12 +985,18 @@ static int cmd_grow(int full_argc, char **full_argv, int argc, char **argv)
             printf("broken links %zu (pieces dropped %zu with %zu particles; %zu particles still falling, not "
                    "counted above)\n",
                    s.breaks, s.pieces_dropped, s.particles_dropped, s.falling);
-        if (cfg->options.particles.break_stress > 0 && s.breaks)
-            printf("first break at %g s: bending stress %.4g MPa (break_stress %.4g MPa) at the joint (%.4g, %.4g, "
-                   "%.4g) m, below %s particle\n",
-                   s.first_break_time, 1e-6 * s.first_break_stress, 1e-6 * cfg->options.particles.break_stress,
-                   s.first_break_joint[0], s.first_break_joint[1], s.first_break_joint[2],
-                   s.first_break_parent_anchored ? "an anchored" : "a free");
+        if (cfg->options.particles.break_stress > 0 && s.breaks) {
+            double mm[3]; /* the joint in mm to 0.1 mm (no "-0.0") */
+            for (int k = 0; k < 3; ++k) {
+                mm[k] = 1e3 * s.first_break_joint[k];
+                if (mm[k] > -0.05 && mm[k] < 0.05)
+                    mm[k] = 0;
+            }
+            printf("first break at %g s: bending stress %.4g MPa (break_stress %.4g MPa) at the joint (%.1f, %.1f, "
+                   "%.1f) mm, below %s particle\n",
+                   s.first_break_time, 1e-6 * s.first_break_stress, 1e-6 * cfg->options.particles.break_stress, mm[0],
+                   mm[1], mm[2], s.first_break_parent_anchored ? "an anchored" : "a free");
+        }
         if (breaking && isfinite(cfg->options.resprout_delay))
             printf("resprouted stumps %zu (a new tip %g s after their axis broke)\n", s.resprouts,
                    cfg->options.resprout_delay);
