@@ -2755,6 +2755,18 @@ static int bad_group(const phc_particles *p, long bad, phc_error *err)
                          bad, p->source_id[bad]);
 }
 
+/* The report of a break of k's parent link: k and its joint, the head
+ * x_k − R(q_k)(0, 0, L_k/2) (m). */
+static void report_break(const phc_particles *p, size_t k, phc_particles_report *report)
+{
+    double hr[3];
+    rotate_z(p->q + 4 * k, p->ax[3 * k + 2], hr);
+    report->broken = 1;
+    report->broken_particle = k;
+    for (int d = 0; d < 3; ++d)
+        report->broken_joint[d] = p->x[3 * k + d] - hr[d];
+}
+
 int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report, phc_error *err)
 {
     if (report) {
@@ -2856,13 +2868,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
             report->max_bend_stress = top;
             report->max_bend_particle = kt;
             if (breaks) {
-                double hr[3];
-                rotate_z(p->q + 4 * kt, p->ax[3 * kt + 2], hr);
-                report->broken = 1;
-                report->broken_particle = kt;
+                report_break(p, kt, report);
                 report->broken_bend_stress = top;
-                for (int d = 0; d < 3; ++d)
-                    report->broken_joint[d] = p->x[3 * kt + d] - hr[d];
             }
         }
     }
@@ -2912,13 +2919,8 @@ int phc_particles_step(phc_particles *p, double dt, phc_particles_report *report
         report->max_stress = smax;
         report->max_stress_group = gmax;
         if (bk != PHC_PARTICLES_NONE) {
-            double hr[3];
-            rotate_z(p->q + 4 * bk, p->ax[3 * bk + 2], hr);
-            report->broken = 1;
-            report->broken_particle = bk;
+            report_break(p, bk, report);
             report->broken_stress = bmax;
-            for (int d = 0; d < 3; ++d)
-                report->broken_joint[d] = p->x[3 * bk + d] - hr[d];
         }
     }
     return PHC_OK;

@@ -8,6 +8,7 @@
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "model/climbing_growth.h"
 
@@ -95,6 +96,28 @@ static inline double *climbing_threads_run(const phc_climbing_options *o, int st
     phc_climbing_free(c);
     omp_set_num_threads(keep);
     return xs;
+}
+
+/* climbing_threads_run on 1 and then 2 threads: counts to ns[2] and
+ * st[2], the numbers compared to *numbers; returns how many differ
+ * (bit for bit; (size_t)-1 when a run failed or the counts differ). */
+static inline size_t climbing_threads_compare(const phc_climbing_options *o, int steps, size_t ns[2],
+                                              phc_climbing_stats st[2], size_t *numbers)
+{
+    double *xs[2] = {NULL, NULL};
+    memset(st, 0, 2 * sizeof *st);
+    for (int run = 0; run < 2; ++run)
+        xs[run] = climbing_threads_run(o, steps, run + 1, &ns[run], &st[run]);
+    size_t differ = (size_t)-1;
+    *numbers = 7 * ns[0];
+    if (xs[0] && xs[1] && ns[0] == ns[1]) {
+        differ = 0;
+        for (size_t k = 0; k < 7 * ns[0]; ++k)
+            differ += memcmp(xs[0] + k, xs[1] + k, sizeof(double)) != 0;
+    }
+    free(xs[0]);
+    free(xs[1]);
+    return differ;
 }
 
 #endif /* PHC_TESTS_CLIMBING_BREAKING_MEASURES_H */

@@ -28,6 +28,10 @@
 #include "check.h"
 
 static const double PI = 3.14159265358979323846;
+/* the scenes' links (m), gravity (m s^-2), step (s), and the load: gravity
+   ramped from 0 over RAMP steps, then held for HOLD */
+static const double ELL = 0.02, R = 0.002, G = 9.81, DT = 0.002;
+enum { RAMP = 3000, HOLD = 2000 };
 
 /* One clamped segment from the origin along +x of length ell, radius r,
  * then n links continuing it (each the next's parent). */
@@ -99,12 +103,14 @@ static double static_moment(const phc_particles *p, size_t k, double half, doubl
     return sqrt(M[0] * M[0] + M[1] * M[1] + M[2] * M[2]);
 }
 
-/* Gravity ramped from 0 to g over `ramp` steps of dt, then held for
- * `hold` steps; returns the steps done (stops at the first break), the
+/* Gravity ramped from 0 to G over RAMP steps of DT, then held for HOLD
+ * steps; returns the steps done (stops at the first break), the
  * break's particle to *broken (NONE without) and the largest reported
  * max_bend_stress to *peak. */
-static size_t ramp_load(phc_particles *p, double g, double dt, size_t ramp, size_t hold, size_t *broken, double *peak)
+static size_t ramp_load(phc_particles *p, size_t *broken, double *peak)
 {
+    const double g = G, dt = DT;
+    const size_t ramp = RAMP, hold = HOLD;
     phc_error err;
     *broken = PHC_PARTICLES_NONE;
     *peak = 0;
@@ -127,9 +133,8 @@ static size_t ramp_load(phc_particles *p, double g, double dt, size_t ramp, size
 
 static void test_cantilever(void)
 {
-    const size_t n = 10;
-    const double ell = 0.02, r = 0.002, g = 9.81, dt = 0.002;
-    const size_t ramp = 3000, hold = 2000;
+    const size_t n = 10, ramp = RAMP, hold = HOLD;
+    const double ell = ELL, r = R, g = G, dt = DT;
     phc_particles_options o = beam_options(2e7, 0.5, 0.02, 0);
     phc_particles *p = cantilever(n, ell, r, &o);
     CHECK(p != NULL);
@@ -137,7 +142,7 @@ static void test_cantilever(void)
         return;
     size_t broken;
     double peak;
-    ramp_load(p, g, dt, ramp, hold, &broken, &peak);
+    ramp_load(p, &broken, &peak);
     double worst = 0, sig[16], tip[3];
     phc_particles_position(p, n, tip);
     size_t top = 0;
@@ -168,7 +173,7 @@ static void test_cantilever(void)
         CHECK(p != NULL);
         if (!p)
             return;
-        const size_t steps = ramp_load(p, g, dt, ramp, hold, &broken, &peak);
+        const size_t steps = ramp_load(p, &broken, &peak);
         printf("beam break, cantilever: break_stress %.6e Pa (%s the base's sigma by 1%%): %s", thr,
                side < 0 ? "below" : "above", broken == PHC_PARTICLES_NONE ? "no break" : "break");
         if (broken != PHC_PARTICLES_NONE)
@@ -211,8 +216,8 @@ static phc_particles *shelf(size_t n, size_t na, double ell, double r, int carry
 
 static void test_shelf(void)
 {
-    const size_t n = 16, na = 8, ramp = 3000, hold = 2000;
-    const double ell = 0.02, r = 0.002, g = 9.81, dt = 0.002;
+    const size_t n = 16, na = 8;
+    const double ell = ELL, r = R, g = G;
     /* the loads at rest, nothing breaking: default anchors and anchors
        that carry the moment */
     double sig[2][17], grp[2][17];
@@ -224,7 +229,7 @@ static void test_shelf(void)
             return;
         size_t broken;
         double peak;
-        ramp_load(p, g, dt, ramp, hold, &broken, &peak);
+        ramp_load(p, &broken, &peak);
         double worst = 0;
         for (size_t k = 1; k <= n; ++k) {
             sig[carry][k] = phc_particles_bend_stress(p, k);
@@ -273,7 +278,7 @@ static void test_shelf(void)
         if (!p)
             return;
         double peak;
-        const size_t steps = ramp_load(p, g, dt, ramp, hold, &at[k], &peak);
+        const size_t steps = ramp_load(p, &at[k], &peak);
         printf("beam break, shelf: %s, %s %.4g: ", runs[k].what, runs[k].bend > 0 ? "break_stress (Pa)" : "break_threshold",
                runs[k].bend > 0 ? runs[k].bend : runs[k].group);
         if (at[k] == PHC_PARTICLES_NONE)
