@@ -1851,13 +1851,21 @@ static void plan_projections(phc_particles *p)
         p->plev[i] = p->glev[i] = -1;
         if (p->anchored[i] && p->anchor_k[i] == 1 && p->hold_q[i])
             p->pins[p->npins++] = i; /* pinned: x_p = a, q_p held after any blend */
-        else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)) ||
-                 anchor_base(p, i))
+        else if (!(p->linked[i] && (p->o.maturity_age > 0 ? p->age[i] > 0 : p->s[i] > 0)))
             need_particle(p, i, N, &np);
         if (np > n / 4)
             return; /* many free particles: project everything */
         /* (s_i > 0 read without the division: age > 0 when t_m > 0) */
     }
+    /* anchored bases of the beam pass (anchors_carry_moment): their motion
+       is the projections' too (a loop of its own: nothing when off) */
+    if (p->o.anchors_carry_moment && p->o.bending == PHC_PARTICLES_BEAM)
+        for (size_t i = 0; i < n; ++i) {
+            if (p->anchored[i] && !(p->anchor_k[i] == 1 && p->hold_q[i]))
+                need_particle(p, i, N, &np);
+            if (np > n / 4)
+                return;
+        }
     /* need_t = plist[0 .. pcount[t]); M_t = gmatch[0 .. gcount[t]) */
     p->pcount[N] = np;
     for (int t = N; t >= 1; --t) {
@@ -1900,8 +1908,6 @@ static void apply_anchor(phc_particles *p, size_t i)
         x[d] = ka == 1 ? a[d] : x[d] + ka * (a[d] - x[d]);
     if (p->hold_q[i])
         memcpy(p->qp + 4 * i, p->anchor_q + 4 * i, 4 * sizeof(double));
-    else if (anchor_base(p, i)) /* held by its support: its orientation too */
-        memcpy(p->qp + 4 * i, p->q + 4 * i, 4 * sizeof(double));
 }
 
 /* Predict (symplectic Euler) particle i: x_p = x + Δt (v + Δt a),
@@ -2404,8 +2410,11 @@ static int beam_articulate(phc_particles *p, double dt)
 static void beam_one(phc_particles *p, size_t i, double dt, double T2)
 {
     const int kind = beam_kind(p, i);
-    if (kind == BEAM_BASE)
-        return; /* s = 0: no hold */
+    if (kind == BEAM_BASE) { /* s = 0: no hold */
+        if (anchor_base(p, i)) /* held by its support: its orientation kept */
+            memcpy(p->qp + 4 * i, p->q + 4 * i, 4 * sizeof(double));
+        return;
+    }
     const size_t u = p->parent[i];
     double *b = p->beam + BEAM_PER * i, *acc = b + BEAM_ACC;
     double au[6];

@@ -191,10 +191,11 @@
  * bends, the most at the board's far end, and the overhang hangs down
  * from orientations that no longer follow the anchored centres).  With
  * anchors_carry_moment, an anchored particle is a BASE: it is not placed
- * by a joint, its motion is the projections' and its anchor's (as a root's),
- * its children hang from it, and nothing of its subtree folds into its
- * parent: the support takes the load through the anchor, as a board
- * carries a shoot lying on it.  The joint from an anchored particle to a
+ * by a joint, its centre is the projections' and its anchor's (as a
+ * root's), its orientation is kept from the step's start (the joint pass
+ * sets it back after the projections), its children hang from it, and
+ * nothing of its subtree folds into its parent: the support takes the
+ * load through the anchor, as a board carries a shoot lying on it.  The joint from an anchored particle to a
  * free child is then a clamp (ℓ̄ = L/2), the overhang a cantilever
  * clamped at the last anchor, and a joint between two anchored particles
  * carries nothing (σ 0).  The projections are computed for the anchored
