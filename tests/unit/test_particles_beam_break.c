@@ -33,9 +33,9 @@ static const double PI = 3.14159265358979323846;
 static const double ELL = 0.02, R = 0.002, G = 9.81, DT = 0.002;
 enum { RAMP = 3000, HOLD = 2000 };
 
-/* One clamped segment from the origin along +x of length ell, radius r,
- * then n links continuing it (each the next's parent). */
-static phc_particles *cantilever(size_t n, double ell, double r, const phc_particles_options *o)
+/* One clamped segment from the origin along +x of length ell, radius r
+ * (a finished graph; NULL on failure). */
+static phc_plant_graph *clamp_graph(double ell, double r)
 {
     phc_plant_graph *g = phc_plant_graph_new(1);
     if (!g)
@@ -46,9 +46,23 @@ static phc_particles *cantilever(size_t n, double ell, double r, const phc_parti
     g->parent[0] = PHC_PLANT_NO_PARENT;
     g->fixed[0] = 1;
     phc_error err;
-    phc_particles *p = NULL;
-    if (!phc_plant_graph_finish(g, "clamp", &err))
-        p = phc_particles_new(g, o, &err);
+    if (phc_plant_graph_finish(g, "clamp", &err)) {
+        fprintf(stderr, "%s\n", err.message);
+        phc_plant_graph_free(g);
+        return NULL;
+    }
+    return g;
+}
+
+/* The clamped segment, then n links continuing it (each the next's
+ * parent). */
+static phc_particles *cantilever(size_t n, double ell, double r, const phc_particles_options *o)
+{
+    phc_plant_graph *g = clamp_graph(ell, r);
+    if (!g)
+        return NULL;
+    phc_error err;
+    phc_particles *p = phc_particles_new(g, o, &err);
     phc_plant_graph_free(g);
     for (size_t k = 1; p && k <= n; ++k) {
         const double h[3] = {ell * (double)k, 0, 0}, t[3] = {ell * (double)(k + 1), 0, 0};
@@ -383,13 +397,11 @@ static void test_off_and_threads(void)
 
 static void test_bad_options(void)
 {
-    phc_plant_graph *g = phc_plant_graph_new(1);
-    g->tail[2] = 0.1;
-    g->radius[0] = 0.01;
-    g->length[0] = 0.1;
-    g->parent[0] = PHC_PLANT_NO_PARENT;
+    phc_plant_graph *g = clamp_graph(0.1, 0.01);
+    CHECK(g != NULL);
+    if (!g)
+        return;
     phc_error err;
-    CHECK(phc_plant_graph_finish(g, "one", &err) == 0);
     struct {
         double bend, group;
         int beam, carry;
