@@ -2057,6 +2057,7 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
     double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
     if (k >= 1) {
         memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
+        quat_normalize(q);
     } else {
         /* the free turn: the segment as it was, hung from J, its centre
          * moved by its load from rest, a Δt²: the shortest turn from its
@@ -2109,15 +2110,28 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
             w2 += w * w;
         }
         const double sn = sqrt(w2);
-        const double phi = phc_atan2_upper(sn, c); /* libm's to about an ulp */
+        /* (1/sin φ first: the division runs beside the angle, not after it) */
+        const double isn = sn > 1e-8 ? 1.0 / sn : 0.0;
+        const double phi = phc_angle_unit(c, sn); /* libm's atan2 to about an ulp */
         double sk, ck;
         phc_sincos_first_quadrant(k * phi, &sk, &ck); /* kφ ≤ φ ≤ π/2 */
         /* sin(kφ)/sin φ, by its limit k/cos φ below 1e-8 (error ~ sn²) */
-        const double fac = sn > 1e-8 ? sk / sn : k / c, a = ck - c * fac;
+        const double fac = sn > 1e-8 ? sk * isn : k / c, a = ck - c * fac;
         for (int d = 0; d < 4; ++d)
             q[d] = a * qf[d] + fac * qn[d];
+        /* normalised: |q|² = 1 + η, η of rounding size here (a slerp of
+         * unit quaternions), so 1/|q| = (3 − |q|²)/2 to (3/8)η²: no square
+         * root and division in the chain that runs from link to link along
+         * a shoot; 1/sqrt beyond |η| = 1e-8 */
+        const double n2 = (q[0] * q[0] + q[1] * q[1]) + (q[2] * q[2] + q[3] * q[3]);
+        double rn;
+        if (__builtin_expect(fabs(n2 - 1) <= 1e-8, 1))
+            rn = 1.5 - 0.5 * n2;
+        else
+            rn = 1.0 / sqrt(n2);
+        for (int d = 0; d < 4; ++d)
+            q[d] *= rn;
     }
-    quat_normalize(q);
     rotate_z(q, half, hr);
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];

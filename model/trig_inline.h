@@ -1,119 +1,62 @@
-/* atan2 and sincos inline, for the climbing plants' turns: the joint
- * pass's partial turn exp(k log δ) (model/particles.c, follow_one) and the
- * tropisms' Rodrigues turn (model/climbing_tropism.c).  Over the ranges
- * they are used on (an angle in (0, π) from y > 0; a turn in [0, π/2])
- * they agree with glibc's atan2, sin and cos to about an ulp (the
- * bounds below; tests/unit/test_trig_inline.c checks them against libm)
- * in some 60 instructions where glibc's atan2 and sincos take some 260;
- * outside those ranges (and for NaN, ±∞, y = 0) they call libm.
+/* The angle of a unit vector and sincos inline, for the joint pass's
+ * partial turn exp(k log δ) (model/particles.c, follow_one): φ and then
+ * sin kφ, cos kφ.  Over the ranges used there (φ and kφ in [0, π/2])
+ * they agree with glibc's atan2, sin and cos to about an ulp (bounds
+ * below; tests/unit/test_trig_inline.c measures them against libm) with
+ * no division and short dependency chains: the joint pass runs each
+ * shoot's links one after another, each waiting for its parent, so the
+ * pass's time is the chain of latencies through a link (its atan2 alone,
+ * with its two divisions, was about 15% of a 25k frame on one thread).
+ * Outside those ranges (and for NaN, ±∞) they call libm.
  *
- * Both reduce by a table at the nodes j/16 (ours; the tables' identities
- * are the textbook ones, Abramowitz & Stegun 4.4.34 and 4.3.16–17):
- *   atan t = atan(c) + atan(u),  u = (t − c)/(1 + t c),  c = j/16 ∈ [0, 1],
- *   sin(c + r) = sin c + (sin c (cos r − 1) + cos c sin r),
- *   cos(c + r) = cos c + (cos c (cos r − 1) − sin c sin r),
- * |t − c| ≤ 1/32, so |u|, |r| ≤ 1/32, where Taylor series of a few terms
- * are exact to far below an ulp: atan u to u¹¹ (next term ≤ |u|·2⁻⁶⁰/13),
- * sin r to r⁷ (next ≤ |r|·2⁻⁴⁰/9!, about 2⁻⁵⁸ |r|), cos r − 1 to r⁸ (next
- * ≤ 2⁻⁵⁰/10!).  t − c and r = a − c are exact (Sterbenz: c/2 ≤ t ≤ 2c for
- * j ≥ 1), and each table value is a pair hi + lo of doubles (π/2 too), so
- * the error is that of the last few roundings: the sum's 1/2 ulp plus the
- * correction term's roundings, at most about 2⁻⁵³ of the correction (which
- * is at most as large as the result); about one ulp in all, two at worst
- * near the smallest nodes (measured: test_trig_inline).  Above π/4 the
- * sincos works on π/2 − θ = (PIO2_HI − θ) + PIO2_LO (the first difference
- * exact by Sterbenz), so cos θ keeps its relative accuracy up to π/2.
+ * Both reduce by a table (ours; the identities are the textbook ones,
+ * Abramowitz & Stegun 4.3.16–17 and 4.4.40):
+ *   angle: (c, s) = (cos φ, sin φ), φ ≤ π/4 (else the angle of (s, c)
+ *     from π/2), node θ_j = asin(j/16), j = round(16 s):
+ *     sin(φ − θ_j) = s cos θ_j − c j/16 =: r, φ = θ_j + asin r, |r| ≤ 0.043
+ *     (j = 1 is taken as j = 0, r = s ≤ 3/32, so that the rounding of r
+ *     stays small against φ); asin r by its Taylor series
+ *     r + Σ_{n ≥ 1} binom(2n, n) r^{2n+1} / (4ⁿ (2n + 1)) to n = 7 (the
+ *     next term ≤ 4e-19 of r), r corrected by 1/|(c, s)| ≈ (3 − |(c, s)|²)/2
+ *     (exact to (3/8)η², η = |(c, s)|² − 1 ≤ 1e-9; beyond that libm's atan2);
+ *   sincos: θ = c + r, c = j/16, j = round(16θ), |r| ≤ 1/32 (j = 1 as 0:
+ *     r ≤ 3/32), above π/4 on π/2 − θ = (PIO2_HI − θ) + PIO2_LO:
+ *     sin(c + r) = sin c + (sin c (cos r − 1) + cos c sin r),
+ *     cos(c + r) = cos c + (cos c (cos r − 1) − sin c sin r),
+ *     sin r to r⁹, cos r − 1 to r¹⁰ (next terms ≤ 2⁻⁵⁹ |r|, 2⁻⁶⁹).
+ * The polynomials are evaluated in Estrin's scheme (Knuth, TAOCP vol. 2,
+ * 4.6.4), not Horner's: half the dependent steps.  Each table value is a
+ * pair hi + lo of doubles (π/2 too), so the error is that of the last few
+ * roundings: the final sum's 1/2 ulp plus about 2⁻⁵⁴ of the terms
+ * s cos θ_j and c j/16 in r (the angle: 1.64 ulps at most of the exact
+ * one in 300,000 angles measured against mpmath at 120 bits, 2 ulps of
+ * libm's atan2; sincos: 1 ulp of libm's).
  *
- * The tables (the values at 200 bits, rounded twice to hi and lo) were
- * made with mpmath 1.3.0 by
- *   hilo = lambda v: (float(v), float(v - mp.mpf(float(v))))
- *   atan table: hilo(mp.atan(j/16)), hilo(π/2 − atan), hilo(π − atan),
- *               hilo(π/2 + atan) for j = 0 .. 16 (mp.mpf(j)/16)
- *   sincos table: hilo(mp.sin(j/16)), hilo(mp.cos(j/16)), j = 0 .. 13
+ * The tables (values at 200 bits, rounded to hi, the rest to lo) were made
+ * with mpmath 1.3.0: hilo(v) = (float(v), float(v − float(v)));
+ *   asin table, j = 0 .. 11, S = mp.mpf(j)/16: hilo(sqrt(1 − S²)),
+ *     hilo(asin S), hilo(π/2 − asin S);
+ *   sincos table, j = 0 .. 13: hilo(sin(j/16)), hilo(cos(j/16)).
  * Pure C, no I/O; header only, so that the callers inline it. */
 #ifndef PHC_TRIG_INLINE_H
 #define PHC_TRIG_INLINE_H
 
-#include <float.h>
 #include <math.h>
 
-static const double phc_trig_atan_table[4][17][2] = {
-    { /* atan(j/16) */
-     {0.0, 0.0},
-     {0x1.ff55bb72cfdeap-5, -0x1.c934d86d23f1dp-60},
-     {0x1.fd5ba9aac2f6ep-4, -0x1.cd37686760c17p-59},
-     {0x1.7b97b4bce5b02p-3, 0x1.347b0b4f881cap-58},
-     {0x1.f5b75f92c80ddp-3, 0x1.8ab6e3cf7afbdp-57},
-     {0x1.362773707ebccp-2, -0x1.963a544b672d8p-57},
-     {0x1.6f61941e4def1p-2, -0x1.c63aae6f6e918p-56},
-     {0x1.a64eec3cc23fdp-2, -0x1.24dec1b50b7ffp-56},
-     {0x1.dac670561bb4fp-2, 0x1.a2b7f222f65e2p-56},
-     {0x1.0657e94db30d0p-1, -0x1.d5b495f6349e6p-56},
-     {0x1.1e00babdefeb4p-1, -0x1.928df287a668fp-58},
-     {0x1.345f01cce37bbp-1, 0x1.1021137c71102p-55},
-     {0x1.4978fa3269ee1p-1, 0x1.2419a87f2a458p-56},
-     {0x1.5d58987169b18p-1, 0x1.0028e4bc5e7cap-57},
-     {0x1.700a7c5784634p-1, -0x1.8c34d25aadef6p-56},
-     {0x1.819d0b7158a4dp-1, -0x1.bf76229d3b917p-56},
-     {0x1.921fb54442d18p-1, 0x1.1a62633145c07p-55},
-    },
-    { /* pi/2 - atan(j/16) */
-     {0x1.921fb54442d18p+0, 0x1.1a62633145c07p-54},
-     {0x1.82250768ac529p+0, -0x1.e78c96d05afcbp-58},
-     {0x1.7249faa996a21p+0, 0x1.a8cc1e7480c68p-54},
-     {0x1.62acbeaca61b8p+0, 0x1.c6ac9f134fa91p-60},
-     {0x1.5368c951e9cfdp+0, -0x1.96f47948a99f1p-54},
-     {0x1.4495d86823225p+0, 0x1.4d29adbab2a62p-54},
-     {0x1.3647503caf55cp+0, 0x1.17e21d9a42c9ap-55},
-     {0x1.288bfa3512419p+0, 0x1.8e684e7a2281bp-56},
-     {0x1.1b6e192ebbe44p+0, 0x1.b1b466a88828ep-54},
-     {0x1.0ef3c09d694b0p+0, 0x1.8fcf88aed2e80p-54},
-     {0x1.031f57e54adbep+0, 0x1.338b4259c0270p-54},
-     {0x1.efe068bba2275p-1, 0x1.24a3b2e61a70bp-55},
-     {0x1.dac670561bb4fp-1, 0x1.a2b7f222f65e2p-55},
-     {0x1.c6e6d2171bf18p-1, 0x1.f4ba8d3373e1bp-55},
-     {0x1.b434ee31013fdp-1, -0x1.0520d0701d877p-55},
-     {0x1.a2a25f172cfe4p-1, -0x1.d700509dad6cep-56},
-     {0x1.921fb54442d18p-1, 0x1.1a62633145c07p-55},
-    },
-    { /* pi - atan(j/16) */
-     {0x1.921fb54442d18p+1, 0x1.1a62633145c07p-53},
-     {0x1.8a225e5677921p+1, -0x1.820b331ddff7bp-53},
-     {0x1.8234d7f6ecb9dp+1, -0x1.3cd17e5a39792p-54},
-     {0x1.7a6639f874768p+1, 0x1.217d15ad92ff1p-54},
-     {0x1.72c43f4b1650ap+1, 0x1.c1b6f4f44e10bp-53},
-     {0x1.6b5ac6d632f9fp+1, -0x1.9873ef1407997p-54},
-     {0x1.643382c07913ap+1, 0x1.a65371fe67254p-54},
-     {0x1.5d55d7bcaa899p+1, -0x1.4101c49818cf9p-53},
-     {0x1.56c6e7397f5aep+1, 0x1.660b64ece6f4bp-53},
-     {0x1.5089baf0d60e4p+1, 0x1.5518f5f00c544p-53},
-     {0x1.4a9f8694c6d6bp+1, 0x1.26f6d2c582f3bp-53},
-     {0x1.4507f4d109f29p+1, 0x1.d65a1e52297c6p-53},
-     {0x1.3fc176b7a8560p+1, -0x1.441a3bd3f1083p-58},
-     {0x1.3ac98f27e8652p+1, 0x1.0a5fd4e57fd8ap-53},
-     {0x1.361d162e61b8bp+1, 0x1.4be8fd7c9b7e6p-53},
-     {0x1.31b87267eca85p+1, 0x1.49449e13b4ca7p-55},
-     {0x1.2d97c7f3321d2p+1, 0x1.a79394c9e8a0ap-54},
-    },
-    { /* pi/2 + atan(j/16) */
-     {0x1.921fb54442d18p+0, 0x1.1a62633145c07p-54},
-     {0x1.a21a631fd9508p+0, -0x1.acc270306ecf6p-54},
-     {0x1.b1f56fdeef00fp+0, 0x1.17f14fdc1574cp-55},
-     {0x1.c192abdbdf879p+0, -0x1.d255ec19c1bddp-54},
-     {0x1.d0d6a1369bd34p+0, -0x1.a23602a65700cp-57},
-     {0x1.dfa992206280bp+0, 0x1.cf36314fb1b58p-55},
-     {0x1.edf81a4bd64d4p+0, 0x1.a8d3b7956a1c1p-54},
-     {0x1.fbb3705373617p+0, 0x1.d12ab2c402e07p-54},
-     {0x1.0468a8ace4df6p+1, 0x1.0620bf7406affp-55},
-     {0x1.0aa5d4f58e2c0p+1, 0x1.49ea7b677131bp-55},
-     {0x1.109009519d639p+1, 0x1.01398408cb59ep-54},
-     {0x1.16279b155a47bp+1, -0x1.76344c4206ddfp-56},
-     {0x1.1b6e192ebbe44p+1, 0x1.b1b466a88828ep-53},
-     {0x1.206600be7bd52p+1, 0x1.3a677fc8d1900p-54},
-     {0x1.251279b802819p+1, 0x1.6eaa5d3534893p-55},
-     {0x1.29771d7e7791fp+1, 0x1.55426d44fb6e1p-53},
-     {0x1.2d97c7f3321d2p+1, 0x1.a79394c9e8a0ap-54},
-    },
+/* {cos θ_j hi, lo, θ_j hi, lo, π/2 − θ_j hi, lo}, θ_j = asin(j/16) */
+static const double phc_trig_asin_table[12][6] = {
+    {0x1.0000000000000p+0, 0.0, 0.0, 0.0, 0x1.921fb54442d18p+0, 0x1.1a62633145c07p-54},
+    {0x1.feffbfdfebf1fp-1, 0x1.5dee51994f18bp-55, 0x1.002abde953619p-4, 0x1.182e2dc6ddeedp-58, 0x1.821d0965ad9b7p+0, -0x1.37207fab281e8p-54},
+    {0x1.fbfbf7ebc755fp-1, -0x1.b2a94084da0b6p-55, 0x1.00abe0c129e1ep-3, 0x1.7ceb0ee49d42ap-60, 0x1.720a392c1d955p+0, -0x1.eb91490a4cb4ap-54},
+    {0x1.f6eb62d27730dp-1, -0x1.401d95ca1ce34p-55, 0x1.82494ed0e78fcp-3, -0x1.443c2697a7d2fp-57, 0x1.61d68b6a25df9p+0, -0x1.7a2c2ff78a8a7p-55},
+    {0x1.efbdeb14f4edap-1, -0x1.3a145fe1be078p-55, 0x1.02be9ce0b87cdp-2, 0x1.e5d09da2e0f04p-58, 0x1.51700e0c14b25p+0, -0x1.fd535474274b1p-61},
+    {0x1.e65b9edeba38ep-1, -0x1.bb73251e8c364p-57, 0x1.457393b90e2aap-2, 0x1.b1f64d329fe98p-56, 0x1.40c2d055ff46ep+0, -0x1.521b301b6239fp-54},
+    {0x1.daa2fefaae1d8p-1, -0x1.3fe0e03f44594p-58, 0x1.899f4edc962d3p-2, 0x1.3e919701b7c6dp-60, 0x1.2fb7e18d1d464p+0, -0x1.ea97e32ac11ebp-54},
+    {0x1.cc665b0328622p-1, -0x1.1baa4d369f814p-55, 0x1.cfaf27460fe9fp-2, -0x1.8bf75f355f723p-57, 0x1.1e33eb72bed71p+0, -0x1.b41eb0e80e515p-54},
+    {0x1.bb67ae8584caap-1, 0x1.cec95d0b5c1e3p-55, 0x1.0c152382d7366p-1, -0x1.ee6913347c2a6p-55, 0x1.0c152382d7366p+0, -0x1.ee6913347c2a6p-54},
+    {0x1.a751f9447b724p-1, 0x1.2b909477e9ed1p-56, 0x1.31df40fbd31cdp-1, 0x1.10ebcfd1cc29dp-60, 0x1.f260298cb2864p-1, -0x1.d3c2981c02e07p-55},
+    {0x1.8fae0c15ad38ap-1, -0x1.db7adb6817f6dp-57, 0x1.59aad71ced00fp-1, -0x1.b5b31565e9408p-58, 0x1.ca94936b98a22p-1, -0x1.9484d6f0b7571p-55},
+    {0x1.73ce704fb7b23p-1, 0x1.1470b816b17a6p-55, 0x1.841deb5114bb4p-1, -0x1.49d1c4e2eba5ep-55, 0x1.a0217f3770e7dp-1, -0x1.02d2e97511b28p-56},
 };
 static const double phc_trig_sincos_table[14][4] = { /* sin(j/16), cos(j/16) */
     {0.0, 0.0, 0x1.0000000000000p+0, 0.0},
@@ -134,30 +77,25 @@ static const double phc_trig_sincos_table[14][4] = { /* sin(j/16), cos(j/16) */
 #define PHC_TRIG_PIO2_HI 0x1.921fb54442d18p+0
 #define PHC_TRIG_PIO2_LO 0x1.1a62633145c07p-54
 
-
-/* atan2(y, x) ∈ (0, π) for y > 0 (rad); libm's atan2 for y ≤ 0 (glibc
- * returns at once for y = 0), NaN, ±∞ or y + |x| > DBL_MAX. */
-static inline double phc_atan2_upper(double y, double x)
+/* The angle φ ∈ [0, π/2] (rad) of (c, s) = (cos φ, sin φ), c, s ≥ 0, a
+ * unit vector to rounding (|c² + s² − 1| ≤ 1e-9); libm's atan2(s, c)
+ * otherwise (also for NaN, ±∞). */
+static inline double phc_angle_unit(double c, double s)
 {
-    const double ax = fabs(x);
-    if (!(y > 0 && y + ax <= DBL_MAX)) /* also NaN, ±∞ and y = ±0 */
-        return atan2(y, x);
-    const int swap = y > ax; /* then atan2 = π/2 ∓ atan(|x|/y) */
-    const double t = swap ? ax / y : y / ax; /* in [0, 1] */
-    int j = (int)(16.0 * t + 0.5);
-    j = j == 1 ? 0 : j; /* t < 3/32 by the series alone (u = t exactly) */
-    const double c = 0.0625 * j;
-    const double u = (t - c) / (1.0 + t * c), u2 = u * u;
-    const double p =
-        u + u * u2 * (-1.0 / 3 +
-                      u2 * (1.0 / 5 +
-                            u2 * (-1.0 / 7 +
-                                  u2 * (1.0 / 9 +
-                                        u2 * (-1.0 / 11 + u2 * (1.0 / 13 + u2 * (-1.0 / 15 + u2 * (1.0 / 17))))))));
-    /* quadrant: 0 atan t, 1 π/2 − atan t, 2 π − atan t, 3 π/2 + atan t */
-    const int k = (x < 0) * 2 + swap;
-    const double *e = phc_trig_atan_table[k][j];
-    return e[0] + (e[1] + ((k == 1 || k == 2) ? -p : p));
+    const double n2 = c * c + s * s;
+    if (!(c >= 0 && s >= 0 && fabs(n2 - 1) <= 1e-9))
+        return atan2(s, c);
+    const int flip = s > c; /* φ > π/4: π/2 − the angle of (s, c) */
+    const double y = flip ? c : s, x = flip ? s : c; /* y ≤ 0.7072 */
+    int j = (int)(16.0 * y + 0.5);
+    j = j == 1 ? 0 : j;
+    const double *e = phc_trig_asin_table[j];
+    const double r = ((y * e[0] - x * (0.0625 * j)) + y * e[1]) * (1.5 - 0.5 * n2);
+    const double z = r * r, z2 = z * z, z4 = z2 * z2;
+    const double p = ((1.0 / 6 + z * (3.0 / 40)) + z2 * (5.0 / 112 + z * (35.0 / 1152))) +
+                     z4 * ((63.0 / 2816 + z * (231.0 / 13312)) + z2 * (143.0 / 10240));
+    const double rho = r + r * z * p; /* asin r */
+    return flip ? e[4] + (e[5] - rho) : e[2] + (e[3] + rho);
 }
 
 /* *s = sin θ, *c = cos θ for θ ∈ [0, π/2] (rad); libm's elsewhere. */
@@ -175,10 +113,11 @@ static inline void phc_sincos_first_quadrant(double theta, double *s, double *c)
     double r = a - 0.0625 * j; /* exact, |r| ≤ 3/32 */
     if (flip)
         r += PHC_TRIG_PIO2_LO;
-    const double r2 = r * r;
-    const double sr = r + r * r2 * (-1.0 / 6 + r2 * (1.0 / 120 + r2 * (-1.0 / 5040 + r2 * (1.0 / 362880))));
-    const double cm =
-        r2 * (-0.5 + r2 * (1.0 / 24 + r2 * (-1.0 / 720 + r2 * (1.0 / 40320 + r2 * (-1.0 / 3628800)))));
+    const double r2 = r * r, r4 = r2 * r2, r8 = r4 * r4;
+    const double sr =
+        r + r * r2 * ((-1.0 / 6 + r2 * (1.0 / 120)) + r4 * (-1.0 / 5040 + r2 * (1.0 / 362880)));
+    const double cm = r2 * ((-0.5 + r2 * (1.0 / 24)) + r4 * (-1.0 / 720 + r2 * (1.0 / 40320)) +
+                            r8 * (-1.0 / 3628800)); /* cos r − 1 */
     const double *e = phc_trig_sincos_table[j];
     const double sa = e[0] + (e[1] + (e[0] * cm + e[2] * sr));
     const double ca = e[2] + (e[3] + (e[2] * cm - e[0] * sr));
