@@ -677,6 +677,11 @@ static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
  * (which GCC makes when NaNs may occur). */
 static inline double at_most_1(double x) { return x < 1 ? x : 1; }
 
+/* glibc's fmax(x, m) bit for bit (equal operands give x, so −0 and +0
+ * keep x's sign; a NaN gives the other operand, two NaNs m: checked
+ * against it for ±0, ±1, ±∞, ±NaN and subnormals), without the call. */
+static inline double at_least(double x, double m) { return (x >= m || (m != m && x == x)) ? x : m; }
+
 /* Anchor strength of i now (eq. 5), 0 when not anchored (here, so that
  * the hand-over inlines it). */
 static inline double anchor_strength(const phc_climbing *c, size_t i)
@@ -813,7 +818,7 @@ static int hand_change(phc_climbing *c, size_t i, phc_error *err)
  * thickening's (r/r0)^4. */
 static inline double hand_age(const phc_climbing *c, size_t i)
 {
-    return fmax(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i);
+    return at_least(c->age[i], c->o.min_stiffness * c->o.particles.maturity_age) * thickness_factor(c, i);
 }
 
 /* Particle i's age and anchor for the hand-over; the seed clamped at its

@@ -3,6 +3,7 @@
  * choices made where the paper is terse, and the units. */
 #include "model/particles.h"
 #include "model/quaternion.h"
+#include "model/trig_inline.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -2088,11 +2089,12 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
     double *x = p->xp + 3 * i, *q = p->qp + 4 * i;
     if (k >= 1) {
         memcpy(q, qs, sizeof qs); /* s = 1: held at the rest angle */
+        quat_normalize(q);
     } else {
         /* the free turn: the segment as it was, hung from J, its centre
          * moved by its load from rest, a Δt²: the shortest turn from its
-         * axis e to the direction of (L/2) e + a Δt² (phc_quat_from_two_vectors,
-         * (1 + e·d, e × d) normalised; a half turn there when they oppose) */
+         * axis e to the direction of d = (L/2) e + a Δt² (phc_quat_from_two_vectors,
+         * (1 + e·d/|d|, e × d/|d|) normalised; a half turn there when they oppose) */
         double axis[3], dir[3], dq[4], qf[4];
         const double *qt = p->q + 4 * i, *f = p->f + 3 * i;
         rotate_z(qt, 1.0, axis);
@@ -2101,42 +2103,67 @@ static void follow_one(phc_particles *p, size_t i, double dt2, double T2)
             dir[d] = half * axis[d] + dt2 * (p->o.gravity[d] + (loaded ? f[d] / p->m[i] : 0.0));
         const double dn2 = dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2];
         if (dn2 > 0) {
-            const double inv = 1.0 / sqrt(dn2);
-            for (int d = 0; d < 3; ++d)
-                dir[d] *= inv;
+            /* with d not normalised: (|d| + e·d, e × d), whose squared
+             * norm is 2|d|(|d| + e·d) for |e| = 1 (one division fewer) */
+            const double dn = sqrt(dn2);
             const double c = axis[0] * dir[0] + axis[1] * dir[1] + axis[2] * dir[2];
-            if (c < -1.0 + 1e-12) {
+            if (c < (-1.0 + 1e-12) * dn) {
+                for (int d = 0; d < 3; ++d)
+                    dir[d] /= dn;
                 phc_quat_from_two_vectors(axis, dir, dq);
             } else {
-                dq[0] = 1.0 + c;
-                dq[1] = axis[1] * dir[2] - axis[2] * dir[1];
-                dq[2] = axis[2] * dir[0] - axis[0] * dir[2];
-                dq[3] = axis[0] * dir[1] - axis[1] * dir[0];
-                quat_normalize(dq);
+                const double w = dn + c, inv = 1.0 / sqrt(2.0 * dn * w);
+                dq[0] = w * inv;
+                dq[1] = (axis[1] * dir[2] - axis[2] * dir[1]) * inv;
+                dq[2] = (axis[2] * dir[0] - axis[0] * dir[2]) * inv;
+                dq[3] = (axis[0] * dir[1] - axis[1] * dir[0]) * inv;
             }
             quat_mul(dq, qt, qf);
         } else {
             memcpy(qf, qt, sizeof qf);
         }
         /* the joint's spring: turn q_f by the fraction k toward q*,
-         * exp(k log δ) δ = q* q_f⁻¹ = (cos φ, sin φ n): (cos kφ, sin kφ n) */
-        const double qf_inv[4] = {qf[0], -qf[1], -qf[2], -qf[3]};
-        double dev[4];
-        quat_mul(qs, qf_inv, dev);
-        if (dev[0] < 0)
-            for (int d = 0; d < 4; ++d)
-                dev[d] = -dev[d];
-        const double sn = sqrt(dev[1] * dev[1] + dev[2] * dev[2] + dev[3] * dev[3]);
-        const double phi = atan2(sn, dev[0]);
-        const double sk = sin(k * phi), ck = cos(k * phi); /* one sincos call (GCC) */
+         * exp(k log δ) q_f, δ = q* q_f⁻¹ = (cos φ, sin φ n): the spherical
+         * interpolation from q_f to q* (Shoemake, SIGGRAPH 1985, "slerp"),
+         *   q = [sin((1 − k)φ) q_f + sin(kφ) q*] / sin φ,
+         * cos φ = q*·q_f (the 4-vector dot, the real part of δ), q* taken
+         * as −q* when it is negative (δ's shorter turn), and with
+         * sin((1 − k)φ) = sin φ cos kφ − cos φ sin kφ:
+         *   q = (cos kφ − cos φ f) q_f + f q*,  f = sin kφ / sin φ,
+         * sin φ = |q* − cos φ q_f| (the part of q* normal to q_f; two
+         * quaternion products fewer than δ and exp(k log δ) q_f) */
+        double c = qs[0] * qf[0] + qs[1] * qf[1] + qs[2] * qf[2] + qs[3] * qf[3];
+        const double sg = c < 0 ? -1.0 : 1.0;
+        c *= sg;
+        double qn[4], w2 = 0;
+        for (int d = 0; d < 4; ++d) {
+            qn[d] = sg * qs[d];
+            const double w = qn[d] - c * qf[d];
+            w2 += w * w;
+        }
+        const double sn = sqrt(w2);
+        /* (1/sin φ first: the division runs beside the angle, not after it) */
+        const double isn = sn > 1e-8 ? 1.0 / sn : 0.0;
+        const double phi = phc_angle_unit(c, sn); /* libm's atan2 to about an ulp */
+        double sk, ck;
+        phc_sincos_first_quadrant(k * phi, &sk, &ck); /* kφ ≤ φ ≤ π/2 */
         /* sin(kφ)/sin φ, by its limit k/cos φ below 1e-8 (error ~ sn²) */
-        const double fac = sn > 1e-8 ? sk / sn : k / dev[0];
-        dq[0] = ck;
-        for (int d = 1; d < 4; ++d)
-            dq[d] = fac * dev[d];
-        quat_mul(dq, qf, q);
+        const double fac = sn > 1e-8 ? sk * isn : k / c, a = ck - c * fac;
+        for (int d = 0; d < 4; ++d)
+            q[d] = a * qf[d] + fac * qn[d];
+        /* normalised: |q|² = 1 + η, η of rounding size here (a slerp of
+         * unit quaternions), so 1/|q| = (3 − |q|²)/2 to (3/8)η²: no square
+         * root and division in the chain that runs from link to link along
+         * a shoot; 1/sqrt beyond |η| = 1e-8 */
+        const double n2 = (q[0] * q[0] + q[1] * q[1]) + (q[2] * q[2] + q[3] * q[3]);
+        double rn;
+        if (__builtin_expect(fabs(n2 - 1) <= 1e-8, 1))
+            rn = 1.5 - 0.5 * n2;
+        else
+            rn = 1.0 / sqrt(n2);
+        for (int d = 0; d < 4; ++d)
+            q[d] *= rn;
     }
-    quat_normalize(q);
     rotate_z(q, half, hr);
     for (int d = 0; d < 3; ++d)
         x[d] = J[d] + hr[d];
