@@ -74,7 +74,7 @@ int phc_support_mesh_arrays(const phc_support_mesh *m, double **vertices, size_t
  * projection the tree itself ends with: the same c and n bit for bit.
  * The certificates are kept per thread, one per cell of edge 1/256 of the
  * mesh's bounding-box diagonal (the last query's there), and d₂ is sought
- * among the triangles within d₀ + 1/64 of the diagonal.  A point that
+ * among the triangles within d₀ + 1/32 of the diagonal.  A point that
  * moves little between queries (a particle in the collision pass of
  * model/particles.h) is then answered at the cost of one projection. */
 int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double n[3]);

@@ -97,7 +97,7 @@ void build(phc_support_mesh *m)
                                   (m->hi[1] - m->lo[1]) * (m->hi[1] - m->lo[1]) +
                                   (m->hi[2] - m->lo[2]) * (m->hi[2] - m->lo[2]));
     m->cell = diag > 0 ? diag / 256 : 1;
-    m->reach = diag > 0 ? diag / 64 : 1;
+    m->reach = diag > 0 ? diag / 32 : 1;
 }
 
 // The triangles whose bounding boxes overlap a box (an AABB tree

@@ -1106,8 +1106,35 @@ static int push_segment(phc_particles_closest_fn fn, void *user, double r, doubl
         skip[5 * (*nskip)++ + 4] = lb;
     } else
         first = d - r; /* (as the plain push: fmin below) */
+    /* A round's outcome is a function of the state (x, axis) it starts
+     * from: when that state equals, bit for bit, the state of one of the
+     * last CYCLE rounds, the rounds between repeat until the last (a push
+     * that lands on the point it started from, rounding), so the whole
+     * cycles are counted (their pushes) without being made: the same
+     * state and count as making them (ours). */
+    enum { CYCLE = 4 };
+    double seen[CYCLE][6];
+    int seen_pushed[CYCLE], nseen = 0;
     for (int round = 0; round < rounds; ++round) {
         double a[3], b[3], da, db, la, lbb;
+        if (round > 0) {
+            for (int back = 1; back <= nseen && back <= CYCLE; ++back) {
+                const int j = (nseen - back) % CYCLE;
+                if (memcmp(seen[j], x, 3 * sizeof(double)) || memcmp(seen[j] + 3, axis, 3 * sizeof(double)))
+                    continue;
+                const int cycles = (rounds - round) / back;
+                pushed += cycles * (pushed - seen_pushed[j]);
+                round += cycles * back;
+                nseen = 0;
+                break;
+            }
+            if (round >= rounds)
+                break;
+            const int j = nseen++ % CYCLE;
+            memcpy(seen[j], x, 3 * sizeof(double));
+            memcpy(seen[j] + 3, axis, 3 * sizeof(double));
+            seen_pushed[j] = pushed;
+        }
         for (int k = 0; k < 3; ++k) {
             a[k] = x[k] - h * axis[k];
             b[k] = x[k] + h * axis[k];

@@ -17,7 +17,13 @@
  *     repeated, some on the bisector of a convex edge, where two triangles
  *     tie), asked of one mesh with certificates and of a copy without:
  *     the same closest point and normal bit for bit at every point, and
- *     most answers certified (the tree answers fewer than half). */
+ *     most answers certified (the tree answers fewer than half).
+ *  5. The closed wall (wall_window_closed.obj, for the climbing option
+ *     supports_closed): at random points around it the side of the
+ *     closest face, (x − c)·n < 0, says inside exactly where the solid's
+ *     own description (the slab minus the window's recess, plus the
+ *     ledge) does; and before its face (y > 0 off the ledge) its closest
+ *     points are those of the open wall_window.obj. */
 #include "measurements/support_mesh.h"
 
 #include <math.h>
@@ -284,6 +290,50 @@ int main(void)
         for (int w = 0; w < 2; ++w)
             for (int j = 0; j < 2; ++j)
                 phc_support_mesh_free(m[w][j]);
+    }
+    /* 5. the closed wall: inside and outside by the closest face's side */
+    {
+        phc_support_mesh *closed =
+            phc_support_mesh_read(PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window_closed.obj", &err);
+        phc_support_mesh *open =
+            phc_support_mesh_read(PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window.obj", &err);
+        CHECK(closed != NULL && open != NULL);
+        size_t asked = 0, inside = 0, wrong = 0, front = 0, front_differ = 0;
+        unsigned long long s = 13;
+        for (int q = 0; closed && open && q < 20000; ++q) {
+            double u[3], x[3], c[3], n[3];
+            for (int k = 0; k < 3; ++k) {
+                s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+                u[k] = (double)(s >> 11) * 0x1.0p-53;
+            }
+            x[0] = -0.7 + 1.4 * u[0];
+            x[1] = -0.3 + 0.45 * u[1];
+            x[2] = -0.1 + 1.4 * u[2];
+            const int slab = x[0] > -0.6 && x[0] < 0.6 && x[1] > -0.2 && x[1] < 0 && x[2] > 0 && x[2] < 1.2;
+            const int recess = x[0] > -0.2 && x[0] < 0.2 && x[1] > -0.04 && x[2] > 0.5 && x[2] < 0.9;
+            const int ledge = x[0] > -0.3 && x[0] < 0.3 && x[1] >= 0 && x[1] < 0.08 && x[2] > 0.92 && x[2] < 0.96;
+            const int in = (slab && !recess) || ledge;
+            CHECK(phc_support_mesh_closest(closed, x, c, n) == 0);
+            const int behind = (x[0] - c[0]) * n[0] + (x[1] - c[1]) * n[1] + (x[2] - c[2]) * n[2] < 0;
+            ++asked;
+            inside += (size_t)in;
+            wrong += (size_t)(behind != in);
+            if (x[1] > 0 && fabs(x[0]) < 0.6 && x[2] > 0 && x[2] < 1.2 && !(fabs(x[0]) < 0.3 && x[2] > 0.92 && x[2] < 0.96)) {
+                double co[3], no[3];
+                phc_support_mesh_closest(open, x, co, no);
+                const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]}, eo[3] = {x[0] - co[0], x[1] - co[1], x[2] - co[2]};
+                ++front;
+                front_differ += fabs(sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) -
+                                     sqrt(eo[0] * eo[0] + eo[1] * eo[1] + eo[2] * eo[2])) > 1e-12;
+            }
+        }
+        printf("closed wall (%zu triangles): %zu points, %zu inside the solid, %zu on the wrong side of their closest "
+               "face; %zu before the face off the ledge, %zu whose distance differs from the open wall's\n",
+               phc_support_mesh_triangle_count(closed), asked, inside, wrong, front, front_differ);
+        CHECK(wrong == 0 && inside > 1000);
+        CHECK(front > 1000 && front_differ == 0);
+        phc_support_mesh_free(closed);
+        phc_support_mesh_free(open);
     }
     return check_finish("test_support_mesh");
 }
