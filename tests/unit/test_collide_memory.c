@@ -31,6 +31,28 @@
 #include "check.h"
 #include "climbing_same_state.h"
 
+/* Fig. 13's seed and growth values (notebooks_c/climbing_fig13_wall.c)
+ * on the support mesh m, with dynamics (25 substeps per step) and
+ * collide. */
+static phc_climbing_options fig13_options(phc_support_mesh *m)
+{
+    phc_climbing_options o = phc_climbing_options_default();
+    o.seed = 13;
+    o.growth_rate = 0.2;
+    o.apical_dominance = 0.6;
+    o.radius = 0.003;
+    o.branch_probability = 0.35;
+    o.direction_variance = 0.6;
+    o.max_order = 2;
+    o.surface_adaption = 0.5;
+    o.keep_outside = 1;
+    o.closest = phc_support_mesh_closest;
+    o.closest_user = m;
+    o.dynamics_substeps = 25;
+    o.collide = 1;
+    return o;
+}
+
 int main(void)
 {
     phc_error err;
@@ -48,20 +70,7 @@ int main(void)
     phc_climbing *c[RUNS];
     const double seed[3] = {-0.1, 0.02, 0}, up[3] = {0, 0, 1};
     for (int run = 0; run < RUNS; ++run) {
-        phc_climbing_options o = phc_climbing_options_default();
-        o.seed = 13; /* Fig. 13's values (notebooks_c/climbing_fig13_wall.c) */
-        o.growth_rate = 0.2;
-        o.apical_dominance = 0.6;
-        o.radius = 0.003;
-        o.branch_probability = 0.35;
-        o.direction_variance = 0.6;
-        o.max_order = 2;
-        o.surface_adaption = 0.5;
-        o.keep_outside = 1;
-        o.closest = phc_support_mesh_closest;
-        o.closest_user = all[run] ? wall_tree : wall;
-        o.dynamics_substeps = 25;
-        o.collide = 1;
+        phc_climbing_options o = fig13_options(all[run] ? wall_tree : wall);
         o.collide_all = all[run];
         c[run] = phc_climbing_new(seed, up, &o, &err);
         CHECK(c[run] != NULL);
@@ -107,22 +116,9 @@ int main(void)
         phc_support_mesh_certificates(solid_tree, 0);
         phc_climbing *cc[2];
         for (int run = 0; run < 2; ++run) {
-            phc_climbing_options o = phc_climbing_options_default();
-            o.seed = 13;
-            o.growth_rate = 0.2;
-            o.apical_dominance = 0.6;
-            o.radius = 0.003;
-            o.branch_probability = 0.35;
-            o.direction_variance = 0.6;
-            o.max_order = 2;
-            o.surface_adaption = 0.5;
-            o.keep_outside = 1;
-            o.closest = phc_support_mesh_closest;
-            o.closest_user = run ? solid : solid_tree;
-            o.dynamics_substeps = 25;
+            phc_climbing_options o = fig13_options(run ? solid : solid_tree);
             o.particles.bending = PHC_PARTICLES_BEAM;
             o.particles.beam_modulus = 1e7;
-            o.collide = 1;
             o.collide_all = !run;
             o.supports_closed = run;
             cc[run] = phc_climbing_new(seed, up, &o, &err);
