@@ -47,11 +47,11 @@ struct phc_support_mesh {
     std::vector<double> normals;      // 3 nt, unit or zero
     double lo[3], hi[3];
     std::unique_ptr<Tree> tree;
-    // The certified answers (closest_certified below): this mesh's number
-    // (unique in the process, never 0), the cells' edge (m) and how far
+    // The certified answers (certify below): this mesh's number
+    // (unique in the process, never 0), the cells' edge (m) and its inverse, how far
     // beyond a query's distance the second-closest triangle is looked for (m).
     std::uint64_t serial;
-    double cell, reach;
+    double cell, per_cell, reach;
     std::atomic<int> certified{1};            // phc_support_mesh_certificates
     mutable std::atomic<size_t> tree_queries{0}; // phc_support_mesh_tree_queries (counted by const queries)
 };
@@ -97,6 +97,7 @@ void build(phc_support_mesh *m)
                                   (m->hi[1] - m->lo[1]) * (m->hi[1] - m->lo[1]) +
                                   (m->hi[2] - m->lo[2]) * (m->hi[2] - m->lo[2]));
     m->cell = diag > 0 ? diag / 256 : 1;
+    m->per_cell = 1 / m->cell;
     m->reach = diag > 0 ? diag / 32 : 1;
 }
 
@@ -147,11 +148,16 @@ size_t certificate_slot(const phc_support_mesh *m, const double x[3])
 {
     std::uint64_t h = m->serial * 0x9E3779B97F4A7C15ull;
     for (int k = 0; k < 3; ++k) {
-        const double u = std::floor(x[k] / m->cell);
+        const double u = x[k] * m->per_cell; /* (truncated: the cells at 0 are two wide, no matter) */
         const std::int64_t iu = std::fabs(u) < 9e15 ? static_cast<std::int64_t>(u) : 0;
         h = (h ^ static_cast<std::uint64_t>(iu)) * 0x100000001B3ull;
     }
-    return static_cast<size_t>(h >> 50) & (CERTIFICATES - 1);
+    h ^= h >> 33; /* MurmurHash3's finaliser: every bit of the cell moves the slot */
+    h *= 0xFF51AFD7ED558CCDull;
+    h ^= h >> 33;
+    h *= 0xC4CEB9FE1A85EC53ull;
+    h ^= h >> 33;
+    return static_cast<size_t>(h) & (CERTIFICATES - 1);
 }
 
 // The distance from x to the closest point of triangle t (m).
