@@ -399,7 +399,7 @@ int phc_grow_config_load(const char *path, phc_grow_config **out, phc_error *err
                                phc_key_line(root, SECTIONS[s]), SECTIONS[s]);
             goto fail;
         }
-        const char *allowed[16];
+        const char *allowed[N_KEYS + 1]; /* (a section may hold every key) */
         size_t na = 0;
         for (size_t i = 0; i < N_KEYS; ++i)
             if (KEYS[i].section && strcmp(KEYS[i].section, SECTIONS[s]) == 0)
