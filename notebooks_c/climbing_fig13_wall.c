@@ -55,6 +55,8 @@
  *
  * Writes climbing_fig13_wall_front.png (the wall face, x–z),
  * climbing_fig13_wall_side.png (y–z: the plant's depth off the wall),
+ * climbing_fig13_wall_collide_side.png (y–z, the two plants grown with
+ * collisions on the closed wall),
  * climbing_fig13_wall.obj (stems as tubes, leaves as squares, the wall)
  * and climbing_fig13_wall.md.  Exit 1 when a check fails.
  *
@@ -230,6 +232,65 @@ static void free_tip_sag(const phc_climbing *c, size_t *count, double *mean, dou
     free(has_child);
 }
 
+/* How a plant is drawn: its stems coloured by branch order, its leaves as
+ * strokes across their blades (colour 3, half the thickest radius wide). */
+typedef struct strokes {
+    size_t n;                       /* stems + leaves */
+    double *head, *tail, *rad, *val; /* 3n, 3n, n (m), n */
+} strokes;
+
+static void strokes_free(strokes *s)
+{
+    free(s->head);
+    free(s->tail);
+    free(s->rad);
+    free(s->val);
+}
+
+/* The strokes of plant c; 0, or -1 when out of memory (s freed). */
+static int plant_strokes(const phc_climbing *c, strokes *s)
+{
+    const size_t n = phc_climbing_count(c), ns = n + phc_climbing_leaf_count(c);
+    s->n = ns;
+    s->head = malloc(3 * ns * sizeof *s->head);
+    s->tail = malloc(3 * ns * sizeof *s->tail);
+    s->rad = malloc(ns * sizeof *s->rad);
+    s->val = malloc(ns * sizeof *s->val);
+    if (!s->head || !s->tail || !s->rad || !s->val) {
+        strokes_free(s);
+        return -1;
+    }
+    double rmax = 0;
+    for (size_t i = 0; i < n; ++i)
+        rmax = fmax(rmax, phc_climbing_radius(c, i));
+    for (size_t i = 0, j = n; i < n; ++i) {
+        phc_climbing_segment(c, i, s->head + 3 * i, s->tail + 3 * i);
+        s->rad[i] = phc_climbing_radius(c, i);
+        s->val[i] = phc_climbing_order(c, i);
+        double q[12];
+        if (!phc_climbing_leaf_quad(c, i, q))
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            s->head[3 * j + k] = 0.5 * (q[k] + q[9 + k]);
+            s->tail[3 * j + k] = 0.5 * (q[3 + k] + q[6 + k]);
+        }
+        s->rad[j] = 0.5 * rmax;
+        s->val[j++] = 3;
+    }
+    return 0;
+}
+
+/* The views' options: colour = branch order 0-2, 3 for the leaves. */
+static phc_shape_plot_options order_plot_options(void)
+{
+    phc_shape_plot_options po = phc_shape_plot_options_default();
+    po.value_label = "branch order 0-2 (3 = leaves)";
+    po.value_min = 0;
+    po.value_max = 3;
+    po.max_line_width = 6;
+    return po;
+}
+
 /* A plant grown with dynamics and the numbers printed of it. */
 typedef struct dynamic_run {
     double cpu, wall;             /* s: the growth's process CPU time (all threads) and wall time */
@@ -239,8 +300,9 @@ typedef struct dynamic_run {
     double sag_mean, sag_max, links; /* m, m, links (free_tip_sag) */
 } dynamic_run;
 
+/* keep (may be NULL) gets the plant (the caller frees it). */
 static int grow_dynamic(const phc_climbing_options *o, phc_support_mesh *wall, const double seed[3],
-                        const double up[3], size_t steps, double dt, dynamic_run *r)
+                        const double up[3], size_t steps, double dt, dynamic_run *r, phc_climbing **keep)
 {
     const size_t tree0 = phc_support_mesh_tree_queries(wall);
     const clock_t cpu0 = clock();
@@ -268,7 +330,10 @@ static int grow_dynamic(const phc_climbing_options *o, phc_support_mesh *wall, c
             r->min_sd = fmin(r->min_sd, (x[0] - cp[0]) * nf[0] + (x[1] - cp[1]) * nf[1] + (x[2] - cp[2]) * nf[2]);
     }
     free_tip_sag(c, &r->free_tips, &r->sag_mean, &r->sag_max, &r->links);
-    phc_climbing_free(c);
+    if (keep)
+        *keep = c;
+    else
+        phc_climbing_free(c);
     return 0;
 }
 
@@ -403,35 +468,17 @@ int main(int argc, char **argv)
 
     /* the views: stems coloured by branch order, leaves as strokes across
        their blades (colour 3), the wall's corners as markers */
-    const size_t ns = n + nl, nv = phc_support_mesh_vertex_count(wall);
-    double *head = malloc(3 * ns * sizeof *head), *tail = malloc(3 * ns * sizeof *tail);
-    double *rad = malloc(ns * sizeof *rad), *val = malloc(ns * sizeof *val), *mk = malloc(3 * nv * sizeof *mk);
-    if (!head || !tail || !rad || !val || !mk)
+    const size_t nv = phc_support_mesh_vertex_count(wall);
+    strokes st0;
+    double *mk = malloc(3 * nv * sizeof *mk);
+    if (!mk || plant_strokes(c, &st0))
         return 1;
-    for (size_t i = 0, j = n; i < n; ++i) {
-        phc_climbing_segment(c, i, head + 3 * i, tail + 3 * i);
-        rad[i] = phc_climbing_radius(c, i);
-        val[i] = phc_climbing_order(c, i);
-        double q[12];
-        if (!phc_climbing_leaf_quad(c, i, q))
-            continue;
-        for (int k = 0; k < 3; ++k) {
-            head[3 * j + k] = 0.5 * (q[k] + q[9 + k]);
-            tail[3 * j + k] = 0.5 * (q[3 + k] + q[6 + k]);
-        }
-        rad[j] = 0.5 * rmax;
-        val[j++] = 3;
-    }
     for (size_t i = 0; i < nv; ++i)
         phc_support_mesh_vertex(wall, i, mk + 3 * i);
     char title[256];
     snprintf(title, sizeof title, "%zu particles, %zu leaves after %g s", n, nl, duration);
-    phc_shape_panel pan = {ns, head, tail, rad, val, title, nv, mk, "wall, window and ledge corners"};
-    phc_shape_plot_options po = phc_shape_plot_options_default();
-    po.value_label = "branch order 0-2 (3 = leaves)";
-    po.value_min = 0;
-    po.value_max = 3;
-    po.max_line_width = 6;
+    phc_shape_panel pan = {st0.n, st0.head, st0.tail, st0.rad, st0.val, title, nv, mk, "wall, window and ledge corners"};
+    phc_shape_plot_options po = order_plot_options();
     po.page_width = 900;
     po.page_height = 820;
     po.title = "Fig. 13: a vine on a wall, front view (x-z)";
@@ -518,7 +565,7 @@ int main(int argc, char **argv)
         od.dynamics_substeps = (size_t)llround(dt / 0.01);
         od.particles.bending = k ? PHC_PARTICLES_BEAM : PHC_PARTICLES_OWN_WEIGHT;
         od.particles.beam_modulus = 1e7; /* Fig. 12's E_1/2 */
-        if (grow_dynamic(&od, wall, seed, up, steps, dt, &dyn[k]))
+        if (grow_dynamic(&od, wall, seed, up, steps, dt, &dyn[k], NULL))
             return 1;
         const dynamic_run *r = &dyn[k];
         printf("the same seed with dynamics (%zu substeps of %g s per step, gravity, anchors; bending %s%s): CPU "
@@ -564,6 +611,7 @@ int main(int argc, char **argv)
         return 1;
     }
     dynamic_run col[2];
+    phc_climbing *collided[2] = {NULL, NULL};
     int c9 = 1;
     omp_set_num_threads(1);
     for (int k = 0; k < 2; ++k) {
@@ -576,7 +624,7 @@ int main(int argc, char **argv)
             oc.particles.beam_modulus = 1e7; /* Fig. 12's E_1/2 */
         }
         if (grow_dynamic(&oc, solid, cfg->position, cfg->direction, (size_t)llround(cfg->duration / cfg->time_step),
-                         cfg->time_step, &col[k]))
+                         cfg->time_step, &col[k], &collided[k]))
             return 1;
         const dynamic_run *r = &col[k];
         printf("with collisions (wall_window_collide.yaml: the wall as a closed solid, dynamics.collide and "
@@ -594,6 +642,40 @@ int main(int argc, char **argv)
     printf("check: with collisions (both passes) every centre keeps its radius off the wall (smallest signed distance "
            "minus radius >= -1e-12 m) and most particles stay attached (> 0.8): %s\n",
            c9 ? "pass" : "FAIL");
+    /* their side views (y-z), the closed wall's corners as markers */
+    {
+        const size_t ncv = phc_support_mesh_vertex_count(solid);
+        strokes sc[2];
+        double *cmk = malloc(3 * ncv * sizeof *cmk);
+        if (!cmk || plant_strokes(collided[0], &sc[0]) || plant_strokes(collided[1], &sc[1]))
+            return 1;
+        for (size_t i = 0; i < ncv; ++i)
+            phc_support_mesh_vertex(solid, i, cmk + 3 * i);
+        char ctitle[2][128];
+        phc_shape_panel cpan[2];
+        for (int k = 0; k < 2; ++k) {
+            snprintf(ctitle[k], sizeof ctitle[k], "%s: %zu particles, %zu clip", k ? "beam" : "own weight",
+                     phc_climbing_count(collided[k]), col[k].clips);
+            cpan[k] = (phc_shape_panel){sc[k].n, sc[k].head, sc[k].tail, sc[k].rad, sc[k].val, ctitle[k], ncv, cmk,
+                                        "closed wall's corners"};
+        }
+        phc_shape_plot_options cpo = order_plot_options();
+        cpo.across_axis = 1;
+        cpo.columns = 2;
+        cpo.page_width = 1300;
+        cpo.page_height = 1200; /* (tall: the narrow y axis then keeps its labels apart) */
+        cpo.title = "Fig. 13 with collisions, side view (y-z; wall face at y = 0)";
+        snprintf(path, sizeof path, "%s/climbing_fig13_wall_collide_side.png", out);
+        if (phc_shape_plot(path, cpan, 2, &cpo, &err)) {
+            fprintf(stderr, "%s\n", err.message);
+            return 1;
+        }
+        strokes_free(&sc[0]);
+        strokes_free(&sc[1]);
+        free(cmk);
+        phc_climbing_free(collided[0]);
+        phc_climbing_free(collided[1]);
+    }
     const int ok = c1 && c2 && c3 && c4 && c5 && c6 && c7 && c8 && c9;
 
     char md[1024], mdtmp[1024];
@@ -619,6 +701,7 @@ int main(int argc, char **argv)
             "| beam (E_1/2 1e7 Pa) | %zu | %.3f | %.3g | %zu | %zu | %.2f / %.2f |\n\n"
             "**With dynamics and collisions** (`measurements/examples/climbing/wall_window_collide.yaml`: the wall as a "
             "closed solid, every centre and segment end pushed out in every substep):\n\n"
+            "![collisions](climbing_fig13_wall_collide_side.png)\n\n"
             "| joint pass | particles | attached fraction | smallest signed distance − radius, centre / end (m) | "
             "segments clipping | CPU (s) |\n|---|---|---|---|---|---|\n"
             "| own_weight | %zu | %.3f | %.3g / %.3g | %zu | %.1f |\n"
@@ -635,10 +718,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: cannot write the page\n", md);
         return 1;
     }
-    free(head);
-    free(tail);
-    free(rad);
-    free(val);
+    strokes_free(&st0);
     free(mk);
     phc_climbing_free(c);
     phc_support_mesh_free(wall);
