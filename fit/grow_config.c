@@ -120,6 +120,10 @@ static const key_spec KEYS[] = {
     {"dynamics", "collide_ends", K_BOOL, OPT(collide_ends), 0, 1, 0, 0, "",
      "with collide, kinematic plants (substeps 0) only: each segment's two ends are pushed out too and its centre and "
      "direction rebuilt from them (whole segments out of the support)"},
+    {"dynamics", "supports_closed", K_BOOL, OPT(supports_closed), 0, 1, 0, 0, "",
+     "the support is a closed surface with outward faces (a solid's boundary): with collide and substeps, a point "
+     "farther from the support than its radius plus how far it moved since its last query is not queried (exact; "
+     "wrong on an open sheet, whose back side reads as inside; model/particles.h)"},
     {"dynamics", "follow_parent", K_BOOL, OPT(particles.follow_parent), 0, 1, 0, 0, "",
      "after the projections every particle hangs from a joint on its parent, an angular spring: s = 1 keeps the rest "
      "shape, s < 1 lets a link bend down under its load (model/particles.h)"},

@@ -67,6 +67,17 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
     return mesh ? loaded()->closest(mesh, x, c, n) : -1;
 }
 
+void phc_support_mesh_certificates(phc_support_mesh *m, int on)
+{
+    if (m)
+        loaded()->certificates(m, on);
+}
+
+size_t phc_support_mesh_tree_queries(const phc_support_mesh *m)
+{
+    return m ? loaded()->tree_queries(m) : 0;
+}
+
 int phc_support_mesh_arrays(const phc_support_mesh *m, double **vertices, size_t *nv, size_t **triangles,
                             size_t *nt, phc_error *err)
 {

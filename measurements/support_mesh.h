@@ -63,8 +63,28 @@ int phc_support_mesh_arrays(const phc_support_mesh *m, double **vertices, size_t
 /* Closest point c (m) on the mesh to x (m), and the unit normal n of the
  * triangle it lies on (right-hand rule over the triangle's vertex order;
  * (0,0,0) for a degenerate triangle).  `mesh` is a phc_support_mesh *.
- * Returns 0, or -1 when x is not finite (c, n untouched). */
+ * Returns 0, or -1 when x is not finite (c, n untouched).  Safe to call
+ * from several threads at once.
+ *
+ * Certified answers (ours; exact): a query answered by the AABB tree at
+ * x₀, closest triangle T at distance d₀, every other triangle at d₂ or
+ * farther, certifies T for any x with |x − x₀| < (d₂ − d₀)/2 − 1e-9·(1 +
+ * |x₀|∞) m (the distance is 1-Lipschitz: T stays the closest, by more than
+ * rounding).  Such an x is answered by projecting it on T alone, the
+ * projection the tree itself ends with: the same c and n bit for bit.
+ * The certificates are kept per thread, one per cell of edge 1/256 of the
+ * mesh's bounding-box diagonal (the last query's there), and d₂ is sought
+ * among the triangles within d₀ + 1/32 of the diagonal.  A point that
+ * moves little between queries (a particle in the collision pass of
+ * model/particles.h) is then answered at the cost of one projection. */
 int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double n[3]);
+
+/* on = 0: every query goes through the AABB tree (for tests comparing the
+ * two); 1 (default): certified answers are used.  Not while queries run. */
+void phc_support_mesh_certificates(phc_support_mesh *m, int on);
+/* Queries of m answered by the AABB tree since it was made (all threads;
+ * the others were answered by a certificate). */
+size_t phc_support_mesh_tree_queries(const phc_support_mesh *m);
 
 #ifdef __cplusplus
 }

@@ -14,8 +14,10 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -45,6 +47,13 @@ struct phc_support_mesh {
     std::vector<double> normals;      // 3 nt, unit or zero
     double lo[3], hi[3];
     std::unique_ptr<Tree> tree;
+    // The certified answers (certify below): this mesh's number
+    // (unique in the process, never 0), the cells' edge (m) and its inverse, how far
+    // beyond a query's distance the second-closest triangle is looked for (m).
+    std::uint64_t serial;
+    double cell, per_cell, reach;
+    std::atomic<int> certified{1};            // phc_support_mesh_certificates
+    mutable std::atomic<size_t> tree_queries{0}; // phc_support_mesh_tree_queries (counted by const queries)
 };
 
 namespace {
@@ -82,6 +91,113 @@ void build(phc_support_mesh *m)
     m->tree.reset(new Tree(m->cgal.begin(), m->cgal.end()));
     // Builds the search structure now, so that later queries only read.
     m->tree->accelerate_distance_queries();
+    static std::atomic<std::uint64_t> serials(0);
+    m->serial = ++serials;
+    const double diag = std::sqrt((m->hi[0] - m->lo[0]) * (m->hi[0] - m->lo[0]) +
+                                  (m->hi[1] - m->lo[1]) * (m->hi[1] - m->lo[1]) +
+                                  (m->hi[2] - m->lo[2]) * (m->hi[2] - m->lo[2]));
+    m->cell = diag > 0 ? diag / 256 : 1;
+    m->per_cell = 1 / m->cell;
+    m->reach = diag > 0 ? diag / 32 : 1;
+}
+
+// The triangles whose bounding boxes overlap a box (an AABB tree
+// traversal that tests boxes only: every triangle that comes within the
+// box is listed, maybe some more).
+class Box_gather {
+  public:
+    explicit Box_gather(std::vector<size_t> *out, TriangleIterator first) : out_(out), first_(first) {}
+    bool go_further() const { return true; }
+    void intersection(const CGAL::Bbox_3 &q, const Primitive &p)
+    {
+        if (CGAL::do_overlap(q, p.datum().bbox()))
+            out_->push_back(static_cast<size_t>(p.id() - first_));
+    }
+    template <class Node> bool do_intersect(const CGAL::Bbox_3 &q, const Node &node) const
+    {
+        return CGAL::do_overlap(q, node.bbox());
+    }
+
+  private:
+    std::vector<size_t> *out_;
+    TriangleIterator first_;
+};
+
+// Certified closest triangles (ours; exact).  A query at x₀ whose closest
+// triangle T lies at distance d₀ while every other triangle lies at d₂ or
+// farther certifies T for every x with |x − x₀| < ρ = (d₂ − d₀)/2 − margin:
+// the distance to the mesh is 1-Lipschitz, so T lies within d₀ + |x − x₀|
+// of x and every other triangle beyond d₂ − |x − x₀|, farther by more than
+// the margin.  The tree's own traversal then ends on T as well (a triangle
+// replaces its best only when not farther), so the projection of x on T is
+// its answer bit for bit (the same CGAL projection of the same two
+// arguments).  The margin, 1e-9·(1 + |x₀|∞) m, covers the rounding of the
+// projections and distances (a few ulps of the coordinates).  Certificates
+// are kept per thread in a table indexed by the query's cell (edge
+// m->cell): a later query in the same cell within ρ of x₀ costs one
+// projection instead of a tree traversal.
+struct Certificate {
+    std::uint64_t serial;  // the mesh's; 0: empty
+    double x0[3], rho;
+    size_t triangle;
+};
+enum { CERTIFICATES = 1 << 14 };
+thread_local std::unique_ptr<Certificate[]> certificates;
+
+size_t certificate_slot(const phc_support_mesh *m, const double x[3])
+{
+    std::uint64_t h = m->serial * 0x9E3779B97F4A7C15ull;
+    for (int k = 0; k < 3; ++k) {
+        const double u = x[k] * m->per_cell; /* (truncated: the cells at 0 are two wide, no matter) */
+        const std::int64_t iu = std::fabs(u) < 9e15 ? static_cast<std::int64_t>(u) : 0;
+        h = (h ^ static_cast<std::uint64_t>(iu)) * 0x100000001B3ull;
+    }
+    h ^= h >> 33; /* MurmurHash3's finaliser: every bit of the cell moves the slot */
+    h *= 0xFF51AFD7ED558CCDull;
+    h ^= h >> 33;
+    h *= 0xC4CEB9FE1A85EC53ull;
+    h ^= h >> 33;
+    return static_cast<size_t>(h) & (CERTIFICATES - 1);
+}
+
+// The distance from x to the closest point of triangle t (m).
+double distance_to(const phc_support_mesh *m, size_t t, const Point &x)
+{
+    const Point c = Kernel().construct_projected_point_3_object()(m->cgal[t], x);
+    return std::sqrt(CGAL::squared_distance(x, c));
+}
+
+// After the tree's answer (triangle t, point c) for x: the certificate of
+// t around x, stored in x's slot (nothing when ρ <= 0).
+void certify(const phc_support_mesh *m, const double x[3], const Point &q, const Point &c, size_t t)
+{
+    if (!certificates)
+        certificates.reset(new Certificate[CERTIFICATES]());
+    Certificate &e = certificates[certificate_slot(m, x)];
+    e.serial = 0;
+    const double d0 = std::sqrt(CGAL::squared_distance(q, c));
+    const double reach = d0 + m->reach;
+    const double margin = 1e-9 * (1 + std::fmax(std::fabs(x[0]), std::fmax(std::fabs(x[1]), std::fabs(x[2]))));
+    // every triangle not listed lies farther than `reach` (box of half edge
+    // reach·(1 + 1e-12) around x, compared exactly)
+    const double half = reach * (1 + 1e-12);
+    const CGAL::Bbox_3 box(x[0] - half, x[1] - half, x[2] - half, x[0] + half, x[1] + half, x[2] + half);
+    thread_local std::vector<size_t> near;
+    near.clear();
+    Box_gather gather(&near, m->cgal.begin());
+    m->tree->traversal(box, gather);
+    double d2 = reach;
+    for (size_t k : near)
+        if (k != t)
+            d2 = std::fmin(d2, distance_to(m, k, q));
+    const double rho = 0.5 * (d2 - d0) - margin;
+    if (!(rho > 0))
+        return;
+    for (int k = 0; k < 3; ++k)
+        e.x0[k] = x[k];
+    e.rho = rho;
+    e.triangle = t;
+    e.serial = m->serial;
 }
 
 }  // namespace
@@ -251,9 +367,26 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
     if (!m || !std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
         return -1;
     try {
-        const Tree::Point_and_primitive_id pp = m->tree->closest_point_and_primitive(
-            Point(x[0], x[1], x[2]));
+        const Point q(x[0], x[1], x[2]);
+        const int certified = m->certified.load(std::memory_order_relaxed);
+        if (certified && certificates) {
+            const Certificate &e = certificates[certificate_slot(m, x)];
+            const double g[3] = {x[0] - e.x0[0], x[1] - e.x0[1], x[2] - e.x0[2]};
+            if (e.serial == m->serial && g[0] * g[0] + g[1] * g[1] + g[2] * g[2] < e.rho * e.rho) {
+                const Point p = Kernel().construct_projected_point_3_object()(m->cgal[e.triangle], q);
+                c[0] = p.x();
+                c[1] = p.y();
+                c[2] = p.z();
+                for (int k = 0; k < 3; ++k)
+                    n[k] = m->normals[3 * e.triangle + k];
+                return 0;
+            }
+        }
+        const Tree::Point_and_primitive_id pp = m->tree->closest_point_and_primitive(q);
         const size_t t = static_cast<size_t>(pp.second - m->cgal.begin());
+        m->tree_queries.fetch_add(1, std::memory_order_relaxed);
+        if (certified)
+            certify(m, x, q, pp.first, t);
         c[0] = pp.first.x();
         c[1] = pp.first.y();
         c[2] = pp.first.z();
@@ -265,6 +398,17 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
     }
 }
 
+void phc_support_mesh_certificates(phc_support_mesh *m, int on)
+{
+    if (m)
+        m->certified.store(on != 0, std::memory_order_relaxed);
+}
+
+size_t phc_support_mesh_tree_queries(const phc_support_mesh *m)
+{
+    return m ? m->tree_queries.load(std::memory_order_relaxed) : 0;
+}
+
 }  // extern "C"
 
 /* The module's entry point (measurements/support_mesh_module_internal.h):
@@ -273,7 +417,8 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
 static const phc_mesh_module_table phc_mesh_module = {
     phc_support_mesh_read,           phc_support_mesh_from_arrays, phc_support_mesh_free,
     phc_support_mesh_triangle_count, phc_support_mesh_vertex_count, phc_support_mesh_bounds,
-    phc_support_mesh_vertex,         phc_support_mesh_triangle,    phc_support_mesh_closest};
+    phc_support_mesh_vertex,         phc_support_mesh_triangle,    phc_support_mesh_closest,
+    phc_support_mesh_certificates,   phc_support_mesh_tree_queries};
 
 extern "C" const void *phc_mesh_module_entry(int abi)
 {

@@ -8,7 +8,7 @@
 #include "measurements/support_mesh.h"
 
 /* Bumped whenever a member below changes. */
-#define PHC_MESH_MODULE_ABI 1
+#define PHC_MESH_MODULE_ABI 2
 #define PHC_MESH_MODULE_ENTRY "phc_mesh_module_entry"
 #define PHC_MESH_MODULE_FILE "phytocal_mesh.so"
 
@@ -24,6 +24,8 @@ typedef struct phc_mesh_module_table {
     void (*vertex)(const phc_support_mesh *m, size_t i, double v[3]);
     void (*triangle)(const phc_support_mesh *m, size_t t, size_t idx[3]);
     int (*closest)(void *mesh, const double x[3], double c[3], double n[3]);
+    void (*certificates)(phc_support_mesh *m, int on);
+    size_t (*tree_queries)(const phc_support_mesh *m);
 } phc_mesh_module_table;
 
 #endif

@@ -42,8 +42,9 @@ struct phc_particles {
      * x − h·axis, end x + h·axis of the first round; the same of the later
      * rounds: the centre pushed again, the ends), each its last queried
      * point x₀, the unsigned distance d₀ (m) from it to the supports when
-     * it was in front (0 otherwise: no skip by distance), the answer c, n
-     * and 1 (0: nothing known), 12 doubles each: reach[72i + 12s ..].  Facts
+     * it was in front (0 otherwise: no skip by distance), the answer c, n,
+     * 1 (0: nothing known) and d₀ less the skip margin (0: no skip), 12
+     * doubles each: reach[72i + 12s ..].  Facts
      * about points, not particles: kept while the collider is the same;
      * particles reach_n .. n−1 (appended since) start with 0.  skip:
      * scratch of the round-0 points skipped by distance (5 doubles: the
@@ -1008,7 +1009,7 @@ void phc_particles_collision_queries(const phc_particles *p, size_t *queries, si
 }
 
 /* What the collision pass knows of one point (see struct phc_particles):
- * reach = {x₀, d₀, c, n, known} or NULL (nothing kept), whether a point
+ * reach = {x₀, d₀, c, n, known, d₀ − margin} or NULL (nothing kept), whether a point
  * far enough from x₀ may be skipped (closed supports), and the pass's
  * counters. */
 typedef struct point_memory {
@@ -1045,15 +1046,17 @@ static int push_point(phc_particles_closest_fn fn, void *user, double r, double 
     if (!fn)
         return 0;
     double *known = mem ? mem->reach : NULL;
-    if (known && mem->by_distance && known[3] > 0) {
-        const double g[3] = {x[0] - known[0], x[1] - known[1], x[2] - known[2]};
-        const double moved = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-        if (moved + r + skip_margin(known) < known[3]) { /* (NaN: no skip) */
+    if (known && mem->by_distance && known[11] > r) {
+        /* |x − x₀| < d₀ − margin − r, compared squared (known[11] = d₀ −
+           margin, kept with the answer; the margin covers the rounding) */
+        const double g[3] = {x[0] - known[0], x[1] - known[1], x[2] - known[2]}, room = known[11] - r;
+        const double moved2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (moved2 < room * room) { /* (NaN: no skip) */
             ++*mem->skipped;
             if (delta)
                 *delta = NAN;
             if (bound)
-                *bound = known[3] - moved - r;
+                *bound = known[3] - sqrt(moved2) - r;
             return 0;
         }
     }
@@ -1066,7 +1069,7 @@ static int push_point(phc_particles_closest_fn fn, void *user, double r, double 
             ++*mem->queries;
         if (fn(user, x, c, nf)) {
             if (known)
-                known[3] = known[10] = 0;
+                known[3] = known[10] = known[11] = 0;
             return 0;
         }
         if (known) {
@@ -1080,8 +1083,10 @@ static int push_point(phc_particles_closest_fn fn, void *user, double r, double 
     const double dist = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     const int front = e[0] * nf[0] + e[1] * nf[1] + e[2] * nf[2] >= 0;
     const double d = front ? dist : -dist;
-    if (known)
+    if (known) {
         known[3] = front && isfinite(dist) ? dist : 0;
+        known[11] = known[3] > 0 ? known[3] - skip_margin(known) : 0;
+    }
     if (delta)
         *delta = d;
     if (!(d < r))
@@ -1123,15 +1128,42 @@ static int push_segment(phc_particles_closest_fn fn, void *user, double r, doubl
         skip[5 * (*nskip)++ + 4] = lb;
     } else
         first = d - r; /* (as the plain push: fmin below) */
+    /* A round's outcome is a function of the state (x, axis) it starts
+     * from: when that state equals, bit for bit, the state of one of the
+     * last CYCLE rounds, the rounds between repeat until the last (a push
+     * that lands on the point it started from, rounding), so the whole
+     * cycles are counted (their pushes) without being made: the same
+     * state and count as making them (ours). */
+    enum { CYCLE = 4 };
+    double seen[CYCLE][6];
+    int seen_pushed[CYCLE], nseen = 0;
     for (int round = 0; round < rounds; ++round) {
         double a[3], b[3], da, db, la, lbb;
+        if (round > 0) {
+            for (int back = 1; back <= nseen && back <= CYCLE; ++back) {
+                const int j = (nseen - back) % CYCLE;
+                if (memcmp(seen[j], x, 3 * sizeof(double)) || memcmp(seen[j] + 3, axis, 3 * sizeof(double)))
+                    continue;
+                const int cycles = (rounds - round) / back;
+                pushed += cycles * (pushed - seen_pushed[j]);
+                round += cycles * back;
+                nseen = 0;
+                break;
+            }
+            if (round >= rounds)
+                break;
+            const int j = nseen++ % CYCLE;
+            memcpy(seen[j], x, 3 * sizeof(double));
+            memcpy(seen[j] + 3, axis, 3 * sizeof(double));
+            seen_pushed[j] = pushed;
+        }
         for (int k = 0; k < 3; ++k) {
             a[k] = x[k] - h * axis[k];
             b[k] = x[k] + h * axis[k];
         }
         const point_memory *m = mem ? mem + (round ? 3 : 0) : NULL; /* round 0; later rounds */
-        const int pa = push_point(fn, user, r, a, &da, m ? m + 1 : NULL, &la);
-        const int pb = push_point(fn, user, r, b, &db, m ? m + 2 : NULL, &lbb);
+        const int pa = push_point(fn, user, r, a, &da, m ? m + 1 : NULL, round ? NULL : &la);
+        const int pb = push_point(fn, user, r, b, &db, m ? m + 2 : NULL, round ? NULL : &lbb);
         if (round == 0) {
             if (!isnan(la)) {
                 for (int k = 0; k < 3; ++k)

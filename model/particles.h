@@ -343,7 +343,10 @@ void phc_particles_project_all(phc_particles *p, int on);
  * ends x_p ∓ R(q_p)(0, 0, L/2); when an end moved, the centre becomes the
  * pushed ends' midpoint and the axis their direction (length kept: q_p
  * turned by the shortest rotation from the old axis to the new), the
- * centre is pushed again, up to 64 rounds.  (A straight segment across a
+ * centre is pushed again, up to 64 rounds; a round that starts from the
+ * state (centre, axis) of one of the last four, bit for bit, would repeat
+ * the rounds between to the last, so their pushes are counted without
+ * being made (the same state and count).  (A straight segment across a
  * convex edge with both ends and its centre outside is not seen.)
  * Particles whose orientation is held (clamped) are left alone.  The
  * callback is called from one thread, particles in index order.  fn =

@@ -41,10 +41,22 @@
  *     E_1/2 = 1e7 Pa), without collide (see main); printed: the CPU time,
  *     particles, attached fraction, smallest signed distances, segments
  *     clipping, and the free tips' sag (free_tip_sag); checked: attached
- *     fraction > 0.8 and the free tips hang below their rest shape.
+ *     fraction > 0.8 and the free tips hang below their rest shape;
+ *   - with dynamics and collisions: the plant of
+ *     measurements/examples/climbing/wall_window_collide.yaml (the same
+ *     seed and values, dynamics.collide and supports_closed on
+ *     wall_window_closed.obj, the wall as a closed solid) grown as
+ *     `phytocal grow` grows it, then with the beam pass; printed: the CPU
+ *     time, particles, attached fraction, smallest signed distance minus
+ *     radius of a centre and of a segment end, segments clipping, and the
+ *     collision pass's closest-point queries (made, answered by the mesh's
+ *     tree or by a certificate, skipped); checked: every centre at least
+ *     its radius off the wall (>= -1e-12 m) and attached fraction > 0.8.
  *
  * Writes climbing_fig13_wall_front.png (the wall face, x–z),
  * climbing_fig13_wall_side.png (y–z: the plant's depth off the wall),
+ * climbing_fig13_wall_collide_side.png (y–z, the two plants grown with
+ * collisions on the closed wall),
  * climbing_fig13_wall.obj (stems as tubes, leaves as squares, the wall)
  * and climbing_fig13_wall.md.  Exit 1 when a check fails.
  *
@@ -58,6 +70,7 @@
 #include <omp.h>
 
 #include "fit/grow.h"
+#include "fit/grow_config.h"
 #include "fit/grow_mesh.h"
 #include "fit/shape_plots.h"
 #include "measurements/support_mesh.h"
@@ -219,17 +232,79 @@ static void free_tip_sag(const phc_climbing *c, size_t *count, double *mean, dou
     free(has_child);
 }
 
+/* How a plant is drawn: its stems coloured by branch order, its leaves as
+ * strokes across their blades (colour 3, half the thickest radius wide). */
+typedef struct strokes {
+    size_t n;                       /* stems + leaves */
+    double *head, *tail, *rad, *val; /* 3n, 3n, n (m), n */
+} strokes;
+
+static void strokes_free(strokes *s)
+{
+    free(s->head);
+    free(s->tail);
+    free(s->rad);
+    free(s->val);
+}
+
+/* The strokes of plant c; 0, or -1 when out of memory (s freed). */
+static int plant_strokes(const phc_climbing *c, strokes *s)
+{
+    const size_t n = phc_climbing_count(c), ns = n + phc_climbing_leaf_count(c);
+    s->n = ns;
+    s->head = malloc(3 * ns * sizeof *s->head);
+    s->tail = malloc(3 * ns * sizeof *s->tail);
+    s->rad = malloc(ns * sizeof *s->rad);
+    s->val = malloc(ns * sizeof *s->val);
+    if (!s->head || !s->tail || !s->rad || !s->val) {
+        strokes_free(s);
+        return -1;
+    }
+    double rmax = 0;
+    for (size_t i = 0; i < n; ++i)
+        rmax = fmax(rmax, phc_climbing_radius(c, i));
+    for (size_t i = 0, j = n; i < n; ++i) {
+        phc_climbing_segment(c, i, s->head + 3 * i, s->tail + 3 * i);
+        s->rad[i] = phc_climbing_radius(c, i);
+        s->val[i] = phc_climbing_order(c, i);
+        double q[12];
+        if (!phc_climbing_leaf_quad(c, i, q))
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            s->head[3 * j + k] = 0.5 * (q[k] + q[9 + k]);
+            s->tail[3 * j + k] = 0.5 * (q[3 + k] + q[6 + k]);
+        }
+        s->rad[j] = 0.5 * rmax;
+        s->val[j++] = 3;
+    }
+    return 0;
+}
+
+/* The views' options: colour = branch order 0-2, 3 for the leaves. */
+static phc_shape_plot_options order_plot_options(void)
+{
+    phc_shape_plot_options po = phc_shape_plot_options_default();
+    po.value_label = "branch order 0-2 (3 = leaves)";
+    po.value_min = 0;
+    po.value_max = 3;
+    po.max_line_width = 6;
+    return po;
+}
+
 /* A plant grown with dynamics and the numbers printed of it. */
 typedef struct dynamic_run {
     double cpu, wall;             /* s: the growth's process CPU time (all threads) and wall time */
     size_t n, anchored, clips, free_tips;
+    size_t queries, skipped, tree; /* collisions: closest-point queries made, skipped; made ones the mesh's tree answered */
     double min_sd, depth, end_depth; /* m: smallest signed distance of a centre; minus the radius; of an end */
     double sag_mean, sag_max, links; /* m, m, links (free_tip_sag) */
 } dynamic_run;
 
+/* keep (may be NULL) gets the plant (the caller frees it). */
 static int grow_dynamic(const phc_climbing_options *o, phc_support_mesh *wall, const double seed[3],
-                        const double up[3], size_t steps, double dt, dynamic_run *r)
+                        const double up[3], size_t steps, double dt, dynamic_run *r, phc_climbing **keep)
 {
+    const size_t tree0 = phc_support_mesh_tree_queries(wall);
     const clock_t cpu0 = clock();
     struct timespec w0, w1;
     clock_gettime(CLOCK_MONOTONIC, &w0);
@@ -239,6 +314,8 @@ static int grow_dynamic(const phc_climbing_options *o, phc_support_mesh *wall, c
     r->wall = (double)(w1.tv_sec - w0.tv_sec) + 1e-9 * (double)(w1.tv_nsec - w0.tv_nsec);
     if (!c)
         return -1;
+    r->tree = phc_support_mesh_tree_queries(wall) - tree0;
+    phc_climbing_collision_queries(c, &r->queries, &r->skipped);
     phc_climbing_stats st;
     phc_climbing_get_stats(c, &st);
     r->n = phc_climbing_count(c);
@@ -253,7 +330,10 @@ static int grow_dynamic(const phc_climbing_options *o, phc_support_mesh *wall, c
             r->min_sd = fmin(r->min_sd, (x[0] - cp[0]) * nf[0] + (x[1] - cp[1]) * nf[1] + (x[2] - cp[2]) * nf[2]);
     }
     free_tip_sag(c, &r->free_tips, &r->sag_mean, &r->sag_max, &r->links);
-    phc_climbing_free(c);
+    if (keep)
+        *keep = c;
+    else
+        phc_climbing_free(c);
     return 0;
 }
 
@@ -388,35 +468,17 @@ int main(int argc, char **argv)
 
     /* the views: stems coloured by branch order, leaves as strokes across
        their blades (colour 3), the wall's corners as markers */
-    const size_t ns = n + nl, nv = phc_support_mesh_vertex_count(wall);
-    double *head = malloc(3 * ns * sizeof *head), *tail = malloc(3 * ns * sizeof *tail);
-    double *rad = malloc(ns * sizeof *rad), *val = malloc(ns * sizeof *val), *mk = malloc(3 * nv * sizeof *mk);
-    if (!head || !tail || !rad || !val || !mk)
+    const size_t nv = phc_support_mesh_vertex_count(wall);
+    strokes st0;
+    double *mk = malloc(3 * nv * sizeof *mk);
+    if (!mk || plant_strokes(c, &st0))
         return 1;
-    for (size_t i = 0, j = n; i < n; ++i) {
-        phc_climbing_segment(c, i, head + 3 * i, tail + 3 * i);
-        rad[i] = phc_climbing_radius(c, i);
-        val[i] = phc_climbing_order(c, i);
-        double q[12];
-        if (!phc_climbing_leaf_quad(c, i, q))
-            continue;
-        for (int k = 0; k < 3; ++k) {
-            head[3 * j + k] = 0.5 * (q[k] + q[9 + k]);
-            tail[3 * j + k] = 0.5 * (q[3 + k] + q[6 + k]);
-        }
-        rad[j] = 0.5 * rmax;
-        val[j++] = 3;
-    }
     for (size_t i = 0; i < nv; ++i)
         phc_support_mesh_vertex(wall, i, mk + 3 * i);
     char title[256];
     snprintf(title, sizeof title, "%zu particles, %zu leaves after %g s", n, nl, duration);
-    phc_shape_panel pan = {ns, head, tail, rad, val, title, nv, mk, "wall, window and ledge corners"};
-    phc_shape_plot_options po = phc_shape_plot_options_default();
-    po.value_label = "branch order 0-2 (3 = leaves)";
-    po.value_min = 0;
-    po.value_max = 3;
-    po.max_line_width = 6;
+    phc_shape_panel pan = {st0.n, st0.head, st0.tail, st0.rad, st0.val, title, nv, mk, "wall, window and ledge corners"};
+    phc_shape_plot_options po = order_plot_options();
     po.page_width = 900;
     po.page_height = 820;
     po.title = "Fig. 13: a vine on a wall, front view (x-z)";
@@ -487,10 +549,8 @@ int main(int argc, char **argv)
     phc_climbing_free(cends);
 
     /* the same seed grown with dynamics, in Fig. 12's 0.01 s substeps, with
-       each of the two joint passes; without collide (with it the pushes of
-       every centre and both segment ends, three or more closest-point
-       queries per particle per substep, took 127 s (own weight) and 130 s
-       (beam) CPU on one thread).  On one thread: the particles' threads
+       each of the two joint passes; without collide (with collide see
+       below).  On one thread: the particles' threads
        start at 1024 particles (model/particles.c), and at this plant's
        1200–1400 their barriers in each of the 24,000 substeps cost more
        than they save on a shared machine (the beam run took 36.8 s CPU on
@@ -505,7 +565,7 @@ int main(int argc, char **argv)
         od.dynamics_substeps = (size_t)llround(dt / 0.01);
         od.particles.bending = k ? PHC_PARTICLES_BEAM : PHC_PARTICLES_OWN_WEIGHT;
         od.particles.beam_modulus = 1e7; /* Fig. 12's E_1/2 */
-        if (grow_dynamic(&od, wall, seed, up, steps, dt, &dyn[k]))
+        if (grow_dynamic(&od, wall, seed, up, steps, dt, &dyn[k], NULL))
             return 1;
         const dynamic_run *r = &dyn[k];
         printf("the same seed with dynamics (%zu substeps of %g s per step, gravity, anchors; bending %s%s): CPU "
@@ -531,7 +591,92 @@ int main(int argc, char **argv)
     printf("check: with dynamics (both passes) most particles stay attached (> 0.8) and the free tips hang below "
            "their rest shape (mean drop > 0): %s\n",
            c8 ? "pass" : "FAIL");
-    const int ok = c1 && c2 && c3 && c4 && c5 && c6 && c7 && c8;
+
+    /* the same seed with dynamics and collisions, grown as `phytocal grow
+       measurements/examples/climbing/wall_window_collide.yaml` grows it
+       (the config read by the grow config's own reader, its light grid,
+       support and shadows set up as fit/grow.c does): the wall as a closed
+       solid (wall_window_closed.obj, the same face, recess and ledge), so
+       that supports_closed holds and the collision pass skips the points
+       too far off it to be pushed; then the beam pass (the one key
+       changed).  One thread, as above. */
+    phc_grow_config *cfg = NULL;
+    if (phc_grow_config_load(PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window_collide.yaml", &cfg, &err)) {
+        fprintf(stderr, "%s\n", err.message);
+        return 1;
+    }
+    phc_support_mesh *solid = phc_support_mesh_read(cfg->support, &err);
+    if (!solid) {
+        fprintf(stderr, "%s\n", err.message);
+        return 1;
+    }
+    dynamic_run col[2];
+    phc_climbing *collided[2] = {NULL, NULL};
+    int c9 = 1;
+    omp_set_num_threads(1);
+    for (int k = 0; k < 2; ++k) {
+        phc_climbing_options oc = cfg->options;
+        phc_grow_light_grid(cfg, solid, &oc);
+        oc.closest = phc_support_mesh_closest;
+        oc.closest_user = solid;
+        if (k) {
+            oc.particles.bending = PHC_PARTICLES_BEAM;
+            oc.particles.beam_modulus = 1e7; /* Fig. 12's E_1/2 */
+        }
+        if (grow_dynamic(&oc, solid, cfg->position, cfg->direction, (size_t)llround(cfg->duration / cfg->time_step),
+                         cfg->time_step, &col[k], &collided[k]))
+            return 1;
+        const dynamic_run *r = &col[k];
+        printf("with collisions (wall_window_collide.yaml: the wall as a closed solid, dynamics.collide and "
+               "supports_closed; bending %s%s): CPU %.1f s, wall %.1f s\n",
+               k ? "beam" : "own_weight", k ? ", E_1/2 1e7 Pa" : "", r->cpu, r->wall);
+        printf("  %zu particles, attached %zu (%.3f); smallest signed distance minus radius of a centre %.3g m, of a "
+               "segment end %.3g m; %zu segments clip\n",
+               r->n, r->anchored, (double)r->anchored / (double)r->n, r->depth, r->end_depth, r->clips);
+        printf("  closest-point queries of the collision pass: %zu made (%zu by the mesh's tree, %zu by a "
+               "certificate), %zu skipped\n",
+               r->queries, r->tree, r->queries - r->tree, r->skipped);
+        c9 &= r->depth >= -1e-12 && (double)r->anchored / (double)r->n > 0.8;
+    }
+    omp_set_num_threads(threads);
+    printf("check: with collisions (both passes) every centre keeps its radius off the wall (smallest signed distance "
+           "minus radius >= -1e-12 m) and most particles stay attached (> 0.8): %s\n",
+           c9 ? "pass" : "FAIL");
+    /* their side views (y-z), the closed wall's corners as markers */
+    {
+        const size_t ncv = phc_support_mesh_vertex_count(solid);
+        strokes sc[2];
+        double *cmk = malloc(3 * ncv * sizeof *cmk);
+        if (!cmk || plant_strokes(collided[0], &sc[0]) || plant_strokes(collided[1], &sc[1]))
+            return 1;
+        for (size_t i = 0; i < ncv; ++i)
+            phc_support_mesh_vertex(solid, i, cmk + 3 * i);
+        char ctitle[2][128];
+        phc_shape_panel cpan[2];
+        for (int k = 0; k < 2; ++k) {
+            snprintf(ctitle[k], sizeof ctitle[k], "%s: %zu particles, %zu clip", k ? "beam" : "own weight",
+                     phc_climbing_count(collided[k]), col[k].clips);
+            cpan[k] = (phc_shape_panel){sc[k].n, sc[k].head, sc[k].tail, sc[k].rad, sc[k].val, ctitle[k], ncv, cmk,
+                                        "closed wall's corners"};
+        }
+        phc_shape_plot_options cpo = order_plot_options();
+        cpo.across_axis = 1;
+        cpo.columns = 2;
+        cpo.page_width = 1300;
+        cpo.page_height = 1200; /* (tall: the narrow y axis then keeps its labels apart) */
+        cpo.title = "Fig. 13 with collisions, side view (y-z; wall face at y = 0)";
+        snprintf(path, sizeof path, "%s/climbing_fig13_wall_collide_side.png", out);
+        if (phc_shape_plot(path, cpan, 2, &cpo, &err)) {
+            fprintf(stderr, "%s\n", err.message);
+            return 1;
+        }
+        strokes_free(&sc[0]);
+        strokes_free(&sc[1]);
+        free(cmk);
+        phc_climbing_free(collided[0]);
+        phc_climbing_free(collided[1]);
+    }
+    const int ok = c1 && c2 && c3 && c4 && c5 && c6 && c7 && c8 && c9;
 
     char md[1024], mdtmp[1024];
     FILE *f = nb_open_md(out, "climbing_fig13_wall.md", md, mdtmp, sizeof md);
@@ -554,23 +699,31 @@ int main(int argc, char **argv)
             "free tips | their mean / largest drop (cm) |\n|---|---|---|---|---|---|---|\n"
             "| own_weight | %zu | %.3f | %.3g | %zu | %zu | %.2f / %.2f |\n"
             "| beam (E_1/2 1e7 Pa) | %zu | %.3f | %.3g | %zu | %zu | %.2f / %.2f |\n\n"
+            "**With dynamics and collisions** (`measurements/examples/climbing/wall_window_collide.yaml`: the wall as a "
+            "closed solid, every centre and segment end pushed out in every substep):\n\n"
+            "![collisions](climbing_fig13_wall_collide_side.png)\n\n"
+            "| joint pass | particles | attached fraction | smallest signed distance − radius, centre / end (m) | "
+            "segments clipping | CPU (s) |\n|---|---|---|---|---|---|\n"
+            "| own_weight | %zu | %.3f | %.3g / %.3g | %zu | %.1f |\n"
+            "| beam (E_1/2 1e7 Pa) | %zu | %.3f | %.3g / %.3g | %zu | %.1f |\n\n"
             "**Checks**: %s.  The mesh `climbing_fig13_wall.obj` opens in any viewer.\n",
             duration, n, nl, mean_cos, attached, area, min_sd, min_depth, crossing, lu, le, dyn[0].n,
             (double)dyn[0].anchored / (double)dyn[0].n, dyn[0].min_sd, dyn[0].clips, dyn[0].free_tips,
             100 * dyn[0].sag_mean, 100 * dyn[0].sag_max, dyn[1].n, (double)dyn[1].anchored / (double)dyn[1].n,
-            dyn[1].min_sd, dyn[1].clips, dyn[1].free_tips, 100 * dyn[1].sag_mean, 100 * dyn[1].sag_max,
-            ok ? "all pass" : "**some FAIL** (see the program's output)");
+            dyn[1].min_sd, dyn[1].clips, dyn[1].free_tips, 100 * dyn[1].sag_mean, 100 * dyn[1].sag_max, col[0].n,
+            (double)col[0].anchored / (double)col[0].n, col[0].depth, col[0].end_depth, col[0].clips, col[0].cpu,
+            col[1].n, (double)col[1].anchored / (double)col[1].n, col[1].depth, col[1].end_depth, col[1].clips,
+            col[1].cpu, ok ? "all pass" : "**some FAIL** (see the program's output)");
     if (nb_close_md(f, md, mdtmp) != 0) {
         fprintf(stderr, "%s: cannot write the page\n", md);
         return 1;
     }
-    free(head);
-    free(tail);
-    free(rad);
-    free(val);
+    strokes_free(&st0);
     free(mk);
     phc_climbing_free(c);
     phc_support_mesh_free(wall);
+    phc_support_mesh_free(solid);
+    phc_grow_config_free(cfg);
     printf("%s: %s\n", ok ? "ok" : "FAIL", out);
     return !ok;
 }

@@ -146,7 +146,7 @@ int main(void)
         fprintf(f, "plant:\n  position: [0, 0.01, 0]\nlight:\n  ambient: 0.2\n"
                    "  supports_cast_shadows: false\nleaves:\n  step: 2\n  angle: 120\n  size: 0.04\n"
                    "  thickness: 0.0005\n  response: 0.7\n  max_angle: 60\ncambium:\n  rate: 0.05\n"
-                   "  leaf_area: 1e-6\ndynamics:\n  collide: true\n  collide_ends: true\n");
+                   "  leaf_area: 1e-6\ndynamics:\n  collide: true\n  collide_ends: true\n  supports_closed: true\n");
         fclose(f);
         phc_grow_config *cfg = NULL;
         CHECK(phc_grow_config_load(path, &cfg, &err) == PHC_OK);
@@ -161,8 +161,9 @@ int main(void)
             CHECK(o->leaf_angle_deg == 120 && o->leaf_size == 0.04 && o->leaf_thickness == 0.0005);
             CHECK(o->leaf_response == 0.7 && o->leaf_max_angle_deg == 60);
             CHECK(o->cambium_rate == 0.05 && o->leaf_pipe_area == 1e-6);
-            printf("config: dynamics.collide %d, collide_ends %d\n", o->collide, o->collide_ends);
-            CHECK(o->collide == 1 && o->collide_ends == 1);
+            printf("config: dynamics.collide %d, collide_ends %d, supports_closed %d\n", o->collide, o->collide_ends,
+                   o->supports_closed);
+            CHECK(o->collide == 1 && o->collide_ends == 1 && o->supports_closed == 1);
         }
         phc_grow_config_free(cfg);
         /* defaults: shadows on, no leaves, no secondary growth */
@@ -174,7 +175,7 @@ int main(void)
             printf("config defaults: shadows %d, leaves step %u, cambium rate %g, collide %d\n", cfg->shadows,
                    cfg->options.leaf_step, cfg->options.cambium_rate, cfg->options.collide);
             CHECK(cfg->shadows == 1 && cfg->options.leaf_step == 0 && cfg->options.cambium_rate == 0);
-            CHECK(cfg->options.collide == 0 && cfg->options.collide_ends == 0);
+            CHECK(cfg->options.collide == 0 && cfg->options.collide_ends == 0 && cfg->options.supports_closed == 0);
         }
         phc_grow_config_free(cfg);
         unlink(path);

@@ -10,7 +10,20 @@
  *     both to 1e-12.
  *  3. Files: an OBJ square and an ASCII PLY tetrahedron read with the right
  *     triangle counts; a file that is not a mesh, an OBJ with vertices but
- *     no faces and a missing file are refused with the file named. */
+ *     no faces and a missing file are refused with the file named.
+ *  4. Certified answers (phc_support_mesh_certificates): points that walk
+ *     near Fig. 13's wall (measurements/examples/climbing/wall_window.obj)
+ *     and near the sphere of 2., in steps from 1 nm to 5 mm (some
+ *     repeated, some on the bisector of a convex edge, where two triangles
+ *     tie), asked of one mesh with certificates and of a copy without:
+ *     the same closest point and normal bit for bit at every point, and
+ *     most answers certified (the tree answers fewer than half).
+ *  5. The closed wall (wall_window_closed.obj, for the climbing option
+ *     supports_closed): at random points around it the side of the
+ *     closest face, (x − c)·n < 0, says inside exactly where the solid's
+ *     own description (the slab minus the window's recess, plus the
+ *     ledge) does; and before its face (y > 0 off the ledge) its closest
+ *     points are those of the open wall_window.obj. */
 #include "measurements/support_mesh.h"
 
 #include <math.h>
@@ -213,6 +226,114 @@ int main(void)
         remove(ply);
         remove(junk);
         remove(pts);
+    }
+    /* 4. certified answers against the tree's */
+    {
+        phc_support_mesh *m[2][2] = {{NULL, NULL}, {NULL, NULL}};
+        for (int j = 0; j < 2; ++j)
+            m[0][j] = phc_support_mesh_read(PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window.obj", &err);
+        double *V;
+        size_t *F, nv, nf;
+        sphere(3, &V, &nv, &F, &nf);
+        for (int j = 0; j < 2; ++j)
+            m[1][j] = phc_support_mesh_from_arrays(V, nv, F, nf, "sphere", &err);
+        free(V);
+        free(F);
+        CHECK(m[0][0] && m[0][1] && m[1][0] && m[1][1]);
+        const char *name[2] = {"wall with a window and a ledge", "sphere"};
+        /* walks start here (m): before the wall's face, in the window's
+           recess, under the ledge; just outside the sphere */
+        const double start[2][3][3] = {{{-0.1, 0.004, 0.3}, {0.0, -0.02, 0.7}, {0.1, 0.01, 0.9}},
+                                       {{1.003, 0, 0}, {0, 0.6, 0.803}, {-0.58, -0.58, 0.58}}};
+        unsigned long long s = 2026;
+        for (int w = 0; w < 2 && m[w][0] && m[w][1]; ++w) {
+            phc_support_mesh_certificates(m[w][1], 0);
+            const size_t before = phc_support_mesh_tree_queries(m[w][0]);
+            size_t asked = 0, differ = 0;
+            for (int walk = 0; walk < 3; ++walk) {
+                double x[3] = {start[w][walk][0], start[w][walk][1], start[w][walk][2]};
+                for (int q = 0; q < 20000; ++q) {
+                    double u[4];
+                    for (int k = 0; k < 4; ++k) {
+                        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+                        u[k] = (double)(s >> 11) * 0x1.0p-53;
+                    }
+                    /* a step of 1 nm .. 5 mm (log-uniform), every 8th none */
+                    const double step = q % 8 == 7 ? 0 : 1e-9 * pow(5e6, u[3]);
+                    for (int k = 0; k < 3; ++k)
+                        x[k] += step * (2 * u[k] - 1);
+                    if (w == 0 && q % 16 == 3) { /* on the bisector of the reveal's convex edge x = -0.2, y = 0 */
+                        x[0] = -0.2 + 0.5 * u[0] * 0.01;
+                        x[1] = x[0] + 0.2;
+                    }
+                    double c[2][3], n[2][3];
+                    const int r0 = phc_support_mesh_closest(m[w][0], x, c[0], n[0]);
+                    const int r1 = phc_support_mesh_closest(m[w][1], x, c[1], n[1]);
+                    ++asked;
+                    differ += r0 != 0 || r1 != 0 || memcmp(c[0], c[1], sizeof c[0]) || memcmp(n[0], n[1], sizeof n[0]);
+                    /* keep the walk near the surface: back onto its closest point plus 0..8 mm */
+                    const double e[3] = {x[0] - c[0][0], x[1] - c[0][1], x[2] - c[0][2]};
+                    const double d = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+                    if (d > 0.008)
+                        for (int k = 0; k < 3; ++k)
+                            x[k] = c[0][k] + 0.008 * u[k] * (e[k] / d);
+                }
+            }
+            const size_t tree = phc_support_mesh_tree_queries(m[w][0]) - before;
+            printf("certified answers, %s: %zu points asked, %zu answered by the tree, %zu by a certificate; "
+                   "answers that differ from the tree's: %zu\n",
+                   name[w], asked, tree, asked - tree, differ);
+            CHECK(differ == 0);
+            CHECK(2 * tree < asked);
+            CHECK(phc_support_mesh_tree_queries(m[w][1]) == asked);
+        }
+        for (int w = 0; w < 2; ++w)
+            for (int j = 0; j < 2; ++j)
+                phc_support_mesh_free(m[w][j]);
+    }
+    /* 5. the closed wall: inside and outside by the closest face's side */
+    {
+        phc_support_mesh *closed =
+            phc_support_mesh_read(PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window_closed.obj", &err);
+        phc_support_mesh *open =
+            phc_support_mesh_read(PHC_SOURCE_DIR "/measurements/examples/climbing/wall_window.obj", &err);
+        CHECK(closed != NULL && open != NULL);
+        size_t asked = 0, inside = 0, wrong = 0, front = 0, front_differ = 0;
+        unsigned long long s = 13;
+        for (int q = 0; closed && open && q < 20000; ++q) {
+            double u[3], x[3], c[3], n[3];
+            for (int k = 0; k < 3; ++k) {
+                s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+                u[k] = (double)(s >> 11) * 0x1.0p-53;
+            }
+            x[0] = -0.7 + 1.4 * u[0];
+            x[1] = -0.3 + 0.45 * u[1];
+            x[2] = -0.1 + 1.4 * u[2];
+            const int slab = x[0] > -0.6 && x[0] < 0.6 && x[1] > -0.2 && x[1] < 0 && x[2] > 0 && x[2] < 1.2;
+            const int recess = x[0] > -0.2 && x[0] < 0.2 && x[1] > -0.04 && x[2] > 0.5 && x[2] < 0.9;
+            const int ledge = x[0] > -0.3 && x[0] < 0.3 && x[1] >= 0 && x[1] < 0.08 && x[2] > 0.92 && x[2] < 0.96;
+            const int in = (slab && !recess) || ledge;
+            CHECK(phc_support_mesh_closest(closed, x, c, n) == 0);
+            const int behind = (x[0] - c[0]) * n[0] + (x[1] - c[1]) * n[1] + (x[2] - c[2]) * n[2] < 0;
+            ++asked;
+            inside += (size_t)in;
+            wrong += (size_t)(behind != in);
+            if (x[1] > 0 && fabs(x[0]) < 0.6 && x[2] > 0 && x[2] < 1.2 && !(fabs(x[0]) < 0.3 && x[2] > 0.92 && x[2] < 0.96)) {
+                double co[3], no[3];
+                phc_support_mesh_closest(open, x, co, no);
+                const double e[3] = {x[0] - c[0], x[1] - c[1], x[2] - c[2]}, eo[3] = {x[0] - co[0], x[1] - co[1], x[2] - co[2]};
+                ++front;
+                front_differ += fabs(sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) -
+                                     sqrt(eo[0] * eo[0] + eo[1] * eo[1] + eo[2] * eo[2])) > 1e-12;
+            }
+        }
+        printf("closed wall (%zu triangles): %zu points, %zu inside the solid, %zu on the wrong side of their closest "
+               "face; %zu before the face off the ledge, %zu whose distance differs from the open wall's\n",
+               phc_support_mesh_triangle_count(closed), asked, inside, wrong, front, front_differ);
+        CHECK(wrong == 0 && inside > 1000);
+        CHECK(front > 1000 && front_differ == 0);
+        phc_support_mesh_free(closed);
+        phc_support_mesh_free(open);
     }
     return check_finish("test_support_mesh");
 }
