@@ -2735,7 +2735,8 @@ static void follow_lanes(phc_particles *p, const size_t *idx, int nl, double dt2
     }
 }
 
-/* follow_one on order[lo .. hi) (the linked ones); with `check`, each
+/* follow_one (beam_one for beams) on order[lo .. hi) (the linked ones),
+ * the own-weight links four at a time (follow_lanes); with `check`, each
  * particle's new state is checked there, while it is in the cache (the
  * smallest non-finite index lowers *bad). */
 static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, double T2, int check,
@@ -2743,20 +2744,13 @@ static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, doub
 {
     const size_t *order = p->follow_order;
     const double dt2 = dt * dt;
-    if (p->o.bending == PHC_PARTICLES_BEAM) {
+    const int beam = p->o.bending == PHC_PARTICLES_BEAM;
+    if (beam || p->lanes_off) { /* one link at a time, in the order */
         for (size_t t = lo; t < hi; ++t) {
             const size_t i = order[t];
-            if (p->linked[i])
+            if (p->linked[i] && beam)
                 beam_one(p, i, dt, T2);
-            if (check && i < *bad && !state_finite(p, i))
-                *bad = i;
-        }
-        return;
-    }
-    if (p->lanes_off) {
-        for (size_t t = lo; t < hi; ++t) {
-            const size_t i = order[t];
-            if (p->linked[i])
+            else if (p->linked[i])
                 follow_one(p, i, dt2, T2);
             if (check && i < *bad && !state_finite(p, i))
                 *bad = i;
