@@ -3,6 +3,7 @@
  * choices made where the paper is terse, and the units. */
 #include "model/particles.h"
 #include "model/quaternion.h"
+#include "model/particles_joint_lanes.h"
 #include "model/trig_inline.h"
 
 #include <lapacke.h>
@@ -87,6 +88,14 @@ struct phc_particles {
     size_t *follow_order;    /* n */
     size_t *follow_start;    /* n + 1 */
     size_t *subtree;         /* n: subtree sizes (scratch of the order) */
+    /* The same top and items, each sorted by depth inside it (parents at
+     * a smaller depth), lane_level[t] the depth of lane_order[t]: the
+     * links of one depth wait for none of each other, and the own-weight
+     * pass runs them four at a time (follow_lanes); lanes_off: one at a
+     * time (phc_particles_joint_lanes). */
+    size_t *lane_order;      /* n */
+    size_t *lane_level;      /* n */
+    int lanes_off;
     size_t *fstack;          /* n: depth-first stack (scratch of the order) */
     /* The projections that can change the result (plan_projections): the
      * particles to blend at iteration t are plist[0 .. pcount[t]) (t = 0:
@@ -543,6 +552,8 @@ void phc_particles_free(phc_particles *p)
     free(p->follow_order);
     free(p->follow_start);
     free(p->subtree);
+    free(p->lane_order);
+    free(p->lane_level);
     free(p->fstack);
     free(p->plist);
     free(p->gmatch);
@@ -628,6 +639,8 @@ phc_particles *phc_particles_new(const phc_plant_graph *g, const phc_particles_o
     ALLOC(follow_order, n);
     ALLOC(follow_start, n + 1);
     ALLOC(subtree, n);
+    ALLOC(lane_order, n);
+    ALLOC(lane_level, n);
     ALLOC(fstack, n);
     ALLOC(plist, n);
     ALLOC(gmatch, n);
@@ -779,6 +792,8 @@ static int reserve(phc_particles *p, size_t want)
     GROW(topo, 1);
     GROW(follow_order, 1);
     GROW(subtree, 1);
+    GROW(lane_order, 1);
+    GROW(lane_level, 1);
     GROW(fstack, 1);
     GROW(plist, 1);
     GROW(gmatch, 1);
@@ -1930,6 +1945,12 @@ void phc_particles_project_all(phc_particles *p, int on)
         p->project_all = on != 0;
 }
 
+void phc_particles_joint_lanes(phc_particles *p, int on)
+{
+    if (p)
+        p->lanes_off = on == 0;
+}
+
 /* The anchor of particle i (eq. 5) on its predicted state: x_p ← x_p +
  * k_a (a − x_p), exactly a when k_a = 1; q_p ← the held orientation when
  * it is held. */
@@ -2555,6 +2576,38 @@ double phc_particles_bend_stress(const phc_particles *p, size_t i)
     return bend_stress_of(p, i);
 }
 
+/* follow_order[lo .. hi) (the top or an item: parents before children)
+ * into lane_order[lo .. hi), stably sorted by the depth in it (0: the
+ * item's root, or a root of the plant in the top; a particle's parent is
+ * in the range otherwise), the depths into lane_level (a counting sort;
+ * dep, cnt: scratch of n each). */
+static void lanes_by_depth(phc_particles *p, size_t lo, size_t hi, size_t *dep, size_t *cnt)
+{
+    const size_t *order = p->follow_order;
+    size_t deepest = 0;
+    for (size_t t = lo; t < hi; ++t) {
+        const size_t i = order[t], u = p->parent[i];
+        dep[i] = t == lo || u == PHC_PLANT_NO_PARENT ? 0 : dep[u] + 1;
+        deepest = dep[i] > deepest ? dep[i] : deepest;
+    }
+    if (hi == lo)
+        return;
+    for (size_t d = 0; d <= deepest; ++d) /* (deepest < hi − lo <= n) */
+        cnt[d] = 0;
+    for (size_t t = lo; t < hi; ++t)
+        ++cnt[dep[order[t]]];
+    for (size_t d = 0, sum = lo; d <= deepest; ++d) {
+        const size_t c = cnt[d];
+        cnt[d] = sum;
+        sum += c;
+    }
+    for (size_t t = lo; t < hi; ++t) {
+        const size_t i = order[t], at = cnt[dep[i]]++;
+        p->lane_order[at] = i;
+        p->lane_level[at] = dep[i];
+    }
+}
+
 /* The joint pass's order (see struct phc_particles): subtree sizes, the
  * top of the tree (subtrees of more than n/32 + 1 particles, a set closed
  * upwards, in topological order), then each subtree hanging from the top
@@ -2593,6 +2646,11 @@ static void follow_order_build(phc_particles *p)
     }
     p->follow_start[items] = m;
     p->follow_items = items;
+    /* the lanes' order: the top, then each item, sorted by depth (sz and
+       the stack are free again) */
+    lanes_by_depth(p, 0, p->follow_top, sz, stack);
+    for (size_t item = 0; item < items; ++item)
+        lanes_by_depth(p, p->follow_start[item], p->follow_start[item + 1], sz, stack);
     p->follow_dirty = 0;
 }
 
@@ -2642,7 +2700,75 @@ static inline void finish_one(phc_particles *p, size_t i, double keep_dt, double
     p->agen[i] = p->age[i] + dt;
 }
 
-/* follow_one on order[lo .. hi) (the linked ones); with `check`, each
+/* follow_one on the linked particles idx[0 .. nl) (nl <= 4), none of
+ * them the parent of another, four lanes of phc_joint_lanes at once
+ * (follow_one's numbers bit for bit): the lanes gathered (their rest
+ * terms made when stale, as follow_one makes them), computed, scattered;
+ * follow_one for the ones the lanes leave (s = 0 keeps its state), then
+ * each one's anchor. */
+static void follow_lanes(phc_particles *p, const size_t *idx, int nl, double dt2, double T2)
+{
+    phc_joint_lanes_in in;
+    phc_joint_lanes_out out;
+    size_t lane[4];
+    int used = 0;
+    for (int a = 0; a < nl; ++a) {
+        const size_t i = idx[a], u = p->parent[i];
+        const double s = stiffness_of(p, i);
+        if (!(s > 0))
+            continue; /* s = 0: no hold */
+        const int l = used++;
+        lane[l] = i;
+        in.k[l] = s >= 1 ? 1.0 : s * dt2 / (s * dt2 + (1 - s) * T2);
+        const double half = p->ax[3 * i + 2], *ju = joint_terms(p, i, u, half);
+        const double *qu = p->qp + 4 * u, *qt = p->q + 4 * i, *f = p->f + 3 * i;
+        const int loaded = f[0] != 0 || f[1] != 0 || f[2] != 0;
+        in.half[l] = half;
+        for (int d = 0; d < 4; ++d) {
+            in.qu[d][l] = qu[d];
+            in.rel[d][l] = ju[3 + d];
+            in.qt[d][l] = qt[d];
+        }
+        for (int d = 0; d < 3; ++d) {
+            in.xu[d][l] = p->xp[3 * u + d];
+            in.ju[d][l] = ju[d];
+            in.acc[d][l] = p->o.gravity[d] + (loaded ? f[d] / p->m[i] : 0.0);
+        }
+    }
+    if (!used)
+        return;
+    for (int l = used; l < 4; ++l) { /* idle lanes: copies of lane 0 */
+        in.k[l] = in.k[0];
+        in.half[l] = in.half[0];
+        for (int d = 0; d < 4; ++d) {
+            in.qu[d][l] = in.qu[d][0];
+            in.rel[d][l] = in.rel[d][0];
+            in.qt[d][l] = in.qt[d][0];
+        }
+        for (int d = 0; d < 3; ++d) {
+            in.xu[d][l] = in.xu[d][0];
+            in.ju[d][l] = in.ju[d][0];
+            in.acc[d][l] = in.acc[d][0];
+        }
+    }
+    const int placed = phc_joint_lanes(&in, dt2, &out);
+    for (int l = 0; l < used; ++l) {
+        const size_t i = lane[l];
+        if (!(placed >> l & 1)) {
+            follow_one(p, i, dt2, T2); /* (its anchor too) */
+            continue;
+        }
+        for (int d = 0; d < 4; ++d)
+            p->qp[4 * i + d] = out.q[d][l];
+        for (int d = 0; d < 3; ++d)
+            p->xp[3 * i + d] = out.x[d][l];
+        if (p->anchored[i]) /* as after every projection */
+            apply_anchor(p, i);
+    }
+}
+
+/* follow_one (beam_one for beams) on order[lo .. hi) (the linked ones),
+ * the own-weight links four at a time (follow_lanes); with `check`, each
  * particle's new state is checked there, while it is in the cache (the
  * smallest non-finite index lowers *bad). */
 static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, double T2, int check,
@@ -2650,22 +2776,33 @@ static void follow_range(phc_particles *p, size_t lo, size_t hi, double dt, doub
 {
     const size_t *order = p->follow_order;
     const double dt2 = dt * dt;
-    if (p->o.bending == PHC_PARTICLES_BEAM) {
+    const int beam = p->o.bending == PHC_PARTICLES_BEAM;
+    if (beam || p->lanes_off) { /* one link at a time, in the order */
         for (size_t t = lo; t < hi; ++t) {
             const size_t i = order[t];
-            if (p->linked[i])
+            if (p->linked[i] && beam)
                 beam_one(p, i, dt, T2);
+            else if (p->linked[i])
+                follow_one(p, i, dt2, T2);
             if (check && i < *bad && !state_finite(p, i))
                 *bad = i;
         }
         return;
     }
-    for (size_t t = lo; t < hi; ++t) {
-        const size_t i = order[t];
-        if (p->linked[i])
-            follow_one(p, i, dt2, T2);
-        if (check && i < *bad && !state_finite(p, i))
-            *bad = i;
+    /* the same range sorted by depth: up to four linked links of one
+     * depth at a time (no one of them waits for another) */
+    const size_t *lorder = p->lane_order, *level = p->lane_level;
+    for (size_t t = lo; t < hi;) {
+        const size_t t0 = t, depth = level[t];
+        size_t idx[4];
+        int nl = 0;
+        for (; t < hi && level[t] == depth && nl < 4; ++t)
+            if (p->linked[lorder[t]])
+                idx[nl++] = lorder[t];
+        follow_lanes(p, idx, nl, dt2, T2);
+        for (size_t a = t0; check && a < t; ++a)
+            if (lorder[a] < *bad && !state_finite(p, lorder[a]))
+                *bad = lorder[a];
     }
 }
 

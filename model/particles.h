@@ -328,6 +328,14 @@ void phc_particles_measure_stress(phc_particles *p, int on);
  * rounding only, through the polar warm starts).  Default off. */
 void phc_particles_project_all(phc_particles *p, int on);
 
+/* The own-weight joint pass places up to four links of one depth (in the
+ * top of the tree or in a subtree handed to a thread) in one instruction
+ * stream (ours; the same operations per link, so the same numbers bit for
+ * bit: a shoot's links otherwise run one after another, each waiting for
+ * its parent).  on = 0: one link at a time, in the pass's order (for tests
+ * comparing the two).  Default on. */
+void phc_particles_joint_lanes(phc_particles *p, int on);
+
 /* Collisions with supports (ours; the climbing paper's particles only
  * attach to them).  fn gives the closest support point c (m) to x and the
  * unit outward face normal n there (0; nonzero: no support).  With a
