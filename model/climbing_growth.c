@@ -1003,8 +1003,7 @@ static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
                 first_error(i, &mine, &first_bad, err);
         }
         const size_t blocks = (n - 1 + HAND_BLOCK - 1) / HAND_BLOCK; /* (the seed's after) */
-        /* (dynamic: the thread that made fewer changes takes more blocks) */
-#pragma omp for schedule(dynamic, 4)
+#pragma omp for schedule(static)
         for (size_t b = 0; b < blocks; ++b) {
             const size_t lo = 1 + b * HAND_BLOCK, hi = lo + HAND_BLOCK < n ? lo + HAND_BLOCK : n;
             size_t bad;

@@ -347,26 +347,6 @@ static void clear_grid(const phc_climbing_light_grid *g, double *phi)
         memset(phi + b, 0, (cells - b < block ? cells - b : block) * sizeof *phi);
 }
 
-/* φ += each point's volume fraction in its own cell, the points in
- * index order (so the sums are reproducible): each thread of the team
- * adds into its share of the cells (a contiguous range), walking all the
- * points, so a cell's sum is the same on any number of threads.  Ends with
- * a barrier. */
-static void deposit(const light_run *r)
-{
-    const size_t cells = phc_climbing_light_cells(r->g);
-    const size_t tid = (size_t)omp_get_thread_num(), nth = (size_t)omp_get_num_threads();
-    const size_t lo = cells * tid / nth, hi = cells * (tid + 1) / nth;
-    const double h3 = r->g->cell * r->g->cell * r->g->cell;
-    for (size_t i = 0; i < r->n; ++i)
-        if (r->light[i] < 0) {
-            const size_t c = pending_cell(r->light[i]);
-            if (c >= lo && c < hi)
-                r->phi[c] += r->vol[i] / h3;
-        }
-#pragma omp barrier
-}
-
 /* The passes of one light computation.  Its loops are OpenMP worksharing
  * loops: inside a parallel region the team shares them (each point's and
  * each line's result its own, the deposit into φ on one thread in the
@@ -386,7 +366,13 @@ static void light_passes(const light_run *r)
     if (absorb) { /* φ: in the points' order, so the sums are reproducible */
         if (!r->keep_zero)
             clear_grid(g, phi);
-        deposit(r);
+#pragma omp single
+        {
+            const double h3 = g->cell * g->cell * g->cell;
+            for (size_t i = 0; i < n; ++i)
+                if (light[i] < 0)
+                    phi[pending_cell(light[i])] += r->vol[i] / h3;
+        }
     }
     if (r->axis < 0) { /* every point marches */
 #pragma omp for schedule(dynamic, 256)
