@@ -608,12 +608,11 @@ static void tip_step(phc_climbing *c, size_t i, double dt, int rest)
     }
 }
 
-/* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
- * Returns 0 or -1 (out of memory). */
-/* Step 3 for apical i: its size grows by its rate (eq. 4, times the
- * apical dominance a^k, ours) to at most 1, about its base; the growth
- * beyond 1 into c->excess[i] (−1 when below 1).  Touches only particle i,
- * so the tips lengthen on the threads, in the tropisms' loop. */
+/* Step 3 for apical i (§4.2): its size grows by dσ = r·a^k·I·Δt (r the
+ * growth rate, s⁻¹; a^k the apical dominance, ours; I its light) to at
+ * most 1, about its base; the growth beyond 1 into c->excess[i] (−1 when
+ * below 1).  Touches only particle i, so the tips lengthen on the
+ * threads, in the tropisms' loop. */
 static void lengthen(phc_climbing *c, size_t i, double dt)
 {
     const phc_climbing_options *o = &c->o;
