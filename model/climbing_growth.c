@@ -50,6 +50,7 @@ struct phc_climbing {
     double *r0;              /* n: primary radius, m */
     unsigned char *has_child;/* n scratch */
     double *target;          /* n scratch: pipe-model target areas, m^2 */
+    double *excess;          /* n scratch: a tip's growth beyond σ = 1 this step (1), −1 below */
     size_t *grown;           /* n scratch: the tips of this step (step 5 rebuilds their rest) */
     double *sx, *sv, *sI;    /* 6n, 2n, 2n scratch: light points, volumes, light */
     unsigned char *opaque;   /* light-grid cells holding occluders, NULL: none */
@@ -165,6 +166,7 @@ void phc_climbing_free(phc_climbing *c)
     free(c->r0);
     free(c->has_child);
     free(c->target);
+    free(c->excess);
     free(c->grown);
     phc_climbing_light_field_free(&c->field);
     free(c->sx);
@@ -222,6 +224,7 @@ static int reserve(phc_climbing *c, size_t want)
     GROW(r0, 1);
     GROW(has_child, 1);
     GROW(target, 1);
+    GROW(excess, 1);
     GROW(grown, 1);
     GROW(sx, 6);
     GROW(sv, 2);
@@ -578,26 +581,70 @@ static void turn_tip(phc_climbing *c, size_t i, double dt)
     keep_outside(c, i);
 }
 
-/* Steps 3–4: growth of apical i by dsig; spawns the successor and laterals.
- * Returns 0 or -1 (out of memory). */
-static int grow(phc_climbing *c, size_t i, double dsig)
+static void lengthen(phc_climbing *c, size_t i, double dt);
+static void rest_at(phc_climbing *c, size_t i);
+
+/* 1 when a tip's rest centre and volume can be set as it lengthens: no
+ * later change of its direction (keep_outside's second pass) or radius
+ * (secondary growth) before step 5.  (branch changes neither: it only
+ * appends, and a tip's parent is no tip, so its rest tip is final.) */
+static int rest_with_growth(const phc_climbing *c)
+{
+    return !c->o.keep_outside && !(c->o.cambium_rate > 0);
+}
+
+/* Steps 2, 3 and, with rest_with_growth, 5 for tip i (nothing for the
+ * others): tropisms, lengthen, its rest centre and volume.  Touches only
+ * particle i. */
+static void tip_step(phc_climbing *c, size_t i, double dt, int rest)
+{
+    if (!c->apical[i])
+        return;
+    turn_tip(c, i, dt);
+    lengthen(c, i, dt);
+    if (rest) {
+        rest_at(c, i);
+        volume_at(c, i);
+    }
+}
+
+/* Step 3 for apical i (§4.2): its size grows by dσ = r·a^k·I·Δt (r the
+ * growth rate, s⁻¹; a^k the apical dominance, ours; I its light) to at
+ * most 1, about its base; the growth beyond 1 into c->excess[i] (−1 when
+ * below 1).  Touches only particle i, so the tips lengthen on the
+ * threads, in the tropisms' loop. */
+static void lengthen(phc_climbing *c, size_t i, double dt)
 {
     const phc_climbing_options *o = &c->o;
+    /* apical dominance (ours): a tip of order k grows at r·a^k */
+    const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
+    const double dsig = o->growth_rate * dominance * c->light[i] * dt;
     double b[3];
     seg_base(c, i, 0, b);
     double s = c->sigma[i] + dsig;
-    double excess = 0;
+    double excess = -1;
     if (s >= 1) {
         excess = s - 1;
         s = 1;
     }
     c->sigma[i] = s;
+    c->excess[i] = excess;
     const double h = seg_half(c, i);
     for (int k = 0; k < 3; ++k)
         c->x[3 * i + k] = b[k] + h * c->d[3 * i + k];
     /* the rest centre: rebuilt in step 5 */
-    if (s < 1)
+}
+
+/* Steps 3–4 for apical i after lengthen: when it reached σ = 1, it stops
+ * growing and spawns its successor and laterals (the random numbers: in
+ * index order).  Returns 0 or -1 (out of memory). */
+static int branch(phc_climbing *c, size_t i)
+{
+    const phc_climbing_options *o = &c->o;
+    const double excess = c->excess[i];
+    if (!(excess >= 0))
         return 0;
+    const double h = seg_half(c, i);
     c->apical[i] = 0;
     if (c->n >= o->max_particles)
         return 0;
@@ -665,6 +712,8 @@ static void rest_at(phc_climbing *c, size_t i)
  * one it has. */
 static void rebuild_rest(phc_climbing *c, size_t ngrown, size_t n0)
 {
+    if (rest_with_growth(c))
+        ngrown = 0; /* (the tips' rests were set as they lengthened) */
     for (size_t t = 0; t < ngrown; ++t) {
         rest_at(c, c->grown[t]);
         volume_at(c, c->grown[t]);
@@ -1411,25 +1460,26 @@ int phc_climbing_step(phc_climbing *c, double dt, phc_error *err)
     /* 1. light */
     if ((o->light.extinction > 0 || c->opaque) && light_step(c, n0))
         return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory for the light field");
-    /* 2. tropisms of the tips present at the start: each turns only its
+    /* 2.–3. tropisms and lengthening of the tips present at the start
+       (with their rest shape when rest_with_growth): each changes only its
        own particle, so all at once (before any growth appends) */
+    const int rest = rest_with_growth(c);
     if (team(n0)) {
 #pragma omp parallel for schedule(dynamic, 256)
         for (size_t i = 0; i < n0; ++i)
-            turn_tip(c, i, dt);
+            tip_step(c, i, dt, rest);
     } else {
         for (size_t i = 0; i < n0; ++i)
-            turn_tip(c, i, dt);
+            tip_step(c, i, dt, rest);
     }
-    /* 3.–4. growth and branching, in index order (the random numbers) */
+    /* 3.–4. the tips that reached full size branch, in index order (the
+       random numbers) */
     size_t ngrown = 0;
     for (size_t i = 0; i < n0; ++i) {
         if (!c->apical[i])
             continue;
-        c->grown[ngrown++] = i; /* (c->grown may move as grow appends) */
-        /* apical dominance (ours): a tip of order k grows at r·a^k */
-        const double dominance = o->apical_dominance == 1 ? 1 : pow(o->apical_dominance, (double)c->order[i]);
-        if (grow(c, i, o->growth_rate * dominance * c->light[i] * dt)) {
+        c->grown[ngrown++] = i; /* (c->grown may move as branch appends) */
+        if (branch(c, i)) {
             count(c);
             return phc_error_set(err, PHC_ERR_NOMEM, "climbing: out of memory at %zu particles",
                                  c->n);
