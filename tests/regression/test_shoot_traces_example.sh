@@ -31,4 +31,12 @@ else
     grep "^| [a-z_]* | " "$R" 2>/dev/null | tail -5
     FAILED=1
 fi
+# the report says how far its linearised intervals can be trusted (the
+# coverage notebook measured about 4 in 5, not 19 in 20)
+if grep -q "^How far to trust these intervals: .* optimistic\. .*about 4 in 5 of the 95% intervals" "$R"; then
+    echo "ok - the report warns that the intervals are optimistic"
+else
+    echo "not ok - report.md lacks the paragraph on how far to trust the intervals"
+    FAILED=1
+fi
 exit $FAILED
