@@ -12,8 +12,8 @@
 #include "model/trig_inline.h"
 
 /* (the helpers below pass vectors by value and are all inlined here: the
-   ABI note GCC gives for that without AVX concerns no call) */
-#pragma GCC diagnostic ignored "-Wpsabi"
+   ABI note GCC gives for that without AVX concerns no call; CMakeLists.txt
+   silences it with -Wno-psabi, which a pragma cannot) */
 
 typedef phc_v4d v4d;
 typedef long v4l __attribute__((vector_size(32))); /* a comparison's lanes: 0 or −1 */
