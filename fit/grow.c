@@ -407,6 +407,7 @@ int phc_grow_write(const phc_grow_config *cfg, phc_provenance *pv, const char *d
     if (mesh) {
         o.closest = phc_support_mesh_closest;
         o.closest_user = mesh;
+        o.closest_segment = phc_support_mesh_segment_deepest;
     }
     {
         phc_error e;

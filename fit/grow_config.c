@@ -120,6 +120,9 @@ static const key_spec KEYS[] = {
     {"dynamics", "collide_ends", K_BOOL, OPT(collide_ends), 0, 1, 0, 0, "",
      "with collide, kinematic plants (substeps 0) only: each segment's two ends are pushed out too and its centre and "
      "direction rebuilt from them (whole segments out of the support)"},
+    {"dynamics", "collide_segments", K_BOOL, OPT(collide_segments), 0, 1, 0, 0, "",
+     "with collide and substeps: each segment in contact is also pushed off at its deepest point (its point closest "
+     "to a support edge), so no straight segment cuts a convex edge between its pushed ends (model/particles.h)"},
     {"dynamics", "supports_closed", K_BOOL, OPT(supports_closed), 0, 1, 0, 0, "",
      "the support is a closed surface with outward faces (a solid's boundary): with collide and substeps, a point "
      "farther from the support than its radius plus how far it moved since its last query is not queried (exact; "

@@ -67,6 +67,12 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
     return mesh ? loaded()->closest(mesh, x, c, n) : -1;
 }
 
+int phc_support_mesh_segment_deepest(void *mesh, const double a[3], const double b[3], double reach, double *t,
+                                     double *depth)
+{
+    return mesh ? loaded()->segment_deepest(mesh, a, b, reach, t, depth) : -1;
+}
+
 void phc_support_mesh_certificates(phc_support_mesh *m, int on)
 {
     if (m)

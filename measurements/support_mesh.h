@@ -79,6 +79,21 @@ int phc_support_mesh_arrays(const phc_support_mesh *m, double **vertices, size_t
  * model/particles.h) is then answered at the cost of one projection. */
 int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double n[3]);
 
+/* The deepest point of segment a b (m) against the mesh, for the exact
+ * segment push of model/particles.h (phc_particles_set_segment_collider;
+ * the signature of phc_particles_segment_fn).  Candidates: the ends and,
+ * for every edge of every triangle whose box meets the segment's box
+ * grown by `reach` (CGAL AABB tree), the segment's point closest to that
+ * edge (Ericson 2005 §5.1.9); each is given its signed distance δ
+ * (phc_support_mesh_closest, negative behind the face), and the smallest
+ * wins: *t in [0, 1] its parameter, *depth its δ (m).  A straight
+ * segment whose ends lie out can only dip below a convex edge, and its
+ * point closest to that edge is then among the candidates.  Returns 1
+ * when that δ < reach, 0 when not (or no triangle near), -1 when a, b or
+ * reach is not finite.  Thread-safe. */
+int phc_support_mesh_segment_deepest(void *mesh, const double a[3], const double b[3], double reach, double *t,
+                                     double *depth);
+
 /* on = 0: every query goes through the AABB tree (for tests comparing the
  * two); 1 (default): certified answers are used.  Not while queries run. */
 void phc_support_mesh_certificates(phc_support_mesh *m, int on);

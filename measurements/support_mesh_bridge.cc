@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <iterator>
 #include <memory>
 #include <new>
 #include <vector>
@@ -198,6 +199,36 @@ void certify(const phc_support_mesh *m, const double x[3], const Point &q, const
     e.rho = rho;
     e.triangle = t;
     e.serial = m->serial;
+}
+
+// The parameter s in [0, 1] of the point of segment p0 p1 closest to
+// segment q0 q1 (Ericson, "Real-Time Collision Detection", 2005, §5.1.9,
+// ClosestPtSegmentSegment; parallel segments: s = 0).  Coordinates in m.
+double segment_segment_s(const double p0[3], const double p1[3], const double q0[3], const double q1[3])
+{
+    double d1[3], d2[3], r[3];
+    for (int k = 0; k < 3; ++k) {
+        d1[k] = p1[k] - p0[k];
+        d2[k] = q1[k] - q0[k];
+        r[k] = p0[k] - q0[k];
+    }
+    const double a = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2];
+    const double e = d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2];
+    const double f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2];
+    if (!(a > 0))
+        return 0;
+    const double c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2];
+    if (!(e > 0))
+        return std::fmin(1.0, std::fmax(0.0, -c / a));
+    const double b = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2];
+    const double denom = a * e - b * b;
+    double s = denom > 0 ? std::fmin(1.0, std::fmax(0.0, (b * f - c * e) / denom)) : 0;
+    const double u = (b * s + f) / e;
+    if (u < 0)
+        s = std::fmin(1.0, std::fmax(0.0, -c / a));
+    else if (u > 1)
+        s = std::fmin(1.0, std::fmax(0.0, (b - c) / a));
+    return s;
 }
 
 }  // namespace
@@ -398,6 +429,58 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
     }
 }
 
+int phc_support_mesh_segment_deepest(void *mesh, const double a[3], const double b[3], double reach, double *t,
+                                     double *depth)
+{
+    const phc_support_mesh *m = static_cast<const phc_support_mesh *>(mesh);
+    for (int k = 0; k < 3; ++k)
+        if (!std::isfinite(a[k]) || !std::isfinite(b[k]))
+            return -1;
+    if (!m || !(reach >= 0))
+        return -1;
+    try {
+        CGAL::Bbox_3 box(std::fmin(a[0], b[0]) - reach, std::fmin(a[1], b[1]) - reach,
+                         std::fmin(a[2], b[2]) - reach, std::fmax(a[0], b[0]) + reach,
+                         std::fmax(a[1], b[1]) + reach, std::fmax(a[2], b[2]) + reach);
+        std::vector<Tree::Primitive_id> near;
+        m->tree->all_intersected_primitives(box, std::back_inserter(near));
+        if (near.empty())
+            return 0;
+        double best = INFINITY, best_s = 0;
+        auto consider = [&](double s) {
+            double y[3], c[3], n[3];
+            for (int k = 0; k < 3; ++k)
+                y[k] = a[k] + s * (b[k] - a[k]);
+            if (phc_support_mesh_closest(mesh, y, c, n))
+                return;
+            const double e[3] = {y[0] - c[0], y[1] - c[1], y[2] - c[2]};
+            const double dist = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            const double d = e[0] * n[0] + e[1] * n[1] + e[2] * n[2] >= 0 ? dist : -dist;
+            if (d < best) {
+                best = d;
+                best_s = s;
+            }
+        };
+        consider(0);
+        consider(1);
+        for (const Tree::Primitive_id &id : near) {
+            const size_t tri = static_cast<size_t>(id - m->cgal.begin());
+            for (int k = 0; k < 3; ++k) {
+                const double *p = &m->vertices[3 * m->triangles[3 * tri + k]];
+                const double *q = &m->vertices[3 * m->triangles[3 * tri + (k + 1) % 3]];
+                consider(segment_segment_s(a, b, p, q));
+            }
+        }
+        if (depth)
+            *depth = best;
+        if (t)
+            *t = best_s;
+        return best < reach;
+    } catch (const std::exception &) {
+        return -1;
+    }
+}
+
 void phc_support_mesh_certificates(phc_support_mesh *m, int on)
 {
     if (m)
@@ -418,7 +501,7 @@ static const phc_mesh_module_table phc_mesh_module = {
     phc_support_mesh_read,           phc_support_mesh_from_arrays, phc_support_mesh_free,
     phc_support_mesh_triangle_count, phc_support_mesh_vertex_count, phc_support_mesh_bounds,
     phc_support_mesh_vertex,         phc_support_mesh_triangle,    phc_support_mesh_closest,
-    phc_support_mesh_certificates,   phc_support_mesh_tree_queries};
+    phc_support_mesh_certificates,   phc_support_mesh_tree_queries, phc_support_mesh_segment_deepest};
 
 extern "C" const void *phc_mesh_module_entry(int abi)
 {

@@ -8,7 +8,7 @@
 #include "measurements/support_mesh.h"
 
 /* Bumped whenever a member below changes. */
-#define PHC_MESH_MODULE_ABI 2
+#define PHC_MESH_MODULE_ABI 3
 #define PHC_MESH_MODULE_ENTRY "phc_mesh_module_entry"
 #define PHC_MESH_MODULE_FILE "phytocal_mesh.so"
 
@@ -26,6 +26,7 @@ typedef struct phc_mesh_module_table {
     int (*closest)(void *mesh, const double x[3], double c[3], double n[3]);
     void (*certificates)(phc_support_mesh *m, int on);
     size_t (*tree_queries)(const phc_support_mesh *m);
+    int (*segment_deepest)(void *mesh, const double a[3], const double b[3], double reach, double *t, double *depth);
 } phc_mesh_module_table;
 
 #endif

@@ -967,6 +967,8 @@ static int dynamics_sync(phc_climbing *c, size_t ngrown, phc_error *err)
     if (phc_particles_set_gravity(p, c->o.particles.gravity, err)) /* may have been changed */
         return -1;
     phc_particles_set_collider(p, c->o.collide ? c->o.closest : NULL, c->o.closest_user);
+    phc_particles_set_segment_collider(p, c->o.collide && c->o.collide_segments ? c->o.closest_segment : NULL,
+                                       c->o.closest_user);
     phc_particles_collide_all(p, c->o.collide_all);
     phc_particles_supports_closed(p, c->o.supports_closed);
     for (size_t i = known; i < n; ++i) { /* new: at its current place, at rest */

@@ -180,6 +180,10 @@ typedef struct phc_climbing_options {
     /* supports */
     phc_climbing_closest_fn closest; /* NULL: no supports */
     void *closest_user;
+    phc_particles_segment_fn closest_segment; /* deepest point of a segment against the same
+                                   supports (measurements/support_mesh.h
+                                   phc_support_mesh_segment_deepest; user closest_user),
+                                   for collide_segments; NULL: none */
     /* leaves (§4.3; model/climbing_leaves.h) */
     unsigned leaf_step;         /* every leaf_step-th node of a shoot bears a leaf (its
                                    first node, 0, included); 0: no leaves (default) */
@@ -219,6 +223,12 @@ typedef struct phc_climbing_options {
                                    need not join (as with the centre push alone).  Not needed
                                    with dynamics (collide pushes the ends there).  0 (default):
                                    off */
+    int collide_segments;       /* with collide and dynamics (ours): each particle in contact
+                                   is also pushed off at its segment's deepest point
+                                   (closest_segment; model/particles.h
+                                   phc_particles_set_segment_collider), so no straight
+                                   segment cuts a convex edge between its pushed centre and
+                                   ends.  0 (default): off, bit for bit as before */
     int collide_all;            /* with collide and dynamics, for tests: 1 makes every
                                    closest-point query of the collision pass, none skipped
                                    (model/particles.h phc_particles_collide_all; the same

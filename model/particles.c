@@ -36,6 +36,8 @@ struct phc_particles {
     int no_stress;           /* 1: skip the stress pass when nothing breaks */
     phc_particles_closest_fn collide; /* supports, NULL: none */
     void *collide_user;
+    phc_particles_segment_fn collide_segment; /* exact segment push, NULL: none */
+    void *collide_segment_user;
     size_t pushed;           /* particles pushed out in the last step */
     double depth;            /* smallest δ − r before the pushes, m */
     /* Closest-point queries the collision pass skips (exact, see
@@ -997,6 +999,14 @@ void phc_particles_set_collider(phc_particles *p, phc_particles_closest_fn fn, v
     p->collide_user = user;
 }
 
+void phc_particles_set_segment_collider(phc_particles *p, phc_particles_segment_fn fn, void *user)
+{
+    if (!p)
+        return;
+    p->collide_segment = fn;
+    p->collide_segment_user = user;
+}
+
 void phc_particles_supports_moved(phc_particles *p)
 {
     if (p)
@@ -1219,6 +1229,32 @@ int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, doub
     return push_segment(fn, user, r, h, rounds, x, axis, depth, NULL, NULL, NULL);
 }
 
+int phc_particles_push_segment_deepest(phc_particles_closest_fn fn, void *user, phc_particles_segment_fn deepest,
+                                       void *deepest_user, double r, double h, double x[3], const double axis[3])
+{
+    int moved = 0;
+    if (!fn || !deepest)
+        return 0;
+    for (int round = 0; round < 16; ++round) {
+        double a[3], b[3], t;
+        for (int k = 0; k < 3; ++k) {
+            a[k] = x[k] - h * axis[k];
+            b[k] = x[k] + h * axis[k];
+        }
+        if (deepest(deepest_user, a, b, r, &t, NULL) != 1)
+            break;
+        double y[3], y0[3];
+        for (int k = 0; k < 3; ++k)
+            y[k] = y0[k] = a[k] + t * (b[k] - a[k]);
+        if (!push_point(fn, user, r, y, NULL, NULL, NULL))
+            break;
+        for (int k = 0; k < 3; ++k)
+            x[k] += y[k] - y0[k];
+        ++moved;
+    }
+    return moved;
+}
+
 /* The memories of the collision pass for particles 0 .. n−1: grown and
  * the new particles' points zeroed (nothing known).  0, or -1 when out of
  * memory (the pass then queries every point). */
@@ -1273,9 +1309,23 @@ static void collide(phc_particles *p)
         for (int k = 0; k < 6; ++k)
             mem[k] = (point_memory){remember ? p->reach + 72 * i + 12 * k : NULL, p->supports_closed,
                                     &p->queries, &p->skipped};
-        p->pushed += (size_t)push_segment(p->collide, p->collide_user, p->ax[3 * i], p->ax[3 * i + 2], 64,
-                                          p->xp + 3 * i, axis, &d, mem, p->skip, &nskip);
+        const size_t nskip0 = nskip;
+        const int pushed = push_segment(p->collide, p->collide_user, p->ax[3 * i], p->ax[3 * i + 2], 64,
+                                        p->xp + 3 * i, axis, &d, mem, p->skip, &nskip);
+        p->pushed += (size_t)pushed;
         p->depth = fmin(p->depth, d);
+        if (p->collide_segment) {
+            /* in contact: pushed, or a point (its lower bound when
+               skipped) within L/4 of r; else every point of the segment
+               lies within L/4 of one of the three, farther than r */
+            double near = d;
+            for (size_t t = nskip0; t < nskip; ++t)
+                near = fmin(near, p->skip[5 * t + 4]);
+            if (pushed || near < 0.5 * p->ax[3 * i + 2])
+                p->pushed += (size_t)phc_particles_push_segment_deepest(p->collide, p->collide_user, p->collide_segment,
+                                                                        p->collide_segment_user, p->ax[3 * i],
+                                                                        p->ax[3 * i + 2], p->xp + 3 * i, axis);
+        }
         if (memcmp(axis, axis0, sizeof axis) == 0)
             continue;
         /* q_p turned by the shortest rotation taking axis0 to axis:

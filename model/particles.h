@@ -377,6 +377,29 @@ int phc_particles_push_out(phc_particles_closest_fn fn, void *user, double r, do
  * a support). */
 int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, double r, double h,
                                    int rounds, double x[3], double axis[3], double *depth);
+/* The exact segment push (ours; opt-in, default none).  fn(user, a, b, r,
+ * &t, &depth) gives the deepest point a + t(b − a) of segment a b (m)
+ * against the same supports as the collider and returns 1 when its
+ * signed distance is below r, 0 when not, negative on an error
+ * (measurements/support_mesh.h phc_support_mesh_segment_deepest).  With
+ * it set (and a collider), a particle in contact after its capsule push
+ * (a point was pushed, or the smallest δ − r of its centre and ends, or
+ * its lower bound, is below L/4: farther than that, the 1-Lipschitz
+ * distance keeps the whole segment beyond r) is asked for its deepest
+ * point y; while there is one, y is pushed as a point (the push above)
+ * and the whole segment moved by that push (both ends alike: length and
+ * axis kept), up to 16 rounds, each counted as a point pushed.  A
+ * straight segment whose centre and ends lie out but whose middle cuts a
+ * convex edge is so moved off the edge (to distance r, rounding: the
+ * move is along the common perpendicular of the segment and the edge).
+ * fn = NULL: the capsule push alone, bit for bit as without. */
+typedef int (*phc_particles_segment_fn)(void *user, const double a[3], const double b[3], double r, double *t,
+                                        double *depth);
+void phc_particles_set_segment_collider(phc_particles *p, phc_particles_segment_fn fn, void *user);
+/* That push on one segment (centre x, unit axis, half length h, radius
+ * r; m): returns the rounds that moved x (0 without fn or deepest). */
+int phc_particles_push_segment_deepest(phc_particles_closest_fn fn, void *user, phc_particles_segment_fn deepest,
+                                       void *deepest_user, double r, double h, double x[3], const double axis[3]);
 /* Collisions of the last step: points pushed out (centres and ends) and
  * the smallest δ − r (m) of a centre or an end seen before its particle's
  * first push (+INFINITY when none was measured). */
