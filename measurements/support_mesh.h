@@ -86,11 +86,15 @@ int phc_support_mesh_closest(void *mesh, const double x[3], double c[3], double 
  * grown by `reach` (CGAL AABB tree), the segment's point closest to that
  * edge (Ericson 2005 §5.1.9); each is given its signed distance δ
  * (phc_support_mesh_closest, negative behind the face), and the smallest
- * wins: *t in [0, 1] its parameter, *depth its δ (m).  A straight
- * segment whose ends lie out can only dip below a convex edge, and its
- * point closest to that edge is then among the candidates.  Returns 1
- * when that δ < reach, 0 when not (or no triangle near), -1 when a, b or
- * reach is not finite.  Thread-safe. */
+ * wins: *t in [0, 1] its parameter, *depth its δ (m).  A segment that
+ * meets no triangle (CGAL do_intersect) skips the edges reach or farther
+ * from it: its points' δ are their distances to the mesh, smallest at an
+ * end or at a point closest to an edge, so a skipped edge cannot give one
+ * below reach.  A straight segment whose ends lie out can only dip below
+ * a convex edge, and its point closest to that edge is then among the
+ * candidates.  Returns 1 when that δ < reach (exact up to rounding), 0
+ * when no point of the segment lies within reach (*depth then some δ >=
+ * reach), -1 when a, b or reach is not finite.  Thread-safe. */
 int phc_support_mesh_segment_deepest(void *mesh, const double a[3], const double b[3], double reach, double *t,
                                      double *depth);
 

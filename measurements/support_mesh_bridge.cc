@@ -203,8 +203,10 @@ void certify(const phc_support_mesh *m, const double x[3], const Point &q, const
 
 // The parameter s in [0, 1] of the point of segment p0 p1 closest to
 // segment q0 q1 (Ericson, "Real-Time Collision Detection", 2005, §5.1.9,
-// ClosestPtSegmentSegment; parallel segments: s = 0).  Coordinates in m.
-double segment_segment_s(const double p0[3], const double p1[3], const double q0[3], const double q1[3])
+// ClosestPtSegmentSegment; parallel segments: s = 0), and in *dist2 the
+// squared distance between the two closest points (m²).  Coordinates in m.
+double segment_segment_s(const double p0[3], const double p1[3], const double q0[3], const double q1[3],
+                         double *dist2)
 {
     double d1[3], d2[3], r[3];
     for (int k = 0; k < 3; ++k) {
@@ -215,19 +217,31 @@ double segment_segment_s(const double p0[3], const double p1[3], const double q0
     const double a = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2];
     const double e = d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2];
     const double f = d2[0] * r[0] + d2[1] * r[1] + d2[2] * r[2];
-    if (!(a > 0))
-        return 0;
     const double c = d1[0] * r[0] + d1[1] * r[1] + d1[2] * r[2];
-    if (!(e > 0))
-        return std::fmin(1.0, std::fmax(0.0, -c / a));
     const double b = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2];
-    const double denom = a * e - b * b;
-    double s = denom > 0 ? std::fmin(1.0, std::fmax(0.0, (b * f - c * e) / denom)) : 0;
-    const double u = (b * s + f) / e;
-    if (u < 0)
-        s = std::fmin(1.0, std::fmax(0.0, -c / a));
-    else if (u > 1)
-        s = std::fmin(1.0, std::fmax(0.0, (b - c) / a));
+    auto clamp01 = [](double v) { return std::fmin(1.0, std::fmax(0.0, v)); };
+    double s = 0, u = 0;
+    if (!(a > 0))
+        u = e > 0 ? clamp01(f / e) : 0;
+    else if (!(e > 0))
+        s = clamp01(-c / a);
+    else {
+        const double denom = a * e - b * b;
+        s = denom > 0 ? clamp01((b * f - c * e) / denom) : 0;
+        u = (b * s + f) / e;
+        if (u < 0) {
+            u = 0;
+            s = clamp01(-c / a);
+        } else if (u > 1) {
+            u = 1;
+            s = clamp01((b - c) / a);
+        }
+    }
+    *dist2 = 0;
+    for (int k = 0; k < 3; ++k) {
+        const double g = p0[k] + s * d1[k] - q0[k] - u * d2[k];
+        *dist2 += g * g;
+    }
     return s;
 }
 
@@ -463,12 +477,21 @@ int phc_support_mesh_segment_deepest(void *mesh, const double a[3], const double
         };
         consider(0);
         consider(1);
+        // A segment that meets no triangle has its points' δ = their
+        // distance to the mesh on one side, so its smallest is at an end or
+        // at its point closest to an edge: an edge reach or farther from the
+        // segment cannot give one below reach (skipped).  A segment that
+        // meets a triangle: every edge near it.
+        const int cuts = m->tree->do_intersect(Kernel::Segment_3(Point(a[0], a[1], a[2]), Point(b[0], b[1], b[2])));
         for (const Tree::Primitive_id &id : near) {
             const size_t tri = static_cast<size_t>(id - m->cgal.begin());
             for (int k = 0; k < 3; ++k) {
                 const double *p = &m->vertices[3 * m->triangles[3 * tri + k]];
                 const double *q = &m->vertices[3 * m->triangles[3 * tri + (k + 1) % 3]];
-                consider(segment_segment_s(a, b, p, q));
+                double dist2;
+                const double s = segment_segment_s(a, b, p, q, &dist2);
+                if (cuts || dist2 < reach * reach)
+                    consider(s);
             }
         }
         if (depth)
