@@ -1551,6 +1551,10 @@ gr_config gr_collide_ends.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
   collide_ends: 2
 '
 grow_case "grow: collide_ends neither true nor false" "$C/gr_collide_ends.yaml" "gr_collide_ends.yaml:7" "dynamics.collide_ends" "expected a boolean"
+gr_config gr_collide_segments.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
+  collide_segments: maybe
+'
+grow_case "grow: collide_segments neither true nor false" "$C/gr_collide_segments.yaml" "gr_collide_segments.yaml:7" "dynamics.collide_segments" "expected a boolean"
 gr_config gr_bending.yaml gr_wall.obj '[0, 0.03, 0]' 'dynamics:
   bending: springy
 '
