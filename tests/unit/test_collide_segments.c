@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "climbing_fig13_options.h"
 #include "climbing_same_state.h"
 
 /* Distance (m) of segment a b to the line x = z = 1 (the box's edge; y
@@ -39,24 +40,13 @@ static double distance_to_edge(const double a[3], const double b[3])
     return hypot(a[0] + s * d[0] - 1, a[2] + s * d[1] - 1);
 }
 
-static phc_climbing_options fig13_options(phc_support_mesh *m)
+/* The ends a, b of the segment with centre x, unit axis and half length h (m). */
+static void segment_ends(const double x[3], const double axis[3], double h, double a[3], double b[3])
 {
-    phc_climbing_options o = phc_climbing_options_default();
-    o.seed = 13;
-    o.growth_rate = 0.2;
-    o.apical_dominance = 0.6;
-    o.radius = 0.003;
-    o.branch_probability = 0.35;
-    o.direction_variance = 0.6;
-    o.max_order = 2;
-    o.surface_adaption = 0.5;
-    o.keep_outside = 1;
-    o.closest = phc_support_mesh_closest;
-    o.closest_user = m;
-    o.dynamics_substeps = 25;
-    o.collide = 1;
-    o.supports_closed = 1;
-    return o;
+    for (int k = 0; k < 3; ++k) {
+        a[k] = x[k] - h * axis[k];
+        b[k] = x[k] + h * axis[k];
+    }
 }
 
 int main(void)
@@ -83,10 +73,7 @@ int main(void)
     memcpy(xc, x, sizeof xc);
     memcpy(ac, axis, sizeof ac);
     const int capsule = phc_particles_push_segment_out(phc_support_mesh_closest, box, r, h, 64, xc, ac, &depth);
-    for (int k = 0; k < 3; ++k) {
-        sa[k] = xc[k] - h * ac[k];
-        sb[k] = xc[k] + h * ac[k];
-    }
+    segment_ends(xc, ac, h, sa, sb);
     const double before = distance_to_edge(sa, sb);
     double t0, d0;
     const int cut = phc_support_mesh_segment_deepest(box, sa, sb, r, &t0, &d0);
@@ -96,10 +83,7 @@ int main(void)
     CHECK(capsule == 0 && depth > 0 && before < r && cut == 1 && d0 < 0);
     const int rounds = phc_particles_push_segment_deepest(phc_support_mesh_closest, box,
                                                           phc_support_mesh_segment_deepest, box, r, h, x, axis);
-    for (int k = 0; k < 3; ++k) {
-        sa[k] = x[k] - h * axis[k];
-        sb[k] = x[k] + h * axis[k];
-    }
+    segment_ends(x, axis, h, sa, sb);
     const double after = distance_to_edge(sa, sb);
     double tq, dq;
     const int still = phc_support_mesh_segment_deepest(box, sa, sb, r, &tq, &dq);
@@ -122,6 +106,7 @@ int main(void)
     int made = 1;
     for (int run = 0; run < RUNS; ++run) {
         phc_climbing_options o = fig13_options(solid);
+        o.supports_closed = 1;
         o.collide_segments = on[run];
         o.closest_segment = query[run] ? phc_support_mesh_segment_deepest : NULL;
         made &= (c[run] = phc_climbing_new(seed, up, &o, &err)) != NULL;
