@@ -1241,7 +1241,11 @@ int phc_particles_push_segment_deepest(phc_particles_closest_fn fn, void *user, 
             a[k] = x[k] - h * axis[k];
             b[k] = x[k] + h * axis[k];
         }
-        if (deepest(deepest_user, a, b, r, &t, NULL) != 1)
+        /* a point the push left at r less rounding is not pushed again:
+           deeper than 1e-13·(1 + |x|∞) m below r only (ours) */
+        const double ulps = 1e-13 * (1 + fmax(fabs(x[0]), fmax(fabs(x[1]), fabs(x[2]))));
+        double depth;
+        if (deepest(deepest_user, a, b, r, &t, &depth) != 1 || !(depth < r - ulps))
             break;
         double y[3], y0[3];
         for (int k = 0; k < 3; ++k)

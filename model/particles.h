@@ -386,7 +386,8 @@ int phc_particles_push_segment_out(phc_particles_closest_fn fn, void *user, doub
  * (a point was pushed, or the smallest δ − r of its centre and ends, or
  * its lower bound, is below L/4: farther than that, the 1-Lipschitz
  * distance keeps the whole segment beyond r) is asked for its deepest
- * point y; while there is one, y is pushed as a point (the push above)
+ * point y; while there is one deeper than r − 1e-13·(1 + |x|∞) m (a point
+ * pushed to r, less rounding, is left), y is pushed as a point (the push above)
  * and the whole segment moved by that push (both ends alike: length and
  * axis kept), up to 16 rounds, each counted as a point pushed.  A
  * straight segment whose centre and ends lie out but whose middle cuts a
