@@ -264,11 +264,16 @@ finish "installed phytocal --version runs with the installed library"
 if [ ! -f "$LIBDIR/phytocal_mpi.so" ]; then
     why "no $LIBDIR/phytocal_mpi.so"
 elif command -v mpirun >/dev/null 2>&1 && [ -x "$P/bin/phytocal" ]; then
+    # (the loader's report of each process into a file of its own,
+    # LD_DEBUG_OUTPUT.PID: through mpirun's merged stderr the two ranks'
+    # lines could interleave, and a split line was not counted)
+    mkdir -p "$T/ld"
     OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 120 mpirun -np 2 \
-        env -u LD_LIBRARY_PATH LD_DEBUG=libs "$P/bin/phytocal" sensitivity "$T/missing.yaml" >"$T/mpi.out" 2>&1
+        env -u LD_LIBRARY_PATH LD_DEBUG=libs LD_DEBUG_OUTPUT="$T/ld/rank" "$P/bin/phytocal" sensitivity \
+        "$T/missing.yaml" >"$T/mpi.out" 2>&1
     # the path as the loader wrote it (PREFIX/bin/../lib/...), resolved
     n=0
-    for f in $(sed -n 's/.*calling init: \(.*phytocal_mpi\.so\)$/\1/p' "$T/mpi.out"); do
+    for f in $(cat "$T"/ld/rank.* 2>/dev/null | sed -n 's/.*calling init: \(.*phytocal_mpi\.so\)$/\1/p'); do
         [ "$(readlink -f "$f")" = "$(readlink -f "$LIBDIR/phytocal_mpi.so")" ] && n=$((n + 1))
     done
     [ "$n" = 2 ] || why "mpirun -np 2 of the installed command loaded $LIBDIR/phytocal_mpi.so $n times, expected 2"
