@@ -484,10 +484,11 @@ static int st_report_section(phc_dataset *ds, const double *p, char **markdown, 
                "statistics averaged over the same seeds at every parameter value, and for this kind of fit "
                "they are optimistic. In phytocal's coverage study (notebook shoot_traces_coverage: model "
                "plants with known parameters, each fitted like this) about 4 in 5 of the 95%% intervals "
-               "covered the truth, not 19 in 20: the cost is rugged, and the estimates of "
-               "branch_probability, phototropism and surface_adaption scatter about twice as far as their "
-               "standard errors say. Read an estimate's distance from a value of interest, in standard "
-               "errors, as about twice the evidence there is.\n");
+               "covered the truth, not 19 in 20: the cost is rugged, and there the estimates of "
+               "branch_probability, phototropism and surface_adaption scattered about twice as far as "
+               "their standard errors said (growth_rate's and direction_variance's did not). Read an "
+               "estimate's distance from a value of interest, in standard errors, as up to twice the "
+               "evidence there is.\n");
     fputc('\n', f);
     fclose(f);
     free(y);
